@@ -1,0 +1,88 @@
+"""Command-line interface: a thin layer over the public API.
+
+Every module in this package that defines ``COMMAND`` is a subcommand; it
+provides ``HELP``, ``add_arguments(parser)`` and ``run(args) -> int``. Heavy
+imports happen inside ``run`` so that ``synth --help`` and ``synth check``
+start fast.
+
+Exit codes: 0 met / designed, 1 not met / infeasible, 2 bad input.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import pkgutil
+import sys
+from collections.abc import Sequence
+
+from synth import __version__
+from synth.errors import SynthError
+
+EXIT_OK, EXIT_NOT_MET, EXIT_BAD_INPUT = 0, 1, 2
+
+
+class _Parser(argparse.ArgumentParser):
+    def error(self, message: str) -> None:  # one line plus usage, exit 2 (argparse's own convention)
+        self.print_usage(sys.stderr)
+        self.exit(EXIT_BAD_INPUT, f"{self.prog}: error: {message}\n")
+
+
+def _commands() -> list:
+    mods = []
+    for info in pkgutil.iter_modules(__path__):
+        if info.name.startswith("_"):
+            continue
+        mod = importlib.import_module(f"{__name__}.{info.name}")
+        if hasattr(mod, "COMMAND"):
+            mods.append(mod)
+    return sorted(mods, key=lambda m: (getattr(m, "ORDER", 50), m.COMMAND))
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The ``synth`` argument parser with every subcommand."""
+    parser = _Parser(
+        prog="synth",
+        description="Design fixed-structure compensators from measured data and written specs.",
+        epilog="Exit codes: 0 met/designed, 1 not met/infeasible, 2 bad input.",
+    )
+    parser.add_argument("--version", action="version", version=f"synth {__version__}")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
+    for mod in _commands():
+        p = sub.add_parser(mod.COMMAND, help=mod.HELP, description=getattr(mod, "DESCRIPTION", mod.HELP),
+                           formatter_class=argparse.RawDescriptionHelpFormatter)
+        mod.add_arguments(p)
+        p.set_defaults(_run=mod.run)
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Entry point of the ``synth`` command.
+
+    Examples
+    --------
+    >>> main(["check", "specs/x4_rotor.yaml", "--controller", "P(3)", "--quiet"])
+    0
+    """
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    if not getattr(args, "_run", None):
+        parser.print_help()
+        return EXIT_BAD_INPUT
+    try:
+        return int(args._run(args))
+    except SynthError as exc:
+        print(f"synth {args.command}: error: {exc}", file=sys.stderr)
+        return EXIT_BAD_INPUT
+    except KeyboardInterrupt:
+        print("synth: interrupted", file=sys.stderr)
+        return 130
+    except BrokenPipeError:  # output piped into e.g. `head`, which stopped reading
+        import os
+
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 0
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

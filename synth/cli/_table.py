@@ -1,0 +1,52 @@
+"""Plain-text tables and requirement rows for terminal output."""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+from typing import Any
+
+from synth.requirements.base import RequirementResult, fmt
+
+
+def table(headers: list[str], rows: Iterable[list[str]]) -> str:
+    """Left-aligned text table.
+
+    Examples
+    --------
+    >>> print(table(["a", "bb"], [["1", "2"]]))
+    a  bb
+    -  --
+    1  2
+    """
+    rows = [list(map(str, r)) for r in rows]
+    widths = [max(len(h), *(len(r[i]) for r in rows)) if rows else len(h) for i, h in enumerate(headers)]
+    lines = ["  ".join(h.ljust(w) for h, w in zip(headers, widths)).rstrip(),
+             "  ".join("-" * w for w in widths)]
+    lines += ["  ".join(c.ljust(w) for c, w in zip(r, widths)).rstrip() for r in rows]
+    return "\n".join(lines)
+
+
+def requirement_rows(results: list[RequirementResult]) -> list[list[str]]:
+    """Rows ``requirement, value, bound, slack, binding frequency, met`` for a table."""
+    rows = []
+    for r in results:
+        if r.type == "stability":
+            value, bound = ("stable" if r.met else f"{int(r.value)} unstable root(s)"), "stable"
+        else:
+            rel = ">=" if r.type in ("bandwidth", "margins") else "<="
+            value, bound = f"{fmt(r.value)} {r.unit}", f"{rel} {fmt(r.bound)} {r.unit}"
+        plant = f" [{r.plant}]" if r.plant and r.plant != "nominal" else ""
+        rows.append([r.label + plant, value, bound, f"{r.slack:+.4g}",
+                     fmt(r.binding_frequency), "met" if r.met else "NOT MET"])
+    return rows
+
+
+REQUIREMENT_HEADERS = ["requirement", "value", "bound", "slack [Np]", "binding w [rad/s]", ""]
+
+
+def print_requirements(results: list[RequirementResult], out: Any) -> None:
+    """Print the requirement table and each requirement's plain-language line."""
+    print(table(REQUIREMENT_HEADERS, requirement_rows(results)), file=out)
+    print(file=out)
+    for r in results:
+        print(f"- {r.message}", file=out)

@@ -1,0 +1,82 @@
+"""``synth design SPEC``: design the spec's controller and write a report."""
+
+from __future__ import annotations
+
+import argparse
+import shlex
+import sys
+from pathlib import Path
+
+COMMAND = "design"
+ORDER = 20
+HELP = "design the spec's controller and write reports/<name>/"
+DESCRIPTION = """Design the controller a spec asks for and write a report.
+
+Writes <out>/result.json, <out>/report.html and PNG figures (default
+out: reports/<spec name>/). For one free parameter (e.g. a P gain) the exact
+feasible set is computed and reported with what binds at each end.
+Files in <out> that synth did not write are never overwritten.
+
+example:
+  synth design specs/x4_rotor.yaml
+  synth design specs/x4_rotor_strict.yaml --json strict.json
+
+exit codes: 0 designed, 1 infeasible, 2 bad input"""
+
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
+    p.add_argument("spec", help="spec file (YAML)")
+    p.add_argument("--json", metavar="FILE", help="also write result.json's content to FILE ('-' for stdout)")
+    p.add_argument("--out", metavar="DIR", help="report folder (default reports/<spec name>)")
+    p.add_argument("--no-report", action="store_true", help="skip the HTML report and figures")
+    p.add_argument("--force", action="store_true", help="overwrite files synth did not write")
+    p.add_argument("--quiet", "-q", action="store_true", help="print nothing; use the exit code")
+
+
+def run(args: argparse.Namespace) -> int:
+    from synth.cli._table import print_requirements
+    from synth.design import design
+    from synth.outputs import dump_json, write_json
+    from synth.requirements.base import fmt
+    from synth.spec import load_spec
+
+    spec = load_spec(args.spec)
+    result = design(spec)
+    say = (lambda *a: None) if args.quiet or args.json == "-" else print
+    out_dir = Path(args.out) if args.out else Path("reports") / spec.name
+    data = None
+    if not args.no_report:
+        from synth.report.design_report import write_design_report
+
+        command = "synth design " + shlex.quote(args.spec)
+        if args.out:
+            command += f" --out {shlex.quote(args.out)}"
+        files = write_design_report(spec, result, out_dir, command=command, force=args.force)
+        import json
+
+        data = json.loads(files.result_json.read_text(encoding="utf-8"))
+    if args.json:
+        if data is None:
+            from synth.report.design_report import report_data
+
+            data = report_data(spec, result)
+        payload = {k: v for k, v in data.items() if k != "generator"}
+        if args.json == "-":
+            sys.stdout.write(dump_json(payload))
+        else:
+            write_json(args.json, payload, force=args.force)
+    say(f"{spec.name}: {'FEASIBLE' if result.feasible else 'INFEASIBLE'}")
+    say(result.verdict)
+    if result.gain_set is not None:
+        gs = result.gain_set
+        say(f"feasible {gs.parameter}: "
+            + (", ".join(f"[{fmt(a, 6)}, {fmt(b, 6)}]" for a, b in gs.as_list()) or "none"))
+    shown = result.check or result.compromise
+    if shown is not None and not (args.quiet or args.json == "-"):
+        print()
+        if result.compromise is not None:
+            print(f"best compromise (NOT a solution): {result.compromise.controller}")
+        print_requirements(shown.requirements, sys.stdout)
+    if not args.no_report:
+        say(f"\nreport: {out_dir / 'report.html'}")
+    return 0 if result.feasible else 1

@@ -1,0 +1,296 @@
+"""Fixed-structure controllers: P, PI, PID with a derivative filter, lead-lag.
+
+A :class:`ControllerType` knows its parameter names, units, default bounds
+and transfer function; a :class:`Controller` is a type with values. On the
+command line a controller is written ``P(3)``, ``PI(kp=1.2, ki=20)`` or
+``PID(1, 2, 0.1, 0.01)`` (positional in the order of the parameters).
+"""
+
+from __future__ import annotations
+
+import ast
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from synth.errors import ModelError
+from synth.polynomials import format_factored, trim
+
+Polys = tuple[np.ndarray, np.ndarray]
+
+
+@dataclass(frozen=True)
+class ControllerType:
+    """A controller structure.
+
+    Attributes
+    ----------
+    name : str
+        Name used in spec files and on the command line (``"P"``, ``"PI"``, ...).
+    parameters : tuple of str
+        Parameter names in positional order.
+    units : dict
+        Unit of each parameter, written with ``u`` for the plant input unit and
+        ``y`` for the output unit (``"u/y"``, ``"u/(y*s)"``, ``"s"``, ``"rad/s"``).
+    default_bounds : dict
+        Bounds used when the spec gives none.
+    formula : str
+        Transfer function in words, for reports.
+    """
+
+    name: str
+    parameters: tuple[str, ...]
+    units: dict[str, str]
+    default_bounds: dict[str, tuple[float, float]]
+    formula: str
+    build: Callable[[dict[str, float]], Polys] = field(repr=False, compare=False)
+    positive: tuple[str, ...] = ()
+
+    def tf(self, values: dict[str, float]) -> Polys:
+        """Numerator and denominator for the given parameter values.
+
+        Examples
+        --------
+        >>> num, den = CONTROLLER_TYPES["PI"].tf({"kp": 2.0, "ki": 5.0})
+        >>> num.tolist(), den.tolist()
+        ([2.0, 5.0], [1.0, 0.0])
+        """
+        for name in self.positive:
+            if values[name] <= 0:
+                raise ModelError(f"{self.name} parameter {name} must be > 0, got {values[name]:g}")
+        num, den = self.build(values)
+        return trim(np.asarray(num, float)), trim(np.asarray(den, float))
+
+
+def _p(v: dict[str, float]) -> Polys:
+    return np.array([v["kp"]]), np.array([1.0])
+
+
+def _pi(v: dict[str, float]) -> Polys:
+    return np.array([v["kp"], v["ki"]]), np.array([1.0, 0.0])
+
+
+def _pid(v: dict[str, float]) -> Polys:
+    kp, ki, kd, tf = v["kp"], v["ki"], v["kd"], v["tf"]
+    num = np.array([kp * tf + kd, kp + ki * tf, ki])
+    den = np.array([tf, 1.0, 0.0])
+    return num, den
+
+
+def _leadlag(v: dict[str, float]) -> Polys:
+    return v["k"] * np.array([1.0, v["z"]]), np.array([1.0, v["p"]])
+
+
+CONTROLLER_TYPES: dict[str, ControllerType] = {
+    t.name: t
+    for t in (
+        ControllerType("P", ("kp",), {"kp": "u/y"}, {"kp": (0.0, 1e3)}, "C(s) = kp", _p),
+        ControllerType(
+            "PI", ("kp", "ki"), {"kp": "u/y", "ki": "u/(y*s)"},
+            {"kp": (0.0, 1e3), "ki": (0.0, 1e4)}, "C(s) = kp + ki/s", _pi,
+        ),
+        ControllerType(
+            "PID", ("kp", "ki", "kd", "tf"),
+            {"kp": "u/y", "ki": "u/(y*s)", "kd": "u*s/y", "tf": "s"},
+            {"kp": (0.0, 1e3), "ki": (0.0, 1e4), "kd": (0.0, 1e2), "tf": (1e-4, 1.0)},
+            "C(s) = kp + ki/s + kd*s/(tf*s + 1)", _pid, positive=("tf",),
+        ),
+        ControllerType(
+            "leadlag", ("k", "z", "p"), {"k": "u/y", "z": "rad/s", "p": "rad/s"},
+            {"k": (0.0, 1e3), "z": (1e-3, 1e4), "p": (1e-3, 1e4)},
+            "C(s) = k*(s + z)/(s + p)", _leadlag,
+        ),
+    )
+}
+
+_ALIASES = {name.lower(): name for name in CONTROLLER_TYPES}
+_ALIASES.update({"lead_lag": "leadlag", "lead-lag": "leadlag", "ll": "leadlag"})
+
+
+def controller_type(name: str) -> ControllerType:
+    """Look a controller type up by name (case-insensitive).
+
+    Examples
+    --------
+    >>> controller_type("pid").parameters
+    ('kp', 'ki', 'kd', 'tf')
+    """
+    key = _ALIASES.get(str(name).lower())
+    if key is None:
+        raise ModelError(
+            f"unknown controller type {name!r}; expected one of: {', '.join(CONTROLLER_TYPES)}"
+        )
+    return CONTROLLER_TYPES[key]
+
+
+@dataclass(frozen=True)
+class Controller:
+    """A controller of a given type with parameter values.
+
+    Examples
+    --------
+    >>> C = Controller.from_string("PI(kp=1.2, ki=20)")
+    >>> C.parameters
+    {'kp': 1.2, 'ki': 20.0}
+    >>> str(C)
+    'PI(kp=1.2, ki=20)'
+    >>> abs(C.freqresp([1.0])[0]).round(3)
+    np.float64(20.036)
+    """
+
+    type: str
+    parameters: dict[str, float]
+
+    def __post_init__(self) -> None:
+        ctype = controller_type(self.type)
+        missing = [p for p in ctype.parameters if p not in self.parameters]
+        extra = [p for p in self.parameters if p not in ctype.parameters]
+        if extra:
+            raise ModelError(
+                f"{ctype.name} has no parameter {extra[0]!r}; its parameters are "
+                f"{', '.join(ctype.parameters)}"
+            )
+        if missing:
+            raise ModelError(f"{ctype.name} needs a value for {', '.join(missing)}")
+        values = {}
+        for p in ctype.parameters:
+            v = self.parameters[p]
+            if isinstance(v, bool) or not isinstance(v, (int, float, np.floating, np.integer)):
+                raise ModelError(f"{ctype.name} parameter {p} must be a number, got {v!r}")
+            if not np.isfinite(v):
+                raise ModelError(f"{ctype.name} parameter {p} must be finite, got {v!r}")
+            values[p] = float(v)
+        object.__setattr__(self, "type", ctype.name)
+        object.__setattr__(self, "parameters", values)
+        ctype.tf(values)  # validates positivity constraints
+
+    @property
+    def kind(self) -> ControllerType:
+        """The :class:`ControllerType`."""
+        return CONTROLLER_TYPES[self.type]
+
+    @classmethod
+    def from_string(cls, text: str) -> Controller:
+        """Parse ``P(3)``, ``PI(kp=1.2, ki=20)``, ``PID(1, 2, 0.1, 0.01)``.
+
+        Examples
+        --------
+        >>> Controller.from_string("leadlag(k=2, z=1, p=10)").parameters["p"]
+        10.0
+        """
+        if not isinstance(text, str) or not text.strip():
+            raise ModelError("empty controller; write e.g. 'P(3)' or 'PI(kp=1.2, ki=20)'")
+        try:
+            node = ast.parse(text.strip(), mode="eval").body
+        except SyntaxError:
+            raise ModelError(f"cannot parse controller {text!r}; write e.g. 'PI(kp=1.2, ki=20)'") from None
+        if not isinstance(node, ast.Call) or not isinstance(node.func, ast.Name):
+            raise ModelError(f"cannot parse controller {text!r}; write e.g. 'PI(kp=1.2, ki=20)'")
+        ctype = controller_type(node.func.id)
+        if len(node.args) > len(ctype.parameters):
+            raise ModelError(
+                f"{ctype.name} takes {len(ctype.parameters)} parameter(s) "
+                f"({', '.join(ctype.parameters)}), got {len(node.args)}"
+            )
+        values: dict[str, Any] = {}
+        for name, arg in zip(ctype.parameters, node.args):
+            values[name] = _number(arg, text)
+        for kw in node.keywords:
+            if kw.arg is None:
+                raise ModelError(f"cannot parse controller {text!r}")
+            if kw.arg in values:
+                raise ModelError(f"controller {text!r} gives {kw.arg} twice")
+            values[kw.arg] = _number(kw.value, text)
+        try:
+            return cls(ctype.name, values)
+        except ModelError as exc:
+            raise ModelError(f"controller {text!r}: {exc.message}") from None
+
+    def tf(self) -> Polys:
+        """Numerator and denominator polynomials.
+
+        Examples
+        --------
+        >>> Controller("P", {"kp": 3}).tf()
+        (array([3.]), array([1.]))
+        """
+        return self.kind.tf(self.parameters)
+
+    def freqresp(self, w: Any) -> np.ndarray:
+        """Complex response ``C(j w)``.
+
+        Examples
+        --------
+        >>> Controller("P", {"kp": 3}).freqresp([1.0, 10.0])
+        array([3.+0.j, 3.+0.j])
+        """
+        num, den = self.tf()
+        s = 1j * np.asarray(w, dtype=float)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            return np.polyval(num, s) / np.polyval(den, s)
+
+    def dc_gain(self) -> float:
+        """``C(0)``; ``inf`` with integral action.
+
+        Examples
+        --------
+        >>> Controller.from_string("PI(1, 2)").dc_gain()
+        inf
+        """
+        num, den = self.tf()
+        if den[-1] == 0.0:
+            return float("inf") if num[-1] != 0 else float(num[-2] / den[-2])
+        return float(num[-1] / den[-1])
+
+    def with_parameters(self, **values: float) -> Controller:
+        """Copy with some parameters replaced.
+
+        Examples
+        --------
+        >>> Controller("P", {"kp": 3}).with_parameters(kp=4.0).parameters
+        {'kp': 4.0}
+        """
+        return Controller(self.type, {**self.parameters, **values})
+
+    def transfer_function_text(self, digits: int = 4) -> str:
+        """Factored transfer function text.
+
+        Examples
+        --------
+        >>> Controller.from_string("PI(kp=2, ki=4)").transfer_function_text()
+        '2*(s+2)/s'
+        """
+        num, den = self.tf()
+        return format_factored(num, den, digits)
+
+    def __str__(self) -> str:
+        args = ", ".join(f"{k}={v:.6g}" for k, v in self.parameters.items())
+        return f"{self.type}({args})"
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready dict ``{"type": ..., "parameters": {...}, "tf": ...}``.
+
+        Examples
+        --------
+        >>> Controller("P", {"kp": 3}).to_dict()["parameters"]
+        {'kp': 3.0}
+        """
+        return {
+            "type": self.type,
+            "parameters": dict(self.parameters),
+            "units": dict(self.kind.units),
+            "tf": self.transfer_function_text(6),
+            "text": str(self),
+        }
+
+
+def _number(node: ast.AST, text: str) -> float:
+    try:
+        value = ast.literal_eval(node)
+    except ValueError:
+        raise ModelError(f"controller {text!r}: parameters must be numbers") from None
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise ModelError(f"controller {text!r}: parameters must be numbers")
+    return float(value)

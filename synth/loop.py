@@ -1,0 +1,264 @@
+"""The feedback loop of a plant and a controller: L, S, T, KS and classical loop metrics.
+
+Unity negative feedback, ``L = C G``, ``S = 1/(1 + L)``, ``T = L/(1 + L)``,
+``KS = C S``. The plant delay stays exact: every frequency response is
+evaluated as rational part times ``exp(-j w delay)``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import cached_property
+from typing import Any
+
+import numpy as np
+
+from synth.controllers import Controller
+from synth.freqgrid import characteristic_range, crossings, log_grid
+from synth.plant import Plant
+from synth.polynomials import format_factored, magnitude_squared_in_w2, trim
+from synth.stability import StabilityResult, closed_loop_stability, gain_margin_factors
+
+BANDWIDTH_LEVEL = 10 ** (-3 / 20)
+"""|T| relative to |T(0)| that defines the closed-loop bandwidth (-3 dB)."""
+
+
+@dataclass(frozen=True, eq=False)
+class Margins:
+    """Classical stability margins of a loop (delay included).
+
+    Attributes
+    ----------
+    gain_margin_db : float
+        ``20 log10`` of the loop-gain factor above 1 at which the loop turns
+        marginal (``inf`` if none within 80 dB).
+    lower_gain_margin_db : float
+        Same for a gain reduction (``-inf`` if none): conditionally stable loops.
+    phase_crossover : float or None
+        Frequency of the gain-margin crossing (rad/s).
+    phase_margin_deg : float
+        Smallest phase margin over all gain crossovers (``inf`` without a crossover).
+    gain_crossover : float or None
+        Crossover frequency where the phase margin is smallest (rad/s).
+    delay_margin : float
+        Extra loop delay that makes the loop marginal (s): min over crossovers of PM/w.
+    """
+
+    gain_margin_db: float
+    lower_gain_margin_db: float
+    phase_crossover: float | None
+    phase_margin_deg: float
+    gain_crossover: float | None
+    delay_margin: float
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready dict."""
+        return dict(self.__dict__)
+
+
+@dataclass(frozen=True, eq=False)
+class Loop:
+    """Plant and controller in unity negative feedback.
+
+    Examples
+    --------
+    >>> G = Plant.from_string("23*(s+0.43)/((s+9.6)*(s+0.54))")
+    >>> loop = Loop(G, Controller("P", {"kp": 3.0}))
+    >>> np.sort(-loop.closed_loop_poles().real).round(3)
+    array([ 0.443, 78.697])
+    >>> round(loop.bandwidth(), 2)
+    83.16
+    """
+
+    plant: Plant
+    controller: Controller
+
+    # ----------------------------------------------------------- rational parts
+    @cached_property
+    def num(self) -> np.ndarray:
+        """Numerator of the rational part of L."""
+        return trim(np.polymul(self.controller.tf()[0], self.plant.num))
+
+    @cached_property
+    def den(self) -> np.ndarray:
+        """Denominator of the rational part of L."""
+        return trim(np.polymul(self.controller.tf()[1], self.plant.den))
+
+    @property
+    def delay(self) -> float:
+        """Loop delay (s)."""
+        return self.plant.delay
+
+    # --------------------------------------------------------------- responses
+    def L(self, w: Any) -> np.ndarray:
+        """Loop response ``C(jw) G(jw)``."""
+        return self.controller.freqresp(w) * self.plant.freqresp(w)
+
+    def S(self, w: Any) -> np.ndarray:
+        """Sensitivity ``1/(1 + L)``."""
+        with np.errstate(divide="ignore", invalid="ignore"):
+            return 1.0 / (1.0 + self.L(w))
+
+    def T(self, w: Any) -> np.ndarray:
+        """Complementary sensitivity ``L/(1 + L)``; ``1`` where ``L`` is infinite."""
+        L = self.L(w)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            T = L / (1.0 + L)
+        return np.where(np.isinf(np.abs(L)), 1.0 + 0j, T)
+
+    def KS(self, w: Any) -> np.ndarray:
+        """Control sensitivity ``C/(1 + L)`` (input per unit reference or output disturbance)."""
+        C = self.controller.freqresp(w)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            return C / (1.0 + C * self.plant.freqresp(w))
+
+    def T0(self) -> float:
+        """``|T(0)|``: 1 with integral action, ``L(0)/(1 + L(0))`` otherwise."""
+        l0 = self.controller.dc_gain() * self.plant.dc_gain()
+        if np.isinf(l0):
+            return 1.0
+        return float(abs(l0 / (1.0 + l0)))
+
+    # --------------------------------------------------------------- frequencies
+    @cached_property
+    def frequency_range(self) -> tuple[float, float]:
+        """Two decades beyond every corner frequency of C, G and ``1/delay`` (rad/s)."""
+        cn, cd = self.controller.tf()
+        return characteristic_range(cn, cd, self.plant.num, self.plant.den, delay=self.delay)
+
+    def grid(self, per_decade: int = 80) -> np.ndarray:
+        """Log frequency grid over :attr:`frequency_range`."""
+        return log_grid(*self.frequency_range, per_decade)
+
+    def gain_crossovers(self) -> np.ndarray:
+        """All frequencies where ``|L(jw)| = 1`` (exact polynomial roots; the delay has |.| = 1).
+
+        Examples
+        --------
+        >>> loop = Loop(Plant.from_string("10/(s+1)"), Controller("P", {"kp": 1.0}))
+        >>> loop.gain_crossovers().round(4)
+        array([9.9499])
+        """
+        q = trim(np.polysub(magnitude_squared_in_w2(self.num), magnitude_squared_in_w2(self.den)))
+        if q.size < 2:
+            return np.array([])
+        r = np.roots(q)
+        keep = (np.abs(r.imag) <= 1e-9 * (1 + np.abs(r.real))) & (r.real > 0)
+        return np.sort(np.sqrt(r[keep].real))
+
+    def crossover(self) -> float | None:
+        """Lowest gain-crossover frequency (rad/s), or None if ``|L|`` never crosses 1."""
+        wc = self.gain_crossovers()
+        return float(wc[0]) if wc.size else None
+
+    def bandwidth(self, per_decade: int = 80) -> float:
+        """Closed-loop bandwidth: first frequency where ``|T|`` falls 3 dB below ``|T(0)|`` (rad/s).
+
+        The level is ``|T(0)| * 10**(-3/20)`` (python-control's convention).
+        Returns ``nan`` when ``T(0) = 0`` and ``inf`` when ``|T|`` never falls that far.
+        """
+        t0 = self.T0()
+        if t0 == 0.0 or not np.isfinite(t0):
+            return float("nan")
+        level = t0 * BANDWIDTH_LEVEL
+        lo, hi = self.frequency_range
+        grid = log_grid(lo, hi * 10, per_decade)
+        cross = crossings(lambda w: np.abs(self.T(w)), level, grid)
+        below = np.abs(self.T(grid)) < level
+        if cross.size == 0:
+            return float("inf") if not below[0] else float(grid[0])
+        return float(cross[0])
+
+    # ------------------------------------------------------------------ stability
+    @cached_property
+    def _stability(self) -> StabilityResult:
+        return closed_loop_stability(self.num, self.den, self.delay)
+
+    def stability(self) -> StabilityResult:
+        """Exact closed-loop stability (Nyquist count with the delay)."""
+        return self._stability
+
+    def margins(self) -> Margins:
+        """Gain, phase and delay margins, delay included.
+
+        Examples
+        --------
+        >>> G = Plant.from_string("23*(s+0.43)/((s+9.6)*(s+0.54))", delay=0.02)
+        >>> m = Loop(G, Controller("P", {"kp": 3.0})).margins()
+        >>> round(m.gain_margin_db, 2), round(m.phase_crossover, 2)
+        (1.79, 84.28)
+        """
+        k_lo, k_hi, _, w_hi = gain_margin_factors(self.num, self.den, self.delay)
+        gm = 20 * np.log10(k_hi) if np.isfinite(k_hi) else np.inf
+        lgm = 20 * np.log10(k_lo) if k_lo > 0 else -np.inf
+        pm, wpm, dm = np.inf, None, np.inf
+        for wc in self.gain_crossovers():
+            phase = np.degrees(np.angle(self.L(np.array([wc]))[0]))
+            this = (phase + 180.0 + 180.0) % 360.0 - 180.0  # wrapped to [-180, 180)
+            if this < pm:
+                pm, wpm = float(this), float(wc)
+            if this > 0:
+                dm = min(dm, np.radians(this) / wc)
+            else:
+                dm = 0.0
+        return Margins(float(gm), float(lgm), w_hi, pm, wpm, float(dm))
+
+    # --------------------------------------------------------- closed-loop poles
+    def closed_loop_poles(self, pade_order: int = 10) -> np.ndarray:
+        """Closed-loop poles, sorted by decreasing real part.
+
+        Without a delay: roots of ``den + num``. With a delay: roots of the
+        quasi-polynomial ``den(s) + num(s) exp(-delay s)`` found by Newton's
+        method from the roots of a Pade approximation, keeping only converged
+        roots (the dominant ones; there are infinitely many).
+        """
+        if self.delay == 0.0:
+            roots = np.roots(trim(np.polyadd(self.den, self.num)))
+            return roots[np.argsort(-roots.real)]
+        pn, pd = _pade(self.delay, pade_order)
+        seeds = np.roots(trim(np.polyadd(np.polymul(self.den, pd), np.polymul(self.num, pn))))
+        dnum, dden = np.polyder(self.num), np.polyder(self.den)
+        found: list[complex] = []
+        for s in seeds:
+            for _ in range(50):
+                e = np.exp(-self.delay * s)
+                f = np.polyval(self.den, s) + np.polyval(self.num, s) * e
+                df = np.polyval(dden, s) + (np.polyval(dnum, s) - self.delay * np.polyval(self.num, s)) * e
+                if df == 0:
+                    break
+                step = f / df
+                s = s - step
+                if abs(step) <= 1e-13 * max(1.0, abs(s)):
+                    break
+            e = np.exp(-self.delay * s)
+            resid = abs(np.polyval(self.den, s) + np.polyval(self.num, s) * e)
+            scale = abs(np.polyval(self.den, s)) + abs(np.polyval(self.num, s) * e) + 1e-300
+            if resid <= 1e-9 * scale and not any(abs(s - f0) <= 1e-7 * max(1, abs(s)) for f0 in found):
+                found.append(complex(s))
+        roots = np.array(found)
+        return roots[np.argsort(-roots.real)]
+
+    def closed_loop_text(self, digits: int = 4) -> str | None:
+        """``T(s)`` in factored form (None with a delay: T is not rational).
+
+        Examples
+        --------
+        >>> G = Plant.from_string("23*(s+0.43)/((s+9.6)*(s+0.54))")
+        >>> Loop(G, Controller("P", {"kp": 3.0})).closed_loop_text()
+        '69*(s+0.43)/((s+78.7)*(s+0.4429))'
+        """
+        if self.delay:
+            return None
+        return format_factored(self.num, np.polyadd(self.den, self.num), digits)
+
+
+def _pade(delay: float, order: int) -> tuple[np.ndarray, np.ndarray]:
+    """Pade approximation of ``exp(-delay s)`` (numerator, denominator)."""
+    from math import factorial
+
+    n = order
+    coeffs = [factorial(2 * n - k) * factorial(n) / (factorial(2 * n) * factorial(k) * factorial(n - k))
+              for k in range(n + 1)]
+    den = np.array([c * delay**k for k, c in enumerate(coeffs)])[::-1]
+    num = np.array([c * (-delay) ** k for k, c in enumerate(coeffs)])[::-1]
+    return num / den[0], den / den[0]

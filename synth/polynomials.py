@@ -1,0 +1,127 @@
+"""Small polynomial helpers (descending-power coefficient arrays, as numpy.polyval uses)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+
+def trim(p: np.ndarray) -> np.ndarray:
+    """Drop leading zero coefficients (keep ``[0.]`` for the zero polynomial).
+
+    Examples
+    --------
+    >>> trim(np.array([0.0, 0.0, 1.0, 2.0]))
+    array([1., 2.])
+    """
+    p = np.atleast_1d(np.asarray(p, dtype=float))
+    nonzero = np.flatnonzero(p != 0.0)
+    return p[nonzero[0]:] if nonzero.size else np.array([0.0])
+
+
+def mirror(p: np.ndarray) -> np.ndarray:
+    """Coefficients of ``p(-s)``.
+
+    Examples
+    --------
+    >>> mirror(np.array([1.0, 2.0, 3.0]))
+    array([ 1., -2.,  3.])
+    """
+    p = np.asarray(p, dtype=float)
+    signs = (-1.0) ** np.arange(p.size - 1, -1, -1)
+    return p * signs
+
+
+def magnitude_squared_in_w2(p: np.ndarray) -> np.ndarray:
+    """Polynomial ``m(x)`` with ``m(w**2) = |p(j w)|**2`` (coefficients in descending ``x``).
+
+    Examples
+    --------
+    >>> m = magnitude_squared_in_w2(np.array([1.0, 1.0]))  # |jw + 1|^2 = w^2 + 1
+    >>> m
+    array([1., 1.])
+    """
+    q = np.polymul(np.asarray(p, float), mirror(p))  # even polynomial in s
+    even = q[::-1][0::2]  # coefficients of s^0, s^2, s^4, ...
+    signs = (-1.0) ** np.arange(even.size)  # (j w)^(2m) = (-1)^m w^(2m)
+    return trim((even * signs)[::-1])
+
+
+def largest_crossing(num: np.ndarray, den: np.ndarray, level: float) -> float:
+    """Largest ``w >= 0`` with ``|num(jw)/den(jw)| == level`` (0 if there is none).
+
+    Beyond the returned frequency the magnitude stays on one side of ``level``.
+    Exact: it solves ``|num|^2 - level^2 |den|^2 = 0`` as a polynomial in ``w**2``.
+
+    Examples
+    --------
+    >>> round(largest_crossing(np.array([10.0]), np.array([1.0, 1.0]), 1.0), 4)  # |10/(jw+1)| = 1
+    9.9499
+    """
+    q = np.polysub(magnitude_squared_in_w2(num), level**2 * magnitude_squared_in_w2(den))
+    q = trim(q)
+    if q.size < 2:
+        return 0.0
+    roots = np.roots(q)
+    real = roots[(np.abs(roots.imag) <= 1e-9 * (1 + np.abs(roots.real))) & (roots.real > 0)].real
+    return float(np.sqrt(real.max())) if real.size else 0.0
+
+
+def _fmt(x: float, digits: int) -> str:
+    text = f"{x:.{digits}g}"
+    if "e" in text:
+        mant, exp = text.split("e")
+        text = f"{mant}e{int(exp)}"
+    return text
+
+
+def _factors(p: np.ndarray, digits: int) -> tuple[float, list[str]]:
+    p = trim(p)
+    gain = float(p[0])
+    if p.size == 1:
+        return gain, []
+    roots = np.roots(p)
+    scale = max(1.0, float(np.max(np.abs(roots))))
+    n_zero = int(np.sum(np.abs(roots) <= 1e-12 * scale))
+    rest = roots[np.abs(roots) > 1e-12 * scale]
+    real = sorted(rest[np.abs(rest.imag) <= 1e-9 * np.abs(rest)].real, key=lambda r: -abs(r))
+    cplx = rest[(np.abs(rest.imag) > 1e-9 * np.abs(rest)) & (rest.imag > 0)]
+    cplx = sorted(cplx, key=lambda r: -abs(r))
+    factors = []
+    for r in real:
+        a = -r
+        factors.append(f"(s+{_fmt(a, digits)})" if a >= 0 else f"(s-{_fmt(-a, digits)})")
+    for r in cplx:
+        b, c = -2.0 * r.real, abs(r) ** 2
+        sign = "+" if b >= 0 else "-"
+        factors.append(f"(s^2{sign}{_fmt(abs(b), digits)}*s+{_fmt(c, digits)})")
+    if n_zero:
+        factors.append("s" if n_zero == 1 else f"s^{n_zero}")
+    return gain, factors
+
+
+def format_factored(num: np.ndarray, den: np.ndarray, digits: int = 4) -> str:
+    """Factored text of ``num/den``, e.g. ``'23*(s+0.43)/((s+9.6)*(s+0.54))'``.
+
+    Examples
+    --------
+    >>> format_factored(np.array([2.0]), np.array([1.0, 1.0, 0.0]))
+    '2/((s+1)*s)'
+    """
+    gn, fn = _factors(num, digits)
+    gd, fd = _factors(den, digits)
+    gain = gn / gd
+    if fn:
+        if np.isclose(gain, 1.0):
+            top = "*".join(fn)
+        elif np.isclose(gain, -1.0):
+            top = "-" + "*".join(fn)
+        else:
+            top = _fmt(gain, digits) + "*" + "*".join(fn)
+    else:
+        top = _fmt(gain, digits)
+    if not fd:
+        return top
+    bottom = fd[0] if len(fd) == 1 and fd[0].startswith("(") else "(" + "*".join(fd) + ")"
+    if len(fd) == 1 and not fd[0].startswith("("):
+        bottom = fd[0]
+    return f"{top}/{bottom}"

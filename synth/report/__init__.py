@@ -1,0 +1,1 @@
+"""Reports for people: HTML pages, figures and the JSON they are rendered from."""

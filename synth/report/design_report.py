@@ -1,0 +1,171 @@
+"""The design report: ``result.json``, ``report.html`` and PNG figures in one folder."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from jinja2 import Environment, PackageLoader
+
+from synth.controllers import CONTROLLER_TYPES, Controller
+from synth.design import DesignResult, reference_controller, scalar_family
+from synth.loop import Loop
+from synth.outputs import GENERATOR, OutputDir, dump_json, to_jsonable
+from synth.reference import compare
+from synth.report import figures
+from synth.requirements import SlewRate
+from synth.requirements.base import fmt
+from synth.spec import Spec
+
+
+@dataclass
+class ReportFiles:
+    """Paths written by :func:`write_design_report`."""
+
+    folder: Path
+    result_json: Path
+    html: Path
+    figures: dict[str, Path]
+
+
+def report_data(spec: Spec, result: DesignResult) -> dict[str, Any]:
+    """Everything ``result.json`` holds: the design result, the reference controller's check and
+    the comparisons with published numbers.
+
+    Examples
+    --------
+    >>> from synth.spec import load_spec; from synth.design import design
+    >>> spec = load_spec("specs/x4_rotor.yaml")
+    >>> data = report_data(spec, design(spec))
+    >>> data["feasible"], data["reference_check"]["feasible"]
+    (True, True)
+    """
+    shown = result.controller or (result.compromise.controller if result.compromise else None)
+    data = result.to_dict()
+    data["analysis"] = compare(spec, shown)
+    data["description"] = spec.description
+    return to_jsonable(data)
+
+
+def _slack_curves(spec: Spec) -> dict[str, tuple[np.ndarray, np.ndarray]]:
+    family, (lo, hi) = scalar_family(spec)
+    xs = np.linspace(lo, hi, 121)
+    curves = {}
+    plants = spec.plants()
+    for req in spec.requirements:
+        ys = [min(req.evaluate(Loop(p, family.controller(x)), 40).slack for p in plants) for x in xs]
+        curves[req.name()] = (xs, np.array(ys, float))
+    return curves
+
+
+def _columns(data: dict[str, Any]) -> tuple[list[dict], list[dict]]:
+    cols = []
+    if data.get("controller"):
+        cols.append(("design " + data["controller"]["text"], data["requirements"]))
+    elif data.get("compromise"):
+        cols.append(("best compromise " + data["compromise"]["controller"]["text"] + " (not a solution)",
+                     data["compromise"]["requirements"]))
+    if data.get("reference_check"):
+        cols.append(("reference " + data["reference_check"]["controller"]["text"],
+                     data["reference_check"]["requirements"]))
+    columns = [{"title": t, "messages": [r["message"] for r in reqs]} for t, reqs in cols]
+    rows = []
+    for i, r0 in enumerate(cols[0][1] if cols else []):
+        cells = []
+        for _, reqs in cols:
+            r = reqs[i]
+            value = "stable" if r["type"] == "stability" and r["met"] else (
+                "UNSTABLE" if r["type"] == "stability" else f"{fmt(_num(r['value']))} {r['unit']}")
+            cells.append({"value": value, "slack": fmt(_num(r["slack"]), 3), "met": r["met"]})
+        bound = "all roots in the left half-plane" if r0["type"] == "stability" else (
+            f"{'>=' if r0['type'] in ('bandwidth', 'margins') else '<='} {fmt(_num(r0['bound']))} {r0['unit']}")
+        rows.append({"label": r0["label"], "cells": cells, "bound": bound})
+    return columns, rows
+
+
+def _num(x: Any) -> float | None:
+    if x is None:
+        return None
+    if isinstance(x, str):
+        return float(x)
+    return float(x)
+
+
+def write_design_report(spec: Spec, result: DesignResult, out_dir: str | Path, *, command: str = "",
+                        force: bool = False) -> ReportFiles:
+    """Write ``result.json``, ``report.html`` and figures for a design into ``out_dir``.
+
+    Files synth wrote earlier are replaced; any other existing file of the
+    same name is left alone (:class:`~synth.errors.OutputExistsError`) unless
+    ``force`` is given.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from synth.spec import load_spec; from synth.design import design
+    >>> spec = load_spec("specs/x4_rotor.yaml")
+    >>> files = write_design_report(spec, design(spec), tempfile.mkdtemp())
+    >>> sorted(files.figures)
+    ['bode', 'delay', 'gain_set', 'sensitivity', 'step']
+    """
+    out = OutputDir(out_dir, force)
+    data = report_data(spec, result)
+    plant = spec.nominal_plant()
+    loops: list[tuple[str, Loop]] = []
+    shown = result.controller or (result.compromise.controller if result.compromise else None)
+    if shown is not None:
+        loops.append(("design " + str(shown) if result.controller else "compromise " + str(shown),
+                      Loop(plant, shown)))
+    ref = reference_controller(spec)
+    if ref is not None:
+        loops.append(("reference " + str(ref), Loop(plant, ref)))
+    figs: dict[str, Path] = {}
+    slew = [r for r in spec.requirements if isinstance(r, SlewRate)]
+    if slew and loops:
+        figs["bode"] = figures.bode_with_slew_bound(loops, slew, out.claim("bode_slew_bound.png"))
+    if loops:
+        figs["sensitivity"] = figures.sensitivity_plot(loops, list(spec.requirements),
+                                                       out.claim("sensitivity.png"))
+        figs["step"] = figures.step_plot(loops, out.claim("step_response.png"))
+    marks: dict[str, float] = {}
+    for name, loop in loops:
+        if isinstance(loop.controller, Controller) and loop.controller.type == "P":
+            marks[name] = loop.controller.parameters["kp"]
+    gain = data.get("gain_set_detail")
+    if gain is not None:
+        figs["gain_set"] = figures.gain_set_plot(
+            gain["parameter"], tuple(gain["bounds"]), _slack_curves(spec), data["gain_set"], marks,
+            out.claim("gain_set.png"))
+    delay_table = data["analysis"].get("delay_table")
+    if delay_table:
+        rows = [{**r, "critical_gain": float(r["critical_gain"])} for r in delay_table]
+        figs["delay"] = figures.delay_chart(rows, marks, out.claim("critical_gain_vs_delay.png"))
+
+    columns, rows = _columns(data)
+    ref_line = ""
+    env = Environment(loader=PackageLoader("synth.report", "templates"), autoescape=True)
+    html = env.get_template("design.html.j2").render(
+        r=data | {"generator": GENERATOR},
+        description=spec.description,
+        command=command or f"synth design SPEC --out {out.path}",
+        plant=data["analysis"]["plant"],
+        structure=CONTROLLER_TYPES[spec.controller.type].formula + "; bounds "
+        + ", ".join(f"{k} in [{fmt(a)}, {fmt(b)}]" for k, (a, b) in spec.controller.all_bounds().items()),
+        columns=columns, rows=rows, gain=gain,
+        figures={k: v.name for k, v in figs.items()},
+        loops=data["analysis"]["loops"],
+        published=(data["analysis"].get("reference") or {}).get("published_closed_loops", []),
+        reference=data["analysis"].get("reference"),
+        slew=data["analysis"].get("slew_rate", []),
+        delay_table=[{**r, "critical_gain": float(r["critical_gain"])} for r in delay_table or []],
+        marks=marks, certificate=data.get("certificate"), ref_line=ref_line,
+        f=lambda x, d=4: fmt(None if x is None else float(x), d),
+    )
+    html_path = out.claim("report.html")
+    html_path.write_text(html, encoding="utf-8")
+    json_path = out.claim("result.json")
+    json_path.write_text(dump_json(data), encoding="utf-8")
+    out.commit()
+    return ReportFiles(out.path, json_path, html_path, figs)

@@ -1,0 +1,160 @@
+"""Report figures (matplotlib, Agg backend, PNG).
+
+Every figure function takes plain data and a path and returns the path; none
+of them computes a requirement (the numbers come from the result).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt
+import numpy as np
+
+from synth.freqgrid import log_grid
+from synth.loop import Loop
+from synth.requirements import Sensitivity, SlewRate, StaticSensitivity
+from synth.requirements.sensitivity import PeakSensitivity
+from synth.timeresp import default_horizon, step_response
+
+_METADATA = {"Software": "synth"}
+COLORS = ["#1f4e9c", "#c0392b", "#2e8b57", "#8e44ad", "#d35400"]
+
+
+def _save(fig: plt.Figure, path: Path) -> Path:
+    fig.tight_layout()
+    fig.savefig(path, dpi=110, metadata=_METADATA)
+    plt.close(fig)
+    return path
+
+
+def _db(x: np.ndarray) -> np.ndarray:
+    with np.errstate(divide="ignore"):
+        return 20 * np.log10(np.abs(x))
+
+
+def _range(loops: list[tuple[str, Loop]], extra: list[float]) -> np.ndarray:
+    lo = min(loop.frequency_range[0] for _, loop in loops)
+    hi = max(loop.frequency_range[1] for _, loop in loops)
+    if extra:
+        lo, hi = min(lo, min(extra) / 3), max(hi, max(extra) * 3)
+    return log_grid(lo, hi, 100)
+
+
+def bode_with_slew_bound(loops: list[tuple[str, Loop]], slew: list[SlewRate], path: Path) -> Path:
+    """Open-loop plant and compensated loop magnitudes with the slew-rate bound of eq. 12."""
+    extra = [w for r in slew for w in r.band]
+    w = _range(loops, extra)
+    fig, ax = plt.subplots(figsize=(8, 4.8))
+    plant = loops[0][1].plant
+    ax.semilogx(w, _db(plant.freqresp(w)), color="#3b7dd8", lw=1.5, label="open-loop plant |G|")
+    for i, (name, loop) in enumerate(loops):
+        ax.semilogx(w, _db(loop.L(w)), color=["black", "#555555", "#999999"][i % 3],
+                    ls=["-", "--", ":"][i % 3], lw=1.8, label=f"compensated |C G|, {name}")
+    for j, r in enumerate(slew):
+        bound = r.rate_limit / r.max_error * np.abs(plant.freqresp(w)) / w
+        ax.semilogx(w, _db(bound), color="#c0392b", lw=1.6,
+                    label=f"rate bound B|G|/(De w), B/De = {r.rate_limit / r.max_error:.4g} 1/s")
+        ax.axvspan(*r.band, color="#c0392b", alpha=0.06 if j == 0 else 0.03)
+    ax.set_xlabel("frequency [rad/s]")
+    ax.set_ylabel("magnitude [dB]")
+    ax.set_title("Compensated loop against the slew-rate bound (seed eq. 12); shaded: bound's band")
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=8, loc="lower left")
+    return _save(fig, path)
+
+
+def sensitivity_plot(loops: list[tuple[str, Loop]], requirements: list[Any], path: Path) -> Path:
+    """|S| in dB with every sensitivity bound drawn."""
+    bands = [w for r in requirements if isinstance(r, Sensitivity) for w in r.band if w > 0]
+    w = _range(loops, bands)
+    fig, ax = plt.subplots(figsize=(8, 4.5))
+    for i, (name, loop) in enumerate(loops):
+        ax.semilogx(w, _db(loop.S(w)), color=COLORS[i % len(COLORS)], lw=1.8, label=f"|S|, {name}")
+    for r in requirements:
+        if isinstance(r, Sensitivity):
+            lo = r.band[0] if r.band[0] > 0 else w[0]
+            ax.hlines(r.max_db, lo, r.band[1], color="#c0392b", lw=2.5,
+                      label=f"bound {r.max_db:g} dB, {r.band[0]:g}-{r.band[1]:g} rad/s")
+        elif isinstance(r, StaticSensitivity):
+            ax.plot([w[0]], [r.max_db], marker="v", color="#c0392b", ms=10, ls="none",
+                    label=f"static bound {r.max_db:g} dB (plant gain {r.plant_gain if r.plant_gain else 'DC'})")
+        elif isinstance(r, PeakSensitivity):
+            ax.axhline(r.max_db, color="#8e44ad", ls="--", lw=1.2, label=f"peak |S| bound {r.max_db:g} dB")
+    ax.axhline(0, color="grey", lw=0.8)
+    ax.set_xlabel("frequency [rad/s]")
+    ax.set_ylabel("|S| [dB]")
+    ax.set_title("Sensitivity: disturbance attenuation (below 0 dB) and amplification")
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=8, loc="lower right")
+    return _save(fig, path)
+
+
+def step_plot(loops: list[tuple[str, Loop]], path: Path, scale: float = 1.0, unit: str = "",
+              t_end: float | None = None, open_loop: bool = True) -> Path:
+    """Closed-loop responses to a reference step of size ``scale`` (and the plant's open-loop step)."""
+    fig, ax = plt.subplots(figsize=(8, 4.2))
+    horizon = t_end if t_end is not None else max(default_horizon(loop) for _, loop in loops)
+    for i, (name, loop) in enumerate(loops):
+        t, y, dt = step_response(loop, horizon)
+        extra = f" (sampled, dt = {dt:.2g} s)" if dt else ""
+        ax.plot(t, scale * y, color=COLORS[i % len(COLORS)], lw=1.8, label=f"closed loop, {name}{extra}")
+    if open_loop:
+        from scipy.signal import lti
+
+        plant = loops[0][1].plant
+        t = np.linspace(0, horizon, 2001)
+        _, y = lti(plant.num, plant.den).step(T=t)
+        shift = np.clip(t - plant.delay, 0, None)
+        y = np.interp(shift, t, y) * (t >= plant.delay)
+        ax.plot(t, scale * y / max(plant.dc_gain(), 1e-300), color="grey", ls=":", lw=1.5,
+                label="open-loop plant, normalized to its DC gain")
+    ax.set_xlabel("time [s]")
+    ax.set_ylabel(f"output [{unit}]" if unit else "output per unit reference step")
+    ax.set_title("Linear step response (reference step)")
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize=8, loc="lower right")
+    return _save(fig, path)
+
+
+def gain_set_plot(parameter: str, bounds: tuple[float, float], curves: dict[str, tuple[np.ndarray, np.ndarray]],
+                  intervals: list[list[float]], marks: dict[str, float], path: Path) -> Path:
+    """Each requirement's slack against the parameter, feasible intervals shaded."""
+    fig, ax = plt.subplots(figsize=(8, 4.2))
+    for i, (name, (x, y)) in enumerate(curves.items()):
+        finite = np.isfinite(y)
+        ax.plot(x[finite], np.clip(y[finite], -3, 3), lw=1.8, color=COLORS[i % len(COLORS)], label=name)
+    for lo, hi in intervals:
+        ax.axvspan(lo, hi, color="#2e8b57", alpha=0.12)
+    for j, (label, value) in enumerate(marks.items()):
+        ax.axvline(value, color="black", ls=["-", "--", ":"][j % 3], lw=1.2, label=label)
+    ax.axhline(0, color="grey", lw=1)
+    pad = 0.02 * (bounds[1] - bounds[0])
+    ax.set_xlim(bounds[0] - pad, bounds[1] + pad)
+    ax.set_xlabel(parameter)
+    ax.set_ylabel("slack [Np], >= 0 met (clipped at +-3)")
+    ax.set_title(f"Feasible {parameter} (shaded): every requirement's slack")
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize=8, loc="best")
+    return _save(fig, path)
+
+
+def delay_chart(rows: list[dict[str, Any]], marks: dict[str, float], path: Path) -> Path:
+    """Critical proportional gain against the in-loop delay."""
+    fig, ax = plt.subplots(figsize=(7, 3.8))
+    d = np.array([r["delay"] for r in rows]) * 1e3
+    k = np.array([r["critical_gain"] for r in rows], float)
+    finite = np.isfinite(k)
+    ax.semilogy(d[finite], k[finite], "o-", color=COLORS[0], label="critical gain (loop turns unstable)")
+    for j, (label, value) in enumerate(marks.items()):
+        ax.axhline(value, color="black", ls=["-", "--", ":"][j % 3], lw=1.2, label=label)
+    ax.set_xlabel("in-loop delay [ms]")
+    ax.set_ylabel("gain")
+    ax.set_title("Which gains stay stable if the delay is inside the loop")
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=8)
+    return _save(fig, path)

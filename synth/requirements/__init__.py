@@ -1,0 +1,34 @@
+"""Requirement types, registered by the ``type:`` name used in spec files.
+
+Importing this package registers every built-in type in :data:`REQUIREMENT_TYPES`.
+"""
+
+from synth.requirements.bandwidth import Bandwidth
+from synth.requirements.base import (
+    REQUIREMENT_TYPES,
+    Requirement,
+    RequirementResult,
+    register,
+)
+from synth.requirements.margins import MarginsRequirement
+from synth.requirements.sensitivity import (
+    PeakComplementary,
+    PeakSensitivity,
+    Sensitivity,
+    StaticSensitivity,
+)
+from synth.requirements.slew_rate import SlewRate
+
+__all__ = [
+    "REQUIREMENT_TYPES",
+    "Bandwidth",
+    "MarginsRequirement",
+    "PeakComplementary",
+    "PeakSensitivity",
+    "Requirement",
+    "RequirementResult",
+    "Sensitivity",
+    "SlewRate",
+    "StaticSensitivity",
+    "register",
+]

@@ -1,0 +1,60 @@
+"""Closed-loop bandwidth requirement."""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, ClassVar, Literal
+
+import numpy as np
+from pydantic import PositiveFloat, model_validator
+
+from synth.requirements.base import Requirement, RequirementResult, fmt, register
+
+if TYPE_CHECKING:
+    from synth.loop import Loop
+
+
+@register
+class Bandwidth(Requirement):
+    """Closed-loop -3 dB bandwidth of T (relative to ``|T(0)|``) at least ``min`` (and at most ``max``).
+
+    The loop's crossover frequency is reported alongside.
+
+    Examples
+    --------
+    >>> from synth.loop import Loop; from synth.plant import Plant; from synth.controllers import Controller
+    >>> loop = Loop(Plant.from_string("23*(s+0.43)/((s+9.6)*(s+0.54))"), Controller("P", {"kp": 3.0}))
+    >>> r = Bandwidth(type="bandwidth", min=60).evaluate(loop)
+    >>> round(r.value, 2), round(r.details["crossover"], 2), r.met
+    (83.16, 68.33, True)
+    """
+
+    type: Literal["bandwidth"] = "bandwidth"
+    min: PositiveFloat | None = None
+    max: PositiveFloat | None = None
+    title: ClassVar[str] = "closed-loop bandwidth"
+
+    @model_validator(mode="after")
+    def _one_bound(self) -> Bandwidth:
+        if self.min is None and self.max is None:
+            raise ValueError("give 'min' and/or 'max' (rad/s)")
+        if self.min is not None and self.max is not None and self.max < self.min:
+            raise ValueError(f"max ({self.max:g}) is below min ({self.min:g})")
+        return self
+
+    def evaluate(self, loop: Loop, per_decade: int = 80) -> RequirementResult:
+        wb = loop.bandwidth(per_decade)
+        wc = loop.crossover()
+        slacks = []
+        if self.min is not None:
+            slacks.append((np.log(wb / self.min) if wb > 0 else -np.inf, self.min, wb - self.min, ">="))
+        if self.max is not None:
+            slacks.append((np.log(self.max / wb) if wb > 0 else np.inf, self.max, self.max - wb, "<="))
+        slack, bound, margin, rel = min(slacks, key=lambda t: t[0])
+        if np.isnan(wb):
+            slack, margin = -np.inf, -np.inf
+        met = slack >= 0
+        msg = (f"closed-loop bandwidth {fmt(wb)} rad/s {rel} {fmt(bound)} rad/s: "
+               f"{'met' if met else 'NOT met'} (loop crossover {fmt(wc)} rad/s)")
+        return self.result(value=wb, bound=bound, unit="rad/s", slack=slack, margin=margin,
+                           binding_frequency=wb if np.isfinite(wb) else None, message=msg,
+                           crossover=wc, T0=loop.T0())

@@ -1,0 +1,184 @@
+"""Sensitivity requirements: |S| over a band, the seed's static reading, and peak |S| / |T|."""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, ClassVar, Literal
+
+import numpy as np
+from pydantic import Field
+
+from synth.freqgrid import band_grid, crossings, log_grid, peak
+from synth.requirements.base import (
+    NEPER_PER_DB,
+    BandMixin,
+    Requirement,
+    RequirementResult,
+    db,
+    fmt,
+    register,
+)
+
+if TYPE_CHECKING:
+    from synth.loop import Loop
+
+
+def _band_text(band: tuple[float, float]) -> str:
+    lo, hi = band
+    return f"below {fmt(hi)} rad/s" if lo == 0 else f"from {fmt(lo)} to {fmt(hi)} rad/s"
+
+
+@register
+class Sensitivity(BandMixin, Requirement):
+    """``|S(jw)| <= max_db`` for every ``w`` in ``band``, on the full dynamic model.
+
+    Examples
+    --------
+    >>> from synth.loop import Loop; from synth.plant import Plant; from synth.controllers import Controller
+    >>> loop = Loop(Plant.from_string("23*(s+0.43)/((s+9.6)*(s+0.54))"), Controller("P", {"kp": 3.0}))
+    >>> r = Sensitivity(type="sensitivity", max_db=-15, band=(0, 30)).evaluate(loop)
+    >>> r.met, round(r.details["met_up_to"], 2)
+    (False, 10.33)
+    """
+
+    type: Literal["sensitivity"] = "sensitivity"
+    max_db: float
+    title: ClassVar[str] = "sensitivity over a band"
+
+    def evaluate(self, loop: Loop, per_decade: int = 80) -> RequirementResult:
+        grid = band_grid(self.band, loop.frequency_range, per_decade)
+        value, w_peak = peak(lambda w: np.abs(loop.S(w)), grid)
+        value_db = db(value)
+        margin = self.max_db - value_db
+        limit = 10 ** (self.max_db / 20)
+        up_to = None
+        if margin < 0:
+            mags = np.abs(loop.S(grid))
+            if mags[0] <= limit:
+                cross = crossings(lambda w: np.abs(loop.S(w)), limit, grid)
+                up_to = float(cross[0]) if cross.size else None
+        where = _band_text(self.band)
+        if margin >= 0:
+            msg = (f"|S| stays at or below {fmt(self.max_db)} dB {where}: met, "
+                   f"peak {value_db:.2f} dB at {fmt(w_peak)} rad/s ({margin:.2f} dB to spare)")
+        else:
+            held = (f"it holds only up to {fmt(up_to)} rad/s" if up_to is not None
+                    else "it fails already at the low end of the band")
+            msg = (f"|S| <= {fmt(self.max_db)} dB {where}: NOT met, |S| reaches {value_db:.2f} dB "
+                   f"at {fmt(w_peak)} rad/s; {held}")
+        return self.result(value=value_db, bound=self.max_db, unit="dB", slack=margin * NEPER_PER_DB,
+                           margin=margin, binding_frequency=w_peak, message=msg,
+                           met_up_to=up_to, band=list(self.band))
+
+
+@register
+class StaticSensitivity(Requirement):
+    """The seed's static reading ``S = 1/(1 + C(0) * plant_gain) <= max_db``.
+
+    ``plant_gain`` defaults to the plant's own DC gain; the X-4 paper uses 1.8
+    while its eq. 5 model has 1.908.
+
+    Examples
+    --------
+    >>> from synth.loop import Loop; from synth.plant import Plant; from synth.controllers import Controller
+    >>> loop = Loop(Plant.from_string("23*(s+0.43)/((s+9.6)*(s+0.54))"), Controller("P", {"kp": 3.0}))
+    >>> r = StaticSensitivity(type="sensitivity_static", max_db=-15, plant_gain=1.8).evaluate(loop)
+    >>> round(r.value, 2), r.met
+    (-16.12, True)
+    """
+
+    type: Literal["sensitivity_static"] = "sensitivity_static"
+    max_db: float
+    plant_gain: float | None = Field(default=None, description="low-frequency plant gain")
+    title: ClassVar[str] = "static sensitivity"
+
+    def gain(self, loop: Loop) -> float:
+        """Plant gain used: the stated one or the model's DC gain."""
+        return float(self.plant_gain) if self.plant_gain is not None else loop.plant.dc_gain()
+
+    def evaluate(self, loop: Loop, per_decade: int = 80) -> RequirementResult:
+        g = self.gain(loop)
+        c0 = loop.controller.dc_gain()
+        l0 = c0 * g
+        value_db = -np.inf if np.isinf(l0) else db(1.0 / (1.0 + l0)) if l0 != -1 else np.inf
+        margin = self.max_db - value_db
+        source = "stated" if self.plant_gain is not None else "model DC"
+        if np.isinf(c0):
+            msg = (f"static sensitivity: integral action makes S(0) = 0 (-inf dB) <= {fmt(self.max_db)} dB: met")
+        else:
+            msg = (f"static sensitivity 1/(1 + C(0)*{fmt(g)}) = {value_db:.2f} dB "
+                   f"{'<=' if margin >= 0 else '>'} {fmt(self.max_db)} dB: "
+                   f"{'met' if margin >= 0 else 'NOT met'} ({source} plant gain {fmt(g)}, C(0) = {fmt(c0)})")
+        return self.result(value=value_db, bound=self.max_db, unit="dB", slack=margin * NEPER_PER_DB,
+                           margin=margin, binding_frequency=0.0, message=msg, plant_gain=g,
+                           controller_dc_gain=c0, minimum_dc_gain=(10 ** (-self.max_db / 20) - 1) / g)
+
+
+class _PeakRequirement(Requirement):
+    """Peak of a closed-loop magnitude over a band (default: all frequencies)."""
+
+    max_db: float
+    band: tuple[float, float] | None = None
+    symbol: ClassVar[str] = "|S|"
+
+    def curve(self, loop: Loop):  # pragma: no cover - overridden
+        raise NotImplementedError
+
+    def evaluate(self, loop: Loop, per_decade: int = 80) -> RequirementResult:
+        if self.band is not None:
+            BandMixin._check_band(self.band)
+            grid = band_grid(self.band, loop.frequency_range, per_decade)
+            where = _band_text(self.band)
+        else:
+            lo, hi = loop.frequency_range
+            grid = log_grid(lo, hi * 10, per_decade)
+            where = "over all frequencies"
+        value, w_peak = peak(self.curve(loop), grid)
+        value_db = db(value)
+        margin = self.max_db - value_db
+        msg = (f"peak {self.symbol} {where} is {value_db:.2f} dB at {fmt(w_peak)} rad/s "
+               f"{'<=' if margin >= 0 else '>'} {fmt(self.max_db)} dB: {'met' if margin >= 0 else 'NOT met'}")
+        return self.result(value=value_db, bound=self.max_db, unit="dB", slack=margin * NEPER_PER_DB,
+                           margin=margin, binding_frequency=w_peak, message=msg, linear_peak=value)
+
+
+@register
+class PeakSensitivity(_PeakRequirement):
+    """Peak ``|S|`` (Ms) at most ``max_db``.
+
+    Examples
+    --------
+    >>> from synth.loop import Loop; from synth.plant import Plant; from synth.controllers import Controller
+    >>> loop = Loop(Plant.from_string("1/(s+1)^3"), Controller("P", {"kp": 4.0}))
+    >>> r = PeakSensitivity(type="peak_sensitivity", max_db=6).evaluate(loop)
+    >>> round(r.value, 2), r.met
+    (9.54, False)
+    """
+
+    type: Literal["peak_sensitivity"] = "peak_sensitivity"
+    title: ClassVar[str] = "peak sensitivity"
+
+    def curve(self, loop: Loop):
+        return lambda w: np.abs(loop.S(w))
+
+
+@register
+class PeakComplementary(_PeakRequirement):
+    """Peak ``|T|`` (Mt) at most ``max_db``.
+
+    Examples
+    --------
+    >>> from synth.loop import Loop; from synth.plant import Plant; from synth.controllers import Controller
+    >>> loop = Loop(Plant.from_string("1/(s+1)^3"), Controller("P", {"kp": 4.0}))
+    >>> round(PeakComplementary(type="peak_complementary", max_db=3).evaluate(loop).value, 2)
+    7.66
+    """
+
+    type: Literal["peak_complementary"] = "peak_complementary"
+    symbol: ClassVar[str] = "|T|"
+    title: ClassVar[str] = "peak complementary sensitivity"
+
+    def curve(self, loop: Loop):
+        return lambda w: np.abs(loop.T(w))
+
+
+

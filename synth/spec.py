@@ -1,0 +1,437 @@
+"""Spec files: YAML, validated by pydantic, with one-line errors naming file, line and key.
+
+The schema is documented in ``docs/spec-format.md``. Loading is strict: an
+unknown key, a missing field, a string where a number belongs, a reversed
+band, an unparsable transfer function or an unknown type each raise a
+:class:`~synth.errors.SpecError` whose text is
+``<file>:<line>: <key path>: <what is wrong>``.
+"""
+
+from __future__ import annotations
+
+import difflib
+import json
+import re
+from pathlib import Path
+from typing import Annotated, Any, Union
+
+import numpy as np
+import yaml
+from pydantic import (
+    BaseModel,
+    ConfigDict,
+    Field,
+    NonNegativeFloat,
+    ValidationError,
+    ValidationInfo,
+    field_validator,
+    model_validator,
+)
+
+from synth.controllers import CONTROLLER_TYPES, Controller, controller_type
+from synth.errors import ModelError, SpecError
+from synth.objectives import MEASURES
+from synth.plant import Plant, Signal
+from synth.requirements import REQUIREMENT_TYPES
+
+_NAME = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.-]*$")
+
+
+class _Model(BaseModel):
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+
+class SignalSpec(_Model):
+    """Name and unit of a signal."""
+
+    name: str
+    unit: str = ""
+
+
+class PlantSpec(_Model):
+    """A plant given as a transfer-function string, with an optional extra delay."""
+
+    tf: str
+    delay: NonNegativeFloat = 0.0
+    input: SignalSpec = SignalSpec(name="u")
+    output: SignalSpec = SignalSpec(name="y")
+    label: str = "nominal"
+
+    @field_validator("tf")
+    @classmethod
+    def _parses(cls, text: str) -> str:
+        try:
+            Plant.from_string(text)
+        except ModelError as exc:
+            raise ValueError(exc.message) from None
+        return text
+
+    def build(self) -> Plant:
+        """The :class:`~synth.plant.Plant` this entry describes."""
+        return Plant.from_string(
+            self.tf, self.delay, Signal(self.input.name, self.input.unit),
+            Signal(self.output.name, self.output.unit), self.label,
+        )
+
+
+class ControllerSpec(_Model):
+    """Controller structure and parameter bounds (``[lo, hi]``; ``lo == hi`` fixes a parameter)."""
+
+    type: str
+    bounds: dict[str, tuple[float, float]] = Field(default_factory=dict)
+
+    @field_validator("type")
+    @classmethod
+    def _known_type(cls, name: str) -> str:
+        try:
+            return controller_type(name).name
+        except ModelError as exc:
+            raise ValueError(exc.message) from None
+
+    @field_validator("bounds")
+    @classmethod
+    def _check_bounds(cls, bounds: dict[str, tuple[float, float]], info: ValidationInfo):
+        if "type" not in info.data:
+            return bounds
+        ctype = CONTROLLER_TYPES[info.data["type"]]
+        for name, (lo, hi) in bounds.items():
+            if name not in ctype.parameters:
+                raise ValueError(
+                    f"{ctype.name} has no parameter {name!r}; its parameters are "
+                    f"{', '.join(ctype.parameters)}"
+                )
+            if not (np.isfinite(lo) and np.isfinite(hi)):
+                raise ValueError(f"{name}: bounds must be finite, got [{lo:g}, {hi:g}]")
+            if lo > hi:
+                raise ValueError(f"{name}: lower bound {lo:g} is above upper bound {hi:g}")
+            if name in ctype.positive and lo <= 0:
+                raise ValueError(f"{name}: {name} must stay > 0, got lower bound {lo:g}")
+        return bounds
+
+    def all_bounds(self) -> dict[str, tuple[float, float]]:
+        """Bounds for every parameter (defaults where the spec gives none)."""
+        ctype = CONTROLLER_TYPES[self.type]
+        return {p: tuple(self.bounds.get(p, ctype.default_bounds[p])) for p in ctype.parameters}
+
+    def free_parameters(self) -> list[str]:
+        """Parameters whose bounds leave room (``lo < hi``)."""
+        return [p for p, (lo, hi) in self.all_bounds().items() if lo < hi]
+
+
+class ObjectiveSpec(_Model):
+    """What to optimize: ``{maximize: name}`` or ``{minimize: name}``."""
+
+    maximize: str | None = None
+    minimize: str | None = None
+
+    @model_validator(mode="after")
+    def _exactly_one(self) -> ObjectiveSpec:
+        given = [v for v in (self.maximize, self.minimize) if v is not None]
+        if len(given) != 1:
+            raise ValueError("give exactly one of 'maximize' or 'minimize'")
+        if given[0] not in MEASURES:
+            raise ValueError(f"unknown objective {given[0]!r}; expected one of: {', '.join(MEASURES)}")
+        return self
+
+    @property
+    def name(self) -> str:
+        """The measure's name."""
+        return self.maximize or self.minimize  # type: ignore[return-value]
+
+    @property
+    def sense(self) -> str:
+        """``"maximize"`` or ``"minimize"``."""
+        return "maximize" if self.maximize else "minimize"
+
+
+class PublishedTF(_Model):
+    """A published transfer function to compare against (e.g. a paper's closed loop)."""
+
+    label: str
+    tf: str
+
+    @field_validator("tf")
+    @classmethod
+    def _parses(cls, text: str) -> str:
+        try:
+            Plant.from_string(text)
+        except ModelError as exc:
+            raise ValueError(exc.message) from None
+        return text
+
+
+class ReferenceSpec(_Model):
+    """Published numbers the report compares the design with (a paper, an earlier design)."""
+
+    source: str = ""
+    controller: str | None = None
+    closed_loop: list[PublishedTF] = Field(default_factory=list)
+    slew_rate_crossing: float | None = Field(default=None, gt=0)
+    rise_time: float | None = Field(default=None, gt=0)
+    bandwidth: float | None = Field(default=None, gt=0)
+    notes: list[str] = Field(default_factory=list)
+
+    @field_validator("controller")
+    @classmethod
+    def _parses(cls, text: str | None) -> str | None:
+        if text is not None:
+            try:
+                Controller.from_string(text)
+            except ModelError as exc:
+                raise ValueError(exc.message) from None
+        return text
+
+
+class AnalysisSpec(_Model):
+    """Extra analyses for the report."""
+
+    loop_delays: list[NonNegativeFloat] = Field(default_factory=lambda: [0.0, 0.005, 0.01, 0.015, 0.02])
+
+
+def _requirement_union() -> Any:
+    types = tuple(REQUIREMENT_TYPES.values())
+    return Annotated[Union[types], Field(discriminator="type")]  # type: ignore[valid-type]
+
+
+RequirementEntry = _requirement_union()
+
+
+class Spec(_Model):
+    """A design problem: plant, controller structure, requirements and objective.
+
+    Examples
+    --------
+    >>> spec = Spec.model_validate({
+    ...     "name": "demo", "plant": {"tf": "1/(s+1)"}, "controller": {"type": "P"},
+    ...     "requirements": [{"type": "bandwidth", "min": 2}]})
+    >>> spec.requirements[0].min
+    2.0
+    """
+
+    name: str
+    description: str = ""
+    plant: PlantSpec
+    controller: ControllerSpec
+    requirements: list[RequirementEntry] = Field(min_length=1)  # type: ignore[valid-type]
+    objective: ObjectiveSpec | None = None
+    reference: ReferenceSpec | None = None
+    analysis: AnalysisSpec = AnalysisSpec()
+
+    @field_validator("name")
+    @classmethod
+    def _safe_name(cls, name: str) -> str:
+        if not _NAME.match(name):
+            raise ValueError(
+                f"name {name!r} must start with a letter or digit and use only letters, digits, "
+                "'_', '-' or '.' (it names the report folder)"
+            )
+        return name
+
+    def plants(self) -> list[Plant]:
+        """Plants the requirements must hold on (the nominal plant)."""
+        return [self.plant.build()]
+
+    def nominal_plant(self) -> Plant:
+        """The nominal plant."""
+        return self.plant.build()
+
+
+# ------------------------------------------------------------------------------ loading
+class _Loader(yaml.SafeLoader):
+    """SafeLoader that also reads ``1e4`` (no dot) as a float, as people write it."""
+
+
+_Loader.add_implicit_resolver(
+    "tag:yaml.org,2002:float",
+    re.compile(
+        r"""^(?:[-+]?(?:[0-9][0-9_]*)\.[0-9_]*(?:[eE][-+]?[0-9]+)?
+        |[-+]?(?:[0-9][0-9_]*)(?:[eE][-+]?[0-9]+)
+        |\.[0-9_]+(?:[eE][-+]?[0-9]+)?
+        |[-+]?\.(?:inf|Inf|INF)
+        |\.(?:nan|NaN|NAN))$""",
+        re.X,
+    ),
+    list("-+0123456789."),
+)
+
+
+def _line_of(root: yaml.Node | None, loc: tuple[Any, ...]) -> int | None:
+    node = root
+    line = node.start_mark.line + 1 if node is not None else None
+    for key in loc:
+        if isinstance(node, yaml.MappingNode):
+            nxt = None
+            for k, v in node.value:
+                if isinstance(k, yaml.ScalarNode) and k.value == str(key):
+                    nxt, line = v, k.start_mark.line + 1
+                    break
+            if nxt is None:
+                break
+            node = nxt
+        elif isinstance(node, yaml.SequenceNode) and isinstance(key, int) and key < len(node.value):
+            node = node.value[key]
+            line = node.start_mark.line + 1
+        else:
+            break
+    return line
+
+
+def _clean_loc(loc: tuple[Any, ...]) -> tuple[Any, ...]:
+    out: list[Any] = []
+    for i, part in enumerate(loc):
+        if (
+            isinstance(part, str)
+            and i > 0
+            and isinstance(loc[i - 1], int)
+            and part in REQUIREMENT_TYPES
+        ):
+            continue  # discriminated-union tag inserted by pydantic
+        if isinstance(part, str) and ("[" in part or part.startswith("function-")):
+            continue
+        out.append(part)
+    return tuple(out)
+
+
+def _key_path(loc: tuple[Any, ...]) -> str:
+    text = ""
+    for part in loc:
+        text += f"[{part}]" if isinstance(part, int) else (f".{part}" if text else str(part))
+    return text or "(top level)"
+
+
+def _allowed_keys(loc: tuple[Any, ...], data: Any) -> list[str]:
+    """Keys the model at ``loc[:-1]`` accepts (for 'did you mean' hints)."""
+    model: Any = Spec
+    node = data
+    for part in loc[:-1]:
+        if isinstance(part, int):
+            node = node[part] if isinstance(node, list) and part < len(node) else None
+            if model == "requirements":
+                model = REQUIREMENT_TYPES.get(node.get("type")) if isinstance(node, dict) else None
+            continue
+        node = node.get(part) if isinstance(node, dict) else None
+        if model is Spec and part == "requirements":
+            model = "requirements"
+            continue
+        field = getattr(model, "model_fields", {}).get(part)
+        if field is None:
+            return []
+        candidates = [field.annotation, *getattr(field.annotation, "__args__", ())]
+        model = next((c for c in candidates if isinstance(c, type) and issubclass(c, BaseModel)), None)
+    fields = getattr(model, "model_fields", None)
+    return list(fields) if isinstance(fields, dict) else []
+
+
+def _message(err: dict[str, Any], data: Any, loc: tuple[Any, ...]) -> str:
+    kind = err["type"]
+    given = err.get("input")
+    if kind == "missing":
+        return "missing (required)"
+    if kind == "extra_forbidden":
+        allowed = [k for k in _allowed_keys(loc, data) if k != "type"]
+        near = difflib.get_close_matches(str(loc[-1]), allowed, n=1)
+        hint = f"; did you mean {near[0]!r}?" if near else (f"; allowed: {', '.join(allowed)}" if allowed else "")
+        return f"unknown key {loc[-1]!r}{hint}"
+    if kind == "union_tag_invalid":
+        return (f"unknown requirement type {err['ctx']['tag']!r}; expected one of: "
+                f"{', '.join(REQUIREMENT_TYPES)}")
+    if kind == "union_tag_not_found":
+        return f"requirement has no 'type'; expected one of: {', '.join(REQUIREMENT_TYPES)}"
+    if kind in {"float_type", "float_parsing", "int_type", "finite_number"}:
+        return f"expected a number, got {given!r}"
+    if kind in {"string_type"}:
+        return f"expected text, got {given!r}"
+    if kind in {"tuple_type", "list_type", "dict_type", "model_type"}:
+        what = {"tuple_type": "a list [low, high]", "list_type": "a list", "dict_type": "a mapping",
+                "model_type": "a mapping of keys"}[kind]
+        return f"expected {what}, got {given!r}"
+    if kind in {"too_short", "too_long"}:
+        if loc and loc[-1] == "requirements":
+            return "the requirement list is empty; give at least one requirement"
+        return f"expected exactly 2 numbers [low, high], got {given!r}"
+    if kind in {"greater_than", "greater_than_equal"}:
+        limit = err["ctx"].get("gt", err["ctx"].get("ge"))
+        return f"must be {'>' if kind == 'greater_than' else '>='} {limit}, got {given!r}"
+    msg = str(err.get("msg", "invalid value"))
+    return msg.removeprefix("Value error, ")
+
+
+def spec_error(exc: ValidationError, source: str, root: yaml.Node | None, data: Any) -> SpecError:
+    """Turn the first pydantic error into a one-line :class:`SpecError`."""
+    errors = exc.errors(include_url=False)
+    # a misspelled key shows up as "unknown key" plus "missing": the first says more
+    errors.sort(key=lambda e: e["type"] != "extra_forbidden")
+    err = errors[0]
+    loc = _clean_loc(tuple(err["loc"]))
+    if err["type"] in {"union_tag_invalid", "union_tag_not_found"}:
+        loc = (*loc, "type")
+    line = _line_of(root, loc)
+    where = f"{source}:{line}" if line else source
+    return SpecError(_message(err, data, loc), where=f"{where}: {_key_path(loc)}")
+
+
+def parse_spec(text: str, source: str = "<spec>") -> Spec:
+    """Validate spec text (YAML).
+
+    Examples
+    --------
+    >>> parse_spec("name: x\\nplant: {tf: '1/(s+1)'}\\ncontroller: {type: P}\\nrequirements: []")
+    Traceback (most recent call last):
+    ...
+    synth.errors.SpecError: <spec>:4: requirements: the requirement list is empty; give at least one requirement
+    """
+    try:
+        root = yaml.compose(text, Loader=_Loader)
+        data = yaml.load(text, Loader=_Loader)
+    except yaml.YAMLError as exc:
+        mark = getattr(exc, "problem_mark", None)
+        where = f"{source}:{mark.line + 1}" if mark is not None else source
+        problem = getattr(exc, "problem", None) or str(exc)
+        raise SpecError(f"invalid YAML: {problem}", where=where) from None
+    if data is None:
+        raise SpecError("the spec file is empty", where=source)
+    if not isinstance(data, dict):
+        raise SpecError("the spec must be a mapping of keys (name, plant, controller, ...)", where=source)
+    try:
+        return Spec.model_validate_json(json.dumps(data, default=str), strict=True)
+    except ValidationError as exc:
+        raise spec_error(exc, source, root, data) from None
+
+
+def load_spec(path: str | Path) -> Spec:
+    """Read and validate a spec file.
+
+    Parameters
+    ----------
+    path : str or Path
+        A YAML spec file (see ``docs/spec-format.md``).
+
+    Returns
+    -------
+    Spec
+
+    Raises
+    ------
+    SpecError
+        One line naming the file, line, key and problem.
+
+    Examples
+    --------
+    >>> import tempfile, os
+    >>> f = tempfile.NamedTemporaryFile("w", suffix=".yaml", delete=False)
+    >>> _ = f.write("name: demo\\nplant: {tf: '1/(s+1)'}\\ncontroller: {type: P}\\n"
+    ...             "requirements: [{type: bandwidth, min: 2}]\\n"); f.close()
+    >>> load_spec(f.name).controller.type
+    'P'
+    >>> os.unlink(f.name)
+    """
+    path = Path(path)
+    if not path.exists():
+        raise SpecError("spec file not found", where=str(path))
+    if path.is_dir():
+        raise SpecError("is a directory, not a spec file", where=str(path))
+    try:
+        text = path.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as exc:
+        raise SpecError(f"cannot read spec file: {exc}", where=str(path)) from None
+    return parse_spec(text, source=str(path))

@@ -1,0 +1,468 @@
+"""Closed-loop stability of a loop ``L(s) = num(s)/den(s) * exp(-delay*s)``, decided exactly.
+
+Without a delay the closed-loop poles are the roots of ``den + num``. With a
+delay the characteristic function ``den(s) + num(s) exp(-delay s)`` has
+infinitely many roots; the number in the closed right half-plane is counted
+with the argument principle (Nyquist): ``Z = P + W``, where ``P`` counts the
+open-loop poles in the open right half-plane and ``W`` the clockwise winding
+of ``1 + L(jw)`` about the origin. The winding is computed on an adaptively
+refined frequency path, with indentations around open-loop poles on the
+imaginary axis, up to the frequency where ``|L(jw)|`` has fallen below a level
+``r < 1`` for good (found exactly from a polynomial in ``w**2``); beyond it
+``1 + L`` stays in the right half-plane and adds no winding.
+
+:func:`affine_stability_intervals` finds every value of a real parameter
+``rho`` (the controller is ``C0 + rho*C1``) at which a closed-loop root
+crosses the imaginary axis (the D-decomposition), then tests one point
+between neighbouring boundaries: the result is the exact set of stabilizing
+values.
+"""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass
+from itertools import pairwise
+
+import numpy as np
+
+from synth.errors import ModelError
+from synth.polynomials import largest_crossing, trim
+
+_PHASE_STEP = np.pi / 8.0
+
+
+@dataclass(frozen=True)
+class StabilityResult:
+    """Outcome of a closed-loop stability test.
+
+    Attributes
+    ----------
+    stable : bool
+        True when every closed-loop root has a negative real part.
+    unstable_poles : int
+        Closed-loop roots in the closed right half-plane.
+    open_loop_unstable_poles : int
+        Open-loop poles in the open right half-plane (``P`` of the Nyquist count).
+    method : str
+        ``"polynomial roots"`` (no delay) or ``"Nyquist argument principle, exact delay"``.
+    marginal_frequency : float or None
+        Frequency (rad/s) of a closed-loop root on the imaginary axis, if any.
+    """
+
+    stable: bool
+    unstable_poles: int
+    open_loop_unstable_poles: int
+    method: str
+    marginal_frequency: float | None = None
+
+    def to_dict(self) -> dict:
+        """JSON-ready dict."""
+        return asdict(self)
+
+    def describe(self) -> str:
+        """One plain-language line.
+
+        Examples
+        --------
+        >>> closed_loop_stability(np.array([1.0]), np.array([1.0, 1.0])).describe()
+        'closed loop stable (polynomial roots)'
+        """
+        if self.stable:
+            return f"closed loop stable ({self.method})"
+        if self.marginal_frequency is not None:
+            return (f"closed loop marginally stable: a root on the imaginary axis near "
+                    f"{self.marginal_frequency:.4g} rad/s ({self.method})")
+        return f"closed loop UNSTABLE: {self.unstable_poles} root(s) in the right half-plane ({self.method})"
+
+
+def _characteristic_scale(*polys: np.ndarray, delay: float = 0.0) -> tuple[float, float]:
+    """Smallest and largest characteristic frequencies (rad/s): root magnitudes and 1/delay."""
+    mags = []
+    for p in polys:
+        p = trim(np.asarray(p, float))
+        if p.size > 1:
+            r = np.abs(np.roots(p))
+            mags.extend(r[r > 0].tolist())
+    if delay > 0:
+        mags.append(1.0 / delay)
+    if not mags:
+        return 1.0, 1.0
+    return float(min(mags)), float(max(mags))
+
+
+def _axis_poles(den: np.ndarray) -> tuple[int, int, list[tuple[float, int]]]:
+    """(open RHP pole count, poles at the origin, [(w_k > 0, multiplicity)])."""
+    den = trim(den)
+    n_origin = 0
+    while den.size > 1 and den[-1] == 0.0:
+        den = den[:-1]
+        n_origin += 1
+    roots = np.roots(den) if den.size > 1 else np.array([])
+    tol = 1e-9 * np.maximum(1.0, np.abs(roots))
+    on_axis = np.abs(roots.real) <= tol
+    n_rhp = int(np.sum((roots.real > 0) & ~on_axis))
+    axis = []
+    for r in roots[on_axis & (roots.imag > 0)]:
+        w = float(r.imag)
+        for i, (wk, m) in enumerate(axis):
+            if abs(wk - w) <= 1e-7 * max(1.0, w):
+                axis[i] = (wk, m + 1)
+                break
+        else:
+            axis.append((w, 1))
+    n_origin += int(np.sum(on_axis & (np.abs(roots.imag) <= tol)))
+    return n_rhp, n_origin, sorted(axis)
+
+
+class _ReturnDifference:
+    """F(s) = 1 + num(s)/den(s) * exp(-delay*s)."""
+
+    def __init__(self, num: np.ndarray, den: np.ndarray, delay: float) -> None:
+        self.num, self.den, self.delay = num, den, delay
+
+    def __call__(self, s: np.ndarray) -> np.ndarray:
+        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+            return 1.0 + np.polyval(self.num, s) / np.polyval(self.den, s) * np.exp(-self.delay * s)
+
+
+def _segment_phase(F: _ReturnDifference, a: float, b: float, delay: float) -> tuple[float, float]:
+    """Continuous phase change of F(jw) for w from a to b, and min |F| seen."""
+    pts = [np.linspace(a, b, max(3, int(np.ceil((b - a) * delay / _PHASE_STEP)) + 2))]
+    if a > 0:
+        pts.append(np.geomspace(a, b, max(3, int(40 * np.log10(b / a)) + 2)))
+    w = np.unique(np.concatenate(pts))
+    f = F(1j * w)
+    for _ in range(60):
+        ratio = f[1:] / f[:-1]
+        step = np.abs(np.angle(ratio))
+        chord = np.abs(f[1:] - f[:-1])
+        bad = (step > _PHASE_STEP) | (chord > 0.5 * np.minimum(np.abs(f[1:]), np.abs(f[:-1])))
+        if not np.any(bad) or w.size > 2_000_000:
+            break
+        idx = np.flatnonzero(bad)
+        lo, hi = w[idx], w[idx + 1]
+        mid = np.where(lo > 0, np.sqrt(lo * np.maximum(hi, lo)), 0.5 * (lo + hi))
+        mid = np.where((mid <= lo) | (mid >= hi), 0.5 * (lo + hi), mid)
+        w = np.insert(w, idx + 1, mid)
+        f = np.insert(f, idx + 1, F(1j * mid))
+    return float(np.sum(np.angle(f[1:] / f[:-1]))), float(np.min(np.abs(f)))
+
+
+def _indentation_phase(F: _ReturnDifference, center: float, radius: float) -> float:
+    """Phase change of F along the right half-circle around j*center, upward."""
+    phi = np.linspace(-np.pi / 2, np.pi / 2, 721)
+    f = F(1j * center + radius * np.exp(1j * phi))
+    return float(np.sum(np.angle(f[1:] / f[:-1])))
+
+
+def closed_loop_stability(num: np.ndarray, den: np.ndarray, delay: float = 0.0) -> StabilityResult:
+    """Decide closed-loop stability of unity negative feedback around ``L = num/den * exp(-delay s)``.
+
+    Parameters
+    ----------
+    num, den : ndarray
+        Loop numerator and denominator (descending powers of ``s``).
+    delay : float
+        Loop delay in seconds.
+
+    Returns
+    -------
+    StabilityResult
+
+    Raises
+    ------
+    ModelError
+        For an improper loop, or a biproper loop with a delay and
+        ``|L(j inf)| >= 1`` (a neutral-type loop, not stable in any useful sense).
+
+    Examples
+    --------
+    Integrator with a delay, ``L = k exp(-tau s)/s``, is stable iff ``k tau < pi/2``:
+
+    >>> closed_loop_stability(np.array([1.5]), np.array([1.0, 0.0]), delay=1.0).stable
+    True
+    >>> closed_loop_stability(np.array([1.6]), np.array([1.0, 0.0]), delay=1.0).stable
+    False
+    """
+    num, den = trim(np.asarray(num, float)), trim(np.asarray(den, float))
+    if num.size > den.size:
+        raise ModelError("loop transfer function is improper")
+    n_rhp, n_origin, axis = _axis_poles(den)
+    if delay <= 0.0:
+        char = np.polyadd(den, num)
+        if char.size < den.size or char[0] == 0.0:
+            raise ModelError("closed loop is improper (1 + L has lost its leading term)")
+        roots = np.roots(trim(char))
+        tol = 1e-9 * np.maximum(1.0, np.abs(roots))
+        n_bad = int(np.sum(roots.real >= -tol))
+        marginal = roots[np.abs(roots.real) < tol]
+        return StabilityResult(
+            n_bad == 0, n_bad, n_rhp, "polynomial roots",
+            float(np.abs(marginal[0].imag)) if marginal.size else None,
+        )
+
+    c_inf = num[0] / den[0] if num.size == den.size else 0.0
+    if abs(c_inf) >= 1.0:
+        raise ModelError(
+            f"loop with a delay has |L(j inf)| = {abs(c_inf):.3g} >= 1 (neutral type): "
+            "closed-loop stability is not robust to any delay; make the loop strictly proper"
+        )
+    level = max(0.5, 0.5 * (1.0 + abs(c_inf)))
+    w_lo_scale, _ = _characteristic_scale(num, den, delay=delay)
+    w_top = largest_crossing(num, den, level)
+    axis_max = max((w for w, _ in axis), default=0.0)
+    w_top = max(w_top * 1.05, 2.0 * axis_max, 1e-3 * w_lo_scale)
+
+    F = _ReturnDifference(num, den, delay)
+    eps0 = 1e-6 * w_lo_scale
+    total_half = 0.0
+    min_f = np.inf
+    start = eps0 if n_origin else 0.0
+    for wk, _m in axis:
+        eps = 1e-6 * min(w_lo_scale, wk)
+        dphi, mf = _segment_phase(F, start, wk - eps, delay)
+        total_half += dphi + _indentation_phase(F, wk, eps)
+        min_f = min(min_f, mf)
+        start = wk + eps
+    dphi, mf = _segment_phase(F, start, w_top, delay)
+    total_half += dphi
+    min_f = min(min_f, mf)
+    total_half += -float(np.angle(F(np.array([1j * w_top]))[0]))  # tail: F -> right half-plane
+    total = 2.0 * total_half
+    if n_origin:
+        total += _indentation_phase(F, 0.0, eps0)
+    winding = -total / (2.0 * np.pi)
+    n_closed = round(winding) + n_rhp
+    if abs(winding - round(winding)) > 0.1 or n_closed < 0:
+        raise RuntimeError(f"Nyquist count failed to converge (winding {winding:.3f})")
+    marginal = None
+    if min_f < 1e-9:
+        marginal = _marginal_frequency(F, w_top)
+    stable = n_closed == 0 and marginal is None
+    return StabilityResult(stable, n_closed, n_rhp, "Nyquist argument principle, exact delay", marginal)
+
+
+def _marginal_frequency(F: _ReturnDifference, w_top: float) -> float:
+    w = np.geomspace(1e-6 * w_top, w_top, 20000)
+    return float(w[np.argmin(np.abs(F(1j * w)))])
+
+
+# --------------------------------------------------------------------------- D-decomposition
+Rational = tuple[np.ndarray, np.ndarray]
+
+
+@dataclass(frozen=True)
+class StabilityInterval:
+    """A closed interval of a parameter over which the closed loop is stable.
+
+    ``lo_is_boundary`` / ``hi_is_boundary`` tell whether the end is a
+    stability boundary (a closed-loop root on the imaginary axis, excluded)
+    rather than the end of the searched range.
+    """
+
+    lo: float
+    hi: float
+    lo_is_boundary: bool
+    hi_is_boundary: bool
+    lo_frequency: float | None = None
+    hi_frequency: float | None = None
+
+
+def _boundary_function(c0: Rational | None, c1: Rational, num: np.ndarray, den: np.ndarray, delay: float):
+    a1, b1 = c1
+    a0, b0 = c0 if c0 is not None else (np.array([0.0]), np.array([1.0]))
+
+    def parts(w: np.ndarray):
+        s = 1j * np.asarray(w, dtype=float)
+        e = np.exp(-delay * s)
+        n, d = np.polyval(num, s), np.polyval(den, s)
+        X = np.polyval(b0, s) * d + np.polyval(a0, s) * n * e
+        Y = np.polyval(b0, s) * d
+        U = np.polyval(a1, s) * n * e
+        V = np.polyval(b1, s) * d
+        return X * V, Y * U
+
+    def h(w: np.ndarray) -> np.ndarray:
+        top, bottom = parts(w)
+        return np.imag(top * np.conj(bottom))
+
+    def rho(w: np.ndarray) -> np.ndarray:
+        top, bottom = parts(np.atleast_1d(np.asarray(w, dtype=float)))
+        with np.errstate(divide="ignore", invalid="ignore"):
+            return np.where(np.abs(bottom) < 1e-300, np.inf, np.real(-top / bottom))
+
+    return h, rho
+
+
+def stability_boundaries(
+    c0: Rational | None,
+    c1: Rational,
+    num: np.ndarray,
+    den: np.ndarray,
+    delay: float,
+    rho_max: float,
+) -> list[tuple[float, float]]:
+    """Values ``rho`` (with their frequencies) where ``1 + (C0 + rho C1) G`` has a root on the axis.
+
+    ``G = num/den * exp(-delay s)``; only ``|rho| <= rho_max`` is searched.
+
+    Examples
+    --------
+    For ``G = 1/(s+1)^3`` the gain ``rho = 8`` puts roots at ``+-j sqrt(3)``:
+
+    >>> [(round(r, 6), round(w, 6)) for r, w in stability_boundaries(
+    ...     None, (np.array([1.0]), np.array([1.0])), np.array([1.0]),
+    ...     np.array([1.0, 3.0, 3.0, 1.0]), 0.0, 100.0)]
+    [(-1.0, 0.0), (8.0, 1.732051)]
+    """
+    a1, b1 = c1
+    a0, b0 = c0 if c0 is not None else (np.array([0.0]), np.array([1.0]))
+    h, rho = _boundary_function(c0, c1, num, den, delay)
+    loop0_num, loop0_den = np.polymul(a0, num), np.polymul(b0, den)
+    loop1_num, loop1_den = np.polymul(a1, num), np.polymul(b1, den)
+    w_a = largest_crossing(loop0_num, loop0_den, 0.5) if np.any(a0 != 0) else 0.0
+    w_b = largest_crossing(loop1_num, loop1_den, 0.5 / max(rho_max, 1e-300))
+    lo_scale, hi_scale = _characteristic_scale(a0, b0, a1, b1, num, den, delay=delay)
+    w_max = max(w_a, w_b, hi_scale) * 1.2
+    w_min = 1e-4 * lo_scale
+    grid = [np.geomspace(w_min, w_max, int(100 * np.log10(w_max / w_min)) + 2)]
+    if delay > 0:
+        grid.append(np.linspace(0.0, w_max, int(np.ceil(w_max * delay / _PHASE_STEP)) + 2)[1:])
+    w = np.unique(np.concatenate(grid))
+    hv = h(w)
+    scale = np.max(np.abs(hv)) if hv.size else 1.0
+    sign = np.sign(hv)
+    idx = np.flatnonzero(sign[:-1] * sign[1:] < 0)
+    exact = np.flatnonzero((sign == 0) & (np.arange(sign.size) > 0) & (np.abs(hv) <= 1e-14 * scale))
+    w_cross = np.concatenate([[0.0], bisect_roots(h, w[idx], w[idx + 1]), w[exact]])
+    r_cross = rho(w_cross)
+    keep = np.isfinite(r_cross) & (np.abs(r_cross) <= rho_max)
+    return sorted(zip(r_cross[keep].tolist(), w_cross[keep].tolist()))
+
+
+def bisect_roots(f, lo: np.ndarray, hi: np.ndarray, iterations: int = 60) -> np.ndarray:
+    """Refine many sign-change brackets ``[lo, hi]`` of a vectorized ``f`` at once.
+
+    Examples
+    --------
+    >>> float(bisect_roots(lambda x: x**2 - 2.0, np.array([1.0]), np.array([2.0]))[0])
+    1.414213562373095
+    """
+    lo = np.array(lo, dtype=float)
+    hi = np.array(hi, dtype=float)
+    if lo.size == 0:
+        return lo
+    f_lo = f(lo)
+    for _ in range(iterations):
+        mid = 0.5 * (lo + hi)
+        f_mid = f(mid)
+        left = np.sign(f_mid) == np.sign(f_lo)
+        lo = np.where(left, mid, lo)
+        f_lo = np.where(left, f_mid, f_lo)
+        hi = np.where(left, hi, mid)
+        if np.all(hi - lo <= 1e-14 * np.maximum(1.0, np.abs(hi))):
+            break
+    return 0.5 * (lo + hi)
+
+
+def _combine(c0: Rational | None, c1: Rational, rho: float) -> Rational:
+    a1, b1 = c1
+    if c0 is None:
+        return rho * np.asarray(a1, float), np.asarray(b1, float)
+    a0, b0 = c0
+    return np.polyadd(np.polymul(a0, b1), rho * np.polymul(a1, b0)), np.polymul(b0, b1)
+
+
+def affine_stability_intervals(
+    c0: Rational | None,
+    c1: Rational,
+    num: np.ndarray,
+    den: np.ndarray,
+    delay: float,
+    lo: float,
+    hi: float,
+) -> list[StabilityInterval]:
+    """Exact stabilizing set of ``rho`` in ``[lo, hi]`` for the controller ``C0 + rho C1``.
+
+    Parameters
+    ----------
+    c0 : (num, den) or None
+        Fixed part of the controller (None for zero).
+    c1 : (num, den)
+        Part multiplied by ``rho``.
+    num, den, delay
+        Plant rational part and delay.
+    lo, hi : float
+        Range searched.
+
+    Returns
+    -------
+    list of StabilityInterval
+
+    Examples
+    --------
+    The X-4 rotor plant with a 20 ms in-loop delay under P control:
+
+    >>> from synth.plant import Plant
+    >>> G = Plant.from_string("23*(s+0.43)/((s+9.6)*(s+0.54))", delay=0.02)
+    >>> iv = affine_stability_intervals(None, (np.array([1.0]), np.array([1.0])),
+    ...                                 G.num, G.den, G.delay, 0.0, 20.0)
+    >>> [(round(i.lo, 3), round(i.hi, 3)) for i in iv]
+    [(0.0, 3.688)]
+    """
+    if hi < lo:
+        raise ModelError(f"range [{lo}, {hi}] is reversed")
+    rho_max = max(abs(lo), abs(hi)) * 1.0001 + 1e-12
+    bounds = stability_boundaries(c0, c1, num, den, delay, rho_max)
+    cuts = sorted({lo, hi, *[r for r, _ in bounds if lo < r < hi]})
+    freq = {r: w for r, w in bounds}
+    pieces: list[StabilityInterval] = []
+
+    def stable_at(r: float) -> bool:
+        cn, cd = _combine(c0, c1, r)
+        ln, ld = np.polymul(cn, num), np.polymul(cd, den)
+        if np.all(ln == 0):
+            return bool(np.all(np.roots(trim(den)).real < 0)) if trim(den).size > 1 else True
+        return closed_loop_stability(ln, ld, delay).stable
+
+    for a, b in pairwise(cuts) if len(cuts) > 1 else [(lo, hi)]:
+        if not stable_at(0.5 * (a + b)):
+            continue
+        if pieces and pieces[-1].hi == a:
+            # stable on both sides of a boundary the loop only touches: one interval
+            prev = pieces.pop()
+            pieces.append(StabilityInterval(prev.lo, b, prev.lo_is_boundary, b in freq,
+                                            prev.lo_frequency, freq.get(b)))
+        else:
+            pieces.append(StabilityInterval(a, b, a in freq, b in freq, freq.get(a), freq.get(b)))
+    return pieces
+
+
+GAIN_SEARCH_LIMIT = 1e4
+"""Loop-gain factors beyond this (80 dB) are reported as infinite gain margin."""
+
+
+def gain_margin_factors(
+    num: np.ndarray, den: np.ndarray, delay: float
+) -> tuple[float, float, float | None, float | None]:
+    """Scalar loop-gain factors ``(k_lo, k_hi)`` bracketing ``k = 1`` at which ``k L`` turns marginal.
+
+    Returns ``(k_lo, k_hi, w_lo, w_hi)`` with the frequencies of the axis roots;
+    ``k_lo = 0`` and ``k_hi = inf`` when no such gain exists within a factor
+    :data:`GAIN_SEARCH_LIMIT` (80 dB). Only meaningful for a stable loop:
+    ``20 log10(k_hi)`` is the classical gain margin.
+
+    Examples
+    --------
+    >>> k_lo, k_hi, _, w = gain_margin_factors(np.array([1.0]), np.array([1.0, 3.0, 3.0, 1.0]), 0.0)
+    >>> round(k_hi, 6), round(w, 4)
+    (8.0, 1.7321)
+    """
+    bounds = stability_boundaries(None, (num, den), np.array([1.0]), np.array([1.0]), delay,
+                                  GAIN_SEARCH_LIMIT)
+    pos = [(r, w) for r, w in bounds if r > 0]
+    above = [(r, w) for r, w in pos if r > 1.0 + 1e-12]
+    below = [(r, w) for r, w in pos if r < 1.0 - 1e-12 and r > 1.0 / GAIN_SEARCH_LIMIT]
+    k_hi, w_hi = min(above) if above else (np.inf, None)
+    k_lo, w_lo = max(below) if below else (0.0, None)
+    return float(k_lo), float(k_hi), w_lo, w_hi

@@ -1,0 +1,179 @@
+"""Linear closed-loop step responses and step metrics.
+
+Without a delay the response of ``T`` is computed exactly (matrix exponential
+of the closed-loop state-space model at each sample time). With a delay the
+loop is simulated on a fine grid whose step divides the delay, the plant and
+controller held constant over each step (zero-order hold); the error is of
+the order of the step and the step is reported.
+"""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass
+
+import numpy as np
+from scipy.signal import cont2discrete, lti, tf2ss
+
+from synth.loop import Loop
+from synth.polynomials import trim
+
+
+@dataclass(frozen=True)
+class StepMetrics:
+    """Step-response metrics.
+
+    Attributes
+    ----------
+    rise_time : float
+        10 % to 90 % of the change to the final value (s).
+    overshoot : float
+        Peak beyond the final value, percent of the change.
+    settling_time : float
+        Last time the response is outside +-2 % of the change around the final value (s).
+    final_value : float
+        Final value used.
+    peak : float
+        Largest excursion in the direction of the step.
+    """
+
+    rise_time: float
+    overshoot: float
+    settling_time: float
+    final_value: float
+    peak: float
+
+    def to_dict(self) -> dict:
+        """JSON-ready dict."""
+        return asdict(self)
+
+
+def step_metrics(t: np.ndarray, y: np.ndarray, y0: float = 0.0, y_final: float | None = None,
+                 settle_band: float = 0.02) -> StepMetrics:
+    """Rise time (10-90 %), overshoot, settling time of a step response.
+
+    Parameters
+    ----------
+    t, y : ndarray
+        Time (s) and response.
+    y0 : float
+        Value before the step.
+    y_final : float, optional
+        Final value (default: the last sample).
+    settle_band : float
+        Settling band as a fraction of the change.
+
+    Examples
+    --------
+    >>> t = np.linspace(0, 10, 10001)
+    >>> m = step_metrics(t, 1 - np.exp(-t))
+    >>> round(m.rise_time, 3), round(m.settling_time, 2)
+    (2.197, 3.91)
+    """
+    t = np.asarray(t, float)
+    y = np.asarray(y, float)
+    yf = float(y[-1]) if y_final is None else float(y_final)
+    change = yf - y0
+    if change == 0 or not np.isfinite(change):
+        return StepMetrics(float("nan"), float("nan"), float("nan"), yf, float(y.max()))
+    frac = (y - y0) / change
+
+    def first_cross(level: float) -> float:
+        idx = np.flatnonzero(frac >= level)
+        if idx.size == 0:
+            return float("nan")
+        i = int(idx[0])
+        if i == 0:
+            return float(t[0])
+        f0, f1 = frac[i - 1], frac[i]
+        return float(t[i - 1] + (level - f0) / (f1 - f0) * (t[i] - t[i - 1]))
+
+    rise = first_cross(0.9) - first_cross(0.1)
+    peak_frac = float(np.max(frac))
+    overshoot = max(0.0, (peak_frac - 1.0) * 100.0)
+    outside = np.flatnonzero(np.abs(frac - 1.0) > settle_band)
+    if outside.size == 0:
+        settling = float(t[0])
+    elif outside[-1] == t.size - 1:
+        settling = float("nan")
+    else:
+        settling = float(t[outside[-1] + 1])
+    return StepMetrics(rise, overshoot, settling, yf, float(y0 + peak_frac * change))
+
+
+def default_horizon(loop: Loop) -> float:
+    """A time span that shows the dominant closed-loop dynamics: 12 time constants of the fastest
+    dominant pole, at least 20 delays."""
+    poles = loop.closed_loop_poles()
+    fast = [abs(p.real) for p in poles if p.real < 0]
+    span = 12.0 / max(fast) if fast else 1.0
+    dominant = sorted(fast)
+    if len(dominant) > 1 and dominant[-1] / dominant[0] > 50:
+        span = 12.0 / dominant[-1]
+    return max(span, 20 * loop.delay, 1e-3)
+
+
+def step_response(loop: Loop, t_end: float | None = None, n: int = 2001) -> tuple[np.ndarray, np.ndarray, float]:
+    """Response of the output to a unit reference step.
+
+    Returns
+    -------
+    t, y : ndarray
+    dt : float
+        Simulation step with a delay (0 when the response is exact).
+
+    Examples
+    --------
+    >>> from synth.plant import Plant; from synth.controllers import Controller
+    >>> loop = Loop(Plant.from_string("23*(s+0.43)/((s+9.6)*(s+0.54))"), Controller("P", {"kp": 3.0}))
+    >>> t, y, dt = step_response(loop, 0.2)
+    >>> round(step_metrics(t, y, y_final=loop.T0()).rise_time, 4)
+    0.025
+    """
+    t_end = default_horizon(loop) if t_end is None else float(t_end)
+    t = np.linspace(0.0, t_end, n)
+    if loop.delay == 0.0:
+        num = loop.num
+        den = trim(np.polyadd(loop.den, loop.num))
+        _, y = lti(num, den).step(T=t)
+        return t, np.asarray(y, float), 0.0
+    return _delayed_step(loop, t_end, n)
+
+
+def _delayed_step(loop: Loop, t_end: float, n: int) -> tuple[np.ndarray, np.ndarray, float]:
+    dt_target = t_end / 20000
+    if loop.delay >= dt_target:
+        m = int(np.ceil(loop.delay / dt_target))
+        dt = loop.delay / m
+    else:  # a delay shorter than the step: one step of delay (error of order dt)
+        m, dt = 1, dt_target
+    steps = int(np.ceil(t_end / dt))
+    cn, cd = loop.controller.tf()
+    Ac, Bc, Cc, Dc = _zoh(cn, cd, dt)
+    Ap, Bp, Cp, Dp = _zoh(loop.plant.num, loop.plant.den, dt)
+    xc = np.zeros(Ac.shape[0])
+    xp = np.zeros(Ap.shape[0])
+    buffer = np.zeros(m)  # u[k - m] is read at step k
+    y_hist = np.empty(steps + 1)
+    for k in range(steps + 1):
+        u_delayed = buffer[k % m]
+        y = (float(Cp @ xp) if Ap.size else 0.0) + Dp * u_delayed
+        y_hist[k] = y
+        e = 1.0 - y
+        u = (float(Cc @ xc) if Ac.size else 0.0) + Dc * e
+        if Ac.size:
+            xc = Ac @ xc + Bc * e
+        if Ap.size:
+            xp = Ap @ xp + Bp * u_delayed
+        buffer[k % m] = u
+    t_sim = np.arange(steps + 1) * dt
+    t = np.linspace(0.0, t_end, n)
+    return t, np.interp(t, t_sim, y_hist), dt
+
+
+def _zoh(num: np.ndarray, den: np.ndarray, dt: float):
+    num, den = trim(num), trim(den)
+    if den.size == 1:
+        return np.zeros((0, 0)), np.zeros(0), np.zeros(0), float(num[-1] / den[0])
+    A, B, C, D = tf2ss(num, den)
+    Ad, Bd, Cd, Dd, _ = cont2discrete((A, B, C, D), dt, method="zoh")
+    return Ad, Bd[:, 0], Cd[0], float(Dd[0, 0])

@@ -1,0 +1,45 @@
+"""Test helpers: the shared data folder, and running the CLI in-process."""
+
+from __future__ import annotations
+
+import io
+import os
+from contextlib import redirect_stderr, redirect_stdout
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+SHARED = Path(os.environ.get("SYNTH_SHARED", ROOT.parent / "shared"))
+X4_PLANT = "23*(s+0.43)/((s+9.6)*(s+0.54))"
+
+
+def shared_path(*parts: str) -> Path:
+    """Path inside ../shared, skipping the test with a clear reason if it is absent."""
+    path = SHARED.joinpath(*parts)
+    if not path.exists():
+        pytest.skip(f"needs the shared data folder {path} (present in CI and the dev workspace, "
+                    "absent in a plain clone); set SYNTH_SHARED to point elsewhere")
+    return path
+
+
+class CliResult:
+    def __init__(self, code: int, out: str, err: str) -> None:
+        self.code, self.out, self.err = code, out, err
+
+
+@pytest.fixture
+def run_cli():
+    """Run ``synth ARGS`` in-process; returns exit code, stdout, stderr."""
+    from synth.cli import main
+
+    def run(*args: str) -> CliResult:
+        out, err = io.StringIO(), io.StringIO()
+        with redirect_stdout(out), redirect_stderr(err):
+            try:
+                code = main(list(args))
+            except SystemExit as exc:  # argparse
+                code = int(exc.code or 0)
+        return CliResult(code, out.getvalue(), err.getvalue())
+
+    return run
