@@ -48,14 +48,65 @@ class SignalSpec(_Model):
     unit: str = ""
 
 
+class VariantSpec(_Model):
+    """A plant variant the requirements must also hold on (e.g. a battery state).
+
+    ``gain`` scales the nominal plant; ``tf`` replaces its rational part and
+    ``delay`` its delay. At least one must be given.
+    """
+
+    label: str
+    gain: float | None = Field(default=None, gt=0)
+    tf: str | None = None
+    delay: NonNegativeFloat | None = None
+
+    @field_validator("tf")
+    @classmethod
+    def _parses(cls, text: str | None) -> str | None:
+        if text is not None:
+            try:
+                Plant.from_string(text)
+            except ModelError as exc:
+                raise ValueError(exc.message) from None
+        return text
+
+    @model_validator(mode="after")
+    def _something(self) -> VariantSpec:
+        if self.gain is None and self.tf is None and self.delay is None:
+            raise ValueError("a variant needs at least one of gain, tf, delay")
+        return self
+
+    def build(self, nominal: Plant) -> Plant:
+        """The variant plant derived from ``nominal``."""
+        base = nominal
+        if self.tf is not None:
+            parsed = Plant.from_string(self.tf)
+            base = Plant(parsed.num, parsed.den, nominal.delay + parsed.delay, nominal.input, nominal.output)
+        if self.delay is not None:
+            base = base.with_delay(self.delay)
+        if self.gain is not None:
+            base = base.scaled(self.gain)
+        return Plant(base.num, base.den, base.delay, nominal.input, nominal.output, self.label)
+
+
 class PlantSpec(_Model):
-    """A plant given as a transfer-function string, with an optional extra delay."""
+    """A plant given as a transfer-function string, with an optional extra delay and variants."""
 
     tf: str
     delay: NonNegativeFloat = 0.0
     input: SignalSpec = SignalSpec(name="u")
     output: SignalSpec = SignalSpec(name="y")
     label: str = "nominal"
+    variants: list[VariantSpec] = Field(default_factory=list)
+
+    @field_validator("variants")
+    @classmethod
+    def _unique_labels(cls, variants: list[VariantSpec], info: ValidationInfo) -> list[VariantSpec]:
+        labels = [info.data.get("label", "nominal")] + [v.label for v in variants]
+        dupes = sorted({x for x in labels if labels.count(x) > 1})
+        if dupes:
+            raise ValueError(f"plant labels must be unique; repeated: {', '.join(dupes)}")
+        return variants
 
     @field_validator("tf")
     @classmethod
@@ -67,11 +118,16 @@ class PlantSpec(_Model):
         return text
 
     def build(self) -> Plant:
-        """The :class:`~synth.plant.Plant` this entry describes."""
+        """The nominal :class:`~synth.plant.Plant` this entry describes."""
         return Plant.from_string(
             self.tf, self.delay, Signal(self.input.name, self.input.unit),
             Signal(self.output.name, self.output.unit), self.label,
         )
+
+    def build_all(self) -> list[Plant]:
+        """The nominal plant followed by every variant."""
+        nominal = self.build()
+        return [nominal] + [v.build(nominal) for v in self.variants]
 
 
 class ControllerSpec(_Model):
@@ -228,8 +284,8 @@ class Spec(_Model):
         return name
 
     def plants(self) -> list[Plant]:
-        """Plants the requirements must hold on (the nominal plant)."""
-        return [self.plant.build()]
+        """Plants the requirements must hold on: the nominal plant, then every variant."""
+        return self.plant.build_all()
 
     def nominal_plant(self) -> Plant:
         """The nominal plant."""

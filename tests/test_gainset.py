@@ -99,3 +99,36 @@ requirements:
     brute = np.array([check(spec, f"PID(1, 2, 0.05, {t})").feasible for t in ts])
     exact = np.array([gs.contains(t) for t in ts])
     assert np.mean(brute == exact) > 0.98
+
+
+def test_plant_variants_take_the_worst_case():
+    spec = parse_spec(f"""
+name: robust
+plant:
+  tf: "{X4_PLANT}"
+  variants:
+    - {{label: low battery, gain: 0.85}}
+    - {{label: full battery, gain: 1.1}}
+controller: {{type: P, bounds: {{kp: [0, 20]}}}}
+requirements:
+  - {{type: sensitivity_static, max_db: -15}}
+""")
+    assert [p.label for p in spec.plants()] == ["nominal", "low battery", "full battery"]
+    res = check(spec, "P(3)")
+    assert res.requirements[1].plant == "low battery"  # lowest gain binds the static sensitivity
+    gs = feasible_gain_set(list(spec.requirements), spec.plants(), ScalarFamily("P", "kp", {}), (0, 20))
+    g_low = 0.85 * 23 * 0.43 / (9.6 * 0.54)
+    assert gs.intervals[0].lo == pytest.approx((10 ** 0.75 - 1) / g_low, rel=1e-9)
+
+
+def test_variant_validation(run_cli, tmp_path):
+    bad = tmp_path / "bad.yaml"
+    bad.write_text(f"""name: v
+plant:
+  tf: "{X4_PLANT}"
+  variants: [{{label: nominal, gain: 2}}]
+controller: {{type: P}}
+requirements: [{{type: bandwidth, min: 1}}]
+""")
+    res = run_cli("check", str(bad), "--controller", "P(1)")
+    assert res.code == 2 and "plant labels must be unique; repeated: nominal" in res.err
