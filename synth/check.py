@@ -12,7 +12,6 @@ from synth.loop import Loop
 from synth.plant import Plant
 from synth.requirements.base import Requirement, RequirementResult, fmt
 from synth.spec import Spec
-from synth.stability import gain_margin_factors
 
 
 @dataclass
@@ -73,7 +72,7 @@ def stability_result(loop: Loop) -> RequirementResult:
     """
     st = loop.stability()
     if st.stable:
-        k_lo, k_hi, w_lo, w_hi = gain_margin_factors(loop.num, loop.den, loop.delay)
+        k_lo, k_hi, w_lo, w_hi = loop.gain_factors
         up = np.log(k_hi) if np.isfinite(k_hi) else np.inf
         down = -np.log(k_lo) if k_lo > 0 else np.inf
         slack = min(up, down)

@@ -178,6 +178,11 @@ class Loop:
         """Exact closed-loop stability (Nyquist count with the delay)."""
         return self._stability
 
+    @cached_property
+    def gain_factors(self) -> tuple[float, float, float | None, float | None]:
+        """``(k_lo, k_hi, w_lo, w_hi)`` of :func:`synth.stability.gain_margin_factors` (cached)."""
+        return gain_margin_factors(self.num, self.den, self.delay)
+
     def margins(self) -> Margins:
         """Gain, phase and delay margins, delay included.
 
@@ -188,7 +193,7 @@ class Loop:
         >>> round(m.gain_margin_db, 2), round(m.phase_crossover, 2)
         (1.79, 84.28)
         """
-        k_lo, k_hi, _, w_hi = gain_margin_factors(self.num, self.den, self.delay)
+        k_lo, k_hi, _, w_hi = self.gain_factors
         gm = 20 * np.log10(k_hi) if np.isfinite(k_hi) else np.inf
         lgm = 20 * np.log10(k_lo) if k_lo > 0 else -np.inf
         pm, wpm, dm = np.inf, None, np.inf

@@ -458,10 +458,16 @@ def gain_margin_factors(
     >>> round(k_hi, 6), round(w, 4)
     (8.0, 1.7321)
     """
-    bounds = stability_boundaries(None, (num, den), np.array([1.0]), np.array([1.0]), delay,
-                                  GAIN_SEARCH_LIMIT)
-    pos = [(r, w) for r, w in bounds if r > 0]
-    above = [(r, w) for r, w in pos if r > 1.0 + 1e-12]
+    # At a boundary |rho| = 1/|L(jw)|: a search up to |rho| = cap finds every boundary below cap,
+    # so widen the cap tenfold until a gain above 1 turns up (most loops stop at the first step).
+    cap = 10.0
+    while True:
+        bounds = stability_boundaries(None, (num, den), np.array([1.0]), np.array([1.0]), delay, cap)
+        pos = [(r, w) for r, w in bounds if r > 0]
+        above = [(r, w) for r, w in pos if r > 1.0 + 1e-12]
+        if above or cap >= GAIN_SEARCH_LIMIT:
+            break
+        cap = min(cap * 10.0, GAIN_SEARCH_LIMIT)
     below = [(r, w) for r, w in pos if r < 1.0 - 1e-12 and r > 1.0 / GAIN_SEARCH_LIMIT]
     k_hi, w_hi = min(above) if above else (np.inf, None)
     k_lo, w_lo = max(below) if below else (0.0, None)
