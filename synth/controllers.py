@@ -240,8 +240,12 @@ class Controller:
         inf
         """
         num, den = self.tf()
+        if not np.any(num):
+            return 0.0
+        while num.size > 1 and den.size > 1 and num[-1] == 0.0 and den[-1] == 0.0:
+            num, den = num[:-1], den[:-1]  # cancel common factors s
         if den[-1] == 0.0:
-            return float("inf") if num[-1] != 0 else float(num[-2] / den[-2])
+            return float("inf")
         return float(num[-1] / den[-1])
 
     def with_parameters(self, **values: float) -> Controller:

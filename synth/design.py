@@ -2,7 +2,8 @@
 
 With one free parameter (a P gain, or any one parameter with the others
 fixed) the exact feasible set is computed (:mod:`synth.gainset`) and the
-objective is optimized over it. Every returned design is re-checked on a
+objective is optimized over it. With several, the convex-concave procedure
+of :mod:`synth.synthesis` designs the controller. Every returned design is re-checked on a
 grid 20 times denser than the one used while searching, plus exact
 stability; a design that fails that certificate is not reported as a
 solution.
@@ -153,6 +154,24 @@ def _optimize_scalar(f: Callable[[float], float], intervals: list[tuple[float, f
     return float(best_x), float(best_v)
 
 
+INWARD = 1e-6
+"""Relative step by which a design at an end set by a requirement is moved into the feasible set
+(the end itself has zero slack up to rounding)."""
+
+
+def _inside(x: float, gain_set: GainSet) -> float:
+    for iv in gain_set.intervals:
+        step = INWARD * max(1.0, abs(x), iv.hi - iv.lo)
+        lo_req = any(not b.startswith("bounds") for b in iv.lo_binding)
+        hi_req = any(not b.startswith("bounds") for b in iv.hi_binding)
+        if lo_req and abs(x - iv.lo) <= step and iv.hi - iv.lo > 2 * step:
+            return iv.lo + step
+        if hi_req and abs(x - iv.hi) <= step and iv.hi - iv.lo > 2 * step and not any(
+                b.startswith("bounds") for b in iv.hi_binding):
+            return iv.hi - step
+    return x
+
+
 def scalar_family(spec: Spec) -> tuple[ScalarFamily, tuple[float, float]]:
     """The one-parameter family a spec designs over (error if it has several free parameters)."""
     bounds = spec.controller.all_bounds()
@@ -190,6 +209,10 @@ def design(spec: Spec) -> DesignResult:
     >>> result.feasible, result.controller.parameters["kp"], result.gain_set.contains(3.0)
     (True, 20.0, True)
     """
+    if len(spec.controller.free_parameters()) != 1:
+        from synth.synthesis.multi import design_convex
+
+        return design_convex(spec)
     family, bounds = scalar_family(spec)
     requirements = list(spec.requirements)
     plants = spec.plants()
@@ -222,6 +245,7 @@ def design(spec: Spec) -> DesignResult:
             return sign * m.evaluate(Loop(nominal, family.controller(x)))
         label = {"name": m.name, "sense": objective.sense, "unit": m.unit, "description": m.description}
     x, _ = _optimize_scalar(score, [(iv.lo, iv.hi) for iv in gain_set.intervals])
+    x = _inside(x, gain_set)
     controller = family.controller(x)
     if objective is None:
         value = score(x)

@@ -91,26 +91,39 @@ class Loop:
 
     # --------------------------------------------------------------- responses
     def L(self, w: Any) -> np.ndarray:
-        """Loop response ``C(jw) G(jw)``."""
-        return self.controller.freqresp(w) * self.plant.freqresp(w)
+        """Loop response ``C(jw) G(jw)``; ``inf`` at a loop pole on the axis (``w = 0`` with integral action)."""
+        w = np.asarray(w, dtype=float)
+        s = 1j * w
+        d = np.polyval(self.den, s)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            L = np.polyval(self.num, s) / d * np.exp(-s * self.delay)
+        return np.where(d == 0, complex(np.inf, 0.0), L)
+
+    @staticmethod
+    def _infinite(L: np.ndarray) -> np.ndarray:
+        return np.isinf(L.real) | np.isinf(L.imag)
 
     def S(self, w: Any) -> np.ndarray:
-        """Sensitivity ``1/(1 + L)``."""
+        """Sensitivity ``1/(1 + L)`` (0 where ``L`` is infinite)."""
+        L = self.L(w)
         with np.errstate(divide="ignore", invalid="ignore"):
-            return 1.0 / (1.0 + self.L(w))
+            return np.where(self._infinite(L), 0j, 1.0 / (1.0 + L))
 
     def T(self, w: Any) -> np.ndarray:
         """Complementary sensitivity ``L/(1 + L)``; ``1`` where ``L`` is infinite."""
         L = self.L(w)
         with np.errstate(divide="ignore", invalid="ignore"):
             T = L / (1.0 + L)
-        return np.where(np.isinf(np.abs(L)), 1.0 + 0j, T)
+        return np.where(self._infinite(L), 1.0 + 0j, T)
 
     def KS(self, w: Any) -> np.ndarray:
-        """Control sensitivity ``C/(1 + L)`` (input per unit reference or output disturbance)."""
+        """Control sensitivity ``C/(1 + L)`` (input per unit reference or output disturbance);
+        ``1/G`` where the controller has a pole on the axis."""
         C = self.controller.freqresp(w)
+        G = self.plant.freqresp(w)
         with np.errstate(divide="ignore", invalid="ignore"):
-            return C / (1.0 + C * self.plant.freqresp(w))
+            KS = C / (1.0 + C * G)
+            return np.where(self._infinite(C) | np.isnan(C), 1.0 / G, KS)
 
     def T0(self) -> float:
         """``|T(0)|``: 1 with integral action, ``L(0)/(1 + L(0))`` otherwise."""

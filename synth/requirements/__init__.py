@@ -10,6 +10,7 @@ from synth.requirements.base import (
     RequirementResult,
     register,
 )
+from synth.requirements.control_sensitivity import PeakControlSensitivity
 from synth.requirements.margins import MarginsRequirement
 from synth.requirements.sensitivity import (
     PeakComplementary,
@@ -24,6 +25,7 @@ __all__ = [
     "Bandwidth",
     "MarginsRequirement",
     "PeakComplementary",
+    "PeakControlSensitivity",
     "PeakSensitivity",
     "Requirement",
     "RequirementResult",

@@ -1,0 +1,1 @@
+"""Optimization-based synthesis of fixed-structure controllers (convex-concave with cvxpy, NLP with casadi)."""

@@ -1,0 +1,534 @@
+"""Convex-concave synthesis of controllers linear in their parameters (cvxpy + Clarabel).
+
+1. **Feasibility (elastic).** From a stabilizing start, every requirement gets
+   one elastic slack; ``sum(slacks)`` is minimized by repeated convex solves,
+   re-linearizing at each new design. Zero total slack gives a design that
+   meets every requirement on the grid. A positive limit means the
+   requirements conflict: their slacks say by how much, the dual values of
+   their constraints (prices) say which ones push against each other.
+2. **Objective.** From the feasible design, the objective is optimized with
+   every requirement enforced by its inner approximation, so every iterate
+   stays feasible (a step that breaks an exact check is halved). Linear
+   objectives (integral or low-frequency gain) and peak |S| (as the largest
+   lower bound on |1 + L|) are solved directly; bandwidth, crossover, peak
+   |T| and control effort are quasi-convex in this setting and are found by
+   bisection on their level.
+
+The problem is compiled once (cvxpy DPP): each iteration only updates
+parameter values. ``solver=cp.CLARABEL`` throughout.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+from typing import Any
+
+import cvxpy as cp
+import numpy as np
+
+from synth.check import evaluate_all
+from synth.controllers import Controller
+from synth.errors import SynthError
+from synth.freqgrid import characteristic_range, log_grid
+from synth.plant import Plant
+from synth.requirements.base import Requirement
+from synth.stability import closed_loop_stability
+from synth.synthesis.convex_forms import (
+    T0,
+    Form,
+    LowerBoundOnReturnDifference,
+    MovingFloor,
+    UpperBoundOnRatio,
+    build_forms,
+    make_points,
+)
+from synth.synthesis.parametrization import LinearParametrization
+
+SOLVER = cp.CLARABEL
+_OK = {cp.OPTIMAL, cp.OPTIMAL_INACCURATE}
+
+
+@dataclass
+class ConvexSettings:
+    """Settings of the convex-concave procedure.
+
+    Attributes
+    ----------
+    per_decade : int
+        Design-grid density (points per decade) when ``n_points`` is not given.
+    n_points : int or None
+        Exact number of design-grid frequencies (log-spaced), overriding ``per_decade``.
+    max_iterations : int
+        Convex solves per phase.
+    tolerance : float
+        Relative objective change that ends a phase.
+    stability_level : float
+        Every iterate keeps ``|1 + L| >= stability_level`` on the grid (|S| <= 26 dB
+        for 0.05), which keeps the closed loop stable along each step.
+    """
+
+    per_decade: int = 40
+    n_points: int | None = None
+    max_iterations: int = 60
+    tolerance: float = 1e-6
+    stability_level: float = 0.05
+    bisection_steps: int = 18
+
+
+@dataclass
+class RequirementConflict:
+    """One requirement in an infeasibility diagnosis."""
+
+    name: str
+    elastic_slack: float
+    price: float
+    violated: bool
+    exact_slack: float
+    message: str
+
+    def to_dict(self) -> dict[str, Any]:
+        return dict(self.__dict__)
+
+
+@dataclass
+class Diagnosis:
+    """Why a spec cannot be met: the elastic solution, slacks and prices."""
+
+    total_slack: float
+    conflicts: list[RequirementConflict]
+    bounds_active: list[str]
+    controller: Controller
+
+    def conflicting(self) -> list[str]:
+        """Requirements that are violated or actively push against the violated ones."""
+        top = max((c.price for c in self.conflicts), default=0.0)
+        return [c.name for c in self.conflicts if c.violated or (top > 0 and c.price > 1e-3 * top)]
+
+    def to_dict(self) -> dict[str, Any]:
+        return {
+            "total_elastic_slack": self.total_slack,
+            "conflicting": self.conflicting(),
+            "requirements": [c.to_dict() for c in self.conflicts],
+            "bounds_active": self.bounds_active,
+            "elastic_controller": self.controller.to_dict(),
+        }
+
+
+@dataclass
+class ConvexResult:
+    """Outcome of :meth:`ConvexDesigner.run`."""
+
+    status: str
+    controller: Controller
+    rho: np.ndarray
+    objective_value: float | None
+    iterations: int
+    solves: int
+    solve_time: float
+    history: list[dict[str, float]] = field(default_factory=list)
+    diagnosis: Diagnosis | None = None
+    grid_points: int = 0
+    starts_tried: int = 1
+
+    def to_dict(self) -> dict[str, Any]:
+        return {
+            "status": self.status,
+            "controller": self.controller.to_dict(),
+            "objective_value": self.objective_value,
+            "iterations": self.iterations,
+            "convex_solves": self.solves,
+            "solve_time": self.solve_time,
+            "grid_points": self.grid_points,
+            "starts_tried": self.starts_tried,
+            "history": self.history,
+            "diagnosis": self.diagnosis.to_dict() if self.diagnosis else None,
+        }
+
+
+def design_grid(plants: list[Plant], requirements: list[Requirement], settings: ConvexSettings) -> np.ndarray:
+    """Log grid covering every plant's dynamics and every requirement's band."""
+    lo, hi = np.inf, 0.0
+    for p in plants:
+        a, b = characteristic_range(p.num, p.den, delay=p.delay)
+        lo, hi = min(lo, a), max(hi, b)
+    for r in requirements:
+        band = getattr(r, "band", None)
+        if band is not None:
+            lo = min(lo, band[0] / 10 if band[0] > 0 else lo)
+            hi = max(hi, band[1] * 10)
+        for key in ("min", "max"):
+            v = getattr(r, key, None) if r.type == "bandwidth" else None
+            if v:
+                lo, hi = min(lo, v / 100), max(hi, v * 100)
+    if settings.n_points:
+        return np.geomspace(lo, hi, settings.n_points)
+    return log_grid(lo, hi, settings.per_decade)
+
+
+class ConvexDesigner:
+    """Convex-concave design of a linearly parametrized controller for several plants.
+
+    Parameters
+    ----------
+    requirements : list of Requirement
+    names : list of str
+        Display name of each requirement.
+    plants : list of Plant
+    par : LinearParametrization
+    objective : (name, sense) or None
+        Measure to optimize; None minimizes peak |S| (the most robust design).
+    settings : ConvexSettings
+
+    Examples
+    --------
+    >>> from synth.spec import parse_spec
+    >>> from synth.synthesis.parametrization import parametrize
+    >>> spec = parse_spec('''
+    ... name: pi
+    ... plant: {tf: "23*(s+0.43)/((s+9.6)*(s+0.54))"}
+    ... controller: {type: PI, bounds: {kp: [0, 20], ki: [0, 500]}}
+    ... requirements: [{type: peak_sensitivity, max_db: 3}]
+    ... objective: {maximize: integral_gain}''')
+    >>> d = ConvexDesigner(list(spec.requirements), ["Ms"], spec.plants(),
+    ...                    parametrize("PI", spec.controller.all_bounds()), ("integral_gain", "maximize"))
+    >>> r = d.run()
+    >>> r.status, round(r.controller.parameters["ki"], 1)
+    ('optimal', 500.0)
+    """
+
+    def __init__(self, requirements: list[Requirement], names: list[str], plants: list[Plant],
+                 par: LinearParametrization, objective: tuple[str, str] | None,
+                 settings: ConvexSettings | None = None) -> None:
+        self.requirements, self.names, self.plants, self.par = requirements, names, plants, par
+        self.objective = objective or ("peak_sensitivity", "minimize")
+        self.settings = settings or ConvexSettings()
+        self.grid = design_grid(plants, requirements, self.settings)
+        self.solves = 0
+        self.solve_time = 0.0
+        self.round = 0
+        self._build()
+
+    def _build(self) -> None:
+        """(Re)build forms and problems on the current grid (after grid refinement too)."""
+        self.forms = build_forms(self.requirements, self.names, self.plants, self.par, self.grid,
+                                 self.settings.per_decade, self.settings.stability_level)
+        self.elastic_forms = [f for f in self.forms if f.elastic]
+        self.rho = cp.Variable(self.par.size)
+        A, b = self.par.linear_constraints()
+        self.box = [A @ self.rho <= b] if A.size else []
+        self._problems: dict[str, cp.Problem] = {}
+        self._objective_form: Form | None = None
+        self._gamma: cp.Variable | None = None
+        self._level_slack = cp.Variable(nonneg=True)
+
+    # ------------------------------------------------------------------ problems
+    def _constraints(self, slacks: dict[str, Any]) -> list[cp.Constraint]:
+        cons = list(self.box)
+        for f in self.forms:
+            cons += f.constraints(self.rho, slacks.get(id(f), 0.0))
+        return cons
+
+    def _elastic_problem(self) -> cp.Problem:
+        if "elastic" not in self._problems:
+            self._s = cp.Variable(len(self.elastic_forms), nonneg=True)
+            slacks = {id(f): self._s[i] for i, f in enumerate(self.elastic_forms)}
+            self._elastic_box = list(self.box)
+            cons = self._constraints(slacks)
+            self._problems["elastic"] = cp.Problem(cp.Minimize(cp.sum(self._s)), cons)
+        return self._problems["elastic"]
+
+    def _objective_problem(self) -> cp.Problem:
+        if "objective" in self._problems:
+            return self._problems["objective"]
+        name, sense = self.objective
+        cons = self._constraints({})
+        if name in ("integral_gain", "low_frequency_gain"):
+            c = self._linear_objective(name)
+            expr = c @ self.rho
+            goal = cp.Maximize(expr) if sense == "maximize" else cp.Minimize(expr)
+        elif name == "peak_sensitivity" and sense == "minimize":
+            self._gamma = cp.Variable()
+            form = LowerBoundOnReturnDifference("objective", make_points(self.plants, self.par, self.grid),
+                                                self.par.size, 1.0, elastic=False)
+            self._objective_form = form
+            cons += [form.lin.c + form.lin.R @ self.rho >= self._gamma]
+            goal = cp.Maximize(self._gamma)
+        else:
+            form = self._level_form(name, sense)
+            self._objective_form = form
+            cons += form.constraints(self.rho, self._level_slack)
+            goal = cp.Minimize(self._level_slack)
+        self._problems["objective"] = cp.Problem(goal, cons)
+        return self._problems["objective"]
+
+    def _linear_objective(self, name: str) -> np.ndarray:
+        c = np.zeros(self.par.size)
+        if self.par.integrator_index is not None:
+            c[self.par.integrator_index] = 1.0
+        elif name == "low_frequency_gain":
+            c = self.par.dc_basis()
+        else:
+            raise SynthError("objective integral_gain needs a controller with integral action",
+                             where="objective")
+        return c
+
+    def _level_form(self, name: str, sense: str) -> Form:
+        pts = make_points(self.plants, self.par, self.grid)
+        if name == "bandwidth" and sense == "maximize":
+            form = MovingFloor(name, make_points(self.plants, self.par, self.grid), self.par.size, T0(self.plants, self.par))
+        elif name == "crossover" and sense == "maximize":
+            form = MovingFloor(name, make_points(self.plants, self.par, self.grid), self.par.size, None)
+        elif name == "peak_complementary" and sense == "minimize":
+            form = UpperBoundOnRatio(name, pts, pts.A, self.par.size, 1.0)
+        elif name == "control_effort" and sense == "minimize":
+            form = UpperBoundOnRatio(name, pts, pts.phi, self.par.size, 1.0)
+        else:
+            raise SynthError(f"the convex stage cannot {sense} {name}", where="objective")
+        return form
+
+    # ------------------------------------------------------------------ solving
+    def _solve(self, problem: cp.Problem) -> bool:
+        t0 = time.perf_counter()
+        try:
+            problem.solve(solver=SOLVER)
+        except cp.SolverError:
+            return False
+        finally:
+            self.solve_time += time.perf_counter() - t0
+            self.solves += 1
+        return problem.status in _OK and self.rho.value is not None
+
+    def _update(self, rho_c: np.ndarray) -> None:
+        for f in self.forms:
+            f.update(rho_c)
+        if self._objective_form is not None:
+            self._objective_form.update(rho_c)
+
+    def _stable(self, rho: np.ndarray) -> bool:
+        c = self.par.controller(rho)
+        cn, cd = c.tf()
+        for p in self.plants:
+            if not closed_loop_stability(np.polymul(cn, p.num), np.polymul(cd, p.den), p.delay).stable:
+                return False
+        return True
+
+    def exact_slacks(self, rho: np.ndarray) -> np.ndarray:
+        """Worst-plant slack of every requirement (exact evaluation with peak refinement)."""
+        worst, _ = evaluate_all(self.requirements, self.plants, self.par.controller(rho), per_decade=20)
+        return np.array([r.slack for r in worst[1:]])
+
+    def grid_violations(self, rho: np.ndarray) -> np.ndarray:
+        """Exact (not linearized) violation of every requirement form on the design grid (<= 0 met)."""
+        return np.array([f.violation(rho) for f in self.elastic_forms])
+
+    def _accept(self, rho_c: np.ndarray, rho_new: np.ndarray, keep_feasible: bool) -> np.ndarray:
+        """Halve the step until the closed loop stays stable (and the met requirements stay met)."""
+        base = self.grid_violations(rho_c) if keep_feasible else None
+        step = rho_new - rho_c
+        for _ in range(12):
+            cand = rho_c + step
+            if self._stable(cand):
+                if base is None:
+                    return cand
+                v = self.grid_violations(cand)
+                if np.all((v <= 1e-9) | (base > 1e-9)):
+                    return cand
+            step = step / 2
+        return rho_c
+
+    def starts(self, initial: np.ndarray | None = None, count: int = 1, seed: int = 0) -> list[np.ndarray]:
+        """Up to ``count`` stabilizing starts: ``initial``, a small controller, then a seeded random
+        search in the bounds (log-spread towards small values)."""
+        candidates = [initial] if initial is not None else []
+        candidates.append(self.par.start())
+        rng = np.random.default_rng(seed)
+        lo, hi = self.par.box()
+        lo = np.where(np.isfinite(lo), lo, -10.0)
+        hi = np.where(np.isfinite(hi), hi, 10.0)
+        for _ in range(300):
+            x = lo + (hi - lo) * rng.random(self.par.size) ** 3
+            if self.par.ctype == "leadlag":
+                z_lo, z_hi = self.par.bounds["z"]
+                x[1] = x[0] * (z_lo + (z_hi - z_lo) * rng.random())
+            candidates.append(x)
+        found: list[np.ndarray] = []
+        for c in candidates:
+            if c is not None and self._stable(np.asarray(c, float)):
+                found.append(np.asarray(c, float))
+                if len(found) >= count:
+                    break
+        if not found:
+            raise SynthError("found no stabilizing controller in the bounds to start from; give "
+                             "controller.initial or widen the bounds", where="controller")
+        return found
+
+    def start(self, initial: np.ndarray | None = None) -> np.ndarray:
+        """The first stabilizing start (see :meth:`starts`)."""
+        return self.starts(initial, 1)[0]
+
+    def feasible(self, rho0: np.ndarray, history: list) -> tuple[np.ndarray, float]:
+        """Phase 1: minimize the total elastic slack from ``rho0``.
+
+        Returns ``(rho, violation)`` where ``violation`` is 0 when the exact
+        check finds every requirement met at ``rho``, else the elastic total.
+        """
+        problem = self._elastic_problem()
+        rho_c, total = rho0, np.inf
+        for it in range(self.settings.max_iterations):
+            if np.all(self.grid_violations(rho_c) <= 0):
+                return rho_c, 0.0
+            self._update(rho_c)
+            if not self._solve(problem):
+                break
+            new_total = max(float(problem.value), 0.0)
+            rho_c = self._accept(rho_c, np.asarray(self.rho.value, float), keep_feasible=False)
+            history.append({"phase": 1, "iteration": it, "total_slack": new_total})
+            if abs(total - new_total) <= self.settings.tolerance * max(1.0, total) and new_total > 1e-7:
+                total = new_total
+                break
+            total = new_total
+        if np.all(self.grid_violations(rho_c) <= 0):
+            return rho_c, 0.0
+        return rho_c, max(total if np.isfinite(total) else 1.0, 1e-6)
+
+    def diagnose(self, rho: np.ndarray, total: float) -> Diagnosis:
+        """Slacks and prices of the elastic solution at ``rho``."""
+        self._update(rho)
+        problem = self._elastic_problem()
+        self._solve(problem)
+        s = np.asarray(self._s.value if self._s.value is not None else np.zeros(len(self.elastic_forms)))
+        exact = self.exact_slacks(rho)
+        by_name = dict(zip(self.names, exact))
+        worst, _ = evaluate_all(self.requirements, self.plants, self.par.controller(rho), per_decade=40)
+        msgs = {n: r.message for n, r in zip(self.names, worst[1:])}
+        conflicts = []
+        for i, f in enumerate(self.elastic_forms):
+            conflicts.append(RequirementConflict(
+                f.name, float(s[i]), f.price(), bool(s[i] > 1e-6 or by_name.get(f.name, 0) < -1e-6),
+                float(by_name.get(f.name, np.nan)), msgs.get(f.name, "")))
+        active = []
+        if self.box:
+            A, b = self.par.linear_constraints()
+            duals = self.box[0].dual_value
+            for row, d, rhs in zip(A, np.atleast_1d(duals) if duals is not None else [], b):
+                if d > 1e-6:
+                    i = int(np.argmax(np.abs(row)))
+                    active.append(f"{self.par.names[i]} {'<=' if row[i] > 0 else '>='} {rhs * np.sign(row[i]):.6g}")
+        return Diagnosis(total, conflicts, active, self.par.controller(rho))
+
+    def optimize(self, rho_c: np.ndarray, history: list) -> tuple[np.ndarray, float]:
+        """Phase 2 from a feasible ``rho_c``: the objective, every iterate feasible."""
+        name, sense = self.objective
+        problem = self._objective_problem()
+        if isinstance(self._objective_form, (MovingFloor, UpperBoundOnRatio)):
+            return self._bisect(rho_c, history)
+        value = -np.inf
+        for it in range(self.settings.max_iterations):
+            self._update(rho_c)
+            if not self._solve(problem):
+                break
+            rho_c = self._accept(rho_c, np.asarray(self.rho.value, float), keep_feasible=True)
+            new = self.measure(rho_c)
+            history.append({"phase": 2, "round": self.round, "iteration": it, "objective": new,
+                            "max_violation": float(np.max(self.grid_violations(rho_c), initial=-np.inf))})
+            if abs(new - value) <= self.settings.tolerance * max(1.0, abs(new)):
+                value = new
+                break
+            value = new
+        return rho_c, self.measure(rho_c)
+
+    def measure(self, rho: np.ndarray) -> float:
+        """Exact objective value at ``rho`` (nominal plant)."""
+        from synth.loop import Loop
+        from synth.objectives import measure
+
+        return measure(self.objective[0]).evaluate(Loop(self.plants[0], self.par.controller(rho)))
+
+    def _bisect(self, rho_c: np.ndarray, history: list) -> tuple[np.ndarray, float]:
+        name, sense = self.objective
+        form = self._objective_form
+        problem = self._problems["objective"]
+        best_rho, best = rho_c, self.measure(rho_c)
+        maximize = sense == "maximize"
+        if maximize:
+            lo, hi = np.log(max(best, self.grid[0])), np.log(self.grid[-1])
+        else:
+            cap = 10 ** (best / 20) if name in ("peak_complementary", "control_effort") else best
+            lo, hi = np.log(cap), np.log(cap) - np.log(1e3)
+        for step in range(self.settings.bisection_steps):
+            level = float(np.exp(0.5 * (lo + hi)))
+            form.set_level(level)
+            rho_try = best_rho
+            ok = False
+            for it in range(self.settings.max_iterations // 3):
+                self._update(rho_try)
+                if not self._solve(problem):
+                    break
+                rho_try = self._accept(rho_try, np.asarray(self.rho.value, float), keep_feasible=True)
+                if problem.value <= 1e-7:
+                    ok = True
+                    break
+            if ok:
+                value = self.measure(rho_try)
+                better = value > best if maximize else value < best
+                if better:
+                    best_rho, best = rho_try, value
+                lo = np.log(level)
+            else:
+                hi = np.log(level)
+            history.append({"phase": 2, "iteration": step, "level": level, "feasible": ok, "objective": best})
+            if abs(hi - lo) < 1e-4:
+                break
+        return best_rho, best
+
+    def _violations(self, rho: np.ndarray) -> list[float]:
+        """Binding frequencies of requirements the exact check finds violated at ``rho``."""
+        worst, per_plant = evaluate_all(self.requirements, self.plants, self.par.controller(rho),
+                                        per_decade=max(160, 4 * self.settings.per_decade))
+        freqs = []
+        for results in per_plant.values():
+            for r in results[1:]:
+                if r.slack < 0 and r.binding_frequency and r.binding_frequency > 0:
+                    freqs.append(r.binding_frequency)
+        return freqs
+
+    def run(self, initial: np.ndarray | None = None, refinements: int = 4, restarts: int = 6) -> ConvexResult:
+        """Feasibility, then the objective; or a diagnosis when the requirements conflict.
+
+        Phase 1 is local: when it ends with requirements still violated it is
+        repeated from up to ``restarts`` other stabilizing starts before the
+        spec is declared infeasible. After the optimum, the exact check looks
+        between the grid points; where a requirement is violated there, its
+        binding frequency joins the grid and the design is repeated from the
+        last point (at most ``refinements`` times).
+        """
+        history: list[dict[str, float]] = []
+        starts = self.starts(initial, restarts + 1)
+        best: tuple[float, np.ndarray] | None = None
+        for k, rho0 in enumerate(starts):
+            rho, total = self.feasible(rho0, history)
+            if best is None or total < best[0]:
+                best = (total, rho)
+            if total == 0.0:
+                break
+        total, rho = best
+        self.starts_tried = k + 1
+        for round_ in range(refinements + 1):
+            self.round = round_
+            if round_ > 0:
+                rho, total = self.feasible(rho, history)
+            if total > 0.0:
+                diag = self.diagnose(rho, total)
+                return ConvexResult("infeasible", self.par.controller(rho), rho, None, len(history), self.solves,
+                                    self.solve_time, history, diag, self.grid.size, self.starts_tried)
+            rho, value = self.optimize(rho, history)
+            extra = self._violations(rho)
+            if not extra or round_ == refinements:
+                break
+            w = np.asarray(extra)
+            self.grid = np.unique(np.concatenate([self.grid, w, w * (1 - 1e-3), w * (1 + 1e-3)]))
+            history.append({"phase": 0, "iteration": round_, "refined_points": float(w.size)})
+            self._build()
+        return ConvexResult("optimal", self.par.controller(rho), rho, value, len(history), self.solves,
+                            self.solve_time, history, None, self.grid.size, self.starts_tried)
