@@ -276,9 +276,9 @@ class ConvexDesigner:
     def _level_form(self, name: str, sense: str) -> Form:
         pts = make_points(self.plants, self.par, self.grid)
         if name == "bandwidth" and sense == "maximize":
-            form = MovingFloor(name, make_points(self.plants, self.par, self.grid), self.par.size, T0(self.plants, self.par))
+            form = MovingFloor(name, pts, self.par.size, T0(self.plants, self.par))
         elif name == "crossover" and sense == "maximize":
-            form = MovingFloor(name, make_points(self.plants, self.par, self.grid), self.par.size, None)
+            form = MovingFloor(name, pts, self.par.size, None)
         elif name == "peak_complementary" and sense == "minimize":
             form = UpperBoundOnRatio(name, pts, pts.A, self.par.size, 1.0)
         elif name == "control_effort" and sense == "minimize":
@@ -414,12 +414,12 @@ class ConvexDesigner:
             for row, d, rhs in zip(A, np.atleast_1d(duals) if duals is not None else [], b):
                 if d > 1e-6:
                     i = int(np.argmax(np.abs(row)))
-                    active.append(f"{self.par.names[i]} {'<=' if row[i] > 0 else '>='} {rhs * np.sign(row[i]):.6g}")
+                    rel = "<=" if row[i] > 0 else ">="
+                    active.append(f"{self.par.names[i]} {rel} {rhs * np.sign(row[i]):.6g}")
         return Diagnosis(total, conflicts, active, self.par.controller(rho))
 
     def optimize(self, rho_c: np.ndarray, history: list) -> tuple[np.ndarray, float]:
         """Phase 2 from a feasible ``rho_c``: the objective, every iterate feasible."""
-        name, sense = self.objective
         problem = self._objective_problem()
         if isinstance(self._objective_form, (MovingFloor, UpperBoundOnRatio)):
             return self._bisect(rho_c, history)
@@ -461,7 +461,7 @@ class ConvexDesigner:
             form.set_level(level)
             rho_try = best_rho
             ok = False
-            for it in range(self.settings.max_iterations // 3):
+            for _ in range(self.settings.max_iterations // 3):
                 self._update(rho_try)
                 if not self._solve(problem):
                     break
@@ -484,7 +484,7 @@ class ConvexDesigner:
 
     def _violations(self, rho: np.ndarray) -> list[float]:
         """Binding frequencies of requirements the exact check finds violated at ``rho``."""
-        worst, per_plant = evaluate_all(self.requirements, self.plants, self.par.controller(rho),
+        _, per_plant = evaluate_all(self.requirements, self.plants, self.par.controller(rho),
                                         per_decade=max(160, 4 * self.settings.per_decade))
         freqs = []
         for results in per_plant.values():
@@ -506,14 +506,15 @@ class ConvexDesigner:
         history: list[dict[str, float]] = []
         starts = self.starts(initial, restarts + 1)
         best: tuple[float, np.ndarray] | None = None
-        for k, rho0 in enumerate(starts):
+        self.starts_tried = 0
+        for rho0 in starts:
+            self.starts_tried += 1
             rho, total = self.feasible(rho0, history)
             if best is None or total < best[0]:
                 best = (total, rho)
             if total == 0.0:
                 break
         total, rho = best
-        self.starts_tried = k + 1
         for round_ in range(refinements + 1):
             self.round = round_
             if round_ > 0:

@@ -379,7 +379,8 @@ def build_forms(requirements: list[Requirement], names: list[str], plants: list[
             phi = par.basis(w0)
             gains = [req.plant_gain if req.plant_gain is not None else p.dc_gain() for p in plants]
             A = np.concatenate([g * phi for g in gains])
-            pts = Points(np.repeat(w0, len(plants)), np.arange(len(plants)), A, np.concatenate([phi] * len(plants)))
+            pts = Points(np.repeat(w0, len(plants)), np.arange(len(plants)), A,
+                         np.concatenate([phi] * len(plants)))
             forms.append(LowerBoundOnReturnDifference(name, pts, par.size, up * 10 ** (-req.max_db / 20)))
         elif isinstance(req, PeakComplementary):
             pts = _requirement_points(req, plants, par, grid, auto, per_decade)
@@ -406,6 +407,7 @@ def build_forms(requirements: list[Requirement], names: list[str], plants: list[
             # a delay margin has no convex form here: the NLP stage and the certificate enforce it
         else:
             raise TypeError(f"no convex form for requirement type {req.type}")
-    forms.append(LowerBoundOnReturnDifference("stability (kept along the iterations)", make_points(plants, par, grid),
-                                              par.size, stability_level, elastic=False))
+    forms.append(LowerBoundOnReturnDifference("stability (kept along the iterations)",
+                                              make_points(plants, par, grid), par.size, stability_level,
+                                              elastic=False))
     return forms

@@ -48,7 +48,8 @@ def design_convex(spec: Spec, settings: ConvexSettings | None = None) -> DesignR
 
     alt = design(without)
     if alt.feasible and (not main.feasible or _better(alt, main)):
-        alt.method = main.method + "; the same structure without integral action (ki = 0) did better: " + alt.method
+        alt.method = (main.method + "; the same structure without integral action (ki = 0) did better: "
+                      + alt.method)
         alt.extras.setdefault("alternatives", []).append({"ki_free": main.to_dict().get("objective")})
         return alt
     return main
