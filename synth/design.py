@@ -24,6 +24,7 @@ from synth.errors import SynthError
 from synth.gainset import GainSet, ScalarFamily, feasible_gain_set
 from synth.loop import Loop
 from synth.objectives import measure
+from synth.objectives import score as objective_score
 from synth.requirements.base import fmt
 from synth.spec import Spec
 
@@ -236,22 +237,19 @@ def design(spec: Spec) -> DesignResult:
     if objective is None:
         def score(x: float) -> float:
             return min(r.slack for r in check(spec, family.controller(x)).requirements)
-        label = {"name": "smallest slack", "sense": "maximize", "unit": "Np"}
     else:
-        m = measure(objective.name)
-        sign = 1.0 if objective.sense == "maximize" else -1.0
+        terms = objective.terms()
 
         def score(x: float) -> float:
-            return sign * m.evaluate(Loop(nominal, family.controller(x)))
-        label = {"name": m.name, "sense": objective.sense, "unit": m.unit, "description": m.description}
+            return objective_score(Loop(nominal, family.controller(x)), terms)
     x, _ = _optimize_scalar(score, [(iv.lo, iv.hi) for iv in gain_set.intervals])
     x = _inside(x, gain_set)
     controller = family.controller(x)
     if objective is None:
-        value = score(x)
+        label = {"name": "smallest slack", "sense": "maximize", "unit": "Np", "value": float(score(x)),
+                 "description": "no objective in the spec: the largest smallest slack"}
     else:
-        value = measure(objective.name).evaluate(Loop(nominal, controller))
-    label["value"] = float(value)
+        label = objective_label(spec, Loop(nominal, controller))
     final = check(spec, controller, SEARCH_PER_DECADE)
     cert_check = check(spec, controller, CERTIFICATE_PER_DECADE)
     certificate = Certificate(cert_check.feasible, CERTIFICATE_PER_DECADE, cert_check)
@@ -263,6 +261,19 @@ def design(spec: Spec) -> DesignResult:
         + "; ".join(r.message for r in cert_check.failed()) + "): not reported as a solution.")
     ) + reference_verdict(spec, result.reference, gain_set)
     return result
+
+
+def objective_label(spec: Spec, loop: Loop) -> dict[str, Any]:
+    """``{"name", "sense", "unit", "description", "value"}`` of the spec's objective at ``loop``."""
+    obj = spec.objective
+    assert obj is not None
+    if obj.weighted is None:
+        m = measure(obj.name)
+        return {"name": m.name, "sense": obj.sense, "unit": m.unit, "description": m.description,
+                "value": float(m.evaluate(loop))}
+    parts = {n: float(measure(n).evaluate(loop)) for n, _, _ in obj.terms()}
+    return {"name": "weighted", "sense": "maximize", "unit": "", "description": obj.describe(),
+            "value": objective_score(loop, obj.terms()), "terms": parts}
 
 
 def _ends(names: list[str]) -> str:

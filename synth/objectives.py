@@ -94,3 +94,20 @@ def measure(name: str) -> Measure:
         return MEASURES[name]
     except KeyError:
         raise KeyError(f"unknown objective {name!r}; expected one of: {', '.join(MEASURES)}") from None
+
+
+def score(loop: Loop, terms: list[tuple[str, str, float]]) -> float:
+    """Weighted objective to maximize: ``sum(+w f)`` for maximized terms, ``sum(-w f)`` for minimized.
+
+    Examples
+    --------
+    >>> from synth.loop import Loop; from synth.plant import Plant; from synth.controllers import Controller
+    >>> loop = Loop(Plant.from_string("1/(s+1)"), Controller("P", {"kp": 9.0}))
+    >>> round(score(loop, [("crossover", "maximize", 1.0)]), 4)
+    8.9443
+    """
+    total = 0.0
+    for name, sense, weight in terms:
+        value = measure(name).evaluate(loop)
+        total += weight * (value if sense == "maximize" else -value)
+    return float(total)

@@ -83,7 +83,7 @@ def test_every_iterate_stays_feasible():
     spec = _spec("PI", "{kp: [0, 10], ki: [0, 200]}", 0.02, "[{type: peak_sensitivity, max_db: 6}]",
                  "integral_gain", "maximize")
     result = design(spec)
-    history = result.extras["synthesis"]["history"]
+    history = result.extras["synthesis"]["convex"][0]["history"]
     phase2 = [h for h in history if h["phase"] == 2]
     assert len(phase2) >= 2
     assert all(h["max_violation"] <= 1e-9 for h in phase2)  # every iterate meets every requirement on the grid

@@ -101,9 +101,10 @@ class Diagnosis:
     controller: Controller
 
     def conflicting(self) -> list[str]:
-        """Requirements that are violated or actively push against the violated ones."""
+        """Requirements that are violated, or met but pushing against them with a dual price of at
+        least 1 % of the largest."""
         top = max((c.price for c in self.conflicts), default=0.0)
-        return [c.name for c in self.conflicts if c.violated or (top > 0 and c.price > 1e-3 * top)]
+        return [c.name for c in self.conflicts if c.violated or (top > 0 and c.price >= 0.01 * top)]
 
     def to_dict(self) -> dict[str, Any]:
         return {

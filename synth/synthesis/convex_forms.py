@@ -110,12 +110,17 @@ class Form:
         ``<= 0`` when met."""
         return -np.inf
 
+    def slack_coefficient(self) -> Any:
+        """How the elastic slack enters each constraint row (1 when it is added as is)."""
+        return 1.0
+
     def price(self) -> float:
-        """Sum of the dual values of this form's constraints after a solve."""
+        """Dual price of this requirement after an elastic solve: the rate at which the total violation
+        would fall per unit relaxation of this requirement (same normalized units for every one)."""
         total = 0.0
         for c in getattr(self, "_cons", []):
             if c.dual_value is not None:
-                total += float(np.sum(np.abs(c.dual_value)))
+                total += float(np.sum(np.abs(c.dual_value) * self.slack_coefficient()))
         return total
 
 
@@ -154,6 +159,9 @@ class LowerBoundOnReturnDifference(Form):
         if self.points.n == 0:
             return -np.inf
         return float(np.max(self.level - np.abs(1.0 + self.points.A @ rho)) / self.level)
+
+    def slack_coefficient(self):
+        return self.level
 
 
 class UpperBoundOnRatio(Form):
@@ -196,6 +204,9 @@ class SlewForm(Form):
     def violation(self, rho):
         mag = np.abs((self.Pre + 1j * self.Pim) @ rho)
         return float(np.max((mag - self.limit) / self.limit)) if mag.size else -np.inf
+
+    def slack_coefficient(self):
+        return self.limit
 
 
 class BandwidthFloor(Form):

@@ -1,28 +1,52 @@
-"""Design with several free parameters: convex-concave optimization, certificate, diagnosis."""
+"""Design with several free parameters: convex stage, NLP polish, certificate, diagnosis.
+
+1. **Convex** (:mod:`synth.synthesis.convex`) on the linear parametrization. A
+   PID filter ``tf`` or lead-lag pole ``p`` that is free is held at a few
+   log-spaced values and the best is kept.
+2. **NLP polish** (:mod:`synth.synthesis.nlp`) from the convex answer, every
+   parameter free, requirements and objective exact.
+3. **Certificate**: each candidate is re-checked on a grid 20 times denser
+   (plus refined peaks and crossings) and for exact closed-loop stability;
+   the best candidate that passes is the design. None passing means no
+   solution is reported.
+
+When the integral gain may be zero, the structure without it is designed
+too (a type-0 loop has ``|T(0)| < 1``, which changes the bandwidth and static
+readings) and the better certified design wins.
+"""
 
 from __future__ import annotations
 
-from synth.check import check
+from dataclasses import replace
+from typing import Any
+
+import numpy as np
+
+from synth.check import CheckResult, check
+from synth.controllers import Controller
 from synth.design import (
     CERTIFICATE_PER_DECADE,
     Certificate,
     DesignResult,
+    objective_label,
     reference_check,
     reference_verdict,
 )
+from synth.errors import SynthError
 from synth.gainset import _unique_names
+from synth.loop import Loop
+from synth.objectives import score
 from synth.requirements.base import fmt
 from synth.spec import Spec
 from synth.synthesis.convex import ConvexDesigner, ConvexResult, ConvexSettings
+from synth.synthesis.nlp import polish
 from synth.synthesis.parametrization import parametrize
 
+STRUCTURAL = {"PID": "tf", "leadlag": "p"}
 
-def design_convex(spec: Spec, settings: ConvexSettings | None = None) -> DesignResult:
-    """Design a linearly parametrized controller by convex-concave optimization and certify it.
 
-    When the integral gain may be zero, the structure without it (a type-0 loop,
-    whose |T(0)| < 1 changes the bandwidth and static-sensitivity readings) is
-    designed too, and the better certified design is returned.
+def design_convex(spec: Spec, settings: ConvexSettings | None = None, nlp: bool = True) -> DesignResult:
+    """Design a controller with several free parameters and certify it.
 
     Examples
     --------
@@ -38,7 +62,7 @@ def design_convex(spec: Spec, settings: ConvexSettings | None = None) -> DesignR
     (True, 24.93)
     """
     settings = settings or ConvexSettings()
-    main = _design_convex(spec, settings)
+    main = _design(spec, settings, nlp)
     bounds = spec.controller.all_bounds()
     if "ki" not in bounds or bounds["ki"][0] != 0.0 or bounds["ki"][1] == 0.0:
         return main
@@ -50,7 +74,7 @@ def design_convex(spec: Spec, settings: ConvexSettings | None = None) -> DesignR
     if alt.feasible and (not main.feasible or _better(alt, main)):
         alt.method = (main.method + "; the same structure without integral action (ki = 0) did better: "
                       + alt.method)
-        alt.extras.setdefault("alternatives", []).append({"ki_free": main.to_dict().get("objective")})
+        alt.extras.setdefault("alternatives", []).append({"with_integral_action": main.objective})
         return alt
     return main
 
@@ -60,69 +84,132 @@ def _better(a: DesignResult, b: DesignResult) -> bool:
     return va > vb if a.objective["sense"] == "maximize" else va < vb
 
 
-def _design_convex(spec: Spec, settings: ConvexSettings) -> DesignResult:
+def _objective_terms(spec: Spec) -> list[tuple[str, str, float]]:
+    return spec.objective.terms() if spec.objective else [("peak_sensitivity", "minimize", 1.0)]
+
+
+def _structural_values(lo: float, hi: float) -> list[float]:
+    if lo == hi:
+        return [lo]
+    if lo > 0:
+        return list(np.geomspace(lo, hi, 3))
+    return list(np.linspace(lo, hi, 3))
+
+
+def _convex_runs(spec: Spec, settings: ConvexSettings) -> list[tuple[ConvexDesigner, ConvexResult]]:
+    bounds = spec.controller.all_bounds()
+    ctype = spec.controller.type
+    key = STRUCTURAL.get(ctype)
+    values = _structural_values(*bounds[key]) if key else [None]
     requirements = list(spec.requirements)
     names = _unique_names(requirements)
-    par = parametrize(spec.controller.type, spec.controller.all_bounds())
-    objective = (spec.objective.name, spec.objective.sense) if spec.objective else None
-    designer = ConvexDesigner(requirements, names, spec.plants(), par, objective, settings)
-    convex = designer.run()
-    method = (f"convex-concave optimization over ({', '.join(par.names)}) with cvxpy + Clarabel on "
-              f"{convex.grid_points} frequency points per plant x {len(spec.plants())} plant(s); "
-              f"{convex.solves} convex solves")
-    ref = reference_check(spec)
-    extras = {"synthesis": convex.to_dict()}
-    if convex.status != "optimal":
-        compromise = check(spec, convex.controller)
-        result = DesignResult(spec.name, False, None, None, None, None, None, compromise, method,
-                              reference=ref, extras=extras)
-        result.verdict = infeasible_verdict(convex) + reference_verdict(spec, ref)
-        return result
-    controller = convex.controller
-    final = check(spec, controller)
+    name, sense, _ = _objective_terms(spec)[0]
+    runs = []
+    for v in values:
+        b = dict(bounds) if key is None else {**bounds, key: (v, v)}
+        par = parametrize(ctype, b)
+        designer = ConvexDesigner(requirements, names, spec.plants(), par, (name, sense), settings)
+        runs.append((designer, designer.run()))
+    return runs
+
+
+def _certify(spec: Spec, controller: Controller, per_decade: int) -> Certificate:
+    cert = check(spec, controller, per_decade)
+    return Certificate(cert.feasible, per_decade, cert)
+
+
+def _design(spec: Spec, settings: ConvexSettings, nlp: bool) -> DesignResult:
+    terms = _objective_terms(spec)
+    runs = _convex_runs(spec, settings)
     per_decade = max(CERTIFICATE_PER_DECADE, 20 * settings.per_decade)
-    cert_check = check(spec, controller, per_decade)
-    certificate = Certificate(cert_check.feasible, per_decade, cert_check)
-    label = _objective_label(spec, designer, convex)
-    feasible = certificate.passed
-    result = DesignResult(spec.name, feasible, controller if feasible else None, final, label, None,
-                          certificate, None, method, reference=ref, extras=extras)
-    if feasible:
-        result.verdict = (f"{controller} meets all {len(requirements)} requirements and keeps the loop stable on "
-                          f"{len(spec.plants())} plant(s) ({label['sense']} {label['name']}: "
-                          f"{fmt(label['value'])} {label['unit']}).") + reference_verdict(spec, ref)
-    else:
-        result.verdict = (f"The optimum {controller} failed the dense re-check ("
-                          + "; ".join(r.message for r in cert_check.failed()) + "): not reported as a solution.")
+    nominal = spec.nominal_plant()
+    candidates: list[tuple[str, Controller, Certificate]] = []
+    for _, conv in runs:
+        if conv.status == "optimal":
+            candidates.append(("convex", conv.controller, _certify(spec, conv.controller, per_decade)))
+    feasible_runs = [(d, r) for d, r in runs if r.status == "optimal"]
+    extras: dict[str, Any] = {"synthesis": {"convex": [r.to_dict() for _, r in runs]}}
+    ref = reference_check(spec)
+    stages = [f"convex-concave (cvxpy + Clarabel) on {runs[0][1].grid_points} frequency points x "
+              f"{len(spec.plants())} plant(s), {sum(r.solves for _, r in runs)} convex solves"]
+    if len(runs) > 1:
+        key = STRUCTURAL[spec.controller.type]
+        stages[0] += f", {len(runs)} fixed values of {key}"
+    if nlp:
+        if feasible_runs:
+            start_designer, start = max(feasible_runs,
+                                        key=lambda dr: score(Loop(nominal, dr[1].controller), terms))
+        else:
+            start_designer, start = min(runs, key=lambda dr: dr[1].diagnosis.total_slack)
+        res = polish(list(spec.requirements), spec.plants(), start.controller, spec.controller.all_bounds(),
+                     terms, start_designer.grid, settings.per_decade, settings.stability_level)
+        extras["synthesis"]["nlp"] = res.to_dict()
+        stages.append(f"NLP polish (casadi + IPOPT, {res.iterations} iterations, {res.status})")
+        if res.success:
+            candidates.append(("nlp", res.controller, _certify(spec, res.controller, per_decade)))
+    passed = [(stage, c, cert) for stage, c, cert in candidates if cert.passed]
+    method = "; ".join(stages) + f"; certificate: dense re-check, {per_decade} points per decade"
+    if passed:
+        stage, controller, certificate = max(passed, key=lambda t: score(Loop(nominal, t[1]), terms))
+        label = objective_label(spec, Loop(nominal, controller)) if spec.objective else {
+            "name": "peak_sensitivity", "sense": "minimize", "unit": "dB",
+            "value": float(-score(Loop(nominal, controller), terms)),
+            "note": "no objective in the spec: the most robust design (smallest peak |S|) is returned"}
+        extras["synthesis"]["chosen"] = stage
+        result = DesignResult(spec.name, True, controller, check(spec, controller), label, None, certificate,
+                              None, method + f"; chosen: {stage}", reference=ref, extras=extras)
+        result.verdict = (f"{controller} meets all {len(spec.requirements)} requirements and keeps the loop "
+                          f"stable on {len(spec.plants())} plant(s) ({_describe(spec, label)}).") \
+            + reference_verdict(spec, ref)
+        return result
+    if feasible_runs:  # optimal on the grid but none survives the certificate
+        stage, controller, certificate = candidates[-1]
+        result = DesignResult(spec.name, False, None, check(spec, controller), None, None, certificate, None,
+                              method, reference=ref, extras=extras)
+        result.verdict = (f"The best design found, {controller} ({stage}), failed the dense re-check ("
+                          + "; ".join(r.message for r in certificate.check.failed())
+                          + "): not reported as a solution.") + reference_verdict(spec, ref)
+        return result
+    worst = min(runs, key=lambda dr: dr[1].diagnosis.total_slack)[1]
+    compromise = check(spec, worst.controller)
+    result = DesignResult(spec.name, False, None, None, None, None, None, compromise, method, reference=ref,
+                          extras=extras)
+    result.extras["diagnosis"] = worst.diagnosis.to_dict()
+    nlp_note = ""
+    if candidates:  # the NLP returned something from the infeasible start, and it failed the certificate
+        stage, controller, certificate = candidates[-1]
+        nlp_note = (f" The NLP started from the closest design ended at {controller}, which fails the "
+                    "certificate (" + "; ".join(r.message for r in certificate.check.failed()) + ").")
+    result.verdict = infeasible_verdict(worst, compromise) + nlp_note + reference_verdict(spec, ref)
     return result
 
 
-def _objective_label(spec: Spec, designer: ConvexDesigner, convex: ConvexResult) -> dict:
-    from synth.objectives import measure
-
-    name, sense = designer.objective
-    m = measure(name)
-    label = {"name": name, "sense": sense, "unit": m.unit, "description": m.description,
-             "value": designer.measure(convex.rho)}
+def _describe(spec: Spec, label: dict) -> str:
     if spec.objective is None:
-        label["note"] = "no objective in the spec: the most robust design (smallest peak |S|) is returned"
-    return label
+        return f"smallest peak |S|: {fmt(label['value'])} dB"
+    return f"{spec.objective.describe()}: {fmt(label['value'])} {label['unit']}".rstrip()
 
 
-def infeasible_verdict(convex: ConvexResult) -> str:
-    """Plain-language explanation of an infeasible convex design."""
+def infeasible_verdict(convex: ConvexResult, compromise: CheckResult | None = None) -> str:
+    """Plain-language explanation of an infeasible design."""
     diag = convex.diagnosis
-    assert diag is not None
-    parts = ["The requirements cannot all be met within the controller bounds."]
+    if diag is None:
+        raise SynthError("no diagnosis for a design that was not found infeasible")
+    parts = [f"The requirements cannot all be met within the controller bounds (convex-concave from "
+             f"{convex.starts_tried} stabilizing start(s), then NLP from the closest design, found none)."]
     violated = [c for c in diag.conflicts if c.violated]
     pushing = [c for c in diag.conflicts if not c.violated and c.name in diag.conflicting()]
     if violated:
-        parts.append("Closest design (minimum total violation) still violates: "
-                     + "; ".join(f"{c.name} (slack {c.exact_slack:+.3g} Np: {c.message})" for c in violated) + ".")
+        parts.append("The closest design (least total violation) still violates: "
+                     + "; ".join(f"{c.name} (slack {c.exact_slack:+.3g} Np: {c.message})" for c in violated)
+                     + ".")
     if pushing:
-        parts.append("Requirements that hold there but push against them (dual price > 0): "
+        parts.append("Met there but pushing against them (dual price > 0): "
                      + ", ".join(f"{c.name} (price {c.price:.3g})" for c in pushing) + ".")
     if diag.bounds_active:
         parts.append("Active parameter bounds: " + ", ".join(diag.bounds_active) + ".")
-    parts.append("Conflicting: " + ", ".join(diag.conflicting()) + ".")
+    parts.append("Conflicting requirements: " + ", ".join(diag.conflicting()) + ".")
     return " ".join(parts)
+
+
+__all__ = ["design_convex", "infeasible_verdict", "replace"]
