@@ -105,12 +105,60 @@ CONTROLLER_TYPES: dict[str, ControllerType] = {
     )
 }
 
+RATIONAL = "rational"
+
+
+def rational_type(m: int, n: int) -> ControllerType:
+    """Fixed-order controller ``C = (b_m s^m + ... + b0)/(s^n + a_{n-1} s^{n-1} + ... + a0)``.
+
+    ``m <= n`` (proper). Setting ``a0 = 0`` puts an integrator in the controller.
+
+    Examples
+    --------
+    >>> t = rational_type(1, 2)
+    >>> t.parameters
+    ('b0', 'b1', 'a0', 'a1')
+    >>> [c.tolist() for c in t.tf({"b0": 2.0, "b1": 1.0, "a0": 0.0, "a1": 10.0})]
+    [[1.0, 2.0], [1.0, 10.0, 0.0]]
+    """
+    if not (0 <= m <= n) or n < 1:
+        raise ModelError(f"rational controller order [{m}, {n}] must have 0 <= m <= n and n >= 1 (proper)")
+    names = tuple(f"b{i}" for i in range(m + 1)) + tuple(f"a{i}" for i in range(n))
+
+    def build(v: dict[str, float]) -> Polys:
+        num = np.array([v[f"b{i}"] for i in range(m, -1, -1)])
+        den = np.array([1.0] + [v[f"a{i}"] for i in range(n - 1, -1, -1)])
+        return num, den
+
+    units = {p: "" for p in names}
+    bounds = {**{f"b{i}": (-1e4, 1e4) for i in range(m + 1)}, **{f"a{i}": (0.0, 1e4) for i in range(n)}}
+    return ControllerType(RATIONAL, names, units, bounds,
+                          f"C(s) = (b{m} s^{m} + ... + b0)/(s^{n} + a{n - 1} s^{n - 1} + ... + a0)", build)
+
+
+def rational_order(parameters: Any) -> tuple[int, int]:
+    """``(m, n)`` from rational parameter names ``b0..bm, a0..a(n-1)``.
+
+    Examples
+    --------
+    >>> rational_order(["b0", "b1", "a0", "a1"])
+    (1, 2)
+    """
+    names = list(parameters)
+    bs = sorted(int(p[1:]) for p in names if p.startswith("b") and p[1:].isdigit())
+    As = sorted(int(p[1:]) for p in names if p.startswith("a") and p[1:].isdigit())
+    if not bs or not As or bs != list(range(len(bs))) or As != list(range(len(As))):
+        raise ModelError("a rational controller needs coefficients b0..bm and a0..a(n-1)")
+    return len(bs) - 1, len(As)
+
+
 _ALIASES = {name.lower(): name for name in CONTROLLER_TYPES}
-_ALIASES.update({"lead_lag": "leadlag", "lead-lag": "leadlag", "ll": "leadlag"})
+_ALIASES.update({"lead_lag": "leadlag", "lead-lag": "leadlag", "ll": "leadlag", RATIONAL: RATIONAL,
+                 "fixed_order": RATIONAL})
 
 
-def controller_type(name: str) -> ControllerType:
-    """Look a controller type up by name (case-insensitive).
+def controller_type(name: str, order: tuple[int, int] | None = None) -> ControllerType:
+    """Look a controller type up by name (case-insensitive); ``rational`` needs its ``order``.
 
     Examples
     --------
@@ -120,8 +168,12 @@ def controller_type(name: str) -> ControllerType:
     key = _ALIASES.get(str(name).lower())
     if key is None:
         raise ModelError(
-            f"unknown controller type {name!r}; expected one of: {', '.join(CONTROLLER_TYPES)}"
+            f"unknown controller type {name!r}; expected one of: {', '.join(CONTROLLER_TYPES)}, {RATIONAL}"
         )
+    if key == RATIONAL:
+        if order is None:
+            raise ModelError("a rational controller needs its order [m, n]")
+        return rational_type(*order)
     return CONTROLLER_TYPES[key]
 
 
@@ -144,7 +196,9 @@ class Controller:
     parameters: dict[str, float]
 
     def __post_init__(self) -> None:
-        ctype = controller_type(self.type)
+        key = _ALIASES.get(str(self.type).lower())
+        order = rational_order(self.parameters) if key == RATIONAL else None
+        ctype = controller_type(self.type, order)
         missing = [p for p in ctype.parameters if p not in self.parameters]
         extra = [p for p in self.parameters if p not in ctype.parameters]
         if extra:
@@ -169,6 +223,8 @@ class Controller:
     @property
     def kind(self) -> ControllerType:
         """The :class:`ControllerType`."""
+        if self.type == RATIONAL:
+            return rational_type(*rational_order(self.parameters))
         return CONTROLLER_TYPES[self.type]
 
     @classmethod
@@ -188,6 +244,15 @@ class Controller:
             raise ModelError(f"cannot parse controller {text!r}; write e.g. 'PI(kp=1.2, ki=20)'") from None
         if not isinstance(node, ast.Call) or not isinstance(node.func, ast.Name):
             raise ModelError(f"cannot parse controller {text!r}; write e.g. 'PI(kp=1.2, ki=20)'")
+        if _ALIASES.get(node.func.id.lower()) == RATIONAL:
+            if node.args:
+                raise ModelError(f"controller {text!r}: give rational coefficients by name, "
+                                 "e.g. rational(b0=2, b1=1, a0=0, a1=10)")
+            values = {kw.arg: _number(kw.value, text) for kw in node.keywords}
+            try:
+                return cls(RATIONAL, values)
+            except ModelError as exc:
+                raise ModelError(f"controller {text!r}: {exc.message}") from None
         ctype = controller_type(node.func.id)
         if len(node.args) > len(ctype.parameters):
             raise ModelError(
@@ -209,14 +274,20 @@ class Controller:
             raise ModelError(f"controller {text!r}: {exc.message}") from None
 
     def tf(self) -> Polys:
-        """Numerator and denominator polynomials.
+        """Numerator and denominator polynomials, with exact common factors ``s`` cancelled
+        (``PI(kp, 0)`` is the gain ``kp``, not ``kp s / s``).
 
         Examples
         --------
         >>> Controller("P", {"kp": 3}).tf()
         (array([3.]), array([1.]))
+        >>> Controller("PI", {"kp": 2, "ki": 0}).tf()
+        (array([2.]), array([1.]))
         """
-        return self.kind.tf(self.parameters)
+        num, den = self.kind.tf(self.parameters)
+        while num.size > 1 and den.size > 1 and num[-1] == 0.0 and den[-1] == 0.0:
+            num, den = num[:-1], den[:-1]
+        return num, den
 
     def freqresp(self, w: Any) -> np.ndarray:
         """Complex response ``C(j w)``.

@@ -28,7 +28,14 @@ from pydantic import (
     model_validator,
 )
 
-from synth.controllers import CONTROLLER_TYPES, Controller, controller_type
+from synth.controllers import (
+    CONTROLLER_TYPES,
+    RATIONAL,
+    Controller,
+    ControllerType,
+    controller_type,
+    rational_type,
+)
 from synth.errors import ModelError, SpecError
 from synth.objectives import MEASURES
 from synth.plant import Plant, Signal
@@ -131,25 +138,60 @@ class PlantSpec(_Model):
 
 
 class ControllerSpec(_Model):
-    """Controller structure and parameter bounds (``[lo, hi]``; ``lo == hi`` fixes a parameter)."""
+    """Controller structure and parameter bounds (``[lo, hi]``; ``lo == hi`` fixes a parameter).
+
+    ``type: rational`` takes ``order: [m, n]`` (numerator and denominator degrees).
+    """
 
     type: str
+    order: tuple[int, int] | None = None
     bounds: dict[str, tuple[float, float]] = Field(default_factory=dict)
 
     @field_validator("type")
     @classmethod
     def _known_type(cls, name: str) -> str:
+        if str(name).lower() in (RATIONAL, "fixed_order"):
+            return RATIONAL
         try:
             return controller_type(name).name
         except ModelError as exc:
             raise ValueError(exc.message) from None
+
+    @field_validator("order")
+    @classmethod
+    def _order(cls, order: tuple[int, int] | None, info: ValidationInfo):
+        if info.data.get("type") == RATIONAL:
+            if order is None:
+                raise ValueError("a rational controller needs 'order: [m, n]' (numerator, denominator degree)")
+            try:
+                rational_type(*order)
+            except ModelError as exc:
+                raise ValueError(exc.message) from None
+        elif order is not None:
+            raise ValueError(f"'order' applies to rational controllers only, not {info.data.get('type')}")
+        return order
+
+    @model_validator(mode="after")
+    def _rational_needs_order(self) -> ControllerSpec:
+        if self.type == RATIONAL and self.order is None:
+            raise ValueError("a rational controller needs 'order: [m, n]' (numerator, denominator degree)")
+        return self
+
+    def kind(self) -> ControllerType:
+        """The :class:`~synth.controllers.ControllerType`."""
+        return controller_type(self.type, self.order)
 
     @field_validator("bounds")
     @classmethod
     def _check_bounds(cls, bounds: dict[str, tuple[float, float]], info: ValidationInfo):
         if "type" not in info.data:
             return bounds
-        ctype = CONTROLLER_TYPES[info.data["type"]]
+        if info.data["type"] == RATIONAL:
+            if info.data.get("order") is None:
+                return bounds
+            ctype = rational_type(*info.data["order"])
+        else:
+            ctype = CONTROLLER_TYPES[info.data["type"]]
         for name, (lo, hi) in bounds.items():
             if name not in ctype.parameters:
                 raise ValueError(
@@ -166,7 +208,7 @@ class ControllerSpec(_Model):
 
     def all_bounds(self) -> dict[str, tuple[float, float]]:
         """Bounds for every parameter (defaults where the spec gives none)."""
-        ctype = CONTROLLER_TYPES[self.type]
+        ctype = self.kind()
         return {p: tuple(self.bounds.get(p, ctype.default_bounds[p])) for p in ctype.parameters}
 
     def free_parameters(self) -> list[str]:

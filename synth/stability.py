@@ -82,7 +82,7 @@ def _characteristic_scale(*polys: np.ndarray, delay: float = 0.0) -> tuple[float
         p = trim(np.asarray(p, float))
         if p.size > 1:
             r = np.abs(np.roots(p))
-            mags.extend(r[r > 0].tolist())
+            mags.extend(r[r > 1e-10 * max(1.0, float(r.max()))].tolist())
     if delay > 0:
         mags.append(1.0 / delay)
     if not mags:
@@ -99,6 +99,8 @@ def _axis_poles(den: np.ndarray) -> tuple[int, int, list[tuple[float, int]]]:
         n_origin += 1
     roots = np.roots(den) if den.size > 1 else np.array([])
     tol = 1e-9 * np.maximum(1.0, np.abs(roots))
+    tiny = np.abs(roots) <= 1e-10 * max(1.0, float(np.abs(roots).max(initial=0.0)))
+    roots = np.where(tiny, 0.0, roots)  # numerically at the origin
     on_axis = np.abs(roots.real) <= tol
     n_rhp = int(np.sum((roots.real > 0) & ~on_axis))
     axis = []
@@ -188,6 +190,13 @@ def closed_loop_stability(num: np.ndarray, den: np.ndarray, delay: float = 0.0) 
     if num.size > den.size:
         raise ModelError("loop transfer function is improper")
     n_rhp, n_origin, axis = _axis_poles(den)
+    shared_origin = 0
+    while shared_origin < min(num.size, den.size) - 1 and num[-1 - shared_origin] == 0.0 \
+            and den[-1 - shared_origin] == 0.0:
+        shared_origin += 1
+    if delay > 0.0 and shared_origin and np.any(num):
+        # a pole at s = 0 cancelled by a zero: den(0) + num(0) exp(0) = 0, a closed-loop root at the origin
+        return StabilityResult(False, shared_origin, n_rhp, "Nyquist argument principle, exact delay", 0.0)
     if delay <= 0.0:
         char = np.polyadd(den, num)
         if char.size < den.size or char[0] == 0.0:

@@ -9,7 +9,7 @@ from typing import Any
 import numpy as np
 from jinja2 import Environment, PackageLoader
 
-from synth.controllers import CONTROLLER_TYPES, Controller
+from synth.controllers import Controller
 from synth.design import DesignResult, reference_controller, scalar_family
 from synth.loop import Loop
 from synth.outputs import GENERATOR, OutputDir, dump_json, to_jsonable
@@ -151,7 +151,7 @@ def write_design_report(spec: Spec, result: DesignResult, out_dir: str | Path, *
         description=spec.description,
         command=command or f"synth design SPEC --out {out.path}",
         plant=data["analysis"]["plant"],
-        structure=CONTROLLER_TYPES[spec.controller.type].formula + "; bounds "
+        structure=spec.controller.kind().formula + "; bounds "
         + ", ".join(f"{k} in [{fmt(a)}, {fmt(b)}]" for k, (a, b) in spec.controller.all_bounds().items()),
         columns=columns, rows=rows, gain=gain,
         figures={k: v.name for k, v in figs.items()},

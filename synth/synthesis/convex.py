@@ -37,13 +37,12 @@ from synth.stability import closed_loop_stability
 from synth.synthesis.convex_forms import (
     T0,
     Form,
-    LowerBoundOnReturnDifference,
-    MovingFloor,
-    UpperBoundOnRatio,
+    RatioBound,
+    bandwidth_floor,
     build_forms,
     make_points,
 )
-from synth.synthesis.parametrization import LinearParametrization
+from synth.synthesis.parametrization import Parametrization
 
 SOLVER = cp.CLARABEL
 _OK = {cp.OPTIMAL, cp.OPTIMAL_INACCURATE}
@@ -99,10 +98,14 @@ class Diagnosis:
     conflicts: list[RequirementConflict]
     bounds_active: list[str]
     controller: Controller
+    conflict_set: list[str] | None = None
 
     def conflicting(self) -> list[str]:
-        """Requirements that are violated, or met but pushing against them with a dual price of at
-        least 1 % of the largest."""
+        """A minimal set of requirements that cannot be met together (deletion filter) when computed;
+        otherwise those violated at the elastic solution or pushing against them (price >= 1 % of the
+        largest)."""
+        if self.conflict_set is not None:
+            return list(self.conflict_set)
         top = max((c.price for c in self.conflicts), default=0.0)
         return [c.name for c in self.conflicts if c.violated or (top > 0 and c.price >= 0.01 * top)]
 
@@ -110,6 +113,8 @@ class Diagnosis:
         return {
             "total_elastic_slack": self.total_slack,
             "conflicting": self.conflicting(),
+            "conflict_set_method": "deletion filter: each requirement dropped in turn; kept if the rest "
+                                   "became feasible" if self.conflict_set is not None else "elastic prices",
             "requirements": [c.to_dict() for c in self.conflicts],
             "bounds_active": self.bounds_active,
             "elastic_controller": self.controller.to_dict(),
@@ -176,7 +181,7 @@ class ConvexDesigner:
     names : list of str
         Display name of each requirement.
     plants : list of Plant
-    par : LinearParametrization
+    par : LinearParametrization or RationalParametrization
     objective : (name, sense) or None
         Measure to optimize; None minimizes peak |S| (the most robust design).
     settings : ConvexSettings
@@ -199,7 +204,7 @@ class ConvexDesigner:
     """
 
     def __init__(self, requirements: list[Requirement], names: list[str], plants: list[Plant],
-                 par: LinearParametrization, objective: tuple[str, str] | None,
+                 par: Parametrization, objective: tuple[str, str] | None,
                  settings: ConvexSettings | None = None) -> None:
         self.requirements, self.names, self.plants, self.par = requirements, names, plants, par
         self.objective = objective or ("peak_sensitivity", "minimize")
@@ -221,7 +226,10 @@ class ConvexDesigner:
         self._problems: dict[str, cp.Problem] = {}
         self._objective_form: Form | None = None
         self._gamma: cp.Variable | None = None
+        self._gamma_form: _ReturnDifferenceFloor | None = None
+        self._level = _Level()
         self._level_slack = cp.Variable(nonneg=True)
+        self._bracket = getattr(self, "_bracket", None)
 
     # ------------------------------------------------------------------ problems
     def _constraints(self, slacks: dict[str, Any]) -> list[cp.Constraint]:
@@ -243,17 +251,16 @@ class ConvexDesigner:
         if "objective" in self._problems:
             return self._problems["objective"]
         name, sense = self.objective
+        linear = self.par.ctype != "rational"
         cons = self._constraints({})
-        if name in ("integral_gain", "low_frequency_gain"):
+        if name in ("integral_gain", "low_frequency_gain") and linear:
             c = self._linear_objective(name)
             expr = c @ self.rho
             goal = cp.Maximize(expr) if sense == "maximize" else cp.Minimize(expr)
-        elif name == "peak_sensitivity" and sense == "minimize":
+        elif name == "peak_sensitivity" and sense == "minimize" and linear:
             self._gamma = cp.Variable()
-            form = LowerBoundOnReturnDifference("objective", make_points(self.plants, self.par, self.grid),
-                                                self.par.size, 1.0, elastic=False)
-            self._objective_form = form
-            cons += [form.lin.c + form.lin.R @ self.rho >= self._gamma]
+            self._gamma_form = _ReturnDifferenceFloor(make_points(self.plants, self.par, self.grid), self.par.size)
+            cons += self._gamma_form.constraints(self.rho, self._gamma)
             goal = cp.Maximize(self._gamma)
         else:
             form = self._level_form(name, sense)
@@ -268,25 +275,32 @@ class ConvexDesigner:
         if self.par.integrator_index is not None:
             c[self.par.integrator_index] = 1.0
         elif name == "low_frequency_gain":
-            c = self.par.dc_basis()
+            phi0 = self.par.basis(np.array([0.0]))[0]
+            c = np.real(np.where(np.isfinite(phi0), phi0, 0.0))
         else:
             raise SynthError("objective integral_gain needs a controller with integral action",
                              where="objective")
         return c
 
     def _level_form(self, name: str, sense: str) -> Form:
+        """The objective as a constraint whose level is bisected."""
         pts = make_points(self.plants, self.par, self.grid)
+        level = self._level
+        if self.par.ctype == "rational" and name in ("integral_gain", "low_frequency_gain") \
+                and sense == "maximize":
+            return _CoefficientRatioFloor(self.par, level)
         if name == "bandwidth" and sense == "maximize":
-            form = MovingFloor(name, pts, self.par.size, T0(self.plants, self.par))
-        elif name == "crossover" and sense == "maximize":
-            form = MovingFloor(name, pts, self.par.size, None)
-        elif name == "peak_complementary" and sense == "minimize":
-            form = UpperBoundOnRatio(name, pts, pts.A, self.par.size, 1.0)
-        elif name == "control_effort" and sense == "minimize":
-            form = UpperBoundOnRatio(name, pts, pts.phi, self.par.size, 1.0)
-        else:
-            raise SynthError(f"the convex stage cannot {sense} {name}", where="objective")
-        return form
+            return bandwidth_floor(name, pts, self.par.size, T0(self.plants, self.par), below=lambda: level.value)
+        if name == "crossover" and sense == "maximize":
+            return bandwidth_floor(name, pts, self.par.size, None, below=lambda: level.value)
+        ones = np.ones(pts.n)
+        if name == "peak_sensitivity" and sense == "minimize":
+            return RatioBound(name, pts.D, pts.P, lambda rho: level.value * ones, self.par.size)
+        if name == "peak_complementary" and sense == "minimize":
+            return RatioBound(name, pts.N, pts.P, lambda rho: level.value * ones, self.par.size)
+        if name == "control_effort" and sense == "minimize":
+            return RatioBound(name, pts.X, pts.P, lambda rho: level.value * ones, self.par.size)
+        raise SynthError(f"the convex stage cannot {sense} {name}", where="objective")
 
     # ------------------------------------------------------------------ solving
     def _solve(self, problem: cp.Problem) -> bool:
@@ -305,6 +319,8 @@ class ConvexDesigner:
             f.update(rho_c)
         if self._objective_form is not None:
             self._objective_form.update(rho_c)
+        if self._gamma_form is not None:
+            self._gamma_form.update(rho_c)
 
     def _stable(self, rho: np.ndarray) -> bool:
         c = self.par.controller(rho)
@@ -326,6 +342,8 @@ class ConvexDesigner:
     def _accept(self, rho_c: np.ndarray, rho_new: np.ndarray, keep_feasible: bool) -> np.ndarray:
         """Halve the step until the closed loop stays stable (and the met requirements stay met)."""
         base = self.grid_violations(rho_c) if keep_feasible else None
+        lo, hi = self.par.box()
+        rho_new = np.clip(rho_new, lo, hi)  # the solver meets bounds only to its tolerance
         step = rho_new - rho_c
         for _ in range(12):
             cand = rho_c + step
@@ -344,15 +362,7 @@ class ConvexDesigner:
         candidates = [initial] if initial is not None else []
         candidates.append(self.par.start())
         rng = np.random.default_rng(seed)
-        lo, hi = self.par.box()
-        lo = np.where(np.isfinite(lo), lo, -10.0)
-        hi = np.where(np.isfinite(hi), hi, 10.0)
-        for _ in range(300):
-            x = lo + (hi - lo) * rng.random(self.par.size) ** 3
-            if self.par.ctype == "leadlag":
-                z_lo, z_hi = self.par.bounds["z"]
-                x[1] = x[0] * (z_lo + (z_hi - z_lo) * rng.random())
-            candidates.append(x)
+        candidates += [self.par.random(rng) for _ in range(300)]
         found: list[np.ndarray] = []
         for c in candidates:
             if c is not None and self._stable(np.asarray(c, float)):
@@ -422,7 +432,7 @@ class ConvexDesigner:
     def optimize(self, rho_c: np.ndarray, history: list) -> tuple[np.ndarray, float]:
         """Phase 2 from a feasible ``rho_c``: the objective, every iterate feasible."""
         problem = self._objective_problem()
-        if isinstance(self._objective_form, (MovingFloor, UpperBoundOnRatio)):
+        if self._objective_form is not None:
             return self._bisect(rho_c, history)
         value = -np.inf
         for it in range(self.settings.max_iterations):
@@ -448,20 +458,25 @@ class ConvexDesigner:
 
     def _bisect(self, rho_c: np.ndarray, history: list) -> tuple[np.ndarray, float]:
         name, sense = self.objective
-        form = self._objective_form
         problem = self._problems["objective"]
         best_rho, best = rho_c, self.measure(rho_c)
         maximize = sense == "maximize"
-        if maximize:
+        if maximize and isinstance(self._objective_form, _CoefficientRatioFloor):
+            lo, hi = np.log(max(best, 1e-12)), np.log(self._objective_form.upper())
+        elif maximize:
             lo, hi = np.log(max(best, self.grid[0])), np.log(self.grid[-1])
         else:
             cap = 10 ** (best / 20) if name in ("peak_complementary", "control_effort") else best
             lo, hi = np.log(cap), np.log(cap) - np.log(1e3)
+        if self._bracket is not None:  # a refinement round: the optimum moved little, search near it
+            width = max(abs(self._bracket[1] - self._bracket[0]), 1e-3) * 20
+            hi = lo + np.sign(hi - lo) * min(abs(hi - lo), width)
         for step in range(self.settings.bisection_steps):
             level = float(np.exp(0.5 * (lo + hi)))
-            form.set_level(level)
+            self._level.value = level
             rho_try = best_rho
             ok = False
+            previous = np.inf
             for _ in range(self.settings.max_iterations // 3):
                 self._update(rho_try)
                 if not self._solve(problem):
@@ -470,6 +485,9 @@ class ConvexDesigner:
                 if problem.value <= 1e-7:
                     ok = True
                     break
+                if previous - problem.value < 1e-3 * previous:  # stalled: this level is out of reach
+                    break
+                previous = problem.value
             if ok:
                 value = self.measure(rho_try)
                 better = value > best if maximize else value < best
@@ -481,6 +499,7 @@ class ConvexDesigner:
             history.append({"phase": 2, "iteration": step, "level": level, "feasible": ok, "objective": best})
             if abs(hi - lo) < 1e-4:
                 break
+        self._bracket = (lo, hi)
         return best_rho, best
 
     def _violations(self, rho: np.ndarray) -> list[float]:
@@ -493,6 +512,14 @@ class ConvexDesigner:
                 if r.slack < 0 and r.binding_frequency and r.binding_frequency > 0:
                     freqs.append(r.binding_frequency)
         return freqs
+
+    def is_feasible(self, restarts: int = 6) -> bool:
+        """Phase 1 only, from up to ``restarts + 1`` stabilizing starts: can every requirement be met?"""
+        for rho0 in self.starts(None, restarts + 1):
+            _, total = self.feasible(rho0, [])
+            if total == 0.0:
+                return True
+        return False
 
     def run(self, initial: np.ndarray | None = None, refinements: int = 4, restarts: int = 6) -> ConvexResult:
         """Feasibility, then the objective; or a diagnosis when the requirements conflict.
@@ -534,3 +561,73 @@ class ConvexDesigner:
             self._build()
         return ConvexResult("optimal", self.par.controller(rho), rho, value, len(history), self.solves,
                             self.solve_time, history, None, self.grid.size, self.starts_tried)
+
+
+class _Level:
+    """The level an objective form is bisected on (a frequency or a magnitude)."""
+
+    value: float = 1.0
+
+
+class _ReturnDifferenceFloor(Form):
+    """``Re{(1 + L) conj(1 + L_c)}/|1 + L_c| >= gamma``: the largest lower bound on ``|1 + L|`` (linear
+    parametrizations), maximized to minimize peak |S|."""
+
+    name = "peak sensitivity objective"
+    elastic = False
+
+    def __init__(self, points, n_rho: int) -> None:
+        self.points = points
+        self.R = cp.Parameter((points.n, n_rho))
+        self.c = cp.Parameter(points.n)
+
+    def constraints(self, rho, gamma):
+        return [self.R @ rho + self.c >= gamma]
+
+    def update(self, rho_c):
+        P = self.points.P
+        u = P(rho_c)
+        mag = np.maximum(np.abs(u), 1e-300)
+        self.R.value = np.real(np.conj(u)[:, None] * P.Q) / mag[:, None]
+        self.c.value = np.real(np.conj(u) * P.q0) / mag
+
+
+class _CoefficientRatioFloor(Form):
+    """``X(0)/D'(0) >= t`` for a rational controller: the integral gain ``b0/a1`` with an integrator
+    (``a0 = 0``), else the DC gain ``b0/a0``; linear in ``rho`` for a fixed level ``t``:
+    ``b0 - t a_k >= 0``."""
+
+    name = "objective"
+
+    def __init__(self, par, level: _Level) -> None:
+        self.par, self.level = par, level
+        m, n = par.m, par.n
+        scale = par._scale()
+        self.num = np.zeros(par.size)
+        self.num[0] = scale[0]
+        k = 1 if par.has_integrator() else 0  # the denominator coefficient the ratio divides by
+        self.den = np.zeros(par.size)
+        self.den_const = 0.0
+        if k < n:
+            self.den[m + 1 + k] = scale[m + 1 + k]
+        else:
+            self.den_const = 1.0  # D = s^n exactly: the ratio is b0 itself
+        self.t = cp.Parameter(nonneg=True)
+
+    def constraints(self, rho, slack):
+        self._cons = [self.num @ rho - self.t * (self.den @ rho + self.den_const) >= -slack]
+        return self._cons
+
+    def update(self, rho_c):
+        self.t.value = float(self.level.value)
+
+    def violation(self, rho):
+        return float(self.level.value * (self.den @ rho + self.den_const) - self.num @ rho)
+
+    def upper(self) -> float:
+        """A level above any value the bounds allow."""
+        lo, hi = self.par.box()
+        top = float(np.max(np.abs(self.num * np.where(self.num != 0, np.maximum(np.abs(lo), np.abs(hi)), 0))))
+        den_lo = float(np.min((self.den * np.where(self.den != 0, np.maximum(lo, 0), 0))[self.den != 0],
+                              initial=np.inf)) if np.any(self.den) else self.den_const
+        return top / den_lo if den_lo > 0 else top * 1e6

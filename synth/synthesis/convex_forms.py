@@ -1,41 +1,46 @@
 """Convex constraints for each requirement around the current design (convex-concave procedure).
 
-At frequency ``w`` on plant ``G`` the loop is affine in ``rho``:
-``L(rho) = G(jw) phi(jw)^T rho = A rho``. Around the current design
-``rho_c`` with ``u = 1 + A rho_c``,
+With a parametrization in which ``C = X/D`` and ``L = N/D`` (``N = G X``) are
+ratios of quantities affine in ``rho`` (see :mod:`.parametrization`), every
+magnitude requirement reads ``|U(rho)| <= kappa |V(rho)|`` with ``U, V``
+affine. Around the current design ``rho_c`` with ``V_c = V(rho_c)``,
 
-    E(rho) = Re{(1 + A rho) conj(u)} / |u|  <=  |1 + A rho|
+    Re{V(rho) conj(V_c)} / |V_c|  <=  |V(rho)|
 
-is a linear lower bound of ``|1 + L|``, tight at ``rho_c`` (Hast, Astrom,
-Bernhardsson, Boyd 2013). Replacing ``|1 + L|`` by ``E`` in a constraint that
-needs ``|1 + L|`` large gives a convex *inner* approximation: whatever
-satisfies it satisfies the true constraint. Likewise
-``Re{L conj(L_c)}/|L_c| <= |L|``.
+is a linear lower bound, tight at ``rho_c`` (Hast, Astrom, Bernhardsson, Boyd
+2013; for ``C = X/D``: Karimi and Kammer 2017). Replacing ``|V|`` by it gives a
+second-order cone that is an *inner* approximation: whatever satisfies it
+satisfies the true requirement.
 
-=====================  ===================================================  ===========
-requirement            convex form (per frequency, per plant)               kind
-=====================  ===================================================  ===========
-sensitivity, peak |S|  E(rho) >= 1/m                                        linear
-peak |T| <= M          |A rho| <= M E(rho)                                  SOC
-peak |KS| <= M         |phi rho| <= M E(rho)                                SOC
-slew rate              |phi rho| <= B / (De w)                              SOC (exact)
-static sensitivity     E at w = 0 with G = plant gain                       linear
-bandwidth >= wb        l |1 + A rho| <= Re{A rho conj(L_c)}/|L_c|, w <= wb  SOC
-bandwidth <= wb        |A rho| <= l E(rho) at wb                            SOC
-margins                Re{conj(n) (A rho - p1)} >= 0 near crossover          linear
-stability kept         E(rho) >= delta at every frequency                   linear
-=====================  ===================================================  ===========
+=====================  =========  =========  ===================
+requirement            U          V          kappa
+=====================  =========  =========  ===================
+|S| <= m               D          D + N      m
+|T| <= M               N          D + N      M
+|KS| <= M              X          D + N      M
+slew rate              X          D          B / (De w)
+static sensitivity     D(0)       D(0)+gX(0) m
+bandwidth >= wb        D + N      N          1 / (l T0), w <= wb
+bandwidth <= wb        N          D + N      l T0, at wb
+crossover >= wc        D          N          1, w <= wc
+stability kept         D          D + N      1 / delta
+=====================  =========  =========  ===================
 
-Every bound is tightened by :data:`BACKOFF` (1e-4 relative) so that a design
-that is tight on the grid still meets the exact requirement between grid
-points. Every form takes an elastic slack ``s >= 0`` (zero in the normal problem)
-measured in the same normalized units, used to diagnose infeasible specs.
-Constants that change with ``rho_c`` are cvxpy Parameters, so the problem is
-compiled once (DPP) and re-solved with new values at each iteration.
+For linear parametrizations (``D = 1``) the slew-rate cone is exact and
+``|S|`` bounds are linear. Gain and phase margins become a half-plane in the
+Nyquist plane near crossover (linear parametrizations only; for rational
+controllers the NLP stage enforces margins). Every bound is tightened by
+:data:`BACKOFF` (1e-4 relative) so that a design that is tight on the grid
+still meets the exact requirement between grid points. Every form takes an
+elastic slack ``s >= 0`` in relative units (the constraint reads
+``|U|/(kappa |V|) <= 1 + s`` at the linearization point), used to diagnose
+infeasible specs. Constants that change with ``rho_c`` are cvxpy Parameters:
+the problem compiles once (DPP).
 """
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
@@ -56,41 +61,55 @@ from synth.requirements import (
 )
 from synth.requirements.base import Requirement
 from synth.requirements.control_sensitivity import PeakControlSensitivity
-from synth.synthesis.parametrization import LinearParametrization
+from synth.synthesis.parametrization import Affine, Parametrization
+
+BACKOFF = 1e-4
+"""Relative tightening of every convex bound (about 0.001 dB)."""
 
 
 @dataclass
 class Points:
-    """Frequency points of one form on every plant: ``A[i] = G_p(j w_i) phi(j w_i)``."""
+    """Frequency points of one form on every plant, with the loop's affine parts there."""
 
-    w: np.ndarray          # (n,)
+    w: np.ndarray  # (n,)
     plant_index: np.ndarray  # (n,)
-    A: np.ndarray          # (n, n_rho) complex, loop per unit rho
-    phi: np.ndarray        # (n, n_rho) complex, controller per unit rho
+    N: Affine  # loop numerator G X
+    D: Affine  # controller denominator
+    X: Affine  # controller numerator
 
     @property
     def n(self) -> int:
         return self.w.size
 
+    @property
+    def P(self) -> Affine:
+        """``D + N`` (the return difference times D)."""
+        return self.D + self.N
 
-def make_points(plants: list[Plant], par: LinearParametrization, w: np.ndarray) -> Points:
-    """Stack the frequencies ``w`` over every plant.
 
-    Frequencies where the basis is infinite (``w = 0`` with integral action, where
-    ``|1 + L|`` is infinite too) are left out.
-    """
+def make_points(plants: list[Plant], par: Parametrization, w: np.ndarray,
+                gains: list[complex] | None = None) -> Points:
+    """Stack the frequencies ``w`` over every plant (``gains`` replaces the plant response, e.g. by a
+    stated static gain). Frequencies where the controller is infinite (``w = 0`` with an integrator,
+    where ``|1 + L|`` is infinite too) are left out."""
     w = np.asarray(w, dtype=float)
-    phi = par.basis(w)
-    finite = np.all(np.isfinite(phi), axis=1)
-    w, phi = w[finite], phi[finite]
-    A, idx, ws, phis = [], [], [], []
+    X, D = par.numerator(w), par.denominator(w)
+    finite = np.all(np.isfinite(X.Q), axis=1) & np.isfinite(X.q0) & (
+        np.abs(D.q0) + np.sum(np.abs(D.Q), axis=1) > 0)
+    w, X, D = w[finite], X.rows(finite), D.rows(finite)
+    Ns, Ds, Xs, idx, ws = [], [], [], [], []
     for i, plant in enumerate(plants):
-        G = plant.freqresp(w)
-        A.append(G[:, None] * phi)
+        G = plant.freqresp(w) if gains is None else np.full(w.size, gains[i], complex)
+        Ns.append(X.scaled(G))
+        Ds.append(D)
+        Xs.append(X)
         idx.append(np.full(w.size, i))
         ws.append(w)
-        phis.append(phi)
-    return Points(np.concatenate(ws), np.concatenate(idx), np.concatenate(A), np.concatenate(phis))
+
+    def stack(parts: list[Affine]) -> Affine:
+        return Affine(np.concatenate([p.q0 for p in parts]), np.concatenate([p.Q for p in parts]))
+
+    return Points(np.concatenate(ws), np.concatenate(idx), stack(Ns), stack(Ds), stack(Xs))
 
 
 class Form:
@@ -110,195 +129,75 @@ class Form:
         ``<= 0`` when met."""
         return -np.inf
 
-    def slack_coefficient(self) -> Any:
-        """How the elastic slack enters each constraint row (1 when it is added as is)."""
-        return 1.0
-
     def price(self) -> float:
-        """Dual price of this requirement after an elastic solve: the rate at which the total violation
-        would fall per unit relaxation of this requirement (same normalized units for every one)."""
+        """Dual price after an elastic solve: the rate at which the total violation would fall per
+        unit relative relaxation of this requirement."""
         total = 0.0
         for c in getattr(self, "_cons", []):
             if c.dual_value is not None:
-                total += float(np.sum(np.abs(c.dual_value) * self.slack_coefficient()))
+                total += float(np.sum(np.abs(c.dual_value)))
         return total
 
 
-class _Linearization:
-    """Parameters of ``E(rho) = c + R rho`` (lower bound of |1 + A rho| scaled by ``scale``)."""
-
-    def __init__(self, points: Points, n_rho: int) -> None:
-        self.points = points
-        self.R = cp.Parameter((points.n, n_rho))
-        self.c = cp.Parameter(points.n)
-
-    def set(self, rho_c: np.ndarray, scale: np.ndarray | float = 1.0) -> np.ndarray:
-        u = 1.0 + self.points.A @ rho_c
-        mag = np.maximum(np.abs(u), 1e-12)
-        self.R.value = (np.real(np.conj(u)[:, None] * self.points.A) / mag[:, None]) * np.reshape(scale, (-1, 1))
-        self.c.value = np.real(u) / mag * scale
-        return u
+Kappa = Callable[[np.ndarray], np.ndarray]
 
 
-class LowerBoundOnReturnDifference(Form):
-    """``|1 + L| >= 1/m`` at given points: sensitivity bands, peak |S|, static sensitivity, stability."""
+class RatioBound(Form):
+    """``|U(rho)| <= kappa |V(rho)|`` at every point, as ``|U|/(kappa |V_c|) <= Re{V conj(V_c)}/|V_c|^2 + s``.
 
-    def __init__(self, name: str, points: Points, n_rho: int, level: float, elastic: bool = True) -> None:
-        self.name, self.points, self.level, self.elastic = name, points, level, elastic
-        self.lin = _Linearization(points, n_rho)
-
-    def constraints(self, rho, slack):
-        e = self.lin.c + self.lin.R @ rho
-        self._cons = [e >= self.level * (1 - slack)] if self.elastic else [e >= self.level]
-        return self._cons
-
-    def update(self, rho_c):
-        self.lin.set(rho_c)
-
-    def violation(self, rho):
-        if self.points.n == 0:
-            return -np.inf
-        return float(np.max(self.level - np.abs(1.0 + self.points.A @ rho)) / self.level)
-
-    def slack_coefficient(self):
-        return self.level
-
-
-class UpperBoundOnRatio(Form):
-    """``|N rho| <= M |1 + A rho|`` via ``|N rho| <= M E(rho)``: peak |T| (N = A) and |KS| (N = phi)."""
-
-    def __init__(self, name: str, points: Points, numerator: np.ndarray, n_rho: int, level: float) -> None:
-        self.name, self.points, self.level = name, points, level
-        self.Nre, self.Nim = np.real(numerator), np.imag(numerator)
-        self.lin = _Linearization(points, n_rho)
-
-    def constraints(self, rho, slack):
-        mag = cp.norm(cp.vstack([self.Nre @ rho, self.Nim @ rho]), 2, axis=0)
-        self._cons = [mag <= self.lin.c + self.lin.R @ rho + slack]
-        return self._cons
-
-    def update(self, rho_c):
-        self.lin.set(rho_c, scale=self.level)
-
-    def set_level(self, level: float) -> None:
-        """Move the bound ``M`` (used when the objective bisects on it)."""
-        self.level = level
-
-    def violation(self, rho):
-        num = np.abs(np.complex128(self.Nre + 1j * self.Nim) @ rho)
-        return float(np.max(num - self.level * np.abs(1.0 + self.points.A @ rho)) / self.level)
-
-
-class SlewForm(Form):
-    """``De |C(jw)| w <= B``: exact second-order cones (no linearization)."""
-
-    def __init__(self, name: str, w: np.ndarray, phi: np.ndarray, limit: np.ndarray) -> None:
-        self.name = name
-        self.Pre, self.Pim, self.limit = np.real(phi), np.imag(phi), limit
-
-    def constraints(self, rho, slack):
-        mag = cp.norm(cp.vstack([self.Pre @ rho, self.Pim @ rho]), 2, axis=0)
-        self._cons = [mag <= self.limit * (1 + slack)]
-        return self._cons
-
-    def violation(self, rho):
-        mag = np.abs((self.Pre + 1j * self.Pim) @ rho)
-        return float(np.max((mag - self.limit) / self.limit)) if mag.size else -np.inf
-
-    def slack_coefficient(self):
-        return self.limit
-
-
-class BandwidthFloor(Form):
-    """``|T(jw)| >= l T0`` for every ``w <= wb`` via ``l T0 |1 + A rho| <= Re{A rho conj(L_c)}/|L_c|``."""
-
-    def __init__(self, name: str, points: Points, n_rho: int, t0: T0) -> None:
-        self.name, self.points, self.t0 = name, points, t0
-        self.Q = cp.Parameter((points.n, n_rho))
-        self.Are, self.Aim = np.real(points.A), np.imag(points.A)
-
-    def constraints(self, rho, slack):
-        mag = cp.norm(cp.vstack([1 + self.Are @ rho, self.Aim @ rho]), 2, axis=0)
-        self._cons = [mag <= self.Q @ rho + slack]
-        return self._cons
-
-    def update(self, rho_c):
-        Lc = self.points.A @ rho_c
-        mag = np.maximum(np.abs(Lc), 1e-12)
-        level = BANDWIDTH_LEVEL * self.t0.value(rho_c, self.points.plant_index)
-        self.Q.value = np.real(np.conj(Lc)[:, None] * self.points.A) / (mag * level)[:, None]
-
-    def violation(self, rho):
-        L = self.points.A @ rho
-        level = BANDWIDTH_LEVEL * self.t0.value(rho, self.points.plant_index)
-        return float(np.max(level * np.abs(1.0 + L) - np.abs(L)))
-
-
-class MovingFloor(Form):
-    """A floor whose frequency is bisected by the objective: bandwidth (``|T| >= l T0`` for ``w <= wb``)
-    or, with ``t0 = None``, crossover (``|L| >= 1`` for ``w <= wc``, via ``Re{A rho conj(L_c)}/|L_c| >= 1``).
+    ``kappa`` is a number, an array over the points, or a function of ``rho_c``
+    returning such an array (when it depends on the design, e.g. ``T0``).
+    ``active`` (a function of ``rho_c`` returning a boolean mask) switches rows
+    off; an inactive row reads ``0 <= 1 + s``.
     """
 
-    def __init__(self, name: str, points: Points, n_rho: int, t0: T0 | None) -> None:
-        self.name, self.points, self.t0 = name, points, t0
-        self.mask = cp.Parameter(points.n, nonneg=True)
-        self.Q = cp.Parameter((points.n, n_rho))
-        self.Are, self.Aim = np.real(points.A), np.imag(points.A)
-        self.level = float(points.w.min())
+    def __init__(self, name: str, U: Affine, V: Affine, kappa: float | np.ndarray | Kappa, n_rho: int,
+                 elastic: bool = True, active: Callable[[np.ndarray], np.ndarray] | None = None) -> None:
+        self.name, self.U, self.V, self.elastic = name, U, V, elastic
+        self.kappa = kappa
+        self.active = active
+        n = U.q0.size
+        self.Ure, self.Uim = cp.Parameter((n, n_rho)), cp.Parameter((n, n_rho))
+        self.u0re, self.u0im = cp.Parameter(n), cp.Parameter(n)
+        self.R, self.c = cp.Parameter((n, n_rho)), cp.Parameter(n)
 
-    def set_level(self, w: float) -> None:
-        """Move the frequency below which the floor holds."""
-        self.level = w
+    def _kappa(self, rho: np.ndarray) -> np.ndarray:
+        k = self.kappa(rho) if callable(self.kappa) else self.kappa
+        return np.broadcast_to(np.asarray(k, float), self.U.q0.shape)
 
     def constraints(self, rho, slack):
-        if self.t0 is None:
-            self._cons = [self.mask <= self.Q @ rho + slack]
-        else:
-            mag = cp.norm(cp.vstack([1 + self.Are @ rho, self.Aim @ rho]), 2, axis=0)
-            self._cons = [cp.multiply(self.mask, mag) <= self.Q @ rho + slack]
+        mag = cp.norm(cp.vstack([self.Ure @ rho + self.u0re, self.Uim @ rho + self.u0im]), 2, axis=0)
+        rhs = self.R @ rho + self.c
+        self._cons = [mag <= rhs + slack] if self.elastic else [mag <= rhs]
         return self._cons
 
     def update(self, rho_c):
-        Lc = self.points.A @ rho_c
-        mag = np.maximum(np.abs(Lc), 1e-12)
-        active = (self.points.w <= self.level).astype(float)
-        self.mask.value = active
-        level = np.ones(self.points.n) if self.t0 is None else (
-            BANDWIDTH_LEVEL * self.t0.value(rho_c, self.points.plant_index))
-        self.Q.value = active[:, None] * np.real(np.conj(Lc)[:, None] * self.points.A) / (mag * level)[:, None]
+        Vc = self.V(rho_c)
+        mag = np.maximum(np.abs(Vc), 1e-300)
+        on = np.ones(mag.size, bool) if self.active is None else self.active(rho_c)
+        scale = np.where(on, 1.0 / (self._kappa(rho_c) * mag), 0.0)
+        self.Ure.value = np.real(self.U.Q) * scale[:, None]
+        self.Uim.value = np.imag(self.U.Q) * scale[:, None]
+        self.u0re.value = np.real(self.U.q0) * scale
+        self.u0im.value = np.imag(self.U.q0) * scale
+        w = np.where(on, 1.0 / mag**2, 0.0)
+        self.R.value = np.real(np.conj(Vc)[:, None] * self.V.Q) * w[:, None]
+        self.c.value = np.where(on, np.real(np.conj(Vc) * self.V.q0) / mag**2, 1.0)
 
     def violation(self, rho):
-        L = self.points.A @ rho
-        active = self.points.w <= self.level
-        if not np.any(active):
+        if self.U.q0.size == 0:
             return -np.inf
-        if self.t0 is None:
-            return float(np.max(1.0 - np.abs(L[active])))
-        level = BANDWIDTH_LEVEL * self.t0.value(rho, self.points.plant_index)
-        return float(np.max((level * np.abs(1.0 + L) - np.abs(L))[active]))
+        ratio = np.abs(self.U(rho)) / (self._kappa(rho) * np.maximum(np.abs(self.V(rho)), 1e-300))
+        if self.active is not None:
+            on = self.active(rho)
+            if not np.any(on):
+                return -np.inf
+            ratio = ratio[on]
+        return float(np.max(ratio - 1.0))
 
-
-class BandwidthCeiling(Form):
-    """``|T(j wb)| <= l T0`` (the -3 dB crossing happens before ``wb``)."""
-
-    def __init__(self, name: str, points: Points, n_rho: int, t0: T0) -> None:
-        self.name, self.points, self.t0 = name, points, t0
-        self.Are, self.Aim = np.real(points.A), np.imag(points.A)
-        self.lin = _Linearization(points, n_rho)
-
-    def constraints(self, rho, slack):
-        mag = cp.norm(cp.vstack([self.Are @ rho, self.Aim @ rho]), 2, axis=0)
-        self._cons = [mag <= self.lin.c + self.lin.R @ rho + slack]
-        return self._cons
-
-    def update(self, rho_c):
-        level = BANDWIDTH_LEVEL * self.t0.value(rho_c, self.points.plant_index)
-        self.lin.set(rho_c, scale=level)
-
-    def violation(self, rho):
-        L = self.points.A @ rho
-        level = BANDWIDTH_LEVEL * self.t0.value(rho, self.points.plant_index)
-        return float(np.max(np.abs(L) - level * np.abs(1.0 + L)))
+    def set_level(self, level: float) -> None:
+        """Move a level used by ``kappa``/``active`` (objectives bisect on it)."""
+        self.level = level
 
 
 class HalfPlane(Form):
@@ -306,7 +205,8 @@ class HalfPlane(Form):
 
     The boundary passes through ``-1/g`` and ``exp(j(-180 + phi))``; if that
     line would not protect the phase margin, the vertical line through the
-    phase-margin point is used. Applied where ``0.1 <= |L_c| <= 10``.
+    phase-margin point is used. Applied where ``0.1 <= |L_c| <= 10``. Linear
+    parametrizations only (``D = 1``).
     """
 
     def __init__(self, name: str, points: Points, n_rho: int, gm_db: float | None, pm_deg: float | None) -> None:
@@ -331,94 +231,113 @@ class HalfPlane(Form):
         self._cons = [self.H @ rho - self.h >= -slack]
         return self._cons
 
+    def _mask(self, L: np.ndarray) -> np.ndarray:
+        return (np.abs(L) >= 0.1) & (np.abs(L) <= 10.0)
+
     def violation(self, rho):
-        L = self.points.A @ rho
-        mask = (np.abs(L) >= 0.1) & (np.abs(L) <= 10.0)
+        L = self.points.N(rho)
+        mask = self._mask(L)
         if not np.any(mask):
             return -np.inf
         return float(np.max(-np.real(np.conj(self.normal) * (L[mask] - self.anchor))))
 
     def update(self, rho_c):
-        Lc = self.points.A @ rho_c
-        mask = ((np.abs(Lc) >= 0.1) & (np.abs(Lc) <= 10.0)).astype(float)
+        mask = self._mask(self.points.N(rho_c)).astype(float)
         nbar = np.conj(self.normal)
-        self.H.value = mask[:, None] * np.real(nbar * self.points.A)
-        self.h.value = mask * np.real(nbar * self.anchor)
+        self.H.value = mask[:, None] * np.real(nbar * self.points.N.Q)
+        self.h.value = mask * np.real(nbar * (self.anchor - self.points.N.q0))
 
 
 class T0:
-    """``|T(0)|`` per plant at the current design (1 with integral action), times ``1 + backoff``."""
+    """``|T(0)|`` per plant at a design (1 with integral action)."""
 
-    def __init__(self, plants: list[Plant], par: LinearParametrization, backoff: float = 0.0) -> None:
+    def __init__(self, plants: list[Plant], par: Parametrization) -> None:
         self.gains = np.array([p.dc_gain() for p in plants])
-        self.dc = par.dc_basis()
-        self.factor = 1.0 + backoff
+        self.par = par
 
     def value(self, rho: np.ndarray, plant_index: np.ndarray) -> np.ndarray:
-        if self.dc is None:
-            return np.full(plant_index.size, self.factor)
-        l0 = self.gains[plant_index] * float(self.dc @ rho)
-        return self.factor * np.abs(l0 / (1.0 + l0))
+        c0 = self.par.dc_ratio(rho)
+        if np.isinf(c0):
+            return np.ones(plant_index.size)
+        l0 = self.gains[plant_index] * c0
+        return np.abs(l0 / (1.0 + l0))
 
 
-def _requirement_points(req: Any, plants: list[Plant], par: LinearParametrization, grid: np.ndarray,
+def sensitivity_form(name: str, pts: Points, n_rho: int, m: float, elastic: bool = True) -> RatioBound:
+    """``|S| <= m``."""
+    return RatioBound(name, pts.D, pts.P, m, n_rho, elastic)
+
+
+def bandwidth_floor(name: str, pts: Points, n_rho: int, t0: T0 | None, tighten: float = 1.0,
+                    below: Callable[[], float] | None = None) -> RatioBound:
+    """``|T| >= l T0`` (or ``|L| >= 1`` with ``t0=None``: a crossover floor) at the points, or only
+    below the frequency returned by ``below()``."""
+    if t0 is None:
+        U, V, kappa = pts.D, pts.N, tighten
+    else:
+        U, V = pts.P, pts.N
+
+        def kappa(rho: np.ndarray) -> np.ndarray:
+            return tighten / (BANDWIDTH_LEVEL * t0.value(rho, pts.plant_index))
+    active = None if below is None else (lambda rho: pts.w <= below())
+    return RatioBound(name, U, V, kappa, n_rho, active=active)
+
+
+def _requirement_points(req: Any, plants: list[Plant], par: Parametrization, grid: np.ndarray,
                         auto: tuple[float, float], per_decade: int) -> Points:
     band = getattr(req, "band", None)
     w = band_grid(band, auto, per_decade) if band is not None else grid
     return make_points(plants, par, w)
 
 
-BACKOFF = 1e-4
-"""Relative tightening of every convex bound (about 0.001 dB), so that designs that are tight on the
-grid still meet the exact requirement between grid points."""
-
-
 def build_forms(requirements: list[Requirement], names: list[str], plants: list[Plant],
-                par: LinearParametrization, grid: np.ndarray, per_decade: int,
+                par: Parametrization, grid: np.ndarray, per_decade: int,
                 stability_level: float, backoff: float = BACKOFF) -> list[Form]:
     """One form per requirement (plus the stability-keeping form), in spec order."""
     auto = (float(grid[0]), float(grid[-1]))
     forms: list[Form] = []
-    t0 = T0(plants, par, backoff)
-    up, down = 1.0 + backoff, 1.0 - backoff
+    t0 = T0(plants, par)
+    tight = 1.0 - backoff
+    linear = par.ctype != "rational"
     for name, req in zip(names, requirements):
         if isinstance(req, (Sensitivity, PeakSensitivity)):
             pts = _requirement_points(req, plants, par, grid, auto, per_decade)
-            forms.append(LowerBoundOnReturnDifference(name, pts, par.size, up * 10 ** (-req.max_db / 20)))
+            forms.append(sensitivity_form(name, pts, par.size, tight * 10 ** (req.max_db / 20)))
         elif isinstance(req, StaticSensitivity):
-            w0 = np.array([0.0]) if par.dc_basis() is not None else np.array([grid[0] * 1e-3])
-            phi = par.basis(w0)
             gains = [req.plant_gain if req.plant_gain is not None else p.dc_gain() for p in plants]
-            A = np.concatenate([g * phi for g in gains])
-            pts = Points(np.repeat(w0, len(plants)), np.arange(len(plants)), A,
-                         np.concatenate([phi] * len(plants)))
-            forms.append(LowerBoundOnReturnDifference(name, pts, par.size, up * 10 ** (-req.max_db / 20)))
+            w0 = np.array([0.0]) if not par.has_integrator() else np.array([grid[0] * 1e-3])
+            pts = make_points(plants, par, w0, gains)
+            forms.append(sensitivity_form(name, pts, par.size, tight * 10 ** (req.max_db / 20)))
         elif isinstance(req, PeakComplementary):
             pts = _requirement_points(req, plants, par, grid, auto, per_decade)
-            forms.append(UpperBoundOnRatio(name, pts, pts.A, par.size, down * 10 ** (req.max_db / 20)))
+            forms.append(RatioBound(name, pts.N, pts.P, tight * 10 ** (req.max_db / 20), par.size))
         elif isinstance(req, PeakControlSensitivity):
             pts = _requirement_points(req, plants, par, grid, auto, per_decade)
-            forms.append(UpperBoundOnRatio(name, pts, pts.phi, par.size, down * 10 ** (req.max_db / 20)))
+            forms.append(RatioBound(name, pts.X, pts.P, tight * 10 ** (req.max_db / 20), par.size))
         elif isinstance(req, SlewRate):
             w = band_grid(req.band, auto, per_decade)
-            w = w[w > 0]
-            forms.append(SlewForm(name, w, par.basis(w), down * req.rate_limit / (req.max_error * w)))
+            pts = make_points(plants[:1], par, w[w > 0])
+            forms.append(RatioBound(name, pts.X, pts.D, tight * req.rate_limit / (req.max_error * pts.w),
+                                    par.size))
         elif isinstance(req, Bandwidth):
             if req.min is not None:
                 w = np.unique(np.concatenate([grid[grid < req.min], [req.min]]))
-                forms.append(BandwidthFloor(name, make_points(plants, par, w), par.size, t0))
+                forms.append(bandwidth_floor(name, make_points(plants, par, w), par.size, t0, tight))
             if req.max is not None:
-                forms.append(BandwidthCeiling(name, make_points(plants, par, np.array([req.max])), par.size,
-                                              T0(plants, par, -backoff)))
+                pts = make_points(plants, par, np.array([req.max]))
+
+                def kappa(rho: np.ndarray, pts: Points = pts) -> np.ndarray:
+                    return tight * BANDWIDTH_LEVEL * t0.value(rho, pts.plant_index)
+                forms.append(RatioBound(name, pts.N, pts.P, kappa, par.size))
         elif isinstance(req, MarginsRequirement):
-            if req.gain_margin_db is not None or req.phase_margin_deg is not None:
+            if linear and (req.gain_margin_db is not None or req.phase_margin_deg is not None):
                 forms.append(HalfPlane(name, make_points(plants, par, grid), par.size,
-                                       None if req.gain_margin_db is None else req.gain_margin_db * up,
-                                       None if req.phase_margin_deg is None else req.phase_margin_deg * up))
-            # a delay margin has no convex form here: the NLP stage and the certificate enforce it
+                                       None if req.gain_margin_db is None else req.gain_margin_db / tight,
+                                       None if req.phase_margin_deg is None else req.phase_margin_deg / tight))
+            # a delay margin (and rational-controller margins) have no convex form here: the NLP stage
+            # and the certificate enforce them
         else:
             raise TypeError(f"no convex form for requirement type {req.type}")
-    forms.append(LowerBoundOnReturnDifference("stability (kept along the iterations)",
-                                              make_points(plants, par, grid), par.size, stability_level,
-                                              elastic=False))
+    forms.append(sensitivity_form("stability (kept along the iterations)", make_points(plants, par, grid),
+                                  par.size, 1.0 / stability_level, elastic=False))
     return forms

@@ -105,12 +105,22 @@ def _convex_runs(spec: Spec, settings: ConvexSettings) -> list[tuple[ConvexDesig
     names = _unique_names(requirements)
     name, sense, _ = _objective_terms(spec)[0]
     runs = []
+    w0 = _reference_frequency(spec)
     for v in values:
         b = dict(bounds) if key is None else {**bounds, key: (v, v)}
-        par = parametrize(ctype, b)
+        par = parametrize(ctype, b, spec.controller.order, w0)
         designer = ConvexDesigner(requirements, names, spec.plants(), par, (name, sense), settings)
         runs.append((designer, designer.run()))
     return runs
+
+
+def _reference_frequency(spec: Spec) -> float:
+    """Geometric mean of the nominal plant's corner frequencies (scales rational coefficients)."""
+    from synth.freqgrid import characteristic_range
+
+    p = spec.nominal_plant()
+    lo, hi = characteristic_range(p.num, p.den, delay=p.delay)
+    return float(np.sqrt(lo * hi))
 
 
 def _certify(spec: Spec, controller: Controller, per_decade: int) -> Certificate:
@@ -171,6 +181,7 @@ def _design(spec: Spec, settings: ConvexSettings, nlp: bool) -> DesignResult:
                           + "): not reported as a solution.") + reference_verdict(spec, ref)
         return result
     worst = min(runs, key=lambda dr: dr[1].diagnosis.total_slack)[1]
+    worst.diagnosis.conflict_set = conflict_set(spec, settings)
     compromise = check(spec, worst.controller)
     result = DesignResult(spec.name, False, None, None, None, None, None, compromise, method, reference=ref,
                           extras=extras)
@@ -182,6 +193,34 @@ def _design(spec: Spec, settings: ConvexSettings, nlp: bool) -> DesignResult:
                     "certificate (" + "; ".join(r.message for r in certificate.check.failed()) + ").")
     result.verdict = infeasible_verdict(worst, compromise) + nlp_note + reference_verdict(spec, ref)
     return result
+
+
+def conflict_set(spec: Spec, settings: ConvexSettings) -> list[str]:
+    """A minimal set of requirements that cannot be met together (deletion filter).
+
+    Each requirement is dropped in turn; if the others are still infeasible it
+    is left out for good, else it is kept. Feasibility is tested by the convex
+    phase 1 from several stabilizing starts (a local method: a kept requirement
+    is one whose removal let it find a design).
+    """
+    requirements = list(spec.requirements)
+    names = _unique_names(requirements)
+    keep = list(range(len(requirements)))
+    key = STRUCTURAL.get(spec.controller.type)
+    bounds = spec.controller.all_bounds()
+    if key and bounds[key][0] < bounds[key][1]:
+        lo, hi = bounds[key]
+        bounds = {**bounds, key: (float(np.sqrt(lo * hi)) if lo > 0 else 0.5 * (lo + hi),) * 2}
+    par = parametrize(spec.controller.type, bounds, spec.controller.order, _reference_frequency(spec))
+    for i in list(keep):
+        trial = [k for k in keep if k != i]
+        if not trial:
+            continue
+        designer = ConvexDesigner([requirements[k] for k in trial], [names[k] for k in trial], spec.plants(),
+                                  par, None, settings)
+        if not designer.is_feasible():
+            keep = trial
+    return [names[k] for k in keep]
 
 
 def _describe(spec: Spec, label: dict) -> str:
@@ -208,7 +247,8 @@ def infeasible_verdict(convex: ConvexResult, compromise: CheckResult | None = No
                      + ", ".join(f"{c.name} (price {c.price:.3g})" for c in pushing) + ".")
     if diag.bounds_active:
         parts.append("Active parameter bounds: " + ", ".join(diag.bounds_active) + ".")
-    parts.append("Conflicting requirements: " + ", ".join(diag.conflicting()) + ".")
+    parts.append("Conflicting requirements (a minimal set that cannot be met together): "
+                 + ", ".join(diag.conflicting()) + ".")
     return " ".join(parts)
 
 

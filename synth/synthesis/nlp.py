@@ -39,7 +39,7 @@ from typing import Any
 import casadi as ca
 import numpy as np
 
-from synth.controllers import CONTROLLER_TYPES, Controller
+from synth.controllers import RATIONAL, Controller, rational_order
 from synth.freqgrid import band_grid
 from synth.loop import BANDWIDTH_LEVEL, Loop
 from synth.plant import Plant
@@ -84,13 +84,14 @@ class SymbolicController:
 
     def __init__(self, ctype: str, start: Controller, bounds: dict[str, tuple[float, float]]) -> None:
         self.ctype = ctype
-        kind = CONTROLLER_TYPES[ctype]
+        kind = start.kind
         self.free = [p for p in kind.parameters if bounds[p][0] < bounds[p][1]]
         self.fixed = {p: bounds[p][0] for p in kind.parameters if bounds[p][0] == bounds[p][1]}
         self.bounds = bounds
         x0 = np.array([start.parameters[p] for p in self.free], float)
         span = np.array([bounds[p][1] - bounds[p][0] for p in self.free], float)
-        self.scale = np.maximum(np.abs(x0), np.where(np.isfinite(span), 1e-3 * span, 1e-3))
+        # variables of order one: scaled by their start value, or by 1 % of their range when that is larger
+        self.scale = np.maximum(np.abs(x0), np.where(np.isfinite(span), 1e-2 * span, 1.0))
         self.scale = np.where(self.scale > 0, self.scale, 1.0)
         self.u = ca.SX.sym("u", len(self.free))
         self.u0 = x0 / self.scale
@@ -114,6 +115,11 @@ class SymbolicController:
             return Cx(v["kp"], -v["ki"] / w) + v["kd"] * jw / (v["tf"] * jw + 1.0)
         if self.ctype == "leadlag":
             return v["k"] * (jw + v["z"]) / (jw + v["p"])
+        if self.ctype == RATIONAL:
+            m, n = rational_order(v)
+            num = polyval_jw([v[f"b{i}"] for i in range(m, -1, -1)], w)
+            den = polyval_jw([1.0] + [v[f"a{i}"] for i in range(n - 1, -1, -1)], w)
+            return num / den
         raise NotImplementedError(self.ctype)
 
     def dc(self) -> Any | None:
@@ -123,9 +129,13 @@ class SymbolicController:
             return v["kp"]
         if self.ctype == "leadlag":
             return v["k"] * v["z"] / v["p"]
+        if self.ctype == RATIONAL and not (self.fixed.get("a0") == 0.0):
+            return v["b0"] / v["a0"]
         return None
 
     def integral_gain(self) -> Any:
+        if self.ctype == RATIONAL:
+            return self.values["b0"] / self.values["a1"] if "a1" in self.values else self.values["b0"]
         return self.values["ki"]
 
     def controller(self, u: np.ndarray) -> Controller:

@@ -1,8 +1,12 @@
-"""Controllers that are linear in their parameters: ``C(s) = rho^T phi(s)``.
+"""Controller parametrizations in which the loop is affine in a parameter vector ``rho``.
 
-A :class:`LinearParametrization` maps a vector ``rho`` to a controller and
-evaluates the basis ``phi(j w)``; the bounds of the spec become linear
-constraints on ``rho``.
+Every parametrization writes the controller as ``C = X/D`` with ``X`` and ``D``
+affine in ``rho`` at each frequency, so that with the plant ``G`` the loop is
+``L = N/D``, ``N = G X``, and
+
+    S = D/(D + N),  T = N/(D + N),  KS = X/(D + N),  C = X/D.
+
+**Linear in the parameters** (``D = 1``): ``C(s) = rho^T phi(s)``.
 
 ========  ==========================================  ============================
 type      basis phi(s)                                rho
@@ -12,16 +16,55 @@ PI        [1, 1/s]                                    [kp, ki]
 PID       [1, 1/s, s/(tf s + 1)] (tf fixed)           [kp, ki, kd]
 leadlag   [s/(s + p), 1/(s + p)] (p fixed)            [k, k z]
 ========  ==========================================  ============================
+
+**Rational of fixed order** ``[m, n]``: ``X = sum b_i s^i``,
+``D = s^n + sum a_i s^i``, with ``rho = (b, a)``. Powers of ``s`` are taken of
+``s/w0`` internally (``w0`` a characteristic frequency) so that the numbers
+stay of order one; :meth:`RationalParametrization.controller` converts back.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
-from synth.controllers import Controller
+from synth.controllers import RATIONAL, Controller
 from synth.errors import SynthError
+
+
+@dataclass
+class Affine:
+    """A complex quantity affine in ``rho`` at each frequency point: ``q(rho) = q0 + Q rho``.
+
+    Examples
+    --------
+    >>> q = Affine(np.array([1.0 + 0j]), np.array([[2.0j]]))
+    >>> q(np.array([3.0]))
+    array([1.+6.j])
+    """
+
+    q0: np.ndarray  # (n,) complex
+    Q: np.ndarray  # (n, size) complex
+
+    def __call__(self, rho: np.ndarray) -> np.ndarray:
+        return self.q0 + self.Q @ rho
+
+    def __add__(self, other: Affine) -> Affine:
+        return Affine(self.q0 + other.q0, self.Q + other.Q)
+
+    def scaled(self, factor: np.ndarray) -> Affine:
+        """Each row multiplied by ``factor`` (shape (n,))."""
+        factor = np.asarray(factor)
+        return Affine(self.q0 * factor, self.Q * factor[:, None])
+
+    def rows(self, mask: np.ndarray) -> Affine:
+        """The rows where ``mask`` is true."""
+        return Affine(self.q0[mask], self.Q[mask])
+
+    def is_constant(self) -> bool:
+        """True when no row depends on ``rho``."""
+        return not np.any(self.Q)
 
 
 @dataclass
@@ -38,6 +81,8 @@ class LinearParametrization:
         Parameters held fixed (e.g. ``tf`` of a PID, ``p`` of a lead-lag).
     bounds : dict
         ``{name: (lo, hi)}`` of the controller's own parameters.
+    integrator_index : int or None
+        Entry of ``rho`` multiplying ``1/s``.
     """
 
     ctype: str
@@ -45,7 +90,6 @@ class LinearParametrization:
     fixed: dict[str, float]
     bounds: dict[str, tuple[float, float]]
     integrator_index: int | None = None
-    _extra: dict = field(default_factory=dict, repr=False)
 
     @property
     def size(self) -> int:
@@ -70,18 +114,32 @@ class LinearParametrization:
             elif self.ctype == "PID":
                 tf = self.fixed["tf"]
                 cols = [np.ones_like(s), 1.0 / s, s / (tf * s + 1.0)]
-            elif self.ctype == "leadlag":
+            else:  # leadlag
                 p = self.fixed["p"]
                 cols = [s / (s + p), 1.0 / (s + p)]
-            else:  # pragma: no cover - guarded by parametrize()
-                raise SynthError(f"no linear parametrization for {self.ctype}")
         return np.stack(cols, axis=-1)
 
-    def dc_basis(self) -> np.ndarray | None:
-        """``phi(0)`` when finite (None with an integrator)."""
-        if self.integrator_index is not None:
-            return None
-        return self.basis(np.array([0.0]))[0].real
+    def numerator(self, w: np.ndarray) -> Affine:
+        """``X = phi^T rho``."""
+        return Affine(np.zeros(len(w), complex), self.basis(w))
+
+    def denominator(self, w: np.ndarray) -> Affine:
+        """``D = 1``."""
+        return Affine(np.ones(len(w), complex), np.zeros((len(w), self.size), complex))
+
+    def dc_ratio(self, rho: np.ndarray) -> float:
+        """``C(0)`` (``inf`` with integral action)."""
+        if self.integrator_index is not None and rho[self.integrator_index] != 0:
+            return np.inf
+        phi0 = self.basis(np.array([0.0]))[0]
+        finite = np.isfinite(phi0)
+        return float(np.real(phi0[finite] @ np.asarray(rho, float)[finite]))
+
+    def has_integrator(self, rho: np.ndarray | None = None) -> bool:
+        """Whether the controller has integral action (at ``rho``, or structurally)."""
+        if self.integrator_index is None:
+            return False
+        return rho is None or rho[self.integrator_index] != 0
 
     def controller(self, rho: np.ndarray) -> Controller:
         """The controller for ``rho``.
@@ -114,7 +172,7 @@ class LinearParametrization:
         return np.array([v[n] for n in self.names], dtype=float)
 
     def box(self) -> tuple[np.ndarray, np.ndarray]:
-        """Elementwise bounds on ``rho`` implied by the parameter bounds (leadlag: on k only, and kz via k)."""
+        """Elementwise bounds on ``rho`` implied by the parameter bounds."""
         lo = np.array([self.bounds[n][0] if n in self.bounds else -np.inf for n in self.names], float)
         hi = np.array([self.bounds[n][1] if n in self.bounds else np.inf for n in self.names], float)
         if self.ctype == "leadlag":
@@ -126,40 +184,158 @@ class LinearParametrization:
 
     def linear_constraints(self) -> tuple[np.ndarray, np.ndarray]:
         """``(A, b)`` with ``A rho <= b`` expressing every bound exactly (linear for lead-lag with k >= 0)."""
-        lo, hi = self.box()
-        rows, rhs = [], []
-        for i in range(self.size):
-            e = np.zeros(self.size)
-            e[i] = 1.0
-            if np.isfinite(hi[i]):
-                rows.append(e.copy())
-                rhs.append(hi[i])
-            if np.isfinite(lo[i]):
-                rows.append(-e)
-                rhs.append(-lo[i])
+        A, b = _box_rows(*self.box())
         if self.ctype == "leadlag":
             (z_lo, z_hi) = self.bounds["z"]
-            rows += [np.array([z_lo, -1.0]), np.array([-z_hi, 1.0])]  # z_lo k <= kz <= z_hi k
-            rhs += [0.0, 0.0]
-        return np.array(rows), np.array(rhs)
+            A = np.vstack([A, [z_lo, -1.0], [-z_hi, 1.0]])  # z_lo k <= kz <= z_hi k
+            b = np.concatenate([b, [0.0, 0.0]])
+        return A, b
 
     def start(self) -> np.ndarray:
         """A small, typically stabilizing starting point inside the bounds."""
         lo, hi = self.box()
-        x = np.zeros(self.size)
-        for i in range(self.size):
-            span = hi[i] - lo[i] if np.isfinite(hi[i] - lo[i]) else 1.0
-            x[i] = lo[i] + 1e-3 * span if lo[i] >= 0 else (0.0 if hi[i] >= 0 else hi[i])
+        x = _small_inside(lo, hi)
         if self.ctype == "leadlag":
             (z_lo, z_hi) = self.bounds["z"]
             x[1] = x[0] * 0.5 * (z_lo + z_hi)
         return x
 
+    def random(self, rng: np.random.Generator) -> np.ndarray:
+        """A random point in the bounds, spread towards small values."""
+        lo, hi = self.box()
+        lo = np.where(np.isfinite(lo), lo, -10.0)
+        hi = np.where(np.isfinite(hi), hi, 10.0)
+        x = lo + (hi - lo) * rng.random(self.size) ** 3
+        if self.ctype == "leadlag":
+            z_lo, z_hi = self.bounds["z"]
+            x[1] = x[0] * (z_lo + (z_hi - z_lo) * rng.random())
+        return x
 
-def parametrize(ctype: str, bounds: dict[str, tuple[float, float]]) -> LinearParametrization:
-    """The linear parametrization of a controller type given its bounds.
 
-    Parameters fixed by their bounds (``lo == hi``) that the basis needs
+@dataclass
+class RationalParametrization:
+    """``C = X/D``, ``X = sum b_i s^i`` (degree m), ``D = s^n + sum a_i s^i``; ``rho`` holds the
+    coefficients of powers of ``s/w0`` (see the module docstring).
+
+    Examples
+    --------
+    >>> par = RationalParametrization(1, 2, {"b0": (-10, 10), "b1": (-10, 10), "a0": (0, 0), "a1": (0, 50)}, 10.0)
+    >>> c = par.controller(par.rho(Controller.from_string("rational(b0=2, b1=1, a0=0, a1=10)")))
+    >>> c.parameters
+    {'b0': 2.0, 'b1': 1.0, 'a0': 0.0, 'a1': 10.0}
+    """
+
+    m: int
+    n: int
+    bounds: dict[str, tuple[float, float]]
+    w0: float = 1.0
+
+    ctype = RATIONAL
+
+    @property
+    def names(self) -> list[str]:
+        return [f"b{i}" for i in range(self.m + 1)] + [f"a{i}" for i in range(self.n)]
+
+    @property
+    def size(self) -> int:
+        return self.m + 1 + self.n
+
+    def _scale(self) -> np.ndarray:
+        """True coefficient = rho * scale (b_i and a_i both scale with w0^(n - i))."""
+        return np.array([self.w0 ** (self.n - i) for i in range(self.m + 1)]
+                        + [self.w0 ** (self.n - i) for i in range(self.n)])
+
+    def _powers(self, w: np.ndarray, count: int) -> np.ndarray:
+        x = 1j * np.asarray(w, dtype=float) / self.w0
+        return np.stack([x**i for i in range(count)], axis=-1)
+
+    def numerator(self, w: np.ndarray) -> Affine:
+        Q = np.zeros((len(w), self.size), complex)
+        Q[:, : self.m + 1] = self._powers(w, self.m + 1)
+        return Affine(np.zeros(len(w), complex), Q)
+
+    def denominator(self, w: np.ndarray) -> Affine:
+        Q = np.zeros((len(w), self.size), complex)
+        Q[:, self.m + 1:] = self._powers(w, self.n)
+        return Affine((1j * np.asarray(w, float) / self.w0) ** self.n, Q)
+
+    def dc_ratio(self, rho: np.ndarray) -> float:
+        a0 = rho[self.m + 1]
+        return np.inf if a0 == 0 else float(rho[0] / a0)
+
+    def has_integrator(self, rho: np.ndarray | None = None) -> bool:
+        lo, hi = self.bounds["a0"]
+        if rho is None:
+            return lo == hi == 0.0
+        return rho[self.m + 1] == 0.0
+
+    def controller(self, rho: np.ndarray) -> Controller:
+        true = np.asarray(rho, float) * self._scale()
+        return Controller(RATIONAL, {name: float(v) for name, v in zip(self.names, true)})
+
+    def rho(self, controller: Controller) -> np.ndarray:
+        return np.array([controller.parameters[n] for n in self.names], float) / self._scale()
+
+    def box(self) -> tuple[np.ndarray, np.ndarray]:
+        scale = self._scale()
+        lo = np.array([self.bounds[n][0] for n in self.names]) / scale
+        hi = np.array([self.bounds[n][1] for n in self.names]) / scale
+        return lo, hi
+
+    def linear_constraints(self) -> tuple[np.ndarray, np.ndarray]:
+        return _box_rows(*self.box())
+
+    def start(self) -> np.ndarray:
+        """A small controller with a stable denominator: ``D = (s/w0 + 1)^n`` (or ``s (s/w0 + 1)^(n-1)``
+        with an integrator), ``X`` small."""
+        lo, hi = self.box()
+        poly = np.poly1d([1.0, 1.0]) ** self.n
+        a = poly.coeffs[::-1][: self.n].astype(float)
+        if self.has_integrator():
+            integ = np.poly1d([1.0, 0.0]) * np.poly1d([1.0, 1.0]) ** (self.n - 1)
+            a = integ.coeffs[::-1][: self.n].astype(float)
+        b = np.zeros(self.m + 1)
+        b[0] = 1e-3
+        x = np.concatenate([b, a])
+        return np.clip(x, lo, hi)
+
+    def random(self, rng: np.random.Generator) -> np.ndarray:
+        x = self.start()
+        x[: self.m + 1] = rng.normal(size=self.m + 1) * 10 ** rng.uniform(-3, 1)
+        lo, hi = self.box()
+        return np.clip(x, lo, hi)
+
+
+def _box_rows(lo: np.ndarray, hi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    rows, rhs = [], []
+    for i in range(lo.size):
+        e = np.zeros(lo.size)
+        e[i] = 1.0
+        if np.isfinite(hi[i]):
+            rows.append(e.copy())
+            rhs.append(hi[i])
+        if np.isfinite(lo[i]):
+            rows.append(-e)
+            rhs.append(-lo[i])
+    return np.array(rows).reshape(-1, lo.size), np.array(rhs)
+
+
+def _small_inside(lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+    x = np.zeros(lo.size)
+    for i in range(lo.size):
+        span = hi[i] - lo[i] if np.isfinite(hi[i] - lo[i]) else 1.0
+        x[i] = lo[i] + 1e-3 * span if lo[i] >= 0 else (0.0 if hi[i] >= 0 else hi[i])
+    return x
+
+
+Parametrization = LinearParametrization | RationalParametrization
+
+
+def parametrize(ctype: str, bounds: dict[str, tuple[float, float]], order: tuple[int, int] | None = None,
+                w0: float = 1.0) -> Parametrization:
+    """The parametrization of a controller type given its bounds.
+
+    Parameters fixed by their bounds (``lo == hi``) that the linear basis needs
     (``tf`` of a PID, ``p`` of a lead-lag) must be fixed; free ones raise
     :class:`SynthError` (the NLP stage handles them).
 
@@ -188,4 +364,8 @@ def parametrize(ctype: str, bounds: dict[str, tuple[float, float]]) -> LinearPar
             raise SynthError("lead-lag synthesis needs k >= 0 (bounds on z become linear in (k, k z))",
                              where="controller.bounds.k")
         return LinearParametrization("leadlag", ["k", "kz"], {"p": lo}, bounds)
-    raise SynthError(f"no linear parametrization for controller type {ctype}", where="controller.type")
+    if ctype == RATIONAL:
+        if order is None:
+            raise SynthError("a rational controller needs its order", where="controller.order")
+        return RationalParametrization(order[0], order[1], bounds, w0)
+    raise SynthError(f"no parametrization for controller type {ctype}", where="controller.type")
