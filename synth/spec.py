@@ -146,6 +146,7 @@ class ControllerSpec(_Model):
     type: str
     order: tuple[int, int] | None = None
     bounds: dict[str, tuple[float, float]] = Field(default_factory=dict)
+    initial: dict[str, float] | None = None
 
     @field_validator("type")
     @classmethod
@@ -205,6 +206,28 @@ class ControllerSpec(_Model):
             if name in ctype.positive and lo <= 0:
                 raise ValueError(f"{name}: {name} must stay > 0, got lower bound {lo:g}")
         return bounds
+
+    @field_validator("initial")
+    @classmethod
+    def _check_initial(cls, initial: dict[str, float] | None, info: ValidationInfo):
+        if initial is None or "type" not in info.data:
+            return initial
+        order = info.data.get("order")
+        names = (rational_type(*order) if info.data["type"] == RATIONAL and order else
+                 CONTROLLER_TYPES.get(info.data["type"]))
+        if names is None:
+            return initial
+        missing = [p for p in names.parameters if p not in initial]
+        extra = [p for p in initial if p not in names.parameters]
+        if extra:
+            raise ValueError(f"{names.name} has no parameter {extra[0]!r}")
+        if missing:
+            raise ValueError(f"initial needs a value for every parameter; missing {', '.join(missing)}")
+        return initial
+
+    def initial_controller(self) -> Controller | None:
+        """The starting controller given in the spec, if any."""
+        return None if self.initial is None else Controller(self.type, dict(self.initial))
 
     def all_bounds(self) -> dict[str, tuple[float, float]]:
         """Bounds for every parameter (defaults where the spec gives none)."""

@@ -138,6 +138,10 @@ def write_design_report(spec: Spec, result: DesignResult, out_dir: str | Path, *
         figs["gain_set"] = figures.gain_set_plot(
             gain["parameter"], tuple(gain["bounds"]), _slack_curves(spec), data["gain_set"], marks,
             out.claim("gain_set.png"))
+    if result.gain_set is None and result.controller is not None:
+        fmap = figures.feasibility_map(spec, result.controller, out.claim("feasible_region.png"), reference=ref)
+        if fmap is not None:
+            figs["region"] = fmap
     delay_table = data["analysis"].get("delay_table")
     if delay_table:
         rows = [{**r, "critical_gain": float(r["critical_gain"])} for r in delay_table]
@@ -161,6 +165,7 @@ def write_design_report(spec: Spec, result: DesignResult, out_dir: str | Path, *
         slew=data["analysis"].get("slew_rate", []),
         delay_table=[{**r, "critical_gain": float(r["critical_gain"])} for r in delay_table or []],
         marks=marks, certificate=data.get("certificate"), ref_line=ref_line,
+        synthesis=data.get("synthesis"), diagnosis=data.get("diagnosis"),
         f=lambda x, d=4: fmt(None if x is None else float(x), d),
     )
     html_path = out.claim("report.html")

@@ -158,3 +158,53 @@ def delay_chart(rows: list[dict[str, Any]], marks: dict[str, float], path: Path)
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=8)
     return _save(fig, path)
+
+
+def feasibility_map(spec: Any, design_controller: Any, path: Path, n: int = 70,
+                    reference: Any | None = None) -> Path | None:
+    """For two free parameters: where in the parameter plane each requirement holds (exact check on a
+    grid), the feasible region shaded, the design marked."""
+    from synth.check import evaluate_all
+    from synth.controllers import Controller
+
+    free = spec.controller.free_parameters()
+    if len(free) != 2 or design_controller is None:
+        return None
+    bounds = spec.controller.all_bounds()
+    (xa, (xa_lo, xa_hi)), (xb, (xb_lo, xb_hi)) = [(p, bounds[p]) for p in free]
+    # zoom to the neighbourhood of the design (at most the bounds)
+    xa_hi = min(xa_hi, max(2.5 * abs(design_controller.parameters[xa]), xa_lo + 1e-9))
+    xb_hi = min(xb_hi, max(2.5 * abs(design_controller.parameters[xb]), xb_lo + 1e-9))
+    A = np.linspace(xa_lo, xa_hi, n)
+    B = np.linspace(xb_lo, xb_hi, n)
+    names = [r.name() for r in spec.requirements]
+    slack = np.full((len(names) + 1, n, n), np.nan)
+    base = dict(design_controller.parameters)
+    plants = spec.plants()
+    for i, a in enumerate(A):
+        for j, b in enumerate(B):
+            c = Controller(design_controller.type, {**base, xa: float(a), xb: float(b)})
+            worst, _ = evaluate_all(list(spec.requirements), plants, c, per_decade=20)
+            slack[:, j, i] = [r.slack for r in worst]
+    fig, ax = plt.subplots(figsize=(7.5, 5.2))
+    ok = np.all(slack >= 0, axis=0)
+    ax.contourf(A, B, ok.astype(float), levels=[0.5, 1.5], colors=["#2e8b57"], alpha=0.18)
+    unstable = slack[0] < 0
+    if np.any(unstable):
+        ax.contourf(A, B, unstable.astype(float), levels=[0.5, 1.5], colors=["#555555"], alpha=0.25)
+        ax.plot([], [], color="#555555", lw=6, alpha=0.4, label="closed loop unstable")
+    for k, name in enumerate(names):
+        s = np.nan_to_num(slack[k + 1], nan=-10, posinf=10, neginf=-10)
+        if np.nanmin(s) < 0 < np.nanmax(s):
+            cs = ax.contour(A, B, s, levels=[0.0], colors=[COLORS[k % len(COLORS)]], linewidths=1.8)
+            ax.plot([], [], color=COLORS[k % len(COLORS)], label=f"{name} boundary")
+            del cs
+    ax.plot(design_controller.parameters[xa], design_controller.parameters[xb], "k*", ms=14, label="design")
+    if reference is not None and reference.type == design_controller.type:
+        ax.plot(reference.parameters[xa], reference.parameters[xb], "ko", mfc="none", ms=10, label="reference")
+    ax.set_xlabel(xa)
+    ax.set_ylabel(xb)
+    ax.set_title("Feasible parameters (shaded), exact check on a grid")
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize=8, loc="best")
+    return _save(fig, path)

@@ -359,7 +359,8 @@ class ConvexDesigner:
     def starts(self, initial: np.ndarray | None = None, count: int = 1, seed: int = 0) -> list[np.ndarray]:
         """Up to ``count`` stabilizing starts: ``initial``, a small controller, then a seeded random
         search in the bounds (log-spread towards small values)."""
-        candidates = [initial] if initial is not None else []
+        lo, hi = self.par.box()
+        candidates = [np.clip(initial, lo, hi)] if initial is not None else []
         candidates.append(self.par.start())
         rng = np.random.default_rng(seed)
         candidates += [self.par.random(rng) for _ in range(300)]

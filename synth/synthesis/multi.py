@@ -106,11 +106,16 @@ def _convex_runs(spec: Spec, settings: ConvexSettings) -> list[tuple[ConvexDesig
     name, sense, _ = _objective_terms(spec)[0]
     runs = []
     w0 = _reference_frequency(spec)
+    start = spec.controller.initial_controller()
     for v in values:
         b = dict(bounds) if key is None else {**bounds, key: (v, v)}
         par = parametrize(ctype, b, spec.controller.order, w0)
         designer = ConvexDesigner(requirements, names, spec.plants(), par, (name, sense), settings)
-        runs.append((designer, designer.run()))
+        initial = None
+        if start is not None:
+            fixed = start if key is None else start.with_parameters(**{key: v})
+            initial = par.rho(fixed)
+        runs.append((designer, designer.run(initial)))
     return runs
 
 

@@ -267,7 +267,7 @@ def _add_margins(b: _Builder, req: MarginsRequirement, plant: Plant, start: Cont
     loop = Loop(plant, start)
     ctrl = b.ctrl
     for wc in loop.gain_crossovers():
-        v = b.var("wc", float(wc), 0.7 * wc, 1.3 * wc)
+        v = b.var("wc", float(wc), wc / 3.0, 3.0 * wc)
         _, L = _loop(ctrl, plant, v)
         b.eq(L.abs2() - 1.0)
         if req.phase_margin_deg is not None:
@@ -276,7 +276,7 @@ def _add_margins(b: _Builder, req: MarginsRequirement, plant: Plant, start: Cont
             b.geq((1.0 + L).abs2() - 4 * ca.sin(ca.fmin(v * req.delay_margin, np.pi) / 2) ** 2)
     if req.gain_margin_db is not None:
         for wp in _phase_crossovers(loop):
-            v = b.var("wp", float(wp), 0.7 * wp, 1.3 * wp)
+            v = b.var("wp", float(wp), wp / 3.0, 3.0 * wp)
             _, L = _loop(ctrl, plant, v)
             b.eq(L.im)
             b.geq(L.re + 10 ** (-req.gain_margin_db * (1 + BACKOFF) / 20))
@@ -350,7 +350,7 @@ def _add_objective(b: _Builder, terms: list[tuple[str, str, float]], plants: lis
 
 def polish(requirements: list[Requirement], plants: list[Plant], start: Controller,
            bounds: dict[str, tuple[float, float]], objective: list[tuple[str, str, float]], grid: np.ndarray,
-           per_decade: int = 40, stability_level: float = 0.05, rounds: int = 4) -> NLPResult:
+           per_decade: int = 40, stability_level: float = 0.05, rounds: int = 6) -> NLPResult:
     """Improve ``start`` with IPOPT on the exact requirements; see the module docstring.
 
     Parameters
@@ -409,10 +409,16 @@ def polish(requirements: list[Requirement], plants: list[Plant], start: Controll
             break
         moved = _crossovers_changed(current, candidate, plants)
         between = _violated_frequencies(requirements, plants, candidate)
+        from synth.objectives import score as _score
+
+        gain = _score(Loop(plants[0], candidate), objective) - _score(Loop(plants[0], current), objective)
+        improved = gain > 1e-6 * max(1.0, abs(_score(Loop(plants[0], current), objective)))
         current = candidate
         if between.size:
             extra = np.unique(np.concatenate([extra, between, between * (1 - 1e-3), between * (1 + 1e-3)]))
-        if not moved and not between.size:
+        # crossovers are re-detected every round: a round that still improved may have been held back by
+        # the crossover variables' boxes around the previous design
+        if not moved and not between.size and not improved:
             break
     value = None
     if success:

@@ -1,0 +1,343 @@
+"""Trade-off studies: sweep one or two spec values, design at every point, find the Pareto front.
+
+A sweep names a value in the spec by a dotted path and lists its values:
+
+- ``requirements.bandwidth.min=40:100:13`` (13 values from 40 to 100; a
+  requirement is picked by its ``label``, its ``type`` when unique, or its index),
+- ``plant.delay=0,0.005,0.01`` (a list),
+- ``controller.bounds.kp.1=5:20:4`` (list items by index).
+
+Neighbouring points are warm-started from each other: the points are cut into
+contiguous chunks, one per worker, and each chunk is designed in order with the
+previous design as ``controller.initial``. Chunks run in a local process pool,
+or on a Dask distributed cluster when a scheduler address is given.
+"""
+
+from __future__ import annotations
+
+import copy
+import json
+import os
+import time
+from collections.abc import Callable
+from concurrent.futures import ProcessPoolExecutor, as_completed
+from dataclasses import asdict, dataclass, field
+from typing import Any
+
+import numpy as np
+
+from synth.errors import SpecError, SynthError
+from synth.spec import Spec
+
+# how each swept key tightens the spec when it grows (+1) or shrinks (-1)
+STRICTER_WHEN = {"min": +1, "max": -1, "max_db": -1, "rate_limit": -1, "max_error": +1, "gain_margin_db": +1,
+                 "phase_margin_deg": +1, "delay_margin": +1, "delay": +1, "plant_gain": -1}
+
+
+@dataclass
+class Sweep:
+    """One swept spec value.
+
+    Examples
+    --------
+    >>> Sweep.parse("requirements.bandwidth.min=40:100:4").values
+    [40.0, 60.0, 80.0, 100.0]
+    >>> Sweep.parse("plant.delay=0,0.01").path
+    'plant.delay'
+    """
+
+    path: str
+    values: list[float]
+
+    @classmethod
+    def parse(cls, text: str) -> Sweep:
+        """Parse ``PATH=start:stop:count`` or ``PATH=v1,v2,...``."""
+        if "=" not in text:
+            raise SpecError(f"sweep {text!r} needs the form PATH=start:stop:count or PATH=v1,v2,...",
+                            where="--sweep")
+        path, spec = (t.strip() for t in text.split("=", 1))
+        try:
+            if ":" in spec:
+                start, stop, count = spec.split(":")
+                n = int(count)
+                if n < 1:
+                    raise ValueError
+                values = list(np.linspace(float(start), float(stop), n))
+            else:
+                values = [float(v) for v in spec.split(",") if v.strip()]
+        except ValueError:
+            raise SpecError(f"sweep {text!r}: values must be start:stop:count (count >= 1) or a list of numbers",
+                            where="--sweep") from None
+        if not values:
+            raise SpecError(f"sweep {text!r} has no values", where="--sweep")
+        return cls(path, [float(v) for v in values])
+
+    @property
+    def key(self) -> str:
+        """Last path element (e.g. ``min``)."""
+        return self.path.split(".")[-1] if not self.path.split(".")[-1].isdigit() else self.path.split(".")[-2]
+
+
+def set_value(data: dict[str, Any], path: str, value: float) -> dict[str, Any]:
+    """Copy of the spec data with ``path`` set to ``value``.
+
+    Examples
+    --------
+    >>> d = {"requirements": [{"type": "bandwidth", "min": 60}]}
+    >>> set_value(d, "requirements.bandwidth.min", 80.0)["requirements"][0]["min"]
+    80.0
+    """
+    out = copy.deepcopy(data)
+    parts = path.split(".")
+    node: Any = out
+    for i, part in enumerate(parts[:-1]):
+        if isinstance(node, list):
+            node = node[_index(node, part, ".".join(parts[: i + 1]), parts[i - 1] if i else "")]
+        elif isinstance(node, dict):
+            if part not in node:
+                raise SpecError(f"no key {part!r} in the spec", where=f"--sweep {path}")
+            node = node[part]
+        else:
+            raise SpecError(f"{'.'.join(parts[:i])} is a value, not a section", where=f"--sweep {path}")
+    last = parts[-1]
+    if isinstance(node, list):
+        node[_index(node, last, path, parts[-2] if len(parts) > 1 else "")] = value
+    elif isinstance(node, dict):
+        node[last] = value
+    else:
+        raise SpecError(f"cannot set {path}", where=f"--sweep {path}")
+    return out
+
+
+def _index(items: list, key: str, where: str, parent: str) -> int:
+    if key.isdigit():
+        if int(key) >= len(items):
+            raise SpecError(f"index {key} out of range ({len(items)} items)", where=f"--sweep {where}")
+        return int(key)
+    labelled = [i for i, it in enumerate(items) if isinstance(it, dict) and it.get("label") == key]
+    typed = [i for i, it in enumerate(items) if isinstance(it, dict) and it.get("type") == key]
+    match = labelled or typed
+    if len(match) == 1:
+        return match[0]
+    if not match:
+        raise SpecError(f"no {parent or 'item'} with label or type {key!r}", where=f"--sweep {where}")
+    raise SpecError(f"{len(match)} requirements of type {key!r}: give a label or an index", where=f"--sweep {where}")
+
+
+@dataclass
+class TradeoffPoint:
+    """The design at one point of the sweep."""
+
+    values: dict[str, float]
+    feasible: bool
+    objective: float | None
+    controller: dict[str, float] | None
+    binding: list[str]
+    slacks: dict[str, float]
+    verdict: str
+    seconds: float
+    pareto: bool = False
+
+    def to_dict(self) -> dict[str, Any]:
+        return asdict(self)
+
+
+@dataclass
+class TradeoffResult:
+    """Every point of a sweep, the objective's name and sense, and how the run went."""
+
+    spec: str
+    sweeps: list[Sweep]
+    objective: dict[str, Any]
+    points: list[TradeoffPoint]
+    scheduler: str
+    workers: int
+    seconds: float
+    extras: dict[str, Any] = field(default_factory=dict)
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"spec": self.spec, "sweeps": [asdict(s) for s in self.sweeps], "objective": self.objective,
+                "scheduler": self.scheduler, "workers": self.workers, "seconds": self.seconds,
+                "points": [p.to_dict() for p in self.points], **self.extras}
+
+
+def _binding(design_result: Any) -> list[str]:
+    if not design_result.feasible:
+        diag = design_result.extras.get("diagnosis")
+        if diag:
+            return list(diag.get("conflicting", []))
+        gs = design_result.gain_set
+        return gs.never_met() + [n for pair in gs.conflicts() for n in pair] if gs is not None else []
+    gs = design_result.gain_set
+    if gs is not None:
+        x = design_result.controller.parameters[gs.parameter]
+        for iv in gs.intervals:
+            if iv.lo <= x <= iv.hi:
+                near_hi = abs(x - iv.hi) <= 1e-4 * max(1.0, abs(x))
+                near_lo = abs(x - iv.lo) <= 1e-4 * max(1.0, abs(x))
+                return (iv.hi_binding if near_hi else []) + (iv.lo_binding if near_lo else [])
+    active = [r.label for r in design_result.check.requirements[1:] if r.slack <= 1e-3]
+    return active
+
+
+def design_point(data: dict[str, Any], sweeps: list[Sweep], values: tuple[float, ...],
+                 initial: dict[str, float] | None) -> TradeoffPoint:
+    """Design one point (used by workers; module level so it can be pickled)."""
+    from synth.design import design
+
+    t0 = time.perf_counter()
+    point = dict(data)
+    for sw, v in zip(sweeps, values):
+        point = set_value(point, sw.path, v)
+    if initial is not None:
+        point["controller"] = {**point["controller"], "initial": initial}
+    labels = {sw.path: v for sw, v in zip(sweeps, values)}
+    try:
+        spec = Spec.model_validate_json(json.dumps(point), strict=True)
+        result = design(spec)
+    except SynthError as exc:
+        return TradeoffPoint(labels, False, None, None, [], {}, f"not designed: {exc}", time.perf_counter() - t0)
+    except Exception as exc:
+        return TradeoffPoint(labels, False, None, None, [], {}, f"not designed: {exc}".splitlines()[0],
+                             time.perf_counter() - t0)
+    shown = result.check or result.compromise
+    slacks = {r.label: r.slack for r in shown.requirements} if shown else {}
+    controller = result.controller.parameters if result.controller else None
+    objective = result.objective["value"] if result.objective else None
+    return TradeoffPoint(labels, result.feasible, objective, controller, _binding(result), slacks,
+                         result.verdict, time.perf_counter() - t0)
+
+
+def design_chunk(data: dict[str, Any], sweeps: list[Sweep], chunk: list[tuple[float, ...]]) -> list[TradeoffPoint]:
+    """Design a contiguous run of points, each warm-started from the previous feasible design."""
+    out = []
+    initial = None
+    for values in chunk:
+        point = design_point(data, sweeps, values, initial)
+        if point.feasible and point.controller is not None:
+            initial = point.controller
+        out.append(point)
+    return out
+
+
+def _grid(sweeps: list[Sweep]) -> list[tuple[float, ...]]:
+    if len(sweeps) == 1:
+        return [(v,) for v in sweeps[0].values]
+    a, b = sweeps
+    rows = []
+    for i, va in enumerate(a.values):  # serpentine order keeps neighbours adjacent for warm starts
+        vb = b.values if i % 2 == 0 else list(reversed(b.values))
+        rows += [(va, x) for x in vb]
+    return rows
+
+
+def _chunks(points: list, n: int) -> list[list]:
+    n = max(1, min(n, len(points)))
+    return [list(c) for c in np.array_split(np.array(points, dtype=object), n) if len(c)]
+
+
+def mark_pareto(points: list[TradeoffPoint], sweeps: list[Sweep], sense: str) -> None:
+    """Flag feasible points that no other feasible point beats on both the swept demand and the objective."""
+    if len(sweeps) != 1:
+        return
+    sign_x = STRICTER_WHEN.get(sweeps[0].key, +1)
+    sign_y = 1.0 if sense == "maximize" else -1.0
+    feas = [p for p in points if p.feasible and p.objective is not None]
+    for p in feas:
+        x, y = sign_x * p.values[sweeps[0].path], sign_y * p.objective
+        p.pareto = not any(
+            (sign_x * q.values[sweeps[0].path] >= x and sign_y * q.objective >= y)
+            and (sign_x * q.values[sweeps[0].path] > x or sign_y * q.objective > y)
+            for q in feas
+        )
+
+
+def tradeoff(spec: Spec, sweeps: list[Sweep], scheduler: str | Any | None = None, workers: int | None = None,
+             progress: Callable[[int, int], None] | None = None) -> TradeoffResult:
+    """Design the spec at every point of one or two sweeps.
+
+    Parameters
+    ----------
+    spec : Spec
+    sweeps : list of Sweep
+        One or two swept values.
+    scheduler : str, dask Client, or None
+        A Dask scheduler address (``"tcp://host:8786"``) or client; None runs a local process pool.
+    workers : int, optional
+        Local processes (default: the number of CPUs); ignored with Dask.
+    progress : callable, optional
+        Called as ``progress(done, total)`` after every finished chunk.
+
+    Returns
+    -------
+    TradeoffResult
+
+    Examples
+    --------
+    >>> from synth.spec import load_spec
+    >>> r = tradeoff(load_spec("specs/x4_rotor.yaml"), [Sweep.parse("requirements.bandwidth.min=60:80:2")], workers=1)
+    >>> [(p.values["requirements.bandwidth.min"], p.feasible) for p in r.points]
+    [(60.0, True), (80.0, True)]
+    """
+    if not 1 <= len(sweeps) <= 2:
+        raise SpecError("give one or two sweeps", where="--sweep")
+    data = spec.model_dump(mode="json", exclude_none=True)
+    for sw in sweeps:  # fail early on a bad path
+        set_value(data, sw.path, sw.values[0])
+    grid = _grid(sweeps)
+    t0 = time.perf_counter()
+    results: list[TradeoffPoint] = []
+    if scheduler is not None:
+        client, label, n = _dask_client(scheduler)
+        chunks = _chunks(grid, n)
+        futures = [client.submit(design_chunk, data, sweeps, c, pure=False) for c in chunks]
+        from distributed import as_completed as dask_completed
+
+        done = 0
+        for fut in dask_completed(futures):
+            results += fut.result()
+            done += len(fut.result())
+            if progress:
+                progress(done, len(grid))
+    else:
+        n = workers or os.cpu_count() or 1
+        chunks = _chunks(grid, n)
+        label = f"local process pool ({min(n, len(chunks))} workers)"
+        if n == 1 or len(chunks) == 1:
+            for c in chunks:
+                results += design_chunk(data, sweeps, c)
+                if progress:
+                    progress(len(results), len(grid))
+        else:
+            with ProcessPoolExecutor(max_workers=min(n, len(chunks))) as pool:
+                futures = [pool.submit(design_chunk, data, sweeps, c) for c in chunks]
+                for fut in as_completed(futures):
+                    results += fut.result()
+                    if progress:
+                        progress(len(results), len(grid))
+    order = {values: i for i, values in enumerate(grid)}
+    results.sort(key=lambda p: order[tuple(p.values[s.path] for s in sweeps)])
+    if len(sweeps) == 2:  # back to row-major order for tables
+        results.sort(key=lambda p: (p.values[sweeps[0].path], p.values[sweeps[1].path]))
+    objective = {"name": spec.objective.name, "sense": spec.objective.sense,
+                 "description": spec.objective.describe()} if spec.objective else {
+        "name": "default", "sense": "maximize", "description": "no objective in the spec"}
+    mark_pareto(results, sweeps, objective["sense"])
+    return TradeoffResult(spec.name, sweeps, objective, results, label, len(chunks),
+                          time.perf_counter() - t0)
+
+
+def _dask_client(scheduler: Any) -> tuple[Any, str, int]:
+    try:
+        from distributed import Client
+    except ImportError:
+        raise SynthError("--scheduler needs dask.distributed: pip install 'synth[dask]'", where="--scheduler") from None
+    if isinstance(scheduler, str):
+        try:
+            client = Client(scheduler, timeout="10s")
+        except OSError as exc:
+            raise SynthError(f"cannot reach the Dask scheduler: {exc}", where=f"--scheduler {scheduler}") from None
+    else:
+        client = scheduler
+    n = max(1, sum(client.nthreads().values()))
+    return client, f"dask cluster at {client.scheduler.address} ({n} threads)", n
