@@ -1,0 +1,1 @@
+"""Nonlinear sampled simulation: blocks, closed and open loop, step metrics, limit cycles."""
