@@ -34,4 +34,7 @@ def jit(func: Callable[..., Any]) -> Callable[..., Any]:
     """
     if _njit is None:  # pragma: no cover
         return func
-    return _njit(cache=True)(func)
+    try:
+        return _njit(cache=True)(func)
+    except RuntimeError:  # no file to cache next to (interactive or doctest code)
+        return _njit(func)

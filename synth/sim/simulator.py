@@ -247,6 +247,9 @@ class SimResult:
         Block types in chain order (for reading ``flags``).
     actuator_flags, sensor_flags : list of str or None
         Each block's metric name (``"rate_limited"``, ``"saturated"``, ...).
+    label : str
+    actuator_rest : float
+        Actuator output at rest before ``t = 0`` (plant input units).
     """
 
     t: np.ndarray
@@ -262,6 +265,7 @@ class SimResult:
     actuator_flags: list[str | None]
     sensor_flags: list[str | None]
     label: str = ""
+    actuator_rest: float = float("nan")
 
     def active(self, name: str) -> np.ndarray:
         """Steps where any block with metric ``name`` (e.g. ``"saturated"``) was active.
@@ -312,6 +316,7 @@ class BatchResult:
     flags: np.ndarray
     dt: float
     loops: list[Any]
+    actuator_rest: np.ndarray = field(default_factory=lambda: np.zeros(0))
 
     def __len__(self) -> int:
         return self.output.shape[0]
@@ -322,7 +327,8 @@ class BatchResult:
         return SimResult(self.t, ref, self.output[i], self.measured[i], self.command[i], self.actuator[i],
                          self.flags[i], self.dt, [b.kind for b in chains[0]], [b.kind for b in chains[1]],
                          [b.flag for b in chains[0]], [b.flag for b in chains[1]],
-                         getattr(self.loops[i], "label", ""))
+                         getattr(self.loops[i], "label", ""),
+                         float(self.actuator_rest[i]) if self.actuator_rest.size else float("nan"))
 
     def _chains(self, i: int) -> tuple[list[Block], list[Block]]:
         loop = self.loops[i]
@@ -648,7 +654,8 @@ def _run(loops: Sequence[Any], mode: int, inputs: Sequence[np.ndarray], t_end: f
     if not (np.all(np.isfinite(Y)) and np.all(np.isfinite(U))):
         Y, U = np.nan_to_num(Y, nan=np.inf), np.nan_to_num(U, nan=np.inf)
     return BatchResult(t[keep], arrays["ref"][:, keep], Y[:, keep], YM[:, keep], U[:, keep], UA[:, keep],
-                       FLAGS[:, keep], dt, list(loops))
+                       FLAGS[:, keep], dt, list(loops),
+                       UA[:, n_pre - 1] if n_pre else arrays["w0"] + arrays["u0"])
 
 
 # ------------------------------------------------------------------------------------- public API
@@ -685,9 +692,9 @@ def simulate(loop: NonlinearLoop, reference: Reference, t_end: float, disturbanc
     ...                      operating_point=OperatingPoint(200, 870))
     >>> r = simulate(loop, step_reference(820, 920), 0.5)
     >>> round(float(r.output[0]), 2), round(float(r.output[-1]), 2)  # P control: steady-state error
-    (827.4, 912.6)
-    >>> round(r.time_active("saturated"), 3)
-    0.016
+    (827.44, 914.64)
+    >>> round(r.time_active("saturated"), 3)  # the step asks for 477 PWM; 255 is the top
+    0.05
     """
     return _run([loop], 0, [reference], t_end, disturbances, seed, settle)[0]
 
