@@ -11,9 +11,11 @@ Closed forms:
   ``N = (2/pi) (asin(a/A) + (a/A) sqrt(1 - (a/A)^2))``;
 * dead zone of half-width ``d``: ``N = 1 - N_sat(A; a = d)``;
 * rate limiter of rate ``R``: ``N = 1`` for ``A w <= R``;
-  ``N = (4 R/(pi A w)) exp(-j arccos(pi R/(2 A w)))`` for ``A w >= pi R/2`` (the output is a
-  triangle wave). In between the output tracks the input part of the time; that ``N`` is
-  computed exactly from the piecewise output (ramps at ``+-R`` joined to the sine).
+  ``N = (4 R/(pi A w)) exp(-j arccos(pi R/(2 A w)))`` when the output is a triangle wave, which
+  is exactly the case for ``A w >= R sqrt(1 + pi^2/4) = 1.862 R`` (the textbook bound
+  ``pi R/2 = 1.571 R`` is where the formula is defined, not where it is exact). In between
+  the output tracks the input part of the time; that ``N`` is computed exactly from the
+  piecewise output (ramps at ``+-R`` joined to the sine).
 
 Stability of a predicted cycle follows Loeb's criterion on
 ``F(A, w) = 1 + L N``: stable when ``dU/dA dV/dw - dU/dw dV/dA > 0``
@@ -58,8 +60,19 @@ def dead_zone_df(A: Any, width: float) -> np.ndarray:
     return 1.0 - saturation_df(A, width)
 
 
-def rate_limiter_df(A: float, w: float, rate: float) -> complex:
+TRIANGLE_RHO = 1.0 / np.sqrt(1.0 + np.pi**2 / 4)
+"""``R/(A w)`` below which a rate limiter's output is a pure triangle wave (0.537)."""
+
+
+def rate_limiter_df(A: float, w: float, rate: float, exact: bool = True) -> complex:
     """Describing function of a rate limiter (rate ``R``) for input ``A sin(w t)``.
+
+    The textbook form ``(4R/(pi A w)) exp(-j arccos(pi R/(2 A w)))`` (``exact=False``, used for
+    ``A w >= pi R/2``) assumes the output is a triangle wave. That holds exactly only for
+    ``A w >= R sqrt(1 + pi^2/4) = 1.862 R``: the triangle must cross the sine with the sine
+    falling faster than ``R``. Between ``R`` and ``1.862 R`` the output tracks the input part
+    of each cycle, and ``exact=True`` (default) computes that ``N`` from the piecewise output;
+    at ``A w = pi R/2`` it is ``0.762 - 0.261j`` against the textbook ``0.811``.
 
     Examples
     --------
@@ -68,6 +81,9 @@ def rate_limiter_df(A: float, w: float, rate: float) -> complex:
     >>> n = rate_limiter_df(10.0, 1.0, 1.0)  # fully rate limited: 4R/(pi A w) at -arccos(pi R/(2 A w))
     >>> round(abs(n), 5), round(float(np.angle(n)), 5)
     (0.12732, -1.41306)
+    >>> n = rate_limiter_df(1.0, 1.0, 2 / np.pi)
+    >>> round(n.real, 3), round(n.imag, 3), round(rate_limiter_df(1.0, 1.0, 2 / np.pi, exact=False).real, 3)
+    (0.762, -0.261, 0.811)
     """
     A, w, rate = float(A), float(w), float(rate)
     if A <= 0 or w <= 0:
@@ -75,13 +91,16 @@ def rate_limiter_df(A: float, w: float, rate: float) -> complex:
     rho = rate / (A * w)
     if rho >= 1.0:
         return complex(1.0)
-    if rho <= 2 / np.pi:
+    if rho <= (TRIANGLE_RHO if exact else 2 / np.pi):
         return complex((4 * rate / (np.pi * A * w)) * np.exp(-1j * np.arccos(np.pi * rate / (2 * A * w))))
+    if not exact:
+        raise ModelError(f"the textbook rate-limiter describing function needs A w >= pi R/2; "
+                         f"here A w = {A * w:g}, R = {rate:g}")
     return _rate_limiter_partial(rho)
 
 
 def _rate_limiter_partial(rho: float, n: int = 4096) -> complex:
-    """Exact N for 2/pi < rho = R/(A w) < 1 (unit amplitude): one period of the piecewise output."""
+    """Exact N for 0.537 < rho = R/(A w) < 1 (unit amplitude): one period of the piecewise output."""
     theta_s = np.pi - np.arccos(rho)  # the falling input's slope first exceeds the limit here
 
     def gap(th: float) -> float:

@@ -119,7 +119,10 @@ def detect_oscillation(t: Any, x: Any, window: float | None = None, min_amplitud
     third = max(1, r.size // 3)
     rms_early, rms_late = np.sqrt(np.mean(r[:third] ** 2)), np.sqrt(np.mean(r[-third:] ** 2))
     growth = float(rms_late / rms_early) if rms_early > 0 else float("inf")
-    diverging = growth > 3.0
+    dev = xw - np.mean(xw[:third])
+    early_dev = max(float(np.max(np.abs(dev[:third]))), floor)
+    late_dev = float(np.max(np.abs(dev[-third:])))
+    diverging = growth > 3.0 or (late_dev > 10 * early_dev and late_dev > 10 * floor)
     if growth < sustain:
         return Oscillation(False, float(half), None, None, None, growth, 0, float(np.mean(xw)),
                            f"decaying: the last third of the window has {growth:.2g} times the RMS of the first")
@@ -135,7 +138,8 @@ def detect_oscillation(t: Any, x: Any, window: float | None = None, min_amplitud
     if np.std(periods) > 0.35 * period and not diverging:
         return Oscillation(False, float(half), period, w0, None, growth, cycles, float(np.mean(xw)),
                            "irregular: cycle lengths vary by more than 35 %")
-    last = tw >= tw[-1] - min(2 * period, window) if diverging else tw >= ups[max(0, ups.size - 3)]
+    last = tw >= tw[-1] - min(2 * period, window) if diverging else \
+        (tw >= ups[max(0, ups.size - 3)]) & (tw < ups[-1])
     amplitude = 0.5 * float(xw[last].max() - xw[last].min())
     center = float(np.mean(xw[last]))
     whole = (tw >= ups[0]) & (tw < ups[-1])
