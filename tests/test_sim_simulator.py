@@ -186,5 +186,5 @@ def test_bad_inputs_raise_model_errors():
         simulate(NonlinearLoop(G, C), np.zeros(3), 1.0)
     with pytest.raises(ModelError, match="anti_windup needs the actuator chain"):
         simulate(NonlinearLoop(G, Controller.from_string("PI(1, 1)"), anti_windup=True), 1.0, 0.1)
-    with pytest.raises(ModelError, match="min .* must be below max"):
+    with pytest.raises(ModelError, match=r"min .* must be below max"):
         Saturation(5, 1)

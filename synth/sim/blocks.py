@@ -35,6 +35,7 @@ delay          pure delay; pooled with the loop delay (it commutes with every
 
 from __future__ import annotations
 
+import itertools
 from dataclasses import asdict, dataclass, field
 from typing import Any, ClassVar
 
@@ -459,7 +460,7 @@ class Static(Block):
         xs = [a for a, _ in pts]
         if not all(np.isfinite(v) for p in pts for v in p):
             raise ModelError("static: table values must be finite")
-        if any(b <= a for a, b in zip(xs, xs[1:])):
+        if any(b <= a for a, b in itertools.pairwise(xs)):
             raise ModelError("static: table x values must be strictly increasing")
         object.__setattr__(self, "table", pts)
 

@@ -113,7 +113,7 @@ def nonlinear_step_metrics(result: SimResult, t_step: float = 0.0, final_value: 
     after = t >= t_step - 1e-12
     i0 = int(np.argmax(after))
     ta, ya = t[after], y[after]
-    tail = max(1, int(round(0.05 * ya.size)))
+    tail = max(1, round(0.05 * ya.size))
     yf = float(np.mean(ya[-tail:])) if final_value is None else float(final_value)
     y0 = float(y[i0])
     base: StepMetrics = step_metrics(ta - ta[0], ya, y0=y0, y_final=yf, settle_band=settle_band)

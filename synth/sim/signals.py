@@ -11,6 +11,7 @@ equals the sum ``S(w_k) dw`` exactly, whatever the seed.
 from __future__ import annotations
 
 import csv
+import itertools
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -35,7 +36,7 @@ def validate_psd(table: Any, where: str = "psd") -> tuple[tuple[float, float], .
     if len(pts) < 2:
         raise ModelError(f"{where}: give at least 2 [w, S] points")
     ws = [w for w, _ in pts]
-    if any(not np.isfinite(w) or w <= 0 for w in ws) or any(b <= a for a, b in zip(ws, ws[1:])):
+    if any(not np.isfinite(w) or w <= 0 for w in ws) or any(b <= a for a, b in itertools.pairwise(ws)):
         raise ModelError(f"{where}: frequencies must be > 0 rad/s and strictly increasing")
     if any(not np.isfinite(s) or s < 0 for _, s in pts):
         raise ModelError(f"{where}: PSD values must be finite and >= 0")

@@ -131,9 +131,9 @@ class NonlinearLoop:
             raise ModelError(f"dt must be > 0 s, got {self.dt!r}")
         if not (np.isfinite(self.loop_delay) and self.loop_delay >= 0):
             raise ModelError(f"loop_delay must be >= 0 s, got {self.loop_delay!r}")
-        if sum(1 for _ in self.actuator) > 16 or sum(1 for _ in self.sensor) > 15:
+        if len(self.actuator) > 16 or len(self.sensor) > 15:
             raise ModelError("at most 16 actuator and 15 sensor blocks")
-        self.controller_ratio  # validates the rate
+        _ = self.controller_ratio  # validates the rate
         if self.discretization not in ("tustin", "zoh", "backward_euler", "forward_euler"):
             raise ModelError(f"unknown controller discretization {self.discretization!r}; expected tustin, "
                              "zoh, backward_euler or forward_euler")
@@ -148,7 +148,7 @@ class NonlinearLoop:
         if not (np.isfinite(ratio) and ratio >= 1 - 1e-9 and abs(ratio - round(ratio)) <= 1e-6 * ratio):
             raise ModelError(f"controller_rate {self.controller_rate:g} Hz must be 1/dt divided by a whole "
                              f"number (dt = {self.dt:g} s)")
-        return int(round(ratio))
+        return round(ratio)
 
     @property
     def controller_period(self) -> float:
@@ -631,8 +631,8 @@ def _run(loops: Sequence[Any], mode: int, inputs: Sequence[np.ndarray], t_end: f
         raise ModelError(f"the simulated time must be > 0 s, got {t_end!r}")
     if settle < 0:
         raise ModelError(f"settle must be >= 0 s, got {settle!r}")
-    n_main = int(round(t_end / dt)) + 1
-    n_pre = int(round(settle / dt))
+    n_main = round(t_end / dt) + 1
+    n_pre = round(settle / dt)
     t = (np.arange(n_pre + n_main) - n_pre) * dt
     items = []
     for b, (loop, ref) in enumerate(zip(loops, inputs)):
