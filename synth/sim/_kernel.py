@@ -22,7 +22,7 @@ from __future__ import annotations
 import numpy as np
 
 from synth.sim._jit import jit
-from synth.sim.blocks import NOISE, block_step
+from synth.sim._steps import NOISE, block_step
 
 SENSOR_BIT = 16
 

@@ -117,7 +117,11 @@ def detect_oscillation(t: Any, x: Any, window: float | None = None, min_amplitud
         return Oscillation(False, float(half), None, None, None, None, 0, float(np.mean(xw)),
                            f"amplitude {half:.3g} is below the threshold {floor:.3g}")
     third = max(1, r.size // 3)
-    rms_early, rms_late = np.sqrt(np.mean(r[:third] ** 2)), np.sqrt(np.mean(r[-third:] ** 2))
+    with np.errstate(over="ignore", invalid="ignore"):
+        rms_early, rms_late = np.sqrt(np.mean(r[:third] ** 2)), np.sqrt(np.mean(r[-third:] ** 2))
+    if not (np.isfinite(rms_early) and np.isfinite(rms_late)):
+        return Oscillation(False, float(half), None, None, None, float("inf"), 0, None, "signal diverged",
+                           diverging=True)
     growth = float(rms_late / rms_early) if rms_early > 0 else float("inf")
     dev = xw - np.mean(xw[:third])
     early_dev = max(float(np.max(np.abs(dev[:third]))), floor)

@@ -699,6 +699,23 @@ def simulate(loop: NonlinearLoop, reference: Reference, t_end: float, disturbanc
     return _run([loop], 0, [reference], t_end, disturbances, seed, settle)[0]
 
 
+def simulate_step(loop: NonlinearLoop, start: float, end: float, t_end: float, t_step: float = 0.0,
+                  disturbances: Sequence[Any] = (), seed: int = 0, settle: float = 0.0) -> SimResult:
+    """Response to a reference step from ``start`` to ``end`` (absolute output units) at ``t_step``,
+    starting at rest at ``start``.
+
+    Examples
+    --------
+    >>> loop = NonlinearLoop(Plant.from_string("10/(s+10)"), Controller.from_string("PI(1, 10)"))
+    >>> r = simulate_step(loop, 0.0, 2.0, 1.0, t_step=0.1)
+    >>> float(r.output[100]), round(float(r.output[-1]), 4)
+    (0.0, 2.0)
+    """
+    from synth.sim.signals import step_reference
+
+    return simulate(loop, step_reference(start, end, t_step), t_end, disturbances, seed, settle)
+
+
 def simulate_batch(loops: Sequence[NonlinearLoop], reference: Reference | Sequence[Reference], t_end: float,
                    disturbances: Sequence[Any] = (), seed: int = 0, settle: float = 0.0) -> BatchResult:
     """Simulate many variants at once (sweeps, Monte Carlo): one compiled call for the batch.
