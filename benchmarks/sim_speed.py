@@ -56,7 +56,7 @@ def naive_python_loop(kp: float = 3.0) -> np.ndarray:
     A, B, C, _ = tf_to_ss(G.num, G.den)
     d = delayed_zoh(A, B, DT, 0.0)
     Ad, Bd = d.Ad, d.B_late
-    n = int(round(T_END / DT)) + 1
+    n = round(T_END / DT) + 1
     y_rest = 870 + kp * G.dc_gain() * (820 - 870) / (1 + kp * G.dc_gain())
     x = np.linalg.solve(np.eye(2) - Ad, Bd * ((y_rest - 870) / G.dc_gain()))
     u_prev = 200 + kp * (820 - y_rest)
@@ -83,7 +83,7 @@ def python_control_linear() -> np.ndarray:
 
     G = control.tf(*[list(p) for p in (Plant.from_string(PLANT).num, Plant.from_string(PLANT).den)])
     T = control.feedback(3.0 * control.c2d(G, DT, "zoh"), 1)
-    t = np.arange(int(round(T_END / DT)) + 1) * DT
+    t = np.arange(round(T_END / DT) + 1) * DT
     return np.asarray(control.forced_response(T, t, np.full(t.size, 50.0)).outputs)
 
 
@@ -102,7 +102,7 @@ def main() -> None:
     args = parser.parse_args()
     ref = step_reference(820, 920)
     loop = x4_loop()
-    fresh = [sys.executable, "-c", "import sys; sys.path.insert(0, %r)\n" % str(ROOT)
+    fresh = [sys.executable, "-c", f"import sys; sys.path.insert(0, {str(ROOT)!r})\n"
              + "from benchmarks.sim_speed import x4_loop\nfrom synth.sim.signals import step_reference\n"
              "from synth.sim.simulator import simulate\nimport time\nloop = x4_loop()\n"
              "t0 = time.perf_counter()\nsimulate(loop, step_reference(820, 920), 10.0)\n"
@@ -111,10 +111,11 @@ def main() -> None:
     env = {**os.environ, "NUMBA_DISABLE_JIT": "1"}
     no_jit = [float(subprocess.run(fresh, cwd=ROOT, check=True, capture_output=True, text=True, env=env)
                     .stdout.split()[-1]) for _ in range(2)]
-    batch_script = fresh[:2] + [fresh[2].replace(
+    batch_code = fresh[2].replace(
         "simulate(loop, step_reference(820, 920), 10.0)",
         "import numpy as np\nfrom synth.sim.simulator import simulate_batch\n"
-        "simulate_batch([x4_loop(k) for k in np.linspace(1, 10, 100)], step_reference(820, 920), 10.0)")]
+        "simulate_batch([x4_loop(k) for k in np.linspace(1, 10, 100)], step_reference(820, 920), 10.0)")
+    batch_script = [*fresh[:2], batch_code]
     batch_no_jit = [float(subprocess.run(batch_script, cwd=ROOT, check=True, capture_output=True, text=True,
                                          env=env).stdout.split()[-1])]
     simulate(loop, ref, T_END)  # warm: compiled code loaded
@@ -123,7 +124,8 @@ def main() -> None:
     agree = float(np.max(np.abs(a - b)))
     loops100 = [x4_loop(k) for k in np.linspace(1, 10, 100)]
     rows = [
-        ("synth simulate, nonlinear X-4 loop, 10 s @ 1 kHz", timed(lambda: simulate(loop, ref, T_END), args.repeat)),
+        ("synth simulate, nonlinear X-4 loop, 10 s @ 1 kHz",
+         timed(lambda: simulate(loop, ref, T_END), args.repeat)),
         ("python-control forced_response, linear loop (baseline)",
          timed(python_control_linear, max(3, args.repeat // 2))),
         ("plain Python per-step loop, nonlinear, hand-specialized (baseline)", timed(naive_python_loop, 3)),
@@ -138,7 +140,8 @@ def main() -> None:
     med = statistics.median(rows[0][1])
     print(f"\nplain-Python loop and synth agree to {agree:.2e} rad/s (same equations)")
     print(f"batch: {statistics.median(rows[4][1]) / 100 * 1000:.2f} ms per 10 s variant")
-    print(f"goal: 10 s of 1 kHz closed loop under 0.5 s -> {'MET' if med < 0.5 else 'NOT MET'} ({med:.4f} s median)")
+    verdict = "MET" if med < 0.5 else "NOT MET"
+    print(f"goal: 10 s of 1 kHz closed loop under 0.5 s -> {verdict} ({med:.4f} s median)")
 
 
 if __name__ == "__main__":
