@@ -92,15 +92,33 @@ class Block:
     flag: ClassVar[str | None] = None
 
     def parameters(self, dt: float, operating_input: float = 0.0) -> np.ndarray:
-        """Parameter vector (length :data:`P_MAX`) for simulation step ``dt``."""
+        """Parameter vector (length :data:`P_MAX`) for simulation step ``dt``.
+
+        Examples
+        --------
+        >>> RateLimit(10000).parameters(0.001)[:2].tolist()  # R dt, F dt
+        [10.0, 10.0]
+        """
         return _pad([], P_MAX)
 
     def initial_state(self, x: float, dt: float) -> np.ndarray:
-        """State vector (length :data:`S_MAX`) at rest with constant input ``x``."""
+        """State vector (length :data:`S_MAX`) at rest with constant input ``x``.
+
+        Examples
+        --------
+        >>> RateLimit(10000).initial_state(200.0, 0.001)[0]
+        np.float64(200.0)
+        """
         return _pad([], S_MAX)
 
     def dc_gain(self) -> float:
-        """Static gain used to initialise the loop at rest (1 for nonlinear blocks)."""
+        """Static gain used to initialise the loop at rest (1 for nonlinear blocks).
+
+        Examples
+        --------
+        >>> Saturation(0, 255).dc_gain(), Lag(0.1, gain=2.0).dc_gain()
+        (1.0, 2.0)
+        """
         return 1.0
 
     def to_dict(self) -> dict[str, Any]:
@@ -364,7 +382,13 @@ class Dynamics(Block):
 
     @classmethod
     def from_string(cls, text: str) -> Dynamics:
-        """Parse a transfer function such as ``"442/((s+45)*(s+9.7))"``."""
+        """Parse a transfer function such as ``"442/((s+45)*(s+9.7))"``.
+
+        Examples
+        --------
+        >>> Dynamics.from_string("10/(s+10)").den
+        (1.0, 10.0)
+        """
         from synth.plant import Plant
 
         p = Plant.from_string(text)
@@ -376,7 +400,14 @@ class Dynamics(Block):
         return float(self.num[-1] / self.den[-1])
 
     def state_space(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
-        """Continuous ``(A, B, C, D)`` of the block."""
+        """Continuous ``(A, B, C, D)`` of the block.
+
+        Examples
+        --------
+        >>> A, B, C, D = Dynamics.from_string("10/(s+10)").state_space()
+        >>> A.tolist(), C.tolist()
+        ([[-10.0]], [10.0])
+        """
         from synth.sim.discretize import tf_to_ss
 
         return tf_to_ss(np.asarray(self.num), np.asarray(self.den))
@@ -509,7 +540,13 @@ class SupplySag(Block):
             object.__setattr__(self, "v_nominal", _positive("v_nominal", self.v_nominal, self.kind))
 
     def nominal_voltage(self, operating_input: float) -> float:
-        """``v_nominal``, or the steady terminal voltage at ``operating_input``."""
+        """``v_nominal``, or the steady terminal voltage at ``operating_input``.
+
+        Examples
+        --------
+        >>> round(SupplySag(v_open=16.8, r_internal=0.1, i_static=0.04).nominal_voltage(200), 6)
+        16.0
+        """
         if self.v_nominal is not None:
             return self.v_nominal
         v = self.v_open - self.r_internal * max(0.0, self.i_static * operating_input)
@@ -585,7 +622,13 @@ class Noise(Block):
             raise ModelError("noise: give std > 0 or a psd table")
 
     def samples(self, n: int, dt: float, rng: np.random.Generator) -> np.ndarray:
-        """``n`` noise samples at step ``dt``."""
+        """``n`` noise samples at step ``dt``.
+
+        Examples
+        --------
+        >>> Noise(std=1.0).samples(3, 0.001, np.random.default_rng(0)).shape
+        (3,)
+        """
         from synth.sim.signals import psd_signal
 
         out = np.zeros(n)
@@ -630,11 +673,6 @@ BLOCK_TYPES: dict[str, type[Block]] = {
 """Every block class by its ``type:`` name."""
 
 
-def flag_names(blocks: list[Block]) -> list[str | None]:
-    """The metric name of each block's active flag (None for blocks without one)."""
-    return [b.flag for b in blocks]
-
-
 @dataclass
 class _ChainArrays:
     codes: np.ndarray
@@ -645,7 +683,14 @@ class _ChainArrays:
 
 def chain_arrays(blocks: list[Block], dt: float, x0: float, operating_input: float, n_steps: int,
                  rng: np.random.Generator | None) -> _ChainArrays:
-    """Codes, parameters, initial states (at rest with input ``x0``) and noise of a chain."""
+    """Codes, parameters, initial states (at rest with input ``x0``) and noise of a chain.
+
+    Examples
+    --------
+    >>> arr = chain_arrays([RateLimit(1000), Saturation(0, 1)], 0.001, 0.5, 0.5, 10, None)
+    >>> arr.codes.tolist(), arr.state[0, 0]
+    ([1, 2], np.float64(0.5))
+    """
     codes = np.zeros(max(1, len(blocks)), np.int64)
     params = np.zeros((max(1, len(blocks)), P_MAX))
     state = np.zeros((max(1, len(blocks)), S_MAX))

@@ -161,7 +161,13 @@ class PredictedCycle:
     stable: bool
 
     def to_dict(self) -> dict[str, Any]:
-        """JSON-ready dict."""
+        """JSON-ready dict.
+
+        Examples
+        --------
+        >>> PredictedCycle(1.0, 2.0, 3.14, True).to_dict()["stable"]
+        True
+        """
         return asdict(self)
 
 
@@ -234,10 +240,3 @@ def _loeb_stable(L: Callable[[np.ndarray], np.ndarray], N: Callable[[float, floa
     FA = (F(a + da, w) - F(a - da, w)) / (2 * da)
     Fw = (F(a, w + dw) - F(a, w - dw)) / (2 * dw)
     return bool(FA.real * Fw.imag - Fw.real * FA.imag > 0)
-
-
-def check_ranges(w_range: tuple[float, float], a_range: tuple[float, float]) -> None:
-    """Validate search ranges (positive, increasing)."""
-    for name, (lo, hi) in (("frequency range", w_range), ("amplitude range", a_range)):
-        if not (0 < lo < hi and np.isfinite(hi)):
-            raise ModelError(f"{name} must be 0 < low < high, got [{lo:g}, {hi:g}]")

@@ -162,6 +162,8 @@ class RecordDisturbance:
         if np.any(np.diff(t) <= 0):
             i = int(np.flatnonzero(np.diff(t) <= 0)[0]) + 1
             raise DataError(f"time is not strictly increasing at row {i + 1} (t = {t[i]:g} s)", where=where)
+        object.__setattr__(self, "time", tuple(float(x) for x in t))
+        object.__setattr__(self, "value", tuple(float(x) for x in v))
 
     def signal(self, t: np.ndarray, rng: np.random.Generator) -> np.ndarray:
         """The record at times ``t`` (record time 0 = simulation time 0)."""
@@ -178,6 +180,14 @@ class RecordDisturbance:
 
         ``start`` shifts the record so that this record time is simulation time 0 (default:
         its first time); ``scale`` multiplies the values.
+
+        Examples
+        --------
+        >>> import tempfile, pathlib
+        >>> p = pathlib.Path(tempfile.mkdtemp()) / "d.csv"
+        >>> _ = p.write_text("t,load\\n1.0,0\\n2.0,4\\n")
+        >>> RecordDisturbance.from_csv(p, "t", "load", scale=0.5).value
+        (0.0, 2.0)
         """
         path = Path(path)
         if not path.exists():

@@ -347,7 +347,15 @@ class SimulationSpec(_Model):
         return [b.build() for b in self.sensor]
 
     def build_loop(self, plant: Any, controller: Any, label: str = "") -> Any:
-        """The :class:`~synth.sim.simulator.NonlinearLoop` of ``plant`` and ``controller``."""
+        """The :class:`~synth.sim.simulator.NonlinearLoop` of ``plant`` and ``controller``.
+
+        Examples
+        --------
+        >>> from synth.plant import Plant; from synth.controllers import Controller
+        >>> sim = SimulationSpec.model_validate({"loop_delay": 0.01})
+        >>> sim.build_loop(Plant.from_string("1/(s+1)"), Controller("P", {"kp": 1})).total_delay
+        0.01
+        """
         from synth.sim.simulator import NonlinearLoop, OperatingPoint
 
         return NonlinearLoop(plant, controller, tuple(self.actuator_blocks()), tuple(self.sensor_blocks()),
@@ -356,7 +364,13 @@ class SimulationSpec(_Model):
                              self.controller_discretization, self.anti_windup, label)
 
     def build_disturbances(self) -> list[Any]:
-        """Disturbance objects (record files are read here; errors name the file and column)."""
+        """Disturbance objects (record files are read here; errors name the file and column).
+
+        Examples
+        --------
+        >>> SimulationSpec.model_validate({"disturbances": [{"type": "step", "size": 2}]}).build_disturbances()
+        [StepDisturbance(size=2.0, at_time=0.0, at='output')]
+        """
         out = []
         for i, d in enumerate(self.disturbances):
             try:
@@ -366,7 +380,13 @@ class SimulationSpec(_Model):
         return out
 
     def default_step(self) -> tuple[float, float]:
-        """The spec's step, or one from the operating-point output to 10 % above it (1 if it is 0)."""
+        """The spec's step, or one from the operating-point output to 10 % above it (1 if it is 0).
+
+        Examples
+        --------
+        >>> SimulationSpec.model_validate({"operating_point": {"output": 870}}).default_step()
+        (870.0, 957.0)
+        """
         if self.step is not None:
             return self.step
         y0 = self.operating_point.output
