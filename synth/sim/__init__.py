@@ -13,8 +13,9 @@ Public API (imported on first use, so ``import synth`` does not load numba):
     Exogenous signals (:mod:`synth.sim.signals`).
 ``nonlinear_step_metrics``, ``detect_oscillation``
     Step metrics and limit-cycle detection.
-``saturation_df``, ``rate_limiter_df``, ``dead_zone_df``, ``numeric_df``, ``harmonic_balance``
-    Describing functions (:mod:`synth.sim.describing`).
+``saturation_df``, ``rate_limiter_df``, ``dead_zone_df``, ``numeric_df``, ``harmonic_balance``,
+``sampled_loop_response``, ``predict_loop_cycles``
+    Describing functions and harmonic balance (:mod:`synth.sim.describing`).
 ``oscillation_onset``, ``rate_variants``
     Onset gain of oscillation against delay and rate limit (:mod:`synth.sim.onset`).
 
@@ -43,7 +44,8 @@ _WHERE = {
     "synth.sim.metrics": ("NonlinearStepMetrics", "nonlinear_step_metrics"),
     "synth.sim.limitcycle": ("Oscillation", "detect_oscillation"),
     "synth.sim.describing": ("saturation_df", "rate_limiter_df", "dead_zone_df", "numeric_df", "harmonic_balance",
-                             "PredictedCycle"),
+                             "PredictedCycle", "sampled_loop_response", "predict_loop_cycles",
+                             "LoopCyclePrediction"),
     "synth.sim.onset": ("oscillation_onset", "rate_variants", "OnsetResult", "OnsetRow"),
 }
 _INDEX = {name: module for module, names in _WHERE.items() for name in names}

@@ -240,3 +240,134 @@ def _loeb_stable(L: Callable[[np.ndarray], np.ndarray], N: Callable[[float, floa
     FA = (F(a + da, w) - F(a - da, w)) / (2 * da)
     Fw = (F(a, w + dw) - F(a, w - dw)) / (2 * dw)
     return bool(FA.real * Fw.imag - Fw.real * FA.imag > 0)
+
+
+def sampled_loop_response(loop: Any, w: Any) -> np.ndarray:
+    """Frequency response of the linear part of a sampled loop as seen by its actuator chain.
+
+    ``L(jw) = C(e^{jw Tc}) P(e^{jw dt}) S(jw)``: the discretized controller, the exact pulse
+    transfer function of the plant core (zero-order hold, delays, folded linear blocks) from the
+    actuator output to the sensed output, and the sensor chain's sample-and-holds approximated by
+    their mean delay ``(T_s - dt)/2`` (quantizers and noise count as identity). With the actuator
+    chain's input ``x`` and output ``y`` (deviations), ``x = -L y``: a limit cycle needs
+    ``1 + L N = 0``.
+
+    Examples
+    --------
+    >>> from synth.plant import Plant; from synth.controllers import Controller
+    >>> from synth.sim.simulator import NonlinearLoop
+    >>> loop = NonlinearLoop(Plant.from_string("10/(s+10)"), Controller("P", {"kp": 2}), dt=0.001)
+    >>> abs(sampled_loop_response(loop, [1e-3])[0]).round(6)  # K G(0)
+    np.float64(2.0)
+    """
+    return np.prod(_loop_parts(loop, w), axis=0)
+
+
+def _loop_parts(loop: Any, w: Any) -> np.ndarray:
+    """Rows: controller, plant core (actuator output to sensed output), sensor chain."""
+    from synth.sim.blocks import Delay, Dynamics, SampleHold
+    from synth.sim.discretize import delayed_zoh, discretize_controller, zoh
+    from synth.sim.simulator import _core, _fold_counts
+
+    w = np.atleast_1d(np.asarray(w, float))
+    dt = loop.dt
+    act = [b for b in loop.actuator if not isinstance(b, Delay)]
+    sen = [b for b in loop.sensor if not isinstance(b, Delay)]
+    na, ns = _fold_counts(act, sen)
+    core = _core(loop.plant, act[len(act) - na:], sen[:ns], loop.operating_point)
+    dz = delayed_zoh(core.A, core.B[:, 0], dt, loop.total_delay)
+    n = core.A.shape[0]
+    num, den = loop.controller.tf()
+    tc = loop.controller_period
+    Ac, Bc, Cc, Dc = discretize_controller(num, den, tc, loop.discretization)
+    out = np.empty((3, w.size), complex)
+    for i, om in enumerate(w):
+        z = np.exp(1j * om * dt)
+        zc = np.exp(1j * om * tc)
+        if n:
+            X = np.linalg.solve(z * np.eye(n) - dz.Ad, dz.B_early + dz.B_late * z)
+            P = (core.C[1] @ X) * z ** (-dz.steps - 1) + core.D[1, 0] * z ** (-dz.steps - 1)
+        else:
+            P = core.D[1, 0] * z ** (-dz.steps - 1)
+        C = Dc + (Cc @ np.linalg.solve(zc * np.eye(Ac.shape[0]) - Ac, Bc) if Ac.size else 0.0)
+        S = 1.0 + 0j
+        for b in sen[ns:]:
+            if isinstance(b, SampleHold):
+                S *= np.exp(-1j * om * max(0.0, 1.0 / b.rate - dt) / 2)
+            elif isinstance(b, Dynamics):
+                A_, B_, C_, D_ = b.state_space()
+                Ad, Bd = zoh(A_, B_[:, None], dt)
+                S *= D_ + (C_ @ np.linalg.solve(z * np.eye(Ad.shape[0]) - Ad, Bd[:, 0]) if Ad.size else 0.0)
+        out[:, i] = (C, P, S)
+    return out
+
+
+@dataclass(frozen=True)
+class LoopCyclePrediction:
+    """Harmonic-balance prediction for a sampled loop (see :func:`predict_loop_cycles`).
+
+    Attributes
+    ----------
+    cycle : PredictedCycle
+        Amplitude at the actuator chain's input, frequency, period, stability.
+    output_amplitude : float
+        Fundamental amplitude of the sensed output it implies: ``A |N| |P|``.
+    bias : float
+        Actuator chain input about which the describing function was taken.
+    """
+
+    cycle: PredictedCycle
+    output_amplitude: float
+    bias: float
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready dict.
+
+        Examples
+        --------
+        >>> LoopCyclePrediction(PredictedCycle(1.0, 2.0, 3.1, True), 0.5, 200.0).to_dict()["bias"]
+        200.0
+        """
+        return {**self.cycle.to_dict(), "output_amplitude": self.output_amplitude, "bias": self.bias}
+
+
+def predict_loop_cycles(loop: Any, bias: float, w_range: tuple[float, float] | None = None,
+                        a_range: tuple[float, float] = (1e-2, 1e4),
+                        points: int = 120) -> list[LoopCyclePrediction]:
+    """Limit cycles of a sampled loop predicted with the describing function of its actuator chain.
+
+    The actuator chain's describing function is computed by simulation about ``bias`` (its
+    input at rest, e.g. the trim plus the controller's steady output), so asymmetric limits such
+    as 0-255 PWM around 222 PWM are handled in the fundamental (not the bias shift).
+
+    Examples
+    --------
+    >>> from synth.plant import Plant; from synth.controllers import Controller
+    >>> from synth.sim.simulator import NonlinearLoop
+    >>> from synth.sim.blocks import Saturation
+    >>> loop = NonlinearLoop(Plant.from_string("1/(s*(s+1)*(s+2))"), Controller("P", {"kp": 20}),
+    ...                      actuator=[Saturation(-1, 1)], dt=0.001)
+    >>> [p] = predict_loop_cycles(loop, 0.0, (0.5, 5.0), points=40)
+    >>> round(p.cycle.frequency, 2), round(p.cycle.amplitude, 1)  # continuous: 1.41 rad/s, 4.2
+    (1.41, 4.2)
+    """
+    from synth.sim.blocks import Delay
+
+    chain = [b for b in loop.actuator if not isinstance(b, Delay) and not b.linear]
+    if not chain:
+        return []
+    hi = np.pi / loop.dt
+    w_range = w_range or (1e-2 * hi, 0.999 * hi)
+
+    def N(a: float, w: float) -> complex:
+        return numeric_df(chain, a, w, bias=bias, points=160, periods=8)
+
+    def L(w: np.ndarray) -> np.ndarray:
+        return sampled_loop_response(loop, w)
+
+    out = []
+    for c in harmonic_balance(L, N, w_range, a_range, points):
+        _, P, S = _loop_parts(loop, [c.frequency])[:, 0]
+        gain = abs(N(c.amplitude, c.frequency)) * abs(P * S)
+        out.append(LoopCyclePrediction(c, float(c.amplitude * gain), bias))
+    return out
