@@ -200,8 +200,8 @@ def _df_check(loop: Any, onset: OnsetResult, step: tuple[float, float], sim: Sim
         bias = lp.operating_point.input + k * (step[1] - y_ss)
         preds = predict_loop_cycles(lp, bias, (10.0, 0.999 * np.pi / lp.dt), points=80)
         stable = [p for p in preds if p.cycle.stable] or preds
-        target = sim_y.period
-        pred = min(stable, key=lambda p: abs(p.cycle.period - (target or p.cycle.period))) if stable else None
+        # several stable cycles: the largest is the one a large step settles on
+        pred = max(stable, key=lambda p: p.cycle.amplitude) if stable else None
         out.append({
             "delay": delay, "gain": k,
             "simulated": {"present": sim_y.present, "output_amplitude": sim_y.fundamental_amplitude,
