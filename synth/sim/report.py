@@ -333,9 +333,17 @@ def _statements(out: dict[str, Any], report: SimulationReport, sim: SimulationSp
                f"{fmt(100 * abs(nolim - spec_rise) / spec_rise, 2)} %."
                if abs(nolim - spec_rise) < 0.05 * spec_rise else "."))
         need = out.get("rate_for_published_rise")
-        if need is not None:
+        sweep = report.rise_vs_rate
+        if need is not None and sweep is not None:
             lines.append(f"With every other assumption kept, a rate limit of {fmt(need)} {u}/s gives exactly the "
-                         f"published rise time (the spec uses {fmt(report.rise_vs_rate['specified'])} {u}/s).")
+                         f"published rise time (the spec uses {fmt(sweep['specified'])} {u}/s).")
+        elif sweep is not None:
+            rr = np.asarray(sweep["rise_times"], float)
+            flat = np.asarray(sweep["rates"])[np.flatnonzero(rr <= 1.02 * np.nanmin(rr))[0]]
+            lo_rate, hi_rate = fmt(sweep["rates"][0]), fmt(sweep["rates"][-1])
+            lines.append(f"No rate limit between {lo_rate} and {hi_rate} {u}/s gives the published "
+                         f"{fmt(rise['published'])} s exactly: above about {fmt(flat, 2)} {u}/s the rise time stays "
+                         f"at {fmt(float(np.nanmin(rr)))} s, set by the other limits of the loop.")
     ol = out.get("open_loop")
     if ol:
         lines.append(
