@@ -342,8 +342,8 @@ def _statements(out: dict[str, Any], report: SimulationReport, sim: SimulationSp
             flat = np.asarray(sweep["rates"])[np.flatnonzero(rr <= 1.02 * np.nanmin(rr))[0]]
             lo_rate, hi_rate = fmt(sweep["rates"][0]), fmt(sweep["rates"][-1])
             lines.append(f"No rate limit between {lo_rate} and {hi_rate} {u}/s gives the published "
-                         f"{fmt(rise['published'])} s exactly: above about {fmt(flat, 2)} {u}/s the rise time stays "
-                         f"at {fmt(float(np.nanmin(rr)))} s, set by the other limits of the loop.")
+                         f"{fmt(rise['published'])} s exactly: above about {fmt(flat, 2)} {u}/s the rise time "
+                         f"stays at {fmt(float(np.nanmin(rr)))} s, set by the other limits of the loop.")
     ol = out.get("open_loop")
     if ol:
         lines.append(
