@@ -40,6 +40,7 @@ from synth.errors import ModelError, SpecError
 from synth.objectives import MEASURES
 from synth.plant import Plant, Signal
 from synth.requirements import REQUIREMENT_TYPES
+from synth.sim.spec import BLOCK_TAGS, DISTURBANCE_TAGS, SIMULATION_TAGS, SimulationSpec
 
 _NAME = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.-]*$")
 
@@ -392,6 +393,7 @@ class Spec(_Model):
     objective: ObjectiveSpec | None = None
     reference: ReferenceSpec | None = None
     analysis: AnalysisSpec = AnalysisSpec()
+    simulation: SimulationSpec | None = None
 
     @field_validator("name")
     @classmethod
@@ -459,7 +461,7 @@ def _clean_loc(loc: tuple[Any, ...]) -> tuple[Any, ...]:
             isinstance(part, str)
             and i > 0
             and isinstance(loc[i - 1], int)
-            and part in REQUIREMENT_TYPES
+            and (part in REQUIREMENT_TYPES or part in SIMULATION_TAGS)
         ):
             continue  # discriminated-union tag inserted by pydantic
         if isinstance(part, str) and ("[" in part or part.startswith("function-")):
@@ -484,6 +486,8 @@ def _allowed_keys(loc: tuple[Any, ...], data: Any) -> list[str]:
             node = node[part] if isinstance(node, list) and part < len(node) else None
             if model == "requirements":
                 model = REQUIREMENT_TYPES.get(node.get("type")) if isinstance(node, dict) else None
+            elif isinstance(model, dict):  # a list of tagged models (simulation blocks, disturbances)
+                model = model.get(node.get("type")) if isinstance(node, dict) else None
             continue
         node = node.get(part) if isinstance(node, dict) else None
         if model is Spec and part == "requirements":
@@ -492,10 +496,34 @@ def _allowed_keys(loc: tuple[Any, ...], data: Any) -> list[str]:
         field = getattr(model, "model_fields", {}).get(part)
         if field is None:
             return []
+        tagged = _tagged_members(field.annotation)
+        if tagged:
+            model = tagged
+            continue
         candidates = [field.annotation, *getattr(field.annotation, "__args__", ())]
         model = next((c for c in candidates if isinstance(c, type) and issubclass(c, BaseModel)), None)
     fields = getattr(model, "model_fields", None)
     return list(fields) if isinstance(fields, dict) else []
+
+
+def _tagged_members(annotation: Any) -> dict[str, type[BaseModel]]:
+    """``{tag: model}`` when ``annotation`` is a list of models told apart by a ``type`` literal."""
+    from typing import get_args, get_origin
+
+    if get_origin(annotation) is not list:
+        return {}
+    found: dict[str, type[BaseModel]] = {}
+    stack = list(get_args(annotation))
+    while stack:
+        item = stack.pop()
+        if isinstance(item, type) and issubclass(item, BaseModel):
+            field = item.model_fields.get("type")
+            tags = get_args(field.annotation) if field is not None else ()
+            if tags and all(isinstance(t, str) for t in tags):
+                found.update({t: item for t in tags})
+        else:
+            stack.extend(get_args(item))
+    return found
 
 
 def _message(err: dict[str, Any], data: Any, loc: tuple[Any, ...]) -> str:
@@ -508,6 +536,12 @@ def _message(err: dict[str, Any], data: Any, loc: tuple[Any, ...]) -> str:
         near = difflib.get_close_matches(str(loc[-1]), allowed, n=1)
         hint = f"; did you mean {near[0]!r}?" if near else (f"; allowed: {', '.join(allowed)}" if allowed else "")
         return f"unknown key {loc[-1]!r}{hint}"
+    if kind in {"union_tag_invalid", "union_tag_not_found"} and loc and loc[0] == "simulation":
+        what = "disturbance" if "disturbances" in loc else "block"
+        expected = ", ".join(DISTURBANCE_TAGS if what == "disturbance" else BLOCK_TAGS)
+        if kind == "union_tag_not_found":
+            return f"{what} has no 'type'; expected one of: {expected}"
+        return f"unknown {what} type {err['ctx']['tag']!r}; expected one of: {expected}"
     if kind == "union_tag_invalid":
         return (f"unknown requirement type {err['ctx']['tag']!r}; expected one of: "
                 f"{', '.join(REQUIREMENT_TYPES)}")

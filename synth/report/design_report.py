@@ -46,6 +46,10 @@ def report_data(spec: Spec, result: DesignResult) -> dict[str, Any]:
     data = result.to_dict()
     data["analysis"] = compare(spec, shown)
     data["description"] = spec.description
+    if spec.simulation is not None:  # nonlinear step check (issue 5): logic in synth.sim.report
+        from synth.sim.report import simulation_report
+
+        data["simulation"] = simulation_report(spec, shown, reference_controller(spec)).data
     return to_jsonable(data)
 
 
@@ -108,7 +112,7 @@ def write_design_report(spec: Spec, result: DesignResult, out_dir: str | Path, *
     >>> spec = load_spec("specs/x4_rotor.yaml")
     >>> files = write_design_report(spec, design(spec), tempfile.mkdtemp())
     >>> sorted(files.figures)
-    ['bode', 'delay', 'gain_set', 'sensitivity', 'step']
+    ['bode', 'delay', 'gain_set', 'sensitivity', 'sim_onset', 'sim_rise', 'sim_step', 'step']
     """
     out = OutputDir(out_dir, force)
     data = report_data(spec, result)
@@ -147,6 +151,11 @@ def write_design_report(spec: Spec, result: DesignResult, out_dir: str | Path, *
         rows = [{**r, "critical_gain": float(r["critical_gain"])} for r in delay_table]
         figs["delay"] = figures.delay_chart(rows, marks, out.claim("critical_gain_vs_delay.png"))
 
+    if spec.simulation is not None:
+        from synth.sim.report import simulation_figures
+
+        figs.update(simulation_figures(spec, shown, ref, out, marks))
+
     columns, rows = _columns(data)
     ref_line = ""
     env = Environment(loader=PackageLoader("synth.report", "templates"), autoescape=True)
@@ -164,7 +173,7 @@ def write_design_report(spec: Spec, result: DesignResult, out_dir: str | Path, *
         reference=data["analysis"].get("reference"),
         slew=data["analysis"].get("slew_rate", []),
         delay_table=[{**r, "critical_gain": float(r["critical_gain"])} for r in delay_table or []],
-        marks=marks, certificate=data.get("certificate"), ref_line=ref_line,
+        marks=marks, certificate=data.get("certificate"), ref_line=ref_line, sim=data.get("simulation"),
         synthesis=data.get("synthesis"), diagnosis=data.get("diagnosis"),
         f=lambda x, d=4: fmt(None if x is None else float(x), d),
     )

@@ -1,0 +1,266 @@
+"""``synth simulate SPEC --controller "P(3)" --step 820:920``: the sampled nonlinear closed loop."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+from typing import Any
+
+COMMAND = "simulate"
+ORDER = 30
+HELP = "simulate the sampled nonlinear closed loop of a spec (rate limit, saturation, sensor, delay)"
+DESCRIPTION = """Simulate a step of the sampled nonlinear closed loop described by the spec's
+`simulation:` block (actuator and sensor blocks, operating point, controller rate,
+in-loop delay; see docs/simulation.md) and report the step metrics: rise time,
+overshoot, settling time, peak actuator rate and amplitude, time rate-limited
+and saturated, and whether the run ends in a limit cycle (amplitude, period).
+
+Writes the time series (CSV) and a plot (PNG) into --out (default
+reports/<spec name>/simulate/); --csv and --plot put them elsewhere. Files
+synth did not write are never overwritten (use --force).
+
+example:
+  synth simulate specs/x4_rotor.yaml --controller "P(3)" --step 820:920
+  synth simulate specs/x4_rotor.yaml -c "P(8)" --delay 0.015 --json -
+  synth simulate specs/x4_rotor.yaml --sweep kp=1:12:23 --json sweep.json
+
+exit codes: 0 settles, 1 ends in a sustained oscillation or diverges, 2 bad input"""
+
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
+    p.add_argument("spec", help="spec file (YAML)")
+    p.add_argument("--controller", "-c",
+                   help='controller, e.g. "P(3)" (default: the spec\'s reference controller)')
+    p.add_argument("--step", metavar="FROM:TO", help="reference step in output units (default: simulation.step)")
+    p.add_argument("--horizon", type=float, metavar="S", help="simulated seconds (default: simulation.horizon)")
+    p.add_argument("--step-time", type=float, metavar="S", help="time of the step (default: simulation.step_time)")
+    p.add_argument("--delay", type=float, metavar="S",
+                   help="in-loop delay in seconds (default: simulation.loop_delay)")
+    p.add_argument("--sweep", metavar="NAME=LO:HI:N",
+                   help="simulate N values of a controller parameter at once (geometric spacing), e.g. kp=1:12:23")
+    p.add_argument("--out", metavar="DIR", help="folder for timeseries.csv and step.png "
+                   "(default reports/<spec name>/simulate)")
+    p.add_argument("--csv", metavar="FILE", help="write the time series to FILE instead")
+    p.add_argument("--plot", metavar="FILE", help="write the plot to FILE instead")
+    p.add_argument("--json", metavar="FILE", help="write the metrics as JSON to FILE ('-' for standard output)")
+    p.add_argument("--force", action="store_true", help="overwrite files synth did not write")
+    p.add_argument("--quiet", "-q", action="store_true", help="print nothing; use the exit code")
+
+
+def _step(text: str) -> tuple[float, float]:
+    from synth.errors import SynthError
+
+    parts = text.split(":")
+    try:
+        if len(parts) != 2:
+            raise ValueError
+        return float(parts[0]), float(parts[1])
+    except ValueError:
+        raise SynthError(f"expected FROM:TO in output units, e.g. 820:920, got {text!r}", where="--step") from None
+
+
+def _sweep(text: str, controller: Any) -> tuple[str, list[float]]:
+    import numpy as np
+
+    from synth.errors import SynthError
+
+    try:
+        name, rng = text.split("=", 1)
+        lo, hi, n = rng.split(":")
+        lo_f, hi_f, count = float(lo), float(hi), int(n)
+    except ValueError:
+        raise SynthError(f"expected NAME=LO:HI:N, e.g. kp=1:12:23, got {text!r}", where="--sweep") from None
+    name = name.strip()
+    if name not in controller.parameters:
+        raise SynthError(f"{controller.type} has no parameter {name!r}; its parameters are "
+                         f"{', '.join(controller.parameters)}", where="--sweep")
+    if not (0 < lo_f < hi_f) or count < 2 or count > 10000:
+        raise SynthError(f"need 0 < LO < HI and 2 <= N <= 10000, got {text!r}", where="--sweep")
+    return name, [float(v) for v in np.geomspace(lo_f, hi_f, count)]
+
+
+def _ours(path: Path) -> bool:
+    """A file synth wrote: a CSV starting with '# synth', a PNG tagged Software=synth."""
+    try:
+        head = path.read_bytes()[:4096]
+    except OSError:
+        return False
+    return head.startswith(b"# synth") or b"Software\x00synth" in head
+
+
+def _claim(path: Path, force: bool) -> Path:
+    from synth.errors import OutputExistsError
+
+    if path.is_dir():
+        raise OutputExistsError("is a directory", where=str(path))
+    if path.exists() and not force and not _ours(path):
+        raise OutputExistsError("exists and was not written by synth; not overwriting it (use --force)",
+                                where=str(path))
+    path.parent.mkdir(parents=True, exist_ok=True)
+    return path
+
+
+def _write_csv(path: Path, columns: dict[str, Any], header: str) -> None:
+    import numpy as np
+
+    names = list(columns)
+    data = np.column_stack([np.asarray(columns[n], float) for n in names])
+    with path.open("w", encoding="utf-8") as fh:
+        fh.write(f"# {header}\n")
+        fh.write(",".join(names) + "\n")
+        np.savetxt(fh, data, delimiter=",", fmt="%.10g")
+
+
+def run(args: argparse.Namespace) -> int:
+    from synth.controllers import Controller
+    from synth.errors import ModelError, SynthError
+    from synth.outputs import GENERATOR, OutputDir, dump_json, to_jsonable, write_json
+    from synth.sim.spec import SimulationSpec
+    from synth.spec import load_spec
+
+    spec = load_spec(args.spec)
+    sim = spec.simulation or SimulationSpec()
+    text = args.controller or (spec.reference.controller if spec.reference else None)
+    if text is None:
+        raise SynthError("give a controller, e.g. --controller \"P(3)\" (the spec has no reference controller)",
+                         where="--controller")
+    try:
+        controller = Controller.from_string(text)
+    except ModelError as exc:
+        raise exc.located("--controller") from None
+    step = _step(args.step) if args.step else sim.default_step()
+    horizon = sim.horizon if args.horizon is None else args.horizon
+    t_step = sim.step_time if args.step_time is None else args.step_time
+    if not horizon > 0:
+        raise SynthError(f"must be > 0 s, got {horizon:g}", where="--horizon")
+    if not 0 <= t_step < horizon:
+        raise SynthError(f"must be in [0, horizon), got {t_step:g} s", where="--step-time")
+    if args.delay is not None and args.delay < 0:
+        raise SynthError(f"must be >= 0 s, got {args.delay:g}", where="--delay")
+    loop = sim.build_loop(spec.nominal_plant(), controller, str(controller))
+    if args.delay is not None:
+        loop = loop.replace(loop_delay=args.delay)
+    disturbances = sim.build_disturbances()
+    say = (lambda *a: None) if args.quiet or args.json == "-" else print
+    if args.sweep:
+        return _run_sweep(args, spec, sim, loop, step, horizon, t_step, disturbances, say)
+
+    from synth.sim.metrics import nonlinear_step_metrics
+    from synth.sim.simulator import simulate_step
+
+    result = simulate_step(loop, step[0], step[1], horizon, t_step, disturbances, sim.seed)
+    metrics = nonlinear_step_metrics(result, t_step, min_amplitude=sim.limit_cycle.min_amplitude,
+                                     window=sim.limit_cycle.window)
+    payload = {"spec": spec.name, "controller": str(controller), "step": list(step), "step_time": t_step,
+               "horizon": horizon, "loop": loop.to_dict(), **metrics.to_dict()}
+    out_dir = Path(args.out) if args.out else Path("reports") / spec.name / "simulate"
+    folder = OutputDir(out_dir, args.force) if not (args.csv and args.plot) else None
+    csv_path = _claim(Path(args.csv), args.force) if args.csv else folder.claim("timeseries.csv")  # type: ignore[union-attr]
+    plot_path = _claim(Path(args.plot), args.force) if args.plot else folder.claim("step.png")  # type: ignore[union-attr]
+    _write_csv(csv_path, result.series(), f"{GENERATOR}: {spec.name}, {controller}, step {step[0]:g} -> "
+               f"{step[1]:g} at {t_step:g} s")
+    _plot(result, loop, metrics, step, spec, plot_path)
+    if folder is not None:
+        json_path = folder.claim("metrics.json")
+        json_path.write_text(dump_json(payload), encoding="utf-8")
+        folder.commit()
+    if args.json == "-":
+        sys.stdout.write(dump_json(to_jsonable(payload)))
+    elif args.json:
+        write_json(args.json, payload, force=args.force)
+    _print_metrics(say, spec, loop, metrics, step)
+    say(f"\ntime series: {csv_path}\nplot: {plot_path}")
+    lc = metrics.limit_cycle
+    return 1 if (lc.present or lc.diverging) else 0
+
+
+def _print_metrics(say: Any, spec: Any, loop: Any, m: Any, step: tuple[float, float]) -> None:
+    from synth.cli._table import table
+    from synth.requirements.base import fmt
+
+    u = spec.plant.input.unit or "input units"
+    y = spec.plant.output.unit or "output units"
+    lc = m.limit_cycle
+    cycle = (f"{fmt(lc.amplitude)} {y} every {fmt(lc.period)} s" if lc.present else
+             ("diverges" if lc.diverging else "none"))
+    rows = [
+        ["rise time 10-90 %", f"{fmt(m.rise_time)} s"],
+        ["overshoot", f"{fmt(m.overshoot)} %"],
+        ["settling time (2 %)", f"{fmt(m.settling_time)} s" if m.settling_time is not None else "not settled"],
+        ["final value", f"{fmt(m.final_value)} {y}"],
+        ["peak actuator rate", f"{fmt(m.actuator_peak_rate)} {u}/s"],
+        ["actuator range", f"{fmt(m.actuator_min)} to {fmt(m.actuator_max)} {u}"],
+        ["time rate-limited", f"{fmt(m.rate_limited_time)} s"],
+        ["time saturated", f"{fmt(m.saturated_time)} s"],
+        ["limit cycle", cycle],
+    ]
+    say(f"{spec.name}: {loop.controller}, step {fmt(step[0])} -> {fmt(step[1])} {y}, in-loop delay "
+        f"{fmt(loop.loop_delay * 1000)} ms")
+    say(table(["metric", "value"], rows))
+
+
+def _plot(result: Any, loop: Any, metrics: Any, step: tuple[float, float], spec: Any, path: Path) -> None:
+    from synth.sim.figures import step_comparison
+    from synth.sim.simulator import simulate_step
+
+    linear = simulate_step(loop.linear(), step[0], step[1], float(result.t[-1]))
+    units = {"input": spec.plant.input.unit, "output": spec.plant.output.unit}
+    step_comparison({str(loop.controller): {"nonlinear": result, "linear": linear}}, path, units)
+
+
+def _run_sweep(args: argparse.Namespace, spec: Any, sim: Any, loop: Any, step: tuple[float, float], horizon: float,
+               t_step: float, disturbances: list[Any], say: Any) -> int:
+    from tqdm import tqdm
+
+    from synth.cli._table import table
+    from synth.outputs import GENERATOR, OutputDir, dump_json, to_jsonable, write_json
+    from synth.requirements.base import fmt
+    from synth.sim.metrics import nonlinear_step_metrics
+    from synth.sim.signals import step_reference
+    from synth.sim.simulator import simulate_batch
+
+    name, values = _sweep(args.sweep, loop.controller)
+    loops = [loop.with_gain(name, v) for v in values]
+    rows, entries = [], []
+    chunk = 50
+    show = not (args.quiet or args.json == "-") and len(loops) > chunk
+    bar = tqdm(total=len(loops), desc="simulating", unit="run", disable=not show, file=sys.stderr)
+    series: dict[str, Any] = {}
+    for start in range(0, len(loops), chunk):
+        batch = simulate_batch(loops[start:start + chunk], step_reference(step[0], step[1], t_step), horizon,
+                               disturbances, sim.seed)
+        for i, res in enumerate(batch):
+            m = nonlinear_step_metrics(res, t_step, min_amplitude=sim.limit_cycle.min_amplitude,
+                                       window=sim.limit_cycle.window)
+            value = values[start + i]
+            entries.append({name: value, **m.to_dict()})
+            series.setdefault("t", res.t)
+            series[f"output_{name}={value:.6g}"] = res.output
+            lc = m.limit_cycle
+            rows.append([f"{value:.4g}", fmt(m.rise_time), fmt(m.overshoot),
+                         fmt(m.settling_time) if m.settling_time is not None else "-",
+                         fmt(m.rate_limited_time), fmt(m.saturated_time),
+                         f"{fmt(lc.amplitude)} / {fmt(lc.period)} s" if lc.present else
+                         ("diverges" if lc.diverging else "none")])
+        bar.update(len(batch))
+    bar.close()
+    payload = {"spec": spec.name, "controller": str(loop.controller), "parameter": name, "step": list(step),
+               "step_time": t_step, "horizon": horizon, "loop": loop.to_dict(), "runs": entries}
+    out_dir = Path(args.out) if args.out else Path("reports") / spec.name / "simulate"
+    folder = OutputDir(out_dir, args.force) if not args.csv else None
+    csv_path = _claim(Path(args.csv), args.force) if args.csv else folder.claim("sweep.csv")  # type: ignore[union-attr]
+    _write_csv(csv_path, series, f"{GENERATOR}: {spec.name}, sweep of {name}, output of every run")
+    if folder is not None:
+        (folder.claim("sweep.json")).write_text(dump_json(payload), encoding="utf-8")
+        folder.commit()
+    if args.json == "-":
+        sys.stdout.write(dump_json(to_jsonable(payload)))
+    elif args.json:
+        write_json(args.json, payload, force=args.force)
+    say(f"{spec.name}: sweep of {name} over {len(values)} values, step {fmt(step[0])} -> {fmt(step[1])}")
+    say(table([name, "rise [s]", "overshoot [%]", "settling [s]", "rate-limited [s]", "saturated [s]",
+               "limit cycle (amplitude / period)"], rows))
+    say(f"\ntime series: {csv_path}")
+    oscillating = [e for e in entries if e["limit_cycle"]["present"] or e["limit_cycle"]["diverging"]]
+    return 1 if oscillating else 0
