@@ -1,0 +1,11 @@
+"""Measured records: loading (CSV, MAT), validation and explicit resampling.
+
+A :class:`Record` is one experiment: time, the plant input (the command) and
+the plant output (the measurement), with names and units, plus any extra
+logged channels. Every problem with a file is a :class:`~synth.errors.DataError`
+naming the file and column.
+"""
+
+from synth.data.record import Record, load_record, record_from_arrays
+
+__all__ = ["Record", "load_record", "record_from_arrays"]

@@ -1,0 +1,348 @@
+"""One measured experiment: time, input, output (and extra channels), validated.
+
+Loading is strict and says what it did: NaN or inf, non-increasing time,
+columns of different length, a missing column, a constant input or an output
+that never responds raise a :class:`~synth.errors.DataError` naming the file
+and the column; irregular sampling is resampled onto a uniform grid by linear
+interpolation and the record's ``notes`` say so.
+"""
+
+from __future__ import annotations
+
+import csv
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from synth.errors import DataError
+from synth.plant import Signal
+
+#: relative spread of the sample intervals above which a record counts as irregularly sampled
+IRREGULAR_TOLERANCE = 1e-3
+
+
+@dataclass(frozen=True, eq=False)
+class Record:
+    """A uniformly sampled input/output record.
+
+    Parameters
+    ----------
+    t, u, y : numpy.ndarray
+        Time [s], plant input and plant output, same length, ``t`` strictly
+        increasing and uniformly spaced.
+    input, output : Signal
+        Names and units of ``u`` and ``y``.
+    aux : dict of str to numpy.ndarray
+        Extra logged channels (current, voltage, ...) on the same time base.
+    source : str
+        Where the record came from (a file path, or ``"arrays"``).
+    notes : tuple of str
+        What loading did to the data (for example resampling); shown in reports.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> r = record_from_arrays(np.arange(5) * 0.1, [0, 1, 1, 1, 1], [0, 0, 0.5, 0.8, 0.9])
+    >>> r.dt, r.n, r.duration
+    (0.1, 5, 0.4)
+    """
+
+    t: np.ndarray
+    u: np.ndarray
+    y: np.ndarray
+    input: Signal = field(default_factory=lambda: Signal("u", ""))
+    output: Signal = field(default_factory=lambda: Signal("y", ""))
+    aux: dict[str, np.ndarray] = field(default_factory=dict)
+    source: str = "arrays"
+    notes: tuple[str, ...] = ()
+
+    @property
+    def n(self) -> int:
+        """Number of samples."""
+        return int(self.t.size)
+
+    @property
+    def dt(self) -> float:
+        """Sample interval [s] (the record is uniformly sampled)."""
+        return float(round((self.t[-1] - self.t[0]) / (self.t.size - 1), 12))
+
+    @property
+    def fs(self) -> float:
+        """Sample rate [Hz]."""
+        return 1.0 / self.dt
+
+    @property
+    def duration(self) -> float:
+        """Length of the record [s]."""
+        return float(round(self.t[-1] - self.t[0], 12))
+
+    def segment(self, t0: float, t1: float) -> Record:
+        """The part of the record with ``t0 <= t <= t1``, time not shifted.
+
+        Examples
+        --------
+        >>> r = record_from_arrays(np.arange(10.0), np.r_[0, np.ones(9)], np.arange(10.0) ** 0.5)
+        >>> r.segment(2, 5).t.tolist()
+        [2.0, 3.0, 4.0, 5.0]
+        """
+        keep = (self.t >= t0) & (self.t <= t1)
+        if np.count_nonzero(keep) < 2:
+            raise DataError(f"segment [{t0}, {t1}] s holds fewer than 2 samples", where=self.source)
+        return Record(self.t[keep], self.u[keep], self.y[keep], self.input, self.output,
+                      {k: v[keep] for k, v in self.aux.items()}, self.source, self.notes)
+
+    def require_duration(self, w_min: float) -> None:
+        """Raise unless the record is long enough to resolve ``w_min`` [rad/s].
+
+        The lowest frequency a record of length ``T`` resolves is taken as
+        ``2 pi / T`` (one full period in the record; a spectral estimate with
+        averaging needs more, see :mod:`synth.ident`).
+
+        Examples
+        --------
+        >>> r = record_from_arrays(np.arange(0, 10, 0.01), np.sin(np.arange(0, 10, 0.01)), np.arange(0, 10, 0.01))
+        >>> r.require_duration(0.1)
+        Traceback (most recent call last):
+        synth.errors.DataError: arrays: record is 9.99 s long; the lowest frequency 0.1 rad/s needs at least 62.8 s ...
+        """
+        need = 2.0 * np.pi / w_min
+        if self.duration < need:
+            raise DataError(f"record is {self.duration:.3g} s long; the lowest frequency {w_min:g} rad/s "
+                            f"needs at least {need:.3g} s (one period)", where=self.source)
+
+    def to_dict(self) -> dict[str, Any]:
+        """Summary for JSON (not the samples).
+
+        Examples
+        --------
+        >>> record_from_arrays([0, 1, 2], [0, 1, 1], [0, 0.5, 1]).to_dict()["samples"]
+        3
+        """
+        return {"source": self.source, "samples": self.n, "dt": self.dt, "duration": self.duration,
+                "input": {"name": self.input.name, "unit": self.input.unit},
+                "output": {"name": self.output.name, "unit": self.output.unit},
+                "aux": sorted(self.aux), "notes": list(self.notes)}
+
+
+def record_from_arrays(
+    t: Sequence[float] | np.ndarray,
+    u: Sequence[float] | np.ndarray,
+    y: Sequence[float] | np.ndarray,
+    input: Signal | None = None,
+    output: Signal | None = None,
+    aux: Mapping[str, Sequence[float] | np.ndarray] | None = None,
+    source: str = "arrays",
+    names: tuple[str, str, str] = ("time", "input", "output"),
+) -> Record:
+    """Validate arrays and build a :class:`Record` (resampling irregular time explicitly).
+
+    Parameters
+    ----------
+    t, u, y : array_like
+        Time [s], input and output samples.
+    input, output : Signal, optional
+        Names and units; default ``u`` and ``y`` without unit.
+    aux : mapping, optional
+        Extra channels on the same time base.
+    source : str
+        Named in every error message (a file path).
+    names : tuple of str
+        Column names of ``t``, ``u``, ``y`` as the user wrote them, for error messages.
+
+    Raises
+    ------
+    DataError
+        NaN or inf, non-increasing time, different lengths, fewer than 3 samples,
+        a constant input or an output that never changes.
+
+    Examples
+    --------
+    >>> r = record_from_arrays([0, 0.1, 0.25, 0.3], [0, 1, 1, 1], [0, 1, 2, 3])
+    >>> r.t.round(3).tolist(), r.notes[0].split(":")[0]
+    ([0.0, 0.1, 0.2, 0.3], 'resampled')
+    >>> record_from_arrays([0, 1, 1], [0, 1, 2], [0, 1, 2])
+    Traceback (most recent call last):
+    synth.errors.DataError: arrays: column 'time': time is not strictly increasing at sample 2 (t = 1 s)
+    """
+    input = input or Signal(names[1], "")
+    output = output or Signal(names[2], "")
+    columns = {names[0]: t, names[1]: u, names[2]: y, **dict(aux or {})}
+    arrays: dict[str, np.ndarray] = {}
+    for name, values in columns.items():
+        try:
+            a = np.asarray(values, dtype=float).ravel()
+        except (TypeError, ValueError):
+            raise DataError(f"column '{name}': values are not numbers", where=source) from None
+        bad = np.flatnonzero(~np.isfinite(a))
+        if bad.size:
+            raise DataError(f"column '{name}': {bad.size} value(s) are NaN or inf (first at sample {bad[0]})",
+                            where=source)
+        arrays[name] = a
+    lengths = {name: a.size for name, a in arrays.items()}
+    if len(set(lengths.values())) > 1:
+        listed = ", ".join(f"'{k}' {v}" for k, v in lengths.items())
+        raise DataError(f"columns have different lengths ({listed})", where=source)
+    tt = arrays.pop(names[0])
+    if tt.size < 3:
+        raise DataError(f"column '{names[0]}': a record needs at least 3 samples, got {tt.size}", where=source)
+    steps = np.diff(tt)
+    if np.any(steps <= 0):
+        k = int(np.flatnonzero(steps <= 0)[0]) + 1
+        raise DataError(f"column '{names[0]}': time is not strictly increasing at sample {k} (t = {tt[k]:g} s)",
+                        where=source)
+    uu, yy = arrays.pop(names[1]), arrays.pop(names[2])
+    if np.ptp(uu) == 0:
+        raise DataError(f"column '{names[1]}': the input is constant ({uu[0]:g}); nothing excites the plant",
+                        where=source)
+    if np.ptp(yy) == 0:
+        raise DataError(f"column '{names[2]}': the output never responds (constant {yy[0]:g})", where=source)
+    notes: list[str] = []
+    spread = (steps.max() - steps.min()) / np.median(steps)
+    if spread > IRREGULAR_TOLERANCE:
+        dt = float(np.median(steps))
+        grid = tt[0] + dt * np.arange(int(np.floor((tt[-1] - tt[0]) / dt + 1e-9)) + 1)
+        notes.append(f"resampled: sample intervals ranged {steps.min():.4g}-{steps.max():.4g} s; linearly "
+                     f"interpolated onto a uniform {dt:.4g} s grid ({tt.size} -> {grid.size} samples)")
+        uu, yy = np.interp(grid, tt, uu), np.interp(grid, tt, yy)
+        arrays = {k: np.interp(grid, tt, v) for k, v in arrays.items()}
+        tt = grid
+    return Record(tt, uu, yy, input, output, arrays, source, tuple(notes))
+
+
+def _read_csv(path: Path) -> dict[str, np.ndarray]:
+    try:
+        with path.open(newline="", encoding="utf-8-sig") as fh:
+            sample = fh.read(4096)
+            fh.seek(0)
+            try:
+                dialect = csv.Sniffer().sniff(sample, delimiters=",;\t ")
+            except csv.Error:
+                dialect = csv.excel
+            reader = csv.reader(fh, dialect)
+            header = [h.strip() for h in next(reader, [])]
+            if not header:
+                raise DataError("file is empty", where=str(path))
+            rows = [row for row in reader if any(cell.strip() for cell in row)]
+    except OSError as exc:
+        raise DataError(f"cannot read: {exc.strerror or exc}", where=str(path)) from None
+    except UnicodeDecodeError:
+        raise DataError("not a text CSV file", where=str(path)) from None
+    columns: dict[str, list[float]] = {h: [] for h in header}
+    for i, row in enumerate(rows, start=2):
+        for h, cell in zip(header, row):
+            text = cell.strip()
+            try:
+                columns[h].append(float(text) if text else np.nan)
+            except ValueError:
+                raise DataError(f"line {i}: column '{h}': '{text}' is not a number", where=str(path)) from None
+    return {h: np.asarray(v, float) for h, v in columns.items()}
+
+
+def _read_mat(path: Path) -> dict[str, np.ndarray]:
+    from scipy.io import loadmat
+
+    try:
+        raw = loadmat(str(path), squeeze_me=True)
+    except (OSError, ValueError, NotImplementedError) as exc:  # NotImplementedError: v7.3 (HDF5) files
+        raise DataError(f"cannot read as a MATLAB file: {exc}", where=str(path)) from None
+    out: dict[str, np.ndarray] = {}
+    for key, value in raw.items():
+        if key.startswith("__"):
+            continue
+        a = np.asarray(value)
+        if a.dtype.kind in "iuf" and a.ndim == 1 and a.size > 1:
+            out[key] = a.astype(float)
+    return out
+
+
+def read_columns(path: str | Path) -> dict[str, np.ndarray]:
+    """All numeric columns of a CSV file (header row) or of a MAT file (1-D variables).
+
+    Examples
+    --------
+    >>> import pathlib, tempfile
+    >>> p = pathlib.Path(tempfile.mkdtemp()) / "r.csv"
+    >>> _ = p.write_text("t,u,y\\n0,0,0\\n1,1,0.5\\n")
+    >>> sorted(read_columns(p))
+    ['t', 'u', 'y']
+    """
+    path = Path(path)
+    if not path.exists():
+        raise DataError("file not found", where=str(path))
+    if path.suffix.lower() == ".mat":
+        return _read_mat(path)
+    return _read_csv(path)
+
+
+def _pick(columns: dict[str, np.ndarray], name: str | None, role: str, path: Path, fallback: int) -> str:
+    if name is None:
+        keys = list(columns)
+        if len(keys) <= fallback:
+            raise DataError(f"no {role} column given and the file has only {len(keys)} column(s)", where=str(path))
+        return keys[fallback]
+    if name not in columns:
+        import difflib
+
+        close = difflib.get_close_matches(name, list(columns), n=1)
+        hint = f"; did you mean '{close[0]}'?" if close else f"; columns are {', '.join(columns)}"
+        raise DataError(f"{role} column '{name}' not found{hint}", where=str(path))
+    return name
+
+
+def load_record(
+    path: str | Path,
+    time: str | None = None,
+    input: str | None = None,
+    output: str | None = None,
+    aux: Sequence[str] = (),
+    input_unit: str = "",
+    output_unit: str = "",
+    dt: float | None = None,
+) -> Record:
+    """Load one record from a CSV (header row) or MAT file.
+
+    Parameters
+    ----------
+    path : str or Path
+        ``.csv`` (any of ``, ; tab space`` as separator) or ``.mat`` (MATLAB v5).
+    time, input, output : str, optional
+        Column names; default the first, second and third column. ``time`` may be
+        omitted for a file without a time column if ``dt`` is given.
+    aux : sequence of str
+        Extra channels to carry along (current, voltage, ...).
+    input_unit, output_unit : str
+        Units of the input and output, carried into reports.
+    dt : float, optional
+        Sample interval [s] when the file has no time column.
+
+    Examples
+    --------
+    >>> import pathlib, tempfile
+    >>> p = pathlib.Path(tempfile.mkdtemp()) / "r.csv"
+    >>> _ = p.write_text("t,pwm,speed\\n0,175,820\\n0.001,225,821\\n0.002,225,825\\n")
+    >>> r = load_record(p, "t", "pwm", "speed", input_unit="PWM", output_unit="rad/s")
+    >>> r.input.label(), r.y.tolist()
+    ('pwm [PWM]', [820.0, 821.0, 825.0])
+    >>> load_record(p, "t", "pwm", "sped")
+    Traceback (most recent call last):
+    synth.errors.DataError: ...r.csv: output column 'sped' not found; did you mean 'speed'?
+    """
+    path = Path(path)
+    columns = read_columns(path)
+    if not columns:
+        raise DataError("no numeric columns found", where=str(path))
+    if time is None and dt is not None:
+        n = max(a.size for a in columns.values())
+        columns = {"__time__": np.arange(n) * float(dt), **columns}
+        time = "__time__"
+    t_name = _pick(columns, time, "time", path, 0)
+    u_name = _pick(columns, input, "input", path, 1)
+    y_name = _pick(columns, output, "output", path, 2)
+    aux_cols = {_pick(columns, a, "aux", path, 0): columns[a] for a in aux}
+    return record_from_arrays(
+        columns[t_name], columns[u_name], columns[y_name],
+        Signal(u_name, input_unit), Signal(y_name, output_unit), aux_cols, str(path), (t_name, u_name, y_name),
+    )
