@@ -89,5 +89,6 @@ def test_every_iterate_stays_feasible():
     assert all(h["max_violation"] <= 1e-9 for h in phase2)  # every iterate meets every requirement on the grid
     for rnd in {h["round"] for h in phase2}:
         values = [h["objective"] for h in phase2 if h["round"] == rnd]
-        assert all(b >= a - 1e-9 for a, b in itertools.pairwise(values))  # and the objective never gets worse
+        # and the objective never gets worse (up to the solver's accuracy, about 1e-8 relative)
+        assert all(b >= a - 1e-8 * abs(a) for a, b in itertools.pairwise(values))
     assert np.isfinite(phase2[-1]["objective"])

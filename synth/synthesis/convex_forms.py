@@ -34,8 +34,8 @@ controllers the NLP stage enforces margins). Every bound is tightened by
 still meets the exact requirement between grid points. Every form takes an
 elastic slack ``s >= 0`` in relative units (the constraint reads
 ``|U|/(kappa |V|) <= 1 + s`` at the linearization point), used to diagnose
-infeasible specs. Constants that change with ``rho_c`` are cvxpy Parameters:
-the problem compiles once (DPP).
+infeasible specs. Constants that change with ``rho_c`` are cvxpy Parameters,
+so the problem is built once and only their values change between solves.
 """
 
 from __future__ import annotations
@@ -157,9 +157,13 @@ class RatioBound(Form):
         self.kappa = kappa
         self.active = active
         n = U.q0.size
-        self.Ure, self.Uim = cp.Parameter((n, n_rho)), cp.Parameter((n, n_rho))
-        self.u0re, self.u0im = cp.Parameter(n), cp.Parameter(n)
+        # |U| is built from constants; only the right-hand side changes with the design (small DPP tensor):
+        #   |U(rho)| <= on * kappa |V_c| (Re{V conj V_c}/|V_c|^2 + s)  =  R rho + c + w s
+        self.Ure, self.Uim = np.real(U.Q), np.imag(U.Q)
+        self.u0re, self.u0im = np.real(U.q0), np.imag(U.q0)
+        self.on = cp.Parameter(n, nonneg=True)
         self.R, self.c = cp.Parameter((n, n_rho)), cp.Parameter(n)
+        self.w = cp.Parameter(n, nonneg=True)
 
     def _kappa(self, rho: np.ndarray) -> np.ndarray:
         k = self.kappa(rho) if callable(self.kappa) else self.kappa
@@ -167,22 +171,28 @@ class RatioBound(Form):
 
     def constraints(self, rho, slack):
         mag = cp.norm(cp.vstack([self.Ure @ rho + self.u0re, self.Uim @ rho + self.u0im]), 2, axis=0)
+        lhs = cp.multiply(self.on, mag)
         rhs = self.R @ rho + self.c
-        self._cons = [mag <= rhs + slack] if self.elastic else [mag <= rhs]
+        self._cons = [lhs <= rhs + cp.multiply(self.w, slack)] if self.elastic else [lhs <= rhs]
         return self._cons
 
     def update(self, rho_c):
         Vc = self.V(rho_c)
         mag = np.maximum(np.abs(Vc), 1e-300)
         on = np.ones(mag.size, bool) if self.active is None else self.active(rho_c)
-        scale = np.where(on, 1.0 / (self._kappa(rho_c) * mag), 0.0)
-        self.Ure.value = np.real(self.U.Q) * scale[:, None]
-        self.Uim.value = np.imag(self.U.Q) * scale[:, None]
-        self.u0re.value = np.real(self.U.q0) * scale
-        self.u0im.value = np.imag(self.U.q0) * scale
-        w = np.where(on, 1.0 / mag**2, 0.0)
-        self.R.value = np.real(np.conj(Vc)[:, None] * self.V.Q) * w[:, None]
-        self.c.value = np.where(on, np.real(np.conj(Vc) * self.V.q0) / mag**2, 1.0)
+        scale = np.where(on, self._kappa(rho_c) / mag, 0.0)  # kappa |V_c| / |V_c|^2
+        self.on.value = on.astype(float)
+        self.R.value = np.real(np.conj(Vc)[:, None] * self.V.Q) * scale[:, None]
+        self.c.value = np.where(on, np.real(np.conj(Vc) * self.V.q0) * scale, 1.0)
+        self.w.value = np.where(on, self._kappa(rho_c) * mag, 1.0)
+
+    def price(self) -> float:
+        """Dual price in relative units: duals times the slack's weight in each row."""
+        total = 0.0
+        for c in getattr(self, "_cons", []):
+            if c.dual_value is not None and self.w.value is not None:
+                total += float(np.sum(np.abs(c.dual_value) * self.w.value))
+        return total
 
     def violation(self, rho):
         if self.U.q0.size == 0:

@@ -66,6 +66,10 @@ def design_convex(spec: Spec, settings: ConvexSettings | None = None, nlp: bool 
     bounds = spec.controller.all_bounds()
     if "ki" not in bounds or bounds["ki"][0] != 0.0 or bounds["ki"][1] == 0.0:
         return main
+    terms = _objective_terms(spec)
+    if main.feasible and all(n in ("integral_gain", "low_frequency_gain") and s == "maximize"
+                             for n, s, _ in terms):
+        return main  # without integral action these objectives are 0 (or finite): never better
     without = spec.model_copy(update={"controller": spec.controller.model_copy(
         update={"bounds": {**bounds, "ki": (0.0, 0.0)}})})
     from synth.design import design

@@ -243,11 +243,17 @@ def mark_pareto(points: list[TradeoffPoint], sweeps: list[Sweep], sense: str) ->
     sign_x = STRICTER_WHEN.get(sweeps[0].key, +1)
     sign_y = 1.0 if sense == "maximize" else -1.0
     feas = [p for p in points if p.feasible and p.objective is not None]
+    scale = max((abs(p.objective) for p in feas), default=1.0) or 1.0
+    tol = 1e-6 * scale  # objectives equal to this tolerance tie (solver noise must not decide the front)
+
+    def at_least(a: float, b: float) -> bool:
+        return a >= b - tol
+
     for p in feas:
         x, y = sign_x * p.values[sweeps[0].path], sign_y * p.objective
         p.pareto = not any(
-            (sign_x * q.values[sweeps[0].path] >= x and sign_y * q.objective >= y)
-            and (sign_x * q.values[sweeps[0].path] > x or sign_y * q.objective > y)
+            (sign_x * q.values[sweeps[0].path] >= x and at_least(sign_y * q.objective, y))
+            and (sign_x * q.values[sweeps[0].path] > x or sign_y * q.objective > y + tol)
             for q in feas
         )
 
