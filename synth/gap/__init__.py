@@ -1,0 +1,18 @@
+"""Sim-to-real gap: where a model and the measured hardware disagree.
+
+The model is driven by the measured command and compared with the measured
+output; the residual ``e = y_measured - y_model`` is then localized
+
+- in time (:mod:`synth.gap.steps`, :mod:`synth.gap.drift`, :mod:`synth.gap.where_time`):
+  which phase of which step, energy windows, slow drift by CUSUM;
+- in frequency (:mod:`synth.gap.xcorr`, :mod:`synth.gap.coherence`,
+  :mod:`synth.gap.error_model`, :mod:`synth.gap.where_frequency`): prewhitened
+  input-residual cross-correlation, coherence, and a model-error model with
+  its confidence region;
+- by regime (:mod:`synth.gap.where_regime`): residual against amplitude, rate,
+  operating point, direction of motion and auxiliary channels.
+
+:func:`synth.gap.localize.localize_gap` runs all of them and writes a
+one-line headline; :func:`synth.gap.gapmap.gap_map_figure` draws the gap map.
+The modules are imported by their full path (this package imports nothing).
+"""

@@ -1,0 +1,175 @@
+"""The residual of a model on a measured record, and the size of the gap.
+
+The model is driven by the measured input (held samples, exact delay, see
+:func:`synth.ident.simulate.simulate_plant`); the residual is
+``e = y_measured - (y_model + offset)``. The gap is measured by
+
+``NRMSE = ||e|| / ||y - mean(y)||`` and ``fit_percent = 100 (1 - NRMSE)``,
+
+so a model that only reproduces the mean of the record scores NRMSE = 1
+(fit 0 %) and a perfect model NRMSE = 0 (fit 100 %).
+
+The optional output offset is the operating point the linear model does not
+know: a record of a plant whose static map is affine (friction, a dead-zone
+intercept) is reproduced by a linear model only up to a constant. With
+``offset="fit"`` it is the least-squares constant, ``mean(y - y_model)``;
+with ``offset="none"`` it is zero; a number is used as given.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from synth.data.record import Record
+from synth.errors import ModelError
+from synth.ident.simulate import simulate_plant
+from synth.plant import Plant
+
+
+@dataclass(frozen=True, eq=False)
+class ModelResidual:
+    """A model's output on a record and its residual.
+
+    Attributes
+    ----------
+    t, u, y : numpy.ndarray
+        Time [s], measured input and measured output.
+    y_model : numpy.ndarray
+        Model output on the measured input, offset included.
+    e : numpy.ndarray
+        Residual ``y - y_model``.
+    offset : float
+        Output offset added to the simulated model (output units).
+    offset_mode : str
+        ``"fit"``, ``"none"`` or ``"given"``.
+    initial : str
+        Initial condition of the simulation (``"steady"`` or ``"zero"``).
+    nrmse : float
+        ``||e|| / ||y - mean(y)||``.
+    fit_percent : float
+        ``100 (1 - nrmse)``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from synth.data import record_from_arrays
+    >>> t = np.arange(0, 4, 0.01)
+    >>> u = np.where(t >= 1, 1.0, 0.0)
+    >>> G = Plant.from_string("1/(0.2*s+1)")
+    >>> r = model_residual(G, record_from_arrays(t, u, simulate_plant(G, t, u) + 0.5))
+    >>> round(r.offset, 6), round(r.nrmse, 9), r.fit_percent
+    (0.5, 0.0, 100.0)
+    """
+
+    t: np.ndarray
+    u: np.ndarray
+    y: np.ndarray
+    y_model: np.ndarray
+    e: np.ndarray
+    offset: float
+    offset_mode: str
+    initial: str
+    nrmse: float
+    fit_percent: float
+
+    @property
+    def dt(self) -> float:
+        """Sample interval [s]."""
+        return float((self.t[-1] - self.t[0]) / (self.t.size - 1))
+
+    @property
+    def rms(self) -> float:
+        """Root mean square of the residual (output units)."""
+        return float(np.sqrt(np.mean(self.e**2)))
+
+    def to_dict(self) -> dict[str, Any]:
+        """The ``"gap"`` part of the diagnosis JSON.
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> from synth.data import record_from_arrays
+        >>> t = np.arange(0, 2, 0.01)
+        >>> u = np.where(t >= 0.5, 1.0, 0.0)
+        >>> r = model_residual(Plant.from_string("1/(0.1*s+1)"), record_from_arrays(t, u, 0.9 * u + 0.01 * t))
+        >>> sorted(r.to_dict())
+        ['fit_percent', 'initial', 'nrmse', 'offset', 'offset_mode', 'rms', 'samples']
+        """
+        return {"nrmse": self.nrmse, "fit_percent": self.fit_percent, "rms": self.rms, "offset": self.offset,
+                "offset_mode": self.offset_mode, "initial": self.initial, "samples": int(self.t.size)}
+
+
+def gap_size(y: np.ndarray, e: np.ndarray) -> tuple[float, float]:
+    """NRMSE ``||e|| / ||y - mean(y)||`` and fit ``100 (1 - NRMSE)`` [%].
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> gap_size(np.array([0.0, 2.0]), np.array([0.1, -0.1]))
+    (0.1, 90.0)
+    """
+    y = np.asarray(y, float)
+    spread = float(np.linalg.norm(y - y.mean()))
+    if spread == 0.0:
+        raise ModelError("the measured output is constant; the NRMSE is undefined", where="record.y")
+    nrmse = float(np.linalg.norm(np.asarray(e, float)) / spread)
+    return nrmse, 100.0 * (1.0 - nrmse)
+
+
+def model_residual(plant: Plant, record: Record, initial: str = "steady", offset: str | float = "fit") -> ModelResidual:
+    """Simulate ``plant`` on the record's input and return the residual.
+
+    Parameters
+    ----------
+    plant : Plant
+        The model (exact delay).
+    record : Record
+        The measured input (the command) and output.
+    initial : {"steady", "zero"}
+        Initial condition, see :func:`synth.ident.simulate.simulate_plant`.
+    offset : "fit", "none" or float
+        Output offset (operating point): fitted by least squares, zero, or given.
+
+    Returns
+    -------
+    ModelResidual
+
+    Raises
+    ------
+    ModelError
+        A bad ``offset`` or ``initial``, or a plant without a steady state with ``initial="steady"``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from synth.data import record_from_arrays
+    >>> t = np.arange(0, 3, 0.01)
+    >>> u = np.where(t >= 1, 1.0, 0.0)
+    >>> G = Plant.from_string("2/(0.1*s+1)")
+    >>> r = model_residual(G, record_from_arrays(t, u, 1.8 * u), offset="none")
+    >>> round(r.nrmse, 2) > 0.0, round(float(r.e[-1]), 3)
+    (True, -0.2)
+    """
+    if not isinstance(plant, Plant):
+        raise ModelError(f"expected a Plant, got {type(plant).__name__}", where="plant")
+    if not isinstance(record, Record):
+        raise ModelError(f"expected a Record, got {type(record).__name__}", where="record")
+    y_sim = simulate_plant(plant, record.t, record.u, initial=initial)
+    if isinstance(offset, str):
+        if offset == "fit":
+            c, mode = float(np.mean(record.y - y_sim)), "fit"
+        elif offset == "none":
+            c, mode = 0.0, "none"
+        else:
+            raise ModelError(f"must be 'fit', 'none' or a number, got {offset!r}", where="offset")
+    else:
+        c, mode = float(offset), "given"
+        if not np.isfinite(c):
+            raise ModelError(f"must be finite, got {offset!r}", where="offset")
+    y_model = y_sim + c
+    e = record.y - y_model
+    nrmse, fit = gap_size(record.y, e)
+    return ModelResidual(record.t, record.u, record.y, y_model, e, c, mode, initial, nrmse, fit)
