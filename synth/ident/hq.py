@@ -110,10 +110,13 @@ def find_crossings(w: np.ndarray, y: np.ndarray, level: float,
     for i in idx:
         lo, hi = np.log(w[i]), np.log(w[i + 1])
         direction = -1 if positive[i] else 1
+        x = lo + (hi - lo) * d[i] / (d[i] - d[i + 1])
         if func is not None:
-            x = brentq(lambda z: func(np.exp(z)) - level, lo, hi, xtol=1e-13, rtol=1e-13)
-        else:
-            x = lo + (hi - lo) * d[i] / (d[i] - d[i + 1])
+            fa, fb = func(w[i]) - level, func(w[i + 1]) - level
+            if fa == 0 or fb == 0:
+                x = lo if fa == 0 else hi
+            elif fa * fb < 0:  # else the level sits on a grid point within round-off: keep the interpolation
+                x = brentq(lambda z: func(np.exp(z)) - level, lo, hi, xtol=1e-13, rtol=1e-13)
         out.append(Crossing(float(np.exp(x)), direction))
     return out
 
