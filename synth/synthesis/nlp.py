@@ -166,14 +166,18 @@ class _Builder:
         return v
 
     def geq(self, expr: Any) -> None:
-        self.g.append(expr)
-        self.lbg.append(0.0)
-        self.ubg.append(np.inf)
+        """``expr >= 0`` (a scalar or one entry per frequency)."""
+        self._add(expr, np.inf)
 
     def eq(self, expr: Any) -> None:
+        """``expr == 0``."""
+        self._add(expr, 0.0)
+
+    def _add(self, expr: Any, upper: float) -> None:
+        expr = expr if isinstance(expr, (ca.SX, ca.MX)) else ca.SX(expr)
         self.g.append(expr)
-        self.lbg.append(0.0)
-        self.ubg.append(0.0)
+        self.lbg.extend([0.0] * expr.numel())
+        self.ubg.extend([upper] * expr.numel())
 
     def solve(self) -> tuple[np.ndarray, dict[str, Any]]:
         x = ca.vertcat(*self.x)
@@ -185,10 +189,18 @@ class _Builder:
 
 
 def _loop(ctrl: SymbolicController, plant: Plant, w: Any) -> tuple[Cx, Cx]:
-    """``(C(jw), L(jw))`` with the plant exact (delay included)."""
+    """``(C(jw), L(jw))`` with the plant exact (delay included).
+
+    ``w`` is a casadi symbol, a number, or an array of frequencies: then every
+    part is a column with one entry per frequency (one vectorized expression
+    instead of one per frequency, which keeps building the NLP cheap).
+    """
     C = ctrl.response(w)
     if isinstance(w, (ca.SX, ca.MX)):
         G = polyval_jw(plant.num, w) / polyval_jw(plant.den, w) * delay_jw(plant.delay, w)
+    elif np.ndim(w):
+        g = plant.freqresp(np.asarray(w, float))
+        G = Cx(np.real(g), np.imag(g))
     else:
         G = Cx.of(complex(plant.freqresp(np.array([w]))[0]))
     return C, C * G
@@ -227,10 +239,8 @@ def _add_requirement(b: _Builder, req: Requirement, plants: list[Plant], grid: n
     for plant in plants:
         if isinstance(req, (Sensitivity, PeakSensitivity)):
             m2 = 10 ** (req.max_db / 10) * tight
-            w = _band(req, grid, extra, per_decade)
-            for wk in w:
-                _, L = _loop(ctrl, plant, float(wk))
-                b.geq(m2 * (1.0 + L).abs2() - 1.0)
+            _, L = _loop(ctrl, plant, _band(req, grid, extra, per_decade))
+            b.geq(m2 * (1.0 + L).abs2() - 1.0)
         elif isinstance(req, StaticSensitivity):
             dc = ctrl.dc()
             if dc is not None:
@@ -238,22 +248,19 @@ def _add_requirement(b: _Builder, req: Requirement, plants: list[Plant], grid: n
                 b.geq(10 ** (-req.max_db / 10) * tight * (1.0 + g * dc) ** 2 - 1.0)
         elif isinstance(req, (PeakComplementary, PeakControlSensitivity)):
             inv = 10 ** (-req.max_db / 10) / tight
-            w = _band(req, grid, extra, per_decade)
-            for wk in w:
-                C, L = _loop(ctrl, plant, float(wk))
-                top = L if isinstance(req, PeakComplementary) else C
-                b.geq((1.0 + L).abs2() - inv * top.abs2())
+            C, L = _loop(ctrl, plant, _band(req, grid, extra, per_decade))
+            top = L if isinstance(req, PeakComplementary) else C
+            b.geq((1.0 + L).abs2() - inv * top.abs2())
         elif isinstance(req, SlewRate):
-            for wk in _band(req, grid, extra, per_decade):
-                C, _ = _loop(ctrl, plant, float(wk))
-                b.geq(tight - (req.max_error * wk / req.rate_limit) ** 2 * C.abs2())
+            w = _band(req, grid, extra, per_decade)
+            C, _ = _loop(ctrl, plant, w)
+            b.geq(tight - (req.max_error * w / req.rate_limit) ** 2 * C.abs2())
         elif isinstance(req, Bandwidth):
             t02 = _t0_squared(ctrl, plant)
             if req.min is not None:
                 pts = np.concatenate([grid[grid < req.min], extra[extra < req.min], [req.min]])
-                for wk in np.unique(pts):
-                    _, L = _loop(ctrl, plant, float(wk))
-                    b.geq(tight * L.abs2() - BANDWIDTH_LEVEL**2 * t02 * (1.0 + L).abs2())
+                _, L = _loop(ctrl, plant, np.unique(pts))
+                b.geq(tight * L.abs2() - BANDWIDTH_LEVEL**2 * t02 * (1.0 + L).abs2())
             if req.max is not None:
                 _, L = _loop(ctrl, plant, float(req.max))
                 b.geq(tight * BANDWIDTH_LEVEL**2 * t02 * (1.0 + L).abs2() - L.abs2())
@@ -319,19 +326,17 @@ def _term(b: _Builder, name: str, plants: list[Plant], grid: np.ndarray, start: 
         ms0 = float(np.max(np.abs(loop0.S(grid))))
         gamma = b.var("gamma", 1.0 / ms0, 1e-6, 1.0)
         for p in plants:
-            for wk in grid:
-                _, L = _loop(ctrl, p, float(wk))
-                b.geq((1.0 + L).abs2() - gamma**2)
+            _, L = _loop(ctrl, p, grid)
+            b.geq((1.0 + L).abs2() - gamma**2)
         return -20 * ca.log10(gamma)
     if name in ("peak_complementary", "control_effort"):
         curve = loop0.T if name == "peak_complementary" else loop0.KS
         m0 = float(np.max(np.abs(curve(grid))))
         M = b.var("M", m0, 1e-9, 1e3 * m0)
         for p in plants:
-            for wk in grid:
-                C, L = _loop(ctrl, p, float(wk))
-                top = L if name == "peak_complementary" else C
-                b.geq(M**2 * (1.0 + L).abs2() - top.abs2())
+            C, L = _loop(ctrl, p, grid)
+            top = L if name == "peak_complementary" else C
+            b.geq(M**2 * (1.0 + L).abs2() - top.abs2())
         return 20 * ca.log10(M)
     raise ValueError(f"no NLP objective {name}")
 
@@ -395,9 +400,8 @@ def polish(requirements: list[Requirement], plants: list[Plant], start: Controll
         for req in requirements:
             _add_requirement(b, req, plants, grid, current, per_decade, extra)
         for p in plants:  # keep |1 + L| away from zero: no closed-loop pole crosses the axis on the grid
-            for wk in grid:
-                _, L = _loop(ctrl, p, float(wk))
-                b.geq((1.0 + L).abs2() - stability_level**2)
+            _, L = _loop(ctrl, p, grid)
+            b.geq((1.0 + L).abs2() - stability_level**2)
         _add_objective(b, objective, plants, grid, current)
         x, stats = b.solve()
         iterations += int(stats.get("iter_count", 0))
