@@ -380,7 +380,7 @@ def find_spikes(w: np.ndarray, S: np.ndarray, threshold_db: float = 10.0,
             if denom < 0:
                 wp += 0.5 * (a - c) / denom * dw
         power = float(np.sum(S[lo:hi + 1] - 10 ** (med[lo:hi + 1] / 10)) * dw)
-        spikes.append(Spike(wp, float(db[peak]), float(excess[peak]), power))
+        spikes.append(Spike(float(wp), float(db[peak]), float(excess[peak]), power))
         mask[lo:hi + 1] = True
         k = max(j, hi) + 1
     return spikes, mask
