@@ -7,6 +7,7 @@ An ARX model from the input to the residual is fitted by least squares,
 (the constant ``c`` absorbs any offset; the ``A`` polynomial both shapes the
 error dynamics and whitens coloured noise, which keeps the least-squares
 covariance honest). The parameter covariance is ``P = s^2 (Phi^T Phi)^-1``
+(normal equations on unit-norm columns)
 with ``s^2`` the residual variance. The error model's frequency response
 ``E(e^{jw dt}) = B/A`` gets its covariance by the Gauss approximation
 formula: with ``J = dE/dtheta`` (``z^-j/A`` for ``b_j``, ``-E z^-i/A`` for
@@ -155,26 +156,27 @@ def fit_error_model(u: np.ndarray, e: np.ndarray, dt: float, na: int = 4, nb: in
         raise DataError(f"record too short for an error model of {n_par} parameters ({u.size} samples)",
                         where="residual")
     uc = u - u.mean()
+    target = e[k0:]
     while True:
         Phi = np.column_stack([-e[k0 - i: u.size - i] for i in range(1, na + 1)]
                               + [uc[k0 - j: u.size - j] for j in range(nb)] + [np.ones(n)])
         scale = np.linalg.norm(Phi, axis=0)
         scale[scale == 0.0] = 1.0
-        Q, R = np.linalg.qr(Phi / scale)
-        d = np.abs(np.diag(R))
-        if np.min(d) >= 1e-8 * np.max(d):
+        Phis = Phi / scale
+        gram = np.einsum("ki,kj->ij", Phis, Phis)  # small normal equations (no threaded BLAS on a busy machine)
+        eig = np.linalg.eigvalsh(gram)
+        if eig[0] >= 1e-14 * eig[-1]:
             break
         if na == 0:
             raise DataError("the input does not excite the error model (regressors are collinear); lower nb",
                             where="residual")
         na -= 1  # a noise-free residual that a lower-order ARX fits exactly
-    target = e[k0:]
-    theta = np.linalg.solve(R, Q.T @ target) / scale
-    resid = target - Phi @ theta
+    ginv = np.linalg.inv(gram)
+    theta = ginv @ np.einsum("ki,k->i", Phis, target) / scale
+    resid = target - np.einsum("ki,i->k", Phi, theta)
     n_par = na + nb + 1
-    s2 = max(float(resid @ resid) / (n - n_par), 1e-300)
-    Rinv = np.linalg.inv(R)
-    cov = s2 * (Rinv @ Rinv.T) / np.outer(scale, scale)
+    s2 = max(float(np.dot(resid, resid)) / (n - n_par), 1e-300)
+    cov = s2 * ginv / np.outer(scale, scale)
     a = np.r_[1.0, theta[:na]]
     b = theta[na: na + nb]
     P = cov[: na + nb, : na + nb]

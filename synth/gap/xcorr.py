@@ -4,7 +4,8 @@ The usual bound ``+-1.96/sqrt(N)`` on the normalized cross-correlation holds
 only if at least one of the two signals is white; a step train or a
 low-passed input is far from white, and with it the naive bound raises false
 alarms at most lags. So the input is prewhitened: an AR model ``A(q)`` is
-fitted to the (mean-removed) input by least squares, its order chosen by
+fitted to the (mean-removed) input (Yule-Walker equations solved by the
+Levinson-Durbin recursion), its order chosen by
 Akaike's criterion up to ``max_order``; the input and the residual are both
 filtered by ``A(q)``. The filtered input is white, the filtered residual is
 still independent of it when the model is right, and a linear filter applied
@@ -28,7 +29,7 @@ from synth.errors import DataError
 
 
 def fit_ar(x: np.ndarray, max_order: int = 20) -> np.ndarray:
-    """Whitening filter ``[1, a_1, ..., a_p]`` of ``x`` (least squares, order by AIC).
+    """Whitening filter ``[1, a_1, ..., a_p]`` of ``x`` (Yule-Walker by Levinson-Durbin, order by AIC).
 
     Examples
     --------
@@ -41,18 +42,25 @@ def fit_ar(x: np.ndarray, max_order: int = 20) -> np.ndarray:
     """
     x = np.asarray(x, float) - np.mean(x)
     n = x.size
-    p_max = int(min(max_order, max(1, n // 10)))
     if n < 20:
         raise DataError(f"need at least 20 samples to fit a whitening filter, got {n}", where="input")
-    best = (n * np.log(np.mean(x**2) + 1e-300), np.array([1.0]))
-    target = x[p_max:]
-    lagged = np.column_stack([x[p_max - i: n - i] for i in range(1, p_max + 1)])
+    p_max = int(min(max_order, max(1, n // 10)))
+    spec = np.fft.rfft(x, 2 * n)
+    r = np.fft.irfft(np.abs(spec) ** 2)[: p_max + 1] / n
+    if r[0] <= 0.0:
+        return np.array([1.0])
+    a = np.array([1.0])
+    err = float(r[0])
+    best = (n * np.log(err), a)
     for p in range(1, p_max + 1):
-        coef, *_ = np.linalg.lstsq(lagged[:, :p], target, rcond=None)
-        rss = float(np.mean((target - lagged[:, :p] @ coef) ** 2))
-        aic = n * np.log(rss + 1e-300) + 2 * p
+        k = -float(np.dot(a, r[p:0:-1])) / err
+        a = np.r_[a, 0.0] + k * np.r_[a, 0.0][::-1]
+        err *= 1.0 - k * k
+        if err <= 1e-15 * r[0]:
+            return a
+        aic = n * np.log(err) + 2 * p
         if aic < best[0]:
-            best = (aic, np.r_[1.0, -coef])
+            best = (aic, a)
     return best[1]
 
 
@@ -113,7 +121,7 @@ class CrossCorrelation:
                 "peak_lag_s": float(self.lags[np.argmax(np.abs(self.r))] * self.dt),
                 "peak": float(self.r[np.argmax(np.abs(self.r))]),
                 "causal_significant": bool(np.any(causal)),
-                "method": "AR prewhitening of the input (order by AIC), both signals filtered"}
+                "method": "AR (Yule-Walker) prewhitening of the input, order by AIC; both signals filtered"}
 
 
 def prewhitened_xcorr(u: np.ndarray, e: np.ndarray, dt: float, max_lag: int = 50, max_order: int = 20,
