@@ -170,6 +170,18 @@ def load_disturbance(path: str | Path, time: str | None, signal: str, unit: str 
     return disturbance_from_arrays(t, x, signal, unit, str(path), time or "time")
 
 
+def unit_squared(unit: str) -> str:
+    """``unit^2`` written unambiguously (parentheses around a compound unit).
+
+    Examples
+    --------
+    >>> unit_squared("rad/s"), unit_squared("V"), unit_squared("")
+    ('(rad/s)^2', 'V^2', 'unit^2')
+    """
+    unit = unit or "unit"
+    return f"({unit})^2" if any(c in unit for c in "/* ") else f"{unit}^2"
+
+
 # ------------------------------------------------------------------------------------------ parts
 @dataclass(frozen=True)
 class Spike:
@@ -548,7 +560,8 @@ class PsdAnalysis:
 
     def to_dict(self, curves: bool = False) -> dict[str, Any]:
         """JSON-ready form; ``curves=True`` adds ``w``, ``psd`` and ``psd_db``."""
-        u = f"{self.unit}^2/(rad/s)" if self.unit else "unit^2/(rad/s)"
+        sq = unit_squared(self.unit)
+        u = f"{sq}/(rad/s)"
         out: dict[str, Any] = {
             "records": self.records, "segments": self.segments, "segment_length": self.segment_length,
             "resolution": self.resolution, "floor": self.floor, "floor_db": self.floor_db,
@@ -558,7 +571,7 @@ class PsdAnalysis:
             "share_frequency": self.share_frequency, "share_frequency_with_spikes": self.share_frequency_with_spikes,
             "total_power": self.total_power, "disturbance_power": self.disturbance_power,
             "units": {"w": "rad/s", "psd": u, "psd_db": f"dB re 1 {u}", "segment_length": "s",
-                      "resolution": "rad/s", "power": f"{self.unit or 'unit'}^2", "share_frequency": "rad/s"},
+                      "resolution": "rad/s", "power": sq, "share_frequency": "rad/s"},
             "notes": list(self.notes),
         }
         if curves:

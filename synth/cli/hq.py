@@ -1,0 +1,164 @@
+"""``synth hq``: handling-qualities bandwidth and phase delay of an attitude response."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+from typing import Any
+
+COMMAND = "hq"
+ORDER = 40
+HELP = "bandwidth and phase delay (seed 2, fig. 1) of a model or a measured frequency response"
+DESCRIPTION = """Handling-qualities metrics of an attitude response (seed 2, sec. 6.2, fig. 1).
+
+w180 (phase -180 deg), phase bandwidth (-135 deg), gain bandwidth (6 dB above the gain at w180),
+the bandwidth by the response type's rule (rate: the lesser; attitude: the phase bandwidth) and
+the phase delay tau_p = -(phi(2 w180) + 180 deg)/(2 w180). Measured data: a rough phase is read
+through a least-squares line between w180 and 2 w180; the coherence gives each metric an
+uncertainty.
+
+--frd FILE is a CSV with columns w, mag_db, phase_deg[, coherence] (rad/s, dB, deg) or the JSON
+of `synth freqresp` (keys w, magnitude_db, phase_deg, coherence, and optionally averages).
+
+example:
+  synth hq --tf "1/(s^2+s+1)" --delay 0.1
+  synth hq --frd roll.csv --averages 20 --json hq.json --out reports/roll_hq
+
+exit codes: 0 computed, 2 bad input"""
+
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
+    src = p.add_mutually_exclusive_group(required=True)
+    src.add_argument("--tf", help='attitude response model, e.g. "1/(s^2+s+1)"')
+    src.add_argument("--frd", metavar="FILE", help="measured frequency response (CSV or synth freqresp JSON)")
+    p.add_argument("--delay", type=float, default=0.0, help="delay added to --tf [s]")
+    p.add_argument("--response-type", choices=["auto", "rate", "attitude"], default="auto",
+                   help="rate: bandwidth is the lesser of phase and gain bandwidths; attitude: the phase "
+                        "bandwidth; auto (default): an integrator at low frequency means rate")
+    p.add_argument("--averages", type=float, help="number of averages behind a measured response (uncertainty)")
+    p.add_argument("--phase-fit", choices=["auto", "raw", "line"], default="auto",
+                   help="measured data: how the phase at 2 w180 is read (default auto)")
+    p.add_argument("--fit-band", nargs=2, type=float, metavar=("W1", "W2"),
+                   help="band of the least-squares phase line [rad/s] (default w180 to 2 w180)")
+    p.add_argument("--json", metavar="FILE", help="write the metrics as JSON ('-' for standard output)")
+    p.add_argument("--out", metavar="DIR", help="folder for hq.json and hq_bode.png")
+    p.add_argument("--force", action="store_true", help="overwrite files synth did not write")
+
+
+def read_frd(path: str | Path) -> dict[str, Any]:
+    """Read a measured frequency response: ``synth freqresp`` JSON or CSV ``w, mag_db, phase_deg[, coherence]``.
+
+    Returns ``{"w", "H", "coherence", "averages"}`` (``H`` complex).
+
+    Examples
+    --------
+    >>> import pathlib, tempfile
+    >>> p = pathlib.Path(tempfile.mkdtemp()) / "f.csv"
+    >>> _ = p.write_text("w,mag_db,phase_deg\\n1,0,-90\\n2,-6,-120\\n")
+    >>> d = read_frd(p); d["H"].round(3).tolist(), d["coherence"]
+    ([-0.0-1.0j, -0.251-0.434j], None)
+    """
+    import numpy as np
+
+    from synth.data.record import read_columns
+    from synth.errors import DataError
+
+    path = Path(path)
+    if path.suffix.lower() == ".json":
+        try:
+            data = json.loads(path.read_text(encoding="utf-8"))
+        except OSError as exc:
+            raise DataError(f"cannot read: {exc.strerror or exc}", where=str(path)) from None
+        except ValueError as exc:
+            raise DataError(f"not valid JSON: {exc}", where=str(path)) from None
+        keys = {"w": "w", "mag_db": "magnitude_db", "phase_deg": "phase_deg", "coherence": "coherence"}
+        averages = data.get("averages") if isinstance(data, dict) else None
+    else:
+        data = read_columns(path)
+        keys = {"w": "w", "mag_db": "mag_db", "phase_deg": "phase_deg", "coherence": "coherence"}
+        averages = None
+    if not isinstance(data, dict):
+        raise DataError("expected an object with w, magnitude_db, phase_deg", where=str(path))
+    cols: dict[str, Any] = {}
+    for role, key in keys.items():
+        if key not in data or data[key] is None:
+            if role == "coherence":
+                cols[role] = None
+                continue
+            raise DataError(f"column '{key}' not found; found {', '.join(map(str, data)) or 'nothing'}",
+                            where=str(path))
+        try:
+            cols[role] = np.asarray(data[key], float).ravel()
+        except (TypeError, ValueError):
+            raise DataError(f"column '{key}': values are not numbers", where=str(path)) from None
+        bad = np.flatnonzero(~np.isfinite(cols[role]))
+        if bad.size:
+            raise DataError(f"column '{key}': {bad.size} value(s) are NaN or inf (first at row {bad[0]})",
+                            where=str(path))
+    H = 10 ** (cols["mag_db"] / 20) * np.exp(1j * np.radians(cols["phase_deg"]))
+    return {"w": cols["w"], "H": H, "coherence": cols["coherence"], "averages": averages}
+
+
+def _fmt(value: Any, unit: str, sigma: Any = None, digits: int = 4) -> str:
+    if value is None:
+        return "undefined"
+    text = f"{value:.{digits}g} {unit}"
+    return text + (f" +- {sigma:.2g}" if sigma is not None else "")
+
+
+def run(args: argparse.Namespace) -> int:
+    from synth.errors import DataError, ModelError
+    from synth.ident.hq import hq_from_frd, hq_from_plant
+    from synth.outputs import OutputDir, check_writable, dump_json, write_json
+    from synth.plant import Plant
+
+    if args.tf is not None:
+        try:
+            plant = Plant.from_string(args.tf, delay=args.delay)
+        except ModelError as exc:
+            raise exc.located("--tf") from None
+        m = hq_from_plant(plant, args.response_type)
+        title = plant.to_string()
+    else:
+        frd = read_frd(args.frd)
+        averages = args.averages if args.averages is not None else frd["averages"]
+        try:
+            m = hq_from_frd(frd["w"], frd["H"], frd["coherence"], averages, args.response_type, args.phase_fit,
+                            tuple(args.fit_band) if args.fit_band else None)
+        except DataError as exc:
+            raise exc.located(args.frd) if exc.where == "frequency response" else exc from None
+        title = str(args.frd)
+    data = m.to_dict()
+    if args.json and args.json != "-":
+        check_writable(Path(args.json), args.force)
+    out = OutputDir(args.out, args.force) if args.out else None
+    if out:
+        write_json(out.claim("hq.json"), m.to_dict(curves=True), force=True)
+        from synth.ident.hq_figures import hq_bode
+
+        hq_bode(m, out.claim("hq_bode.png"), title)
+        out.commit()
+    if args.json == "-":
+        sys.stdout.write(dump_json(data))
+        return 0
+    if args.json:
+        write_json(args.json, data, force=args.force)
+    u = m.uncertainty or {}
+    rows = [("w180", _fmt(m.w180, "rad/s", u.get("w180"))),
+            ("bandwidth_phase (-135 deg)", _fmt(m.bandwidth_phase, "rad/s", u.get("bandwidth_phase"))),
+            ("bandwidth_gain (+6 dB)", _fmt(m.bandwidth_gain, "rad/s", u.get("bandwidth_gain"))),
+            ("bandwidth", _fmt(m.bandwidth, "rad/s", u.get("bandwidth"))
+             + (f"  ({m.bandwidth_limit}-limited)" if m.bandwidth else "")),
+            ("phase delay tau_p", _fmt(m.phase_delay, "s", u.get("phase_delay"), 3)
+             + (f"  (phase at 2 w180: {m.phase_2w180:.1f} deg, {m.phase_method})" if m.phase_2w180 is not None else ""))]
+    print(f"{title}: {m.response_type} response type ({m.response_type_reason})")
+    width = max(len(r[0]) for r in rows)
+    for name, value in rows:
+        print(f"  {name:<{width}}  {value}")
+    for note in m.notes:
+        print(f"note: {note}")
+    if out:
+        print(f"wrote {out.path}/hq.json and {out.path}/hq_bode.png")
+    return 0

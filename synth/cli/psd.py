@@ -1,0 +1,100 @@
+"""``synth psd``: spectrum of measured disturbance records (seed 1, section 5)."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+COMMAND = "psd"
+ORDER = 45
+HELP = "disturbance spectrum: Welch PSD, trend, noise floor, spikes, bandwidth from the power share"
+DESCRIPTION = """Power spectral density of one or several disturbance records (seed 1, sec. 5).
+
+One-sided Welch PSD in unit^2/(rad/s) on rad/s (records averaged), its log-log trend (dB/decade),
+the noise floor, narrow-band spikes, and the frequency below which --share of the disturbance
+power above the floor lies. The suggested bandwidth requirement is --factor times that frequency:
+feedback attenuates a disturbance only below the loop's bandwidth.
+
+example:
+  synth psd --data env.csv --data env2.csv --time t --signal speed --unit rad/s
+  synth psd --data hover.mat --time t --signal speed --noise-data stopped.mat --share 0.9 --out reports/psd
+
+exit codes: 0 computed, 2 bad input"""
+
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--data", action="append", required=True, metavar="FILE",
+                   help="CSV or MAT record (repeat for several; same sample rate)")
+    p.add_argument("--time", help="time column [s] (omit with --dt)")
+    p.add_argument("--signal", required=True, help="disturbance column")
+    p.add_argument("--unit", default="", help="unit of the signal (labels)")
+    p.add_argument("--dt", type=float, help="sample interval [s] for files without a time column")
+    p.add_argument("--noise-data", action="append", default=[], metavar="FILE",
+                   help="noise-only record (e.g. motor stopped) whose level is the noise floor")
+    p.add_argument("--share", type=float, default=0.9, help="share of disturbance power (default 0.9)")
+    p.add_argument("--factor", type=float, default=1.0, help="bandwidth = factor x share frequency (default 1)")
+    p.add_argument("--band", nargs=2, type=float, metavar=("W1", "W2"), help="trend band [rad/s]")
+    p.add_argument("--floor-band", nargs=2, type=float, metavar=("W1", "W2"),
+                   help="band where the spectrum is flat noise [rad/s] (default: upper half)")
+    p.add_argument("--w-min", type=float, help="lowest frequency of interest [rad/s] (sets the segment length)")
+    p.add_argument("--segment", type=float, help="Welch segment length [s]")
+    p.add_argument("--spike-db", type=float, default=10.0, help="spike threshold above the running median [dB]")
+    p.add_argument("--detrend", choices=["constant", "linear"], default="constant",
+                   help="removed from each segment (linear for battery drift)")
+    p.add_argument("--json", metavar="FILE", help="write the analysis as JSON ('-' for standard output)")
+    p.add_argument("--out", metavar="DIR", help="folder for psd.json and psd.png")
+    p.add_argument("--force", action="store_true", help="overwrite files synth did not write")
+
+
+def run(args: argparse.Namespace) -> int:
+    from synth.ident.psd import analyze_records, load_disturbance, suggest_bandwidth, unit_squared
+    from synth.outputs import OutputDir, check_writable, dump_json, write_json
+
+    records = [load_disturbance(f, args.time, args.signal, args.unit, args.dt) for f in args.data]
+    noise = [load_disturbance(f, args.time, args.signal, args.unit, args.dt) for f in args.noise_data]
+    a = analyze_records(records, noise, share=args.share, band=tuple(args.band) if args.band else None,
+                        segment=args.segment, w_min=args.w_min,
+                        floor_band=tuple(args.floor_band) if args.floor_band else None, spike_db=args.spike_db,
+                        detrend=args.detrend)
+    suggestion = suggest_bandwidth(a, args.factor) if a.share_frequency is not None else None
+    data = {**a.to_dict(), "records": [r.to_dict() for r in records], "noise_records": [r.to_dict() for r in noise],
+            "bandwidth_suggestion": suggestion.to_dict() if suggestion else None}
+    if args.json and args.json != "-":
+        check_writable(Path(args.json), args.force)
+    out = OutputDir(args.out, args.force) if args.out else None
+    if out:
+        write_json(out.claim("psd.json"), {**data, "curves": a.to_dict(curves=True)["curves"]}, force=True)
+        from synth.ident.psd_figures import psd_plot
+
+        psd_plot(a, out.claim("psd.png"), f"{args.signal}: " + ", ".join(Path(f).name for f in args.data))
+        out.commit()
+    if args.json == "-":
+        sys.stdout.write(dump_json(data))
+        return 0
+    if args.json:
+        write_json(args.json, data, force=args.force)
+    u, u2 = args.unit or "unit", unit_squared(args.unit)
+    print(f"{args.signal} [{u}]: {len(records)} record(s), {a.segments} Welch segments of {a.segment_length:.4g} s, "
+          f"resolution {a.resolution:.3g} rad/s")
+    rows = [("noise floor", f"{a.floor_db:.1f} dB re 1 {u2}/(rad/s) ({a.floor_source}, "
+                            f"{a.floor_band[0]:.4g}-{a.floor_band[1]:.4g} rad/s)"),
+            ("trend", f"{a.trend.slope_db_per_decade:+.1f} dB/decade over {a.trend.band[0]:.3g}-{a.trend.band[1]:.3g} "
+                      f"rad/s (rms {a.trend.rms_residual_db:.1f} dB)" if a.trend else "none"),
+            ("spikes", ", ".join(f"{s.w:.1f} rad/s (+{s.height_db:.0f} dB, amplitude {s.amplitude:.3g} {u})"
+                                 for s in a.spikes[:8]) + (" ..." if len(a.spikes) > 8 else "") or "none"),
+            (f"{100 * a.share:g} % of disturbance power below",
+             f"{a.share_frequency:.4g} rad/s (spikes counted: {a.share_frequency_with_spikes:.4g} rad/s)"
+             if a.share_frequency is not None else "undefined"),
+            ("mean square", f"{a.total_power:.4g} {u2} (above the floor: {a.disturbance_power:.4g} {u2})")]
+    if suggestion:
+        rows.append(("suggested requirement", f"{suggestion.spec_entry()}  (bandwidth >= {suggestion.factor:g} x "
+                                              f"{suggestion.share_frequency:.4g} rad/s)"))
+    width = max(len(r[0]) for r in rows)
+    for name, value in rows:
+        print(f"  {name:<{width}}  {value}")
+    for note in a.notes:
+        print(f"note: {note}")
+    if out:
+        print(f"wrote {out.path}/psd.json and {out.path}/psd.png")
+    return 0
