@@ -1,0 +1,108 @@
+"""``synth hq``: the printed table, JSON keys, measured files (CSV and freqresp JSON), errors."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from synth.ident.hq import hq_from_plant
+from synth.plant import Plant
+
+
+def test_prints_the_seed_example(run_cli):
+    r = run_cli("hq", "--tf", "1/(s^2+s+1)", "--delay", "0.1")
+    assert r.code == 0, r.err
+    assert "w180                        3.262 rad/s" in r.out
+    assert "phase delay tau_p           0.0761 s" in r.out
+    assert "bandwidth_gain (+6 dB)      2.351 rad/s" in r.out
+    assert "attitude response type" in r.out
+
+
+@pytest.mark.parametrize(("tf", "delay", "expect"), [
+    ("1/(s*(s+1))", "0.1", (3.111, 0.844, 2.149, 0.844, 0.0744)),
+    ("4/(s*(0.1*s+1))", "0.05", (13.07, 5.56, 8.29, 5.56, 0.0360)),
+])
+def test_json_keys_and_values(run_cli, tf, delay, expect):
+    r = run_cli("hq", "--tf", tf, "--delay", delay, "--json", "-")
+    assert r.code == 0, r.err
+    d = json.loads(r.out)
+    got = [d[k] for k in ("w180", "bandwidth_phase", "bandwidth_gain", "bandwidth", "phase_delay")]
+    assert np.allclose(got, expect, rtol=6e-4)
+    assert d["response_type"] == "rate" and d["bandwidth_limit"] == "phase"
+
+
+def test_response_type_option(run_cli):
+    r = run_cli("hq", "--tf", "(s/2+1)/(s*(s/6+1))", "--delay", "0.1", "--response-type", "attitude", "--json", "-")
+    d = json.loads(r.out)
+    assert d["bandwidth"] == d["bandwidth_phase"] > d["bandwidth_gain"]
+
+
+def _measured(tmp_path, fmt):
+    G = Plant.from_string("1/(s*(s+1))", delay=0.1)
+    w = np.logspace(-1, 1.5, 120)
+    H = G.freqresp(w)
+    coh = np.full(w.size, 0.9)
+    mag, ph = 20 * np.log10(np.abs(H)), np.degrees(np.unwrap(np.angle(H)))
+    if fmt == "csv":
+        p = tmp_path / "roll.csv"
+        np.savetxt(p, np.column_stack([w, mag, ph, coh]), delimiter=",", header="w,mag_db,phase_deg,coherence",
+                   comments="")
+    else:
+        p = tmp_path / "roll.json"
+        p.write_text(json.dumps({"generator": "synth", "w": w.tolist(), "magnitude_db": mag.tolist(),
+                                 "phase_deg": ph.tolist(), "coherence": coh.tolist(), "averages": 12}))
+    return p, G
+
+
+@pytest.mark.parametrize("fmt", ["csv", "json"])
+def test_measured_file(run_cli, tmp_path, fmt):
+    p, G = _measured(tmp_path, fmt)
+    r = run_cli("hq", "--frd", str(p), "--averages", "12", "--json", "-") if fmt == "csv" else \
+        run_cli("hq", "--frd", str(p), "--json", "-")
+    assert r.code == 0, r.err
+    d = json.loads(r.out)
+    exact = hq_from_plant(G)
+    assert d["w180"] == pytest.approx(exact.w180, rel=2e-3)
+    assert d["source"] == "measured" and d["uncertainty"]["w180"] > 0
+    e = np.sqrt(0.1) / (np.sqrt(0.9) * np.sqrt(24))  # n_d = 12 from the option or the JSON
+    slope = 1 / (1 + exact.w180**2) + 0.1
+    assert d["uncertainty"]["w180"] == pytest.approx(e / slope, rel=0.02)
+
+
+def test_out_folder_and_table_uncertainty(run_cli, tmp_path):
+    p, _ = _measured(tmp_path, "csv")
+    out = tmp_path / "report"
+    r = run_cli("hq", "--frd", str(p), "--averages", "12", "--out", str(out))
+    assert r.code == 0, r.err
+    assert "+-" in r.out
+    assert (out / "hq_bode.png").stat().st_size > 10_000
+    d = json.loads((out / "hq.json").read_text())
+    assert len(d["curves"]["w"]) == 120
+
+
+@pytest.mark.parametrize(("args", "content", "match"), [
+    (["--tf", "1/(s^2+s"], None, "--tf"),
+    (["--frd", "{f}"], "w,mag_db\n1,0\n2,1\n", "column 'phase_deg' not found"),
+    (["--frd", "{f}"], "w,mag_db,phase_deg\n1,0,-90\n2,nan,-100\n3,1,-110\n4,1,-120\n", "'mag_db': 1 value"),
+    (["--frd", "{f}"], "w,mag_db,phase_deg\n1,0,-90\n3,0,-100\n2,1,-110\n4,1,-120\n", "increase strictly"),
+    (["--frd", "{f}", "--averages", "0"], "w,mag_db,phase_deg,coherence\n1,0,-90,1\n2,0,-100,1\n3,1,-110,1\n4,1,-120,1\n",
+     "averages must be >= 1"),
+])
+def test_bad_input_one_line_exit_2(run_cli, tmp_path, args, content, match):
+    f = tmp_path / "bad.csv"
+    if content is not None:
+        f.write_text(content)
+    r = run_cli("hq", *[a.format(f=f) for a in args])
+    assert r.code == 2
+    assert match in r.err and len(r.err.strip().splitlines()) == 1 and "Traceback" not in r.err
+
+
+def test_missing_file_and_refuses_to_overwrite(run_cli, tmp_path):
+    r = run_cli("hq", "--frd", str(tmp_path / "nope.csv"))
+    assert r.code == 2 and "file not found" in r.err
+    mine = tmp_path / "mine.json"
+    mine.write_text("my notes")
+    r = run_cli("hq", "--tf", "1/(s*(s+1))", "--delay", "0.1", "--json", str(mine))
+    assert r.code == 2 and "not overwriting" in r.err and mine.read_text() == "my notes"
