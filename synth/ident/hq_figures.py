@@ -14,6 +14,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
+from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter
 
 from synth.errors import ModelError
 from synth.ident.hq import GAIN_MARGIN_DB, HQMetrics
@@ -103,6 +104,9 @@ def hq_bode(m: HQMetrics, path: str | Path, title: str = "") -> Path:
     fig.suptitle((title + "\n" if title else "") + bw, fontsize=10)
     for ax in axes:
         ax.grid(True, which="both", alpha=0.3)
+        ax.xaxis.set_major_locator(LogLocator(subs=(1.0, 2.0, 5.0)))
+        ax.xaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
+        ax.xaxis.set_minor_formatter(NullFormatter())
     fig.tight_layout()
     path.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(path, dpi=110, metadata=_METADATA)
