@@ -3,10 +3,11 @@
 Regime variables (each sample of the record gets a value):
 
 - ``amplitude``: ``|u - median(u)|``, the input's deviation from its operating point;
-- ``rate``: ``sqrt(2)`` times the RMS of ``du/dt`` over the trailing window of the
-  model's 63 % response time; for a sinusoid of amplitude ``A`` and frequency
-  ``w`` (with a window of at least one period) this is ``A w``, and after a step it
-  grows with the step size;
+- ``rate``: ``sqrt(2)`` times the RMS of ``du/dt`` over a trailing window of four
+  times the model's 63 % response time (about its 2 % settling time for a
+  first-order model: an error caused by a fast input lasts about that long);
+  for a sinusoid of amplitude ``A`` and frequency ``w`` (window of at least one
+  period) this is ``A w``, and after a step it grows with the step size;
 - ``operating_point``: the measured output level;
 - ``direction``: direction of motion of the model output: ``up``/``down`` where
   ``|dy_model/dt|`` exceeds 2 % of its largest value, ``still`` elsewhere;
@@ -297,7 +298,7 @@ def localize_regime(residual: ModelResidual, plant: Plant, aux: dict[str, np.nda
     factor = _neff_factor(e)
     out: dict[str, RegimeVariable] = {}
     amp = np.abs(residual.u - np.median(residual.u))
-    rate = input_rate(residual.u, dt, response_time(plant, dt))
+    rate = input_rate(residual.u, dt, 4.0 * response_time(plant, dt))
     candidates = [("amplitude", amp, "input deviation from its median", uu),
                   ("rate", rate, "input rate A*w (sqrt 2 x trailing RMS of du/dt)", f"{uu}/s" if uu else "1/s"),
                   ("operating_point", residual.y, "measured output level", yu)]
