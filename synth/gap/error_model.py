@@ -13,7 +13,9 @@ with ``s^2`` the residual variance. The error model's frequency response
 formula: with ``J = dE/dtheta`` (``z^-j/A`` for ``b_j``, ``-E z^-i/A`` for
 ``a_i``), the covariance of ``[Re E, Im E]`` is ``[Re J; Im J] P [Re J; Im J]^T``.
 At each frequency the 2-D confidence ellipse excludes 0 when
-``g^T C^-1 g > chi2_2(level)``. To keep the chance of any false band near
+``g^T C^-1 g > chi2_2(level)`` (near 0 and Nyquist, where ``E`` is real and
+``C`` singular, only the direction with variance is tested, with one degree
+of freedom; ``stat`` is reported on the ``chi2_2`` scale). To keep the chance of any false band near
 ``1 - level`` over the whole grid, bands are only reported when the error
 model as a whole is significant first: a Wald test of ``b = 0``,
 ``b^T P_bb^-1 b > chi2_nb(level)`` (a gatekeeping procedure). When the
@@ -191,8 +193,13 @@ def fit_error_model(u: np.ndarray, e: np.ndarray, dt: float, na: int = 4, nb: in
     G = np.stack([J.real, J.imag], axis=1)  # (nw, 2, npar)
     C = np.einsum("wip,pq,wjq->wij", G, P, G)
     g = np.stack([E.real, E.imag], axis=1)
-    stat = np.einsum("wi,wi->w", g, np.linalg.solve(C, g[..., None])[..., 0])
-    radius = np.sqrt(chi2.ppf(level, 2) * np.linalg.eigvalsh(C)[:, -1])
+    lam, vec = np.linalg.eigh(C)
+    proj = np.einsum("wij,wi->wj", vec, g)
+    keep = lam > 1e-6 * lam[:, -1:]  # near 0 and Nyquist E is real: Im has no variance, test one dimension
+    stat = np.sum(np.where(keep, proj**2 / np.where(keep, lam, 1.0), 0.0), axis=1)
+    dof = keep.sum(axis=1)
+    stat = chi2.isf(np.maximum(chi2.sf(stat, dof), 1e-300), 2)  # on the chi2(2) scale: one threshold for all w
+    radius = np.sqrt(chi2.ppf(level, 2) * lam[:, -1])
     mag = np.abs(E)
     return ErrorModel(a, b, P, float(dt), w, E, stat, np.maximum(mag - radius, 0.0), mag + radius,
                       wald, wald_p, float(level))

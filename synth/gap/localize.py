@@ -185,7 +185,8 @@ def localize_gap(plant: Plant, record: Record, initial: str = "steady", offset: 
     """
     residual = model_residual(plant, record, initial=initial, offset=offset)
     time = localize_time(residual, false_alarm=1.0 - level)
-    frequency = localize_frequency(residual, max_lag=max_lag, n_segments=n_segments, na=na, nb=nb, level=level)
+    frequency = localize_frequency(residual, max_lag=max_lag, n_segments=n_segments, na=na, nb=nb, level=level,
+                                   plant=plant)
     regimes = localize_regime(residual, plant, record.aux, n_bins=n_bins, level=level,
                               units=(record.input.unit, record.output.unit))
     where = WhereResult(time, frequency, regimes)

@@ -1,7 +1,10 @@
 """Where in frequency the residual lies: bands where the model-error model is significant.
 
 A band is a run of neighbouring grid frequencies where the error model's
-confidence region excludes zero (see :mod:`synth.gap.error_model`); runs
+confidence region excludes zero (see :mod:`synth.gap.error_model`) and,
+when the model is given, the error is also relevant: ``|E| >= relevance |G|``
+(default 10 % of the model's own response; with little noise a 0.2 % error
+is significant too, but it is not where the gap is); runs
 separated by a gap narrower than a factor ``merge_ratio`` in frequency are
 merged. Each band is reported as ``[w0, w1, share]`` [rad/s] with ``share``
 the fraction of the residual's power (Welch PSD, same segments as the
@@ -23,6 +26,7 @@ from synth.gap.coherence import Coherence, input_residual_coherence
 from synth.gap.error_model import ErrorModel, fit_error_model
 from synth.gap.residual import ModelResidual
 from synth.gap.xcorr import CrossCorrelation, prewhitened_xcorr
+from synth.plant import Plant
 
 
 @dataclass(frozen=True)
@@ -53,7 +57,7 @@ def _power_share(w: np.ndarray, psd: np.ndarray, w0: float, w1: float) -> float:
 
 
 def significant_bands(model: ErrorModel, w_psd: np.ndarray, e_psd: np.ndarray, u_psd: np.ndarray,
-                      merge_ratio: float = 1.1) -> list[FrequencyBand]:
+                      merge_ratio: float = 1.1, relevant: np.ndarray | None = None) -> list[FrequencyBand]:
     """Bands of the error model's significant frequencies with their power shares, largest share first.
 
     Examples
@@ -67,7 +71,7 @@ def significant_bands(model: ErrorModel, w_psd: np.ndarray, e_psd: np.ndarray, u
     >>> len(b), round(b[0].w1 / b[0].w0) > 100
     (1, True)
     """
-    sig = model.significant
+    sig = model.significant if relevant is None else model.significant & relevant
     w = model.w
     runs: list[list[int]] = []
     for i in np.flatnonzero(sig):
@@ -133,7 +137,7 @@ class FrequencyLocalization:
 
 
 def localize_frequency(residual: ModelResidual, max_lag: int = 50, n_segments: int = 16, na: int = 4, nb: int = 10,
-                       level: float = 0.95) -> FrequencyLocalization:
+                       level: float = 0.95, plant: Plant | None = None, relevance: float = 0.1) -> FrequencyLocalization:
     """Cross-correlation, coherence, error model and significant bands of a model's residual.
 
     Parameters
@@ -147,6 +151,10 @@ def localize_frequency(residual: ModelResidual, max_lag: int = 50, n_segments: i
         Error-model orders.
     level : float
         Confidence level of every test (``alpha = 1 - level``).
+    plant : Plant, optional
+        The model; with it, bands also need ``|E| >= relevance |G|``.
+    relevance : float
+        Smallest relative error a band must show.
 
     Examples
     --------
@@ -173,5 +181,8 @@ def localize_frequency(residual: ModelResidual, max_lag: int = 50, n_segments: i
     _, pu = welch(u - u.mean(), fs=1.0 / dt, window="hann", nperseg=nper, noverlap=nper // 2)
     w = 2.0 * np.pi * f
     pe, pu = pe / (2.0 * np.pi), pu / (2.0 * np.pi)
-    bands = significant_bands(model, w, pe, pu)
+    relevant = None
+    if plant is not None:
+        relevant = np.abs(model.response) >= relevance * np.abs(plant.freqresp(model.w))
+    bands = significant_bands(model, w, pe, pu, relevant=relevant)
     return FrequencyLocalization(bands, xc, coh, model, w, pe)
