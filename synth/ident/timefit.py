@@ -713,11 +713,12 @@ def fit_structure(record: Record, structure: Structure | str, delay: str | float
         m = int(np.floor(d_start / dt + 1e-9))
         f = d_start - m * dt
         xi = theta_start / prob.scale
-        shifts, seen, b_start = 0, set(), b0
+        shifts, seen, b_start, iters = 0, set(), b0, 0
         while True:
             if fit_delay:
                 x0 = np.r_[xi, f, b_start]
                 xs, ssr, st_info = prob.solve(x0, prob.inputs(w, m), nonnegative_f=(m == 0))
+                iters += st_info["iterations"]
                 fx = float(xs[len(xi)])
                 seen.add(m)
                 move = int(np.floor(fx / dt))  # f left [0, dt): the delay is in another sample interval
@@ -728,6 +729,8 @@ def fit_structure(record: Record, structure: Structure | str, delay: str | float
             else:
                 fixed_f = d_start - m * dt
                 xs, ssr, st_info = prob.solve(np.r_[xi, b_start], prob.inputs(w, m, fixed_f))
+                iters += st_info["iterations"]
+            st_info["iterations"] = iters
             return xs, ssr, m, st_info, shifts
 
     xs, ssr, m, st_info, shifts = run(theta0, d0)

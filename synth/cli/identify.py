@@ -1,0 +1,145 @@
+"""``synth identify --data FILE ... --structure FORMULA``: fit a plant structure to a measured record."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+from typing import Any
+
+COMMAND = "identify"
+ORDER = 5
+HELP = "identify a plant structure from a step train or any input/output record"
+DESCRIPTION = """Identify a parametric plant from a measured record (CSV or MAT).
+
+A two-level input with several steps is a step train: the steps are found,
+aligned and averaged (SNR before and after is printed), then the structure is
+fitted to the average by simulation error (casadi + IPOPT) with an optional
+delay and an optional known sensor in series (the fit is F*H; F is reported).
+Any other record is fitted as it is. Prints each parameter with its standard
+error and 95 % interval and the fit percent; writes identify.json, fit.png
+(data, model, residuals) and train.png into --out (default
+reports/identify/<data file stem>/). Files synth did not write are never
+overwritten (use --force).
+
+example:
+  synth identify --x4-demo
+  synth identify --data run.csv --time t --input pwm --output speed \\
+      --structure "k*(s+z)/((s+p1)*(s+p2))" --delay fit --sensor "442/((s+45)*(s+9.7))"
+  synth identify --data 06_dc_step_5_15_00.mat --time Zeit --input Motorspannung \\
+      --output Geschwindigkeit --structure "K/(T1*s+1)^2" --delay fit --json dc.json
+
+--x4-demo uses a SYNTHETIC X-4 step train generated from the seed paper's model
+(not measured data; see synth.ident.x4_record).
+
+exit codes: 0 identified, 2 bad input"""
+
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--data", metavar="FILE", help="record: CSV with a header row, or MAT")
+    p.add_argument("--time", metavar="COL", help="time column (default: the first)")
+    p.add_argument("--input", metavar="COL", help="input column (default: the second)")
+    p.add_argument("--output", metavar="COL", help="output column (default: the third)")
+    p.add_argument("--input-unit", default="", metavar="UNIT", help="unit of the input, e.g. PWM or V")
+    p.add_argument("--output-unit", default="", metavar="UNIT", help="unit of the output, e.g. rad/s")
+    p.add_argument("--structure", metavar="FORMULA",
+                   help='plant structure; names other than s are parameters, e.g. "k*(s+z)/((s+p1)*(s+p2))"')
+    p.add_argument("--delay", metavar="fit|SECONDS",
+                   help="fit the delay or fix it (default: the formula's exp(-Td*s), else none)")
+    p.add_argument("--sensor", metavar="TF", help='known sensor in series, e.g. "442/((s+45)*(s+9.7))"')
+    p.add_argument("--average", choices=["auto", "cycle", "edge", "none"], default="auto",
+                   help="step-train averaging (default auto: average a two-level input with several steps)")
+    p.add_argument("--x4-demo", action="store_true",
+                   help="use the SYNTHETIC X-4 step train (generated on first use) with the paper's structure and sensor")
+    p.add_argument("--out", metavar="DIR", help="folder for identify.json and figures "
+                   "(default reports/identify/<data file stem>)")
+    p.add_argument("--json", metavar="FILE", help="also write the JSON to FILE ('-' for standard output)")
+    p.add_argument("--no-figures", action="store_true", help="skip the figures")
+    p.add_argument("--force", action="store_true", help="overwrite files synth did not write")
+    p.add_argument("--quiet", "-q", action="store_true", help="print nothing; use the exit code")
+
+
+def _demo_defaults(args: argparse.Namespace) -> None:
+    from synth.ident import x4_record as x4
+
+    args.data = args.data or str(x4.x4_step_train_path())
+    args.time = args.time or x4.COLUMNS[0]
+    args.input = args.input or x4.COLUMNS[1]
+    args.output = args.output or x4.COLUMNS[2]
+    args.input_unit = args.input_unit or "PWM"
+    args.output_unit = args.output_unit or "rad/s"
+    args.structure = args.structure or x4.STRUCTURE
+    args.sensor = args.sensor or x4.SENSOR
+    args.delay = args.delay or "fit"
+
+
+def run(args: argparse.Namespace) -> int:
+    from synth.data import load_record
+    from synth.errors import ModelError, SynthError
+    from synth.ident.structure import parse_structure
+    from synth.ident.timefit import identify
+    from synth.outputs import OutputDir, dump_json, write_json
+
+    if args.x4_demo:
+        _demo_defaults(args)
+    if not args.data:
+        raise SynthError("give the record, e.g. --data run.csv (or --x4-demo)", where="--data")
+    if not args.structure:
+        raise SynthError('give the plant structure, e.g. --structure "k/(s+p)"', where="--structure")
+    try:
+        structure = parse_structure(args.structure)
+    except ModelError as exc:
+        raise exc.located("--structure") from None
+    record = load_record(args.data, args.time, args.input, args.output,
+                         input_unit=args.input_unit, output_unit=args.output_unit)
+    try:
+        result = identify(record, structure, args.delay, args.sensor, args.average)
+    except ModelError as exc:
+        where = "--delay" if "delay" in exc.message and "structure" not in exc.message else None
+        raise (exc.located(where) if where else exc) from None
+    payload: dict[str, Any] = {"data": str(args.data), **result.to_dict()}
+    if args.x4_demo:
+        payload["synthetic"] = "SYNTHETIC record generated from the seed paper's model (synth.ident.x4_record)"
+    out_dir = Path(args.out) if args.out else Path("reports") / "identify" / Path(args.data).stem
+    folder = OutputDir(out_dir, args.force)
+    json_path = folder.claim("identify.json")
+    figures: list[Path] = []
+    if not args.no_figures:
+        from synth.ident.step_figures import fit_figure, train_figure
+
+        figures.append(fit_figure(result.fit, folder.claim("fit.png")))
+        figures.append(train_figure(record, folder.claim("train.png")))
+    json_path.write_text(dump_json(payload), encoding="utf-8")
+    folder.commit()
+    if args.json == "-":
+        sys.stdout.write(dump_json(payload))
+    elif args.json:
+        write_json(args.json, payload, force=args.force)
+    if not args.quiet and args.json != "-":
+        _print(result, args, json_path, figures)
+    return 0
+
+
+def _print(result: Any, args: argparse.Namespace, json_path: Path, figures: list[Path]) -> None:
+    from synth.cli._table import table
+
+    fit = result.fit
+    rows = []
+    for name, value in fit.parameters.items():
+        lo, hi = fit.ci95[name]
+        fixed = name not in fit.names
+        rows.append([name, f"{value:.6g}", "fixed" if fixed else f"{fit.std[name]:.3g}",
+                     "-" if fixed else f"[{lo:.6g}, {hi:.6g}]"])
+    rows.append(["offset", f"{fit.offset:.6g}", f"{fit.offset_std:.3g}", ""])
+    print(f"{args.data}{' (SYNTHETIC)' if args.x4_demo else ''}: {fit.structure.formula}"
+          f"{', sensor ' + fit.sensor.to_string() if fit.sensor is not None else ''}")
+    avg = result.average
+    if avg is not None:
+        print(f"averaged {avg.count} {avg.mode}s ({avg.up} up, {avg.down} down steps, {avg.dropped} dropped): "
+              f"SNR {avg.snr_before_db:.1f} dB -> {avg.snr_after_db:.1f} dB "
+              f"(noise std {avg.noise_std_before:.3g} -> {avg.noise_std_after:.3g}, step {avg.step_size:.4g})")
+    print(table(["parameter", "value", "std", "95 % interval"], rows))
+    print(f"fit {fit.fit_percent:.2f} %, residual std {fit.residual_std:.3g}, "
+          f"IPOPT {fit.solver.get('status')} ({fit.solver.get('iterations')} iterations)")
+    print(f"plant: {fit.plant.to_string()}")
+    print(f"\nresult: {json_path}" + "".join(f"\nfigure: {p}" for p in figures))
