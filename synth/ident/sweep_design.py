@@ -1,0 +1,179 @@
+"""Frequency-sweep test design: from the frequency range to periods, run length and an input signal.
+
+The recipe (the NASA Bell 214ST sweep report, sections 2 and 6.1)
+------------------------------------------------------------------
+- The lowest frequency sets the longest period, ``T_max = 2 pi / w_min``: the
+  Bell 214 roll sweeps used ``w_min = 0.4 rad/s``, so ``T_max = 15.7 s`` (the
+  report rounds to 16 s; 20 s in heave). The highest, ``f_max = w_max / 2 pi``
+  (about 2 Hz there, kept below the 12 rad/s rotor-pylon mode).
+- Each run starts with two low-frequency cycles of period ``T_max`` and then
+  increases the frequency gradually (no jump to high frequency) up to ``w_max``;
+  it starts and ends at trim.
+- A run lasts 90 s (experience on the XV-15: an even spread of frequency content
+  between the low- and high-frequency cycles); 3 runs are flown per axis and the
+  best 2 are concatenated for the spectral analysis.
+
+What this module adds (design choices, not the report's): the run length is
+``max(90 s, 4.5 T_max)``: the report's two cases have 90/15.7 = 5.7 and 90/20 =
+4.5 periods of ``T_max`` per run; the spectral analysis needs windows of
+``2 T_max`` (:func:`synth.ident.spectra.required_window`), which fit at least
+three times, overlapped by half, into such a run. The generated input is the
+exponential sweep ``w(t) = w_min + C2 (w_max - w_min)(exp(C1 t/T) - 1)`` with
+``C1 = 4``, ``C2 = 1 / (exp(C1) - 1)`` after the two ``T_max`` cycles, with a
+raised-cosine fade-in and fade-out.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from synth.errors import DataError
+from synth.ident.spectra import default_windows
+
+#: run length the report recommends [s]
+SEED_RUN_LENGTH = 90.0
+#: least run length in periods of T_max (the report's heave sweeps: 90 s / 20 s)
+MIN_PERIODS_PER_RUN = 4.5
+
+
+@dataclass(frozen=True)
+class SweepDesign:
+    """A frequency-sweep test plan.
+
+    Attributes
+    ----------
+    w_min, w_max : float
+        Frequency range [rad/s].
+    t_max : float
+        Longest period ``2 pi / w_min`` [s].
+    f_max : float
+        Highest input frequency [Hz].
+    run_length : float
+        Recommended length of one run [s].
+    runs_flown, runs_used : int
+        Runs to record and to concatenate (3 and 2 in the report).
+    low_cycles : int
+        Cycles at ``T_max`` at the start of each run.
+    sample_rate : float
+        Suggested sample rate [Hz]: at least 25 samples per period of ``w_max``.
+    windows : tuple of float
+        Composite analysis windows [s] (:func:`synth.ident.spectra.default_windows`).
+
+    Examples
+    --------
+    >>> d = design_sweep(0.4, 12.0)
+    >>> round(d.t_max, 1), d.run_length, d.runs_flown, d.runs_used, round(d.f_max, 2)
+    (15.7, 90.0, 3, 2, 1.91)
+    """
+
+    w_min: float
+    w_max: float
+    t_max: float
+    f_max: float
+    run_length: float
+    runs_flown: int
+    runs_used: int
+    low_cycles: int
+    sample_rate: float
+    windows: tuple[float, ...]
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready plan with units in the keys.
+
+        Examples
+        --------
+        >>> design_sweep(0.4, 12.0).to_dict()["run_length_s"]
+        90.0
+        """
+        return {"w_min_rad_s": self.w_min, "w_max_rad_s": self.w_max, "t_max_s": self.t_max,
+                "f_max_hz": self.f_max, "run_length_s": self.run_length, "runs_flown": self.runs_flown,
+                "runs_used": self.runs_used, "low_cycles": self.low_cycles,
+                "sample_rate_hz": self.sample_rate, "windows_s": list(self.windows)}
+
+    def signal(self, amplitude: float = 1.0, sample_rate: float | None = None, fade: float | None = None,
+               c1: float = 4.0) -> tuple[np.ndarray, np.ndarray]:
+        """Generate one run of the sweep input.
+
+        Parameters
+        ----------
+        amplitude : float
+            Peak input amplitude (input units).
+        sample_rate : float, optional
+            [Hz]; default :attr:`sample_rate`.
+        fade : float, optional
+            Raised-cosine fade-in and fade-out length [s]; default a quarter of ``T_max``.
+        c1 : float
+            Exponential rate of the sweep (4 in the common recipe; larger dwells
+            longer at low frequency).
+
+        Returns
+        -------
+        t, u : numpy.ndarray
+            Time [s] from 0 to :attr:`run_length`, input samples.
+
+        Examples
+        --------
+        >>> t, u = design_sweep(0.4, 12.0).signal(amplitude=1.5, sample_rate=50)
+        >>> float(t[-1]), round(float(abs(u).max()), 2), float(u[0]), round(abs(float(u[-1])), 12)
+        (90.0, 1.5, 0.0, 0.0)
+        """
+        fs = float(sample_rate or self.sample_rate)
+        if not fs > 2.0 * self.f_max:
+            raise DataError(f"sample rate {fs:g} Hz must exceed twice f_max = {self.f_max:.3g} Hz")
+        if not amplitude > 0:
+            raise DataError(f"amplitude must be positive, got {amplitude:g}")
+        t = np.arange(round(self.run_length * fs) + 1) / fs
+        t_low = self.low_cycles * self.t_max
+        sweep = max(self.run_length - t_low, 1e-9)
+        c2 = 1.0 / np.expm1(c1)
+        tau = np.clip(t - t_low, 0.0, None)
+        dw = self.w_max - self.w_min
+        phase = self.w_min * t + c2 * dw * (sweep / c1 * np.expm1(c1 * tau / sweep) - tau)
+        u = np.sin(phase)
+        fade = 0.25 * self.t_max if fade is None else float(fade)
+        if fade > 0:
+            ramp = np.clip(np.minimum(t, t[-1] - t) / fade, 0.0, 1.0)
+            u = u * 0.5 * (1.0 - np.cos(np.pi * ramp))
+        return t, amplitude * u / np.max(np.abs(u))
+
+
+def design_sweep(w_min: float, w_max: float, runs_used: int = 2) -> SweepDesign:
+    """Plan a frequency sweep for the range ``w_min`` .. ``w_max`` [rad/s] (the report's recipe).
+
+    Parameters
+    ----------
+    w_min, w_max : float
+        Lowest and highest frequency of interest [rad/s].
+    runs_used : int
+        Runs to concatenate (2 in the report); one more is flown as a spare.
+
+    Returns
+    -------
+    SweepDesign
+
+    Raises
+    ------
+    DataError
+        If the range is not ``0 < w_min < w_max``.
+
+    Examples
+    --------
+    >>> d = design_sweep(2 * np.pi / 20, 9.4)     # heave: T_max = 20 s
+    >>> d.t_max, d.run_length
+    (20.0, 90.0)
+    >>> design_sweep(0.1, 5).run_length          # T_max = 62.8 s: 4.5 periods
+    282.8
+    """
+    if not (np.isfinite(w_min) and np.isfinite(w_max) and 0 < w_min < w_max):
+        raise DataError(f"need 0 < w_min < w_max in rad/s, got w_min = {w_min!r}, w_max = {w_max!r}")
+    if runs_used < 1:
+        raise DataError(f"runs_used must be at least 1, got {runs_used}")
+    t_max = 2.0 * np.pi / w_min
+    run = max(SEED_RUN_LENGTH, float(np.ceil(MIN_PERIODS_PER_RUN * t_max * 10.0) / 10.0))
+    f_max = w_max / (2.0 * np.pi)
+    rate = float(np.ceil(25.0 * f_max))
+    return SweepDesign(float(w_min), float(w_max), float(round(t_max, 12)), f_max, run, runs_used + 1, runs_used, 2,
+                       rate, default_windows(w_min))
