@@ -3,7 +3,8 @@
 Every name other than ``s`` (the Laplace variable) and ``exp`` is a parameter.
 The grammar is the one of :func:`synth.tfparse.parse_tf` (numbers, ``+ - * /``,
 integer powers ``^`` or ``**``, parentheses, implicit multiplication such as
-``2s``, ``k(s+z)`` or ``(s+a)(s+b)``) with parameter names added, and an
+``2s``, ``2k`` or ``(s+a)(s+b)``; a name directly before a parenthesis is a
+function call, so write ``k*(s+z)``) with parameter names added, and an
 optional delay factor ``exp(-Td*s)`` (a parameter) or ``exp(-0.02*s)`` (a
 number) multiplying the rational part.
 
@@ -49,7 +50,10 @@ def _tokenize(text: str) -> str:
             pkind, pvalue = tokens[i - 1]
             ends_operand = pkind in ("num", "name") or pvalue == ")"
             starts_operand = kind in ("num", "name") or value == "("
-            if ends_operand and starts_operand and not (pkind == "name" and pvalue == "exp" and value == "("):
+            if pkind == "name" and pvalue != "exp" and value == "(":
+                raise ModelError(f"structure {text!r}: unknown function {pvalue!r}; only exp(-tau*s) is a function, "
+                                 f"write {pvalue}*(...) for a product")
+            if ends_operand and starts_operand and not (pkind == "name" and value == "("):
                 out.append("*")
         out.append(value)
     return "".join(out)
