@@ -461,16 +461,23 @@ def lowest_frequency(records: Record | Sequence[Record], overlap: float = 0.5) -
     return float(hi)
 
 
-def default_windows(w_min: float, count: int = 5, ratio: float = 10.0) -> tuple[float, ...]:
-    """Composite window lengths [s]: ``count`` lengths from ``2 * 2 pi / w_min`` down by ``ratio``.
+def default_windows(w_min: float, count: int = 5, ratio: float = 10.0, longest: float | None = None) -> tuple[float, ...]:
+    """Composite window lengths [s]: ``count`` lengths from ``longest`` down to ``2 * 2 pi / w_min / ratio``.
+
+    ``longest`` defaults to ``2 * 2 pi / w_min``; :func:`frequency_response`
+    passes the longest window that fits :data:`MIN_SEGMENTS` times into the runs
+    (less leakage bias at the lowest frequencies).
 
     Examples
     --------
     >>> [round(x, 2) for x in default_windows(0.4)]
     [31.42, 17.67, 9.93, 5.59, 3.14]
+    >>> [round(x, 1) for x in default_windows(0.4, longest=60.0)]
+    [60.0, 28.7, 13.7, 6.6, 3.1]
     """
-    longest = required_window(w_min)
-    return tuple(float(x) for x in np.geomspace(longest, longest / ratio, count))
+    shortest = required_window(w_min) / ratio
+    top = max(required_window(w_min), longest or 0.0)
+    return tuple(float(x) for x in np.geomspace(top, shortest, count))
 
 
 def log_grid(w_min: float, w_max: float, points_per_decade: int = 40) -> np.ndarray:
@@ -505,8 +512,10 @@ def frequency_response(
         Frequency range [rad/s]; defaults: the lowest frequency the runs support
         (:func:`lowest_frequency`) and a fifth of the Nyquist frequency.
     windows : sequence of float, optional
-        Window lengths [s]; default :func:`default_windows` (5 lengths, the longest
-        ``2 * 2 pi / w_min``). One length gives a single-window estimate.
+        Window lengths [s]; default :func:`default_windows`: 5 lengths from the
+        longest that fits :data:`MIN_SEGMENTS` times into the runs (at least
+        ``2 * 2 pi / w_min``) down to a tenth of ``2 * 2 pi / w_min``. One length
+        gives a single-window estimate.
     overlap : float
         Segment overlap fraction (0 <= overlap < 1).
     points_per_decade : int
@@ -536,7 +545,7 @@ def frequency_response(
     >>> t, u = design_sweep(0.4, 10).signal(sample_rate=50)
     >>> r = frequency_response(record_from_arrays(t, u, simulate_plant(G, t, u, "zero")), 0.4, 10)
     >>> k = np.argmin(abs(r.w - 2)); round(float(abs(r.H[k])), 2), round(float(abs(G.freqresp(r.w[k]))), 2)
-    (1.76, 1.77)
+    (1.79, 1.77)
     """
     runs = _as_runs(records)
     fs = runs[0].fs
@@ -553,7 +562,10 @@ def frequency_response(
         raise DataError(f"w_max = {w_max:g} rad/s is above the Nyquist frequency {nyquist:.4g} rad/s "
                         f"(sample rate {fs:g} Hz)")
     check_length(runs, w_min, overlap)
-    lengths = tuple(windows) if windows is not None else default_windows(w_min)
+    if windows is None:
+        lengths = default_windows(w_min, longest=required_window(lowest_frequency(runs, overlap)) * (1 - 1e-9))
+    else:
+        lengths = tuple(windows)
     grid = log_grid(w_min, w_max, points_per_decade)
     longest_run = max(r.n for r in runs)
     results = []
