@@ -90,18 +90,18 @@ def x4_step_train(seed: int = SEED, noise_std: float = NOISE_STD, periods: int =
                               source=f"SYNTHETIC X-4 step train (seed {seed})", names=COLUMNS)
 
 
-def write_x4_csv(path: str | Path, seed: int = SEED) -> Path:
+def write_x4_csv(path: str | Path, seed: int = SEED, periods: int = PERIODS) -> Path:
     """Write the SYNTHETIC record as CSV (header ``time_s,pwm_SYNTHETIC,speed_SYNTHETIC``).
 
     Examples
     --------
     >>> import tempfile, pathlib
-    >>> p = write_x4_csv(pathlib.Path(tempfile.mkdtemp()) / "x4.csv")
-    >>> p.read_text().splitlines()[0]
-    'time_s,pwm_SYNTHETIC,speed_SYNTHETIC'
+    >>> p = write_x4_csv(pathlib.Path(tempfile.mkdtemp()) / "x4.csv", periods=1)
+    >>> p.read_text().splitlines()[:2]
+    ['time_s,pwm_SYNTHETIC,speed_SYNTHETIC', '0.000,175,820.2018']
     """
     path = Path(path)
-    r = x4_step_train(seed)
+    r = x4_step_train(seed, periods=periods)
     path.parent.mkdir(parents=True, exist_ok=True)
     lines = [",".join(COLUMNS)]
     lines += [f"{a:.3f},{b:.0f},{c:.4f}" for a, b, c in zip(r.t, r.u, r.y)]
