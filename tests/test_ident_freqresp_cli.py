@@ -1,0 +1,82 @@
+"""``synth freqresp``: JSON keys, figures, fit and verification, one-line errors with exit 2."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from synth.ident.simulate import simulate_plant
+from synth.ident.sweep_design import design_sweep
+from synth.plant import Plant
+
+RATE = Plant.from_string("31.6*s/((s+0.49)*(s+2.30))", delay=0.041)
+ATT = Plant.from_string("31.6/((s+0.49)*(s+2.30))", delay=0.041)
+
+
+@pytest.fixture(scope="module")
+def files(tmp_path_factory):
+    d = tmp_path_factory.mktemp("sweeps")
+    rng = np.random.default_rng(5)
+    paths = []
+    for k in range(2):
+        t, u = design_sweep(0.4, 12.0).signal(1.0, 50.0)
+        y = simulate_plant(RATE, t, u, "zero")
+        y = y + 0.05 * np.std(y) * rng.standard_normal(t.size)
+        p = d / f"run{k}.csv"
+        np.savetxt(p, np.c_[t, u, y], delimiter=",", header="t,lat,p", comments="")
+        paths.append(str(p))
+    t = np.arange(0, 20, 0.02)
+    u = np.where(t > 2, 1.0, 0.0)
+    step = d / "step.csv"
+    np.savetxt(step, np.c_[t, u, simulate_plant(ATT, t, u)], delimiter=",", header="t,lat,p", comments="")
+    short = d / "short.csv"
+    np.savetxt(short, np.c_[t, np.sin(t * t / 4), np.cos(t)], delimiter=",", header="t,lat,p", comments="")
+    return {"runs": paths, "step": str(step), "short": str(short), "dir": d}
+
+
+def test_json_keys_fit_and_verification(run_cli, files, tmp_path):
+    out = tmp_path / "r.json"
+    res = run_cli("freqresp", "--data", files["runs"][0], "--data", files["runs"][1], "--time", "t", "--input", "lat",
+                  "--output", "p", "--wmin", "0.4", "--wmax", "12", "--rate-to-attitude", "--fit", "0/2",
+                  "--verify", files["step"], "--json", str(out), "--out", str(tmp_path / "rep"))
+    assert res.code == 0, res.err
+    data = json.loads(out.read_text())
+    n = len(data["w"])
+    for key in ("magnitude_db", "phase_deg", "coherence", "random_error"):
+        assert len(data[key]) == n
+    assert data["w"][0] == pytest.approx(0.4) and data["w"][-1] == pytest.approx(12.0)
+    w = np.array(data["w"])
+    k = np.argmin(abs(w - 2.0))
+    assert data["magnitude_db"][k] == pytest.approx(20 * np.log10(abs(ATT.freqresp(w[k]))), abs=0.5)
+    assert data["coherent_band"]["w_min"] == pytest.approx(0.4) and data["coherent_band"]["threshold"] == 0.8
+    fit = data["fit"]
+    assert set(fit["parameters"]) == {"b0", "a1", "a0", "delay"} and fit["J"] > 0
+    assert fit["parameters"]["b0"] == pytest.approx(31.6, rel=0.05)
+    assert data["verification"]["fit_percent"] > 90
+    assert (tmp_path / "rep" / "bode.png").exists() and (tmp_path / "rep" / "verify.png").exists()
+    assert "coherent band" in res.out and "J = " in res.out
+
+
+def test_bad_input_exits_2_with_one_line(run_cli, files):
+    cases = [
+        (("--data", files["short"], "--wmin", "0.4"), "one run of"),
+        (("--data", files["runs"][0], "--output", "q"), "output column 'q' not found"),
+        (("--data", files["runs"][0], "--wmin", "0.4", "--fit", "k/(s+"), "--fit: cannot parse structure"),
+        (("--data", files["runs"][0], "--wmin", "0.4", "--verify", files["step"]), "--verify: needs --fit"),
+        (("--data", files["runs"][0], "--wmin", "0.4", "--fit", "0/2", "--delay", "soon"), "--delay"),
+        (("--data", str(files["dir"] / "missing.csv")), "file not found"),
+    ]
+    for args, message in cases:
+        res = run_cli("freqresp", *args)
+        assert res.code == 2, (args, res.out, res.err)
+        assert message in res.err and len(res.err.strip().splitlines()) == 1, res.err
+        assert "Traceback" not in res.err
+
+
+def test_does_not_overwrite_user_file(run_cli, files, tmp_path):
+    mine = tmp_path / "mine.json"
+    mine.write_text("my notes")
+    res = run_cli("freqresp", "--data", files["runs"][0], "--wmin", "0.4", "--json", str(mine))
+    assert res.code == 2 and "not overwriting" in res.err and mine.read_text() == "my notes"
