@@ -15,6 +15,7 @@ from synth.ident.spectra import (
     frequency_response,
     random_error,
     rate_to_attitude,
+    required_window,
 )
 from synth.ident.sweep_design import design_sweep
 from synth.plant import Plant
@@ -60,7 +61,7 @@ def test_composite_beats_single_window_scipy_on_noisy_case():
         r = frequency_response(recs, 0.4, 12.0)
         m = r.band.contains(r.w)
         H0 = PLANT.freqresp(r.w[m])
-        n = round(r.windows[0] * FS)
+        n = round(required_window(0.4) * FS)         # the single window w_min needs: 31.4 s
         pxy = sum(csd(x.u, x.y, fs=FS, nperseg=n, detrend="linear")[1] for x in recs)
         f, _ = welch(recs[0].u, fs=FS, nperseg=n)
         pxx = sum(welch(x.u, fs=FS, nperseg=n, detrend="linear")[1] for x in recs)
@@ -69,8 +70,8 @@ def test_composite_beats_single_window_scipy_on_noisy_case():
         Hs_grid = np.interp(r.w[m], w, Hs.real) + 1j * np.interp(r.w[m], w, Hs.imag)
         e_comp = np.sqrt(np.mean(np.abs(r.H[m] / H0 - 1) ** 2))
         e_scipy = np.sqrt(np.mean(np.abs(Hs_grid / H0 - 1) ** 2))
-        assert e_comp < 0.1
-        assert e_comp < 0.5 * e_scipy
+        assert e_comp < 0.06                          # measured 0.039 and 0.046 (benchmarks/freqresp.py)
+        assert e_comp < 0.8 * e_scipy
 
 
 def test_random_error_formula_and_noise_scaling():
