@@ -17,6 +17,11 @@ closed_loop_stability
     Exact closed-loop stability with a delay.
 write_design_report
     ``result.json``, ``report.html`` and figures.
+load_record, Record
+    Measured records (CSV, MAT) with one-line errors naming file and column.
+identify
+    Identify a structure such as ``k*(s+z)/((s+p1)*(s+p2))`` from a record
+    (step trains are averaged first); more in :mod:`synth.ident`.
 
 Examples
 --------
@@ -28,8 +33,16 @@ True
 
 __version__ = "0.1.0"
 
+import os as _os
+
+# synth's matrices are small (a few states, a few parameters): threaded BLAS only adds overhead, and on a
+# loaded 2-core machine its spinning threads made 3x3 matrix exponentials 1000x slower. A user's own
+# setting wins; this takes effect only if numpy was not imported before synth.
+_os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+
 from synth.check import CheckResult, check
 from synth.controllers import Controller
+from synth.data import Record, load_record
 from synth.design import DesignResult, design
 from synth.errors import DataError, ModelError, SpecError, SynthError
 from synth.gainset import GainSet, ScalarFamily, feasible_gain_set
@@ -49,6 +62,26 @@ def write_design_report(*args, **kwargs):
     return _write(*args, **kwargs)
 
 
+def identify(*args, **kwargs):
+    """Identify a structure from a record (see :func:`synth.ident.timefit.identify`).
+
+    Imported on first use: casadi is not loaded by ``import synth``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from synth.ident.simulate import simulate_plant
+    >>> from synth.data import record_from_arrays
+    >>> t = np.arange(0, 3, 0.01); u = np.where(t >= 0.5, 1.0, 0.0)
+    >>> y = simulate_plant(Plant.from_string("2/(s+3)"), t, u)
+    >>> identify(record_from_arrays(t, u, y), "k/(s+p)", average="none").plant.to_string(4)
+    '2/(s+3)'
+    """
+    from synth.ident.timefit import identify as _identify
+
+    return _identify(*args, **kwargs)
+
+
 __all__ = [
     "CheckResult",
     "Controller",
@@ -58,6 +91,7 @@ __all__ = [
     "Loop",
     "ModelError",
     "Plant",
+    "Record",
     "ScalarFamily",
     "Signal",
     "Spec",
@@ -68,6 +102,8 @@ __all__ = [
     "closed_loop_stability",
     "design",
     "feasible_gain_set",
+    "identify",
+    "load_record",
     "load_spec",
     "parse_spec",
     "write_design_report",

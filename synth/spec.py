@@ -22,6 +22,7 @@ from pydantic import (
     ConfigDict,
     Field,
     NonNegativeFloat,
+    PrivateAttr,
     ValidationError,
     ValidationInfo,
     field_validator,
@@ -97,15 +98,86 @@ class VariantSpec(_Model):
         return Plant(base.num, base.den, base.delay, nominal.input, nominal.output, self.label)
 
 
-class PlantSpec(_Model):
-    """A plant given as a transfer-function string, with an optional extra delay and variants."""
+class IdentifySpec(_Model):
+    """Identify the plant from a measured record (``plant: {identify: {...}}``).
 
-    tf: str
+    ``data`` is a CSV or MAT file (relative to the spec file) or ``builtin:x4_step_train``
+    (the SYNTHETIC X-4 step train); ``structure`` a formula such as
+    ``k*(s+z)/((s+p1)*(s+p2))``; ``delay`` is ``fit`` or a value in seconds;
+    ``sensor`` a known sensor transfer function in series (divided out);
+    ``in_loop_delay`` says whether the identified delay is inside the control
+    loop (the rotor paper does not say); ``uncertainty`` makes the requirements
+    hold on the plants at the ends of the parameter confidence ellipsoid's axes.
+    """
+
+    data: str
+    time: str | None = None
+    input: str | None = None
+    output: str | None = None
+    structure: str
+    delay: Union[float, str] = "fit"
+    sensor: str | None = None
+    average: str = "auto"
+    in_loop_delay: bool = True
+    confidence: float = Field(default=0.95, gt=0, lt=1)
+    uncertainty_variants: bool = True
+
+    @field_validator("structure")
+    @classmethod
+    def _formula(cls, text: str) -> str:
+        from synth.ident.structure import parse_structure
+
+        try:
+            parse_structure(text)
+        except ModelError as exc:
+            raise ValueError(exc.message) from None
+        return text
+
+    @field_validator("delay")
+    @classmethod
+    def _delay(cls, value: float | str) -> float | str:
+        if isinstance(value, str) and value != "fit":
+            raise ValueError(f"delay must be 'fit' or a number of seconds >= 0, got {value!r}")
+        if not isinstance(value, str) and (not np.isfinite(value) or value < 0):
+            raise ValueError(f"delay must be 'fit' or a number of seconds >= 0, got {value!r}")
+        return value
+
+    @field_validator("sensor")
+    @classmethod
+    def _sensor(cls, text: str | None) -> str | None:
+        if text is not None:
+            try:
+                Plant.from_string(text)
+            except ModelError as exc:
+                raise ValueError(exc.message) from None
+        return text
+
+    @field_validator("average")
+    @classmethod
+    def _average(cls, value: str) -> str:
+        if value not in ("auto", "cycle", "edge", "none"):
+            raise ValueError(f"average must be one of auto, cycle, edge, none, got {value!r}")
+        return value
+
+    def settings(self) -> Any:
+        """The :class:`synth.ident.from_spec.IdentifySettings` of this block."""
+        from synth.ident.from_spec import IdentifySettings
+
+        return IdentifySettings(self.data, self.time, self.input, self.output, self.structure, self.delay,
+                                self.sensor, self.average, self.confidence, self.uncertainty_variants)
+
+
+class PlantSpec(_Model):
+    """A plant given as a transfer-function string (or identified from data), with an extra delay and variants."""
+
+    tf: str | None = None
+    identify: IdentifySpec | None = None
     delay: NonNegativeFloat = 0.0
     input: SignalSpec = SignalSpec(name="u")
     output: SignalSpec = SignalSpec(name="y")
     label: str = "nominal"
     variants: list[VariantSpec] = Field(default_factory=list)
+    _base: Path | None = PrivateAttr(default=None)
 
     @field_validator("variants")
     @classmethod
@@ -118,24 +190,55 @@ class PlantSpec(_Model):
 
     @field_validator("tf")
     @classmethod
-    def _parses(cls, text: str) -> str:
+    def _parses(cls, text: str | None) -> str | None:
+        if text is None:
+            return text
         try:
             Plant.from_string(text)
         except ModelError as exc:
             raise ValueError(exc.message) from None
         return text
 
+    @model_validator(mode="after")
+    def _one_source(self) -> PlantSpec:
+        if (self.tf is None) == (self.identify is None):
+            raise ValueError("give exactly one of 'tf' (a transfer function) or 'identify' (a record to fit)")
+        return self
+
+    def _signals(self) -> tuple[Signal, Signal]:
+        return Signal(self.input.name, self.input.unit), Signal(self.output.name, self.output.unit)
+
+    def identification(self) -> Any | None:
+        """The :class:`synth.ident.timefit.IdentifyResult` of an ``identify:`` plant (None for ``tf:``)."""
+        if self.identify is None:
+            return None
+        from synth.ident.from_spec import identify_plant
+
+        return identify_plant(self.identify.settings(), self._base, *self._signals())
+
+    def _loop_delay(self, identified_delay: float) -> float:
+        assert self.identify is not None
+        return (identified_delay if self.identify.in_loop_delay else 0.0) + self.delay
+
     def build(self) -> Plant:
         """The nominal :class:`~synth.plant.Plant` this entry describes."""
-        return Plant.from_string(
-            self.tf, self.delay, Signal(self.input.name, self.input.unit),
-            Signal(self.output.name, self.output.unit), self.label,
-        )
+        inp, out = self._signals()
+        if self.identify is not None:
+            fitted = self.identification().plant
+            return Plant(fitted.num, fitted.den, self._loop_delay(fitted.delay), inp, out, self.label)
+        assert self.tf is not None
+        return Plant.from_string(self.tf, self.delay, inp, out, self.label)
 
     def build_all(self) -> list[Plant]:
-        """The nominal plant followed by every variant."""
+        """The nominal plant, the identification's uncertainty plants (if any), then every variant."""
         nominal = self.build()
-        return [nominal] + [v.build(nominal) for v in self.variants]
+        extra: list[Plant] = []
+        if self.identify is not None and self.identify.uncertainty_variants:
+            from synth.ident.from_spec import uncertainty_plants
+
+            for p in uncertainty_plants(self.identification(), self.identify.confidence, *self._signals()):
+                extra.append(Plant(p.num, p.den, self._loop_delay(p.delay), p.input, p.output, p.label))
+        return [nominal, *extra] + [v.build(nominal) for v in self.variants]
 
 
 class ControllerSpec(_Model):
@@ -603,9 +706,30 @@ def parse_spec(text: str, source: str = "<spec>") -> Spec:
     if not isinstance(data, dict):
         raise SpecError("the spec must be a mapping of keys (name, plant, controller, ...)", where=source)
     try:
-        return Spec.model_validate_json(json.dumps(data, default=str), strict=True)
+        spec = Spec.model_validate_json(json.dumps(data, default=str), strict=True)
     except ValidationError as exc:
         raise spec_error(exc, source, root, data) from None
+    if spec.plant.identify is not None:
+        _check_identify_data(spec, source, root)
+    return spec
+
+
+def _check_identify_data(spec: Spec, source: str, root: yaml.Node | None) -> None:
+    """Resolve ``plant.identify.data`` against the spec file's folder; a missing file is a spec error."""
+    from synth.ident.from_spec import resolve_data
+
+    base = Path(source).parent if source != "<spec>" else None
+    spec.plant._base = base
+    try:
+        path = resolve_data(spec.plant.identify.data, base)
+    except ModelError as exc:
+        path, problem = None, exc.message
+    else:
+        problem = None if path.is_file() else f"data file {str(path)!r} not found"
+    if problem:
+        loc = ("plant", "identify", "data")
+        line = _line_of(root, loc)
+        raise SpecError(problem, where=f"{source}:{line}: {_key_path(loc)}" if line else f"{source}: {_key_path(loc)}")
 
 
 def load_spec(path: str | Path) -> Spec:

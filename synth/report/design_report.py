@@ -46,6 +46,15 @@ def report_data(spec: Spec, result: DesignResult) -> dict[str, Any]:
     data = result.to_dict()
     data["analysis"] = compare(spec, shown)
     data["description"] = spec.description
+    ident = spec.plant.identification()
+    if ident is not None:  # plant identified from a record (issue 4): parameters, uncertainty, fit
+        fit = ident.to_dict()
+        data["identification"] = {
+            key: fit[key] for key in ("structure", "parameters", "std", "ci95", "fit_percent", "tf", "delay",
+                                      "delay_fitted", "offset", "residual_std", "samples", "record", "averaging")
+        } | {"in_loop_delay": spec.plant.identify.in_loop_delay, "confidence": spec.plant.identify.confidence,
+             "uncertainty_plants": [p.label for p in spec.plants()[1:] if p.label.startswith("identified")],
+             "sensor": spec.plant.identify.sensor}
     if spec.simulation is not None:  # nonlinear step check (issue 5): logic in synth.sim.report
         from synth.sim.report import simulation_report
 
@@ -174,7 +183,7 @@ def write_design_report(spec: Spec, result: DesignResult, out_dir: str | Path, *
         slew=data["analysis"].get("slew_rate", []),
         delay_table=[{**r, "critical_gain": float(r["critical_gain"])} for r in delay_table or []],
         marks=marks, certificate=data.get("certificate"), ref_line=ref_line, sim=data.get("simulation"),
-        synthesis=data.get("synthesis"), diagnosis=data.get("diagnosis"),
+        synthesis=data.get("synthesis"), diagnosis=data.get("diagnosis"), ident=data.get("identification"),
         f=lambda x, d=4: fmt(None if x is None else float(x), d),
     )
     html_path = out.claim("report.html")
