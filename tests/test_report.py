@@ -27,7 +27,8 @@ def _compare(a, b, path="$"):
         assert a == b, f"{path}: {a!r} != {b!r}"
 
 
-@pytest.mark.parametrize("name", ["x4_rotor", "x4_rotor_strict", "x4_rotor_pi", "x4_rotor_robust", "dcmotor_leadlag"])
+@pytest.mark.parametrize("name", ["x4_rotor", "x4_rotor_strict", "x4_rotor_pi", "x4_rotor_robust", "dcmotor_leadlag",
+                                  "x4_rotor_from_data"])
 def test_committed_report_regenerates(name, tmp_path):
     committed = Path("reports") / name / "result.json"
     assert committed.exists(), f"run `synth design specs/{name}.yaml` and commit reports/{name}"
