@@ -1,0 +1,612 @@
+"""The library of effects a linear model may be missing, each a nested augmentation of it.
+
+An effect adds one mechanism to the nominal linear model ``G`` (rational
+transfer function times an exact delay) and is switched off by a parameter
+value, so the nominal model is nested in every augmented one:
+
+=====================  ========  ===========================================================  ==============
+effect                 side      augmented model                                             parameters
+=====================  ========  ===========================================================  ==============
+``delay``              linear    ``G exp(-d s)``                                             ``delay``
+``lag``                linear    ``G / (tau s + 1)``, actuator or sensor placement            ``tau``
+``resonance``          linear    ``G wn^2 / (s^2 + 2 zeta wn s + wn^2)``                      ``wn, zeta``
+``rate_limit``         input     :class:`synth.sim.blocks.RateLimit` before ``G``             ``rate``
+``saturation``         input     :class:`synth.sim.blocks.Saturation` before ``G``            ``lower, upper``
+``deadzone``           input     :class:`synth.sim.blocks.DeadZone` before ``G``              ``width``
+``backlash``           input     :class:`synth.sim.blocks.Backlash` before ``G``              ``width``
+``quantization``       input     :class:`synth.sim.blocks.Quantizer` before ``G``             ``step``
+``supply_sag``         input     ``u - a u max(0, u - u_f)``, ``tau u_f' + u_f = u``          ``sag, tau``
+``static_nonlinearity``input     ``u + a2 x^2 + a3 x^3``, ``x = (u - c)/h``                   ``a2, a3``
+``drift``              output    ``y + d1 (t - t0) + d2 (t - t0)^2``                          ``slope, curvature``
+=====================  ========  ===========================================================  ==============
+
+The input-side blocks run on the measured command with the block equations of
+:mod:`synth.sim.blocks` (supply sag is that block with a 1 V battery, a 1 ohm
+internal resistance and no static current, so ``sag`` is the relative voltage
+drop per input unit of the command's fast part). How each parameter is fitted
+is part of the effect's description: *grid* parameters (non-smooth in the
+output: a rate, a limit, a width, a step) are searched on the deterministic
+grid :meth:`Effect.grid` built from the record; *factor* parameters (``tau``,
+``wn``, ``zeta``, the delay) join the nominal coefficients in the casadi fit,
+the grid only giving starting values; *basis* parameters (``a2``, ``a3``,
+``sag``, ``slope``, ``curvature``) enter the output linearly for a given
+linear model and are solved by least squares (:mod:`synth.gap.refit`).
+
+``Effect.apply(plant, t, u, params)`` is the augmented model's output; the
+nominal model is ``Effect.apply`` with the effect switched off.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any, ClassVar
+
+import numpy as np
+
+from synth.errors import ModelError
+from synth.ident.simulate import simulate_plant
+from synth.plant import Plant
+from synth.sim.blocks import Backlash, DeadZone, Quantizer, RateLimit, Saturation, SupplySag
+
+Params = dict[str, float]
+
+
+def _span(u: np.ndarray) -> float:
+    span = float(np.max(u) - np.min(u))
+    if span <= 0:
+        raise ModelError("the input is constant; no effect can be fitted", where="record.u")
+    return span
+
+
+def _slowest_pole(plant: Plant) -> float:
+    """Magnitude of the slowest nonzero pole [rad/s] (1 rad/s for a static gain)."""
+    p = np.abs(plant.poles())
+    p = p[p > 0]
+    return float(np.min(p)) if p.size else 1.0
+
+
+def _fastest_pole(plant: Plant) -> float:
+    p = np.abs(plant.poles())
+    p = p[p > 0]
+    return float(np.max(p)) if p.size else 1.0
+
+
+@dataclass(frozen=True)
+class Effect:
+    """One mechanism the nominal model may be missing (base class).
+
+    Attributes
+    ----------
+    name : str
+        Effect name as it appears in the verdict.
+    side : str
+        ``"input"`` (acts on the command before the plant), ``"output"`` (after it) or
+        ``"linear"`` (changes the linear model).
+    parameter_names : tuple of str
+        The effect's parameters, as keys of ``params``.
+    grid_names, factor_names, basis_names : tuple of str
+        How each parameter is fitted (see the module text).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> t = np.arange(0, 2, 0.01); u = np.where(t >= 0.5, 1.0, 0.0)
+    >>> G = Plant.from_string("1/(0.1*s+1)")
+    >>> y = RateLimitEffect().apply(G, t, u, {"rate": 2.0})
+    >>> round(float(y[100]), 3), round(float(simulate_plant(G, t, u)[100]), 3)  # slower than the nominal
+    (0.811, 0.993)
+    """
+
+    name: ClassVar[str] = ""
+    side: ClassVar[str] = "input"
+    parameter_names: ClassVar[tuple[str, ...]] = ()
+    grid_names: ClassVar[tuple[str, ...]] = ()
+    factor_names: ClassVar[tuple[str, ...]] = ()
+    basis_names: ClassVar[tuple[str, ...]] = ()
+
+    @property
+    def label(self) -> str:
+        """Name used in results and verdicts (placement included where it matters)."""
+        return self.name
+
+    # -- description -------------------------------------------------------------------------------------------
+    def bounds(self, t: np.ndarray, u: np.ndarray, plant: Plant) -> dict[str, tuple[float, float]]:
+        """Physical bounds of each parameter for this record (the grid lies inside them)."""
+        return {}
+
+    def grid(self, t: np.ndarray, u: np.ndarray, plant: Plant) -> list[Params]:
+        """Deterministic grid (or starting values) of the non-basis parameters, built from the record."""
+        return [{}]
+
+    def off(self) -> Params:
+        """Parameter values that switch the effect off (the nominal model)."""
+        return {}
+
+    # -- model -------------------------------------------------------------------------------------------------
+    def input_map(self, u: np.ndarray, dt: float, params: Params) -> np.ndarray:
+        """Input-side block applied to the command (identity for other sides)."""
+        return u
+
+    def input_basis(self, u: np.ndarray, dt: float, params: Params) -> list[np.ndarray]:
+        """Signals added to the plant input, one per basis parameter (input side)."""
+        return []
+
+    def output_basis(self, t: np.ndarray) -> list[np.ndarray]:
+        """Signals added to the plant output, one per basis parameter (output side)."""
+        return []
+
+    def factor(self) -> str | None:
+        """Transfer-function factor (in the factor parameters) multiplying the nominal model."""
+        return None
+
+    def augment_plant(self, plant: Plant, params: Params) -> Plant:
+        """The linear part of the augmented model."""
+        return plant
+
+    def plant_input(self, u: np.ndarray, dt: float, params: Params) -> np.ndarray:
+        """What drives the linear part: the input block plus the basis terms."""
+        v = self.input_map(np.asarray(u, float), dt, params)
+        for name, phi in zip(self.basis_names, self.input_basis(u, dt, params)):
+            v = v + params.get(name, 0.0) * phi
+        return v
+
+    def apply(self, plant: Plant, t: np.ndarray, u: np.ndarray, params: Params, offset: float = 0.0,
+              initial: str = "steady") -> np.ndarray:
+        """Output of the augmented model on the command ``u`` sampled at ``t``.
+
+        Parameters
+        ----------
+        plant : Plant
+            The (re-fitted) nominal linear model.
+        t, u : numpy.ndarray
+            Uniform sample times [s] and the measured command.
+        params : dict
+            The effect's parameters (missing ones: the effect's "off" values).
+        offset : float
+            Output operating-point constant added to the simulated output.
+        initial : {"steady", "zero"}
+            Initial state, see :func:`synth.ident.simulate.simulate_plant`.
+
+        Returns
+        -------
+        numpy.ndarray
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> t = np.arange(0, 1, 0.1); u = np.where(t >= 0.2, 1.0, 0.0)
+        >>> y = SaturationEffect().apply(Plant.from_string("2"), t, u, {"upper": 0.5})
+        >>> y.tolist()[:4]
+        [0.0, 0.0, 1.0, 1.0]
+        """
+        t = np.asarray(t, float)
+        dt = float((t[-1] - t[0]) / (t.size - 1))
+        p = {**self.off(), **params}
+        v = self.plant_input(np.asarray(u, float), dt, p)
+        y = simulate_plant(self.augment_plant(plant, p), t, v, initial=initial) + offset
+        for name, psi in zip(self.basis_names, self.output_basis(t)):
+            y = y + p.get(name, 0.0) * psi
+        return y
+
+    def to_dict(self) -> dict[str, Any]:
+        """``{"effect", "side", "parameters"}``.
+
+        Examples
+        --------
+        >>> LagEffect("sensor").to_dict()
+        {'effect': 'lag(sensor)', 'side': 'output', 'parameters': ['tau']}
+        """
+        return {"effect": self.label, "side": self.side, "parameters": list(self.parameter_names)}
+
+
+# ------------------------------------------------------------------------------------------------ linear
+@dataclass(frozen=True)
+class DelayEffect(Effect):
+    """Extra pure delay ``d`` [s] (fitted jointly with the nominal coefficients, exact fractional delay).
+
+    Examples
+    --------
+    >>> DelayEffect().augment_plant(Plant.from_string("1/(s+1)", delay=0.01), {"delay": 0.02}).delay
+    0.03
+    """
+
+    name: ClassVar[str] = "delay"
+    side: ClassVar[str] = "linear"
+    parameter_names: ClassVar[tuple[str, ...]] = ("delay",)
+    factor_names: ClassVar[tuple[str, ...]] = ("delay",)
+
+    def off(self) -> Params:
+        return {"delay": 0.0}
+
+    def bounds(self, t: np.ndarray, u: np.ndarray, plant: Plant) -> dict[str, tuple[float, float]]:
+        return {"delay": (-plant.delay, 0.25 * float(t[-1] - t[0]))}
+
+    def grid(self, t: np.ndarray, u: np.ndarray, plant: Plant) -> list[Params]:
+        dt = float(t[1] - t[0])
+        return [{"delay": 2.0 * dt}]
+
+    def augment_plant(self, plant: Plant, params: Params) -> Plant:
+        return plant.with_delay(max(0.0, plant.delay + params.get("delay", 0.0)))
+
+
+@dataclass(frozen=True)
+class LagEffect(Effect):
+    """Extra first-order lag ``1/(tau s + 1)`` at the actuator or at the sensor.
+
+    On a linear model both placements give the same output; only a record with
+    the actuator output logged (or a known excitation entering at the output)
+    tells them apart.
+
+    Examples
+    --------
+    >>> LagEffect().augment_plant(Plant.from_string("1/(s+1)"), {"tau": 0.5}).den.tolist()
+    [1.0, 3.0, 2.0]
+    """
+
+    placement: str = "actuator"
+    name: ClassVar[str] = "lag"
+    side: ClassVar[str] = "linear"
+    parameter_names: ClassVar[tuple[str, ...]] = ("tau",)
+    factor_names: ClassVar[tuple[str, ...]] = ("tau",)
+
+    def __post_init__(self) -> None:
+        if self.placement not in ("actuator", "sensor"):
+            raise ModelError(f"must be 'actuator' or 'sensor', got {self.placement!r}", where="lag.placement")
+
+    @property
+    def label(self) -> str:
+        return "lag" if self.placement == "actuator" else "lag(sensor)"
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"effect": self.label, "side": "input" if self.placement == "actuator" else "output",
+                "parameters": list(self.parameter_names)}
+
+    def off(self) -> Params:
+        return {"tau": 0.0}
+
+    def bounds(self, t: np.ndarray, u: np.ndarray, plant: Plant) -> dict[str, tuple[float, float]]:
+        return {"tau": (0.0, 2.0 / _slowest_pole(plant))}
+
+    def grid(self, t: np.ndarray, u: np.ndarray, plant: Plant) -> list[Params]:
+        dt = float(t[1] - t[0])
+        fast = 1.0 / _fastest_pole(plant)
+        return [{"tau": float(x)} for x in np.geomspace(max(3 * dt, 0.03 * fast), max(6 * dt, fast), 3)]
+
+    def factor(self) -> str:
+        return "1/(tau*s+1)"
+
+    def augment_plant(self, plant: Plant, params: Params) -> Plant:
+        tau = params.get("tau", 0.0)
+        return Plant(plant.num, np.polymul(plant.den, [tau, 1.0]), plant.delay, plant.input, plant.output,
+                     plant.label)
+
+
+@dataclass(frozen=True)
+class ResonanceEffect(Effect):
+    """A lightly damped mode ``wn^2/(s^2 + 2 zeta wn s + wn^2)`` in series (unit DC gain).
+
+    Examples
+    --------
+    >>> G = ResonanceEffect().augment_plant(Plant.from_string("1/(s+1)"), {"wn": 10.0, "zeta": 0.1})
+    >>> round(float(abs(G.freqresp([10.0])[0]) * abs(1 + 10j)), 3)  # peak 1/(2 zeta) at wn
+    5.0
+    """
+
+    name: ClassVar[str] = "resonance"
+    side: ClassVar[str] = "linear"
+    parameter_names: ClassVar[tuple[str, ...]] = ("wn", "zeta")
+    factor_names: ClassVar[tuple[str, ...]] = ("wn", "zeta")
+
+    def off(self) -> Params:
+        return {"wn": np.inf, "zeta": 1.0}
+
+    def bounds(self, t: np.ndarray, u: np.ndarray, plant: Plant) -> dict[str, tuple[float, float]]:
+        return {"wn": (0.0, np.pi / float(t[1] - t[0])), "zeta": (0.0, 1.0)}
+
+    def grid(self, t: np.ndarray, u: np.ndarray, plant: Plant) -> list[Params]:
+        nyquist = np.pi / float(t[1] - t[0])
+        lo = min(2.0 * _fastest_pole(plant), nyquist / 20)
+        return [{"wn": float(w), "zeta": 0.2} for w in np.geomspace(lo, nyquist / 5, 4)]
+
+    def factor(self) -> str:
+        return "wn^2/(s^2+2*zeta*wn*s+wn^2)"
+
+    def augment_plant(self, plant: Plant, params: Params) -> Plant:
+        wn, zeta = params.get("wn", np.inf), params.get("zeta", 1.0)
+        if not np.isfinite(wn):
+            return plant
+        return Plant(plant.num * wn**2, np.polymul(plant.den, [1.0, 2 * zeta * wn, wn**2]), plant.delay,
+                     plant.input, plant.output, plant.label)
+
+
+# ------------------------------------------------------------------------------------------------ input side
+def _log_grid(lo: float, hi: float, n: int, name: str) -> list[Params]:
+    return [{name: float(x)} for x in np.geomspace(lo, hi, n)]
+
+
+@dataclass(frozen=True)
+class RateLimitEffect(Effect):
+    """Slew-rate limit ``rate`` [input units/s] on the command (:class:`synth.sim.blocks.RateLimit`).
+
+    The grid runs from a ramp lasting two slowest plant time constants over the
+    input's span up to the fastest rate in the command (inactive).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> RateLimitEffect().input_map(np.array([0.0, 0, 5, 5, 5]), 1.0, {"rate": 2.0}).tolist()
+    [0.0, 0.0, 2.0, 4.0, 5.0]
+    """
+
+    name: ClassVar[str] = "rate_limit"
+    parameter_names: ClassVar[tuple[str, ...]] = ("rate",)
+    grid_names: ClassVar[tuple[str, ...]] = ("rate",)
+
+    def off(self) -> Params:
+        return {"rate": np.inf}
+
+    def bounds(self, t: np.ndarray, u: np.ndarray, plant: Plant) -> dict[str, tuple[float, float]]:
+        dt = float(t[1] - t[0])
+        top = float(np.max(np.abs(np.diff(u)))) / dt
+        return {"rate": (0.5 * _span(u) * _slowest_pole(plant), top)}
+
+    def grid(self, t: np.ndarray, u: np.ndarray, plant: Plant) -> list[Params]:
+        lo, hi = self.bounds(t, u, plant)["rate"]
+        return _log_grid(lo, hi, 10, "rate")
+
+    def input_map(self, u: np.ndarray, dt: float, params: Params) -> np.ndarray:
+        rate = params.get("rate", np.inf)
+        return u if not np.isfinite(rate) else RateLimit(rate).apply(u, dt)
+
+
+@dataclass(frozen=True)
+class SaturationEffect(Effect):
+    """Amplitude limits ``lower <= u <= upper`` on the command (:class:`synth.sim.blocks.Saturation`).
+
+    Grid: the upper limit alone, then the lower limit alone, each at fractions
+    of the input's span inside its range.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> SaturationEffect().input_map(np.array([0.0, 5, 10]), 1.0, {"upper": 8.0}).tolist()
+    [0.0, 5.0, 8.0]
+    """
+
+    name: ClassVar[str] = "saturation"
+    parameter_names: ClassVar[tuple[str, ...]] = ("lower", "upper")
+    grid_names: ClassVar[tuple[str, ...]] = ("lower", "upper")
+
+    def off(self) -> Params:
+        return {"lower": -np.inf, "upper": np.inf}
+
+    def bounds(self, t: np.ndarray, u: np.ndarray, plant: Plant) -> dict[str, tuple[float, float]]:
+        return {"lower": (float(np.min(u)), float(np.max(u))), "upper": (float(np.min(u)), float(np.max(u)))}
+
+    def grid(self, t: np.ndarray, u: np.ndarray, plant: Plant) -> list[Params]:
+        span, lo, hi = _span(u), float(np.min(u)), float(np.max(u))
+        fractions = (0.03, 0.1, 0.2, 0.35, 0.5, 0.7)
+        return [{"upper": hi - f * span} for f in fractions] + [{"lower": lo + f * span} for f in fractions]
+
+    def input_map(self, u: np.ndarray, dt: float, params: Params) -> np.ndarray:
+        lo, hi = params.get("lower", -np.inf), params.get("upper", np.inf)
+        if not (np.isfinite(lo) or np.isfinite(hi)):
+            return u
+        big = 1e30
+        return Saturation(max(lo, -big), min(hi, big)).apply(u, dt)
+
+
+@dataclass(frozen=True)
+class DeadzoneEffect(Effect):
+    """Dead zone of half-width ``width`` around ``center`` (:class:`synth.sim.blocks.DeadZone`).
+
+    The center is the command at rest (the first sample) unless given: the
+    drive does not move until the command leaves the band around where it rests.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> DeadzoneEffect().input_map(np.array([0.0, 0.5, 3.0]), 1.0, {"width": 1.0, "center": 0.0}).tolist()
+    [0.0, 0.0, 2.0]
+    """
+
+    name: ClassVar[str] = "deadzone"
+    parameter_names: ClassVar[tuple[str, ...]] = ("width", "center")
+    grid_names: ClassVar[tuple[str, ...]] = ("width",)
+
+    def off(self) -> Params:
+        return {"width": 0.0, "center": 0.0}
+
+    def bounds(self, t: np.ndarray, u: np.ndarray, plant: Plant) -> dict[str, tuple[float, float]]:
+        return {"width": (0.0, _span(u))}
+
+    def grid(self, t: np.ndarray, u: np.ndarray, plant: Plant) -> list[Params]:
+        span, c = _span(u), float(u[0])
+        return [{"width": float(f * span), "center": c} for f in (0.02, 0.05, 0.1, 0.2, 0.35, 0.5)]
+
+    def input_map(self, u: np.ndarray, dt: float, params: Params) -> np.ndarray:
+        w = params.get("width", 0.0)
+        return u if w <= 0 else DeadZone(w, params.get("center", 0.0)).apply(u, dt)
+
+
+@dataclass(frozen=True)
+class BacklashEffect(Effect):
+    """Backlash (play) of total ``width`` (:class:`synth.sim.blocks.Backlash`).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> BacklashEffect().input_map(np.array([0.0, 0.5, 2, 1.5]), 1.0, {"width": 2.0}).tolist()
+    [0.0, 0.0, 1.0, 1.0]
+    """
+
+    name: ClassVar[str] = "backlash"
+    parameter_names: ClassVar[tuple[str, ...]] = ("width",)
+    grid_names: ClassVar[tuple[str, ...]] = ("width",)
+
+    def off(self) -> Params:
+        return {"width": 0.0}
+
+    def bounds(self, t: np.ndarray, u: np.ndarray, plant: Plant) -> dict[str, tuple[float, float]]:
+        return {"width": (0.0, _span(u))}
+
+    def grid(self, t: np.ndarray, u: np.ndarray, plant: Plant) -> list[Params]:
+        return [{"width": float(f * _span(u))} for f in (0.02, 0.05, 0.1, 0.2, 0.35, 0.5)]
+
+    def input_map(self, u: np.ndarray, dt: float, params: Params) -> np.ndarray:
+        w = params.get("width", 0.0)
+        return u if w <= 0 else Backlash(w).apply(u, dt)
+
+
+@dataclass(frozen=True)
+class QuantizationEffect(Effect):
+    """Command resolution ``step`` (:class:`synth.sim.blocks.Quantizer`, rounding).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> QuantizationEffect().input_map(np.array([0.4, 0.6, 1.7]), 1.0, {"step": 1.0}).tolist()
+    [0.0, 1.0, 2.0]
+    """
+
+    name: ClassVar[str] = "quantization"
+    parameter_names: ClassVar[tuple[str, ...]] = ("step",)
+    grid_names: ClassVar[tuple[str, ...]] = ("step",)
+
+    def off(self) -> Params:
+        return {"step": 0.0}
+
+    def bounds(self, t: np.ndarray, u: np.ndarray, plant: Plant) -> dict[str, tuple[float, float]]:
+        return {"step": (0.0, 0.5 * _span(u))}
+
+    def grid(self, t: np.ndarray, u: np.ndarray, plant: Plant) -> list[Params]:
+        return _log_grid(0.005 * _span(u), 0.3 * _span(u), 8, "step")
+
+    def input_map(self, u: np.ndarray, dt: float, params: Params) -> np.ndarray:
+        q = params.get("step", 0.0)
+        return u if q <= 0 else Quantizer(q).apply(u, dt)
+
+
+@dataclass(frozen=True)
+class SupplySagEffect(Effect):
+    """Battery sag on fast command increases (:class:`synth.sim.blocks.SupplySag`, normalized).
+
+    With a 1 V battery, 1 ohm, no static current and no brown-out the block is
+    ``v = u (1 - sag max(0, u - u_f))``, ``tau u_f' + u_f = u``: linear in
+    ``sag`` (a basis parameter), ``tau`` on a grid.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> phi = SupplySagEffect().input_basis(np.array([1.0, 1.0, 2.0, 2.0]), 0.01, {"tau": 1.0})[0]
+    >>> phi.round(4).tolist()  # -u (u - u_f) once the command steps up
+    [0.0, 0.0, -2.0, -1.9801]
+    """
+
+    name: ClassVar[str] = "supply_sag"
+    parameter_names: ClassVar[tuple[str, ...]] = ("sag", "tau")
+    grid_names: ClassVar[tuple[str, ...]] = ("tau",)
+    basis_names: ClassVar[tuple[str, ...]] = ("sag",)
+
+    def off(self) -> Params:
+        return {"sag": 0.0, "tau": 0.1}
+
+    def bounds(self, t: np.ndarray, u: np.ndarray, plant: Plant) -> dict[str, tuple[float, float]]:
+        return {"sag": (0.0, 1.0 / max(_span(u), 1e-12)), "tau": (float(t[1] - t[0]), float(t[-1] - t[0]))}
+
+    def grid(self, t: np.ndarray, u: np.ndarray, plant: Plant) -> list[Params]:
+        slow = 1.0 / _slowest_pole(plant)
+        return [{"tau": float(x)} for x in np.geomspace(0.05 * slow, 2.0 * slow, 5)]
+
+    def input_basis(self, u: np.ndarray, dt: float, params: Params) -> list[np.ndarray]:
+        eps = 1e-9 / max(float(np.max(np.abs(u))), 1.0) ** 2  # keeps the normalized voltage near 1: exact linearity
+        block = SupplySag(v_open=1.0, r_internal=1.0, i_dynamic=eps, tau=params.get("tau", 0.1), v_reset=0.0)
+        return [(block.apply(u, dt) - u) / eps]
+
+
+@dataclass(frozen=True)
+class StaticNonlinearityEffect(Effect):
+    """Smooth static input map ``u + h (a2 x^2 + a3 x^3)``, ``x = (u - c)/h`` (c the center, h half the span).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> e = StaticNonlinearityEffect()
+    >>> e.plant_input(np.array([0.0, 1.0, 2.0]), 1.0, {"a2": 0.1, "a3": 0.0, "center": 1.0, "scale": 1.0}).tolist()
+    [0.1, 1.0, 2.1]
+    """
+
+    name: ClassVar[str] = "static_nonlinearity"
+    parameter_names: ClassVar[tuple[str, ...]] = ("a2", "a3", "center", "scale")
+    basis_names: ClassVar[tuple[str, ...]] = ("a2", "a3")
+
+    def off(self) -> Params:
+        return {"a2": 0.0, "a3": 0.0, "center": 0.0, "scale": 1.0}
+
+    def bounds(self, t: np.ndarray, u: np.ndarray, plant: Plant) -> dict[str, tuple[float, float]]:
+        return {"a2": (-1.0, 1.0), "a3": (-1.0, 1.0)}
+
+    def grid(self, t: np.ndarray, u: np.ndarray, plant: Plant) -> list[Params]:
+        return [{"center": float(0.5 * (np.max(u) + np.min(u))), "scale": 0.5 * _span(u)}]
+
+    def input_basis(self, u: np.ndarray, dt: float, params: Params) -> list[np.ndarray]:
+        h = params.get("scale", 1.0)
+        x = (np.asarray(u, float) - params.get("center", 0.0)) / h
+        return [h * x**2, h * x**3]
+
+
+# ------------------------------------------------------------------------------------------------ output side
+@dataclass(frozen=True)
+class DriftEffect(Effect):
+    """Slow output drift ``slope (t - t0) + curvature (t - t0)^2`` (t0 the record's start).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> t = np.arange(0, 3, 1.0)
+    >>> DriftEffect().apply(Plant.from_string("1"), t, np.zeros(3), {"slope": 0.5}).tolist()
+    [0.0, 0.5, 1.0]
+    """
+
+    name: ClassVar[str] = "drift"
+    side: ClassVar[str] = "output"
+    parameter_names: ClassVar[tuple[str, ...]] = ("slope", "curvature")
+    basis_names: ClassVar[tuple[str, ...]] = ("slope", "curvature")
+
+    def off(self) -> Params:
+        return {"slope": 0.0, "curvature": 0.0}
+
+    def output_basis(self, t: np.ndarray) -> list[np.ndarray]:
+        tau = np.asarray(t, float) - self.t0
+        return [tau, tau**2]
+
+    t0: float = 0.0
+
+
+EFFECTS: dict[str, type[Effect]] = {
+    "delay": DelayEffect, "lag": LagEffect, "resonance": ResonanceEffect, "rate_limit": RateLimitEffect,
+    "saturation": SaturationEffect, "deadzone": DeadzoneEffect, "backlash": BacklashEffect,
+    "quantization": QuantizationEffect, "supply_sag": SupplySagEffect,
+    "static_nonlinearity": StaticNonlinearityEffect, "drift": DriftEffect,
+}
+"""Every effect class by name."""
+
+
+def make_effect(spec: str | Effect) -> Effect:
+    """An effect from its name (``"lag(sensor)"`` places the lag at the sensor).
+
+    Examples
+    --------
+    >>> make_effect("rate_limit").name, make_effect("lag(sensor)").label
+    ('rate_limit', 'lag(sensor)')
+    """
+    if isinstance(spec, Effect):
+        return spec
+    text = str(spec).strip()
+    if text in ("lag(sensor)", "sensor_lag"):
+        return LagEffect("sensor")
+    if text in ("lag(actuator)", "actuator_lag"):
+        return LagEffect("actuator")
+    if text not in EFFECTS:
+        raise ModelError(f"unknown effect {text!r}; known: {', '.join(EFFECTS)}", where="candidates")
+    return EFFECTS[text]()

@@ -1,0 +1,397 @@
+"""Joint re-fit of the nominal model and one effect's parameters by simulation error.
+
+The nominal linear model is written as a structure in its own nonzero
+coefficients, ``(n_1 s + n_0)/(s^2 + d_1 s + d_0)`` (monic denominator;
+coefficients that are zero in the nominal, such as an integrator's, stay zero)
+and every coefficient is re-fitted together with the effect, so an effect is
+never credited with what a parameter re-fit alone would do. The fit minimizes
+the simulation error ``sum_k (y_k - yhat_k)^2`` with
+``yhat = c + G_aug (N(u) + sum_j a_j phi_j(u)) + sum_j d_j psi_j(t)``:
+
+- the linear part ``G_aug`` (nominal coefficients, effect factor parameters
+  such as a lag's ``tau``, a resonance's ``wn, zeta``, and the delay for the
+  ``delay`` effect) by casadi/IPOPT through
+  :func:`synth.ident.timefit.fit_structure` (exact zero-order-hold
+  discretization with fractional delay, Gauss-Newton Hessian), started at the
+  nominal coefficients;
+- the input block ``N`` (rate limit, saturation, dead zone, backlash,
+  quantizer: not smooth in their parameter) by the effect's deterministic grid
+  and then a golden-section search in the log of the parameter between the
+  best grid point's neighbours, every point a full casadi fit of the rest;
+- the *basis* parameters ``a_j, d_j`` and the output constant ``c`` (linear in
+  the output for a given ``G_aug``) by linear least squares, alternating with
+  the casadi fit (three rounds).
+
+Intervals: casadi-fitted parameters carry the Jacobian intervals of
+:class:`synth.ident.timefit.TimeFitResult`; grid parameters a profile interval
+(the parameter values whose training SSR is within ``chi2_1(0.95) s^2`` of the
+best, ``s^2 = SSR/N``, interpolated in log between grid points); basis
+parameters their least-squares interval. All assume white residuals and are too
+narrow otherwise.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any, ClassVar
+
+import numpy as np
+
+from synth.data.record import record_from_arrays
+from synth.errors import DataError, ModelError
+from synth.gap.effects import Effect, Params
+from synth.ident.simulate import simulate_plant
+from synth.ident.timefit import fit_structure
+from synth.plant import Plant
+
+_CHI2_1_95 = 3.841458820694124
+_ROUNDS = 3  # alternations of the casadi fit and the least-squares basis step
+_GOLDEN = 12  # most golden-section evaluations after the grid
+_GOLDEN_TOL = 0.01  # ... or until the bracket is this narrow in log
+
+
+def nominal_structure(plant: Plant) -> tuple[str, dict[str, float]]:
+    """Structure formula in the plant's nonzero coefficients (monic denominator) and their values.
+
+    Examples
+    --------
+    >>> nominal_structure(Plant.from_string("23*(s+0.43)/((s+9.6)*(s+0.54))"))[0]
+    '(n1*s+n0)/(s^2+d1*s+d0)'
+    >>> nominal_structure(Plant.from_string("2/(s*(0.5*s+1))"))
+    ('(n0)/(s^2+d1*s)', {'n0': 4.0, 'd1': 2.0})
+    """
+    num, den = plant.num, plant.den
+    values: dict[str, float] = {}
+
+    def poly(coeffs: np.ndarray, prefix: str, monic: bool) -> str:
+        deg = coeffs.size - 1
+        terms = []
+        for i, c in enumerate(coeffs):
+            power = deg - i
+            if c == 0.0:
+                continue
+            mono = "" if power == 0 else ("s" if power == 1 else f"s^{power}")
+            if monic and i == 0:
+                terms.append(mono or "1")
+                continue
+            name = f"{prefix}{power}"
+            values[name] = float(c)
+            terms.append(f"{name}*{mono}" if mono else name)
+        return "+".join(terms) if terms else "0"
+
+    text_num = poly(num, "n", False)
+    text_den = poly(den, "d", True)
+    if text_num == "0":
+        raise ModelError("the nominal model is zero; nothing to re-fit", where="plant")
+    return f"({text_num})/({text_den})", values
+
+
+def _plant_from(plant: Plant, values: dict[str, float], delay: float) -> Plant:
+    num = np.array([values.get(f"n{plant.num.size - 1 - i}", 0.0) if c != 0.0 else 0.0
+                    for i, c in enumerate(plant.num)])
+    den = np.array([1.0 if i == 0 else (values.get(f"d{plant.den.size - 1 - i}", 0.0) if c != 0.0 else 0.0)
+                    for i, c in enumerate(plant.den)])
+    return Plant(num, den, max(0.0, delay), plant.input, plant.output, "re-fitted")
+
+
+@dataclass(frozen=True)
+class _NoEffect(Effect):
+    """The re-fit alone (an effect with nothing to add)."""
+
+    name: ClassVar[str] = "parameter_mismatch"
+
+
+@dataclass(frozen=True, eq=False)
+class AugmentedFit:
+    """The re-fitted nominal model with one effect (``effect=None``: the re-fit alone).
+
+    Attributes
+    ----------
+    effect : Effect or None
+    plant : Plant
+        Re-fitted nominal linear model (without the effect's factor).
+    params : dict
+        Effect parameters (the effect's "off" values filled in).
+    offset : float
+        Output constant ``c``.
+    nominal : dict
+        Re-fitted nominal coefficients (and ``delay``).
+    parameter_ci : dict
+        Approximate 95 % interval of each fitted effect parameter (see the module text).
+    ssr : float
+        Training sum of squared simulation errors.
+    samples : int
+        Training samples.
+    profile : list of (dict, float)
+        Every grid / search point tried and its training SSR.
+    solver : dict
+        IPOPT status of the best point.
+    """
+
+    effect: Effect | None
+    plant: Plant
+    params: Params
+    offset: float
+    nominal: dict[str, float]
+    parameter_ci: dict[str, tuple[float, float]]
+    ssr: float
+    samples: int
+    profile: list[tuple[Params, float]] = field(repr=False, default_factory=list)
+    solver: dict[str, Any] = field(default_factory=dict)
+
+    def predict(self, t: np.ndarray, u: np.ndarray) -> np.ndarray:
+        """Model output on a command (the record simulated from rest at its first sample).
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> t = np.arange(0, 3, 0.01); u = np.where(t >= 0.5, 1.0, 0.0)
+        >>> y = simulate_plant(Plant.from_string("2/(s+2)"), t, u) + 1.0
+        >>> f = fit_augmented(Plant.from_string("2.1/(s+2)"), t, u, y)
+        >>> round(float(np.max(np.abs(f.predict(t, u) - y))), 6)
+        0.0
+        """
+        eff = self.effect if self.effect is not None else _NoEffect()
+        return eff.apply(self.plant, t, u, self.params, offset=self.offset)
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready summary.
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> t = np.arange(0, 3, 0.01); u = np.where(t >= 0.5, 1.0, 0.0)
+        >>> G = Plant.from_string("2/(s+2)")
+        >>> d = fit_augmented(G, t, u, simulate_plant(G, t, u)).to_dict()
+        >>> d["effect"], d["tf"]
+        (None, '2/(s+2)')
+        """
+        eff = self.effect
+        return {
+            "effect": eff.label if eff is not None else None,
+            "parameters": {k: float(self.params[k]) for k in (eff.parameter_names if eff else ())},
+            "parameter_ci": {k: [float(a), float(b)] for k, (a, b) in self.parameter_ci.items()},
+            "nominal": dict(self.nominal),
+            "tf": self.plant.to_string(6),
+            "offset": self.offset,
+            "ssr": self.ssr,
+            "samples": self.samples,
+            "solver": dict(self.solver),
+        }
+
+
+@dataclass
+class _Point:
+    params: Params
+    ssr: float
+    plant: Plant
+    offset: float
+    nominal: dict[str, float]
+    ci: dict[str, tuple[float, float]]
+    solver: dict[str, Any]
+    key: str | None = None
+
+
+def _linear_fit(plant: Plant, effect: Effect, params: Params, t: np.ndarray, v: np.ndarray, y: np.ndarray,
+                formula: str, start: dict[str, float]) -> tuple[Plant, Params, dict[str, float],
+                                                                 dict[str, tuple[float, float]], dict[str, Any]]:
+    """casadi fit of the nominal coefficients and the effect's factor parameters on the plant input ``v``."""
+    factor = effect.factor()
+    full = f"({formula})*{factor}" if factor else formula
+    init = dict(start)
+    for name in effect.factor_names:
+        if name != "delay":
+            init[name] = float(params[name])
+    fit_delay = "delay" in effect.factor_names
+    if fit_delay:
+        init["delay"] = plant.delay + float(params.get("delay", 0.0))
+    rec = record_from_arrays(t, v, y)
+    res = fit_structure(rec, full, delay="fit" if fit_delay else plant.delay, initial=init)
+    new = dict(params)
+    ci: dict[str, tuple[float, float]] = {}
+    for name in effect.factor_names:
+        if name == "delay":
+            new["delay"] = res.delay - plant.delay
+            lo, hi = res.ci95.get("delay", (res.delay, res.delay))
+            ci["delay"] = (lo - plant.delay, hi - plant.delay)
+        else:
+            new[name] = float(res.parameters[name])
+            ci[name] = tuple(map(float, res.ci95[name]))  # type: ignore[assignment]
+    nominal = {k: float(res.parameters[k]) for k in start}
+    nominal["delay"] = float(res.delay)
+    return _plant_from(plant, nominal, res.delay), new, nominal, ci, dict(res.solver)
+
+
+def _basis_step(effect: Effect, G: Plant, params: Params, t: np.ndarray, u: np.ndarray, y: np.ndarray,
+                dt: float) -> tuple[Params, float, dict[str, tuple[float, float]]]:
+    """Least squares for the output constant and the basis parameters, the linear model fixed."""
+    Gaug = effect.augment_plant(G, params)
+    v0 = effect.input_map(u, dt, params)
+    cols = [np.ones_like(y)]
+    cols += [simulate_plant(Gaug, t, phi) for phi in effect.input_basis(u, dt, params)]
+    cols += list(effect.output_basis(t))
+    X = np.column_stack(cols)
+    target = y - simulate_plant(Gaug, t, v0)
+    scale = np.maximum(np.sqrt(np.sum(X**2, axis=0)), 1e-300)
+    Xs = X / scale
+    coef, *_ = np.linalg.lstsq(Xs, target, rcond=None)
+    r = target - Xs @ coef
+    dof = max(1, y.size - X.shape[1])
+    s2 = float(r @ r) / dof
+    try:
+        cov = s2 * np.linalg.inv(Xs.T @ Xs)
+    except np.linalg.LinAlgError:
+        cov = s2 * np.linalg.pinv(Xs.T @ Xs)
+    coef = coef / scale
+    sd = np.sqrt(np.clip(np.diag(cov), 0, None)) / scale
+    new = dict(params)
+    ci = {}
+    for j, name in enumerate(effect.basis_names):
+        new[name] = float(coef[j + 1])
+        ci[name] = (float(coef[j + 1] - 1.96 * sd[j + 1]), float(coef[j + 1] + 1.96 * sd[j + 1]))
+    return new, float(coef[0]), ci
+
+
+def _fit_point(plant: Plant, effect: Effect, params: Params, t: np.ndarray, u: np.ndarray, y: np.ndarray,
+               formula: str, start: dict[str, float]) -> _Point:
+    dt = float((t[-1] - t[0]) / (t.size - 1))
+    p = {**effect.off(), **params}
+    G, nominal, ci, solver, offset = plant, dict(start), {}, {}, 0.0
+    rounds = _ROUNDS if effect.basis_names else 1
+    try:
+        for _ in range(rounds):
+            v = effect.plant_input(u, dt, p)
+            drift = sum((p[n] * psi for n, psi in zip(effect.basis_names, effect.output_basis(t))), np.zeros_like(y))
+            G, p, nominal, ci_f, solver = _linear_fit(plant, effect, p, t, v, y - drift, formula,
+                                                      {k: v_ for k, v_ in nominal.items() if k != "delay"})
+            p, offset, ci_b = _basis_step(effect, G, p, t, u, y, dt)
+            ci = {**ci_f, **ci_b}
+    except (DataError, ModelError, np.linalg.LinAlgError, RuntimeError) as exc:
+        return _Point(p, np.inf, plant, 0.0, dict(start), {}, {"status": f"failed: {exc}"})
+    yhat = effect.apply(G, t, u, p, offset=offset)
+    ssr = float(np.sum((y - yhat) ** 2))
+    return _Point(p, ssr if np.isfinite(ssr) else np.inf, G, offset, nominal, ci, solver)
+
+
+def _profile_ci(points: list[_Point], best: _Point, name: str, n: int) -> tuple[float, float]:
+    """Profile interval of a grid parameter in log: SSR within chi2_1(0.95) SSR_min/N of the best."""
+    pts = sorted(((p.params[name], p.ssr) for p in points if name in p.params and np.isfinite(p.ssr)
+                  and p.params[name] > 0 and np.isfinite(p.params[name])), key=lambda x: x[0])
+    level = best.ssr * (1.0 + _CHI2_1_95 / n)
+    x0 = best.params[name]
+    if not pts or not (np.isfinite(x0) and x0 > 0):
+        return (float(x0), float(x0))
+    xs = np.log([p[0] for p in pts])
+    ss = np.array([p[1] for p in pts])
+    i0 = int(np.argmin(np.abs(xs - np.log(x0))))
+
+    def walk(step: int) -> float:
+        i = i0
+        while 0 <= i + step < xs.size and ss[i + step] <= level:
+            i += step
+        j = i + step
+        if not 0 <= j < xs.size:
+            return float(np.exp(xs[i]))
+        frac = (level - ss[i]) / (ss[j] - ss[i]) if ss[j] != ss[i] else 0.0
+        return float(np.exp(xs[i] + frac * (xs[j] - xs[i])))
+
+    return walk(-1), walk(1)
+
+
+def fit_augmented(plant: Plant, t: np.ndarray, u: np.ndarray, y: np.ndarray, effect: Effect | None = None,
+                  refine: bool = True) -> AugmentedFit:
+    """Re-fit the nominal coefficients jointly with one effect's parameters on a (training) record.
+
+    Parameters
+    ----------
+    plant : Plant
+        Nominal model; its nonzero coefficients and delay are the starting point.
+    t, u, y : numpy.ndarray
+        Uniform time [s], command and measured output (the plant at rest at the start).
+    effect : Effect, optional
+        The augmentation; ``None`` re-fits the nominal coefficients alone (``parameter_mismatch``).
+    refine : bool
+        Golden-section search of a grid parameter after the grid.
+
+    Returns
+    -------
+    AugmentedFit
+
+    Raises
+    ------
+    ModelError
+        No grid point could be fitted.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from synth.gap.effects import RateLimitEffect
+    >>> t = np.arange(0, 6, 0.01); u = np.where((t % 3) >= 1, 1.0, 0.0)
+    >>> G = Plant.from_string("2/(0.2*s+1)")
+    >>> y = RateLimitEffect().apply(G, t, u, {"rate": 4.0})
+    >>> f = fit_augmented(Plant.from_string("2.1/(0.21*s+1)"), t, u, y, RateLimitEffect())
+    >>> round(f.params["rate"], 1), f.plant.to_string(2)
+    (4.0, '10/(s+5)')
+    """
+    t = np.asarray(t, float)
+    u = np.asarray(u, float)
+    y = np.asarray(y, float)
+    formula, start = nominal_structure(plant)
+    eff = effect if effect is not None else _NoEffect()
+    grid = eff.grid(t, u, plant)
+    points = [_fit_point(plant, eff, g, t, u, y, formula, start) for g in grid]
+    for g, p in zip(grid, points):
+        p.key = next((k for k in eff.grid_names if k in g), None)
+    best = min(points, key=lambda p: p.ssr)
+    if not np.isfinite(best.ssr):
+        raise ModelError(f"no fit succeeded ({best.solver.get('status')})", where=f"effect {eff.label}")
+    ci = dict(best.ci)
+    key = best.key
+    if key is not None:
+        same = [p for p in points if p.key == key]
+        if refine:
+            extra = _golden(plant, eff, best, same, key, t, u, y, formula, start)
+            for p in extra:
+                p.key = key
+            points += extra
+            same += extra
+            best = min(points, key=lambda p: p.ssr)
+        ci[key] = _profile_ci(same, best, key, y.size)
+    return AugmentedFit(effect, best.plant, best.params, best.offset, best.nominal, ci, best.ssr, int(y.size),
+                        [(p.params, p.ssr) for p in points], best.solver)
+
+
+def _golden(plant: Plant, eff: Effect, best: _Point, same: list[_Point], key: str, t: np.ndarray, u: np.ndarray,
+            y: np.ndarray, formula: str, start: dict[str, float]) -> list[_Point]:
+    """Golden-section search in log(key) between the best grid point's neighbours."""
+    vals = sorted({p.params[key] for p in same if np.isfinite(p.params.get(key, np.nan)) and p.params[key] > 0})
+    x0 = best.params.get(key, np.nan)
+    if len(vals) < 2 or not (np.isfinite(x0) and x0 > 0) or x0 not in vals:
+        return []
+    i = vals.index(x0)
+    lo = np.log(vals[i - 1]) if i > 0 else np.log(vals[0]) - (np.log(vals[1]) - np.log(vals[0]))
+    hi = np.log(vals[i + 1]) if i + 1 < len(vals) else np.log(vals[-1]) + (np.log(vals[-1]) - np.log(vals[-2]))
+    base = {k: v for k, v in best.params.items() if k not in eff.basis_names}
+    out: list[_Point] = []
+    g = (np.sqrt(5.0) - 1.0) / 2.0
+
+    def f(x: float) -> float:
+        pt = _fit_point(plant, eff, {**base, key: float(np.exp(x))}, t, u, y, formula, start)
+        out.append(pt)
+        return pt.ssr
+
+    a, b = lo, hi
+    c, d = b - g * (b - a), a + g * (b - a)
+    fc, fd = f(c), f(d)
+    for _ in range(_GOLDEN - 2):
+        if b - a < _GOLDEN_TOL:
+            break
+        if fc < fd:
+            b, d, fd = d, c, fc
+            c = b - g * (b - a)
+            fc = f(c)
+        else:
+            a, c, fc = c, d, fd
+            d = a + g * (b - a)
+            fd = f(d)
+    return out
