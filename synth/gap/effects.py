@@ -135,13 +135,21 @@ class Effect:
         """Signals added to the plant output, one per basis parameter (output side)."""
         return []
 
-    def factor(self) -> str | None:
-        """Transfer-function factor (in the factor parameters) multiplying the nominal model."""
+    def factor(self, params: Params | None = None) -> str | None:
+        """Transfer-function factor (in the factor parameters; grid parameters as numbers) times the nominal."""
         return None
 
     def augment_plant(self, plant: Plant, params: Params) -> Plant:
         """The linear part of the augmented model."""
         return plant
+
+    def to_factor(self, params: Params) -> dict[str, float]:
+        """Values of the factor's structure parameters (square roots keep ``tau``, ``zeta`` >= 0 in the fit)."""
+        return {name: float(np.sqrt(max(params[name], 0.0))) for name in self.factor_names if name != "delay"}
+
+    def from_factor(self, values: dict[str, float]) -> Params:
+        """Effect parameters from the factor's structure parameters (inverse of :meth:`to_factor`)."""
+        return {name: float(values[name]) ** 2 for name in self.factor_names if name in values and name != "delay"}
 
     def plant_input(self, u: np.ndarray, dt: float, params: Params) -> np.ndarray:
         """What drives the linear part: the input block plus the basis terms."""
@@ -231,11 +239,13 @@ class DelayEffect(Effect):
 
 @dataclass(frozen=True)
 class LagEffect(Effect):
-    """Extra first-order lag ``1/(tau s + 1)`` at the actuator or at the sensor.
+    """Extra first-order lag ``1/(tau s + 1)`` at the actuator or at the sensor (exact, in series with ``G``).
 
     On a linear model both placements give the same output; only a record with
     the actuator output logged (or a known excitation entering at the output)
-    tells them apart.
+    tells them apart. ``tau`` is searched on a grid (then golden section) with
+    the nominal coefficients fitted by casadi at each point, which keeps the
+    fit away from the stiff ``tau -> 0`` end.
 
     Examples
     --------
@@ -247,7 +257,7 @@ class LagEffect(Effect):
     name: ClassVar[str] = "lag"
     side: ClassVar[str] = "linear"
     parameter_names: ClassVar[tuple[str, ...]] = ("tau",)
-    factor_names: ClassVar[tuple[str, ...]] = ("tau",)
+    grid_names: ClassVar[tuple[str, ...]] = ("tau",)
 
     def __post_init__(self) -> None:
         if self.placement not in ("actuator", "sensor"):
@@ -269,11 +279,12 @@ class LagEffect(Effect):
 
     def grid(self, t: np.ndarray, u: np.ndarray, plant: Plant) -> list[Params]:
         dt = float(t[1] - t[0])
-        fast = 1.0 / _fastest_pole(plant)
-        return [{"tau": float(x)} for x in np.geomspace(max(3 * dt, 0.03 * fast), max(6 * dt, fast), 3)]
+        top = 1.0 / _slowest_pole(plant)
+        return [{"tau": float(x)} for x in np.geomspace(dt, max(2 * dt, top), 8)]
 
-    def factor(self) -> str:
-        return "1/(tau*s+1)"
+    def factor(self, params: Params | None = None) -> str | None:
+        tau = float((params or {}).get("tau", 0.0))
+        return f"1/({tau!r}*s+1)" if tau > 0 else None
 
     def augment_plant(self, plant: Plant, params: Params) -> Plant:
         tau = params.get("tau", 0.0)
@@ -285,6 +296,9 @@ class LagEffect(Effect):
 class ResonanceEffect(Effect):
     """A lightly damped mode ``wn^2/(s^2 + 2 zeta wn s + wn^2)`` in series (unit DC gain).
 
+    ``wn`` is searched on a grid (then golden section); ``zeta`` (as its square
+    root, so it stays >= 0) joins the nominal coefficients in the casadi fit.
+
     Examples
     --------
     >>> G = ResonanceEffect().augment_plant(Plant.from_string("1/(s+1)"), {"wn": 10.0, "zeta": 0.1})
@@ -295,7 +309,8 @@ class ResonanceEffect(Effect):
     name: ClassVar[str] = "resonance"
     side: ClassVar[str] = "linear"
     parameter_names: ClassVar[tuple[str, ...]] = ("wn", "zeta")
-    factor_names: ClassVar[tuple[str, ...]] = ("wn", "zeta")
+    grid_names: ClassVar[tuple[str, ...]] = ("wn",)
+    factor_names: ClassVar[tuple[str, ...]] = ("zeta",)
 
     def off(self) -> Params:
         return {"wn": np.inf, "zeta": 1.0}
@@ -306,10 +321,11 @@ class ResonanceEffect(Effect):
     def grid(self, t: np.ndarray, u: np.ndarray, plant: Plant) -> list[Params]:
         nyquist = np.pi / float(t[1] - t[0])
         lo = min(2.0 * _fastest_pole(plant), nyquist / 20)
-        return [{"wn": float(w), "zeta": 0.2} for w in np.geomspace(lo, nyquist / 5, 4)]
+        return [{"wn": float(w), "zeta": 0.2} for w in np.geomspace(lo, nyquist / 5, 6)]
 
-    def factor(self) -> str:
-        return "wn^2/(s^2+2*zeta*wn*s+wn^2)"
+    def factor(self, params: Params | None = None) -> str:
+        wn = float((params or {}).get("wn", 1.0))
+        return f"{wn**2!r}/(s^2+2*zeta^2*{wn!r}*s+{wn**2!r})"
 
     def augment_plant(self, plant: Plant, params: Params) -> Plant:
         wn, zeta = params.get("wn", np.inf), params.get("zeta", 1.0)

@@ -196,12 +196,9 @@ def _linear_fit(plant: Plant, effect: Effect, params: Params, t: np.ndarray, v: 
                 formula: str, start: dict[str, float]) -> tuple[Plant, Params, dict[str, float],
                                                                  dict[str, tuple[float, float]], dict[str, Any]]:
     """casadi fit of the nominal coefficients and the effect's factor parameters on the plant input ``v``."""
-    factor = effect.factor()
+    factor = effect.factor(params)
     full = f"({formula})*{factor}" if factor else formula
-    init = dict(start)
-    for name in effect.factor_names:
-        if name != "delay":
-            init[name] = float(params[name])
+    init = {**start, **effect.to_factor(params)}
     fit_delay = "delay" in effect.factor_names
     if fit_delay:
         init["delay"] = plant.delay + float(params.get("delay", 0.0))
@@ -209,17 +206,19 @@ def _linear_fit(plant: Plant, effect: Effect, params: Params, t: np.ndarray, v: 
     res = fit_structure(rec, full, delay="fit" if fit_delay else plant.delay, initial=init)
     new = dict(params)
     ci: dict[str, tuple[float, float]] = {}
-    for name in effect.factor_names:
-        if name == "delay":
-            new["delay"] = res.delay - plant.delay
-            lo, hi = res.ci95.get("delay", (res.delay, res.delay))
-            ci["delay"] = (lo - plant.delay, hi - plant.delay)
-        else:
-            new[name] = float(res.parameters[name])
-            ci[name] = tuple(map(float, res.ci95[name]))  # type: ignore[assignment]
+    names = [k for k in effect.factor_names if k != "delay"]
+    new.update(effect.from_factor({k: res.parameters[k] for k in names}))
+    for k in names:  # the structure holds the square root: map the interval's ends (0 if it spans zero)
+        lo, hi = res.ci95[k]
+        ends = sorted(effect.from_factor({k: x})[k] for x in (lo, hi))
+        ci[k] = (0.0 if lo < 0 < hi else ends[0], ends[1])
+    if "delay" in effect.factor_names:
+        new["delay"] = res.delay - plant.delay
+        lo, hi = res.ci95.get("delay", (res.delay, res.delay))
+        ci["delay"] = (lo - plant.delay, hi - plant.delay)
     nominal = {k: float(res.parameters[k]) for k in start}
-    nominal["delay"] = float(res.delay)
-    return _plant_from(plant, nominal, res.delay), new, nominal, ci, dict(res.solver)
+    nominal["delay"] = plant.delay  # an extra delay is the effect's parameter, not the nominal's
+    return _plant_from(plant, nominal, plant.delay), new, nominal, ci, dict(res.solver)
 
 
 def _basis_step(effect: Effect, G: Plant, params: Params, t: np.ndarray, u: np.ndarray, y: np.ndarray,

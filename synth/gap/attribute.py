@@ -1,0 +1,444 @@
+"""Which effect closes the gap, and how far: nested augmentations judged on held-out data.
+
+Procedure (:func:`diagnose_effects`)
+-----------------------------------
+1. **Split.** With a validation record the fits use the whole record and the
+   held-out data is the validation record. Without one, the first
+   ``train_fraction`` of the record trains and the rest is held out (one
+   contiguous block: the model is simulated over the whole record from rest,
+   so the held-out part starts from the state the data put it in). The
+   held-out samples are cut into ``blocks`` contiguous segments for the
+   bootstrap.
+2. **Fits.** The nominal model (only its output constant fitted on the
+   training part), the re-fit of its coefficients alone
+   (``parameter_mismatch``) and every candidate effect with the nominal
+   coefficients re-fitted jointly (:func:`synth.gap.refit.fit_augmented`).
+3. **Held-out cost** ``J = mean((y - yhat)^2)`` over the held-out samples;
+   the shrinkage of an effect is ``1 - J_with / J_without`` with ``J_without``
+   the re-fit alone, the shrinkage of ``parameter_mismatch`` is
+   ``1 - J_refit / J_nominal``. Intervals (95 %) resample the held-out
+   segments with replacement (the same draws for every model).
+4. **Noise floor** ``sigma^2`` from the re-fit's held-out residual: the median
+   absolute deviation of its second difference, ``sigma = 1.4826 MAD /
+   sqrt(6)`` (white measurement noise; slow model errors barely enter a second
+   difference and steps are outliers a median ignores). *None*: the nominal
+   model's held-out ``J / sigma^2`` is not above ``1 + relevance`` (upper end
+   of its interval below, or lower end not above).
+5. **Calibration** by parametric bootstrap of the re-fit: ``n_null`` records
+   are simulated from the re-fitted model plus white noise of the floor's
+   variance, the re-fit is repeated on each, and the held-out shrinkage a
+   *perfect* model achieves against that re-fit, ``1 - J_true / J_refit``,
+   is recorded. Its ``1 - alpha`` quantile is what estimating the nominal
+   parameters from noisy data leaves on the table by chance: an effect is
+   *significant* when the lower end of its shrinkage interval exceeds it, and
+   *relevant* when it also explains at least ``min_share`` of the re-fit's
+   held-out excess over the noise floor.
+6. **Verdict.** The significant, relevant effect with the lowest held-out
+   ``J`` is the answer; ``["parameter_mismatch"]`` if none is but the re-fit
+   shrinks the gap significantly; ``[]`` when there is no gap.
+   Candidates whose held-out ``J`` does not differ from the winner's beyond the
+   bootstrap interval and whose held-out outputs differ by less than the noise
+   floor's standard deviation are *indistinguishable* from it, reported as a
+   group with the experiment that would separate them.
+
+Only one effect is attributed per diagnosis; a second effect on top of the
+first (nested forward selection) is not attempted.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from synth.data.record import Record
+from synth.errors import ModelError
+from synth.gap.effects import Effect, make_effect
+from synth.gap.refit import AugmentedFit, fit_augmented
+from synth.ident.simulate import simulate_plant
+from synth.plant import Plant
+
+DEFAULT_CANDIDATES: tuple[str, ...] = (
+    "delay", "lag", "lag(sensor)", "resonance", "rate_limit", "saturation", "deadzone", "backlash",
+    "quantization", "supply_sag", "static_nonlinearity", "drift")
+"""Every effect of :mod:`synth.gap.effects` (both placements of the lag)."""
+
+SEPARATING_EXPERIMENTS: dict[frozenset[str], str] = {
+    frozenset({"delay", "lag"}): "a sweep to higher frequency: a delay's phase keeps falling linearly with "
+                                 "frequency, an extra lag's stops at -90 deg",
+    frozenset({"lag", "lag(sensor)"}): "log the actuator output (or inject a known excitation at the output): "
+                                       "an actuator lag shows in the actuator signal, a sensor lag does not",
+    frozenset({"rate_limit", "lag"}): "steps of several amplitudes: a rate limit slows only the large ones, "
+                                      "a lag slows all of them in proportion",
+    frozenset({"rate_limit", "delay"}): "steps of several amplitudes: a rate limit's lag grows with the step, "
+                                        "a delay's does not",
+    frozenset({"saturation", "static_nonlinearity"}): "a slow staircase over the whole input range: a "
+                                                      "saturation is flat beyond its limit, a smooth map bends",
+    frozenset({"deadzone", "backlash"}): "small reversals around one operating point: backlash loses motion "
+                                         "at every reversal, a dead zone only near its center",
+    frozenset({"drift", "supply_sag"}): "repeat the same step early and late in the run: drift changes the "
+                                        "level, sag the transient",
+}
+"""Experiments that separate two effects the data could not tell apart."""
+
+
+def _noise_sigma(e: np.ndarray) -> float:
+    """Robust white-noise standard deviation from the second difference (MAD)."""
+    d2 = np.diff(np.asarray(e, float), 2)
+    if d2.size < 3:
+        raise ModelError("too few held-out samples to estimate the noise floor", where="record")
+    mad = float(np.median(np.abs(d2 - np.median(d2))))
+    return 1.4826 * mad / np.sqrt(6.0)
+
+
+def _block_ids(n_held: int, blocks: int) -> np.ndarray:
+    edges = np.linspace(0, n_held, blocks + 1).round().astype(int)
+    return np.repeat(np.arange(blocks), np.diff(edges))
+
+
+def _block_sums(e2: np.ndarray, ids: np.ndarray, blocks: int) -> np.ndarray:
+    return np.bincount(ids, weights=e2, minlength=blocks)
+
+
+@dataclass(frozen=True)
+class EffectResult:
+    """One candidate effect judged on held-out data.
+
+    Attributes
+    ----------
+    effect : str
+    parameters : dict
+        Fitted effect parameters.
+    parameter_ci : dict
+        Their approximate 95 % intervals (see :mod:`synth.gap.refit`).
+    shrinkage : float
+        ``1 - J_with / J_without`` on held-out data (``J_without``: the re-fit alone).
+    shrinkage_ci : tuple of float
+        95 % bootstrap interval over held-out segments.
+    significant : bool
+        Lower end of ``shrinkage_ci`` above the calibrated threshold.
+    share_of_gap : float
+        ``(J_nominal - J_with) / (J_nominal - sigma^2)``: part of the nominal model's
+        held-out excess over the noise floor this model removes.
+    accepted : bool
+        In the verdict.
+    j_heldout : float
+        Held-out mean squared error (output units squared).
+    nominal : dict
+        Nominal coefficients re-fitted with the effect.
+    """
+
+    effect: str
+    parameters: dict[str, float]
+    parameter_ci: dict[str, tuple[float, float]]
+    shrinkage: float
+    shrinkage_ci: tuple[float, float]
+    significant: bool
+    share_of_gap: float
+    accepted: bool
+    j_heldout: float
+    nominal: dict[str, float]
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON entry of ``"effects"``.
+
+        Examples
+        --------
+        >>> r = EffectResult("delay", {"delay": 0.01}, {"delay": (0.009, 0.011)}, 0.8, (0.7, 0.9), True, 0.8,
+        ...                  True, 1.0, {"n0": 2.0})
+        >>> r.to_dict()["shrinkage_ci"], r.to_dict()["accepted"]
+        ([0.7, 0.9], True)
+        """
+        return {"effect": self.effect, "parameters": dict(self.parameters),
+                "parameter_ci": {k: [float(a), float(b)] for k, (a, b) in self.parameter_ci.items()},
+                "shrinkage": self.shrinkage, "shrinkage_ci": [float(x) for x in self.shrinkage_ci],
+                "significant": self.significant, "share_of_gap": self.share_of_gap, "accepted": self.accepted,
+                "j_heldout": self.j_heldout, "nominal": dict(self.nominal)}
+
+
+@dataclass(frozen=True, eq=False)
+class EffectDiagnosis:
+    """Which effect explains the gap and how far it shrinks on held-out data.
+
+    Attributes
+    ----------
+    effects : list of EffectResult
+        Every candidate, largest shrinkage first.
+    verdict : dict
+        ``effects`` (accepted, most important first; ``[]`` for none,
+        ``["parameter_mismatch"]`` when only the re-fit was needed),
+        ``indistinguishable`` (groups), ``experiments`` (one per group),
+        ``status`` and ``headline``.
+    noise_floor : float
+        ``sigma^2`` (output units squared).
+    j_nominal, j_refit : float
+        Held-out mean squared errors of the nominal model and the re-fit.
+    refit_shrinkage, refit_shrinkage_ci
+        ``1 - J_refit / J_nominal`` and its interval.
+    threshold : float
+        Calibrated shrinkage an effect must exceed (parametric bootstrap).
+    refit : AugmentedFit
+    split : dict
+        Training / held-out samples, blocks, bootstrap sizes.
+    t, y, y_nominal, y_refit, y_best, heldout
+        Held-out-side arrays for the overlay figure (not in ``to_dict``).
+    """
+
+    effects: list[EffectResult]
+    verdict: dict[str, Any]
+    noise_floor: float
+    j_nominal: float
+    j_refit: float
+    refit_shrinkage: float
+    refit_shrinkage_ci: tuple[float, float]
+    threshold: float
+    refit: AugmentedFit
+    split: dict[str, Any]
+    t: np.ndarray = field(repr=False)
+    y: np.ndarray = field(repr=False)
+    y_nominal: np.ndarray = field(repr=False)
+    y_refit: np.ndarray = field(repr=False)
+    y_best: np.ndarray | None = field(repr=False)
+    heldout: np.ndarray = field(repr=False)
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON: ``effects``, ``verdict``, noise floor, re-fit, threshold, split.
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> from synth.data import record_from_arrays
+        >>> t = np.arange(0, 8, 0.01); u = np.where((t % 2) >= 1, 1.0, 0.0)
+        >>> G = Plant.from_string("2/(0.2*s+1)")
+        >>> y = simulate_plant(G, t, u) + 0.01 * np.random.default_rng(1).normal(size=t.size)
+        >>> d = diagnose_effects(G, record_from_arrays(t, u, y), candidates=["delay"], n_null=5).to_dict()
+        >>> d["verdict"]["effects"], d["verdict"]["status"]
+        ([], 'none')
+        """
+        return {"effects": [e.to_dict() for e in self.effects], "verdict": dict(self.verdict),
+                "noise_floor": self.noise_floor, "noise_std": float(np.sqrt(self.noise_floor)),
+                "j_nominal": self.j_nominal, "j_refit": self.j_refit,
+                "parameter_mismatch": {"shrinkage": self.refit_shrinkage,
+                                       "shrinkage_ci": [float(x) for x in self.refit_shrinkage_ci],
+                                       "refit": self.refit.to_dict()},
+                "threshold": self.threshold, "split": dict(self.split)}
+
+
+def _experiment(a: str, b: str, t: np.ndarray, ya: np.ndarray, yb: np.ndarray) -> str:
+    key = frozenset({a, b})
+    if key in SEPARATING_EXPERIMENTS:
+        return f"{a} vs {b}: {SEPARATING_EXPERIMENTS[key]}"
+    k = int(np.argmax(np.abs(ya - yb)))
+    return (f"{a} vs {b}: excite the regime where their outputs differ most (held-out t = {t[k]:.3g} s, "
+            f"difference {abs(ya[k] - yb[k]):.3g})")
+
+
+def diagnose_effects(plant: Plant, record: Record, validate: Record | None = None,
+                     candidates: list[str | Effect] | tuple[str, ...] = DEFAULT_CANDIDATES,
+                     train_fraction: float = 0.5, blocks: int = 10, n_null: int = 19, n_boot: int = 1000,
+                     alpha: float = 0.05, relevance: float = 0.1, min_share: float = 0.25,
+                     seed: int = 0) -> EffectDiagnosis:
+    """Attribute the gap between ``plant`` and ``record`` to one effect, and measure its shrinkage.
+
+    Parameters
+    ----------
+    plant : Plant
+        The nominal model (exact delay), driven by the record's input.
+    record : Record
+        Measured command and output, starting at rest.
+    validate : Record, optional
+        Held-out record; without it the record is split (see the module text).
+    candidates : sequence of str or Effect
+        Effects to try (names of :data:`synth.gap.effects.EFFECTS`, or ``"lag(sensor)"``).
+    train_fraction : float
+        Part of the record used for fitting when there is no validation record.
+    blocks : int
+        Held-out segments for the bootstrap.
+    n_null : int
+        Parametric-bootstrap replicates of the re-fit (calibration).
+    n_boot : int
+        Segment-bootstrap draws (intervals).
+    alpha : float
+        Level of the calibrated threshold (one-sided).
+    relevance : float
+        Held-out excess over the noise floor, relative to it, below which there is no gap.
+    min_share : float
+        Part of the re-fit's held-out excess over noise an effect must remove to be relevant.
+    seed : int
+        Seed of the bootstrap draws.
+
+    Returns
+    -------
+    EffectDiagnosis
+
+    Raises
+    ------
+    ModelError
+        Bad options, unknown candidates, or too few samples.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from synth.data import record_from_arrays
+    >>> t = np.arange(0, 12, 0.01); u = np.where((t % 2) >= 1, 1.0, 0.0)
+    >>> y = simulate_plant(Plant.from_string("2/(0.2*s+1)", delay=0.05), t, u)
+    >>> y = y + 0.005 * np.random.default_rng(0).normal(size=t.size)
+    >>> dg = diagnose_effects(Plant.from_string("2.1/(0.2*s+1)"), record_from_arrays(t, u, y),
+    ...                       candidates=["delay"], n_null=5)
+    >>> dg.verdict["effects"], round(dg.effects[0].parameters["delay"], 3), dg.effects[0].shrinkage > 0.9
+    (['delay'], 0.05, True)
+    """
+    if not 0.1 <= train_fraction <= 0.9:
+        raise ModelError(f"must be in [0.1, 0.9], got {train_fraction!r}", where="train_fraction")
+    if blocks < 3 or n_null < 1 or n_boot < 10:
+        raise ModelError("need blocks >= 3, n_null >= 1 and n_boot >= 10", where="diagnose_effects")
+    effects = [make_effect(c) for c in candidates]
+    labels = [e.label for e in effects]
+    if len(set(labels)) != len(labels):
+        raise ModelError(f"repeated candidates in {labels}", where="candidates")
+    rng = np.random.default_rng(seed)
+    if validate is None:
+        k = round(train_fraction * record.n)
+        t_tr, u_tr, y_tr = record.t[:k], record.u[:k], record.y[:k]
+        t_ev, u_ev, y_ev = record.t, record.u, record.y
+        held = np.arange(record.n) >= k
+    else:
+        t_tr, u_tr, y_tr = record.t, record.u, record.y
+        t_ev, u_ev, y_ev = validate.t, validate.u, validate.y
+        held = np.ones(validate.n, bool)
+    n_held = int(held.sum())
+    if n_held < 10 * blocks:
+        raise ModelError(f"{n_held} held-out samples are too few for {blocks} segments", where="record")
+    ids = _block_ids(n_held, blocks)
+    draws = rng.integers(0, blocks, size=(n_boot, blocks))
+    counts = np.bincount(ids, minlength=blocks).astype(float)
+    boot_n = counts[draws].sum(axis=1)
+
+    def sums(yhat: np.ndarray) -> np.ndarray:
+        return _block_sums((y_ev[held] - yhat[held]) ** 2, ids, blocks)
+
+    def boot(s: np.ndarray) -> np.ndarray:
+        return s[draws].sum(axis=1) / boot_n
+
+    def ratio_ci(num: np.ndarray, den: np.ndarray) -> tuple[float, float]:
+        r = 1.0 - boot(num) / boot(den)
+        return float(np.quantile(r, 0.025)), float(np.quantile(r, 0.975))
+
+    c_nom = float(np.mean(y_tr - simulate_plant(plant, t_tr, u_tr)))
+    y_nom = simulate_plant(plant, t_ev, u_ev) + c_nom
+    refit = fit_augmented(plant, t_tr, u_tr, y_tr)
+    y_ref = refit.predict(t_ev, u_ev)
+    s_nom, s_ref = sums(y_nom), sums(y_ref)
+    j_nom, j_ref = float(s_nom.sum() / n_held), float(s_ref.sum() / n_held)
+    sigma = _noise_sigma((y_ev - y_ref)[held])
+    floor = sigma**2
+    pm_shrink = 1.0 - j_ref / j_nom if j_nom > 0 else 0.0
+    pm_ci = ratio_ci(s_ref, s_nom)
+    excess_nom = boot(s_nom) / floor - 1.0
+    excess_ref = boot(s_ref) / floor - 1.0
+    gap_present = float(np.quantile(excess_nom, 0.025)) > relevance
+    gap_after_refit = float(np.quantile(excess_ref, 0.025)) > relevance
+
+    # calibration: parametric bootstrap of the re-fit
+    null = []
+    y_ref_tr = refit.predict(t_tr, u_tr)
+    for _ in range(n_null):
+        n_tr = sigma * rng.standard_normal(t_tr.size)
+        if validate is None:
+            noise = np.r_[n_tr, sigma * rng.standard_normal(t_ev.size - t_tr.size)]
+        else:
+            noise = sigma * rng.standard_normal(t_ev.size)
+        fit_b = fit_augmented(refit.plant, t_tr, u_tr, y_ref_tr + n_tr)
+        y_b = y_ref + noise
+        j_fit = float(np.mean((y_b - fit_b.predict(t_ev, u_ev))[held] ** 2))
+        j_true = float(np.mean(noise[held] ** 2))
+        null.append(1.0 - j_true / j_fit)
+    threshold = float(np.quantile(null, 1.0 - alpha, method="higher"))
+
+    fits: list[tuple[Effect, AugmentedFit, np.ndarray, np.ndarray]] = []
+    for eff in effects:
+        try:
+            fit = fit_augmented(plant, t_tr, u_tr, y_tr, eff)
+        except ModelError:
+            continue
+        yhat = fit.predict(t_ev, u_ev)
+        fits.append((eff, fit, yhat, sums(yhat)))
+
+    results: list[tuple[EffectResult, np.ndarray, np.ndarray]] = []
+    for eff, fit, yhat, s in fits:
+        j = float(s.sum() / n_held)
+        shrink = 1.0 - j / j_ref if j_ref > 0 else 0.0
+        ci = ratio_ci(s, s_ref)
+        share = (j_nom - j) / (j_nom - floor) if j_nom > floor else 0.0
+        share_ref = (j_ref - j) / (j_ref - floor) if j_ref > floor else 0.0
+        significant = bool(gap_present and ci[0] > threshold)
+        relevant = bool(significant and share_ref >= min_share)
+        params = {k: float(fit.params[k]) for k in eff.parameter_names}
+        res = EffectResult(eff.label, params, fit.parameter_ci, shrink, ci, significant, float(share), relevant, j,
+                           dict(fit.nominal))
+        results.append((res, yhat, s))
+    results.sort(key=lambda r: -r[0].shrinkage)
+
+    relevant = [r for r in results if r[0].accepted]
+    indist: list[list[str]] = []
+    experiments: list[str] = []
+    y_best = None
+    if not gap_present:
+        verdict_effects: list[str] = []
+        status = "none"
+    elif relevant:
+        best, y_best, s_best = relevant[0]
+        verdict_effects = [best.effect]
+        status = "effect"
+        group = [best.effect]
+        for res, yhat, s in results:
+            if res.effect == best.effect or not res.significant:
+                continue
+            d = (boot(s) - boot(s_best)) / boot(s_ref)
+            same_j = float(np.quantile(d, 0.025)) <= 0.0 <= float(np.quantile(d, 0.975))
+            close = float(np.sqrt(np.mean((yhat - y_best)[held] ** 2))) < sigma
+            if same_j and close:
+                group.append(res.effect)
+                experiments.append(_experiment(best.effect, res.effect, t_ev[held], y_best[held], yhat[held]))
+        if len(group) > 1:
+            indist.append(group)
+        results = [(r if r.effect == best.effect else _unaccept(r), y, s) for r, y, s in results]
+    elif pm_ci[0] > 0.0:
+        verdict_effects = ["parameter_mismatch"]
+        status = "unexplained" if gap_after_refit else "parameter_mismatch"
+    else:
+        verdict_effects = []
+        status = "unexplained"
+    headline = _headline(status, verdict_effects, indist, results, pm_shrink, j_nom, floor)
+    verdict = {"effects": verdict_effects, "indistinguishable": indist, "experiments": experiments,
+               "status": status, "headline": headline}
+    split = {"train_samples": int(t_tr.size), "heldout_samples": n_held, "blocks": blocks, "n_null": n_null,
+             "n_boot": n_boot, "alpha": alpha, "validation_record": validate is not None, "seed": seed}
+    return EffectDiagnosis([r for r, _, _ in results], verdict, floor, j_nom, j_ref, pm_shrink, pm_ci, threshold,
+                           refit, split, t_ev, y_ev, y_nom, y_ref, y_best, held)
+
+
+def _unaccept(r: EffectResult) -> EffectResult:
+    from dataclasses import replace
+
+    return replace(r, accepted=False)
+
+
+def _headline(status: str, effects: list[str], indist: list[list[str]], results: list[Any], pm: float,
+              j_nom: float, floor: float) -> str:
+    if status == "none":
+        return (f"no gap: the nominal model's held-out error is within the noise floor "
+                f"(J/sigma^2 = {j_nom / floor:.2f})")
+    if status == "effect":
+        best = next(r for r, _, _ in results if r.effect == effects[0])
+        text = (f"{best.effect}: held-out shrinkage {best.shrinkage:.2f} "
+                f"[{best.shrinkage_ci[0]:.2f}, {best.shrinkage_ci[1]:.2f}] beyond the re-fit, "
+                f"{100 * best.share_of_gap:.0f} % of the gap above noise")
+        if indist:
+            text += "; not separable from " + ", ".join(indist[0][1:])
+        return text
+    if status == "parameter_mismatch":
+        return f"parameter mismatch: re-fitting the nominal coefficients shrinks the held-out error by {pm:.2f}"
+    return "gap not explained by the candidate effects" + (
+        f" (the re-fit shrinks it by {pm:.2f})" if effects else "")
