@@ -39,7 +39,8 @@ def test_issue_example_loads(tmp_path):
 BAD = {
     "unknown key": (EXAMPLE + "colour: red\n", "16: colour: unknown key 'colour'"),
     "unknown nested key": (EXAMPLE.replace("  delay: 0.0", "  dlay: 0.0"), "5: plant.dlay: unknown key 'dlay'; did you mean 'delay'?"),
-    "missing field": (EXAMPLE.replace('  tf: "23*(s+0.43)/((s+9.6)*(s+0.54))"\n', ""), "plant.tf: missing (required)"),
+    "missing field": (EXAMPLE.replace("controller:\n  type: P\n", "controller:\n"), "controller.type: missing (required)"),
+    "missing plant model": (EXAMPLE.replace('  tf: "23*(s+0.43)/((s+9.6)*(s+0.54))"\n', ""), "3: plant: give exactly one of 'tf' (a transfer function) or 'identify'"),
     "wrong type": (EXAMPLE.replace("min: 60", "min: sixty"), "13: requirements[1].min: expected a number, got 'sixty'"),
     "negative band": (EXAMPLE.replace("band: [0.1, 100]", "band: [-1, 100]"), "requirements[2].band: band must be non-negative"),
     "reversed band": (EXAMPLE.replace("band: [0.1, 100]", "band: [100, 0.1]"), "requirements[2].band: band must be [low, high] with low < high, got [100, 0.1]"),
