@@ -16,15 +16,7 @@ import numpy as np
 
 from synth.ident.freqfit import FreqFit, StepVerification
 from synth.ident.spectra import FrequencyResponse
-
-_METADATA = {"Software": "synth"}
-
-
-def _save(fig: plt.Figure, path: Path) -> Path:
-    fig.tight_layout()
-    fig.savefig(path, dpi=110, metadata=_METADATA)
-    plt.close(fig)
-    return Path(path)
+from synth.report.png import save_figure
 
 
 def bode_figure(resp: FrequencyResponse, path: str | Path, fit: FreqFit | None = None) -> Path:
@@ -69,7 +61,7 @@ def bode_figure(resp: FrequencyResponse, path: str | Path, fit: FreqFit | None =
     ax_c.set_xlabel("frequency [rad/s]  (shaded: coherent band)")
     ax_m.set_title(f"{resp.output} / {resp.input}")
     ax_m.legend(loc="best", fontsize=8)
-    return _save(fig, Path(path))
+    return save_figure(fig, Path(path))
 
 
 def verification_figure(v: StepVerification, path: str | Path, label: str = "model") -> Path:
@@ -94,4 +86,4 @@ def verification_figure(v: StepVerification, path: str | Path, label: str = "mod
     ax_y.legend(loc="best", fontsize=8)
     for ax in (ax_y, ax_u):
         ax.grid(True, alpha=0.3)
-    return _save(fig, Path(path))
+    return save_figure(fig, Path(path))

@@ -18,8 +18,7 @@ from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter
 
 from synth.errors import ModelError
 from synth.ident.hq import GAIN_MARGIN_DB, HQMetrics
-
-_METADATA = {"Software": "synth"}
+from synth.report.png import save_figure
 
 
 def hq_bode(m: HQMetrics, path: str | Path, title: str = "") -> Path:
@@ -107,8 +106,4 @@ def hq_bode(m: HQMetrics, path: str | Path, title: str = "") -> Path:
         ax.xaxis.set_major_locator(LogLocator(subs=(1.0, 2.0, 5.0)))
         ax.xaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
         ax.xaxis.set_minor_formatter(NullFormatter())
-    fig.tight_layout()
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=110, metadata=_METADATA)
-    plt.close(fig)
-    return path
+    return save_figure(fig, path)

@@ -14,8 +14,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 from synth.ident.psd import PsdAnalysis, unit_squared
-
-_METADATA = {"Software": "synth"}
+from synth.report.png import save_figure
 
 
 def psd_plot(a: PsdAnalysis, path: str | Path, title: str = "") -> Path:
@@ -56,8 +55,4 @@ def psd_plot(a: PsdAnalysis, path: str | Path, title: str = "") -> Path:
     ax.legend(fontsize=8, loc="upper right")
     if title:
         ax.set_title(title, fontsize=10)
-    fig.tight_layout()
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=110, metadata=_METADATA)
-    plt.close(fig)
-    return path
+    return save_figure(fig, path)

@@ -16,15 +16,7 @@ import numpy as np  # noqa: F401  (doctest namespace)
 
 from synth.data.record import Record
 from synth.ident.timefit import TimeFitResult
-
-_METADATA = {"Software": "synth"}
-
-
-def _save(fig: plt.Figure, path: Path) -> Path:
-    fig.tight_layout()
-    fig.savefig(path, dpi=110, metadata=_METADATA)
-    plt.close(fig)
-    return Path(path)
+from synth.report.png import save_figure
 
 
 def _label(name: str, unit: str) -> str:
@@ -63,7 +55,7 @@ def fit_figure(fit: TimeFitResult, path: str | Path, title: str = "") -> Path:
     ax_r.set_xlabel("time [s]")
     ax_r.grid(alpha=0.3)
     ax_r.legend(loc="upper right", fontsize=8)
-    return _save(fig, Path(path))
+    return save_figure(fig, Path(path))
 
 
 def train_figure(record: Record, path: str | Path, max_points: int = 20000) -> Path:
@@ -87,4 +79,4 @@ def train_figure(record: Record, path: str | Path, max_points: int = 20000) -> P
     ax_y.grid(alpha=0.3)
     note = f" (every {stride}th sample drawn)" if stride > 1 else ""
     ax_u.set_title(f"{record.source}{note}", fontsize=9)
-    return _save(fig, Path(path))
+    return save_figure(fig, Path(path))

@@ -17,19 +17,13 @@ import numpy as np
 
 from synth.freqgrid import log_grid
 from synth.loop import Loop
+from synth.report.png import save_figure
 from synth.requirements import Sensitivity, SlewRate, StaticSensitivity
 from synth.requirements.sensitivity import PeakSensitivity
 from synth.timeresp import default_horizon, step_response
 
-_METADATA = {"Software": "synth"}
 COLORS = ["#1f4e9c", "#c0392b", "#2e8b57", "#8e44ad", "#d35400"]
 
-
-def _save(fig: plt.Figure, path: Path) -> Path:
-    fig.tight_layout()
-    fig.savefig(path, dpi=110, metadata=_METADATA)
-    plt.close(fig)
-    return path
 
 
 def _db(x: np.ndarray) -> np.ndarray:
@@ -65,7 +59,7 @@ def bode_with_slew_bound(loops: list[tuple[str, Loop]], slew: list[SlewRate], pa
     ax.set_title("Compensated loop against the slew-rate bound (seed eq. 12); shaded: bound's band")
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=8, loc="lower left")
-    return _save(fig, path)
+    return save_figure(fig, path)
 
 
 def sensitivity_plot(loops: list[tuple[str, Loop]], requirements: list[Any], path: Path) -> Path:
@@ -91,7 +85,7 @@ def sensitivity_plot(loops: list[tuple[str, Loop]], requirements: list[Any], pat
     ax.set_title("Sensitivity: disturbance attenuation (below 0 dB) and amplification")
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=8, loc="lower right")
-    return _save(fig, path)
+    return save_figure(fig, path)
 
 
 def step_plot(loops: list[tuple[str, Loop]], path: Path, scale: float = 1.0, unit: str = "",
@@ -118,7 +112,7 @@ def step_plot(loops: list[tuple[str, Loop]], path: Path, scale: float = 1.0, uni
     ax.set_title("Linear step response (reference step)")
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize=8, loc="lower right")
-    return _save(fig, path)
+    return save_figure(fig, path)
 
 
 def gain_set_plot(parameter: str, bounds: tuple[float, float], curves: dict[str, tuple[np.ndarray, np.ndarray]],
@@ -140,7 +134,7 @@ def gain_set_plot(parameter: str, bounds: tuple[float, float], curves: dict[str,
     ax.set_title(f"Feasible {parameter} (shaded): every requirement's slack")
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize=8, loc="best")
-    return _save(fig, path)
+    return save_figure(fig, path)
 
 
 def delay_chart(rows: list[dict[str, Any]], marks: dict[str, float], path: Path) -> Path:
@@ -157,7 +151,7 @@ def delay_chart(rows: list[dict[str, Any]], marks: dict[str, float], path: Path)
     ax.set_title("Which gains stay stable if the delay is inside the loop")
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=8)
-    return _save(fig, path)
+    return save_figure(fig, path)
 
 
 def feasibility_map(spec: Any, design_controller: Any, path: Path, n: int = 70,
@@ -207,4 +201,4 @@ def feasibility_map(spec: Any, design_controller: Any, path: Path, n: int = 70,
     ax.set_title("Feasible parameters (shaded), exact check on a grid")
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize=8, loc="best")
-    return _save(fig, path)
+    return save_figure(fig, path)

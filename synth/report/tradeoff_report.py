@@ -11,7 +11,8 @@ import numpy as np
 from jinja2 import Environment, PackageLoader
 
 from synth.outputs import GENERATOR, OutputDir, dump_json
-from synth.report.figures import COLORS, _save, plt
+from synth.report.figures import COLORS, plt
+from synth.report.png import save_figure
 from synth.requirements.base import fmt
 from synth.synthesis.tradeoff import TradeoffResult
 
@@ -102,7 +103,7 @@ def tradeoff_figure(result: TradeoffResult, path: Path) -> Path:
     ax.set_title(f"Trade-off: {result.spec}")
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize=8, loc="best")
-    return _save(fig, path)
+    return save_figure(fig, path)
 
 
 def write_tradeoff_report(result: TradeoffResult, out_dir: str | Path, command: str = "",

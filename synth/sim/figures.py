@@ -15,17 +15,11 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
 
+from synth.report.png import save_figure
 from synth.sim.simulator import SimResult
 
-_METADATA = {"Software": "synth"}
 COLORS = ["#1f4e9c", "#c0392b", "#2e8b57", "#8e44ad", "#d35400", "#7f8c8d"]
 
-
-def _save(fig: plt.Figure, path: Path) -> Path:
-    fig.tight_layout()
-    fig.savefig(path, dpi=110, metadata=_METADATA)
-    plt.close(fig)
-    return path
 
 
 def step_comparison(runs: dict[str, dict[str, SimResult]], path: Path, units: dict[str, str],
@@ -85,7 +79,7 @@ def step_comparison(runs: dict[str, dict[str, SimResult]], path: Path, units: di
     ax_u.set_ylim(lo - pad, hi + pad)  # linear actuator signals may run far outside: see the legend
     if t_end is not None:
         ax_u.set_xlim(first.t[0], t_end)
-    return _save(fig, path)
+    return save_figure(fig, path)
 
 
 def onset_chart(onset: dict[str, Any], continuous: list[dict[str, Any]], marks: dict[str, float], path: Path,
@@ -126,7 +120,7 @@ def onset_chart(onset: dict[str, Any], continuous: list[dict[str, Any]], marks: 
     ax.set_title("Onset of sustained oscillation (triangles: none up to the top of the range)")
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=8, loc="upper right")
-    return _save(fig, path)
+    return save_figure(fig, path)
 
 
 def rise_vs_rate_chart(sweep: dict[str, Any], unit: str, path: Path) -> Path:
@@ -150,4 +144,4 @@ def rise_vs_rate_chart(sweep: dict[str, Any], unit: str, path: Path) -> Path:
     ax.set_title("Which rate limit reproduces the measured rise time")
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=8)
-    return _save(fig, path)
+    return save_figure(fig, path)

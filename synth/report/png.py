@@ -1,0 +1,30 @@
+"""Saving figures: one PNG format for every report (matplotlib's Agg backend, 110 dpi, tagged as synth's)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt
+
+METADATA = {"Software": "synth"}
+
+
+def save_figure(fig: plt.Figure, path: str | Path, dpi: int = 110) -> Path:
+    """Lay out, write ``path`` as PNG (creating its folder) and close ``fig``.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> fig, ax = plt.subplots(); _ = ax.plot([0, 1], [0, 1])
+    >>> save_figure(fig, Path(tempfile.mkdtemp()) / "sub" / "line.png").name
+    'line.png'
+    """
+    path = Path(path)
+    fig.tight_layout()
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path, dpi=dpi, metadata=METADATA)
+    plt.close(fig)
+    return path
