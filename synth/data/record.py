@@ -127,6 +127,62 @@ class Record:
                 "aux": sorted(self.aux), "notes": list(self.notes)}
 
 
+def uniform_columns(
+    columns: Mapping[str, Sequence[float] | np.ndarray], time: str, source: str = "arrays", min_samples: int = 3,
+) -> tuple[np.ndarray, dict[str, np.ndarray], tuple[str, ...]]:
+    """Check columns of numbers on one time base and put them on a uniform grid.
+
+    Returns the time, the other columns (by name) and notes on what was done.
+    Irregular sampling (intervals spread by more than 0.1 %) is resampled by
+    linear interpolation onto the median interval, and a note says so.
+
+    Raises
+    ------
+    DataError
+        Values that are not numbers, NaN or inf, different lengths, fewer than
+        ``min_samples`` samples, non-increasing time; the column is named.
+
+    Examples
+    --------
+    >>> t, cols, notes = uniform_columns({"t": [0, 0.1, 0.25, 0.3], "x": [0, 1, 2, 3]}, "t")
+    >>> t.round(3).tolist(), cols["x"].round(3).tolist(), notes[0].split(":")[0]
+    ([0.0, 0.1, 0.2, 0.3], [0.0, 1.0, 1.667, 3.0], 'resampled')
+    """
+    arrays: dict[str, np.ndarray] = {}
+    for name, values in columns.items():
+        try:
+            a = np.asarray(values, dtype=float).ravel()
+        except (TypeError, ValueError):
+            raise DataError(f"column '{name}': values are not numbers", where=source) from None
+        bad = np.flatnonzero(~np.isfinite(a))
+        if bad.size:
+            raise DataError(f"column '{name}': {bad.size} value(s) are NaN or inf (first at sample {bad[0]})",
+                            where=source)
+        arrays[name] = a
+    lengths = {name: a.size for name, a in arrays.items()}
+    if len(set(lengths.values())) > 1:
+        listed = ", ".join(f"'{k}' {v}" for k, v in lengths.items())
+        raise DataError(f"columns have different lengths ({listed})", where=source)
+    tt = arrays.pop(time)
+    if tt.size < min_samples:
+        raise DataError(f"column '{time}': needs at least {min_samples} samples, got {tt.size}", where=source)
+    steps = np.diff(tt)
+    if np.any(steps <= 0):
+        k = int(np.flatnonzero(steps <= 0)[0]) + 1
+        raise DataError(f"column '{time}': time is not strictly increasing at sample {k} (t = {tt[k]:g} s)",
+                        where=source)
+    notes: tuple[str, ...] = ()
+    spread = (steps.max() - steps.min()) / np.median(steps)
+    if spread > IRREGULAR_TOLERANCE:
+        dt = float(np.median(steps))
+        grid = tt[0] + dt * np.arange(int(np.floor((tt[-1] - tt[0]) / dt + 1e-9)) + 1)
+        notes = (f"resampled: sample intervals ranged {steps.min():.4g}-{steps.max():.4g} s; linearly "
+                 f"interpolated onto a uniform {dt:.4g} s grid ({tt.size} -> {grid.size} samples)",)
+        arrays = {k: np.interp(grid, tt, v) for k, v in arrays.items()}
+        tt = grid
+    return tt, arrays, notes
+
+
 def record_from_arrays(
     t: Sequence[float] | np.ndarray,
     u: Sequence[float] | np.ndarray,
@@ -169,47 +225,14 @@ def record_from_arrays(
     """
     input = input or Signal(names[1], "")
     output = output or Signal(names[2], "")
-    columns = {names[0]: t, names[1]: u, names[2]: y, **dict(aux or {})}
-    arrays: dict[str, np.ndarray] = {}
-    for name, values in columns.items():
-        try:
-            a = np.asarray(values, dtype=float).ravel()
-        except (TypeError, ValueError):
-            raise DataError(f"column '{name}': values are not numbers", where=source) from None
-        bad = np.flatnonzero(~np.isfinite(a))
-        if bad.size:
-            raise DataError(f"column '{name}': {bad.size} value(s) are NaN or inf (first at sample {bad[0]})",
-                            where=source)
-        arrays[name] = a
-    lengths = {name: a.size for name, a in arrays.items()}
-    if len(set(lengths.values())) > 1:
-        listed = ", ".join(f"'{k}' {v}" for k, v in lengths.items())
-        raise DataError(f"columns have different lengths ({listed})", where=source)
-    tt = arrays.pop(names[0])
-    if tt.size < 3:
-        raise DataError(f"column '{names[0]}': a record needs at least 3 samples, got {tt.size}", where=source)
-    steps = np.diff(tt)
-    if np.any(steps <= 0):
-        k = int(np.flatnonzero(steps <= 0)[0]) + 1
-        raise DataError(f"column '{names[0]}': time is not strictly increasing at sample {k} (t = {tt[k]:g} s)",
-                        where=source)
+    tt, arrays, notes = uniform_columns({names[0]: t, names[1]: u, names[2]: y, **dict(aux or {})}, names[0], source)
     uu, yy = arrays.pop(names[1]), arrays.pop(names[2])
     if np.ptp(uu) == 0:
         raise DataError(f"column '{names[1]}': the input is constant ({uu[0]:g}); nothing excites the plant",
                         where=source)
     if np.ptp(yy) == 0:
         raise DataError(f"column '{names[2]}': the output never responds (constant {yy[0]:g})", where=source)
-    notes: list[str] = []
-    spread = (steps.max() - steps.min()) / np.median(steps)
-    if spread > IRREGULAR_TOLERANCE:
-        dt = float(np.median(steps))
-        grid = tt[0] + dt * np.arange(int(np.floor((tt[-1] - tt[0]) / dt + 1e-9)) + 1)
-        notes.append(f"resampled: sample intervals ranged {steps.min():.4g}-{steps.max():.4g} s; linearly "
-                     f"interpolated onto a uniform {dt:.4g} s grid ({tt.size} -> {grid.size} samples)")
-        uu, yy = np.interp(grid, tt, uu), np.interp(grid, tt, yy)
-        arrays = {k: np.interp(grid, tt, v) for k, v in arrays.items()}
-        tt = grid
-    return Record(tt, uu, yy, input, output, arrays, source, tuple(notes))
+    return Record(tt, uu, yy, input, output, arrays, source, notes)
 
 
 def _read_csv(path: Path) -> dict[str, np.ndarray]:

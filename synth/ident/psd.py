@@ -33,6 +33,7 @@ import numpy as np
 from scipy import signal as sps
 from scipy.stats import chi2
 
+from synth.data.record import uniform_columns
 from synth.errors import DataError
 
 #: correlation of adjacent 50 %-overlapped Hann segments' estimates (Welch 1967), for the degrees of freedom
@@ -92,37 +93,10 @@ def disturbance_from_arrays(t: Any, x: Any, name: str = "y", unit: str = "", sou
     Traceback (most recent call last):
     synth.errors.DataError: arrays: column 'time': time is not strictly increasing at sample 5 (t = 4 s)
     """
-    cols = {}
-    for col, values in ((time_name, t), (name, x)):
-        try:
-            a = np.asarray(values, float).ravel()
-        except (TypeError, ValueError):
-            raise DataError(f"column '{col}': values are not numbers", where=source) from None
-        bad = np.flatnonzero(~np.isfinite(a))
-        if bad.size:
-            raise DataError(f"column '{col}': {bad.size} value(s) are NaN or inf (first at sample {bad[0]})",
-                            where=source)
-        cols[col] = a
-    tt, xx = cols[time_name], cols[name]
-    if tt.size != xx.size:
-        raise DataError(f"columns have different lengths ('{time_name}' {tt.size}, '{name}' {xx.size})", where=source)
-    if tt.size < 16:
-        raise DataError(f"column '{name}': a spectrum needs at least 16 samples, got {tt.size}", where=source)
-    steps = np.diff(tt)
-    if np.any(steps <= 0):
-        k = int(np.flatnonzero(steps <= 0)[0]) + 1
-        raise DataError(f"column '{time_name}': time is not strictly increasing at sample {k} (t = {tt[k]:g} s)",
-                        where=source)
+    tt, cols, notes = uniform_columns({time_name: t, name: x}, time_name, source, min_samples=16)
+    xx = cols[name]
     if np.ptp(xx) == 0:
         raise DataError(f"column '{name}': the signal is constant ({xx[0]:g}); it has no spectrum", where=source)
-    notes: tuple[str, ...] = ()
-    spread = (steps.max() - steps.min()) / np.median(steps)
-    if spread > 1e-3:
-        dt = float(np.median(steps))
-        grid = tt[0] + dt * np.arange(int(np.floor((tt[-1] - tt[0]) / dt + 1e-9)) + 1)
-        notes = (f"resampled: sample intervals ranged {steps.min():.4g}-{steps.max():.4g} s; linearly interpolated "
-                 f"onto a uniform {dt:.4g} s grid",)
-        tt, xx = grid, np.interp(grid, tt, xx)
     return DisturbanceRecord(tt, xx, name, unit, source, notes)
 
 
