@@ -18,7 +18,7 @@ Procedure (:func:`diagnose_effects`)
    the re-fit alone, the shrinkage of ``parameter_mismatch`` is
    ``1 - J_refit / J_nominal``. Intervals (95 %) resample the held-out
    segments with replacement (the same draws for every model).
-4. **Noise floor** ``sigma^2`` from the re-fit's held-out residual: the median
+4. **Noise floor** ``sigma^2`` from the re-fit's residual on the evaluated record: the median
    absolute deviation of its second difference, ``sigma = 1.4826 MAD /
    sqrt(6)`` (white measurement noise; slow model errors barely enter a second
    difference and steps are outliers a median ignores). *None*: the nominal
@@ -331,7 +331,7 @@ def diagnose_effects(plant: Plant, record: Record, validate: Record | None = Non
     y_ref = refit.predict(t_ev, u_ev)
     s_nom, s_ref = sums(y_nom), sums(y_ref)
     j_nom, j_ref = float(s_nom.sum() / n_held), float(s_ref.sum() / n_held)
-    sigma = _noise_sigma((y_ev - y_ref)[held])
+    sigma = _noise_sigma(y_ev - y_ref)  # every sample of the evaluated record (more samples, same white noise)
     floor = sigma**2
     pm_shrink = 1.0 - j_ref / j_nom if j_nom > 0 else 0.0
     pm_ci = ratio_ci(s_ref, s_nom)
@@ -359,7 +359,7 @@ def diagnose_effects(plant: Plant, record: Record, validate: Record | None = Non
     fits: list[tuple[Effect, AugmentedFit, np.ndarray, np.ndarray]] = []
     for eff in effects:
         try:
-            fit = fit_augmented(plant, t_tr, u_tr, y_tr, eff)
+            fit = fit_augmented(plant, t_tr, u_tr, y_tr, eff, start=refit.plant)
         except ModelError:
             continue
         yhat = fit.predict(t_ev, u_ev)

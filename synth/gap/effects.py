@@ -275,16 +275,16 @@ class LagEffect(Effect):
         return {"tau": 0.0}
 
     def bounds(self, t: np.ndarray, u: np.ndarray, plant: Plant) -> dict[str, tuple[float, float]]:
-        return {"tau": (0.0, 2.0 / _slowest_pole(plant))}
+        return {"tau": (0.0, 1.0 / _fastest_pole(plant))}
 
     def grid(self, t: np.ndarray, u: np.ndarray, plant: Plant) -> list[Params]:
         dt = float(t[1] - t[0])
-        top = 1.0 / _slowest_pole(plant)
+        top = 1.0 / _fastest_pole(plant)  # an actuator or sensor lag is faster than the plant it is added to
         return [{"tau": float(x)} for x in np.geomspace(dt, max(2 * dt, top), 8)]
 
     def factor(self, params: Params | None = None) -> str | None:
         tau = float((params or {}).get("tau", 0.0))
-        return f"1/({tau!r}*s+1)" if tau > 0 else None
+        return f"{1.0 / tau!r}/(s+{1.0 / tau!r})" if tau > 0 else None  # monic: better scaled for the fit
 
     def augment_plant(self, plant: Plant, params: Params) -> Plant:
         tau = params.get("tau", 0.0)
@@ -344,7 +344,7 @@ def _log_grid(lo: float, hi: float, n: int, name: str) -> list[Params]:
 class RateLimitEffect(Effect):
     """Slew-rate limit ``rate`` [input units/s] on the command (:class:`synth.sim.blocks.RateLimit`).
 
-    The grid runs from a ramp lasting two slowest plant time constants over the
+    The grid runs from a ramp lasting twenty slowest plant time constants over the
     input's span up to the fastest rate in the command (inactive).
 
     Examples
@@ -364,11 +364,11 @@ class RateLimitEffect(Effect):
     def bounds(self, t: np.ndarray, u: np.ndarray, plant: Plant) -> dict[str, tuple[float, float]]:
         dt = float(t[1] - t[0])
         top = float(np.max(np.abs(np.diff(u)))) / dt
-        return {"rate": (0.5 * _span(u) * _slowest_pole(plant), top)}
+        return {"rate": (0.05 * _span(u) * _slowest_pole(plant), top)}
 
     def grid(self, t: np.ndarray, u: np.ndarray, plant: Plant) -> list[Params]:
         lo, hi = self.bounds(t, u, plant)["rate"]
-        return _log_grid(lo, hi, 10, "rate")
+        return _log_grid(lo, hi, 12, "rate")
 
     def input_map(self, u: np.ndarray, dt: float, params: Params) -> np.ndarray:
         rate = params.get("rate", np.inf)

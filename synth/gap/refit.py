@@ -20,7 +20,7 @@ the simulation error ``sum_k (y_k - yhat_k)^2`` with
   best grid point's neighbours, every point a full casadi fit of the rest;
 - the *basis* parameters ``a_j, d_j`` and the output constant ``c`` (linear in
   the output for a given ``G_aug``) by linear least squares, alternating with
-  the casadi fit (three rounds).
+  the casadi fit (until the SSR settles, at most twelve rounds).
 
 Intervals: casadi-fitted parameters carry the Jacobian intervals of
 :class:`synth.ident.timefit.TimeFitResult`; grid parameters a profile interval
@@ -45,7 +45,8 @@ from synth.ident.timefit import fit_structure
 from synth.plant import Plant
 
 _CHI2_1_95 = 3.841458820694124
-_ROUNDS = 3  # alternations of the casadi fit and the least-squares basis step
+_ROUNDS = 12  # most alternations of the casadi fit and the least-squares basis step
+_ROUNDS_TOL = 1e-6  # ... stopped when the training SSR changes less than this (relative)
 _GOLDEN = 12  # most golden-section evaluations after the grid
 _GOLDEN_TOL = 0.01  # ... or until the bracket is this narrow in log
 
@@ -222,15 +223,21 @@ def _linear_fit(plant: Plant, effect: Effect, params: Params, t: np.ndarray, v: 
 
 
 def _basis_step(effect: Effect, G: Plant, params: Params, t: np.ndarray, u: np.ndarray, y: np.ndarray,
-                dt: float) -> tuple[Params, float, dict[str, tuple[float, float]]]:
+                dt: float) -> tuple[Params, float, dict[str, tuple[float, float]], float]:
     """Least squares for the output constant and the basis parameters, the linear model fixed."""
     Gaug = effect.augment_plant(G, params)
     v0 = effect.input_map(u, dt, params)
     cols = [np.ones_like(y)]
-    cols += [simulate_plant(Gaug, t, phi) for phi in effect.input_basis(u, dt, params)]
+    phis = effect.input_basis(u, dt, params)
+    cols += [simulate_plant(Gaug, t, phi) for phi in phis]
     cols += list(effect.output_basis(t))
+    y0 = simulate_plant(Gaug, t, v0)
+    if phis:  # the gain of G moves with the input basis (a ridge that alternation alone climbs slowly)
+        cols.append(y0)
+        target = y.copy()
+    else:
+        target = y - y0
     X = np.column_stack(cols)
-    target = y - simulate_plant(Gaug, t, v0)
     scale = np.maximum(np.sqrt(np.sum(X**2, axis=0)), 1e-300)
     Xs = X / scale
     coef, *_ = np.linalg.lstsq(Xs, target, rcond=None)
@@ -243,12 +250,16 @@ def _basis_step(effect: Effect, G: Plant, params: Params, t: np.ndarray, u: np.n
         cov = s2 * np.linalg.pinv(Xs.T @ Xs)
     coef = coef / scale
     sd = np.sqrt(np.clip(np.diag(cov), 0, None)) / scale
+    gain = float(coef[-1]) if phis else 1.0
+    if phis and not (np.isfinite(gain) and gain > 0):
+        raise ModelError("the input basis step lost the plant's gain", where=f"effect {effect.label}")
     new = dict(params)
     ci = {}
     for j, name in enumerate(effect.basis_names):
-        new[name] = float(coef[j + 1])
-        ci[name] = (float(coef[j + 1] - 1.96 * sd[j + 1]), float(coef[j + 1] + 1.96 * sd[j + 1]))
-    return new, float(coef[0]), ci
+        g = gain if j < len(phis) else 1.0
+        new[name] = float(coef[j + 1]) / g
+        ci[name] = (float(coef[j + 1] - 1.96 * sd[j + 1]) / g, float(coef[j + 1] + 1.96 * sd[j + 1]) / g)
+    return new, float(coef[0]), ci, gain
 
 
 def _fit_point(plant: Plant, effect: Effect, params: Params, t: np.ndarray, u: np.ndarray, y: np.ndarray,
@@ -257,14 +268,23 @@ def _fit_point(plant: Plant, effect: Effect, params: Params, t: np.ndarray, u: n
     p = {**effect.off(), **params}
     G, nominal, ci, solver, offset = plant, dict(start), {}, {}, 0.0
     rounds = _ROUNDS if effect.basis_names else 1
+    last = np.inf
     try:
         for _ in range(rounds):
             v = effect.plant_input(u, dt, p)
             drift = sum((p[n] * psi for n, psi in zip(effect.basis_names, effect.output_basis(t))), np.zeros_like(y))
             G, p, nominal, ci_f, solver = _linear_fit(plant, effect, p, t, v, y - drift, formula,
                                                       {k: v_ for k, v_ in nominal.items() if k != "delay"})
-            p, offset, ci_b = _basis_step(effect, G, p, t, u, y, dt)
+            p, offset, ci_b, gain = _basis_step(effect, G, p, t, u, y, dt)
+            if gain != 1.0:
+                G = G.scaled(gain, label=G.label)
+                nominal = {k: (v_ * gain if k.startswith("n") else v_) for k, v_ in nominal.items()}
             ci = {**ci_f, **ci_b}
+            if effect.basis_names:
+                ssr = float(np.sum((y - effect.apply(G, t, u, p, offset=offset)) ** 2))
+                if abs(last - ssr) <= _ROUNDS_TOL * max(ssr, 1e-300):
+                    break
+                last = ssr
     except (DataError, ModelError, np.linalg.LinAlgError, RuntimeError) as exc:
         return _Point(p, np.inf, plant, 0.0, dict(start), {}, {"status": f"failed: {exc}"})
     yhat = effect.apply(G, t, u, p, offset=offset)
@@ -298,7 +318,7 @@ def _profile_ci(points: list[_Point], best: _Point, name: str, n: int) -> tuple[
 
 
 def fit_augmented(plant: Plant, t: np.ndarray, u: np.ndarray, y: np.ndarray, effect: Effect | None = None,
-                  refine: bool = True) -> AugmentedFit:
+                  refine: bool = True, start: Plant | None = None) -> AugmentedFit:
     """Re-fit the nominal coefficients jointly with one effect's parameters on a (training) record.
 
     Parameters
@@ -311,6 +331,9 @@ def fit_augmented(plant: Plant, t: np.ndarray, u: np.ndarray, y: np.ndarray, eff
         The augmentation; ``None`` re-fits the nominal coefficients alone (``parameter_mismatch``).
     refine : bool
         Golden-section search of a grid parameter after the grid.
+    start : Plant, optional
+        Starting coefficients for the casadi fits (same structure as ``plant``, e.g. the
+        re-fit alone); default ``plant``'s.
 
     Returns
     -------
@@ -335,10 +358,15 @@ def fit_augmented(plant: Plant, t: np.ndarray, u: np.ndarray, y: np.ndarray, eff
     t = np.asarray(t, float)
     u = np.asarray(u, float)
     y = np.asarray(y, float)
-    formula, start = nominal_structure(plant)
+    formula, start_values = nominal_structure(plant)
+    if start is not None:
+        formula_s, values_s = nominal_structure(start)
+        if formula_s != formula:
+            raise ModelError(f"start {formula_s} does not have the structure {formula}", where="start")
+        start_values = values_s
     eff = effect if effect is not None else _NoEffect()
     grid = eff.grid(t, u, plant)
-    points = [_fit_point(plant, eff, g, t, u, y, formula, start) for g in grid]
+    points = [_fit_point(plant, eff, g, t, u, y, formula, start_values) for g in grid]
     for g, p in zip(grid, points):
         p.key = next((k for k in eff.grid_names if k in g), None)
     best = min(points, key=lambda p: p.ssr)
@@ -349,7 +377,7 @@ def fit_augmented(plant: Plant, t: np.ndarray, u: np.ndarray, y: np.ndarray, eff
     if key is not None:
         same = [p for p in points if p.key == key]
         if refine:
-            extra = _golden(plant, eff, best, same, key, t, u, y, formula, start)
+            extra = _golden(plant, eff, best, same, key, t, u, y, formula, start_values)
             for p in extra:
                 p.key = key
             points += extra
