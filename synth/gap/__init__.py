@@ -14,5 +14,13 @@ output; the residual ``e = y_measured - y_model`` is then localized
 
 :func:`synth.gap.localize.localize_gap` runs all of them and writes a
 one-line headline; :func:`synth.gap.gapmap.gap_map_figure` draws the gap map.
+
+Which unmodelled effect causes the gap, and how far it shrinks once added:
+:mod:`synth.gap.effects` (the library of nested augmentations: delay, lag,
+resonance, rate limit, saturation, dead zone, backlash, quantization, supply
+sag, static nonlinearity, drift), :mod:`synth.gap.refit` (the nominal
+parameters re-fitted jointly with an effect), :mod:`synth.gap.attribute`
+(held-out shrinkage with bootstrap intervals, calibrated acceptance, the
+verdict) and :mod:`synth.gap.overlay` (the before/after figure).
 The modules are imported by their full path (this package imports nothing).
 """
