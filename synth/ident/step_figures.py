@@ -51,7 +51,7 @@ def fit_figure(fit: TimeFitResult, path: str | Path, title: str = "") -> Path:
     band = 1.96 * fit.residual_std
     ax_r.axhline(band, color="k", ls="--", lw=0.7)
     ax_r.axhline(-band, color="k", ls="--", lw=0.7, label="+-1.96 residual std")
-    ax_r.set_ylabel("residual")
+    ax_r.set_ylabel(_label("residual", out.unit))
     ax_r.set_xlabel("time [s]")
     ax_r.grid(alpha=0.3)
     ax_r.legend(loc="upper right", fontsize=8)
