@@ -1,0 +1,133 @@
+"""``synth diagnose --plant MODEL --data RUN.csv``: where a model and the hardware disagree, and why."""
+
+from __future__ import annotations
+
+import argparse
+import shlex
+import sys
+from pathlib import Path
+from typing import Any
+
+COMMAND = "diagnose"
+ORDER = 50
+HELP = "sim-to-real gap: where the model and a measured record disagree, and which effect explains it"
+DESCRIPTION = """Diagnose the gap between a linear model and a measured record.
+
+The model is driven by the measured command (--input) and compared with the
+measured output (--output). Prints the size of the gap (NRMSE), where it lies
+(time windows, frequency bands, regimes such as input rate or an --aux
+channel) and which unmodelled effect explains it (rate limit, saturation,
+delay, lag, ...): each candidate is fitted together with the nominal
+coefficients and judged by how far it shrinks the error on held-out data (the
+second half of the record, or --validate). Writes result.json, report.html,
+gap_map.png and overlay.png into --out (default reports/diagnose/<data file
+stem>/). Files synth did not write are never overwritten (use --force).
+
+MODEL is a transfer function ("23*(s+0.43)/((s+9.6)*(s+0.54))", with
+--delay), the JSON of `synth identify --json`, or a spec file (its plant).
+
+example:
+  synth diagnose --plant "23*(s+0.43)/((s+9.6)*(s+0.54))" --data run.csv \\
+      --time t --input pwm --output speed --aux current --json gap.json
+  synth diagnose --plant identify.json --data run1.csv --validate run2.csv \\
+      --candidates rate_limit,saturation,delay
+
+exit codes: 0 diagnosed (whatever the verdict), 2 bad input"""
+
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--plant", required=True, metavar="MODEL",
+                   help="transfer function, synth identify JSON, or spec file (.yaml)")
+    p.add_argument("--delay", type=float, metavar="S",
+                   help="delay [s]: added to a transfer function, replaces a file's delay")
+    p.add_argument("--data", required=True, metavar="FILE", help="measured record: CSV with a header row, or MAT")
+    p.add_argument("--validate", metavar="FILE", help="held-out record with the same columns (default: the second "
+                   "half of --data is held out)")
+    p.add_argument("--time", metavar="COL", help="time column (default: the first)")
+    p.add_argument("--input", metavar="COL", help="measured command column (default: the second)")
+    p.add_argument("--output", metavar="COL", help="measured output column (default: the third)")
+    p.add_argument("--aux", metavar="COL", action="append", default=[],
+                   help="extra logged channel (current, voltage, ...); repeat or separate by commas")
+    p.add_argument("--input-unit", default="", metavar="UNIT", help="unit of the input, e.g. PWM or V")
+    p.add_argument("--output-unit", default="", metavar="UNIT", help="unit of the output, e.g. rad/s")
+    p.add_argument("--candidates", metavar="A,B,...",
+                   help="effects to try (default: all: delay, lag, lag(sensor), resonance, rate_limit, saturation, "
+                        "deadzone, backlash, quantization, supply_sag, static_nonlinearity, drift)")
+    p.add_argument("--seed", type=int, default=0, help="seed of the bootstrap (default 0)")
+    p.add_argument("--out", metavar="DIR", help="folder for the report (default reports/diagnose/<data file stem>)")
+    p.add_argument("--json", metavar="FILE", help="also write the JSON to FILE ('-' for standard output)")
+    p.add_argument("--no-report", action="store_true", help="write no report folder")
+    p.add_argument("--force", action="store_true", help="overwrite files synth did not write")
+    p.add_argument("--quiet", "-q", action="store_true", help="print nothing; use the exit code")
+
+
+def _split(values: list[str]) -> list[str]:
+    return [v.strip() for item in values for v in item.split(",") if v.strip()]
+
+
+def run(args: argparse.Namespace) -> int:
+    from synth.data import load_record
+    from synth.errors import SynthError
+    from synth.gap.diagnose import check_candidates, diagnose, load_model
+    from synth.outputs import check_writable, dump_json, write_json
+
+    try:
+        candidates = check_candidates(_split([args.candidates])) if args.candidates is not None else None
+    except SynthError as exc:
+        raise SynthError(exc.message, where="--candidates") from None
+    if args.json and args.json != "-":
+        check_writable(Path(args.json), args.force)  # refuse before the slow part
+    plant = load_model(args.plant, args.delay, where="--plant")
+    aux = _split(args.aux)
+    kw: dict[str, Any] = {"aux": aux, "input_unit": args.input_unit, "output_unit": args.output_unit}
+    record = load_record(args.data, args.time, args.input, args.output, **kw)
+    validate = load_record(args.validate, args.time, args.input, args.output, **kw) if args.validate else None
+    diag = diagnose(plant, record, validate, candidates, seed=args.seed)
+    data = diag.to_dict()
+    data = {"data": str(args.data), "validate_data": str(args.validate) if args.validate else None,
+            "plant_argument": args.plant, **data}
+    report = None
+    if not args.no_report:
+        from synth.gap.report import write_diagnosis_report
+
+        out_dir = Path(args.out) if args.out else Path("reports") / "diagnose" / Path(args.data).stem
+        command = _command(args)
+        report = write_diagnosis_report(diag, out_dir, command=command, force=args.force,
+                                        title=f"{Path(args.data).name} against {plant.to_string()}",
+                                        extra={k: data[k] for k in ("data", "validate_data", "plant_argument")})
+    if args.json == "-":
+        sys.stdout.write(dump_json(data))
+    elif args.json:
+        write_json(args.json, data, force=args.force)
+    if not args.quiet and args.json != "-":
+        _print(data, report)
+    return 0
+
+
+def _command(args: argparse.Namespace) -> str:
+    parts = ["synth", "diagnose"]
+    for opt in ("plant", "delay", "data", "validate", "time", "input", "output", "input_unit", "output_unit",
+                "candidates", "out"):
+        value = getattr(args, opt)
+        if value not in (None, ""):
+            parts += [f"--{opt.replace('_', '-')}", shlex.quote(str(value))]
+    for a in _split(args.aux):
+        parts += ["--aux", shlex.quote(a)]
+    return " ".join(parts + ([f"--seed {args.seed}"] if args.seed else []))
+
+
+def _print(d: dict[str, Any], report: Any) -> None:
+    v = d["verdict"]
+    print(d["summary"])
+    print(f"where: {d['headline']}")
+    print(f"verdict: {', '.join(v['effects']) if v['effects'] else 'none'} ({v['status']}): {v['headline']}")
+    for group, experiment in zip(v["indistinguishable"], v["experiments"] or [""] * len(v["indistinguishable"])):
+        print(f"indistinguishable: {' / '.join(group)}{'; separate by ' + experiment if experiment else ''}")
+    for e in d["effects"][:3]:
+        lo, hi = e["shrinkage_ci"]
+        params = ", ".join(f"{k} = {x:.4g}" if isinstance(x, float) else f"{k} = {x}" for k, x in e["parameters"].items()
+                           if k not in ("center", "scale"))
+        print(f"  {e['effect']:<20} shrinkage {e['shrinkage']:+.3f} [{lo:+.3f}, {hi:+.3f}]  {params}"
+              f"{'  accepted' if e['accepted'] else ''}")
+    if report is not None:
+        print(f"\nreport: {report.html}")
