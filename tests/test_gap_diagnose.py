@@ -1,0 +1,121 @@
+"""synth.gap.diagnose: the JSON contract, a rate-limited record, the three model sources, bad input."""
+
+import json
+
+import numpy as np
+import pytest
+
+from synth.data import record_from_arrays
+from synth.errors import DataError, ModelError, SpecError
+from synth.gap.diagnose import check_candidates, diagnose, load_model
+from synth.ident.simulate import simulate_plant
+from synth.plant import Plant, Signal
+from synth.sim.blocks import RateLimit
+
+X4 = "23*(s+0.43)/((s+9.6)*(s+0.54))"
+
+
+def rate_limited_record(rate=400.0, dt=0.01, seconds=8.0, noise=0.2, seed=0):
+    t = np.arange(0, seconds, dt)
+    u = np.where((t % 2) >= 1, 100.0, 0.0)
+    y = simulate_plant(Plant.from_string("20/(s+10)"), t, RateLimit(rate).apply(u, dt))
+    return record_from_arrays(t, u, y + noise * np.random.default_rng(seed).normal(size=t.size),
+                              input=Signal("pwm", "PWM"), output=Signal("speed", "rad/s"))
+
+
+@pytest.fixture(scope="module")
+def rate_limited():
+    return diagnose(Plant.from_string("20/(s+10)"), rate_limited_record(), candidates=["rate_limit", "delay"],
+                    n_null=3)
+
+
+def test_rate_limited_record_gives_rate_limit(rate_limited):
+    d = rate_limited.to_dict()
+    assert d["verdict"]["effects"] == ["rate_limit"]
+    assert d["verdict"]["status"] == "effect"
+    best = d["effects"][0]
+    assert best["effect"] == "rate_limit" and best["accepted"] is True
+    assert best["parameters"]["rate"] == pytest.approx(400.0, rel=0.03)
+    assert best["shrinkage"] > 0.95 and best["shrinkage_ci"][0] > 0.9
+    # the delay explains part of it, but is not accepted beside the winner
+    delay = next(e for e in d["effects"] if e["effect"] == "delay")
+    assert delay["accepted"] is False and delay["shrinkage"] < best["shrinkage"]
+    # the ramp takes 0.25 s of each 1 s half period: the gap is large and sits in the rise
+    assert 0.2 < d["gap"]["nrmse"] < 0.8
+    assert "rise" in d["headline"]
+    assert "explained by rate limit (rate = " in d["summary"]
+
+
+def test_json_contract_keys_and_types(rate_limited):
+    d = json.loads(json.dumps(rate_limited.to_dict()))
+    assert {"gap", "where", "effects", "verdict"} <= set(d)
+    assert isinstance(d["gap"]["nrmse"], float)
+    assert d["gap"]["fit_percent"] == pytest.approx(100 * (1 - d["gap"]["nrmse"]))
+    for key in ("time_windows", "frequency_bands"):
+        assert isinstance(d["where"][key], list)
+        for row in d["where"][key]:
+            assert len(row) == 3 and all(isinstance(x, float) for x in row) and row[0] < row[1] and 0 < row[2] <= 1
+    assert d["where"]["time_windows"] and d["where"]["frequency_bands"]
+    assert isinstance(d["where"]["regimes"], dict) and "rate" in d["where"]["regimes"]
+    for e in d["effects"]:
+        assert {"effect", "parameters", "shrinkage", "shrinkage_ci", "accepted"} <= set(e)
+        assert isinstance(e["parameters"], dict) and isinstance(e["accepted"], bool)
+        assert len(e["shrinkage_ci"]) == 2 and e["shrinkage_ci"][0] <= e["shrinkage"] <= e["shrinkage_ci"][1] + 1e-12
+    assert isinstance(d["verdict"]["effects"], list) and isinstance(d["verdict"]["indistinguishable"], list)
+    assert d["units"] == {"input": "PWM", "output": "rad/s"}
+    assert d["noise_floor"]["std"] == pytest.approx(0.2, rel=0.15)  # the added white noise
+
+
+def test_no_gap_gives_empty_verdict():
+    G = Plant.from_string("20/(s+10)")
+    rec = rate_limited_record(rate=1e9)  # the limit never acts: the model is right
+    d = diagnose(G, rec, candidates=["rate_limit"], n_null=3).to_dict()
+    assert d["verdict"]["effects"] == [] and d["verdict"]["status"] == "none"
+    assert d["summary"].startswith("No gap")
+
+
+def test_model_sources_give_the_same_plant(tmp_path):
+    from synth.outputs import write_json
+
+    tf = load_model(X4, delay=0.02)
+    ident = write_json(tmp_path / "identify.json", {"tf": tf.to_string(6), "delay": 0.02, "plant": tf.to_dict()})
+    tf_only = write_json(tmp_path / "tf_only.json", {"tf": tf.to_string(6), "delay": 0.02})  # tf carries exp(-0.02 s)
+    spec = load_model("specs/x4_rotor.yaml", delay=0.02)
+    for other in (load_model(str(ident)), load_model(str(tf_only)), spec):
+        assert np.allclose(other.num, tf.num) and np.allclose(other.den, tf.den)
+        assert other.delay == pytest.approx(0.02)
+    assert load_model("specs/x4_rotor.yaml").delay == 0.0
+    assert load_model(str(ident), delay=0.0).delay == 0.0  # --delay replaces a file's delay
+
+
+@pytest.mark.parametrize("text, error, needle", [
+    ("23*(s+0.43)/((s+9.6)*(s+", ModelError, "--plant"),
+    ("missing_model.json", DataError, "model file not found"),
+    ("missing_spec.yaml", DataError, "model file not found"),
+])
+def test_bad_models(text, error, needle):
+    with pytest.raises(error) as exc:
+        load_model(text)
+    assert needle in str(exc.value) and "\n" not in str(exc.value)
+
+
+def test_bad_model_files(tmp_path):
+    (tmp_path / "bad.json").write_text("{not json")
+    (tmp_path / "empty.json").write_text('{"fit_percent": 99}')
+    (tmp_path / "bad.yaml").write_text("name: x\n")
+    for name, error in (("bad.json", ModelError), ("empty.json", ModelError), ("bad.yaml", SpecError)):
+        with pytest.raises(error) as exc:
+            load_model(str(tmp_path / name))
+        assert "\n" not in str(exc.value)
+    with pytest.raises(ModelError, match="delay"):
+        load_model(X4, delay=-1.0)
+
+
+def test_candidates_validated():
+    assert check_candidates(["lag(sensor)", "rate_limit"]) == ["lag(sensor)", "rate_limit"]
+    with pytest.raises(ModelError, match="unknown effect 'ratelimit'"):
+        check_candidates(["ratelimit"])
+    with pytest.raises(ModelError, match="repeated"):
+        check_candidates(["delay", "delay"])
+    with pytest.raises(ModelError, match="at least one"):
+        check_candidates([])
