@@ -1,0 +1,85 @@
+"""synth diagnose: JSON, report files, printed verdict, exit 2 with one line on bad input, no overwrite."""
+
+import json
+
+import numpy as np
+import pytest
+
+from synth.ident.simulate import simulate_plant
+from synth.plant import Plant
+from synth.sim.blocks import RateLimit
+
+PLANT = "20/(s+10)"
+
+
+@pytest.fixture(scope="module")
+def csv(tmp_path_factory):
+    t = np.arange(0, 8, 0.01)
+    u = np.where((t % 2) >= 1, 100.0, 0.0)
+    y = simulate_plant(Plant.from_string(PLANT), t, RateLimit(400.0).apply(u, 0.01))
+    y = y + 0.2 * np.random.default_rng(0).normal(size=t.size)
+    path = tmp_path_factory.mktemp("data") / "run.csv"
+    np.savetxt(path, np.c_[t, u, y, 0.01 * u], delimiter=",", header="t,pwm,speed,current", comments="")
+    return path
+
+
+ARGS = ["--time", "t", "--input", "pwm", "--output", "speed"]
+
+
+@pytest.fixture(scope="module")
+def diagnosed(csv, tmp_path_factory):
+    import io
+    from contextlib import redirect_stdout
+
+    from synth.cli import main  # run in-process once for the module (run_cli is function-scoped)
+
+    out = tmp_path_factory.mktemp("rep")
+    buf = io.StringIO()
+    with redirect_stdout(buf):
+        code = main(["diagnose", "--plant", PLANT, "--data", str(csv), *ARGS, "--aux", "current",
+                     "--candidates", "rate_limit,delay", "--input-unit", "PWM", "--output-unit", "rad/s",
+                     "--json", str(out / "gap.json"), "--out", str(out / "report")])
+    return code, buf.getvalue(), out
+
+
+def test_cli_diagnoses_the_rate_limit(diagnosed):
+    code, text, out = diagnosed
+    assert code == 0
+    d = json.loads((out / "gap.json").read_text())
+    assert d["verdict"]["effects"] == ["rate_limit"]
+    assert d["effects"][0]["parameters"]["rate"] == pytest.approx(400.0, rel=0.03)
+    assert {"gap", "where", "effects", "verdict"} <= set(d)
+    assert d["record"]["aux"] == ["current"] and "aux:current" in d["where"]["regimes"]
+    assert d["units"] == {"input": "PWM", "output": "rad/s"}
+    lines = text.splitlines()
+    assert lines[0].startswith("The gap (") and "rate limit" in lines[0]
+    assert any(line.startswith("verdict: rate_limit") for line in lines)
+    for name in ("report.html", "result.json", "gap_map.png", "overlay.png"):
+        assert (out / "report" / name).stat().st_size > 1000, name
+    html = (out / "report" / "report.html").read_text()
+    assert "explained by rate limit" in html and "rad/s" in html and "shrinkage" in html
+    assert json.loads((out / "report" / "result.json").read_text())["verdict"] == d["verdict"]
+
+
+@pytest.mark.parametrize("args, needle", [
+    (["--plant", PLANT, "--data", "{csv}", "--time", "t", "--input", "pwm", "--output", "sped"], "'sped' not found"),
+    (["--plant", "20/(s+", "--data", "{csv}", *ARGS], "--plant"),
+    (["--plant", PLANT, "--data", "{csv}", *ARGS, "--candidates", "rate_limit,ratelimit"],
+     "--candidates: unknown effect 'ratelimit'"),
+    (["--plant", PLANT, "--data", "{dir}/missing.csv", *ARGS], "missing.csv"),
+    (["--plant", "{dir}/missing.json", "--data", "{csv}", *ARGS], "model file not found"),
+    (["--plant", PLANT, "--data", "{csv}", *ARGS, "--aux", "voltage"], "'voltage' not found"),
+])
+def test_bad_input_exit_2_one_line(run_cli, csv, args, needle):
+    args = [a.format(csv=csv, dir=csv.parent) for a in args]
+    res = run_cli("diagnose", *args)
+    assert res.code == 2, res.err
+    assert needle in res.err and len(res.err.strip().splitlines()) == 1 and "Traceback" not in res.err
+
+
+def test_does_not_overwrite_a_users_file(run_cli, csv, tmp_path):
+    mine = tmp_path / "notes.json"
+    mine.write_text('{"mine": true}')
+    res = run_cli("diagnose", "--plant", PLANT, "--data", str(csv), *ARGS, "--json", str(mine), "--no-report")
+    assert res.code == 2 and "not overwriting" in res.err
+    assert mine.read_text() == '{"mine": true}'
