@@ -57,6 +57,7 @@ from synth.requirements.control_sensitivity import PeakControlSensitivity
 from synth.synthesis.cxcomplex import Cx, delay_jw, polyval_jw
 
 IPOPT_OPTIONS = {"ipopt.print_level": 0, "print_time": False, "ipopt.sb": "yes", "ipopt.max_iter": 1500,
+                 "ipopt.hessian_approximation": "limited-memory",
                  "ipopt.tol": 1e-9, "ipopt.constr_viol_tol": 1e-9}
 
 
