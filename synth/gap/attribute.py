@@ -13,6 +13,13 @@ Procedure (:func:`diagnose_effects`)
    training part), the re-fit of its coefficients alone
    (``parameter_mismatch``) and every candidate effect with the nominal
    coefficients re-fitted jointly (:func:`synth.gap.refit.fit_augmented`).
+   With ``confirm=k`` every candidate is first *screened*
+   (:mod:`synth.gap.screen`: the denominator held at the nominal's or the
+   re-fit's, the rest by least squares, milliseconds per point) and only the
+   ``k`` with the lowest screened training SSR are re-fitted jointly, started
+   at the screened parameters; the others keep their screened fit (marked
+   ``fit="screened"``), which can be significant and join a group but is never
+   the verdict. ``confirm=None`` re-fits every candidate jointly.
 3. **Held-out cost** ``J = mean((y - yhat)^2)`` over the held-out samples;
    the shrinkage of an effect is ``1 - J_with / J_without`` with ``J_without``
    the re-fit alone, the shrinkage of ``parameter_mismatch`` is
@@ -28,7 +35,12 @@ Procedure (:func:`diagnose_effects`)
    are simulated from the re-fitted model plus white noise of the floor's
    variance, the re-fit is repeated on each, and the held-out shrinkage a
    *perfect* model achieves against that re-fit, ``1 - J_true / J_refit``,
-   is recorded. Its ``1 - alpha`` quantile is what estimating the nominal
+   is recorded. ``calibration="linearized"`` (default) replaces each re-fit
+   by its Gauss-Newton step from the re-fit (``J_tr`` the sensitivity of the
+   simulated output to the nominal coefficients and the output constant:
+   ``delta = lstsq(J_tr, noise_tr)``), exact to first order in the noise, which
+   is where a re-fit of a few-% mismatch lives; ``"refit"`` repeats the casadi
+   fit on each replicate. Its ``1 - alpha`` quantile is what estimating the nominal
    parameters from noisy data leaves on the table by chance: an effect is
    *significant* when the lower end of its shrinkage interval exceeds it, and
    *relevant* when it also explains at least ``min_share`` of the re-fit's
@@ -42,12 +54,14 @@ Procedure (:func:`diagnose_effects`)
    group with the experiment that would separate them.
 
 Only one effect is attributed per diagnosis; a second effect on top of the
-first (nested forward selection) is not attempted.
+first (nested forward selection) is not attempted. Lag at the actuator and at
+the sensor give the same output on a linear model; the candidate listed first
+(``lag``) is reported, the other in its indistinguishable group.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields
 from typing import Any
 
 import numpy as np
@@ -56,6 +70,7 @@ from synth.data.record import Record
 from synth.errors import ModelError
 from synth.gap.effects import Effect, make_effect
 from synth.gap.refit import AugmentedFit, fit_augmented
+from synth.gap.screen import ScreenedFit, screen_effect
 from synth.ident.simulate import simulate_plant
 from synth.plant import Plant
 
@@ -127,6 +142,9 @@ class EffectResult:
         Held-out mean squared error (output units squared).
     nominal : dict
         Nominal coefficients re-fitted with the effect.
+    fit : str
+        ``"joint"`` (casadi re-fit with the nominal coefficients) or ``"screened"``
+        (denominator fixed, see :mod:`synth.gap.screen`; never accepted).
     """
 
     effect: str
@@ -139,6 +157,7 @@ class EffectResult:
     accepted: bool
     j_heldout: float
     nominal: dict[str, float]
+    fit: str = "joint"
 
     def to_dict(self) -> dict[str, Any]:
         """JSON entry of ``"effects"``.
@@ -154,7 +173,7 @@ class EffectResult:
                 "parameter_ci": {k: [float(a), float(b)] for k, (a, b) in self.parameter_ci.items()},
                 "shrinkage": self.shrinkage, "shrinkage_ci": [float(x) for x in self.shrinkage_ci],
                 "significant": self.significant, "share_of_gap": self.share_of_gap, "accepted": self.accepted,
-                "j_heldout": self.j_heldout, "nominal": dict(self.nominal)}
+                "j_heldout": self.j_heldout, "nominal": dict(self.nominal), "fit": self.fit}
 
 
 @dataclass(frozen=True, eq=False)
@@ -236,9 +255,9 @@ def _experiment(a: str, b: str, t: np.ndarray, ya: np.ndarray, yb: np.ndarray) -
 
 def diagnose_effects(plant: Plant, record: Record, validate: Record | None = None,
                      candidates: list[str | Effect] | tuple[str, ...] = DEFAULT_CANDIDATES,
-                     train_fraction: float = 0.5, blocks: int = 10, n_null: int = 19, n_boot: int = 1000,
+                     train_fraction: float = 0.5, blocks: int = 10, n_null: int = 199, n_boot: int = 1000,
                      alpha: float = 0.05, relevance: float = 0.1, min_share: float = 0.25,
-                     seed: int = 0) -> EffectDiagnosis:
+                     seed: int = 0, calibration: str = "linearized", confirm: int | None = 3) -> EffectDiagnosis:
     """Attribute the gap between ``plant`` and ``record`` to one effect, and measure its shrinkage.
 
     Parameters
@@ -267,6 +286,11 @@ def diagnose_effects(plant: Plant, record: Record, validate: Record | None = Non
         Part of the re-fit's held-out excess over noise an effect must remove to be relevant.
     seed : int
         Seed of the bootstrap draws.
+    calibration : {"linearized", "refit"}
+        How each calibration replicate is re-fitted (see the module text).
+    confirm : int or None
+        Candidates re-fitted jointly after screening (lowest screened training SSR first);
+        ``None``: every candidate, no screening.
 
     Returns
     -------
@@ -293,6 +317,10 @@ def diagnose_effects(plant: Plant, record: Record, validate: Record | None = Non
         raise ModelError(f"must be in [0.1, 0.9], got {train_fraction!r}", where="train_fraction")
     if blocks < 3 or n_null < 1 or n_boot < 10:
         raise ModelError("need blocks >= 3, n_null >= 1 and n_boot >= 10", where="diagnose_effects")
+    if calibration not in ("linearized", "refit"):
+        raise ModelError(f"must be 'linearized' or 'refit', got {calibration!r}", where="calibration")
+    if confirm is not None and confirm < 1:
+        raise ModelError(f"must be None or >= 1, got {confirm!r}", where="confirm")
     effects = [make_effect(c) for c in candidates]
     labels = [e.label for e in effects]
     if len(set(labels)) != len(labels):
@@ -341,44 +369,32 @@ def diagnose_effects(plant: Plant, record: Record, validate: Record | None = Non
     gap_after_refit = float(np.quantile(excess_ref, 0.025)) > relevance
 
     # calibration: parametric bootstrap of the re-fit
-    null = []
-    y_ref_tr = refit.predict(t_tr, u_tr)
-    for _ in range(n_null):
-        n_tr = sigma * rng.standard_normal(t_tr.size)
-        if validate is None:
-            noise = np.r_[n_tr, sigma * rng.standard_normal(t_ev.size - t_tr.size)]
-        else:
-            noise = sigma * rng.standard_normal(t_ev.size)
-        fit_b = fit_augmented(refit.plant, t_tr, u_tr, y_ref_tr + n_tr)
-        y_b = y_ref + noise
-        j_fit = float(np.mean((y_b - fit_b.predict(t_ev, u_ev))[held] ** 2))
-        j_true = float(np.mean(noise[held] ** 2))
-        null.append(1.0 - j_true / j_fit)
+    if calibration == "linearized":
+        null = _linearized_null(refit, t_tr, u_tr, t_ev, u_ev, held, validate is None, sigma, n_null, rng)
+    else:
+        null = _refit_null(refit, t_tr, u_tr, t_ev, u_ev, held, validate is None, sigma, n_null, rng)
     threshold = float(np.quantile(null, 1.0 - alpha, method="higher"))
 
-    fits: list[tuple[Effect, AugmentedFit, np.ndarray, np.ndarray]] = []
-    for eff in effects:
-        try:
-            fit = fit_augmented(plant, t_tr, u_tr, y_tr, eff, start=refit.plant)
-        except ModelError:
-            continue
-        yhat = fit.predict(t_ev, u_ev)
-        fits.append((eff, fit, yhat, sums(yhat)))
+    fits = _candidate_fits(plant, effects, refit, t_tr, u_tr, y_tr, t_ev, u_ev, confirm)
 
     results: list[tuple[EffectResult, np.ndarray, np.ndarray]] = []
-    for eff, fit, yhat, s in fits:
+    for eff, fit, _, yhat in fits:
+        s = sums(yhat)
         j = float(s.sum() / n_held)
         shrink = 1.0 - j / j_ref if j_ref > 0 else 0.0
         ci = ratio_ci(s, s_ref)
         share = (j_nom - j) / (j_nom - floor) if j_nom > floor else 0.0
         share_ref = (j_ref - j) / (j_ref - floor) if j_ref > floor else 0.0
         significant = bool(gap_present and ci[0] > threshold)
-        relevant = bool(significant and share_ref >= min_share)
+        joint = isinstance(fit, AugmentedFit)
+        relevant = bool(significant and share_ref >= min_share and joint)
         params = {k: float(fit.params[k]) for k in eff.parameter_names}
-        res = EffectResult(eff.label, params, fit.parameter_ci, shrink, ci, significant, float(share), relevant, j,
-                           dict(fit.nominal))
+        p_ci = fit.parameter_ci if joint else {}
+        nominal = dict(fit.nominal) if joint else _coefficients(fit.plant)
+        res = EffectResult(eff.label, params, p_ci, shrink, ci, significant, float(share), relevant, j, nominal,
+                           "joint" if joint else "screened")
         results.append((res, yhat, s))
-    results.sort(key=lambda r: -r[0].shrinkage)
+    results.sort(key=lambda r: (-r[0].shrinkage, r[0].fit != "joint"))
 
     relevant = [r for r in results if r[0].accepted]
     indist: list[list[str]] = []
@@ -414,9 +430,122 @@ def diagnose_effects(plant: Plant, record: Record, validate: Record | None = Non
     verdict = {"effects": verdict_effects, "indistinguishable": indist, "experiments": experiments,
                "status": status, "headline": headline}
     split = {"train_samples": int(t_tr.size), "heldout_samples": n_held, "blocks": blocks, "n_null": n_null,
-             "n_boot": n_boot, "alpha": alpha, "validation_record": validate is not None, "seed": seed}
+             "n_boot": n_boot, "alpha": alpha, "validation_record": validate is not None, "seed": seed,
+             "calibration": calibration, "confirm": confirm,
+             "joint_fits": [r.effect for r, _, _ in results if r.fit == "joint"]}
     return EffectDiagnosis([r for r, _, _ in results], verdict, floor, j_nom, j_ref, pm_shrink, pm_ci, threshold,
                            refit, split, t_ev, y_ev, y_nom, y_ref, y_best, held)
+
+
+def _coefficients(plant: Plant) -> dict[str, float]:
+    from synth.gap.refit import nominal_structure
+
+    return nominal_structure(plant)[1] | {"delay": plant.delay}
+
+
+def _sensitivity(plant: Plant, t: np.ndarray, u: np.ndarray) -> np.ndarray:
+    """d(simulated output)/d(each nonzero coefficient, monic denominator) and d/d(offset), central differences."""
+    cols = []
+    for which in ("num", "den"):
+        base = getattr(plant, which)
+        for i, c in enumerate(base):
+            if c == 0.0 or (which == "den" and i == 0):
+                continue
+            h = 1e-6 * max(abs(c), 1e-8)
+            out = []
+            for sgn in (1.0, -1.0):
+                arr = base.astype(float).copy()
+                arr[i] += sgn * h
+                num, den = (arr, plant.den) if which == "num" else (plant.num, arr)
+                out.append(simulate_plant(Plant(num, den, plant.delay), t, u))
+            cols.append((out[0] - out[1]) / (2 * h))
+    cols.append(np.ones_like(t))
+    return np.column_stack(cols)
+
+
+def _linearized_null(refit: AugmentedFit, t_tr: np.ndarray, u_tr: np.ndarray, t_ev: np.ndarray, u_ev: np.ndarray,
+                     held: np.ndarray, split: bool, sigma: float, n_null: int,
+                     rng: np.random.Generator) -> np.ndarray:
+    """Held-out shrinkage of a perfect model against the re-fit, re-fit linearized (Gauss-Newton step)."""
+    J_ev = _sensitivity(refit.plant, t_ev, u_ev)
+    J_tr = J_ev[:t_tr.size] if split else _sensitivity(refit.plant, t_tr, u_tr)
+    n_tr = sigma * rng.standard_normal((t_tr.size, n_null))
+    scale = np.maximum(np.sqrt(np.sum(J_tr**2, axis=0)), 1e-300)
+    delta = np.linalg.lstsq(J_tr / scale, n_tr, rcond=None)[0] / scale[:, None]
+    noise = sigma * rng.standard_normal((int(held.sum()), n_null))
+    e_fit = noise - J_ev[held] @ delta
+    return 1.0 - np.mean(noise**2, axis=0) / np.mean(e_fit**2, axis=0)
+
+
+def _refit_null(refit: AugmentedFit, t_tr: np.ndarray, u_tr: np.ndarray, t_ev: np.ndarray, u_ev: np.ndarray,
+                held: np.ndarray, split: bool, sigma: float, n_null: int, rng: np.random.Generator) -> np.ndarray:
+    """The same with the casadi re-fit repeated on every replicate."""
+    null = []
+    y_ref = refit.predict(t_ev, u_ev)
+    y_ref_tr = refit.predict(t_tr, u_tr)
+    for _ in range(n_null):
+        n_tr = sigma * rng.standard_normal(t_tr.size)
+        noise = np.r_[n_tr, sigma * rng.standard_normal(t_ev.size - t_tr.size)] if split else \
+            sigma * rng.standard_normal(t_ev.size)
+        fit_b = fit_augmented(refit.plant, t_tr, u_tr, y_ref_tr + n_tr)
+        j_fit = float(np.mean((y_ref + noise - fit_b.predict(t_ev, u_ev))[held] ** 2))
+        j_true = float(np.mean(noise[held] ** 2))
+        null.append(1.0 - j_true / j_fit)
+    return np.asarray(null)
+
+
+def _seeded(effect: Effect, screened: ScreenedFit) -> Effect:
+    """The effect with its search grid replaced by the screened point and its neighbours (+-15 % in the key)."""
+    point = {k: v for k, v in screened.params.items() if k not in effect.basis_names}
+    keys = [k for k in effect.grid_names if k in point and np.isfinite(point[k]) and point[k] > 0]
+    grid = [point] if not keys else [{**point, keys[0]: point[keys[0]] * f} for f in (1 / 1.15, 1.0, 1.15)]
+    if effect.name == "saturation":  # one limit at a time, as the effect's own grid
+        side = "upper" if np.isfinite(point.get("upper", np.inf)) else "lower"
+        other = "lower" if side == "upper" else "upper"
+        span = abs(point[side]) if np.isfinite(point.get(side, np.inf)) else 1.0
+        grid = [{side: point[side] + f * 0.01 * span} for f in (-1.0, 0.0, 1.0)]
+        grid = [{k: v for k, v in g.items() if k != other} for g in grid]
+    cls = type(effect)
+    sub = type(f"Seeded{cls.__name__}", (cls,), {"grid": lambda self, t, u, plant: [dict(g) for g in grid]})
+    return sub(**{f.name: getattr(effect, f.name) for f in fields(effect)})
+
+
+def _candidate_fits(plant: Plant, effects: list[Effect], refit: AugmentedFit, t_tr: np.ndarray, u_tr: np.ndarray,
+                    y_tr: np.ndarray, t_ev: np.ndarray, u_ev: np.ndarray, confirm: int | None,
+                    ) -> list[tuple[Effect, AugmentedFit | ScreenedFit, np.ndarray, np.ndarray]]:
+    """Every candidate's fit: joint for all (``confirm=None``) or screened, the best ``confirm`` then joint."""
+    out: list[tuple[Effect, AugmentedFit | ScreenedFit, np.ndarray, np.ndarray]] = []
+    if confirm is None:
+        for eff in effects:
+            try:
+                fit = fit_augmented(plant, t_tr, u_tr, y_tr, eff, start=refit.plant)
+            except ModelError:
+                continue
+            out.append((eff, fit, fit.predict(t_tr, u_tr), fit.predict(t_ev, u_ev)))
+        return out
+    bases = [("nominal", plant), ("refit", refit.plant)]
+    screened: list[tuple[Effect, ScreenedFit]] = []
+    for eff in effects:
+        try:
+            screened.append((eff, screen_effect(eff, bases, t_tr, u_tr, y_tr, t_ev, u_ev)))
+        except ModelError:
+            continue
+    screened.sort(key=lambda es: es[1].ssr)
+    for rank, (eff, sc) in enumerate(screened):
+        fit: AugmentedFit | ScreenedFit = sc
+        if rank < confirm:
+            try:
+                joint = fit_augmented(plant, t_tr, u_tr, y_tr, _seeded(eff, sc), start=refit.plant)
+                if joint.ssr <= sc.ssr * (1 + 1e-9):
+                    fit = AugmentedFit(eff, joint.plant, joint.params, joint.offset, joint.nominal,
+                                       joint.parameter_ci, joint.ssr, joint.samples, joint.profile, joint.solver)
+            except ModelError:
+                pass
+        if isinstance(fit, AugmentedFit):
+            out.append((eff, fit, fit.predict(t_tr, u_tr), fit.predict(t_ev, u_ev)))
+        else:
+            out.append((eff, fit, sc.yhat_train, sc.yhat_eval))
+    return out
 
 
 def _unaccept(r: EffectResult) -> EffectResult:

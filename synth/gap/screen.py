@@ -1,0 +1,274 @@
+"""Cheap screening of candidate effects before the joint casadi re-fit.
+
+Every candidate is first fitted with the **denominator of the linear model
+held fixed** and everything that enters the output linearly solved by least
+squares: the numerator coefficients of the (augmented) linear part, the
+output constant, the effect's basis parameters (``a2, a3``, ``sag``, drift
+terms). For a fixed denominator and fixed non-smooth parameters the output is
+linear in those, so each point of the effect's parameter search costs a few
+linear simulations (:func:`synth.ident.simulate.simulate_plant`, milliseconds)
+instead of an IPOPT solve on the whole record. The search runs the effect's own
+grid (:meth:`synth.gap.effects.Effect.grid`) plus a golden-section search in the
+log of the grid parameter between the best point's neighbours; the extra delay
+and a resonance's damping, which the joint fit treats as smooth, get a grid of
+their own here. The denominator is tried at two places, the nominal model's and
+the re-fit's, since the re-fit alone may have moved its poles to mimic the
+effect (a slower plant for a rate limit) and the nominal has not.
+
+The screened training SSR ranks the candidates; :func:`synth.gap.attribute.diagnose_effects`
+re-fits only the best few jointly (nominal coefficients and effect, casadi),
+started at the screened parameters. A screened fit is never better than the joint
+fit of the same effect could be (it is the same model with fewer free
+coefficients), so the ranking errs against an effect only when a pole shift
+the screen cannot make is what the effect needs.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from synth.errors import ModelError
+from synth.gap.effects import Effect, Params
+from synth.ident.simulate import simulate_plant
+from synth.plant import Plant
+
+_GOLDEN_STEPS = 14
+_GOLDEN = (np.sqrt(5.0) - 1.0) / 2.0
+_ZETAS = (0.05, 0.1, 0.2, 0.4, 0.7)
+
+
+@dataclass(frozen=True, eq=False)
+class ScreenedFit:
+    """One candidate's screened fit (denominator fixed, linear parameters by least squares).
+
+    Attributes
+    ----------
+    effect : Effect
+    params : dict
+        Effect parameters at the best screened point (basis parameters included).
+    ssr : float
+        Training sum of squared errors there.
+    plant : Plant
+        The linear model with the least-squares numerator (without the effect's factor).
+    offset : float
+        Output constant.
+    base : str
+        Which denominator: ``"nominal"`` or ``"refit"``.
+    points : int
+        Parameter points evaluated.
+    yhat_train, yhat_eval : numpy.ndarray
+        Screened model output on the training and the evaluated record.
+    """
+
+    effect: Effect
+    params: Params
+    ssr: float
+    plant: Plant
+    offset: float
+    base: str
+    points: int
+    yhat_train: np.ndarray = field(repr=False)
+    yhat_eval: np.ndarray = field(repr=False)
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON summary.
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> from synth.gap.effects import make_effect
+        >>> t = np.arange(0, 4, 0.01); u = np.where((t % 2) >= 1, 1.0, 0.0)
+        >>> G = Plant.from_string("2/(0.2*s+1)")
+        >>> y = simulate_plant(G.with_delay(0.05), t, u)
+        >>> d = screen_effect(make_effect("delay"), [("nominal", G)], t, u, y, t, u).to_dict()
+        >>> d["effect"], round(d["parameters"]["delay"], 4), d["base"]
+        ('delay', 0.05, 'nominal')
+        """
+        return {"effect": self.effect.label, "parameters": {k: float(v) for k, v in self.params.items()},
+                "ssr": self.ssr, "tf": self.plant.to_string(6), "offset": self.offset, "base": self.base,
+                "points": self.points}
+
+
+def _unit_numerators(plant: Plant) -> list[Plant]:
+    """One plant per nonzero numerator coefficient of ``plant`` (that coefficient 1, the others 0)."""
+    out = []
+    for i, c in enumerate(plant.num):
+        if c != 0.0:
+            e = np.zeros_like(plant.num, dtype=float)
+            e[i] = 1.0
+            out.append(Plant(e, plant.den, plant.delay, plant.input, plant.output, plant.label))
+    return out
+
+
+class _Design:
+    """Least-squares design of one effect on one denominator: columns on the training and evaluated records."""
+
+    def __init__(self, effect: Effect, base: Plant, records: list[tuple[np.ndarray, np.ndarray]]) -> None:
+        self.effect, self.base, self.records = effect, base, records
+        self.units = _unit_numerators(base)
+
+    def columns(self, params: Params, t: np.ndarray, u: np.ndarray) -> tuple[np.ndarray, int]:
+        eff = self.effect
+        dt = float((t[-1] - t[0]) / (t.size - 1))
+        p = {**eff.off(), **params}
+        v0 = eff.input_map(u, dt, p)
+        cols = [simulate_plant(eff.augment_plant(g, p), t, v0) for g in self.units]
+        k_num = len(cols)
+        g_aug = eff.augment_plant(self.base, p)
+        cols += [simulate_plant(g_aug, t, phi) for phi in eff.input_basis(u, dt, p)]
+        cols += list(eff.output_basis(t))
+        cols.append(np.ones_like(t))
+        return np.column_stack(cols), k_num
+
+    def fit(self, params: Params, y: np.ndarray) -> tuple[float, np.ndarray, int]:
+        t_tr, u_tr = self.records[0]
+        X, k_num = self.columns(params, t_tr, u_tr)
+        if not np.all(np.isfinite(X)):
+            return np.inf, np.zeros(X.shape[1]), k_num
+        scale = np.maximum(np.sqrt(np.sum(X**2, axis=0)), 1e-300)
+        coef, *_ = np.linalg.lstsq(X / scale, y, rcond=None)
+        coef = coef / scale
+        r = y - X @ coef
+        return float(r @ r), coef, k_num
+
+    def evaluate(self, params: Params, coef: np.ndarray, t: np.ndarray, u: np.ndarray) -> np.ndarray:
+        X, _ = self.columns(params, t, u)
+        return X @ coef
+
+
+def _extra_grid(effect: Effect, t: np.ndarray, u: np.ndarray, plant: Plant) -> list[Params] | None:
+    """Screening grids for parameters the joint fit treats as smooth (delay, damping)."""
+    dt = float(t[1] - t[0])
+    if effect.name == "delay":
+        p = np.abs(plant.poles())
+        slow = float(np.min(p[p > 0])) if np.any(p > 0) else 1.0
+        top = min(0.25 * float(t[-1] - t[0]), 1.0 / slow)
+        return [{"delay": float(d)} for d in np.geomspace(0.25 * dt, max(top, dt), 16)]
+    if effect.name == "resonance":
+        return [{**g, "zeta": z} for g in effect.grid(t, u, plant) for z in _ZETAS]
+    return None
+
+
+def _search_key(effect: Effect, grid: list[Params]) -> str | None:
+    for name in ("delay", *effect.grid_names):
+        if any(name in g for g in grid):
+            return name
+    return None
+
+
+def screen_effect(effect: Effect, bases: list[tuple[str, Plant]], t_tr: np.ndarray, u_tr: np.ndarray,
+                  y_tr: np.ndarray, t_ev: np.ndarray, u_ev: np.ndarray) -> ScreenedFit:
+    """Screen one effect: its parameter search with each base denominator fixed, the rest by least squares.
+
+    Parameters
+    ----------
+    effect : Effect
+    bases : list of (str, Plant)
+        Named linear models whose denominators (and delay) are held fixed.
+    t_tr, u_tr, y_tr : numpy.ndarray
+        Training record (the model starts at rest at its first sample).
+    t_ev, u_ev : numpy.ndarray
+        Evaluated record (the training record's continuation, or a validation record).
+
+    Returns
+    -------
+    ScreenedFit
+
+    Raises
+    ------
+    ModelError
+        No point could be evaluated.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from synth.gap.effects import make_effect
+    >>> t = np.arange(0, 6, 0.01); u = np.where((t % 3) >= 1, 1.0, 0.0)
+    >>> G = Plant.from_string("2/(0.2*s+1)")
+    >>> y = make_effect("rate_limit").apply(G, t, u, {"rate": 4.0})
+    >>> s = screen_effect(make_effect("rate_limit"), [("nominal", G)], t, u, y, t, u)
+    >>> round(s.params["rate"], 2), s.ssr < 1e-6
+    (4.0, True)
+    """
+    t_tr, u_tr, y_tr = (np.asarray(a, float) for a in (t_tr, u_tr, y_tr))
+    best: tuple[float, Params, np.ndarray, int, str, _Design] | None = None
+    points = 0
+    for base_name, base in bases:
+        design = _Design(effect, base, [(t_tr, u_tr), (t_ev, u_ev)])
+        try:
+            grid = _extra_grid(effect, t_tr, u_tr, base) or effect.grid(t_tr, u_tr, base)
+        except ModelError:
+            continue
+        tried: dict[tuple[tuple[str, float], ...], tuple[float, np.ndarray, int]] = {}
+
+        def run(g: Params, design: _Design = design, tried: dict = tried) -> float:
+            key = tuple(sorted(g.items()))
+            if key not in tried:
+                ssr, coef, k_num = design.fit(g, y_tr)
+                tried[key] = (ssr if np.isfinite(ssr) else np.inf, coef, k_num)
+            return tried[key][0]
+
+        for g in grid:
+            run(g)
+        key_name = _search_key(effect, grid)
+        g_best = min(grid, key=lambda g: run(g))
+        if key_name is not None:
+            g_best = _golden(run, grid, g_best, key_name)
+        points += len(tried)
+        ssr = run(g_best)
+        if best is None or ssr < best[0]:
+            _, coef, k_num = tried[tuple(sorted(g_best.items()))]
+            best = (ssr, g_best, coef, k_num, base_name, design)
+    if best is None or not np.isfinite(best[0]):
+        raise ModelError("no screening point could be evaluated", where=f"effect {effect.label}")
+    ssr, g, coef, k_num, base_name, design = best
+    base = design.base
+    params = {**effect.off(), **g}
+    n_basis_in = len(effect.input_basis(u_tr, float(t_tr[1] - t_tr[0]), params))
+    for j, name in enumerate(effect.basis_names):
+        params[name] = float(coef[k_num + j])
+    num = np.zeros_like(base.num, dtype=float)
+    num[np.flatnonzero(base.num != 0.0)] = coef[:k_num]
+    plant = Plant(num, base.den, base.delay, base.input, base.output, "screened")
+    if n_basis_in:  # the basis columns ran through the base numerator: express them per unit of the new gain
+        gain = float(num @ base.num) / float(base.num @ base.num)  # least-squares ratio of the numerators
+        for name in effect.basis_names[:n_basis_in]:
+            params[name] = params[name] / gain if gain != 0 else params[name]
+    y_train = design.evaluate(g, coef, t_tr, u_tr)
+    y_eval = design.evaluate(g, coef, np.asarray(t_ev, float), np.asarray(u_ev, float))
+    return ScreenedFit(effect, params, float(ssr), plant, float(coef[-1]), base_name, points, y_train, y_eval)
+
+
+def _golden(run: Any, grid: list[Params], g_best: Params, key: str) -> Params:
+    """Golden-section search in log(key) between the best grid point's neighbours (the other keys fixed)."""
+    x0 = g_best.get(key, np.nan)
+    rest = {k: v for k, v in g_best.items() if k != key}
+    vals = sorted({g[key] for g in grid if key in g and np.isfinite(g[key]) and g[key] > 0
+                   and {k: v for k, v in g.items() if k != key} == rest})
+    if len(vals) < 2 or not (np.isfinite(x0) and x0 > 0) or x0 not in vals:
+        return g_best
+    i = vals.index(x0)
+    lx = np.log(vals)
+    step = lx[1] - lx[0]
+    a = lx[i - 1] if i > 0 else lx[0] - step
+    b = lx[i + 1] if i + 1 < len(vals) else lx[-1] + (lx[-1] - lx[-2])
+
+    def f(x: float) -> float:
+        return run({**rest, key: float(np.exp(x))})
+
+    c, d = b - _GOLDEN * (b - a), a + _GOLDEN * (b - a)
+    fc, fd = f(c), f(d)
+    for _ in range(_GOLDEN_STEPS):
+        if fc < fd:
+            b, d, fd = d, c, fc
+            c = b - _GOLDEN * (b - a)
+            fc = f(c)
+        else:
+            a, c, fc = c, d, fd
+            d = a + _GOLDEN * (b - a)
+            fd = f(d)
+    cands = [g_best, {**rest, key: float(np.exp(c))}, {**rest, key: float(np.exp(d))}]
+    return min(cands, key=run)
