@@ -12,6 +12,9 @@ effect                 side      augmented model                                
 ``resonance``          linear    ``G wn^2 / (s^2 + 2 zeta wn s + wn^2)``                      ``wn, zeta``
 ``rate_limit``         input     :class:`synth.sim.blocks.RateLimit` before ``G``             ``rate``
 ``saturation``         input     :class:`synth.sim.blocks.Saturation` before ``G``            ``lower, upper``
+``saturation(output)`` output    ``min(upper, max(lower, y))`` after ``G`` (clipping, overflow) ``lower, upper``
+``friction``           input     Coulomb force ``-fc sign(velocity)``, stick-slip; ``G`` to     ``fc``
+                                 a position (pole at the origin) or a velocity
 ``deadzone``           input     :class:`synth.sim.blocks.DeadZone` before ``G``              ``width``
 ``backlash``           input     :class:`synth.sim.blocks.Backlash` before ``G``              ``width``
 ``quantization``       input     :class:`synth.sim.blocks.Quantizer` before ``G``             ``step``
@@ -33,7 +36,13 @@ the grid only giving starting values; *basis* parameters (``a2``, ``a3``,
 linear model and are solved by least squares (:mod:`synth.gap.refit`).
 
 ``Effect.apply(plant, t, u, params)`` is the augmented model's output; the
-nominal model is ``Effect.apply`` with the effect switched off.
+nominal model is ``Effect.apply`` with the effect switched off. Two effects
+need more than the command: output clipping is fitted on the output's scale
+(its grid comes from the measured output, :meth:`Effect.data_grid`, and the
+linear part is fitted to the data with the clipped samples censored,
+:meth:`Effect.censor`), and Coulomb friction depends on the model's own
+velocity (:meth:`Effect.base_input` gets the linear model; the re-fit
+alternates the friction signal and the linear fit until the error settles).
 """
 
 from __future__ import annotations
@@ -151,9 +160,38 @@ class Effect:
         """Effect parameters from the factor's structure parameters (inverse of :meth:`to_factor`)."""
         return {name: float(values[name]) ** 2 for name in self.factor_names if name in values and name != "delay"}
 
-    def plant_input(self, u: np.ndarray, dt: float, params: Params) -> np.ndarray:
+    #: the input side depends on the linear model (re-fit alternates it with the linear fit)
+    needs_plant: ClassVar[bool] = False
+
+    def data_grid(self, t: np.ndarray, u: np.ndarray, y: np.ndarray, plant: Plant) -> list[Params]:
+        """Grid built from the record's output as well (default: :meth:`grid`)."""
+        return self.grid(t, u, plant)
+
+    def output_map(self, y: np.ndarray, params: Params) -> np.ndarray:
+        """Output-side static map applied last (identity for other sides)."""
+        return y
+
+    def censor(self, y: np.ndarray, y_linear: np.ndarray, params: Params) -> np.ndarray:
+        """Data for the linear part's fit given its current output ``y_linear`` (default: ``y``).
+
+        For an output map ``N``, ``y + y_linear - N(y_linear)``: a sample the map
+        clips keeps the residual ``y - N(y_linear)`` it has in the augmented model.
+        """
+        return y + y_linear - self.output_map(y_linear, params)
+
+    def base_input(self, plant: Plant, u: np.ndarray, dt: float, params: Params) -> np.ndarray:
+        """Input block applied to the command, given the linear model (default: :meth:`input_map`)."""
+        return self.input_map(u, dt, params)
+
+    def plant_input(self, u: np.ndarray, dt: float, params: Params, plant: Plant | None = None) -> np.ndarray:
         """What drives the linear part: the input block plus the basis terms."""
-        v = self.input_map(np.asarray(u, float), dt, params)
+        u = np.asarray(u, float)
+        if self.needs_plant:
+            if plant is None:
+                raise ModelError("needs the linear model", where=f"effect {self.label}")
+            v = self.base_input(plant, u, dt, params)
+        else:
+            v = self.input_map(u, dt, params)
         for name, phi in zip(self.basis_names, self.input_basis(u, dt, params)):
             v = v + params.get(name, 0.0) * phi
         return v
@@ -190,11 +228,12 @@ class Effect:
         t = np.asarray(t, float)
         dt = float((t[-1] - t[0]) / (t.size - 1))
         p = {**self.off(), **params}
-        v = self.plant_input(np.asarray(u, float), dt, p)
-        y = simulate_plant(self.augment_plant(plant, p), t, v, initial=initial) + offset
+        G = self.augment_plant(plant, p)
+        v = self.plant_input(np.asarray(u, float), dt, p, plant=G)
+        y = simulate_plant(G, t, v, initial=initial) + offset
         for name, psi in zip(self.basis_names, self.output_basis(t)):
             y = y + p.get(name, 0.0) * psi
-        return y
+        return self.output_map(y, p)
 
     def to_dict(self) -> dict[str, Any]:
         """``{"effect", "side", "parameters"}``.
@@ -377,21 +416,43 @@ class RateLimitEffect(Effect):
 
 @dataclass(frozen=True)
 class SaturationEffect(Effect):
-    """Amplitude limits ``lower <= u <= upper`` on the command (:class:`synth.sim.blocks.Saturation`).
+    """Amplitude limits ``lower <= . <= upper`` on the command or on the output.
 
-    Grid: the upper limit alone, then the lower limit alone, each at fractions
-    of the input's span inside its range.
+    ``placement="input"`` (default): the command is limited before ``G``
+    (:class:`synth.sim.blocks.Saturation`; an actuator's range). Grid: the upper
+    limit alone, then the lower limit alone, at fractions of the input's span.
+
+    ``placement="output"``: the model's output (offset included) is clipped
+    after ``G`` (a sensor's range, a tank that overflows). Grid: the upper limit
+    at the measured maximum and a little below it, then the lower limit likewise
+    (a clipped record rests on its limit). The linear part is fitted with the
+    clipped samples censored (:meth:`Effect.censor`).
 
     Examples
     --------
     >>> import numpy as np
     >>> SaturationEffect().input_map(np.array([0.0, 5, 10]), 1.0, {"upper": 8.0}).tolist()
     [0.0, 5.0, 8.0]
+    >>> t = np.arange(4.0); u = np.array([0.0, 1, 2, 3])
+    >>> SaturationEffect("output").apply(Plant.from_string("2"), t, u, {"upper": 3.0}).tolist()
+    [0.0, 2.0, 3.0, 3.0]
     """
 
+    placement: str = "input"
     name: ClassVar[str] = "saturation"
     parameter_names: ClassVar[tuple[str, ...]] = ("lower", "upper")
     grid_names: ClassVar[tuple[str, ...]] = ("lower", "upper")
+
+    def __post_init__(self) -> None:
+        if self.placement not in ("input", "output"):
+            raise ModelError(f"must be 'input' or 'output', got {self.placement!r}", where="saturation.placement")
+
+    @property
+    def label(self) -> str:
+        return "saturation" if self.placement == "input" else "saturation(output)"
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"effect": self.label, "side": self.placement, "parameters": list(self.parameter_names)}
 
     def off(self) -> Params:
         return {"lower": -np.inf, "upper": np.inf}
@@ -404,12 +465,151 @@ class SaturationEffect(Effect):
         fractions = (0.03, 0.1, 0.2, 0.35, 0.5, 0.7)
         return [{"upper": hi - f * span} for f in fractions] + [{"lower": lo + f * span} for f in fractions]
 
-    def input_map(self, u: np.ndarray, dt: float, params: Params) -> np.ndarray:
+    def data_grid(self, t: np.ndarray, u: np.ndarray, y: np.ndarray, plant: Plant) -> list[Params]:
+        if self.placement == "input":
+            return self.grid(t, u, plant)
+        y = np.asarray(y, float)
+        span, lo, hi = _span(y), float(np.min(y)), float(np.max(y))
+        fractions = (0.0, 0.01, 0.03, 0.1, 0.2)
+        return [{"upper": hi - f * span} for f in fractions] + [{"lower": lo + f * span} for f in fractions]
+
+    def _clip(self, x: np.ndarray, params: Params) -> np.ndarray:
         lo, hi = params.get("lower", -np.inf), params.get("upper", np.inf)
         if not (np.isfinite(lo) or np.isfinite(hi)):
-            return u
+            return x
         big = 1e30
-        return Saturation(max(lo, -big), min(hi, big)).apply(u, dt)
+        return Saturation(max(lo, -big), min(hi, big)).apply(x, 1.0)
+
+    def input_map(self, u: np.ndarray, dt: float, params: Params) -> np.ndarray:
+        return self._clip(u, params) if self.placement == "input" else u
+
+    def output_map(self, y: np.ndarray, params: Params) -> np.ndarray:
+        return self._clip(y, params) if self.placement == "output" else y
+
+
+@dataclass(frozen=True)
+class FrictionEffect(Effect):
+    """Coulomb friction of a drive: the force ``fc`` [input units] against the motion, with sticking.
+
+    The linear model ``G`` (output a position if ``G`` has a pole at the
+    origin, else a velocity) is driven by ``u + f``, ``f = -fc sign(v)`` while
+    the model's own velocity ``v`` (``s G`` or ``G``, simulated sample by sample) is
+    nonzero; at rest the drive sticks while ``|u| <= fc`` (``f = -u``) and
+    breaks away with ``f = -fc sign(u)`` otherwise; a velocity that changes
+    sign within a sample stops there. The viscous part stays in ``G``. Exact
+    for a first-order velocity model (mass and viscous friction,
+    ``G = b/(s (s + a))``); for higher orders, stopping resets the velocity
+    model's state. A delay of ``G`` acts on the command before the friction
+    (whole samples). ``fc`` times the drive gain is the Coulomb force.
+
+    A dead zone on the command is the same only while the force and the
+    velocity have the same sign (steady motion); when a drive brakes they do
+    not, and the dead zone then pushes where friction holds back.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> G = Plant.from_string("1/(s*(s+1))")  # unit mass, unit viscous friction
+    >>> t = np.arange(0, 6, 0.01); u = np.where((t >= 0.5) & (t < 3), 1.5, 0.0)
+    >>> v = np.gradient(FrictionEffect().apply(G, t, u, {"fc": 1.0}), t)
+    >>> round(float(v[290]), 3), round(abs(float(v[-1])), 3)  # 1.5 - 1 drives it; friction stops it after the push
+    (0.455, 0.0)
+    """
+
+    name: ClassVar[str] = "friction"
+    parameter_names: ClassVar[tuple[str, ...]] = ("fc",)
+    grid_names: ClassVar[tuple[str, ...]] = ("fc",)
+    needs_plant: ClassVar[bool] = True
+
+    def off(self) -> Params:
+        return {"fc": 0.0}
+
+    def bounds(self, t: np.ndarray, u: np.ndarray, plant: Plant) -> dict[str, tuple[float, float]]:
+        return {"fc": (0.0, float(np.max(np.abs(u))))}
+
+    def grid(self, t: np.ndarray, u: np.ndarray, plant: Plant) -> list[Params]:
+        top = float(np.max(np.abs(u)))
+        if top <= 0:
+            raise ModelError("the input is zero; no friction can be fitted", where="record.u")
+        return _log_grid(0.01 * top, 0.5 * top, 8, "fc")
+
+    def base_input(self, plant: Plant, u: np.ndarray, dt: float, params: Params) -> np.ndarray:
+        fc = float(params.get("fc", 0.0))
+        if fc <= 0:
+            return u
+        return u + coulomb_force(plant, u, dt, fc)
+
+
+def _velocity_model(plant: Plant) -> tuple[np.ndarray, np.ndarray]:
+    """Numerator and denominator of the velocity model: ``s G`` for a position output, else ``G``."""
+    den = np.asarray(plant.den, float)
+    if den[-1] == 0.0:
+        den = den[:-1]
+        if den.size < 2 or den[-1] == 0.0:
+            raise ModelError("friction needs a drive with at most one pole at the origin", where="plant")
+    num = np.asarray(plant.num, float)
+    if num.size >= den.size:
+        raise ModelError("friction needs a strictly proper velocity model s*G", where="plant")
+    return num, den
+
+
+def coulomb_force(plant: Plant, u: np.ndarray, dt: float, fc: float) -> np.ndarray:
+    """Friction term ``f`` (input units) that makes ``G (u + f)`` a drive with Coulomb friction ``fc``.
+
+    Parameters
+    ----------
+    plant : Plant
+        Position model (one pole at the origin) or velocity model of the drive.
+    u : numpy.ndarray
+        Command samples (held), the drive at rest before the first one.
+    dt : float
+        Sample time [s].
+    fc : float
+        Coulomb friction in input units.
+
+    Returns
+    -------
+    numpy.ndarray
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> coulomb_force(Plant.from_string("1/(s*(s+1))"), np.array([0.5, 2.0, 2.0, -0.5]), 0.1, 1.0).round(3).tolist()
+    [-0.5, -1.0, -1.0, -1.0]
+    """
+    from scipy.linalg import expm
+
+    from synth.sim.discretize import tf_to_ss
+
+    num, den = _velocity_model(plant)
+    A, B, C, _D = tf_to_ss(num, den)
+    n = A.shape[0]
+    M = expm(np.block([[A, B[:, None]], [np.zeros((1, n + 1))]]) * dt)
+    Ad, Bd = M[:n, :n], M[:n, n]
+    u = np.asarray(u, float)
+    k = round(plant.delay / dt)
+    ud = np.r_[np.full(k, 0.0), u[:u.size - k]] if k > 0 else u
+    w = np.empty_like(ud)
+    x = np.zeros(n)
+    stuck = True
+    for i in range(ud.size):
+        ui = ud[i]
+        if stuck:
+            if abs(ui) <= fc:
+                w[i] = 0.0
+                continue
+            w[i] = ui - fc * np.sign(ui)
+            stuck = False
+            direction = np.sign(ui)
+        else:
+            w[i] = ui - fc * direction
+        x = Ad @ x + Bd * w[i]
+        v = float(C @ x)
+        if v * direction <= 0.0:  # the velocity reached zero within the sample: stop there
+            x = np.zeros(n)
+            stuck = True
+    f = w - ud
+    return np.r_[f[k:], np.full(k, f[-1])] if k > 0 else f
 
 
 @dataclass(frozen=True)
@@ -601,7 +801,7 @@ class DriftEffect(Effect):
 
 EFFECTS: dict[str, type[Effect]] = {
     "delay": DelayEffect, "lag": LagEffect, "resonance": ResonanceEffect, "rate_limit": RateLimitEffect,
-    "saturation": SaturationEffect, "deadzone": DeadzoneEffect, "backlash": BacklashEffect,
+    "saturation": SaturationEffect, "friction": FrictionEffect, "deadzone": DeadzoneEffect, "backlash": BacklashEffect,
     "quantization": QuantizationEffect, "supply_sag": SupplySagEffect,
     "static_nonlinearity": StaticNonlinearityEffect, "drift": DriftEffect,
 }
@@ -609,7 +809,7 @@ EFFECTS: dict[str, type[Effect]] = {
 
 
 def make_effect(spec: str | Effect) -> Effect:
-    """An effect from its name (``"lag(sensor)"`` places the lag at the sensor).
+    """An effect from its name (``"lag(sensor)"``: the lag at the sensor; ``"saturation(output)"``: clipping).
 
     Examples
     --------
@@ -623,6 +823,10 @@ def make_effect(spec: str | Effect) -> Effect:
         return LagEffect("sensor")
     if text in ("lag(actuator)", "actuator_lag"):
         return LagEffect("actuator")
+    if text in ("saturation(output)", "clipping"):
+        return SaturationEffect("output")
+    if text == "saturation(input)":
+        return SaturationEffect("input")
     if text not in EFFECTS:
         raise ModelError(f"unknown effect {text!r}; known: {', '.join(EFFECTS)}", where="candidates")
     return EFFECTS[text]()

@@ -20,7 +20,13 @@ the simulation error ``sum_k (y_k - yhat_k)^2`` with
   best grid point's neighbours, every point a full casadi fit of the rest;
 - the *basis* parameters ``a_j, d_j`` and the output constant ``c`` (linear in
   the output for a given ``G_aug``) by linear least squares, alternating with
-  the casadi fit (until the SSR settles, at most twelve rounds).
+  the casadi fit (until the SSR settles, at most twelve rounds);
+- an output map ``M`` (clipping: ``yhat = M(c + G_aug N(u))``) by censoring: the
+  linear part is fitted to ``y + yhat_lin - M(yhat_lin)``, so a clipped sample
+  keeps the residual it has in the clipped model, alternating as above;
+- an input side that depends on the linear model (Coulomb friction, driven by
+  the model's own velocity) by alternating the friction signal of the current
+  linear model with the casadi fit, as above.
 
 Intervals: casadi-fitted parameters carry the Jacobian intervals of
 :class:`synth.ident.timefit.TimeFitResult`; grid parameters a profile interval
@@ -226,7 +232,7 @@ def _basis_step(effect: Effect, G: Plant, params: Params, t: np.ndarray, u: np.n
                 dt: float) -> tuple[Params, float, dict[str, tuple[float, float]], float]:
     """Least squares for the output constant and the basis parameters, the linear model fixed."""
     Gaug = effect.augment_plant(G, params)
-    v0 = effect.input_map(u, dt, params)
+    v0 = effect.base_input(Gaug, u, dt, params) if effect.needs_plant else effect.input_map(u, dt, params)
     cols = [np.ones_like(y)]
     phis = effect.input_basis(u, dt, params)
     cols += [simulate_plant(Gaug, t, phi) for phi in phis]
@@ -267,20 +273,27 @@ def _fit_point(plant: Plant, effect: Effect, params: Params, t: np.ndarray, u: n
     dt = float((t[-1] - t[0]) / (t.size - 1))
     p = {**effect.off(), **params}
     G, nominal, ci, solver, offset = plant, dict(start), {}, {}, 0.0
-    rounds = _ROUNDS if effect.basis_names else 1
+    # alternate when a step depends on the others: basis terms, an output map (censoring), a plant-dependent input
+    output_side = type(effect).output_map is not Effect.output_map
+    iterate = bool(effect.basis_names) or output_side or effect.needs_plant
+    rounds = _ROUNDS if iterate else 1
     last = np.inf
+    target = y
     try:
         for _ in range(rounds):
-            v = effect.plant_input(u, dt, p)
+            v = effect.plant_input(u, dt, p, plant=effect.augment_plant(G, p))
             drift = sum((p[n] * psi for n, psi in zip(effect.basis_names, effect.output_basis(t))), np.zeros_like(y))
-            G, p, nominal, ci_f, solver = _linear_fit(plant, effect, p, t, v, y - drift, formula,
+            G, p, nominal, ci_f, solver = _linear_fit(plant, effect, p, t, v, target - drift, formula,
                                                       {k: v_ for k, v_ in nominal.items() if k != "delay"})
-            p, offset, ci_b, gain = _basis_step(effect, G, p, t, u, y, dt)
+            p, offset, ci_b, gain = _basis_step(effect, G, p, t, u, target, dt)
             if gain != 1.0:
                 G = G.scaled(gain, label=G.label)
                 nominal = {k: (v_ * gain if k.startswith("n") else v_) for k, v_ in nominal.items()}
             ci = {**ci_f, **ci_b}
-            if effect.basis_names:
+            if iterate:
+                if output_side:
+                    y_lin = _Linear(effect).apply(G, t, u, p, offset=offset)
+                    target = effect.censor(y, y_lin, p)
                 ssr = float(np.sum((y - effect.apply(G, t, u, p, offset=offset)) ** 2))
                 if abs(last - ssr) <= _ROUNDS_TOL * max(ssr, 1e-300):
                     break
@@ -290,6 +303,22 @@ def _fit_point(plant: Plant, effect: Effect, params: Params, t: np.ndarray, u: n
     yhat = effect.apply(G, t, u, p, offset=offset)
     ssr = float(np.sum((y - yhat) ** 2))
     return _Point(p, ssr if np.isfinite(ssr) else np.inf, G, offset, nominal, ci, solver)
+
+
+class _Linear:
+    """An effect's model without its output map (the linear part's output, for censoring)."""
+
+    def __init__(self, effect: Effect) -> None:
+        self.effect = effect
+
+    def apply(self, G: Plant, t: np.ndarray, u: np.ndarray, params: Params, offset: float) -> np.ndarray:
+        eff = self.effect
+        dt = float((t[-1] - t[0]) / (t.size - 1))
+        Ga = eff.augment_plant(G, params)
+        y = simulate_plant(Ga, t, eff.plant_input(u, dt, params, plant=Ga)) + offset
+        for name, psi in zip(eff.basis_names, eff.output_basis(t)):
+            y = y + params.get(name, 0.0) * psi
+        return y
 
 
 def _profile_ci(points: list[_Point], best: _Point, name: str, n: int) -> tuple[float, float]:
@@ -365,7 +394,7 @@ def fit_augmented(plant: Plant, t: np.ndarray, u: np.ndarray, y: np.ndarray, eff
             raise ModelError(f"start {formula_s} does not have the structure {formula}", where="start")
         start_values = values_s
     eff = effect if effect is not None else _NoEffect()
-    grid = eff.grid(t, u, plant)
+    grid = eff.data_grid(t, u, y, plant)
     points = [_fit_point(plant, eff, g, t, u, y, formula, start_values) for g in grid]
     for g, p in zip(grid, points):
         p.key = next((k for k in eff.grid_names if k in g), None)
