@@ -59,6 +59,10 @@ def report_data(spec: Spec, result: DesignResult) -> dict[str, Any]:
         from synth.sim.report import simulation_report
 
         data["simulation"] = simulation_report(spec, shown, reference_controller(spec)).data
+        from synth.gap.x4_case import gap_case_applies, x4_gap_case
+
+        if gap_case_applies(spec):  # seed 1's gap diagnosed on the simulated rig (issue 6): synth.gap.x4_case
+            data["sim_to_real_gap"] = x4_gap_case(spec)
     return to_jsonable(data)
 
 
@@ -184,7 +188,7 @@ def write_design_report(spec: Spec, result: DesignResult, out_dir: str | Path, *
         delay_table=[{**r, "critical_gain": float(r["critical_gain"])} for r in delay_table or []],
         marks=marks, certificate=data.get("certificate"), ref_line=ref_line, sim=data.get("simulation"),
         synthesis=data.get("synthesis"), diagnosis=data.get("diagnosis"), ident=data.get("identification"),
-        f=lambda x, d=4: fmt(None if x is None else float(x), d),
+        f=lambda x, d=4: fmt(None if x is None else float(x), d), gap=data.get("sim_to_real_gap"),
     )
     html_path = out.claim("report.html")
     html_path.write_text(html, encoding="utf-8")
