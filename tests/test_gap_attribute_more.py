@@ -1,0 +1,120 @@
+"""Screening, joint confirmation, linearized calibration, the validate= path, dead zone and backlash end to end."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from synth.data import record_from_arrays
+from synth.gap.attribute import DEFAULT_CANDIDATES, _linearized_null, _refit_null, diagnose_effects
+from synth.gap.effects import make_effect
+from synth.gap.refit import fit_augmented
+from synth.gap.screen import screen_effect
+
+TRUE_TF = "23*(s+0.43)/((s+9.6)*(s+0.54))"
+NOMINAL_TF = "22*(s+0.45)/((s+9.3)*(s+0.56))"
+DT = 0.02
+T = np.arange(0, 24, DT)
+LEVELS = np.array([175, 225, 185, 235, 170, 205, 240, 180, 220, 195, 230, 175, 215, 185, 245, 190], float)
+U = LEVELS[(T // 1.5).astype(int) % LEVELS.size]
+
+
+def _plants():
+    from synth.plant import Plant
+
+    return Plant.from_string(TRUE_TF), Plant.from_string(NOMINAL_TF)
+
+
+def _record(effect: str | None, params: dict[str, float], seed: int = 1, u: np.ndarray = U):
+    true, _ = _plants()
+    clean = make_effect(effect).apply(true, T, u, params) if effect else make_effect("delay").apply(true, T, u, {})
+    y = clean + np.random.default_rng(seed).normal(size=T.size)
+    return record_from_arrays(T, u, y), clean
+
+
+def test_screen_ranks_the_true_effect_first_and_recovers_its_parameter():
+    rec, _ = _record("rate_limit", {"rate": 300.0})
+    _, nominal = _plants()
+    k = rec.n // 2
+    refit = fit_augmented(nominal, rec.t[:k], rec.u[:k], rec.y[:k])
+    bases = [("nominal", nominal), ("refit", refit.plant)]
+    screened = sorted((screen_effect(make_effect(c), bases, rec.t[:k], rec.u[:k], rec.y[:k], rec.t, rec.u)
+                       for c in DEFAULT_CANDIDATES), key=lambda s: s.ssr)
+    best = screened[0]
+    assert best.effect.name == "rate_limit"
+    assert best.params["rate"] == pytest.approx(300.0, rel=0.05)
+    assert best.ssr / k == pytest.approx(1.0, rel=0.2)  # down to the noise (variance 1) on the training half
+    assert screened[1].ssr > 1.5 * best.ssr
+    assert best.yhat_eval.size == rec.n and np.allclose(best.yhat_eval[:k], best.yhat_train)
+
+
+def test_confirming_one_candidate_gives_the_full_joint_answer():
+    rec, clean = _record("saturation", {"upper": 215.0})
+    _, nominal = _plants()
+    fast = diagnose_effects(nominal, rec, confirm=1, n_null=49)
+    full = diagnose_effects(nominal, rec, candidates=["saturation"], confirm=None, n_null=49)
+    assert fast.verdict["effects"] == full.verdict["effects"] == ["saturation"]
+    a = next(e for e in fast.effects if e.effect == "saturation")
+    b = full.effects[0]
+    assert a.fit == "joint" and a.accepted
+    assert a.parameters["upper"] == pytest.approx(b.parameters["upper"], abs=0.5)
+    assert a.shrinkage == pytest.approx(b.shrinkage, abs=0.01)
+    true = 1.0 - np.mean((rec.y - clean)[fast.heldout] ** 2) / fast.j_refit
+    assert a.shrinkage == pytest.approx(true, abs=0.03)
+    screened = [e for e in fast.effects if e.fit == "screened"]
+    assert len(screened) == len(DEFAULT_CANDIDATES) - 1 and not any(e.accepted for e in screened)
+    assert fast.to_dict()["split"]["joint_fits"] == ["saturation"]
+
+
+def test_linearized_calibration_matches_the_repeated_refit():
+    rec, _ = _record(None, {})
+    _, nominal = _plants()
+    k = rec.n // 2
+    held = np.arange(rec.n) >= k
+    refit = fit_augmented(nominal, rec.t[:k], rec.u[:k], rec.y[:k])
+    args = (refit, rec.t[:k], rec.u[:k], rec.t, rec.u, held, True, 1.0)
+    lin = _linearized_null(*args, 400, np.random.default_rng(0))
+    ref = _refit_null(*args, 40, np.random.default_rng(1))
+    # a perfect model beats an estimated one by about p / N on held-out data (p = 5 coefficients here)
+    assert np.mean(lin) == pytest.approx(np.mean(ref), abs=0.004)
+    assert 0.0 < np.mean(lin) < 0.02
+    assert np.quantile(lin, 0.95) == pytest.approx(np.quantile(ref, 0.95), abs=0.01)
+
+
+def test_validation_record_is_the_held_out_data():
+    rec, _ = _record("rate_limit", {"rate": 300.0}, seed=2)
+    val, clean = _record("rate_limit", {"rate": 300.0}, seed=3, u=np.roll(U, 300))
+    _, nominal = _plants()
+    dg = diagnose_effects(nominal, rec, validate=val, candidates=["rate_limit", "delay", "lag"])
+    assert dg.verdict["effects"] == ["rate_limit"]
+    assert dg.heldout.all() and dg.split["heldout_samples"] == val.n and dg.split["train_samples"] == rec.n
+    best = dg.effects[0]
+    assert best.parameters["rate"] == pytest.approx(300.0, rel=0.05)
+    true = 1.0 - np.mean((val.y - clean) ** 2) / dg.j_refit
+    assert best.shrinkage == pytest.approx(true, abs=0.03)
+
+
+@pytest.mark.parametrize("effect, params, key, tol", [
+    ("deadzone", {"width": 6.0, "center": 175.0}, "width", 0.3),
+    ("backlash", {"width": 8.0}, "width", 0.4),
+])
+def test_deadzone_and_backlash_end_to_end(effect, params, key, tol):
+    rec, clean = _record(effect, params)
+    _, nominal = _plants()
+    dg = diagnose_effects(nominal, rec)
+    assert dg.verdict["effects"] == [effect]
+    best = next(e for e in dg.effects if e.effect == effect)
+    assert best.parameters[key] == pytest.approx(params[key], abs=tol)
+    true = 1.0 - np.mean((rec.y - clean)[dg.heldout] ** 2) / dg.j_refit
+    assert best.shrinkage == pytest.approx(true, abs=0.05)
+
+
+def test_bad_new_options_raise():
+    from synth.errors import ModelError
+
+    rec, _ = _record(None, {})
+    _, nominal = _plants()
+    with pytest.raises(ModelError, match="calibration"):
+        diagnose_effects(nominal, rec, calibration="exact")
+    with pytest.raises(ModelError, match="confirm"):
+        diagnose_effects(nominal, rec, confirm=0)
