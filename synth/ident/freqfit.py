@@ -39,7 +39,7 @@ from synth.polynomials import format_factored
 W_G = 1.0
 W_P = 0.01745
 IPOPT_OPTIONS = {"ipopt.print_level": 0, "print_time": False, "ipopt.sb": "yes", "ipopt.max_iter": 500,
-                 "ipopt.tol": 1e-10}
+                 "ipopt.tol": 1e-10, "show_eval_warnings": False}
 
 
 def coherence_weight(coherence: Any) -> np.ndarray:

@@ -561,7 +561,7 @@ class _Problem:
         H = lam_f * (J.T @ J) / s2
         hess = ca.Function("nlp_hess_l", [dec, params, lam_f, lam_g], [ca.triu(H)],
                            ["x", "p", "lam_f", "lam_g"], ["triu_hess_gamma_x_x"])
-        opts = {"print_time": False, "hess_lag": hess,
+        opts = {"print_time": False, "hess_lag": hess, "show_eval_warnings": False,  # diverging trial points: IPOPT recovers
                 "ipopt": {"print_level": 0, "sb": "yes", "tol": 1e-12, "acceptable_tol": 1e-9, "max_iter": 300}}
         self.solver = ca.nlpsol("timefit", "ipopt", {"x": dec, "p": params, "f": obj}, opts)
         self.p = p
