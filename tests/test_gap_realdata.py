@@ -31,7 +31,7 @@ def test_emps_linear_model_leaves_coulomb_friction():
     rec = emps_record(shared_path("data", "emps_friction_drive", "DATA_EMPS.mat"))
     fit = identify(rec, "b/(s+a)", delay=0.0).fit
     nominal = Plant.from_string(f"{fit.parameters['b']!r}/(s+{fit.parameters['a']!r})")
-    dg = diagnose_effects(nominal, rec, candidates=["friction", "deadzone", "saturation", "drift"], confirm=None)
+    dg = diagnose_effects(nominal, rec, candidates=["friction", "deadzone", "saturation", "drift"])
     assert dg.verdict["effects"] == ["friction"] and dg.verdict["status"] == "effect"
     best = dg.effects[0]
     assert best.effect == "friction" and best.shrinkage_ci[0] > 0.5

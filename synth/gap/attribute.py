@@ -513,7 +513,11 @@ def _seeded(effect: Effect, screened: ScreenedFit) -> Effect:
 def _candidate_fits(plant: Plant, effects: list[Effect], refit: AugmentedFit, t_tr: np.ndarray, u_tr: np.ndarray,
                     y_tr: np.ndarray, t_ev: np.ndarray, u_ev: np.ndarray, confirm: int | None,
                     ) -> list[tuple[Effect, AugmentedFit | ScreenedFit, np.ndarray, np.ndarray]]:
-    """Every candidate's fit: joint for all (``confirm=None``) or screened, the best ``confirm`` then joint."""
+    """Every candidate's fit: joint for all (``confirm=None``) or screened, the best ``confirm`` then joint.
+
+    Effects the screen cannot represent (``Effect.screenable`` false: friction, output-side clipping) are
+    always fitted jointly.
+    """
     out: list[tuple[Effect, AugmentedFit | ScreenedFit, np.ndarray, np.ndarray]] = []
     if confirm is None:
         for eff in effects:
@@ -526,6 +530,13 @@ def _candidate_fits(plant: Plant, effects: list[Effect], refit: AugmentedFit, t_
     bases = [("nominal", plant), ("refit", refit.plant)]
     screened: list[tuple[Effect, ScreenedFit]] = []
     for eff in effects:
+        if not eff.screenable:  # the screen holds the input fixed and has no output map: fit these jointly
+            try:
+                fit = fit_augmented(plant, t_tr, u_tr, y_tr, eff, start=refit.plant)
+            except ModelError:
+                continue
+            out.append((eff, fit, fit.predict(t_tr, u_tr), fit.predict(t_ev, u_ev)))
+            continue
         try:
             screened.append((eff, screen_effect(eff, bases, t_tr, u_tr, y_tr, t_ev, u_ev)))
         except ModelError:

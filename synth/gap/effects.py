@@ -163,6 +163,11 @@ class Effect:
     #: the input side depends on the linear model (re-fit alternates it with the linear fit)
     needs_plant: ClassVar[bool] = False
 
+    @property
+    def screenable(self) -> bool:
+        """Whether :mod:`synth.gap.screen` can fit it (an input-side block on a fixed input, no output map)."""
+        return not self.needs_plant
+
     def data_grid(self, t: np.ndarray, u: np.ndarray, y: np.ndarray, plant: Plant) -> list[Params]:
         """Grid built from the record's output as well (default: :meth:`grid`)."""
         return self.grid(t, u, plant)
@@ -485,6 +490,10 @@ class SaturationEffect(Effect):
 
     def output_map(self, y: np.ndarray, params: Params) -> np.ndarray:
         return self._clip(y, params) if self.placement == "output" else y
+
+    @property
+    def screenable(self) -> bool:
+        return self.placement == "input"
 
 
 @dataclass(frozen=True)
