@@ -62,6 +62,9 @@ def _csv(tmp_path, header, rows):
     ("nan", "NaN or inf"),
     ("constant", "input is constant"),
     ("formula", "--structure"),
+    ("time", "time is not strictly increasing at sample 20"),
+    ("length", "columns have different lengths"),
+    ("flat", "the output never responds"),
 ])
 def test_bad_input_exit_2_one_line(run_cli, tmp_path, case, message):
     rows = [f"{i * 0.01:.2f},{1.0 if i > 5 else 0.0},{np.tanh(i / 10):.6f}" for i in range(50)]
@@ -75,6 +78,12 @@ def test_bad_input_exit_2_one_line(run_cli, tmp_path, case, message):
         rows = [f"{i * 0.01:.2f},1.0,{np.tanh(i / 10):.6f}" for i in range(50)]
     if case == "formula":
         structure = "K/(T*s+1"
+    if case == "time":
+        rows[20] = "0.18" + rows[20][4:]
+    if case == "length":
+        rows[30] = rows[30].rsplit(",", 1)[0]
+    if case == "flat":
+        rows = [f"{i * 0.01:.2f},{1.0 if i > 5 else 0.0},0.5" for i in range(50)]
     path = _csv(tmp_path, header, rows)
     res = run_cli("identify", "--data", str(path), "--time", "t", "--input", "volt", "--output", "speed",
                   "--structure", structure, "--out", str(tmp_path / "o"))
