@@ -499,6 +499,8 @@ def _seeded(effect: Effect, screened: ScreenedFit) -> Effect:
     point = {k: v for k, v in screened.params.items() if k not in effect.basis_names}
     keys = [k for k in effect.grid_names if k in point and np.isfinite(point[k]) and point[k] > 0]
     grid = [point] if not keys else [{**point, keys[0]: point[keys[0]] * f} for f in (1 / 1.15, 1.0, 1.15)]
+    if effect.name == "quantization":  # the screen searched step and offset jointly and densely (piecewise-constant cost)
+        grid = [point]
     if effect.name == "saturation":  # one limit at a time, as the effect's own grid
         side = "upper" if np.isfinite(point.get("upper", np.inf)) else "lower"
         other = "lower" if side == "upper" else "upper"

@@ -17,7 +17,7 @@ effect                 side      augmented model                                
                                  a position (pole at the origin) or a velocity
 ``deadzone``           input     :class:`synth.sim.blocks.DeadZone` before ``G``              ``width``
 ``backlash``           input     :class:`synth.sim.blocks.Backlash` before ``G``              ``width``
-``quantization``       input     :class:`synth.sim.blocks.Quantizer` before ``G``             ``step``
+``quantization``       input     :class:`synth.sim.blocks.Quantizer` before ``G``             ``step, offset``
 ``supply_sag``         input     ``u - a u max(0, u - u_f)``, ``tau u_f' + u_f = u``          ``sag, tau``
 ``static_nonlinearity``input     ``u + a2 x^2 + a3 x^3``, ``x = (u - c)/h``                   ``a2, a3``
 ``drift``              output    ``y + d1 (t - t0) + d2 (t - t0)^2``                          ``slope, curvature``
@@ -340,8 +340,10 @@ class LagEffect(Effect):
 class ResonanceEffect(Effect):
     """A lightly damped mode ``wn^2/(s^2 + 2 zeta wn s + wn^2)`` in series (unit DC gain).
 
-    ``wn`` is searched on a grid (then golden section); ``zeta`` (as its square
-    root, so it stays >= 0) joins the nominal coefficients in the casadi fit.
+    ``wn`` is searched on a grid (then golden section); ``zeta`` joins the nominal
+    coefficients in the casadi fit as ``z`` with ``zeta = z^2 / (1 + z^2)``, so the
+    fitted damping stays in ``[0, 1)``: a lightly damped mode, never an overdamped
+    pair of real poles (which the lag effect, or the re-fit's own poles, describe).
 
     Examples
     --------
@@ -367,12 +369,36 @@ class ResonanceEffect(Effect):
         lo = min(2.0 * _fastest_pole(plant), nyquist / 20)
         return [{"wn": float(w), "zeta": 0.2} for w in np.geomspace(lo, nyquist / 5, 6)]
 
+    #: largest damping handed to the fit (``z`` finite)
+    zeta_max: ClassVar[float] = 1.0 - 1e-6
+
     def factor(self, params: Params | None = None) -> str:
         wn = float((params or {}).get("wn", 1.0))
-        return f"{wn**2!r}/(s^2+2*zeta^2*{wn!r}*s+{wn**2!r})"
+        return f"{wn**2!r}/(s^2+2*(zeta^2/(1+zeta^2))*{wn!r}*s+{wn**2!r})"
+
+    def to_factor(self, params: Params) -> dict[str, float]:
+        """``z = sqrt(zeta / (1 - zeta))`` (``zeta`` clamped to ``[0, 1)``).
+
+        Examples
+        --------
+        >>> e = ResonanceEffect()
+        >>> round(e.to_factor({"zeta": 0.5})["zeta"], 6), round(e.from_factor({"zeta": 1.0})["zeta"], 6)
+        (1.0, 0.5)
+        >>> e.from_factor({"zeta": 1e3})["zeta"] <= 1.0  # never overdamped, whatever the solver returns
+        True
+        """
+        zeta = float(np.clip(params.get("zeta", 0.2), 0.0, self.zeta_max))
+        return {"zeta": float(np.sqrt(zeta / (1.0 - zeta)))}
+
+    def from_factor(self, values: dict[str, float]) -> Params:
+        """``zeta = z^2 / (1 + z^2)`` (inverse of :meth:`to_factor`)."""
+        if "zeta" not in values:
+            return {}
+        z2 = float(values["zeta"]) ** 2
+        return {"zeta": z2 / (1.0 + z2) if np.isfinite(z2) else 1.0}
 
     def augment_plant(self, plant: Plant, params: Params) -> Plant:
-        wn, zeta = params.get("wn", np.inf), params.get("zeta", 1.0)
+        wn, zeta = params.get("wn", np.inf), float(np.clip(params.get("zeta", 1.0), 0.0, 1.0))
         if not np.isfinite(wn):
             return plant
         return Plant(plant.num * wn**2, np.polymul(plant.den, [1.0, 2 * zeta * wn, wn**2]), plant.delay,
@@ -685,31 +711,62 @@ class BacklashEffect(Effect):
 
 @dataclass(frozen=True)
 class QuantizationEffect(Effect):
-    """Command resolution ``step`` (:class:`synth.sim.blocks.Quantizer`, rounding).
+    """Command resolution ``step`` with the lattice at ``offset + k step`` (:class:`synth.sim.blocks.Quantizer`).
+
+    ``offset`` in ``[0, step)`` places the lattice relative to the signal (a converter's zero, a
+    PWM's bias). For a fixed linear model the output depends on ``(step, offset)`` only through which
+    level each sample rounds to, so the error is piecewise constant in both: they are searched densely
+    and jointly on the record with the linear model's denominator fixed
+    (:func:`synth.gap.screen.quantizer_grid`, :meth:`data_grid`), never by a one-dimensional golden search.
+    :meth:`grid` (no output data) is a coarse joint grid.
 
     Examples
     --------
     >>> import numpy as np
     >>> QuantizationEffect().input_map(np.array([0.4, 0.6, 1.7]), 1.0, {"step": 1.0}).tolist()
     [0.0, 1.0, 2.0]
+    >>> QuantizationEffect().input_map(np.array([0.4, 0.6, 1.7]), 1.0, {"step": 1.0, "offset": 0.5}).tolist()
+    [0.5, 0.5, 1.5]
     """
 
     name: ClassVar[str] = "quantization"
-    parameter_names: ClassVar[tuple[str, ...]] = ("step",)
-    grid_names: ClassVar[tuple[str, ...]] = ("step",)
+    parameter_names: ClassVar[tuple[str, ...]] = ("step", "offset")
+    grid_names: ClassVar[tuple[str, ...]] = ("step", "offset")
 
     def off(self) -> Params:
-        return {"step": 0.0}
+        return {"step": 0.0, "offset": 0.0}
 
     def bounds(self, t: np.ndarray, u: np.ndarray, plant: Plant) -> dict[str, tuple[float, float]]:
-        return {"step": (0.0, 0.5 * _span(u))}
+        return {"step": (0.0, 0.5 * _span(u)), "offset": (0.0, 0.5 * _span(u))}
 
     def grid(self, t: np.ndarray, u: np.ndarray, plant: Plant) -> list[Params]:
-        return _log_grid(0.005 * _span(u), 0.3 * _span(u), 8, "step")
+        return [{**g, "offset": float(f * g["step"])} for g in _log_grid(0.005 * _span(u), 0.3 * _span(u), 8, "step")
+                for f in (0.0, 0.25, 0.5, 0.75)]
+
+    def data_grid(self, t: np.ndarray, u: np.ndarray, y: np.ndarray, plant: Plant) -> list[Params]:
+        """The best point of the dense joint search of :func:`synth.gap.screen.quantizer_grid` on ``plant``.
+
+        A subclass's own :meth:`grid` (a seeded search) wins.
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> t = np.arange(0, 8, 0.01); u = 1.0 + 0.8 * np.sin(2.3 * t) * np.sin(0.37 * t)
+        >>> G = Plant.from_string("2/(0.2*s+1)")
+        >>> y = QuantizationEffect().apply(G, t, u, {"step": 0.25, "offset": 0.07})
+        >>> g = QuantizationEffect().data_grid(t, u, y, G)[0]
+        >>> round(g["step"], 2), round(g["offset"], 2)
+        (0.25, 0.07)
+        """
+        if type(self).grid is not QuantizationEffect.grid:
+            return self.grid(t, u, plant)
+        from synth.gap.screen import quantizer_grid  # the screen imports this module
+
+        return quantizer_grid(plant, t, u, y, keep=1)
 
     def input_map(self, u: np.ndarray, dt: float, params: Params) -> np.ndarray:
         q = params.get("step", 0.0)
-        return u if q <= 0 else Quantizer(q).apply(u, dt)
+        return u if q <= 0 else Quantizer(q, float(params.get("offset", 0.0)) % q).apply(u, dt)
 
 
 @dataclass(frozen=True)
