@@ -144,7 +144,7 @@ def _optimize_scalar(f: Callable[[float], float], intervals: list[tuple[float, f
         vals = [f(x) for x in cand]
         i = int(np.nanargmax(vals))
         x, v = cand[i], vals[i]
-        if hi > lo:
+        if hi > lo and np.all(np.isfinite(vals[max(i - 1, 0):i + 2])):  # Brent needs finite values around the best
             a, b = cand[max(i - 1, 0)], cand[min(i + 1, len(cand) - 1)]
             res = minimize_scalar(lambda t: -f(t), bounds=(a, b), method="bounded",
                                   options={"xatol": 1e-10 * max(1.0, abs(b))})

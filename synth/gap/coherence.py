@@ -102,7 +102,8 @@ def input_residual_coherence(u: np.ndarray, e: np.ndarray, dt: float, n_segments
     if n_segments < 2 or nper < 8:
         raise DataError(f"need at least 2 segments of 8 samples ({u.size} samples, {n_segments} segments)",
                         where="n_segments")
-    f, g = welch_coherence(u, e, fs=1.0 / dt, window="hann", nperseg=nper, noverlap=0, detrend="constant")
+    with np.errstate(divide="ignore", invalid="ignore"):  # bins where a segment has no power: coherence 0
+        f, g = welch_coherence(u, e, fs=1.0 / dt, window="hann", nperseg=nper, noverlap=0, detrend="constant")
     keep = f > 0
     return Coherence(2 * np.pi * f[keep], np.nan_to_num(g[keep]), coherence_threshold(n_segments, alpha),
                      n_segments, alpha)
