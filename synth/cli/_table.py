@@ -50,3 +50,18 @@ def print_requirements(results: list[RequirementResult], out: Any) -> None:
     print(file=out)
     for r in results:
         print(f"- {r.message}", file=out)
+
+
+def name_values(rows: list[tuple[str, str]], notes: Iterable[str] = ()) -> str:
+    """Two aligned columns (name, value with unit), then one ``note:`` line per note.
+
+    Examples
+    --------
+    >>> print(name_values([("w180", "3.262 rad/s"), ("phase delay", "0.0761 s")], ["exact"]))
+      w180         3.262 rad/s
+      phase delay  0.0761 s
+    note: exact
+    """
+    width = max((len(name) for name, _ in rows), default=0)
+    lines = [f"  {name:<{width}}  {value}" for name, value in rows] + [f"note: {n}" for n in notes]
+    return "\n".join(lines)

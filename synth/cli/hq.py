@@ -110,6 +110,7 @@ def _fmt(value: Any, unit: str, sigma: Any = None, digits: int = 4) -> str:
 
 
 def run(args: argparse.Namespace) -> int:
+    from synth.cli._table import name_values
     from synth.errors import DataError, ModelError
     from synth.ident.hq import hq_from_frd, hq_from_plant
     from synth.outputs import OutputDir, check_writable, dump_json, write_json
@@ -155,11 +156,7 @@ def run(args: argparse.Namespace) -> int:
             ("phase delay tau_p", _fmt(m.phase_delay, "s", u.get("phase_delay"), 3)
              + (f"  (phase at 2 w180: {m.phase_2w180:.1f} deg, {m.phase_method})" if m.phase_2w180 is not None else ""))]
     print(f"{title}: {m.response_type} response type ({m.response_type_reason})")
-    width = max(len(r[0]) for r in rows)
-    for name, value in rows:
-        print(f"  {name:<{width}}  {value}")
-    for note in m.notes:
-        print(f"note: {note}")
+    print(name_values(rows, m.notes))
     if out:
         print(f"wrote {out.path}/hq.json and {out.path}/hq_bode.png")
     return 0

@@ -48,6 +48,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    from synth.cli._table import name_values
     from synth.ident.psd import analyze_records, load_disturbance, suggest_bandwidth, unit_squared
     from synth.outputs import OutputDir, check_writable, dump_json, write_json
 
@@ -90,11 +91,7 @@ def run(args: argparse.Namespace) -> int:
     if suggestion:
         rows.append(("suggested requirement", f"{suggestion.spec_entry()}  (bandwidth >= {suggestion.factor:g} x "
                                               f"{suggestion.share_frequency:.4g} rad/s)"))
-    width = max(len(r[0]) for r in rows)
-    for name, value in rows:
-        print(f"  {name:<{width}}  {value}")
-    for note in a.notes:
-        print(f"note: {note}")
+    print(name_values(rows, a.notes))
     if out:
         print(f"wrote {out.path}/psd.json and {out.path}/psd.png")
     return 0
