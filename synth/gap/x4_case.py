@@ -71,7 +71,7 @@ def _rise(result: Any, t_step: float) -> float:
 
 
 def x4_gap_case(spec: Any, *, steps: int = 8, period: float = 0.25, noise_std: float = 1.0, decimate: int = 2,
-                n_null: int = 2, seed: int = 0) -> dict[str, Any]:
+                n_null: int = 2, seed: int = 0, objects: dict[str, Any] | None = None) -> dict[str, Any]:
     """Simulate the rig's step train, diagnose it against the linear model, and place the paper's numbers.
 
     Parameters
@@ -91,6 +91,8 @@ def x4_gap_case(spec: Any, *, steps: int = 8, period: float = 0.25, noise_std: f
         Parametric-bootstrap replicates of the attribution's threshold.
     seed : int
         Seed of the noise and of the bootstrap.
+    objects : dict, optional
+        Receives the :class:`~synth.gap.diagnose.Diagnosis` under ``"diagnosis"`` (for figures).
 
     Returns
     -------
@@ -127,7 +129,10 @@ def x4_gap_case(spec: Any, *, steps: int = 8, period: float = 0.25, noise_std: f
     record = record_from_arrays(run.t[keep], run.command[keep] - u0, run.measured[keep],
                                 input=Signal("command - operating point", plant.input.unit),
                                 output=Signal("measured speed", plant.output.unit), source="simulated rig")
-    diag = diagnose(plant, record, candidates=list(CANDIDATES), n_null=n_null, seed=seed).to_dict()
+    diagnosis = diagnose(plant, record, candidates=list(CANDIDATES), n_null=n_null, seed=seed)
+    if objects is not None:
+        objects["diagnosis"] = diagnosis
+    diag = diagnosis.to_dict()
 
     # rise times of one step lo -> hi: the linear model, the simulated rig (no noise), the paper
     horizon = max(sim.horizon, 0.5)

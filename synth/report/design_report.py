@@ -30,7 +30,7 @@ class ReportFiles:
     figures: dict[str, Path]
 
 
-def report_data(spec: Spec, result: DesignResult) -> dict[str, Any]:
+def report_data(spec: Spec, result: DesignResult, keep: dict[str, Any] | None = None) -> dict[str, Any]:
     """Everything ``result.json`` holds: the design result, the reference controller's check and
     the comparisons with published numbers.
 
@@ -62,7 +62,7 @@ def report_data(spec: Spec, result: DesignResult) -> dict[str, Any]:
         from synth.gap.x4_case import gap_case_applies, x4_gap_case
 
         if gap_case_applies(spec):  # seed 1's gap diagnosed on the simulated rig (issue 6): synth.gap.x4_case
-            data["sim_to_real_gap"] = x4_gap_case(spec)
+            data["sim_to_real_gap"] = x4_gap_case(spec, objects=keep)
     return to_jsonable(data)
 
 
@@ -128,7 +128,8 @@ def write_design_report(spec: Spec, result: DesignResult, out_dir: str | Path, *
     ['bode', 'delay', 'gain_set', 'sensitivity', 'sim_onset', 'sim_rise', 'sim_step', 'step']
     """
     out = OutputDir(out_dir, force)
-    data = report_data(spec, result)
+    objects: dict[str, Any] = {}
+    data = report_data(spec, result, keep=objects)
     plant = spec.nominal_plant()
     loops: list[tuple[str, Loop]] = []
     shown = result.controller or (result.compromise.controller if result.compromise else None)
@@ -168,6 +169,15 @@ def write_design_report(spec: Spec, result: DesignResult, out_dir: str | Path, *
         from synth.sim.report import simulation_figures
 
         figs.update(simulation_figures(spec, shown, ref, out, marks))
+
+    if "diagnosis" in objects:  # the seed-1 gap case: gap map and before/after overlay of the simulated rig
+        from synth.gap.gapmap import write_gap_map
+        from synth.gap.overlay import overlay_figure
+        from synth.report.png import save_figure
+
+        diag = objects["diagnosis"]
+        figs["gap_map"] = write_gap_map(diag.localization, out.claim("gap_map.png"), diag.plant)
+        figs["gap_overlay"] = save_figure(overlay_figure(diag.attribution), out.claim("gap_overlay.png"))
 
     columns, rows = _columns(data)
     ref_line = ""
