@@ -125,7 +125,7 @@ def write_design_report(spec: Spec, result: DesignResult, out_dir: str | Path, *
     >>> spec = load_spec("specs/x4_rotor.yaml")
     >>> files = write_design_report(spec, design(spec), tempfile.mkdtemp())
     >>> sorted(files.figures)
-    ['bode', 'delay', 'gain_set', 'sensitivity', 'sim_onset', 'sim_rise', 'sim_step', 'step']
+    ['bode', 'delay', 'gain_set', 'gap_map', 'gap_overlay', 'sensitivity', 'sim_onset', 'sim_rise', 'sim_step', 'step']
     """
     out = OutputDir(out_dir, force)
     objects: dict[str, Any] = {}
