@@ -57,6 +57,16 @@ class SignalSpec(_Model):
     unit: str = ""
 
 
+def _transfer_function(text: str | None) -> str | None:
+    """Validator body: ``text`` must parse as a proper transfer function (None passes)."""
+    if text is not None:
+        try:
+            Plant.from_string(text)
+        except ModelError as exc:
+            raise ValueError(exc.message) from None
+    return text
+
+
 class VariantSpec(_Model):
     """A plant variant the requirements must also hold on (e.g. a battery state).
 
@@ -69,15 +79,7 @@ class VariantSpec(_Model):
     tf: str | None = None
     delay: NonNegativeFloat | None = None
 
-    @field_validator("tf")
-    @classmethod
-    def _parses(cls, text: str | None) -> str | None:
-        if text is not None:
-            try:
-                Plant.from_string(text)
-            except ModelError as exc:
-                raise ValueError(exc.message) from None
-        return text
+    _parses = field_validator("tf")(classmethod(lambda cls, text: _transfer_function(text)))
 
     @model_validator(mode="after")
     def _something(self) -> VariantSpec:
@@ -142,15 +144,7 @@ class IdentifySpec(_Model):
             raise ValueError(f"delay must be 'fit' or a number of seconds >= 0, got {value!r}")
         return value
 
-    @field_validator("sensor")
-    @classmethod
-    def _sensor(cls, text: str | None) -> str | None:
-        if text is not None:
-            try:
-                Plant.from_string(text)
-            except ModelError as exc:
-                raise ValueError(exc.message) from None
-        return text
+    _sensor = field_validator("sensor")(classmethod(lambda cls, text: _transfer_function(text)))
 
     @field_validator("average")
     @classmethod
@@ -188,16 +182,7 @@ class PlantSpec(_Model):
             raise ValueError(f"plant labels must be unique; repeated: {', '.join(dupes)}")
         return variants
 
-    @field_validator("tf")
-    @classmethod
-    def _parses(cls, text: str | None) -> str | None:
-        if text is None:
-            return text
-        try:
-            Plant.from_string(text)
-        except ModelError as exc:
-            raise ValueError(exc.message) from None
-        return text
+    _parses = field_validator("tf")(classmethod(lambda cls, text: _transfer_function(text)))
 
     @model_validator(mode="after")
     def _one_source(self) -> PlantSpec:
