@@ -22,7 +22,9 @@ parametrized compilation for these many small cones, see benchmarks/).
 
 from __future__ import annotations
 
+import itertools
 import time
+from collections.abc import Iterator
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -48,6 +50,9 @@ from synth.synthesis.parametrization import Parametrization
 
 SOLVER = cp.CLARABEL
 _OK = {cp.OPTIMAL, cp.OPTIMAL_INACCURATE}
+GRID_TOLERANCE = 1e-9
+"""Largest relative violation of a (backed-off) form on the design grid that still counts as met: the
+solver meets the linearized cones to its own accuracy, and every form is tightened by 1e-4."""
 
 
 @dataclass
@@ -308,9 +313,9 @@ class ConvexDesigner:
     def _solve(self, problem: cp.Problem) -> bool:
         t0 = time.perf_counter()
         try:
-            # ignore_dpp: with thousands of small cones the DPP parameter tensor costs seconds to build
-            # (cvxpy permutes it as one sparse matrix); compiling the numbers each time takes ~0.1 s
-            problem.solve(solver=SOLVER, ignore_dpp=True)
+            # DPP: the first solve compiles the problem with its Parameters, later solves only re-stuff the
+            # numbers (cones written directly with cp.SOC keep the parameter tensor small)
+            problem.solve(solver=SOLVER)
         except cp.SolverError:
             return False
         finally:
@@ -355,7 +360,7 @@ class ConvexDesigner:
                 if base is None:
                     return cand
                 v = self.grid_violations(cand)
-                if np.all((v <= 1e-9) | (base > 1e-9)):
+                if np.all((v <= GRID_TOLERANCE) | (base > GRID_TOLERANCE)):
                     return cand
             step = step / 2
         return rho_c
@@ -363,21 +368,29 @@ class ConvexDesigner:
     def starts(self, initial: np.ndarray | None = None, count: int = 1, seed: int = 0) -> list[np.ndarray]:
         """Up to ``count`` stabilizing starts: ``initial``, a small controller, then a seeded random
         search in the bounds (log-spread towards small values)."""
+        found: list[np.ndarray] = []
+        for c in self.iter_starts(initial, seed):
+            found.append(c)
+            if len(found) >= count:
+                break
+        return found
+
+    def iter_starts(self, initial: np.ndarray | None = None, seed: int = 0) -> Iterator[np.ndarray]:
+        """The starts of :meth:`starts` one at a time, each tested for stability only when it is asked
+        for (the first one usually suffices)."""
         lo, hi = self.par.box()
         candidates = [np.clip(initial, lo, hi)] if initial is not None else []
         candidates.append(self.par.start())
         rng = np.random.default_rng(seed)
         candidates += [self.par.random(rng) for _ in range(300)]
-        found: list[np.ndarray] = []
+        any_found = False
         for c in candidates:
             if c is not None and self._stable(np.asarray(c, float)):
-                found.append(np.asarray(c, float))
-                if len(found) >= count:
-                    break
-        if not found:
+                any_found = True
+                yield np.asarray(c, float)
+        if not any_found:
             raise SynthError("found no stabilizing controller in the bounds to start from; give "
                              "controller.initial or widen the bounds", where="controller")
-        return found
 
     def start(self, initial: np.ndarray | None = None) -> np.ndarray:
         """The first stabilizing start (see :meth:`starts`)."""
@@ -392,7 +405,7 @@ class ConvexDesigner:
         problem = self._elastic_problem()
         rho_c, total = rho0, np.inf
         for it in range(self.settings.max_iterations):
-            if np.all(self.grid_violations(rho_c) <= 0):
+            if np.all(self.grid_violations(rho_c) <= GRID_TOLERANCE):
                 return rho_c, 0.0
             self._update(rho_c)
             if not self._solve(problem):
@@ -400,11 +413,12 @@ class ConvexDesigner:
             new_total = max(float(problem.value), 0.0)
             rho_c = self._accept(rho_c, np.asarray(self.rho.value, float), keep_feasible=False)
             history.append({"phase": 1, "iteration": it, "total_slack": new_total})
-            if abs(total - new_total) <= self.settings.tolerance * max(1.0, total) and new_total > 1e-7:
+            if np.isfinite(total) and abs(total - new_total) <= self.settings.tolerance * max(1.0, total) \
+                    and new_total > 1e-7:
                 total = new_total
                 break
             total = new_total
-        if np.all(self.grid_violations(rho_c) <= 0):
+        if np.all(self.grid_violations(rho_c) <= GRID_TOLERANCE):
             return rho_c, 0.0
         return rho_c, max(total if np.isfinite(total) else 1.0, 1e-6)
 
@@ -520,7 +534,7 @@ class ConvexDesigner:
 
     def is_feasible(self, restarts: int = 6) -> bool:
         """Phase 1 only, from up to ``restarts + 1`` stabilizing starts: can every requirement be met?"""
-        for rho0 in self.starts(None, restarts + 1):
+        for rho0 in itertools.islice(self.iter_starts(None), restarts + 1):
             _, total = self.feasible(rho0, [])
             if total == 0.0:
                 return True
@@ -537,7 +551,7 @@ class ConvexDesigner:
         last point (at most ``refinements`` times).
         """
         history: list[dict[str, float]] = []
-        starts = self.starts(initial, restarts + 1)
+        starts = itertools.islice(self.iter_starts(initial), restarts + 1)
         best: tuple[float, np.ndarray] | None = None
         self.starts_tried = 0
         for rho0 in starts:

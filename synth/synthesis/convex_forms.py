@@ -161,6 +161,7 @@ class RatioBound(Form):
         #   |U(rho)| <= on * kappa |V_c| (Re{V conj V_c}/|V_c|^2 + s)  =  R rho + c + w s
         self.Ure, self.Uim = np.real(U.Q), np.imag(U.Q)
         self.u0re, self.u0im = np.real(U.q0), np.imag(U.q0)
+        self.constant = not np.any(U.Q)  # |U| a number at each point (|S| bounds of a linear parametrization)
         self.on = cp.Parameter(n, nonneg=True)
         self.R, self.c = cp.Parameter((n, n_rho)), cp.Parameter(n)
         self.w = cp.Parameter(n, nonneg=True)
@@ -170,10 +171,23 @@ class RatioBound(Form):
         return np.broadcast_to(np.asarray(k, float), self.U.q0.shape)
 
     def constraints(self, rho, slack):
-        mag = cp.norm(cp.vstack([self.Ure @ rho + self.u0re, self.Uim @ rho + self.u0im]), 2, axis=0)
-        lhs = cp.multiply(self.on, mag)
+        """One second-order cone per point, written as ``cp.SOC(rhs, [Re U; Im U])`` (no epigraph
+        variable per point), or one linear row per point where ``|U|`` does not depend on ``rho``.
+
+        Parameters scale expressions through ``cp.diag(p) @ e``: cvxpy's DPP compilation of
+        ``cp.multiply(p, e)`` grows with the square of the number of points, ``diag`` linearly."""
+        n = self.U.q0.size
         rhs = self.R @ rho + self.c
-        self._cons = [lhs <= rhs + cp.multiply(self.w, slack)] if self.elastic else [lhs <= rhs]
+        if self.elastic and not (isinstance(slack, (int, float)) and slack == 0):
+            rhs = rhs + cp.diag(self.w) @ (np.ones(n) * slack)
+        if self.constant:
+            lhs = np.abs(self.U.q0) if self.active is None else cp.diag(self.on) @ np.abs(self.U.q0)
+            self._cons = [lhs <= rhs]
+        else:
+            parts = cp.vstack([self.Ure @ rho + self.u0re, self.Uim @ rho + self.u0im])
+            if self.active is not None:
+                parts = parts @ cp.diag(self.on)
+            self._cons = [cp.SOC(rhs, parts, axis=0)]
         return self._cons
 
     def update(self, rho_c):
@@ -190,8 +204,11 @@ class RatioBound(Form):
         """Dual price in relative units: duals times the slack's weight in each row."""
         total = 0.0
         for c in getattr(self, "_cons", []):
-            if c.dual_value is not None and self.w.value is not None:
-                total += float(np.sum(np.abs(c.dual_value) * self.w.value))
+            dual = c.dual_value
+            if isinstance(dual, list):  # a cone: the multiplier of its right-hand side
+                dual = dual[0]
+            if dual is not None and self.w.value is not None:
+                total += float(np.sum(np.abs(dual) * self.w.value))
         return total
 
     def violation(self, rho):
