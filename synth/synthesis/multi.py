@@ -137,15 +137,34 @@ def _certify(spec: Spec, controller: Controller, per_decade: int) -> Certificate
     return Certificate(cert.feasible, per_decade, cert)
 
 
+def _certify_best(spec: Spec, found: list[tuple[str, Controller]], terms: list[tuple[str, str, float]],
+                  per_decade: int) -> tuple[list[tuple[str, Controller, Certificate]],
+                                            tuple[str, Controller, Certificate] | None]:
+    """The best-scoring candidate that passes the certificate, and every candidate certified on the way.
+
+    Candidates are certified from the best score down and the search stops at the first that passes: the
+    same choice as certifying all of them and taking the best that passed (ties keep the earlier
+    candidate), without certifying designs that could not be chosen. When none passes, all are certified
+    and returned in their original order.
+    """
+    nominal = spec.nominal_plant()
+    scores = [score(Loop(nominal, c), terms) for _, c in found]
+    order = sorted(range(len(found)), key=lambda i: -scores[i])  # stable: ties keep the original order
+    certified: dict[int, Certificate] = {}
+    for i in order:
+        certified[i] = _certify(spec, found[i][1], per_decade)
+        if certified[i].passed:
+            return [(*found[k], certified[k]) for k in sorted(certified)], (*found[i], certified[i])
+    return [(*found[k], certified[k]) for k in range(len(found))], None
+
+
 def _design(spec: Spec, settings: ConvexSettings, nlp: bool) -> DesignResult:
     terms = _objective_terms(spec)
     runs = _convex_runs(spec, settings)
     per_decade = max(CERTIFICATE_PER_DECADE, 20 * settings.per_decade)
     nominal = spec.nominal_plant()
-    candidates: list[tuple[str, Controller, Certificate]] = []
-    for _, conv in runs:
-        if conv.status == "optimal":
-            candidates.append(("convex", conv.controller, _certify(spec, conv.controller, per_decade)))
+    found: list[tuple[str, Controller]] = [("convex", conv.controller) for _, conv in runs
+                                           if conv.status == "optimal"]
     feasible_runs = [(d, r) for d, r in runs if r.status == "optimal"]
     extras: dict[str, Any] = {"synthesis": {"convex": [r.to_dict() for _, r in runs]}}
     ref = reference_check(spec)
@@ -165,11 +184,11 @@ def _design(spec: Spec, settings: ConvexSettings, nlp: bool) -> DesignResult:
         extras["synthesis"]["nlp"] = res.to_dict()
         stages.append(f"NLP polish (casadi + IPOPT, {res.iterations} iterations, {res.status})")
         if res.success:
-            candidates.append(("nlp", res.controller, _certify(spec, res.controller, per_decade)))
-    passed = [(stage, c, cert) for stage, c, cert in candidates if cert.passed]
+            found.append(("nlp", res.controller))
+    candidates, passed = _certify_best(spec, found, terms, per_decade)
     method = "; ".join(stages) + f"; certificate: dense re-check, {per_decade} points per decade"
-    if passed:
-        stage, controller, certificate = max(passed, key=lambda t: score(Loop(nominal, t[1]), terms))
+    if passed is not None:
+        stage, controller, certificate = passed
         label = objective_label(spec, Loop(nominal, controller)) if spec.objective else {
             "name": "peak_sensitivity", "sense": "minimize", "unit": "dB",
             "value": float(-score(Loop(nominal, controller), terms)),
