@@ -16,8 +16,8 @@
 
 The problem is built once with cvxpy Parameters for everything that changes
 with the design; each iteration sets their values and solves with
-``solver=cp.CLARABEL`` (``ignore_dpp=True``: measured faster than cvxpy's
-parametrized compilation for these many small cones, see benchmarks/).
+``solver=cp.CLARABEL``. The problems are DPP: cvxpy compiles each once and
+later solves only re-stuff the numbers (see benchmarks/synthesis.py).
 """
 
 from __future__ import annotations
