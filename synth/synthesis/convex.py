@@ -143,12 +143,14 @@ class ConvexResult:
     diagnosis: Diagnosis | None = None
     grid_points: int = 0
     starts_tried: int = 1
+    converged: bool = False
 
     def to_dict(self) -> dict[str, Any]:
         return {
             "status": self.status,
             "controller": self.controller.to_dict(),
             "objective_value": self.objective_value,
+            "converged": self.converged,
             "iterations": self.iterations,
             "convex_solves": self.solves,
             "solve_time": self.solve_time,
@@ -220,6 +222,7 @@ class ConvexDesigner:
         self.solves = 0
         self.solve_time = 0.0
         self.round = 0
+        self.converged = False
         self._build()
 
     def _build(self) -> None:
@@ -231,6 +234,7 @@ class ConvexDesigner:
         A, b = self.par.linear_constraints()
         self.box = [A @ self.rho <= b] if A.size else []
         self._problems: dict[str, cp.Problem] = {}
+        self._goal: np.ndarray | None = None
         self._objective_form: Form | None = None
         self._gamma: cp.Variable | None = None
         self._gamma_form: _ReturnDifferenceFloor | None = None
@@ -262,6 +266,7 @@ class ConvexDesigner:
         cons = self._constraints({})
         if name in ("integral_gain", "low_frequency_gain") and linear:
             c = self._linear_objective(name)
+            self._goal = c
             expr = c @ self.rho
             goal = cp.Maximize(expr) if sense == "maximize" else cp.Minimize(expr)
         elif name == "peak_sensitivity" and sense == "minimize" and linear:
@@ -449,15 +454,26 @@ class ConvexDesigner:
         return Diagnosis(total, conflicts, active, self.par.controller(rho))
 
     def optimize(self, rho_c: np.ndarray, history: list) -> tuple[np.ndarray, float]:
-        """Phase 2 from a feasible ``rho_c``: the objective, every iterate feasible."""
+        """Phase 2 from a feasible ``rho_c``: the objective, every iterate feasible.
+
+        With a linear objective, :attr:`converged` is set when the last convex problem, built around
+        ``rho_c``, could not improve the objective beyond the tolerance: ``rho_c`` is then optimal for
+        its own inner approximation, whose constraints touch the exact ones at ``rho_c`` with the same
+        gradients, so it is a KKT point of the problem on the grid (Lipp and Boyd 2016).
+        """
         problem = self._objective_problem()
+        self.converged = False
         if self._objective_form is not None:
             return self._bisect(rho_c, history)
         value = -np.inf
         for it in range(self.settings.max_iterations):
             self._update(rho_c)
             if not self._solve(problem):
+                self.converged = False
                 break
+            if self._goal is not None:
+                here, model = float(self._goal @ rho_c), float(self._goal @ np.asarray(self.rho.value, float))
+                self.converged = abs(model - here) <= self.settings.tolerance * max(1.0, abs(model))
             rho_c = self._accept(rho_c, np.asarray(self.rho.value, float), keep_feasible=True)
             new = self.measure(rho_c)
             history.append({"phase": 2, "round": self.round, "iteration": it, "objective": new,
@@ -554,6 +570,7 @@ class ConvexDesigner:
         starts = itertools.islice(self.iter_starts(initial), restarts + 1)
         best: tuple[float, np.ndarray] | None = None
         self.starts_tried = 0
+        self.converged = False
         for rho0 in starts:
             self.starts_tried += 1
             rho, total = self.feasible(rho0, history)
@@ -572,6 +589,8 @@ class ConvexDesigner:
                                     self.solve_time, history, diag, self.grid.size, self.starts_tried)
             rho, value = self.optimize(rho, history)
             extra = self._violations(rho)
+            if extra:
+                self.converged = False  # the grid misses a violation: not the optimum of the exact problem
             if not extra or round_ == refinements:
                 break
             w = np.asarray(extra)
@@ -579,7 +598,7 @@ class ConvexDesigner:
             history.append({"phase": 0, "iteration": round_, "refined_points": float(w.size)})
             self._build()
         return ConvexResult("optimal", self.par.controller(rho), rho, value, len(history), self.solves,
-                            self.solve_time, history, None, self.grid.size, self.starts_tried)
+                            self.solve_time, history, None, self.grid.size, self.starts_tried, self.converged)
 
 
 class _Level:

@@ -4,7 +4,10 @@
    PID filter ``tf`` or lead-lag pole ``p`` that is free is held at a few
    log-spaced values and the best is kept.
 2. **NLP polish** (:mod:`synth.synthesis.nlp`) from the convex answer, every
-   parameter free, requirements and objective exact.
+   parameter free, requirements and objective exact. It is skipped when it
+   cannot add anything: the convex stage converged to a KKT point of the very
+   problem the NLP would solve (see :func:`polish_redundant`) and that answer
+   passed the certificate.
 3. **Certificate**: each candidate is re-checked on a grid 20 times denser
    (plus refined peaks and crossings) and for exact closed-loop stability;
    the best candidate that passes is the design. None passing means no
@@ -36,7 +39,9 @@ from synth.errors import SynthError
 from synth.gainset import _unique_names
 from synth.loop import Loop
 from synth.objectives import score
+from synth.requirements import PeakComplementary, PeakSensitivity, Sensitivity, SlewRate
 from synth.requirements.base import fmt
+from synth.requirements.control_sensitivity import PeakControlSensitivity
 from synth.spec import Spec
 from synth.synthesis.convex import ConvexDesigner, ConvexResult, ConvexSettings
 from synth.synthesis.nlp import polish
@@ -132,27 +137,59 @@ def _reference_frequency(spec: Spec) -> float:
     return float(np.sqrt(lo * hi))
 
 
+EXACT_FORMS = (Sensitivity, PeakSensitivity, PeakComplementary, PeakControlSensitivity, SlewRate)
+"""Requirements whose convex form and NLP constraint are the same set on the same frequencies."""
+
+
+def polish_redundant(spec: Spec, runs: list[ConvexResult]) -> str | None:
+    """Why the NLP polish cannot improve on the convex answer, or None when it might.
+
+    The polish is redundant when the convex stage ended at a KKT point of the problem the polish
+    would solve: one convex run (no structural parameter to vary) of a P, PI or PID controller, whose
+    parameters are then exactly the NLP's variables; every requirement among :data:`EXACT_FORMS`, whose
+    inner approximations touch the exact constraints at the linearization point with the same gradient
+    (the NLP imposes them on the same design and band grids, squared); a linear objective (the integral
+    or low-frequency gain), solved directly; and a converged phase 2 (the last convex problem, built
+    around the answer, could not improve it beyond the tolerance, and the dense check found nothing
+    between the grid points). IPOPT started at a KKT point stays there: the polish would return the
+    same design to its tolerance (tests/test_synthesis_polish.py compares both).
+    """
+    terms = _objective_terms(spec)
+    if len(runs) != 1 or runs[0].status != "optimal" or not runs[0].converged:
+        return None
+    if spec.controller.type not in ("P", "PI", "PID"):
+        return None
+    if not all(isinstance(r, EXACT_FORMS) for r in spec.requirements):
+        return None
+    if len(terms) != 1 or terms[0][0] not in ("integral_gain", "low_frequency_gain"):
+        return None
+    return ("the convex answer is a KKT point of the polish's own problem: same parameters, requirements "
+            "with exact convex forms, linear objective, converged")
+
+
 def _certify(spec: Spec, controller: Controller, per_decade: int) -> Certificate:
     cert = check(spec, controller, per_decade)
     return Certificate(cert.feasible, per_decade, cert)
 
 
 def _certify_best(spec: Spec, found: list[tuple[str, Controller]], terms: list[tuple[str, str, float]],
-                  per_decade: int) -> tuple[list[tuple[str, Controller, Certificate]],
-                                            tuple[str, Controller, Certificate] | None]:
+                  per_decade: int, cache: dict[int, Certificate] | None = None
+                  ) -> tuple[list[tuple[str, Controller, Certificate]], tuple[str, Controller, Certificate] | None]:
     """The best-scoring candidate that passes the certificate, and every candidate certified on the way.
 
     Candidates are certified from the best score down and the search stops at the first that passes: the
     same choice as certifying all of them and taking the best that passed (ties keep the earlier
     candidate), without certifying designs that could not be chosen. When none passes, all are certified
-    and returned in their original order.
+    and returned in their original order. ``cache`` keeps certificates by candidate index across calls
+    (a list that only grows at its end).
     """
     nominal = spec.nominal_plant()
     scores = [score(Loop(nominal, c), terms) for _, c in found]
     order = sorted(range(len(found)), key=lambda i: -scores[i])  # stable: ties keep the original order
-    certified: dict[int, Certificate] = {}
+    certified: dict[int, Certificate] = {} if cache is None else cache
     for i in order:
-        certified[i] = _certify(spec, found[i][1], per_decade)
+        if i not in certified:
+            certified[i] = _certify(spec, found[i][1], per_decade)
         if certified[i].passed:
             return [(*found[k], certified[k]) for k in sorted(certified)], (*found[i], certified[i])
     return [(*found[k], certified[k]) for k in range(len(found))], None
@@ -173,6 +210,14 @@ def _design(spec: Spec, settings: ConvexSettings, nlp: bool) -> DesignResult:
     if len(runs) > 1:
         key = STRUCTURAL[spec.controller.type]
         stages[0] += f", {len(runs)} fixed values of {key}"
+    cache: dict[int, Certificate] = {}
+    redundant = polish_redundant(spec, [r for _, r in runs]) if nlp else None
+    if redundant is not None:
+        _, passed = _certify_best(spec, found, terms, per_decade, cache)
+        if passed is not None:
+            nlp = False
+            extras["synthesis"]["nlp_skipped"] = redundant
+            stages.append(f"NLP polish skipped ({redundant})")
     if nlp:
         if feasible_runs:
             start_designer, start = max(feasible_runs,
@@ -185,7 +230,7 @@ def _design(spec: Spec, settings: ConvexSettings, nlp: bool) -> DesignResult:
         stages.append(f"NLP polish (casadi + IPOPT, {res.iterations} iterations, {res.status})")
         if res.success:
             found.append(("nlp", res.controller))
-    candidates, passed = _certify_best(spec, found, terms, per_decade)
+    candidates, passed = _certify_best(spec, found, terms, per_decade, cache)
     method = "; ".join(stages) + f"; certificate: dense re-check, {per_decade} points per decade"
     if passed is not None:
         stage, controller, certificate = passed
