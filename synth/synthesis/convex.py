@@ -45,6 +45,7 @@ from synth.synthesis.convex_forms import (
     bandwidth_floor,
     build_forms,
     make_points,
+    without_implied,
 )
 from synth.synthesis.parametrization import Parametrization
 
@@ -230,6 +231,8 @@ class ConvexDesigner:
         self.forms = build_forms(self.requirements, self.names, self.plants, self.par, self.grid,
                                  self.settings.per_decade, self.settings.stability_level)
         self.elastic_forms = [f for f in self.forms if f.elastic]
+        self.objective_forms = without_implied(self.forms, self.par.size)
+        self._updated = list({id(f): f for f in self.forms + self.objective_forms}.values())
         self.rho = cp.Variable(self.par.size)
         A, b = self.par.linear_constraints()
         self.box = [A @ self.rho <= b] if A.size else []
@@ -243,9 +246,9 @@ class ConvexDesigner:
         self._bracket = getattr(self, "_bracket", None)
 
     # ------------------------------------------------------------------ problems
-    def _constraints(self, slacks: dict[str, Any]) -> list[cp.Constraint]:
+    def _constraints(self, slacks: dict[str, Any], forms: list[Form] | None = None) -> list[cp.Constraint]:
         cons = list(self.box)
-        for f in self.forms:
+        for f in self.forms if forms is None else forms:
             cons += f.constraints(self.rho, slacks.get(id(f), 0.0))
         return cons
 
@@ -263,7 +266,7 @@ class ConvexDesigner:
             return self._problems["objective"]
         name, sense = self.objective
         linear = self.par.ctype != "rational"
-        cons = self._constraints({})
+        cons = self._constraints({}, self.objective_forms)
         if name in ("integral_gain", "low_frequency_gain") and linear:
             c = self._linear_objective(name)
             self._goal = c
@@ -329,7 +332,7 @@ class ConvexDesigner:
         return problem.status in _OK and self.rho.value is not None
 
     def _update(self, rho_c: np.ndarray) -> None:
-        for f in self.forms:
+        for f in self._updated:
             f.update(rho_c)
         if self._objective_form is not None:
             self._objective_form.update(rho_c)
@@ -384,10 +387,9 @@ class ConvexDesigner:
         """The starts of :meth:`starts` one at a time, each tested for stability only when it is asked
         for (the first one usually suffices)."""
         lo, hi = self.par.box()
-        candidates = [np.clip(initial, lo, hi)] if initial is not None else []
-        candidates.append(self.par.start())
         rng = np.random.default_rng(seed)
-        candidates += [self.par.random(rng) for _ in range(300)]
+        candidates = itertools.chain([np.clip(initial, lo, hi)] if initial is not None else [], [self.par.start()],
+                                     (self.par.random(rng) for _ in range(300)))
         any_found = False
         for c in candidates:
             if c is not None and self._stable(np.asarray(c, float)):

@@ -291,8 +291,37 @@ class T0:
 
 
 def sensitivity_form(name: str, pts: Points, n_rho: int, m: float, elastic: bool = True) -> RatioBound:
-    """``|S| <= m``."""
-    return RatioBound(name, pts.D, pts.P, m, n_rho, elastic)
+    """``|S| <= m`` (the form keeps its points and bound in ``sensitivity``)."""
+    form = RatioBound(name, pts.D, pts.P, m, n_rho, elastic)
+    form.sensitivity = (pts, float(m))
+    return form
+
+
+def without_implied(forms: list[Form], n_rho: int) -> list[Form]:
+    """The forms for a problem without elastic slacks, with the stability-keeping rows that another
+    ``|S|`` bound implies dropped.
+
+    Without slack, ``|D| <= m Re{P conj P_c}/|P_c|`` at a point implies the same row with any larger
+    bound, so the last form (``|S| <= 1/stability_level`` on the design grid) adds nothing where a
+    sensitivity requirement with a smaller bound holds on the same plant and frequency (a peak |S|
+    requirement covers the whole design grid): the feasible set is unchanged, the cone program smaller.
+    """
+    keep = forms[-1]
+    if not hasattr(keep, "sensitivity") or keep.elastic:
+        return forms
+    pts, level = keep.sensitivity
+    covered: set[tuple[int, float]] = set()
+    for f in forms[:-1]:
+        if hasattr(f, "sensitivity") and f.active is None and f.sensitivity[1] <= level:
+            fp = f.sensitivity[0]
+            covered.update(zip(fp.plant_index.tolist(), fp.w.tolist()))
+    if not covered:
+        return forms
+    mask = np.array([(i, w) not in covered for i, w in zip(pts.plant_index.tolist(), pts.w.tolist())], bool)
+    if mask.all():
+        return forms
+    rest = Points(pts.w[mask], pts.plant_index[mask], pts.N.rows(mask), pts.D.rows(mask), pts.X.rows(mask))
+    return [*forms[:-1], sensitivity_form(keep.name, rest, n_rho, level, elastic=False)]
 
 
 def bandwidth_floor(name: str, pts: Points, n_rho: int, t0: T0 | None, tighten: float = 1.0,
