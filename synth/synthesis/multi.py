@@ -167,6 +167,24 @@ def polish_redundant(spec: Spec, runs: list[ConvexResult]) -> str | None:
             "with exact convex forms, linear objective, converged")
 
 
+def certificate_density(settings: ConvexSettings, grids: list[np.ndarray]) -> int:
+    """Points per decade of the certificate: at least 20 times the densest grid the design used (the
+    band grids at ``settings.per_decade``, the design grid, with its refinement points, on average over
+    its span), and at least :data:`synth.design.CERTIFICATE_PER_DECADE`.
+
+    Examples
+    --------
+    >>> certificate_density(ConvexSettings(), [np.geomspace(0.01, 1e4, 500)])
+    1664
+    """
+    density = float(settings.per_decade)
+    for g in grids:
+        decades = float(np.log10(g[-1] / g[0])) if g.size > 1 and g[0] > 0 else 0.0
+        if decades > 0:
+            density = max(density, (g.size - 1) / decades)
+    return int(max(CERTIFICATE_PER_DECADE, np.ceil(20 * density)))
+
+
 def _certify(spec: Spec, controller: Controller, per_decade: int) -> Certificate:
     cert = check(spec, controller, per_decade)
     return Certificate(cert.feasible, per_decade, cert)
@@ -198,7 +216,7 @@ def _certify_best(spec: Spec, found: list[tuple[str, Controller]], terms: list[t
 def _design(spec: Spec, settings: ConvexSettings, nlp: bool) -> DesignResult:
     terms = _objective_terms(spec)
     runs = _convex_runs(spec, settings)
-    per_decade = max(CERTIFICATE_PER_DECADE, 20 * settings.per_decade)
+    per_decade = certificate_density(settings, [d.grid for d, _ in runs])
     nominal = spec.nominal_plant()
     found: list[tuple[str, Controller]] = [("convex", conv.controller) for _, conv in runs
                                            if conv.status == "optimal"]
