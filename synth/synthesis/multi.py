@@ -50,8 +50,11 @@ from synth.synthesis.parametrization import parametrize
 STRUCTURAL = {"PID": "tf", "leadlag": "p"}
 
 
-def design_convex(spec: Spec, settings: ConvexSettings | None = None, nlp: bool = True) -> DesignResult:
+def design_convex(spec: Spec, settings: ConvexSettings | None = None, nlp: bool | str = True) -> DesignResult:
     """Design a controller with several free parameters and certify it.
+
+    ``nlp``: True runs the NLP polish unless :func:`polish_redundant` shows it cannot improve the convex
+    answer; ``"always"`` runs it regardless (for comparison); False never.
 
     Examples
     --------
@@ -213,7 +216,7 @@ def _certify_best(spec: Spec, found: list[tuple[str, Controller]], terms: list[t
     return [(*found[k], certified[k]) for k in range(len(found))], None
 
 
-def _design(spec: Spec, settings: ConvexSettings, nlp: bool) -> DesignResult:
+def _design(spec: Spec, settings: ConvexSettings, nlp: bool | str) -> DesignResult:
     terms = _objective_terms(spec)
     runs = _convex_runs(spec, settings)
     per_decade = certificate_density(settings, [d.grid for d, _ in runs])
@@ -229,7 +232,7 @@ def _design(spec: Spec, settings: ConvexSettings, nlp: bool) -> DesignResult:
         key = STRUCTURAL[spec.controller.type]
         stages[0] += f", {len(runs)} fixed values of {key}"
     cache: dict[int, Certificate] = {}
-    redundant = polish_redundant(spec, [r for _, r in runs]) if nlp else None
+    redundant = polish_redundant(spec, [r for _, r in runs]) if nlp is True else None
     if redundant is not None:
         _, passed = _certify_best(spec, found, terms, per_decade, cache)
         if passed is not None:
