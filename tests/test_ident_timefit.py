@@ -101,3 +101,31 @@ def test_bad_options():
         fit_structure(r, "k/(s+p)", sensor="1/(s+")
     with pytest.raises(DataError, match="cannot determine"):
         fit_structure(record_from_arrays([0, 1, 2, 3], [0, 1, 1, 1], [0, 1, 2, 2]), "k*(s+z)/((s+p)*(s+q))")
+
+
+def test_zero_weights_fit_exactly_the_weighted_part():
+    """Samples weighted 0 are simulated but not fitted: the same answer as the record cut there (causal model)."""
+    t = np.arange(0, 8, 0.01)
+    u = np.where((t % 2) >= 1, 1.0, 0.0)
+    y = simulate_plant(Plant.from_string("2/(0.3*s+1)", delay=0.04), t, u)
+    y = y + 0.01 * np.random.default_rng(0).normal(size=t.size)
+    y[t >= 4] += 5.0  # garbage the weights must hide
+    weighted = fit_structure(record_from_arrays(t, u, y), "k/(T*s+1)", delay="fit", weights=(t < 4).astype(float))
+    cut = fit_structure(record_from_arrays(t[t < 4], u[t < 4], y[t < 4]), "k/(T*s+1)", delay="fit")
+    for name in ("k", "T", "delay"):
+        assert weighted.parameters[name] == pytest.approx(cut.parameters[name], rel=1e-7)
+    assert weighted.fit_percent == pytest.approx(cut.fit_percent, rel=1e-9)
+    with pytest.raises(ModelError, match="weights"):
+        fit_structure(record_from_arrays(t, u, y), "k/(T*s+1)", weights=np.full(t.size, 0.5))
+
+
+def test_lower_bounds_hold_a_pole_in_the_left_half_plane():
+    t = np.arange(0, 4, 0.01)
+    u = np.where(t >= 0.5, 1.0, 0.0)
+    y = 0.2 * (t - 0.5) ** 2 * (t >= 0.5)  # grows without bound: the free fit puts its pole at p < 0
+    free = fit_structure(record_from_arrays(t, u, y), "k/(s+p)", delay=0.0)
+    bounded = fit_structure(record_from_arrays(t, u, y), "k/(s+p)", delay=0.0, lower={"p": 0.0})
+    assert free.parameters["p"] < -0.05
+    assert bounded.parameters["p"] >= -1e-6  # IPOPT relaxes bounds by 1e-8 relative
+    with pytest.raises(ModelError, match="not in the structure"):
+        fit_structure(record_from_arrays(t, u, y), "k/(s+p)", lower={"q": 0.0})

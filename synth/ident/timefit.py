@@ -486,7 +486,7 @@ class _Problem:
     """The casadi simulation-error problem for fixed data length; the delayed inputs are NLP parameters."""
 
     def __init__(self, st: Structure, sensor: Plant | None, n: int, dt: float, periodic: bool, theta0: np.ndarray,
-                 fit_delay: bool, y: np.ndarray, has_d: bool) -> None:
+                 fit_delay: bool, y: np.ndarray, has_d: bool, weights: np.ndarray | None = None) -> None:
         import casadi as ca
 
         self.n, self.dt, self.periodic = n, dt, periodic
@@ -554,11 +554,17 @@ class _Problem:
         self.jac_fn = ca.Function("jacobian", [dec, params], [J])
         s2 = float(np.var(y)) * n or 1.0
         self.obj_scale = s2
-        r = ca.DM(y) - yhat
+        if weights is None:
+            r = ca.DM(y) - yhat
+            Jw = J
+        else:  # samples outside the cost (held out, a start-up transient) weigh 0
+            wdm = ca.DM(np.asarray(weights, float))
+            r = wdm * (ca.DM(y) - yhat)
+            Jw = ca.jacobian(wdm * yhat, dec)
         obj = 0.5 * ca.sumsqr(r) / s2
         lam_f = ca.MX.sym("lam_f")
         lam_g = ca.MX.sym("lam_g", 0)
-        H = lam_f * (J.T @ J) / s2
+        H = lam_f * (Jw.T @ Jw) / s2
         hess = ca.Function("nlp_hess_l", [dec, params, lam_f, lam_g], [ca.triu(H)],
                            ["x", "p", "lam_f", "lam_g"], ["triu_hess_gamma_x_x"])
         opts = {"print_time": False, "hess_lag": hess, "show_eval_warnings": False,  # diverging trial points: IPOPT recovers
@@ -576,9 +582,14 @@ class _Problem:
         vec = np.column_stack([late, early]).ravel()  # column-major vec of the 2 x n matrix
         return vec if fixed_f is None else np.r_[vec, fixed_f]
 
-    def solve(self, x0: np.ndarray, par: np.ndarray, nonnegative_f: bool = False) -> tuple[np.ndarray, float,
-                                                                                          dict[str, Any]]:
+    def solve(self, x0: np.ndarray, par: np.ndarray, nonnegative_f: bool = False,
+              lower: np.ndarray | None = None) -> tuple[np.ndarray, float, dict[str, Any]]:
         lbx = -np.inf * np.ones(x0.size)
+        if lower is not None:  # bounds on the structure's parameters (scaled like them)
+            p = lower.size
+            lbx[:p] = lower / self.scale
+            x0 = x0.copy()
+            x0[:p] = np.maximum(x0[:p], lbx[:p])
         if self.fit_delay and nonnegative_f:  # no delay below 0 (a predictor)
             lbx[self.p] = 0.0
             x0 = x0.copy()
@@ -624,7 +635,9 @@ def _as_sensor(sensor: Plant | str | None) -> Plant | None:
 
 def fit_structure(record: Record, structure: Structure | str, delay: str | float | None = None,
                   sensor: Plant | str | None = None, periodic: bool = False,
-                  initial: dict[str, float] | None = None) -> TimeFitResult:
+                  initial: dict[str, float] | None = None,
+                  lower: dict[str, float] | None = None,
+                  weights: np.ndarray | None = None) -> TimeFitResult:
     """Fit a structure to a record by simulation error (casadi + IPOPT).
 
     Parameters
@@ -645,6 +658,13 @@ def fit_structure(record: Record, structure: Structure | str, delay: str | float
     initial : dict, optional
         Starting values (structure names, optionally ``delay``) instead of the
         deterministic initialization.
+    lower : dict, optional
+        Lower bounds of structure parameters (e.g. ``{"p": 0.0}`` keeps a pole in the
+        left half-plane); the others are free.
+    weights : numpy.ndarray, optional
+        Per-sample 0/1 weights of the cost (0: simulated but not fitted, e.g. held-out
+        segments or a start-up transient from an unknown initial state); the residual
+        statistics use the weighted samples only.
 
     Returns
     -------
@@ -704,10 +724,23 @@ def fit_structure(record: Record, structure: Structure | str, delay: str | float
     if periodic and abs(np.polyval(full_den, 0.0)) < 1e-12 * np.max(np.abs(full_den)):
         raise DataError("a periodic fit needs a model without an integrator (its periodic state is not unique)")
     has_d = (st.num_degree == st.den_degree) and sensor is None
-    prob = _Problem(st, sensor, n, dt, periodic, theta0, fit_delay, y, has_d)
+    mask = None
+    if weights is not None:
+        weights = np.asarray(weights, float)
+        if weights.shape != (n,) or not np.all((weights == 0) | (weights == 1)):
+            raise ModelError(f"weights must be {n} values of 0 or 1", where="weights")
+        mask = weights > 0
+        if int(mask.sum()) <= p_total + 1:
+            raise DataError(f"{int(mask.sum())} weighted samples cannot determine {p_total} parameters",
+                            where=record.source)
+    prob = _Problem(st, sensor, n, dt, periodic, theta0, fit_delay, y, has_d, weights)
     b0 = y_ref if not periodic else y_ref - float(Plant(num_chk, den_chk).dc_gain()) * w_mean * (
         sensor.dc_gain() if sensor is not None else 1.0)
     initial_out = {**dict(zip(st.parameters, theta0.tolist())), delay_name: d0}
+    unknown = sorted(set(lower or {}) - set(st.parameters))
+    if unknown:
+        raise ModelError(f"bounds for parameters not in the structure: {', '.join(unknown)}", where="lower")
+    lb = None if not lower else np.array([float(lower.get(k, -np.inf)) for k in st.parameters])
 
     def run(theta_start: np.ndarray, d_start: float) -> tuple[np.ndarray, float, int, dict[str, Any], int]:
         m = int(np.floor(d_start / dt + 1e-9))
@@ -717,7 +750,7 @@ def fit_structure(record: Record, structure: Structure | str, delay: str | float
         while True:
             if fit_delay:
                 x0 = np.r_[xi, f, b_start]
-                xs, ssr, st_info = prob.solve(x0, prob.inputs(w, m), nonnegative_f=(m == 0))
+                xs, ssr, st_info = prob.solve(x0, prob.inputs(w, m), nonnegative_f=(m == 0), lower=lb)
                 iters += st_info["iterations"]
                 fx = float(xs[len(xi)])
                 seen.add(m)
@@ -728,14 +761,15 @@ def fit_structure(record: Record, structure: Structure | str, delay: str | float
                     continue
             else:
                 fixed_f = d_start - m * dt
-                xs, ssr, st_info = prob.solve(np.r_[xi, b_start], prob.inputs(w, m, fixed_f))
+                xs, ssr, st_info = prob.solve(np.r_[xi, b_start], prob.inputs(w, m, fixed_f), lower=lb)
                 iters += st_info["iterations"]
             st_info["iterations"] = iters
             return xs, ssr, m, st_info, shifts
 
     xs, ssr, m, st_info, shifts = run(theta0, d0)
     info["starts"] = 1
-    init_ssr = float(np.sum((yd - np.mean(yd)) ** 2))
+    yd_fit = yd if mask is None else yd[mask]
+    init_ssr = float(np.sum((yd_fit - np.mean(yd_fit)) ** 2))
     if not st_info["success"] or not np.isfinite(ssr) or ssr > init_ssr:
         for factor in (0.5, 2.0, 0.2, 5.0):
             cand = run(theta0 * factor, d0)
@@ -760,7 +794,10 @@ def fit_structure(record: Record, structure: Structure | str, delay: str | float
     scale_vec = np.r_[prob.scale, 1.0, 1.0] if fit_delay else np.r_[prob.scale, 1.0]
     J = J / scale_vec[None, :]
     resid = y - yhat
-    dof = n - J.shape[1]
+    y_fit = y
+    if mask is not None:
+        J, resid, y_fit = J[mask], resid[mask], y[mask]
+    dof = resid.size - J.shape[1]
     s2 = float(np.sum(resid**2) / dof)
     JtJ = J.T @ J
     try:
@@ -776,7 +813,7 @@ def fit_structure(record: Record, structure: Structure | str, delay: str | float
     if not fit_delay:
         params[delay_name], std[delay_name] = float(d_hat), 0.0
     ci = {k: (params[k] - tq * std[k], params[k] + tq * std[k]) for k in params}
-    fit_pct = float(100.0 * (1.0 - np.linalg.norm(resid) / np.linalg.norm(y - np.mean(y))))
+    fit_pct = float(100.0 * (1.0 - np.linalg.norm(resid) / np.linalg.norm(y_fit - np.mean(y_fit))))
     plant = st.plant(theta, delay=d_hat, input=record.input, output=record.output, label="identified")
     measured = plant.series(sensor) if sensor is not None else plant
     if sensor is not None:
