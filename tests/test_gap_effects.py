@@ -65,7 +65,7 @@ def test_static_nonlinearity_and_drift_are_basis_least_squares():
     y = sn.apply(G, T, U, {"a2": 0.1, "a3": -0.05, "center": center, "scale": scale})
     fit = fit_augmented(G_OFF, T, U, y, sn)
     assert fit.params["a2"] == pytest.approx(0.1, abs=0.005) and fit.params["a3"] == pytest.approx(-0.05, abs=0.005)
-    drift = make_effect("drift")
+    drift = make_effect("drift(quadratic)")
     y = drift.apply(G, T, U, {"slope": 0.02, "curvature": -0.001})
     fit = fit_augmented(G_OFF, T, U, y, drift)
     assert fit.params["slope"] == pytest.approx(0.02, rel=0.02)

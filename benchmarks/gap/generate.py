@@ -230,7 +230,7 @@ def _strength_params(effect: str, s: float, t: np.ndarray, u: np.ndarray, plant:
     if effect == "static_nonlinearity":
         return {"a2": -0.8 * s, "a3": 0.5 * s, "center": float(0.5 * (np.max(u) + np.min(u))), "scale": 0.5 * span}
     if effect == "drift":
-        return {"slope": s * span * abs(plant.dc_gain()) / float(t[-1] - t[0]), "curvature": 0.0}
+        return {"slope": s * span * abs(plant.dc_gain()) / float(t[-1] - t[0])}
     raise ValueError(effect)
 
 

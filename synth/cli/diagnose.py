@@ -54,6 +54,13 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    help="effects to try (default: all: delay, lag, lag(sensor), resonance, rate_limit, saturation, "
                         "deadzone, backlash, quantization, supply_sag, static_nonlinearity, drift)")
     p.add_argument("--seed", type=int, default=0, help="seed of the bootstrap (default 0)")
+    p.add_argument("--split", choices=("tail", "interleaved"), default="tail",
+                   help="without --validate: hold out the second half (tail, default) or every second of "
+                        "20 segments (interleaved, for a record with one transient)")
+    p.add_argument("--burn-in", type=float, default=0.0, metavar="S",
+                   help="seconds at the start of each record left out of every cost (unknown initial state)")
+    p.add_argument("--max-effects", type=int, default=2, metavar="N",
+                   help="effects a verdict may name (forward selection; default 2)")
     p.add_argument("--out", metavar="DIR", help="folder for the report (default reports/diagnose/<data file stem>)")
     p.add_argument("--json", metavar="FILE", help="also write the JSON to FILE ('-' for standard output)")
     p.add_argument("--no-report", action="store_true", help="write no report folder")
@@ -82,7 +89,8 @@ def run(args: argparse.Namespace) -> int:
     kw: dict[str, Any] = {"aux": aux, "input_unit": args.input_unit, "output_unit": args.output_unit}
     record = load_record(args.data, args.time, args.input, args.output, **kw)
     validate = load_record(args.validate, args.time, args.input, args.output, **kw) if args.validate else None
-    diag = diagnose(plant, record, validate, candidates, seed=args.seed)
+    diag = diagnose(plant, record, validate, candidates, seed=args.seed, split=args.split, burn_in=args.burn_in,
+                    max_effects=args.max_effects)
     data = diag.to_dict()
     data = {"data": str(args.data), "validate_data": str(args.validate) if args.validate else None,
             "plant_argument": args.plant, **data}
@@ -113,7 +121,11 @@ def _command(args: argparse.Namespace) -> str:
             parts += [f"--{opt.replace('_', '-')}", shlex.quote(str(value))]
     for a in _split(args.aux):
         parts += ["--aux", shlex.quote(a)]
-    return " ".join(parts + ([f"--seed {args.seed}"] if args.seed else []))
+    extra = [f"--seed {args.seed}"] if args.seed else []
+    extra += [f"--split {args.split}"] if args.split != "tail" else []
+    extra += [f"--burn-in {args.burn_in:g}"] if args.burn_in else []
+    extra += [f"--max-effects {args.max_effects}"] if args.max_effects != 2 else []
+    return " ".join(parts + extra)
 
 
 def _print(d: dict[str, Any], report: Any) -> None:

@@ -68,7 +68,7 @@ import numpy as np
 
 from synth.data.record import Record
 from synth.errors import ModelError
-from synth.gap.effects import Effect, make_effect
+from synth.gap.effects import DelayEffect, Effect, make_effect
 from synth.gap.refit import AugmentedFit, fit_augmented
 from synth.gap.screen import ScreenedFit, screen_effect
 from synth.ident.simulate import simulate_plant
@@ -90,6 +90,8 @@ SEPARATING_EXPERIMENTS: dict[frozenset[str], str] = {
                                         "a delay's does not",
     frozenset({"saturation", "static_nonlinearity"}): "a slow staircase over the whole input range: a "
                                                       "saturation is flat beyond its limit, a smooth map bends",
+    frozenset({"saturation", "deadzone"}): "small steps beyond the lowest (or highest) level used so far: a one-sided "
+                                           "limit holds them all at one level, a dead zone passes them on shifted",
     frozenset({"deadzone", "backlash"}): "small reversals around one operating point: backlash loses motion "
                                          "at every reversal, a dead zone only near its center",
     frozenset({"drift", "supply_sag"}): "repeat the same step early and late in the run: drift changes the "
@@ -257,7 +259,8 @@ def diagnose_effects(plant: Plant, record: Record, validate: Record | None = Non
                      candidates: list[str | Effect] | tuple[str, ...] = DEFAULT_CANDIDATES,
                      train_fraction: float = 0.5, blocks: int = 10, n_null: int = 199, n_boot: int = 1000,
                      alpha: float = 0.05, relevance: float = 0.1, min_share: float = 0.25,
-                     seed: int = 0, calibration: str = "linearized", confirm: int | None = 3) -> EffectDiagnosis:
+                     seed: int = 0, calibration: str = "linearized", confirm: int | None = 3,
+                     split: str = "tail", burn_in: float = 0.0, max_effects: int = 2) -> EffectDiagnosis:
     """Attribute the gap between ``plant`` and ``record`` to one effect, and measure its shrinkage.
 
     Parameters
@@ -291,6 +294,20 @@ def diagnose_effects(plant: Plant, record: Record, validate: Record | None = Non
     confirm : int or None
         Candidates re-fitted jointly after screening (lowest screened training SSR first);
         ``None``: every candidate, no screening.
+    split : {"tail", "interleaved"}
+        Without a validation record: ``"tail"`` fits the first ``train_fraction`` and holds out
+        the rest; ``"interleaved"`` cuts the record into ``2 blocks`` equal segments and holds out
+        every second one (the fits simulate the whole record and count only the training
+        segments), for records whose one transient would otherwise fall entirely on one side.
+    burn_in : float
+        Seconds at the start of the record (and of a validation record) left out of every cost:
+        the model starts at rest or in steady state, a record may not (unknown initial state).
+    max_effects : int
+        Effects a verdict may name. After the first, forward selection: every other significant
+        candidate is fitted on top of the accepted one (:class:`synth.gap.composite.NestedEffect`,
+        nominal coefficients re-fitted jointly again) and accepted when it shrinks the held-out
+        error of the model with the effects before it beyond the same calibrated threshold and
+        removes at least ``min_share`` of that model's excess over the noise floor.
 
     Returns
     -------
@@ -321,20 +338,38 @@ def diagnose_effects(plant: Plant, record: Record, validate: Record | None = Non
         raise ModelError(f"must be 'linearized' or 'refit', got {calibration!r}", where="calibration")
     if confirm is not None and confirm < 1:
         raise ModelError(f"must be None or >= 1, got {confirm!r}", where="confirm")
+    if max_effects < 1:
+        raise ModelError(f"must be >= 1, got {max_effects!r}", where="max_effects")
+    if split not in ("tail", "interleaved"):
+        raise ModelError(f"must be 'tail' or 'interleaved', got {split!r}", where="split")
+    if not (np.isfinite(burn_in) and burn_in >= 0.0):
+        raise ModelError(f"must be a number of seconds >= 0, got {burn_in!r}", where="burn_in")
     effects = [make_effect(c) for c in candidates]
     labels = [e.label for e in effects]
     if len(set(labels)) != len(labels):
         raise ModelError(f"repeated candidates in {labels}", where="candidates")
     rng = np.random.default_rng(seed)
-    if validate is None:
+    train_mask: np.ndarray | None = None
+    if validate is None and split == "tail":
         k = round(train_fraction * record.n)
         t_tr, u_tr, y_tr = record.t[:k], record.u[:k], record.y[:k]
         t_ev, u_ev, y_ev = record.t, record.u, record.y
         held = np.arange(record.n) >= k
+    elif validate is None:  # interleaved: odd segments held out, the fits count the even ones
+        t_tr, u_tr, y_tr = record.t, record.u, record.y
+        t_ev, u_ev, y_ev = record.t, record.u, record.y
+        held = _block_ids(record.n, 2 * blocks) % 2 == 1
+        train_mask = ~held
     else:
         t_tr, u_tr, y_tr = record.t, record.u, record.y
         t_ev, u_ev, y_ev = validate.t, validate.u, validate.y
         held = np.ones(validate.n, bool)
+    if burn_in > 0.0:
+        settled_tr = t_tr >= t_tr[0] + burn_in
+        train_mask = settled_tr if train_mask is None else train_mask & settled_tr
+        held = held & (t_ev >= t_ev[0] + burn_in)
+        if int(train_mask.sum()) < 20:
+            raise ModelError(f"a burn-in of {burn_in:g} s leaves too few training samples", where="burn_in")
     n_held = int(held.sum())
     if n_held < 10 * blocks:
         raise ModelError(f"{n_held} held-out samples are too few for {blocks} segments", where="record")
@@ -353,13 +388,16 @@ def diagnose_effects(plant: Plant, record: Record, validate: Record | None = Non
         r = 1.0 - boot(num) / boot(den)
         return float(np.quantile(r, 0.025)), float(np.quantile(r, 0.975))
 
-    c_nom = float(np.mean(y_tr - simulate_plant(plant, t_tr, u_tr)))
+    fitted = slice(None) if train_mask is None else train_mask
+    c_nom = float(np.mean((y_tr - simulate_plant(plant, t_tr, u_tr))[fitted]))
     y_nom = simulate_plant(plant, t_ev, u_ev) + c_nom
-    refit = fit_augmented(plant, t_tr, u_tr, y_tr)
+    weights = None if train_mask is None else train_mask.astype(float)
+    refit = fit_augmented(plant, t_tr, u_tr, y_tr, weights=weights)
     y_ref = refit.predict(t_ev, u_ev)
     s_nom, s_ref = sums(y_nom), sums(y_ref)
     j_nom, j_ref = float(s_nom.sum() / n_held), float(s_ref.sum() / n_held)
-    sigma = _noise_sigma(y_ev - y_ref)  # every sample of the evaluated record (more samples, same white noise)
+    settled = t_ev >= t_ev[0] + burn_in
+    sigma = _noise_sigma((y_ev - y_ref)[settled])  # every settled sample of the evaluated record (same white noise)
     floor = sigma**2
     pm_shrink = 1.0 - j_ref / j_nom if j_nom > 0 else 0.0
     pm_ci = ratio_ci(s_ref, s_nom)
@@ -370,13 +408,15 @@ def diagnose_effects(plant: Plant, record: Record, validate: Record | None = Non
 
     # calibration: parametric bootstrap of the re-fit
     if calibration == "linearized":
-        null = _linearized_null(refit, t_tr, u_tr, t_ev, u_ev, held, validate is None, sigma, n_null, rng)
+        null = _linearized_null(refit, t_tr, u_tr, t_ev, u_ev, held, validate is None, sigma, n_null, rng,
+                                train_mask)
     else:
-        null = _refit_null(refit, t_tr, u_tr, t_ev, u_ev, held, validate is None, sigma, n_null, rng)
+        null = _refit_null(refit, t_tr, u_tr, t_ev, u_ev, held, validate is None, sigma, n_null, rng, train_mask)
     threshold = float(np.quantile(null, 1.0 - alpha, method="higher"))
 
-    fits = _candidate_fits(plant, effects, refit, t_tr, u_tr, y_tr, t_ev, u_ev, confirm)
+    fits = _candidate_fits(plant, effects, refit, t_tr, u_tr, y_tr, t_ev, u_ev, confirm, train_mask)
 
+    by_label = {eff.label: (eff, fit) for eff, fit, _, _ in fits}
     results: list[tuple[EffectResult, np.ndarray, np.ndarray]] = []
     for eff, fit, _, yhat in fits:
         s = sums(yhat)
@@ -413,13 +453,32 @@ def diagnose_effects(plant: Plant, record: Record, validate: Record | None = Non
                 continue
             d = (boot(s) - boot(s_best)) / boot(s_ref)
             same_j = float(np.quantile(d, 0.025)) <= 0.0 <= float(np.quantile(d, 0.975))
-            close = float(np.sqrt(np.mean((yhat - y_best)[held] ** 2))) < sigma
+            rms_diff = float(np.sqrt(np.mean((yhat - y_best)[held] ** 2)))
+            close = rms_diff < sigma
+            # outputs a tenth of the noise apart: any difference in J is the noise's, whatever the bootstrap says
+            same_j = same_j or rms_diff < 0.1 * sigma
             if same_j and close:
                 group.append(res.effect)
                 experiments.append(_experiment(best.effect, res.effect, t_ev[held], y_best[held], yhat[held]))
         if len(group) > 1:
             indist.append(group)
         results = [(r if r.effect == best.effect else _unaccept(r), y, s) for r, y, s in results]
+        chain = _Chain(plant, t_tr, u_tr, y_tr, t_ev, u_ev, weights, train_mask, sums, ratio_ci, threshold, min_share,
+                       floor, n_held)
+        eff_best, fit_best = by_label[best.effect]
+        tried = {best.effect, *group}
+        while len(verdict_effects) < max_effects:
+            pool = [eff for eff in effects if eff.label not in tried]
+            step = chain.next(eff_best, fit_best, s_best, pool)
+            if step is None:
+                break
+            nested, fit2, res2, y2, s2 = step
+            results.append((res2, y2, s2))
+            tried.add(res2.effect.split("+")[-1])
+            if not res2.accepted:
+                break
+            verdict_effects.append(res2.effect.split("+")[-1])
+            eff_best, fit_best, s_best, y_best = nested, fit2, s2, y2
     elif pm_ci[0] > 0.0:
         verdict_effects = ["parameter_mismatch"]
         status = "unexplained" if gap_after_refit else "parameter_mismatch"
@@ -429,12 +488,87 @@ def diagnose_effects(plant: Plant, record: Record, validate: Record | None = Non
     headline = _headline(status, verdict_effects, indist, results, pm_shrink, j_nom, floor)
     verdict = {"effects": verdict_effects, "indistinguishable": indist, "experiments": experiments,
                "status": status, "headline": headline}
-    split = {"train_samples": int(t_tr.size), "heldout_samples": n_held, "blocks": blocks, "n_null": n_null,
+    n_train = int(t_tr.size if train_mask is None else train_mask.sum())
+    mode = split if validate is None else "validation"
+    split = {"train_samples": n_train, "heldout_samples": n_held, "blocks": blocks, "n_null": n_null,
              "n_boot": n_boot, "alpha": alpha, "validation_record": validate is not None, "seed": seed,
-             "calibration": calibration, "confirm": confirm,
+             "calibration": calibration, "confirm": confirm, "split": mode,
+             "burn_in": burn_in,
              "joint_fits": [r.effect for r, _, _ in results if r.fit == "joint"]}
     return EffectDiagnosis([r for r, _, _ in results], verdict, floor, j_nom, j_ref, pm_shrink, pm_ci, threshold,
                            refit, split, t_ev, y_ev, y_nom, y_ref, y_best, held)
+
+
+@dataclass(frozen=True)
+class _Folded:
+    """``first`` (an extra delay) folded into the linear model, ``second`` fitted alone on top of it."""
+
+    first: Effect
+    second: Effect
+
+    @property
+    def label(self) -> str:
+        return f"{self.first.label}+{self.second.label}"
+
+
+class _Chain:
+    """Forward selection: the best further effect on top of the accepted ones, judged on held-out data."""
+
+    def __init__(self, plant: Plant, t_tr: np.ndarray, u_tr: np.ndarray, y_tr: np.ndarray, t_ev: np.ndarray,
+                 u_ev: np.ndarray, weights: np.ndarray | None, train_mask: np.ndarray | None, sums: Any,
+                 ratio_ci: Any, threshold: float, min_share: float, floor: float, n_held: int) -> None:
+        self.plant, self.t_tr, self.u_tr, self.y_tr, self.t_ev, self.u_ev = plant, t_tr, u_tr, y_tr, t_ev, u_ev
+        self.weights, self.train_mask, self.sums, self.ratio_ci = weights, train_mask, sums, ratio_ci
+        self.threshold, self.min_share, self.floor, self.n_held = threshold, min_share, floor, n_held
+
+    def next(self, eff_a: Effect, fit_a: AugmentedFit, s_a: np.ndarray, pool: list[Effect],
+             keep: int = 2) -> tuple[Effect, AugmentedFit, EffectResult, np.ndarray, np.ndarray] | None:
+        """Screen every effect of ``pool`` on top of ``eff_a``, re-fit the best ``keep`` jointly, judge the best."""
+        from synth.gap.composite import NestedEffect
+
+        fixed = {k: float(v) for k, v in fit_a.params.items()}
+        base_plant = fit_a.plant
+        folded = type(eff_a) is DelayEffect  # an extra delay folds into the linear model: B alone on top of it
+        if folded:
+            base_plant = fit_a.plant.with_delay(fit_a.plant.delay + fixed.get("delay", 0.0))
+        screened: list[tuple[Effect, ScreenedFit | None]] = []
+        for eff_b in pool:
+            try:
+                nested = _Folded(eff_a, eff_b) if folded else NestedEffect(eff_a, fixed, eff_b)
+                bases = [("accepted", base_plant)]
+                model = nested.second if folded else nested
+                sc = screen_effect(model, bases, self.t_tr, self.u_tr, self.y_tr, self.t_ev, self.u_ev,
+                                   self.train_mask) if model.screenable else None
+            except ModelError:
+                continue
+            screened.append((nested, sc))
+        screened.sort(key=lambda es: es[1].ssr if es[1] is not None else -np.inf)
+        best: tuple[Effect, AugmentedFit, np.ndarray, np.ndarray] | None = None
+        for nested, sc in screened[:keep]:
+            try:
+                model = nested.second if folded else nested
+                eff = _seeded(model, sc, self.u_tr) if sc is not None else model
+                fit = fit_augmented(base_plant if folded else self.plant, self.t_tr, self.u_tr, self.y_tr, eff,
+                                    start=base_plant, weights=self.weights)
+            except ModelError:
+                continue
+            yhat = fit.predict(self.t_ev, self.u_ev)
+            s = self.sums(yhat)
+            if np.isfinite(s.sum()) and (best is None or s.sum() < best[3].sum()):
+                best = (nested, fit, yhat, s)
+        if best is None:
+            return None
+        nested, fit, yhat, s = best
+        j_a, j = float(s_a.sum() / self.n_held), float(s.sum() / self.n_held)
+        ci = self.ratio_ci(s, s_a)
+        share = (j_a - j) / (j_a - self.floor) if j_a > self.floor else 0.0
+        significant = bool(ci[0] > self.threshold)
+        accepted = bool(significant and share >= self.min_share)
+        second = nested.second
+        params = {k: float(fit.params[k]) for k in second.parameter_names}
+        res = EffectResult(nested.label, params, dict(fit.parameter_ci), 1.0 - j / j_a if j_a > 0 else 0.0, ci,
+                           significant, float(share), accepted, j, dict(fit.nominal), "joint")
+        return nested, fit, res, yhat, s
 
 
 def _coefficients(plant: Plant) -> dict[str, float]:
@@ -465,11 +599,17 @@ def _sensitivity(plant: Plant, t: np.ndarray, u: np.ndarray) -> np.ndarray:
 
 def _linearized_null(refit: AugmentedFit, t_tr: np.ndarray, u_tr: np.ndarray, t_ev: np.ndarray, u_ev: np.ndarray,
                      held: np.ndarray, split: bool, sigma: float, n_null: int,
-                     rng: np.random.Generator) -> np.ndarray:
-    """Held-out shrinkage of a perfect model against the re-fit, re-fit linearized (Gauss-Newton step)."""
+                     rng: np.random.Generator, train_mask: np.ndarray | None = None) -> np.ndarray:
+    """Held-out shrinkage of a perfect model against the re-fit, re-fit linearized (Gauss-Newton step).
+
+    ``split``: the training record is the start of the evaluated one; ``train_mask``: the training
+    samples that count in the fit's cost (default all).
+    """
     J_ev = _sensitivity(refit.plant, t_ev, u_ev)
     J_tr = J_ev[:t_tr.size] if split else _sensitivity(refit.plant, t_tr, u_tr)
-    n_tr = sigma * rng.standard_normal((t_tr.size, n_null))
+    if train_mask is not None:
+        J_tr = J_tr[train_mask]
+    n_tr = sigma * rng.standard_normal((J_tr.shape[0], n_null))
     scale = np.maximum(np.sqrt(np.sum(J_tr**2, axis=0)), 1e-300)
     delta = np.linalg.lstsq(J_tr / scale, n_tr, rcond=None)[0] / scale[:, None]
     noise = sigma * rng.standard_normal((int(held.sum()), n_null))
@@ -478,23 +618,25 @@ def _linearized_null(refit: AugmentedFit, t_tr: np.ndarray, u_tr: np.ndarray, t_
 
 
 def _refit_null(refit: AugmentedFit, t_tr: np.ndarray, u_tr: np.ndarray, t_ev: np.ndarray, u_ev: np.ndarray,
-                held: np.ndarray, split: bool, sigma: float, n_null: int, rng: np.random.Generator) -> np.ndarray:
+                held: np.ndarray, split: bool, sigma: float, n_null: int, rng: np.random.Generator,
+                train_mask: np.ndarray | None = None) -> np.ndarray:
     """The same with the casadi re-fit repeated on every replicate."""
     null = []
     y_ref = refit.predict(t_ev, u_ev)
     y_ref_tr = refit.predict(t_tr, u_tr)
+    weights = None if train_mask is None else train_mask.astype(float)
     for _ in range(n_null):
         n_tr = sigma * rng.standard_normal(t_tr.size)
         noise = np.r_[n_tr, sigma * rng.standard_normal(t_ev.size - t_tr.size)] if split else \
             sigma * rng.standard_normal(t_ev.size)
-        fit_b = fit_augmented(refit.plant, t_tr, u_tr, y_ref_tr + n_tr)
+        fit_b = fit_augmented(refit.plant, t_tr, u_tr, y_ref_tr + n_tr, weights=weights)
         j_fit = float(np.mean((y_ref + noise - fit_b.predict(t_ev, u_ev))[held] ** 2))
         j_true = float(np.mean(noise[held] ** 2))
         null.append(1.0 - j_true / j_fit)
     return np.asarray(null)
 
 
-def _seeded(effect: Effect, screened: ScreenedFit) -> Effect:
+def _seeded(effect: Effect, screened: ScreenedFit, u_train: np.ndarray | None = None) -> Effect:
     """The effect with its search grid replaced by the screened point and its neighbours (+-15 % in the key)."""
     point = {k: v for k, v in screened.params.items() if k not in effect.basis_names}
     keys = [k for k in effect.grid_names if k in point and np.isfinite(point[k]) and point[k] > 0]
@@ -504,8 +646,9 @@ def _seeded(effect: Effect, screened: ScreenedFit) -> Effect:
     if effect.name == "saturation":  # one limit at a time, as the effect's own grid
         side = "upper" if np.isfinite(point.get("upper", np.inf)) else "lower"
         other = "lower" if side == "upper" else "upper"
-        span = abs(point[side]) if np.isfinite(point.get(side, np.inf)) else 1.0
-        grid = [{side: point[side] + f * 0.01 * span} for f in (-1.0, 0.0, 1.0)]
+        span = float(np.ptp(u_train)) if u_train is not None and np.ptp(u_train) > 0 else abs(point[side]) or 1.0
+        # the screen held the denominator fixed, which biases the limit: bracket it by +-5 % of the command span
+        grid = [{side: point[side] + f * span} for f in (-0.05, -0.02, 0.0, 0.02, 0.05)]
         grid = [{k: v for k, v in g.items() if k != other} for g in grid]
     cls = type(effect)
     sub = type(f"Seeded{cls.__name__}", (cls,), {"grid": lambda self, t, u, plant: [dict(g) for g in grid]})
@@ -514,6 +657,7 @@ def _seeded(effect: Effect, screened: ScreenedFit) -> Effect:
 
 def _candidate_fits(plant: Plant, effects: list[Effect], refit: AugmentedFit, t_tr: np.ndarray, u_tr: np.ndarray,
                     y_tr: np.ndarray, t_ev: np.ndarray, u_ev: np.ndarray, confirm: int | None,
+                    train_mask: np.ndarray | None = None,
                     ) -> list[tuple[Effect, AugmentedFit | ScreenedFit, np.ndarray, np.ndarray]]:
     """Every candidate's fit: joint for all (``confirm=None``) or screened, the best ``confirm`` then joint.
 
@@ -521,10 +665,11 @@ def _candidate_fits(plant: Plant, effects: list[Effect], refit: AugmentedFit, t_
     always fitted jointly.
     """
     out: list[tuple[Effect, AugmentedFit | ScreenedFit, np.ndarray, np.ndarray]] = []
+    weights = None if train_mask is None else train_mask.astype(float)
     if confirm is None:
         for eff in effects:
             try:
-                fit = fit_augmented(plant, t_tr, u_tr, y_tr, eff, start=refit.plant)
+                fit = fit_augmented(plant, t_tr, u_tr, y_tr, eff, start=refit.plant, weights=weights)
             except ModelError:
                 continue
             out.append((eff, fit, fit.predict(t_tr, u_tr), fit.predict(t_ev, u_ev)))
@@ -534,13 +679,13 @@ def _candidate_fits(plant: Plant, effects: list[Effect], refit: AugmentedFit, t_
     for eff in effects:
         if not eff.screenable:  # the screen holds the input fixed and has no output map: fit these jointly
             try:
-                fit = fit_augmented(plant, t_tr, u_tr, y_tr, eff, start=refit.plant)
+                fit = fit_augmented(plant, t_tr, u_tr, y_tr, eff, start=refit.plant, weights=weights)
             except ModelError:
                 continue
             out.append((eff, fit, fit.predict(t_tr, u_tr), fit.predict(t_ev, u_ev)))
             continue
         try:
-            screened.append((eff, screen_effect(eff, bases, t_tr, u_tr, y_tr, t_ev, u_ev)))
+            screened.append((eff, screen_effect(eff, bases, t_tr, u_tr, y_tr, t_ev, u_ev, train_mask)))
         except ModelError:
             continue
     screened.sort(key=lambda es: es[1].ssr)
@@ -548,8 +693,9 @@ def _candidate_fits(plant: Plant, effects: list[Effect], refit: AugmentedFit, t_
         fit: AugmentedFit | ScreenedFit = sc
         if rank < confirm:
             try:
-                joint = fit_augmented(plant, t_tr, u_tr, y_tr, _seeded(eff, sc), start=refit.plant)
-                if joint.ssr <= sc.ssr * (1 + 1e-9):
+                joint = fit_augmented(plant, t_tr, u_tr, y_tr, _seeded(eff, sc, u_tr), start=refit.plant,
+                                      weights=weights)
+                if np.isfinite(joint.ssr):  # the exact model (the screen's SSR is a one-step linearization)
                     fit = AugmentedFit(eff, joint.plant, joint.params, joint.offset, joint.nominal,
                                        joint.parameter_ci, joint.ssr, joint.samples, joint.profile, joint.solver)
             except ModelError:

@@ -367,7 +367,9 @@ class ResonanceEffect(Effect):
     def grid(self, t: np.ndarray, u: np.ndarray, plant: Plant) -> list[Params]:
         nyquist = np.pi / float(t[1] - t[0])
         lo = min(2.0 * _fastest_pole(plant), nyquist / 20)
-        return [{"wn": float(w), "zeta": 0.2} for w in np.geomspace(lo, nyquist / 5, 6)]
+        hi = 0.9 * nyquist  # a mode can sit anywhere below the Nyquist frequency the record resolves
+        count = max(6, int(np.ceil(np.log(hi / lo) / np.log(1.32))) + 1)  # neighbours at most 32 % apart
+        return [{"wn": float(w), "zeta": 0.2} for w in np.geomspace(lo, hi, count)]
 
     #: largest damping handed to the fit (``z`` finite)
     zeta_max: ClassVar[float] = 1.0 - 1e-6
@@ -494,7 +496,17 @@ class SaturationEffect(Effect):
     def grid(self, t: np.ndarray, u: np.ndarray, plant: Plant) -> list[Params]:
         span, lo, hi = _span(u), float(np.min(u)), float(np.max(u))
         fractions = (0.03, 0.1, 0.2, 0.35, 0.5, 0.7)
-        return [{"upper": hi - f * span} for f in fractions] + [{"lower": lo + f * span} for f in fractions]
+        uppers = [hi - f * span for f in fractions]
+        lowers = [lo + f * span for f in fractions]
+        # limits that clip a few samples of a command with outliers (a derivative kick) lie far inside the
+        # span: add the levels above which 0.5 ... 20 % of the samples lie (and below, for the lower limit)
+        for share in (0.005, 0.02, 0.05, 0.2):
+            up, down = float(np.quantile(u, 1.0 - share)), float(np.quantile(u, share))
+            if all(abs(up - x) > 0.01 * span for x in uppers) and lo < up < hi:
+                uppers.append(up)
+            if all(abs(down - x) > 0.01 * span for x in lowers) and lo < down < hi:
+                lowers.append(down)
+        return [{"upper": x} for x in sorted(uppers, reverse=True)] + [{"lower": x} for x in sorted(lowers)]
 
     def data_grid(self, t: np.ndarray, u: np.ndarray, y: np.ndarray, plant: Plant) -> list[Params]:
         if self.placement == "input" or type(self).grid is not SaturationEffect.grid:  # a subclass's own grid wins
@@ -840,7 +852,12 @@ class StaticNonlinearityEffect(Effect):
 # ------------------------------------------------------------------------------------------------ output side
 @dataclass(frozen=True)
 class DriftEffect(Effect):
-    """Slow output drift ``slope (t - t0) + curvature (t - t0)^2`` (t0 the record's start).
+    """Slow output drift: ``slope (t - t0)``, and ``+ curvature (t - t0)^2`` for ``order="quadratic"``.
+
+    ``t0`` is the record's start. The default is the straight line: a curvature fitted on
+    the training part of a record and carried over the held-out part grows quadratically
+    beyond the data it was fitted on, so it is asked for explicitly
+    (``make_effect("drift(quadratic)")``).
 
     Examples
     --------
@@ -848,21 +865,37 @@ class DriftEffect(Effect):
     >>> t = np.arange(0, 3, 1.0)
     >>> DriftEffect().apply(Plant.from_string("1"), t, np.zeros(3), {"slope": 0.5}).tolist()
     [0.0, 0.5, 1.0]
+    >>> DriftEffect("quadratic").basis_names, DriftEffect("quadratic").label
+    (('slope', 'curvature'), 'drift(quadratic)')
     """
 
+    order: str = "linear"
+    t0: float = 0.0
     name: ClassVar[str] = "drift"
     side: ClassVar[str] = "output"
-    parameter_names: ClassVar[tuple[str, ...]] = ("slope", "curvature")
-    basis_names: ClassVar[tuple[str, ...]] = ("slope", "curvature")
+
+    def __post_init__(self) -> None:
+        if self.order not in ("linear", "quadratic"):
+            raise ModelError(f"drift order must be 'linear' or 'quadratic', got {self.order!r}", where="candidates")
+
+    @property
+    def parameter_names(self) -> tuple[str, ...]:  # type: ignore[override]
+        return ("slope", "curvature") if self.order == "quadratic" else ("slope",)
+
+    @property
+    def basis_names(self) -> tuple[str, ...]:  # type: ignore[override]
+        return self.parameter_names
+
+    @property
+    def label(self) -> str:
+        return "drift" if self.order == "linear" else "drift(quadratic)"
 
     def off(self) -> Params:
-        return {"slope": 0.0, "curvature": 0.0}
+        return {name: 0.0 for name in self.parameter_names}
 
     def output_basis(self, t: np.ndarray) -> list[np.ndarray]:
         tau = np.asarray(t, float) - self.t0
-        return [tau, tau**2]
-
-    t0: float = 0.0
+        return [tau, tau**2][: len(self.parameter_names)]
 
 
 EFFECTS: dict[str, type[Effect]] = {
@@ -893,6 +926,8 @@ def make_effect(spec: str | Effect) -> Effect:
         return SaturationEffect("output")
     if text == "saturation(input)":
         return SaturationEffect("input")
+    if text == "drift(quadratic)":
+        return DriftEffect("quadratic")
     if text not in EFFECTS:
         raise ModelError(f"unknown effect {text!r}; known: {', '.join(EFFECTS)}", where="candidates")
     return EFFECTS[text]()

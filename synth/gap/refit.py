@@ -200,8 +200,8 @@ class _Point:
 
 
 def _linear_fit(plant: Plant, effect: Effect, params: Params, t: np.ndarray, v: np.ndarray, y: np.ndarray,
-                formula: str, start: dict[str, float]) -> tuple[Plant, Params, dict[str, float],
-                                                                 dict[str, tuple[float, float]], dict[str, Any]]:
+                formula: str, start: dict[str, float], weights: np.ndarray | None = None,
+                ) -> tuple[Plant, Params, dict[str, float], dict[str, tuple[float, float]], dict[str, Any]]:
     """casadi fit of the nominal coefficients and the effect's factor parameters on the plant input ``v``."""
     factor = effect.factor(params)
     full = f"({formula})*{factor}" if factor else formula
@@ -210,7 +210,11 @@ def _linear_fit(plant: Plant, effect: Effect, params: Params, t: np.ndarray, v: 
     if fit_delay:
         init["delay"] = plant.delay + float(params.get("delay", 0.0))
     rec = record_from_arrays(t, v, y)
-    res = fit_structure(rec, full, delay="fit" if fit_delay else plant.delay, initial=init)
+    res = fit_structure(rec, full, delay="fit" if fit_delay else plant.delay, initial=init, weights=weights)
+    bounds = _stable_bounds(plant, start)
+    if bounds and any(res.parameters[k] < 0.0 for k in bounds):  # rare: again with the bounds (IPOPT is slower)
+        res = fit_structure(rec, full, delay="fit" if fit_delay else plant.delay, initial=init, weights=weights,
+                            lower=bounds)
     new = dict(params)
     ci: dict[str, tuple[float, float]] = {}
     names = [k for k in effect.factor_names if k != "delay"]
@@ -228,8 +232,29 @@ def _linear_fit(plant: Plant, effect: Effect, params: Params, t: np.ndarray, v: 
     return _plant_from(plant, nominal, plant.delay), new, nominal, ci, dict(res.solver)
 
 
+def _stable_bounds(plant: Plant, start: dict[str, float]) -> dict[str, float] | None:
+    """Lower bound 0 on the denominator coefficients of a stable nominal model.
+
+    Positive coefficients are necessary for a Hurwitz polynomial (and sufficient up to second order):
+    a re-fit of a few-% mismatch has no business moving a stable plant's pole into the right half-plane,
+    where a short training record can hide an exponential that ruins every held-out prediction.
+
+    Examples
+    --------
+    >>> _stable_bounds(Plant.from_string("2/(s^2+3*s+2)"), {"n0": 2.0, "d1": 3.0, "d0": 2.0})
+    {'d1': 0.0, 'd0': 0.0}
+    >>> _stable_bounds(Plant.from_string("2/(s^2-1)"), {"n0": 2.0, "d0": -1.0}) is None
+    True
+    """
+    poles = plant.poles()
+    if poles.size == 0 or np.max(poles.real) >= 0.0:
+        return None
+    return {k: 0.0 for k, v in start.items() if k.startswith("d") and k != "delay" and v > 0.0} or None
+
+
 def _basis_step(effect: Effect, G: Plant, params: Params, t: np.ndarray, u: np.ndarray, y: np.ndarray,
-                dt: float) -> tuple[Params, float, dict[str, tuple[float, float]], float]:
+                dt: float, mask: np.ndarray | None = None) -> tuple[Params, float, dict[str, tuple[float, float]],
+                                                                    float]:
     """Least squares for the output constant and the basis parameters, the linear model fixed."""
     Gaug = effect.augment_plant(G, params)
     v0 = effect.base_input(Gaug, u, dt, params) if effect.needs_plant else effect.input_map(u, dt, params)
@@ -244,11 +269,13 @@ def _basis_step(effect: Effect, G: Plant, params: Params, t: np.ndarray, u: np.n
     else:
         target = y - y0
     X = np.column_stack(cols)
+    if mask is not None:  # only the fitted samples
+        X, target = X[mask], target[mask]
     scale = np.maximum(np.sqrt(np.sum(X**2, axis=0)), 1e-300)
     Xs = X / scale
     coef, *_ = np.linalg.lstsq(Xs, target, rcond=None)
     r = target - Xs @ coef
-    dof = max(1, y.size - X.shape[1])
+    dof = max(1, target.size - X.shape[1])
     s2 = float(r @ r) / dof
     try:
         cov = s2 * np.linalg.inv(Xs.T @ Xs)
@@ -269,10 +296,11 @@ def _basis_step(effect: Effect, G: Plant, params: Params, t: np.ndarray, u: np.n
 
 
 def _fit_point(plant: Plant, effect: Effect, params: Params, t: np.ndarray, u: np.ndarray, y: np.ndarray,
-               formula: str, start: dict[str, float]) -> _Point:
+               formula: str, start: dict[str, float], weights: np.ndarray | None = None) -> _Point:
     dt = float((t[-1] - t[0]) / (t.size - 1))
     p = {**effect.off(), **params}
     G, nominal, ci, solver, offset = plant, dict(start), {}, {}, 0.0
+    mask = None if weights is None else np.asarray(weights) > 0
     # alternate when a step depends on the others: basis terms, an output map (censoring), a plant-dependent input
     output_side = type(effect).output_map is not Effect.output_map
     iterate = bool(effect.basis_names) or output_side or effect.needs_plant
@@ -284,8 +312,8 @@ def _fit_point(plant: Plant, effect: Effect, params: Params, t: np.ndarray, u: n
             v = effect.plant_input(u, dt, p, plant=effect.augment_plant(G, p))
             drift = sum((p[n] * psi for n, psi in zip(effect.basis_names, effect.output_basis(t))), np.zeros_like(y))
             G, p, nominal, ci_f, solver = _linear_fit(plant, effect, p, t, v, target - drift, formula,
-                                                      {k: v_ for k, v_ in nominal.items() if k != "delay"})
-            p, offset, ci_b, gain = _basis_step(effect, G, p, t, u, target, dt)
+                                                      {k: v_ for k, v_ in nominal.items() if k != "delay"}, weights)
+            p, offset, ci_b, gain = _basis_step(effect, G, p, t, u, target, dt, mask)
             if gain != 1.0:
                 G = G.scaled(gain, label=G.label)
                 nominal = {k: (v_ * gain if k.startswith("n") else v_) for k, v_ in nominal.items()}
@@ -294,15 +322,19 @@ def _fit_point(plant: Plant, effect: Effect, params: Params, t: np.ndarray, u: n
                 if output_side:
                     y_lin = _Linear(effect).apply(G, t, u, p, offset=offset)
                     target = effect.censor(y, y_lin, p)
-                ssr = float(np.sum((y - effect.apply(G, t, u, p, offset=offset)) ** 2))
+                ssr = _ssr(y, effect.apply(G, t, u, p, offset=offset), mask)
                 if abs(last - ssr) <= _ROUNDS_TOL * max(ssr, 1e-300):
                     break
                 last = ssr
     except (DataError, ModelError, np.linalg.LinAlgError, RuntimeError) as exc:
         return _Point(p, np.inf, plant, 0.0, dict(start), {}, {"status": f"failed: {exc}"})
-    yhat = effect.apply(G, t, u, p, offset=offset)
-    ssr = float(np.sum((y - yhat) ** 2))
+    ssr = _ssr(y, effect.apply(G, t, u, p, offset=offset), mask)
     return _Point(p, ssr if np.isfinite(ssr) else np.inf, G, offset, nominal, ci, solver)
+
+
+def _ssr(y: np.ndarray, yhat: np.ndarray, mask: np.ndarray | None) -> float:
+    r = y - yhat
+    return float(np.sum((r if mask is None else r[mask]) ** 2))
 
 
 class _Linear:
@@ -347,7 +379,8 @@ def _profile_ci(points: list[_Point], best: _Point, name: str, n: int) -> tuple[
 
 
 def fit_augmented(plant: Plant, t: np.ndarray, u: np.ndarray, y: np.ndarray, effect: Effect | None = None,
-                  refine: bool = True, start: Plant | None = None) -> AugmentedFit:
+                  refine: bool = True, start: Plant | None = None,
+                  weights: np.ndarray | None = None) -> AugmentedFit:
     """Re-fit the nominal coefficients jointly with one effect's parameters on a (training) record.
 
     Parameters
@@ -363,6 +396,9 @@ def fit_augmented(plant: Plant, t: np.ndarray, u: np.ndarray, y: np.ndarray, eff
     start : Plant, optional
         Starting coefficients for the casadi fits (same structure as ``plant``, e.g. the
         re-fit alone); default ``plant``'s.
+    weights : numpy.ndarray, optional
+        0/1 per sample: which samples the cost counts (the model is simulated over all of them
+        from rest); default all.
 
     Returns
     -------
@@ -395,7 +431,12 @@ def fit_augmented(plant: Plant, t: np.ndarray, u: np.ndarray, y: np.ndarray, eff
         start_values = values_s
     eff = effect if effect is not None else _NoEffect()
     grid = eff.data_grid(t, u, y, plant)
-    points = [_fit_point(plant, eff, g, t, u, y, formula, start_values) for g in grid]
+    if weights is not None:
+        weights = np.asarray(weights, float)
+        if weights.shape != y.shape or not np.all((weights == 0) | (weights == 1)):
+            raise ModelError(f"weights must be {y.size} values of 0 or 1", where="weights")
+    n_fit = int(y.size if weights is None else np.sum(weights > 0))
+    points = [_fit_point(plant, eff, g, t, u, y, formula, start_values, weights) for g in grid]
     for g, p in zip(grid, points):
         p.key = next((k for k in eff.grid_names if k in g), None)
     best = min(points, key=lambda p: p.ssr)
@@ -406,19 +447,19 @@ def fit_augmented(plant: Plant, t: np.ndarray, u: np.ndarray, y: np.ndarray, eff
     if key is not None:
         same = [p for p in points if p.key == key]
         if refine:
-            extra = _golden(plant, eff, best, same, key, t, u, y, formula, start_values)
+            extra = _golden(plant, eff, best, same, key, t, u, y, formula, start_values, weights)
             for p in extra:
                 p.key = key
             points += extra
             same += extra
             best = min(points, key=lambda p: p.ssr)
-        ci[key] = _profile_ci(same, best, key, y.size)
-    return AugmentedFit(effect, best.plant, best.params, best.offset, best.nominal, ci, best.ssr, int(y.size),
+        ci[key] = _profile_ci(same, best, key, n_fit)
+    return AugmentedFit(effect, best.plant, best.params, best.offset, best.nominal, ci, best.ssr, n_fit,
                         [(p.params, p.ssr) for p in points], best.solver)
 
 
 def _golden(plant: Plant, eff: Effect, best: _Point, same: list[_Point], key: str, t: np.ndarray, u: np.ndarray,
-            y: np.ndarray, formula: str, start: dict[str, float]) -> list[_Point]:
+            y: np.ndarray, formula: str, start: dict[str, float], weights: np.ndarray | None = None) -> list[_Point]:
     """Golden-section search in log(key) between the best grid point's neighbours."""
     vals = sorted({p.params[key] for p in same if np.isfinite(p.params.get(key, np.nan)) and p.params[key] > 0})
     x0 = best.params.get(key, np.nan)
@@ -432,7 +473,7 @@ def _golden(plant: Plant, eff: Effect, best: _Point, same: list[_Point], key: st
     g = (np.sqrt(5.0) - 1.0) / 2.0
 
     def f(x: float) -> float:
-        pt = _fit_point(plant, eff, {**base, key: float(np.exp(x))}, t, u, y, formula, start)
+        pt = _fit_point(plant, eff, {**base, key: float(np.exp(x))}, t, u, y, formula, start, weights)
         out.append(pt)
         return pt.ssr
 

@@ -111,12 +111,39 @@ def _unit_numerators(plant: Plant) -> list[Plant]:
     return out
 
 
+def _denominator_directions(plant: Plant) -> list[Plant]:
+    """``dG/dd_k = -N s^k / D^2`` for every nonzero non-leading denominator coefficient ``d_k`` of ``G = N/D``.
+
+    With these columns in the least squares, the screen takes one Gauss-Newton step in the
+    denominator from the base instead of holding it fixed, so an effect that needs the poles to move
+    (a limit that changes how fast the plant looks) is not ranked as if it could not.
+
+    Examples
+    --------
+    >>> d = _denominator_directions(Plant.from_string("2/(s+3)"))[0]
+    >>> d.num.tolist(), d.den.tolist()
+    ([-2.0], [1.0, 6.0, 9.0])
+    """
+    out = []
+    deg = plant.den.size - 1
+    den2 = np.polymul(plant.den, plant.den)
+    for i, c in enumerate(plant.den):
+        if i == 0 or c == 0.0:
+            continue
+        power = np.zeros(deg - i + 1)
+        power[0] = 1.0
+        out.append(Plant(-np.polymul(plant.num, power), den2, plant.delay, plant.input, plant.output, plant.label))
+    return out
+
+
 class _Design:
     """Least-squares design of one effect on one denominator: columns on the training and evaluated records."""
 
-    def __init__(self, effect: Effect, base: Plant, records: list[tuple[np.ndarray, np.ndarray]]) -> None:
-        self.effect, self.base, self.records = effect, base, records
+    def __init__(self, effect: Effect, base: Plant, records: list[tuple[np.ndarray, np.ndarray]],
+                 mask: np.ndarray | None = None) -> None:
+        self.effect, self.base, self.records, self.mask = effect, base, records, mask
         self.units = _unit_numerators(base)
+        self.directions = _denominator_directions(base)
 
     def columns(self, params: Params, t: np.ndarray, u: np.ndarray) -> tuple[np.ndarray, int]:
         eff = self.effect
@@ -128,12 +155,15 @@ class _Design:
         g_aug = eff.augment_plant(self.base, p)
         cols += [simulate_plant(g_aug, t, phi) for phi in eff.input_basis(u, dt, p)]
         cols += list(eff.output_basis(t))
+        cols += [simulate_plant(eff.augment_plant(g, p), t, v0) for g in self.directions]
         cols.append(np.ones_like(t))
         return np.column_stack(cols), k_num
 
     def fit(self, params: Params, y: np.ndarray) -> tuple[float, np.ndarray, int]:
         t_tr, u_tr = self.records[0]
         X, k_num = self.columns(params, t_tr, u_tr)
+        if self.mask is not None:  # only the fitted samples count
+            X, y = X[self.mask], y[self.mask]
         if not np.all(np.isfinite(X)):
             return np.inf, np.zeros(X.shape[1]), k_num
         scale = np.maximum(np.sqrt(np.sum(X**2, axis=0)), 1e-300)
@@ -161,14 +191,16 @@ def _extra_grid(effect: Effect, t: np.ndarray, u: np.ndarray, plant: Plant) -> l
 
 
 def _step_responses(plant: Plant, t: np.ndarray) -> tuple[list[np.ndarray], list[np.ndarray]]:
-    """Per unit numerator of ``plant``: the response to a unit step at ``t[0]`` from rest, and to a held 1 (steady)."""
-    units = _unit_numerators(plant)
+    """Per unit numerator and denominator direction of ``plant``: the response to a unit step at ``t[0]`` from
+    rest, and to a held 1 (steady)."""
+    units = _unit_numerators(plant) + _denominator_directions(plant)
     ones = np.ones_like(t)
     return ([simulate_plant(g, t, ones, initial="zero") for g in units],
             [simulate_plant(g, t, ones) for g in units])
 
 
-def _batch_ssr(v: np.ndarray, y: np.ndarray, steps: list[np.ndarray], consts: list[np.ndarray]) -> np.ndarray:
+def _batch_ssr(v: np.ndarray, y: np.ndarray, steps: list[np.ndarray], consts: list[np.ndarray],
+               mask: np.ndarray | None = None) -> np.ndarray:
     """Least-squares SSR of ``y`` on the unit-numerator responses to each column of ``v`` plus a constant.
 
     ``v`` is ``(N, M)``: M candidate plant inputs. The response of a linear model started at the
@@ -188,6 +220,8 @@ def _batch_ssr(v: np.ndarray, y: np.ndarray, steps: list[np.ndarray], consts: li
         cols.append(x + v[0][None, :] * c[:, None])
     cols.append(np.ones((n, m)))
     X = np.stack(cols, axis=2)  # (N, M, k)
+    if mask is not None:
+        X, y = X[mask], y[mask]
     scale = np.maximum(np.sqrt(np.einsum("nmk,nmk->mk", X, X)), 1e-300)
     X = X / scale[None]
     gram = np.einsum("nmi,nmj->mij", X, X)
@@ -196,7 +230,8 @@ def _batch_ssr(v: np.ndarray, y: np.ndarray, steps: list[np.ndarray], consts: li
     return np.maximum(float(y @ y) - np.einsum("mi,mi->m", coef, xty), 0.0)
 
 
-def quantizer_grid(plant: Plant, t: np.ndarray, u: np.ndarray, y: np.ndarray, keep: int = 5) -> list[Params]:
+def quantizer_grid(plant: Plant, t: np.ndarray, u: np.ndarray, y: np.ndarray, keep: int = 5,
+                   mask: np.ndarray | None = None) -> list[Params]:
     """Dense joint search of a command quantizer's ``step`` and ``offset`` with ``plant``'s denominator fixed.
 
     The lattice is written as ``c + (phase + k) step`` with ``c`` the command's mid-range, so changing the
@@ -215,6 +250,8 @@ def quantizer_grid(plant: Plant, t: np.ndarray, u: np.ndarray, y: np.ndarray, ke
         Training record.
     keep : int
         Points refined, and returned, best first.
+    mask : numpy.ndarray of bool, optional
+        Samples that count in the SSR (default all).
 
     Returns
     -------
@@ -262,7 +299,7 @@ def quantizer_grid(plant: Plant, t: np.ndarray, u: np.ndarray, y: np.ndarray, ke
             distinct, which = np.unique(levels, axis=1, return_inverse=True)
             cost = np.empty(distinct.shape[1])
             for i in range(0, distinct.shape[1], 512):
-                cost[i:i + 512] = _batch_ssr(distinct[:, i:i + 512][u_index], y, steps_r, consts)
+                cost[i:i + 512] = _batch_ssr(distinct[:, i:i + 512][u_index], y, steps_r, consts, mask)
             out[start:start + chunk] = cost[np.ravel(which)]
         return out
 
@@ -339,7 +376,7 @@ def _search_key(effect: Effect, grid: list[Params]) -> str | None:
 
 
 def screen_effect(effect: Effect, bases: list[tuple[str, Plant]], t_tr: np.ndarray, u_tr: np.ndarray,
-                  y_tr: np.ndarray, t_ev: np.ndarray, u_ev: np.ndarray) -> ScreenedFit:
+                  y_tr: np.ndarray, t_ev: np.ndarray, u_ev: np.ndarray, mask: np.ndarray | None = None) -> ScreenedFit:
     """Screen one effect: its parameter search with each base denominator fixed, the rest by least squares.
 
     Parameters
@@ -351,6 +388,8 @@ def screen_effect(effect: Effect, bases: list[tuple[str, Plant]], t_tr: np.ndarr
         Training record (the model starts at rest at its first sample).
     t_ev, u_ev : numpy.ndarray
         Evaluated record (the training record's continuation, or a validation record).
+    mask : numpy.ndarray of bool, optional
+        Training samples that count in the SSR (default all; the model runs over all of them).
 
     Returns
     -------
@@ -376,10 +415,10 @@ def screen_effect(effect: Effect, bases: list[tuple[str, Plant]], t_tr: np.ndarr
     best: tuple[float, Params, np.ndarray, int, str, _Design] | None = None
     points = 0
     for base_name, base in bases:
-        design = _Design(effect, base, [(t_tr, u_tr), (t_ev, u_ev)])
+        design = _Design(effect, base, [(t_tr, u_tr), (t_ev, u_ev)], mask)
         try:
             if isinstance(effect, QuantizationEffect):
-                grid = quantizer_grid(base, t_tr, u_tr, y_tr)
+                grid = quantizer_grid(base, t_tr, u_tr, y_tr, mask=mask)
             else:
                 grid = _extra_grid(effect, t_tr, u_tr, base) or effect.grid(t_tr, u_tr, base)
         except ModelError:
@@ -414,7 +453,10 @@ def screen_effect(effect: Effect, bases: list[tuple[str, Plant]], t_tr: np.ndarr
         params[name] = float(coef[k_num + j])
     num = np.zeros_like(base.num, dtype=float)
     num[np.flatnonzero(base.num != 0.0)] = coef[:k_num]
-    plant = Plant(num, base.den, base.delay, base.input, base.output, "screened")
+    n_dir = len(design.directions)
+    den = base.den.astype(float).copy()
+    den[[i for i, c in enumerate(base.den) if i > 0 and c != 0.0]] += coef[-1 - n_dir:-1]  # the Gauss-Newton step
+    plant = Plant(num, den, base.delay, base.input, base.output, "screened")
     if n_basis_in:  # the basis columns ran through the base numerator: express them per unit of the new gain
         gain = float(num @ base.num) / float(base.num @ base.num)  # least-squares ratio of the numerators
         for name in effect.basis_names[:n_basis_in]:
