@@ -53,8 +53,13 @@ Procedure (:func:`diagnose_effects`)
    floor's standard deviation are *indistinguishable* from it, reported as a
    group with the experiment that would separate them.
 
-Only one effect is attributed per diagnosis; a second effect on top of the
-first (nested forward selection) is not attempted. Lag at the actuator and at
+7. **Further effects** (``max_effects``, forward selection): every other candidate
+   is screened on top of the accepted effect (:class:`synth.gap.composite.NestedEffect`,
+   the accepted effect's parameters fixed), the best two are re-fitted jointly with
+   the nominal coefficients, and the better one is accepted when its held-out
+   shrinkage against the model before it clears the same calibrated threshold and
+   it removes ``min_share`` of that model's excess over the noise floor. The first
+   effect is not re-fitted given the second. Lag at the actuator and at
 the sensor give the same output on a linear model; the candidate listed first
 (``lag``) is reported, the other in its indistinguishable group.
 """

@@ -46,6 +46,7 @@ import numpy as np
 from synth.data.record import record_from_arrays
 from synth.errors import DataError, ModelError
 from synth.gap.effects import Effect, Params
+from synth.gap.golden import golden_section, log_bracket
 from synth.ident.simulate import simulate_plant
 from synth.ident.timefit import fit_structure
 from synth.plant import Plant
@@ -462,33 +463,16 @@ def _golden(plant: Plant, eff: Effect, best: _Point, same: list[_Point], key: st
             y: np.ndarray, formula: str, start: dict[str, float], weights: np.ndarray | None = None) -> list[_Point]:
     """Golden-section search in log(key) between the best grid point's neighbours."""
     vals = sorted({p.params[key] for p in same if np.isfinite(p.params.get(key, np.nan)) and p.params[key] > 0})
-    x0 = best.params.get(key, np.nan)
-    if len(vals) < 2 or not (np.isfinite(x0) and x0 > 0) or x0 not in vals:
+    bracket = log_bracket(vals, best.params.get(key, np.nan))
+    if bracket is None:
         return []
-    i = vals.index(x0)
-    lo = np.log(vals[i - 1]) if i > 0 else np.log(vals[0]) - (np.log(vals[1]) - np.log(vals[0]))
-    hi = np.log(vals[i + 1]) if i + 1 < len(vals) else np.log(vals[-1]) + (np.log(vals[-1]) - np.log(vals[-2]))
     base = {k: v for k, v in best.params.items() if k not in eff.basis_names}
     out: list[_Point] = []
-    g = (np.sqrt(5.0) - 1.0) / 2.0
 
     def f(x: float) -> float:
         pt = _fit_point(plant, eff, {**base, key: float(np.exp(x))}, t, u, y, formula, start, weights)
         out.append(pt)
         return pt.ssr
 
-    a, b = lo, hi
-    c, d = b - g * (b - a), a + g * (b - a)
-    fc, fd = f(c), f(d)
-    for _ in range(_GOLDEN - 2):
-        if b - a < _GOLDEN_TOL:
-            break
-        if fc < fd:
-            b, d, fd = d, c, fc
-            c = b - g * (b - a)
-            fc = f(c)
-        else:
-            a, c, fc = c, d, fd
-            d = a + g * (b - a)
-            fd = f(d)
+    golden_section(f, *bracket, _GOLDEN - 2, tol=_GOLDEN_TOL)
     return out

@@ -40,11 +40,11 @@ import numpy as np
 
 from synth.errors import ModelError
 from synth.gap.effects import Effect, Params, QuantizationEffect
+from synth.gap.golden import golden_section, log_bracket
 from synth.ident.simulate import simulate_plant
 from synth.plant import Plant
 
 _GOLDEN_STEPS = 14
-_GOLDEN = (np.sqrt(5.0) - 1.0) / 2.0
 _ZETAS = (0.05, 0.1, 0.2, 0.4, 0.7)
 
 
@@ -468,31 +468,12 @@ def screen_effect(effect: Effect, bases: list[tuple[str, Plant]], t_tr: np.ndarr
 
 def _golden(run: Any, grid: list[Params], g_best: Params, key: str) -> Params:
     """Golden-section search in log(key) between the best grid point's neighbours (the other keys fixed)."""
-    x0 = g_best.get(key, np.nan)
     rest = {k: v for k, v in g_best.items() if k != key}
     vals = sorted({g[key] for g in grid if key in g and np.isfinite(g[key]) and g[key] > 0
                    and {k: v for k, v in g.items() if k != key} == rest})
-    if len(vals) < 2 or not (np.isfinite(x0) and x0 > 0) or x0 not in vals:
+    bracket = log_bracket(vals, g_best.get(key, np.nan))
+    if bracket is None:
         return g_best
-    i = vals.index(x0)
-    lx = np.log(vals)
-    step = lx[1] - lx[0]
-    a = lx[i - 1] if i > 0 else lx[0] - step
-    b = lx[i + 1] if i + 1 < len(vals) else lx[-1] + (lx[-1] - lx[-2])
-
-    def f(x: float) -> float:
-        return run({**rest, key: float(np.exp(x))})
-
-    c, d = b - _GOLDEN * (b - a), a + _GOLDEN * (b - a)
-    fc, fd = f(c), f(d)
-    for _ in range(_GOLDEN_STEPS):
-        if fc < fd:
-            b, d, fd = d, c, fc
-            c = b - _GOLDEN * (b - a)
-            fc = f(c)
-        else:
-            a, c, fc = c, d, fd
-            d = a + _GOLDEN * (b - a)
-            fd = f(d)
+    c, d = golden_section(lambda x: run({**rest, key: float(np.exp(x))}), *bracket, _GOLDEN_STEPS)
     cands = [g_best, {**rest, key: float(np.exp(c))}, {**rest, key: float(np.exp(d))}]
     return min(cands, key=run)
