@@ -69,7 +69,8 @@ def main(argv: list[str] | None = None) -> None:
     args = ap.parse_args(argv)
     rec, clean = record(args.samples)
     rows = []
-    runs = [("synth defaults (screen all 12, joint re-fit of the best 3, linearized calibration)", {})]
+    runs = [("synth defaults (screen all 12, joint re-fit of the best 3 on 2 processes, linearized calibration)",
+             {"workers": 2})]
     if not args.no_baseline:
         runs.append(("baseline: joint re-fit of all 12 (grid + golden), casadi calibration x 19",
                      {"confirm": None, "calibration": "refit", "n_null": 19}))

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import os
 import shlex
 import sys
 from pathlib import Path
@@ -59,6 +60,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                         "20 segments (interleaved, for a record with one transient)")
     p.add_argument("--burn-in", type=float, default=0.0, metavar="S",
                    help="seconds at the start of each record left out of every cost (unknown initial state)")
+    p.add_argument("--workers", type=int, default=min(2, os.cpu_count() or 1), metavar="N",
+                   help="processes for the joint re-fits (default: 2, or 1 on a one-core machine)")
     p.add_argument("--max-effects", type=int, default=2, metavar="N",
                    help="effects a verdict may name (forward selection; default 2)")
     p.add_argument("--out", metavar="DIR", help="folder for the report (default reports/diagnose/<data file stem>)")
@@ -90,7 +93,7 @@ def run(args: argparse.Namespace) -> int:
     record = load_record(args.data, args.time, args.input, args.output, **kw)
     validate = load_record(args.validate, args.time, args.input, args.output, **kw) if args.validate else None
     diag = diagnose(plant, record, validate, candidates, seed=args.seed, split=args.split, burn_in=args.burn_in,
-                    max_effects=args.max_effects)
+                    max_effects=args.max_effects, workers=args.workers)
     data = diag.to_dict()
     data = {"data": str(args.data), "validate_data": str(args.validate) if args.validate else None,
             "plant_argument": args.plant, **data}

@@ -66,14 +66,14 @@ the sensor give the same output on a linear model; the candidate listed first
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field, fields
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
 from synth.data.record import Record
 from synth.errors import ModelError
-from synth.gap.effects import DelayEffect, Effect, make_effect
+from synth.gap.effects import DelayEffect, Effect, Params, make_effect
 from synth.gap.refit import AugmentedFit, fit_augmented
 from synth.gap.screen import ScreenedFit, screen_effect
 from synth.ident.simulate import simulate_plant
@@ -265,7 +265,8 @@ def diagnose_effects(plant: Plant, record: Record, validate: Record | None = Non
                      train_fraction: float = 0.5, blocks: int = 10, n_null: int = 199, n_boot: int = 1000,
                      alpha: float = 0.05, relevance: float = 0.1, min_share: float = 0.25,
                      seed: int = 0, calibration: str = "linearized", confirm: int | None = 3,
-                     split: str = "tail", burn_in: float = 0.0, max_effects: int = 2) -> EffectDiagnosis:
+                     split: str = "tail", burn_in: float = 0.0, max_effects: int = 2,
+                     workers: int = 1) -> EffectDiagnosis:
     """Attribute the gap between ``plant`` and ``record`` to one effect, and measure its shrinkage.
 
     Parameters
@@ -307,6 +308,8 @@ def diagnose_effects(plant: Plant, record: Record, validate: Record | None = Non
     burn_in : float
         Seconds at the start of the record (and of a validation record) left out of every cost:
         the model starts at rest or in steady state, a record may not (unknown initial state).
+    workers : int
+        Processes for the joint confirmations (independent casadi fits); 1 runs them in this process.
     max_effects : int
         Effects a verdict may name. After the first, forward selection: every other significant
         candidate is fitted on top of the accepted one (:class:`synth.gap.composite.NestedEffect`,
@@ -419,7 +422,7 @@ def diagnose_effects(plant: Plant, record: Record, validate: Record | None = Non
         null = _refit_null(refit, t_tr, u_tr, t_ev, u_ev, held, validate is None, sigma, n_null, rng, train_mask)
     threshold = float(np.quantile(null, 1.0 - alpha, method="higher"))
 
-    fits = _candidate_fits(plant, effects, refit, t_tr, u_tr, y_tr, t_ev, u_ev, confirm, train_mask)
+    fits = _candidate_fits(plant, effects, refit, t_tr, u_tr, y_tr, t_ev, u_ev, confirm, train_mask, workers)
 
     by_label = {eff.label: (eff, fit) for eff, fit, _, _ in fits}
     results: list[tuple[EffectResult, np.ndarray, np.ndarray]] = []
@@ -469,7 +472,7 @@ def diagnose_effects(plant: Plant, record: Record, validate: Record | None = Non
             indist.append(group)
         results = [(r if r.effect == best.effect else _unaccept(r), y, s) for r, y, s in results]
         chain = _Chain(plant, t_tr, u_tr, y_tr, t_ev, u_ev, weights, train_mask, sums, ratio_ci, threshold, min_share,
-                       floor, n_held)
+                       floor, n_held, workers)
         eff_best, fit_best = by_label[best.effect]
         tried = {best.effect, *group}
         while len(verdict_effects) < max_effects:
@@ -521,10 +524,12 @@ class _Chain:
 
     def __init__(self, plant: Plant, t_tr: np.ndarray, u_tr: np.ndarray, y_tr: np.ndarray, t_ev: np.ndarray,
                  u_ev: np.ndarray, weights: np.ndarray | None, train_mask: np.ndarray | None, sums: Any,
-                 ratio_ci: Any, threshold: float, min_share: float, floor: float, n_held: int) -> None:
+                 ratio_ci: Any, threshold: float, min_share: float, floor: float, n_held: int,
+                 workers: int = 1) -> None:
         self.plant, self.t_tr, self.u_tr, self.y_tr, self.t_ev, self.u_ev = plant, t_tr, u_tr, y_tr, t_ev, u_ev
         self.weights, self.train_mask, self.sums, self.ratio_ci = weights, train_mask, sums, ratio_ci
         self.threshold, self.min_share, self.floor, self.n_held = threshold, min_share, floor, n_held
+        self.workers = workers
 
     def next(self, eff_a: Effect, fit_a: AugmentedFit, s_a: np.ndarray, pool: list[Effect],
              keep: int = 2) -> tuple[Effect, AugmentedFit, EffectResult, np.ndarray, np.ndarray] | None:
@@ -549,13 +554,14 @@ class _Chain:
             screened.append((nested, sc))
         screened.sort(key=lambda es: es[1].ssr if es[1] is not None else -np.inf)
         best: tuple[Effect, AugmentedFit, np.ndarray, np.ndarray] | None = None
+        jobs = []
         for nested, sc in screened[:keep]:
-            try:
-                model = nested.second if folded else nested
-                eff = _seeded(model, sc, self.u_tr) if sc is not None else model
-                fit = fit_augmented(base_plant if folded else self.plant, self.t_tr, self.u_tr, self.y_tr, eff,
-                                    start=base_plant, weights=self.weights)
-            except ModelError:
+            model = nested.second if folded else nested
+            grid = _seeded(model, sc, self.u_tr) if sc is not None else None
+            jobs.append((base_plant if folded else self.plant, self.t_tr, self.u_tr, self.y_tr, model, base_plant,
+                         self.weights, grid))
+        for (nested, _), fit in zip(screened[:keep], _map(_joint_fit, jobs, self.workers)):
+            if fit is None:
                 continue
             yhat = fit.predict(self.t_ev, self.u_ev)
             s = self.sums(yhat)
@@ -641,8 +647,8 @@ def _refit_null(refit: AugmentedFit, t_tr: np.ndarray, u_tr: np.ndarray, t_ev: n
     return np.asarray(null)
 
 
-def _seeded(effect: Effect, screened: ScreenedFit, u_train: np.ndarray | None = None) -> Effect:
-    """The effect with its search grid replaced by the screened point and its neighbours (+-15 % in the key)."""
+def _seeded(effect: Effect, screened: ScreenedFit, u_train: np.ndarray | None = None) -> list[Params]:
+    """The joint fit's search grid: the screened point and its neighbours (+-15 % in the key)."""
     point = {k: v for k, v in screened.params.items() if k not in effect.basis_names}
     keys = [k for k in effect.grid_names if k in point and np.isfinite(point[k]) and point[k] > 0]
     grid = [point] if not keys else [{**point, keys[0]: point[keys[0]] * f} for f in (1 / 1.15, 1.0, 1.15)]
@@ -655,14 +661,12 @@ def _seeded(effect: Effect, screened: ScreenedFit, u_train: np.ndarray | None = 
         # the screen held the denominator fixed, which biases the limit: bracket it by +-5 % of the command span
         grid = [{side: point[side] + f * span} for f in (-0.05, -0.02, 0.0, 0.02, 0.05)]
         grid = [{k: v for k, v in g.items() if k != other} for g in grid]
-    cls = type(effect)
-    sub = type(f"Seeded{cls.__name__}", (cls,), {"grid": lambda self, t, u, plant: [dict(g) for g in grid]})
-    return sub(**{f.name: getattr(effect, f.name) for f in fields(effect)})
+    return [dict(g) for g in grid]
 
 
 def _candidate_fits(plant: Plant, effects: list[Effect], refit: AugmentedFit, t_tr: np.ndarray, u_tr: np.ndarray,
                     y_tr: np.ndarray, t_ev: np.ndarray, u_ev: np.ndarray, confirm: int | None,
-                    train_mask: np.ndarray | None = None,
+                    train_mask: np.ndarray | None = None, workers: int = 1,
                     ) -> list[tuple[Effect, AugmentedFit | ScreenedFit, np.ndarray, np.ndarray]]:
     """Every candidate's fit: joint for all (``confirm=None``) or screened, the best ``confirm`` then joint.
 
@@ -694,22 +698,38 @@ def _candidate_fits(plant: Plant, effects: list[Effect], refit: AugmentedFit, t_
         except ModelError:
             continue
     screened.sort(key=lambda es: es[1].ssr)
+    jobs = [(plant, t_tr, u_tr, y_tr, eff, refit.plant, weights, _seeded(eff, sc, u_tr))
+            for eff, sc in screened[:confirm]]
+    joints = _map(_joint_fit, jobs, workers)
     for rank, (eff, sc) in enumerate(screened):
         fit: AugmentedFit | ScreenedFit = sc
-        if rank < confirm:
-            try:
-                joint = fit_augmented(plant, t_tr, u_tr, y_tr, _seeded(eff, sc, u_tr), start=refit.plant,
-                                      weights=weights)
-                if np.isfinite(joint.ssr):  # the exact model (the screen's SSR is a one-step linearization)
-                    fit = AugmentedFit(eff, joint.plant, joint.params, joint.offset, joint.nominal,
-                                       joint.parameter_ci, joint.ssr, joint.samples, joint.profile, joint.solver)
-            except ModelError:
-                pass
+        joint = joints[rank] if rank < len(joints) else None
+        if joint is not None and np.isfinite(joint.ssr):  # the exact model (the screen's SSR is linearized)
+            fit = joint
         if isinstance(fit, AugmentedFit):
             out.append((eff, fit, fit.predict(t_tr, u_tr), fit.predict(t_ev, u_ev)))
         else:
             out.append((eff, fit, sc.yhat_train, sc.yhat_eval))
     return out
+
+
+def _joint_fit(job: tuple[Any, ...]) -> AugmentedFit | None:
+    """One confirmation: the joint re-fit of an effect on its seeded grid (``None`` if no point could be fitted)."""
+    plant, t, u, y, eff, start, weights, grid = job
+    try:
+        return fit_augmented(plant, t, u, y, eff, start=start, weights=weights, grid=grid)
+    except ModelError:
+        return None
+
+
+def _map(fn: Any, jobs: list[Any], workers: int) -> list[Any]:
+    """``[fn(j) for j in jobs]``, on ``workers`` processes when there are several jobs."""
+    if workers <= 1 or len(jobs) <= 1:
+        return [fn(j) for j in jobs]
+    from concurrent.futures import ProcessPoolExecutor
+
+    with ProcessPoolExecutor(max_workers=min(workers, len(jobs))) as pool:
+        return list(pool.map(fn, jobs))
 
 
 def _unaccept(r: EffectResult) -> EffectResult:

@@ -381,7 +381,7 @@ def _profile_ci(points: list[_Point], best: _Point, name: str, n: int) -> tuple[
 
 def fit_augmented(plant: Plant, t: np.ndarray, u: np.ndarray, y: np.ndarray, effect: Effect | None = None,
                   refine: bool = True, start: Plant | None = None,
-                  weights: np.ndarray | None = None) -> AugmentedFit:
+                  weights: np.ndarray | None = None, grid: list[Params] | None = None) -> AugmentedFit:
     """Re-fit the nominal coefficients jointly with one effect's parameters on a (training) record.
 
     Parameters
@@ -400,6 +400,9 @@ def fit_augmented(plant: Plant, t: np.ndarray, u: np.ndarray, y: np.ndarray, eff
     weights : numpy.ndarray, optional
         0/1 per sample: which samples the cost counts (the model is simulated over all of them
         from rest); default all.
+    grid : list of dict, optional
+        Starting points of the effect's search (e.g. around a screened point) instead of its
+        own grid (:meth:`synth.gap.effects.Effect.data_grid`).
 
     Returns
     -------
@@ -431,7 +434,7 @@ def fit_augmented(plant: Plant, t: np.ndarray, u: np.ndarray, y: np.ndarray, eff
             raise ModelError(f"start {formula_s} does not have the structure {formula}", where="start")
         start_values = values_s
     eff = effect if effect is not None else _NoEffect()
-    grid = eff.data_grid(t, u, y, plant)
+    grid = eff.data_grid(t, u, y, plant) if grid is None else [dict(g) for g in grid]
     if weights is not None:
         weights = np.asarray(weights, float)
         if weights.shape != y.shape or not np.all((weights == 0) | (weights == 1)):
@@ -466,11 +469,14 @@ def _golden(plant: Plant, eff: Effect, best: _Point, same: list[_Point], key: st
     bracket = log_bracket(vals, best.params.get(key, np.nan))
     if bracket is None:
         return []
-    base = {k: v for k, v in best.params.items() if k not in eff.basis_names}
+    # warm start at the best point: its basis parameters and nominal coefficients (the alternation of a basis
+    # effect then needs a round or two instead of up to _ROUNDS)
+    base = dict(best.params)
+    warm = {k: v for k, v in best.nominal.items() if k in start}
     out: list[_Point] = []
 
     def f(x: float) -> float:
-        pt = _fit_point(plant, eff, {**base, key: float(np.exp(x))}, t, u, y, formula, start, weights)
+        pt = _fit_point(plant, eff, {**base, key: float(np.exp(x))}, t, u, y, formula, warm, weights)
         out.append(pt)
         return pt.ssr
 

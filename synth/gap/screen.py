@@ -191,9 +191,11 @@ def _extra_grid(effect: Effect, t: np.ndarray, u: np.ndarray, plant: Plant) -> l
 
 
 def _step_responses(plant: Plant, t: np.ndarray) -> tuple[list[np.ndarray], list[np.ndarray]]:
-    """Per unit numerator and denominator direction of ``plant``: the response to a unit step at ``t[0]`` from
-    rest, and to a held 1 (steady)."""
-    units = _unit_numerators(plant) + _denominator_directions(plant)
+    """Per unit numerator of ``plant``: the response to a unit step at ``t[0]`` from rest, and to a held 1 (steady).
+
+    (The quantizer's dense search holds the denominator: a Gauss-Newton step in it would double the work of
+    every one of its thousands of points; the best points are then screened like every other effect.)"""
+    units = _unit_numerators(plant)
     ones = np.ones_like(t)
     return ([simulate_plant(g, t, ones, initial="zero") for g in units],
             [simulate_plant(g, t, ones) for g in units])
