@@ -214,3 +214,27 @@ def test_two_worker_processes_give_the_same_diagnosis():
     for a, b in zip(one.effects, two.effects):
         assert (a.effect, a.fit) == (b.effect, b.fit)
         assert a.j_heldout == pytest.approx(b.j_heldout, rel=1e-9)
+
+
+def test_screen_moves_the_denominator_one_gauss_newton_step():
+    """With the denominator 10 % off and no effect at all, the screen's step in it takes the SSR down to the
+    noise, and the reported denominator moves toward the truth; held fixed it could not."""
+    from synth.gap import screen as screen_module
+    from synth.plant import Plant
+
+    true, _ = _plants()
+    rec, _ = _record(None, {})
+    off = Plant(true.num, true.den * np.array([1.0, 1.1, 1.1]))  # both denominator coefficients 10 % high
+    k = rec.n // 2
+    t, u, y = rec.t[:k], rec.u[:k], rec.y[:k]
+    delay = make_effect("delay")
+    stepped = screen_effect(delay, [("off", off)], t, u, y, t, u)
+    directions = screen_module._denominator_directions
+    try:
+        screen_module._denominator_directions = lambda plant: []
+        held = screen_effect(delay, [("off", off)], t, u, y, t, u)
+    finally:
+        screen_module._denominator_directions = directions
+    assert stepped.ssr / k == pytest.approx(1.0, rel=0.15)  # down to the noise (variance 1)
+    assert held.ssr / k > 1.3  # numerator, delay and constant alone cannot absorb the 10 % error
+    assert np.all(np.abs(stepped.plant.den - true.den) < np.abs(off.den - true.den) + 1e-12)

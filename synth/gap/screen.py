@@ -457,7 +457,8 @@ def screen_effect(effect: Effect, bases: list[tuple[str, Plant]], t_tr: np.ndarr
     num[np.flatnonzero(base.num != 0.0)] = coef[:k_num]
     n_dir = len(design.directions)
     den = base.den.astype(float).copy()
-    den[[i for i, c in enumerate(base.den) if i > 0 and c != 0.0]] += coef[-1 - n_dir:-1]  # the Gauss-Newton step
+    if n_dir:  # the Gauss-Newton step (one direction per nonzero non-leading coefficient)
+        den[[i for i, c in enumerate(base.den) if i > 0 and c != 0.0]] += coef[-1 - n_dir:-1]
     plant = Plant(num, den, base.delay, base.input, base.output, "screened")
     if n_basis_in:  # the basis columns ran through the base numerator: express them per unit of the new gain
         gain = float(num @ base.num) / float(base.num @ base.num)  # least-squares ratio of the numerators
