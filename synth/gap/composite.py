@@ -54,14 +54,10 @@ _UNIT = Plant(np.array([1.0]), np.array([1.0]))
 
 def _poly(coeffs: np.ndarray) -> str:
     """A polynomial in ``s`` with numeric coefficients, as the structure parser reads it."""
+    from synth.gap.refit import monomial
+
     deg = coeffs.size - 1
-    terms = []
-    for i, c in enumerate(coeffs):
-        power = deg - i
-        if c == 0.0:
-            continue
-        mono = "" if power == 0 else ("*s" if power == 1 else f"*s^{power}")
-        terms.append(f"({float(c)!r}){mono}")
+    terms = [f"({float(c)!r})" + (f"*{monomial(deg - i)}" if deg - i else "") for i, c in enumerate(coeffs) if c != 0.0]
     return "+".join(terms) if terms else "0"
 
 

@@ -58,6 +58,17 @@ _GOLDEN = 12  # most golden-section evaluations after the grid
 _GOLDEN_TOL = 0.01  # ... or until the bracket is this narrow in log
 
 
+def monomial(power: int) -> str:
+    """``s^power`` as the structure parser reads it (``""`` for power 0).
+
+    Examples
+    --------
+    >>> [monomial(k) for k in range(3)]
+    ['', 's', 's^2']
+    """
+    return "" if power == 0 else ("s" if power == 1 else f"s^{power}")
+
+
 def nominal_structure(plant: Plant) -> tuple[str, dict[str, float]]:
     """Structure formula in the plant's nonzero coefficients (monic denominator) and their values.
 
@@ -78,7 +89,7 @@ def nominal_structure(plant: Plant) -> tuple[str, dict[str, float]]:
             power = deg - i
             if c == 0.0:
                 continue
-            mono = "" if power == 0 else ("s" if power == 1 else f"s^{power}")
+            mono = monomial(power)
             if monic and i == 0:
                 terms.append(mono or "1")
                 continue
