@@ -33,6 +33,7 @@ import numpy as np
 from synth.data.record import Record
 from synth.errors import DataError, ModelError
 from synth.gap.attribute import DEFAULT_CANDIDATES, EffectDiagnosis, diagnose_effects
+from synth.gap.clipping import Clipping, record_clipping
 from synth.gap.effects import make_effect
 from synth.gap.localize import GapLocalization, localize_gap
 from synth.plant import Plant, Signal
@@ -150,6 +151,9 @@ class Diagnosis:
         Held-out record, if one was given.
     localization : GapLocalization
     attribution : EffectDiagnosis
+    clipping : tuple of Clipping
+        Signals of the record (and the validation record) resting on their extreme value:
+        direct evidence of a saturation (:mod:`synth.gap.clipping`).
 
     Examples
     --------
@@ -169,15 +173,25 @@ class Diagnosis:
     validate: Record | None
     localization: GapLocalization
     attribution: EffectDiagnosis
+    clipping: tuple[Clipping, ...] = ()
 
     @property
     def verdict(self) -> dict[str, Any]:
-        """``effects``, ``indistinguishable``, ``experiments``, ``status``, ``headline``."""
-        return self.attribution.verdict
+        """``effects``, ``indistinguishable``, ``experiments``, ``status``, ``headline``, ``observed``.
+
+        ``effects`` are the effects accepted on held-out data; ``observed`` the effects seen
+        directly in the data, whatever a model makes of them (a clipped signal: ``saturation``
+        on the logged command, ``saturation(output)`` on the output).
+        """
+        observed = list(dict.fromkeys(c.effect for c in self.clipping))
+        return {**self.attribution.verdict, "observed": observed}
 
     @property
     def summary(self) -> str:
-        """The verdict in one plain sentence (what to tell a person first)."""
+        """The verdict in plain sentences (what to tell a person first), then any clipping seen in the data."""
+        return self._verdict_sentence() + self._clipping_sentence()
+
+    def _verdict_sentence(self) -> str:
         v = self.verdict
         status = v["status"]
         gap = f"{100 * self.localization.residual.nrmse:.0f} % NRMSE"
@@ -199,10 +213,25 @@ class Diagnosis:
                 + (" (re-fitting the nominal coefficients helps, but the gap remains)."
                    if v["effects"] == ["parameter_mismatch"] else "."))
 
+    def _clipping_sentence(self) -> str:
+        """What the clipped signals say, with the matching candidate's held-out shrinkage."""
+        text = ""
+        for clip in self.clipping:
+            text += f" Seen in the data: {clip.describe()}."
+        if "saturation(output)" in self.verdict["observed"]:
+            fit = next((e for e in self.attribution.effects if e.effect == "saturation(output)"), None)
+            if fit is not None and not fit.accepted:
+                lo, hi = fit.shrinkage_ci
+                text += (f" Adding the output clip to the model shrinks the held-out error by {fit.shrinkage:.2f} "
+                         f"[{lo:.2f}, {hi:.2f}] ({'significant' if fit.significant else 'not significant'}), too "
+                         "little to be accepted as the explanation of the gap.")
+        return text
+
     def to_dict(self) -> dict[str, Any]:
         """The ``synth diagnose --json`` contract (JSON-serializable; non-finite numbers as strings).
 
-        Keys: ``gap``, ``where``, ``effects``, ``verdict`` (the contract), and
+        Keys: ``gap``, ``where`` (with ``clipping``: signals resting on their extreme value),
+        ``effects``, ``verdict`` (the contract, with ``observed``), and
         ``headline`` (where), ``summary`` (the verdict in a sentence), ``noise_floor``,
         ``model``, ``record``, ``validate``, ``attribution`` (re-fit, threshold, split).
         """
@@ -212,7 +241,8 @@ class Diagnosis:
         att = self.attribution.to_dict()
         units = {"input": self.record.input.unit, "output": self.record.output.unit}
         return to_jsonable({
-            "gap": loc["gap"], "where": loc["where"], "effects": att["effects"], "verdict": att["verdict"],
+            "gap": loc["gap"], "where": {**loc["where"], "clipping": [c.to_dict() for c in self.clipping]},
+            "effects": att["effects"], "verdict": self.verdict,
             "headline": loc["headline"], "summary": self.summary, "units": units,
             "noise_floor": {"variance": att["noise_floor"], "std": att["noise_std"]},
             "model": self.plant.to_dict(), "record": self.record.to_dict(),
@@ -305,4 +335,5 @@ def diagnose(plant: Plant, record: Record, validate: Record | None = None,
     att = diagnose_effects(plant, record, validate, candidates=names, train_fraction=train_fraction,
                            n_null=n_null, n_boot=n_boot, seed=seed, split=split, burn_in=burn_in,
                            max_effects=max_effects, workers=workers)
-    return Diagnosis(plant, record, validate, loc, att)
+    clips = record_clipping(record) + (record_clipping(validate, "validate") if validate is not None else [])
+    return Diagnosis(plant, record, validate, loc, att, tuple(clips))
