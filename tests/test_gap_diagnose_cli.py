@@ -83,3 +83,22 @@ def test_does_not_overwrite_a_users_file(run_cli, csv, tmp_path):
     res = run_cli("diagnose", "--plant", PLANT, "--data", str(csv), *ARGS, "--json", str(mine), "--no-report")
     assert res.code == 2 and "not overwriting" in res.err
     assert mine.read_text() == '{"mine": true}'
+
+
+def test_cli_prints_and_reports_a_clipped_output(run_cli, tmp_path):
+    t = np.arange(0, 8, 0.01)
+    rng = np.random.default_rng(3)
+    u = np.where((t % 2) >= 1, 100.0, 0.0) + rng.normal(size=t.size)
+    y = simulate_plant(Plant.from_string(PLANT), t, u) + 0.2 * rng.normal(size=t.size)
+    y = np.minimum(y, 180.0)  # a sensor whose range ends at 180 rad/s
+    path = tmp_path / "clipped.csv"
+    np.savetxt(path, np.c_[t, u, y], delimiter=",", header="t,pwm,speed", comments="")
+    res = run_cli("diagnose", "--plant", PLANT, "--data", str(path), *ARGS, "--candidates", "delay",
+                  "--json", str(tmp_path / "gap.json"), "--out", str(tmp_path / "report"))
+    assert res.code == 0, res.err
+    assert "seen in the data: saturation(output)" in res.out
+    d = json.loads((tmp_path / "gap.json").read_text())
+    (clip,) = d["where"]["clipping"]
+    assert clip["level"] == 180.0 and clip["samples"] == int(np.sum(y == 180.0)) and clip["runs"] == 4
+    html = (tmp_path / "report" / "report.html").read_text()
+    assert "clipped signal" in html and "Seen directly in the data: saturation(output)" in html

@@ -136,6 +136,8 @@ def _print(d: dict[str, Any], report: Any) -> None:
     print(d["summary"])
     print(f"where: {d['headline']}")
     print(f"verdict: {', '.join(v['effects']) if v['effects'] else 'none'} ({v['status']}): {v['headline']}")
+    if v.get("observed"):
+        print(f"seen in the data: {', '.join(v['observed'])} (clipped signals: see the summary)")
     for group, experiment in zip(v["indistinguishable"], v["experiments"] or [""] * len(v["indistinguishable"])):
         print(f"indistinguishable: {' / '.join(group)}{'; separate by ' + experiment if experiment else ''}")
     for e in d["effects"][:3]:
