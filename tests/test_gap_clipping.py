@@ -95,3 +95,18 @@ def test_the_diagnosis_finds_clipping_in_the_validation_record_too():
 @pytest.mark.parametrize("bad", [[1.0, np.nan, 2.0, 3.0, 4.0, 5.0, 6.0], [1.0, 1.0]])
 def test_non_finite_or_short_signals_are_not_judged(bad):
     assert find_clipping(np.array(bad)) == []
+
+
+def test_a_heldout_tail_without_transients_is_warned_about():
+    from synth.gap.diagnose import heldout_warnings
+
+    t = np.arange(0.0, 10.0, 0.01)
+    u = np.where(t >= 2.0, 1.0, 0.0)
+    y = simulate_plant(Plant.from_string("1/(0.2*s+1)", delay=0.05), t, u) + 0.01 * RNG.standard_normal(t.size)
+    rec = record_from_arrays(t, u, y)
+    dg = diagnose(Plant.from_string("1/(0.2*s+1)"), rec, candidates=["delay"], n_null=3)
+    (w,) = dg.warnings
+    assert "t >= 5 s" in w and "spans 0 %" in w and dg.to_dict()["warnings"] == [w]
+    assert heldout_warnings(rec, split="interleaved") == []
+    assert heldout_warnings(rec, train_fraction=0.15) == []  # the step at 2 s is then held out
+    assert heldout_warnings(rec, record_from_arrays(t, 0.5 + 1e-3 * np.sin(t), y))[0].startswith("the validation")

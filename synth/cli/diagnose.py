@@ -134,6 +134,8 @@ def _command(args: argparse.Namespace) -> str:
 def _print(d: dict[str, Any], report: Any) -> None:
     v = d["verdict"]
     print(d["summary"])
+    for w in d.get("warnings", []):
+        print(f"warning: {w}")
     print(f"where: {d['headline']}")
     print(f"verdict: {', '.join(v['effects']) if v['effects'] else 'none'} ({v['status']}): {v['headline']}")
     if v.get("observed"):

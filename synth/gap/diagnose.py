@@ -154,6 +154,8 @@ class Diagnosis:
     clipping : tuple of Clipping
         Signals of the record (and the validation record) resting on their extreme value:
         direct evidence of a saturation (:mod:`synth.gap.clipping`).
+    warnings : tuple of str
+        What limits the held-out test (:func:`heldout_warnings`).
 
     Examples
     --------
@@ -174,6 +176,7 @@ class Diagnosis:
     localization: GapLocalization
     attribution: EffectDiagnosis
     clipping: tuple[Clipping, ...] = ()
+    warnings: tuple[str, ...] = ()
 
     @property
     def verdict(self) -> dict[str, Any]:
@@ -230,7 +233,8 @@ class Diagnosis:
     def to_dict(self) -> dict[str, Any]:
         """The ``synth diagnose --json`` contract (JSON-serializable; non-finite numbers as strings).
 
-        Keys: ``gap``, ``where`` (with ``clipping``: signals resting on their extreme value),
+        Keys: ``warnings`` (what limits the held-out test), ``gap``, ``where`` (with ``clipping``:
+        signals resting on their extreme value),
         ``effects``, ``verdict`` (the contract, with ``observed``), and
         ``headline`` (where), ``summary`` (the verdict in a sentence), ``noise_floor``,
         ``model``, ``record``, ``validate``, ``attribution`` (re-fit, threshold, split).
@@ -241,6 +245,7 @@ class Diagnosis:
         att = self.attribution.to_dict()
         units = {"input": self.record.input.unit, "output": self.record.output.unit}
         return to_jsonable({
+            "warnings": list(self.warnings),
             "gap": loc["gap"], "where": {**loc["where"], "clipping": [c.to_dict() for c in self.clipping]},
             "effects": att["effects"], "verdict": self.verdict,
             "headline": loc["headline"], "summary": self.summary, "units": units,
@@ -336,4 +341,55 @@ def diagnose(plant: Plant, record: Record, validate: Record | None = None,
                            n_null=n_null, n_boot=n_boot, seed=seed, split=split, burn_in=burn_in,
                            max_effects=max_effects, workers=workers)
     clips = record_clipping(record) + (record_clipping(validate, "validate") if validate is not None else [])
-    return Diagnosis(plant, record, validate, loc, att, tuple(clips))
+    warnings = heldout_warnings(record, validate, split, train_fraction)
+    return Diagnosis(plant, record, validate, loc, att, tuple(clips), tuple(warnings))
+
+
+def heldout_warnings(record: Record, validate: Record | None = None, split: str = "tail",
+                     train_fraction: float = 0.5, min_span: float = 0.05) -> list[str]:
+    """Why the held-out test may not see an effect: a held-out command that barely moves.
+
+    An effect of the dynamics (a delay, a lag, a limit) shows where the command changes. When
+    the held-out part's command spans less than ``min_span`` of the record's (a single step
+    early in a record split at its tail; a validation record at one operating point), the
+    held-out test judges only the steady state and can neither confirm nor reject such an
+    effect.
+
+    Parameters
+    ----------
+    record, validate : Record
+        As given to :func:`diagnose`.
+    split : {"tail", "interleaved"}
+    train_fraction : float
+    min_span : float
+        Smallest held-out command span, relative to the record's, that counts as excitation.
+
+    Returns
+    -------
+    list of str
+        Plain sentences; empty when the held-out part is excited.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from synth.data import record_from_arrays
+    >>> t = np.arange(0, 10, 0.01); u = np.where(t >= 2, 1.0, 0.0)
+    >>> heldout_warnings(record_from_arrays(t, u, u))[0][:58]
+    'the held-out part (t >= 5 s, the tail of the record) has a'
+    >>> heldout_warnings(record_from_arrays(t, u, u), split="interleaved")
+    []
+    """
+    span = float(np.ptp(record.u))
+    if validate is not None:
+        held, where = validate.u, "the validation record"
+    elif split == "tail":
+        k = round(train_fraction * record.n)
+        held, where = record.u[k:], f"the held-out part (t >= {record.t[k]:.4g} s, the tail of the record)"
+    else:
+        return []
+    held_span = float(np.ptp(held)) if held.size else 0.0
+    if span > 0.0 and held_span >= min_span * span:
+        return []
+    return [f"{where} has a command that spans {100 * held_span / span if span > 0 else 0.0:.2g} % of the "
+            "record's: the held-out test judges only the steady state there and cannot see an effect of the "
+            "transients (a delay, a lag, a limit); give --validate with steps, or --split interleaved"]
