@@ -324,7 +324,8 @@ class LagEffect(Effect):
     def grid(self, t: np.ndarray, u: np.ndarray, plant: Plant) -> list[Params]:
         dt = float(t[1] - t[0])
         top = 1.0 / _fastest_pole(plant)  # an actuator or sensor lag is faster than the plant it is added to
-        return [{"tau": float(x)} for x in np.geomspace(dt, max(2 * dt, top), 8)]
+        # from a quarter sample, as the extra delay's search: the exact discretization sees a sub-sample lag
+        return [{"tau": float(x)} for x in np.geomspace(0.25 * dt, max(2 * dt, top), 8)]
 
     def factor(self, params: Params | None = None) -> str | None:
         tau = float((params or {}).get("tau", 0.0))
