@@ -1,4 +1,4 @@
-"""The sub-sample lag (the verdict rules follow)."""
+"""Verdict order by parsimony, the relevance share against an overestimated noise floor, the sub-sample lag."""
 
 from __future__ import annotations
 
@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 
 from synth.data import record_from_arrays
+from synth.gap.attribute import _free_parameters, _parsimonious_lead, diagnose_effects
 from synth.gap.effects import make_effect
 from synth.gap.screen import screen_effect
 from synth.ident.simulate import simulate_plant
@@ -28,6 +29,69 @@ def _record(effect: str, params: dict[str, float], seed: int):
 
 def _by_label(dg):
     return {e.effect: e for e in dg.effects}
+
+
+# ------------------------------------------------------------------------------------------- parameter counts
+@pytest.mark.parametrize(("effect", "params", "count"), [
+    ("delay", {"delay": 0.01}, 1),
+    ("lag", {"tau": 0.01}, 1),
+    ("resonance", {"wn": 80.0, "zeta": 0.3}, 2),
+    ("saturation", {"lower": 2.4, "upper": np.inf}, 1),  # the unused side is no parameter
+    ("deadzone", {"width": 0.1, "center": 2.0}, 1),  # the center is the command at rest, not fitted
+    ("quantization", {"step": 0.4, "offset": 0.1}, 2),
+    ("supply_sag", {"sag": 0.01, "tau": 0.9}, 2),
+    ("static_nonlinearity", {"a2": 0.1, "a3": 0.0, "center": 6.0, "scale": 4.0}, 2),  # center, scale fixed
+    ("drift", {"slope": 0.5}, 1),
+])
+def test_free_parameters_count_what_the_fit_chose(effect, params, count):
+    assert _free_parameters(make_effect(effect), params) == count
+
+
+def test_parsimonious_lead_needs_a_significant_advantage_against_each_simpler_candidate():
+    def ci(a, b):  # shrinkage of a against b, +-0.01
+        r = 1.0 - a.sum() / b.sum()
+        return r - 0.01, r + 0.01
+
+    three = ("three", np.array([100.0]))
+    two = ("two", np.array([101.0]))  # the best is 1 % better: not above a threshold of 0.02
+    one = ("one", np.array([110.0]))  # 9 % better: significant
+    lead, info = _parsimonious_lead([three, two, one], [3, 2, 1], ci, 0.02)
+    assert lead == 1 and info["lead"] == "two" and info["best"] == "three"
+    assert info["advantage_ci"] == pytest.approx([0.0, 0.02], abs=1e-2)
+    # a simpler candidate that the best beats significantly never leads; an equal count never moves the lead
+    assert _parsimonious_lead([three, one], [3, 1], ci, 0.02) == (0, None)
+    assert _parsimonious_lead([three, two], [2, 2], ci, 0.02) == (0, None)
+    # among candidates the best does not beat, the fewest parameters lead, whatever their order in J
+    lead, _ = _parsimonious_lead([three, two, ("one", np.array([100.5]))], [3, 2, 1], ci, 0.02)
+    assert lead == 2
+
+
+# ------------------------------------------------------------------------------------------------ end to end
+def test_a_true_lag_leads_a_resonance_that_is_better_on_held_out_data_but_not_significantly():
+    dg = diagnose_effects(NOMINAL, _record("lag", {"tau": 0.0144}, seed=3), candidates=["lag", "resonance"],
+                          confirm=None, max_effects=1)
+    res = _by_label(dg)
+    # the premise: the two-parameter resonance has the lower held-out J (it led before the rule)
+    assert res["resonance"].j_heldout < res["lag"].j_heldout
+    assert res["resonance"].significant and res["lag"].significant
+    assert dg.verdict["effects"] == ["lag"]
+    info = dg.verdict["parsimony"]
+    assert info["best"] == "resonance" and info["lead"] == "lag"
+    assert info["lead_parameters"] == 1 and info["best_parameters"] == 2
+    assert info["advantage_ci"][0] <= dg.threshold
+    assert ["lag", "resonance"] in dg.verdict["indistinguishable"]  # still reported as not separable
+    assert dg.to_dict()["verdict"]["parsimony"] == info
+
+
+def test_a_lightly_damped_resonance_is_still_named_resonance():
+    dg = diagnose_effects(NOMINAL, _record("resonance", {"wn": 60.0, "zeta": 0.15}, seed=0),
+                          candidates=["lag", "delay", "resonance"], confirm=None, max_effects=1)
+    res = _by_label(dg)
+    assert res["delay"].significant and res["lag"].significant  # simpler contenders were there
+    assert dg.verdict["effects"] == ["resonance"]
+    assert dg.verdict["parsimony"] is None
+    assert res["resonance"].parameters["wn"] == pytest.approx(60.0, rel=0.05)
+    assert res["resonance"].parameters["zeta"] < 0.25
 
 
 # --------------------------------------------------------------------------------------------- sub-sample lag

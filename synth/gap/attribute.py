@@ -45,13 +45,19 @@ Procedure (:func:`diagnose_effects`)
    *significant* when the lower end of its shrinkage interval exceeds it, and
    *relevant* when it also explains at least ``min_share`` of the re-fit's
    held-out excess over the noise floor.
-6. **Verdict.** The significant, relevant effect with the lowest held-out
-   ``J`` is the answer; ``["parameter_mismatch"]`` if none is but the re-fit
-   shrinks the gap significantly; ``[]`` when there is no gap.
-   Candidates whose held-out ``J`` does not differ from the winner's beyond the
-   bootstrap interval and whose held-out outputs differ by less than the noise
-   floor's standard deviation are *indistinguishable* from it, reported as a
-   group with the experiment that would separate them.
+6. **Verdict.** Among the significant, relevant effects the one with the lowest
+   held-out ``J`` leads unless a candidate with fewer free parameters (grid,
+   factor and basis parameters the fit chose, :func:`_free_parameters`) is not
+   beaten significantly by it: the lower end of the interval of its held-out
+   shrinkage against that simpler candidate must exceed the calibrated
+   threshold, the test every effect passes against the re-fit. Otherwise the
+   simplest such candidate leads (``verdict["parsimony"]`` says which one it
+   displaced and by how much). ``["parameter_mismatch"]`` if no effect is
+   relevant but the re-fit shrinks the gap significantly; ``[]`` when there is
+   no gap. Candidates whose held-out ``J`` does not differ from the leader's
+   beyond the bootstrap interval and whose held-out outputs differ by less than
+   the noise floor's standard deviation are *indistinguishable* from it,
+   reported as a group with the experiment that would separate them.
 
 7. **Further effects** (``max_effects``, forward selection): every other candidate
    is screened on top of the accepted effect (:class:`synth.gap.composite.NestedEffect`,
@@ -195,7 +201,8 @@ class EffectDiagnosis:
         ``effects`` (accepted, most important first; ``[]`` for none,
         ``["parameter_mismatch"]`` when only the re-fit was needed),
         ``indistinguishable`` (groups), ``experiments`` (one per group),
-        ``status`` and ``headline``.
+        ``status``, ``headline`` and ``parsimony`` (``None``, or which candidate with
+        fewer parameters leads over the lowest-``J`` one, see :func:`_parsimonious_lead`).
     noise_floor : float
         ``sigma^2`` (output units squared).
     j_nominal, j_refit : float
@@ -396,6 +403,11 @@ def diagnose_effects(plant: Plant, record: Record, validate: Record | None = Non
         r = 1.0 - boot(num) / boot(den)
         return float(np.quantile(r, 0.025)), float(np.quantile(r, 0.975))
 
+    def diff_ci(s_a: np.ndarray, s_b: np.ndarray) -> tuple[float, float]:
+        """95 % interval of ``(J_a - J_b) / J_refit`` (the same segment draws for both models)."""
+        d = (boot(s_a) - boot(s_b)) / boot(s_ref)
+        return float(np.quantile(d, 0.025)), float(np.quantile(d, 0.975))
+
     fitted = slice(None) if train_mask is None else train_mask
     c_nom = float(np.mean((y_tr - simulate_plant(plant, t_tr, u_tr))[fitted]))
     y_nom = simulate_plant(plant, t_ev, u_ev) + c_nom
@@ -448,19 +460,22 @@ def diagnose_effects(plant: Plant, record: Record, validate: Record | None = Non
     indist: list[list[str]] = []
     experiments: list[str] = []
     y_best = None
+    parsimony: dict[str, Any] | None = None
     if not gap_present:
         verdict_effects: list[str] = []
         status = "none"
     elif relevant:
-        best, y_best, s_best = relevant[0]
+        counts = [_free_parameters(by_label[r.effect][0], r.parameters) for r, _, _ in relevant]
+        lead, parsimony = _parsimonious_lead([(r.effect, s) for r, _, s in relevant], counts, ratio_ci, threshold)
+        best, y_best, s_best = relevant[lead]
         verdict_effects = [best.effect]
         status = "effect"
         group = [best.effect]
         for res, yhat, s in results:
             if res.effect == best.effect or not res.significant:
                 continue
-            d = (boot(s) - boot(s_best)) / boot(s_ref)
-            same_j = float(np.quantile(d, 0.025)) <= 0.0 <= float(np.quantile(d, 0.975))
+            d_lo, d_hi = diff_ci(s, s_best)
+            same_j = d_lo <= 0.0 <= d_hi
             rms_diff = float(np.sqrt(np.mean((yhat - y_best)[held] ** 2)))
             close = rms_diff < sigma
             # outputs a tenth of the noise apart: any difference in J is the noise's, whatever the bootstrap says
@@ -495,7 +510,7 @@ def diagnose_effects(plant: Plant, record: Record, validate: Record | None = Non
         status = "unexplained"
     headline = _headline(status, verdict_effects, indist, results, pm_shrink, j_nom, floor)
     verdict = {"effects": verdict_effects, "indistinguishable": indist, "experiments": experiments,
-               "status": status, "headline": headline}
+               "status": status, "headline": headline, "parsimony": parsimony}
     n_train = int(t_tr.size if train_mask is None else train_mask.sum())
     mode = split if validate is None else "validation"
     split = {"train_samples": n_train, "heldout_samples": n_held, "blocks": blocks, "n_null": n_null,
@@ -730,6 +745,82 @@ def _map(fn: Any, jobs: list[Any], workers: int) -> list[Any]:
 
     with ProcessPoolExecutor(max_workers=min(workers, len(jobs))) as pool:
         return list(pool.map(fn, jobs))
+
+
+def _free_parameters(effect: Effect, params: dict[str, float]) -> int:
+    """Parameters the fit of ``effect`` chose: its grid, factor and basis parameters with a finite value.
+
+    A parameter the effect fixes from the record (a dead zone's center, the static map's center and
+    scale) is not chosen by the fit, and a limit left at infinity (the unused side of a one-sided
+    saturation) is not a parameter of the fitted model. An effect that declares no grid, factor or
+    basis parameters counts its ``parameter_names``.
+
+    Examples
+    --------
+    >>> from synth.gap.effects import make_effect
+    >>> _free_parameters(make_effect("resonance"), {"wn": 80.0, "zeta": 0.3})
+    2
+    >>> _free_parameters(make_effect("saturation"), {"lower": 2.4, "upper": float("inf")})
+    1
+    >>> _free_parameters(make_effect("deadzone"), {"width": 0.1, "center": 2.0})
+    1
+    """
+    names = tuple(dict.fromkeys((*effect.grid_names, *effect.factor_names, *effect.basis_names)))
+    return sum(1 for name in names or effect.parameter_names if np.isfinite(params.get(name, np.nan)))
+
+
+def _parsimonious_lead(candidates: list[tuple[str, np.ndarray]], counts: list[int], advantage_ci: Any,
+                       threshold: float) -> tuple[int, dict[str, Any] | None]:
+    """Which accepted candidate leads the verdict: the simplest one the best does not beat significantly.
+
+    Parameters
+    ----------
+    candidates : list of (str, numpy.ndarray)
+        The relevant candidates' labels and held-out block sums, lowest held-out ``J`` first.
+    counts : list of int
+        Their free parameters (:func:`_free_parameters`).
+    advantage_ci : callable
+        ``advantage_ci(s_a, s_b)``: 95 % bootstrap interval of the held-out shrinkage ``1 - J_a / J_b``
+        of model ``a`` against model ``b`` (the same segment draws for both).
+    threshold : float
+        The calibrated shrinkage an effect must exceed against the re-fit (parametric bootstrap).
+
+    Returns
+    -------
+    int
+        Index of the leader in ``candidates``.
+    dict or None
+        ``{"lead", "lead_parameters", "best", "best_parameters", "advantage_ci", "threshold"}`` when the
+        leader is not the lowest-``J`` candidate (``advantage_ci``: the interval of the best's shrinkage
+        against the leader), else ``None``.
+
+    Notes
+    -----
+    A model with more free parameters also fits the training noise better and carries some of that
+    to held-out data by chance. It leads a simpler accepted candidate only when its held-out
+    shrinkage against that candidate passes the test every effect passes against the re-fit: the
+    lower end of its interval above the calibrated threshold. Among the candidates the best does not
+    beat so, the one with the fewest parameters leads (ties: the lower held-out ``J``).
+
+    Examples
+    --------
+    >>> ci = lambda a, b: (1 - a.sum() / b.sum() - 0.01, 1 - a.sum() / b.sum() + 0.01)  # +-0.01 interval
+    >>> two, one = ("resonance", np.array([10.0])), ("delay", np.array([10.1]))
+    >>> _parsimonious_lead([two, one], [2, 1], ci, 0.02)[0]  # 1 % better: not significant, the delay leads
+    1
+    >>> _parsimonious_lead([two, ("delay", np.array([13.0]))], [2, 1], ci, 0.02)  # 23 % better: resonance
+    (0, None)
+    """
+    s_best = candidates[0][1]
+    lead = 0
+    for i in range(1, len(candidates)):
+        if counts[i] < counts[lead] and advantage_ci(s_best, candidates[i][1])[0] <= threshold:
+            lead = i
+    if lead == 0:
+        return 0, None
+    return lead, {"lead": candidates[lead][0], "lead_parameters": counts[lead], "best": candidates[0][0],
+                  "best_parameters": counts[0], "advantage_ci": list(advantage_ci(s_best, candidates[lead][1])),
+                  "threshold": threshold}
 
 
 def _unaccept(r: EffectResult) -> EffectResult:
