@@ -5,8 +5,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+import synth.gap.attribute as attribute
 from synth.data import record_from_arrays
-from synth.gap.attribute import _free_parameters, _parsimonious_lead, diagnose_effects
+from synth.gap.attribute import _free_parameters, _parsimonious_lead, _share_of_excess, diagnose_effects
 from synth.gap.effects import make_effect
 from synth.gap.screen import screen_effect
 from synth.ident.simulate import simulate_plant
@@ -92,6 +93,25 @@ def test_a_lightly_damped_resonance_is_still_named_resonance():
     assert dg.verdict["parsimony"] is None
     assert res["resonance"].parameters["wn"] == pytest.approx(60.0, rel=0.05)
     assert res["resonance"].parameters["zeta"] < 0.25
+
+
+# ------------------------------------------------------------------------------ relevance against the floor
+def test_share_of_excess_takes_the_floor_as_at_most_the_judged_models_error():
+    assert _share_of_excess(2.0, 1.5, 1.0) == pytest.approx(0.5)  # the floor below both: unchanged
+    assert _share_of_excess(0.95, 0.85, 1.0) == 1.0  # below the floor's estimate: all that can be measured
+    assert _share_of_excess(0.95, 0.97, 1.0) == 0.0  # no better than the model before: nothing removed
+    assert _share_of_excess(1.0, 1.0, 1.0) == 0.0
+
+
+def test_an_effect_that_beats_an_overestimated_noise_floor_is_relevant(monkeypatch):
+    rec = _record("lag", {"tau": 0.0144}, seed=3)
+    # a floor estimate 20 % (in sigma) above the re-fit's error: the re-fit alone looks within the noise
+    monkeypatch.setattr(attribute, "_noise_sigma", lambda e: 1.2 * float(np.sqrt(np.mean(np.square(e)))))
+    dg = diagnose_effects(NOMINAL, rec, candidates=["lag"], confirm=None, max_effects=1)
+    lag = dg.effects[0]
+    assert dg.j_refit < dg.noise_floor  # the premise: no excess over this floor by its estimate
+    assert lag.significant and lag.j_heldout < dg.j_refit
+    assert dg.verdict["effects"] == ["lag"] and lag.accepted
 
 
 # --------------------------------------------------------------------------------------------- sub-sample lag

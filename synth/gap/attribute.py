@@ -44,7 +44,10 @@ Procedure (:func:`diagnose_effects`)
    parameters from noisy data leaves on the table by chance: an effect is
    *significant* when the lower end of its shrinkage interval exceeds it, and
    *relevant* when it also explains at least ``min_share`` of the re-fit's
-   held-out excess over the noise floor.
+   held-out excess over the noise floor (the floor taken as at most the
+   effect's own held-out ``J``: a model cannot beat the noise on held-out data,
+   so one that gets below the floor's estimate shows the estimate is too high,
+   and has removed all of the excess that can be measured).
 6. **Verdict.** Among the significant, relevant effects the one with the lowest
    held-out ``J`` leads unless a candidate with fewer free parameters (grid,
    factor and basis parameters the fit chose, :func:`_free_parameters`) is not
@@ -444,7 +447,7 @@ def diagnose_effects(plant: Plant, record: Record, validate: Record | None = Non
         shrink = 1.0 - j / j_ref if j_ref > 0 else 0.0
         ci = ratio_ci(s, s_ref)
         share = (j_nom - j) / (j_nom - floor) if j_nom > floor else 0.0
-        share_ref = (j_ref - j) / (j_ref - floor) if j_ref > floor else 0.0
+        share_ref = _share_of_excess(j_ref, j, floor)
         significant = bool(gap_present and ci[0] > threshold)
         joint = isinstance(fit, AugmentedFit)
         relevant = bool(significant and share_ref >= min_share and joint)
@@ -587,7 +590,7 @@ class _Chain:
         nested, fit, yhat, s = best
         j_a, j = float(s_a.sum() / self.n_held), float(s.sum() / self.n_held)
         ci = self.ratio_ci(s, s_a)
-        share = (j_a - j) / (j_a - self.floor) if j_a > self.floor else 0.0
+        share = _share_of_excess(j_a, j, self.floor)
         significant = bool(ci[0] > self.threshold)
         accepted = bool(significant and share >= self.min_share)
         second = nested.second
@@ -745,6 +748,39 @@ def _map(fn: Any, jobs: list[Any], workers: int) -> list[Any]:
 
     with ProcessPoolExecutor(max_workers=min(workers, len(jobs))) as pool:
         return list(pool.map(fn, jobs))
+
+
+def _share_of_excess(j_before: float, j: float, floor: float) -> float:
+    """Part of a model's held-out excess over the noise floor that a model with held-out ``J = j`` removes.
+
+    The floor is taken as at most ``j``: the noise variance is no larger than the held-out error of
+    a model of the record (its expectation is the noise variance plus the model's error), so a model
+    that gets below the floor's estimate shows that the estimate is too high there, and removes all
+    of the excess that can be measured.
+
+    Parameters
+    ----------
+    j_before : float
+        Held-out ``J`` of the model before (the re-fit, or the model with the accepted effects).
+    j : float
+        Held-out ``J`` of the model judged.
+    floor : float
+        Noise floor ``sigma^2`` (robust estimate, see the module text).
+
+    Returns
+    -------
+    float
+        ``(j_before - j) / (j_before - min(floor, j))``; 0 when ``j_before`` is not above that floor.
+
+    Examples
+    --------
+    >>> round(_share_of_excess(2.0, 1.5, 1.0), 3), _share_of_excess(0.95, 0.85, 1.0)
+    (0.5, 1.0)
+    >>> _share_of_excess(0.95, 0.97, 1.0)
+    0.0
+    """
+    base = min(floor, j)
+    return (j_before - j) / (j_before - base) if j_before > base else 0.0
 
 
 def _free_parameters(effect: Effect, params: dict[str, float]) -> int:
