@@ -62,6 +62,9 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    help="seconds at the start of each record left out of every cost (unknown initial state)")
     p.add_argument("--workers", type=int, default=min(2, os.cpu_count() or 1), metavar="N",
                    help="processes for the joint re-fits (default: 2, or 1 on a one-core machine)")
+    p.add_argument("--heldout-offset", choices=("auto", "carry", "fit"), default="auto",
+                   help="output offset on held-out data: re-estimated per model (fit), kept from the training "
+                        "fit (carry), or auto: fit with --validate (another run, its own sensor zero), else carry")
     p.add_argument("--max-effects", type=int, default=2, metavar="N",
                    help="effects a verdict may name (forward selection; default 2)")
     p.add_argument("--out", metavar="DIR", help="folder for the report (default reports/diagnose/<data file stem>)")
@@ -93,7 +96,7 @@ def run(args: argparse.Namespace) -> int:
     record = load_record(args.data, args.time, args.input, args.output, **kw)
     validate = load_record(args.validate, args.time, args.input, args.output, **kw) if args.validate else None
     diag = diagnose(plant, record, validate, candidates, seed=args.seed, split=args.split, burn_in=args.burn_in,
-                    max_effects=args.max_effects, workers=args.workers)
+                    max_effects=args.max_effects, workers=args.workers, heldout_offset=args.heldout_offset)
     data = diag.to_dict()
     data = {"data": str(args.data), "validate_data": str(args.validate) if args.validate else None,
             "plant_argument": args.plant, **data}
@@ -128,6 +131,7 @@ def _command(args: argparse.Namespace) -> str:
     extra += [f"--split {args.split}"] if args.split != "tail" else []
     extra += [f"--burn-in {args.burn_in:g}"] if args.burn_in else []
     extra += [f"--max-effects {args.max_effects}"] if args.max_effects != 2 else []
+    extra += [f"--heldout-offset {args.heldout_offset}"] if args.heldout_offset != "auto" else []
     return " ".join(parts + extra)
 
 

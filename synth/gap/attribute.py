@@ -276,7 +276,7 @@ def diagnose_effects(plant: Plant, record: Record, validate: Record | None = Non
                      alpha: float = 0.05, relevance: float = 0.1, min_share: float = 0.25,
                      seed: int = 0, calibration: str = "linearized", confirm: int | None = 3,
                      split: str = "tail", burn_in: float = 0.0, max_effects: int = 2,
-                     workers: int = 1) -> EffectDiagnosis:
+                     workers: int = 1, heldout_offset: str = "auto") -> EffectDiagnosis:
     """Attribute the gap between ``plant`` and ``record`` to one effect, and measure its shrinkage.
 
     Parameters
@@ -320,6 +320,12 @@ def diagnose_effects(plant: Plant, record: Record, validate: Record | None = Non
         the model starts at rest or in steady state, a record may not (unknown initial state).
     workers : int
         Processes for the joint confirmations (independent casadi fits); 1 runs them in this process.
+    heldout_offset : {"auto", "carry", "fit"}
+        The output offset on held-out data. ``"carry"``: every model keeps the offset fitted on the
+        training data. ``"fit"``: each model's offset is re-estimated on the held-out samples (the mean
+        of its held-out residual; the calibration removes it likewise): a validation record from
+        another run has its own operating point and sensor zero, which say nothing about the
+        dynamics. ``"auto"``: ``"fit"`` with a validation record, ``"carry"`` for a split record.
     max_effects : int
         Effects a verdict may name. After the first, forward selection: every other significant
         candidate is fitted on top of the accepted one (:class:`synth.gap.composite.NestedEffect`,
@@ -358,6 +364,9 @@ def diagnose_effects(plant: Plant, record: Record, validate: Record | None = Non
         raise ModelError(f"must be None or >= 1, got {confirm!r}", where="confirm")
     if max_effects < 1:
         raise ModelError(f"must be >= 1, got {max_effects!r}", where="max_effects")
+    if heldout_offset not in ("auto", "carry", "fit"):
+        raise ModelError(f"must be 'auto', 'carry' or 'fit', got {heldout_offset!r}", where="heldout_offset")
+    fit_offset = heldout_offset == "fit" or (heldout_offset == "auto" and validate is not None)
     if split not in ("tail", "interleaved"):
         raise ModelError(f"must be 'tail' or 'interleaved', got {split!r}", where="split")
     if not (np.isfinite(burn_in) and burn_in >= 0.0):
@@ -397,7 +406,14 @@ def diagnose_effects(plant: Plant, record: Record, validate: Record | None = Non
     boot_n = counts[draws].sum(axis=1)
 
     def sums(yhat: np.ndarray) -> np.ndarray:
-        return _block_sums((y_ev[held] - yhat[held]) ** 2, ids, blocks)
+        e = y_ev[held] - yhat[held]
+        return _block_sums((e - e.mean() if fit_offset else e) ** 2, ids, blocks)
+
+    def shifted(yhat: np.ndarray | None) -> np.ndarray | None:
+        """A prediction with its held-out offset re-estimated (as judged), for the figures."""
+        if yhat is None or not fit_offset:
+            return yhat
+        return yhat + float(np.mean((y_ev - yhat)[held]))
 
     def boot(s: np.ndarray) -> np.ndarray:
         return s[draws].sum(axis=1) / boot_n
@@ -432,9 +448,10 @@ def diagnose_effects(plant: Plant, record: Record, validate: Record | None = Non
     # calibration: parametric bootstrap of the re-fit
     if calibration == "linearized":
         null = _linearized_null(refit, t_tr, u_tr, t_ev, u_ev, held, validate is None, sigma, n_null, rng,
-                                train_mask)
+                                train_mask, fit_offset)
     else:
-        null = _refit_null(refit, t_tr, u_tr, t_ev, u_ev, held, validate is None, sigma, n_null, rng, train_mask)
+        null = _refit_null(refit, t_tr, u_tr, t_ev, u_ev, held, validate is None, sigma, n_null, rng, train_mask,
+                           fit_offset)
     threshold = float(np.quantile(null, 1.0 - alpha, method="higher"))
 
     fits = _candidate_fits(plant, effects, refit, t_tr, u_tr, y_tr, t_ev, u_ev, confirm, train_mask, workers)
@@ -479,7 +496,8 @@ def diagnose_effects(plant: Plant, record: Record, validate: Record | None = Non
                 continue
             d_lo, d_hi = diff_ci(s, s_best)
             same_j = d_lo <= 0.0 <= d_hi
-            rms_diff = float(np.sqrt(np.mean((yhat - y_best)[held] ** 2)))
+            gap_ab = (yhat - y_best)[held]
+            rms_diff = float(np.sqrt(np.mean((gap_ab - gap_ab.mean() if fit_offset else gap_ab) ** 2)))
             close = rms_diff < sigma
             # outputs a tenth of the noise apart: any difference in J is the noise's, whatever the bootstrap says
             same_j = same_j or rms_diff < 0.1 * sigma
@@ -519,10 +537,10 @@ def diagnose_effects(plant: Plant, record: Record, validate: Record | None = Non
     split = {"train_samples": n_train, "heldout_samples": n_held, "blocks": blocks, "n_null": n_null,
              "n_boot": n_boot, "alpha": alpha, "validation_record": validate is not None, "seed": seed,
              "calibration": calibration, "confirm": confirm, "split": mode,
-             "burn_in": burn_in,
+             "burn_in": burn_in, "heldout_offset": "fit" if fit_offset else "carry",
              "joint_fits": [r.effect for r, _, _ in results if r.fit == "joint"]}
     return EffectDiagnosis([r for r, _, _ in results], verdict, floor, j_nom, j_ref, pm_shrink, pm_ci, threshold,
-                           refit, split, t_ev, y_ev, y_nom, y_ref, y_best, held)
+                           refit, split, t_ev, y_ev, shifted(y_nom), shifted(y_ref), shifted(y_best), held)
 
 
 @dataclass(frozen=True)
@@ -628,11 +646,13 @@ def _sensitivity(plant: Plant, t: np.ndarray, u: np.ndarray) -> np.ndarray:
 
 def _linearized_null(refit: AugmentedFit, t_tr: np.ndarray, u_tr: np.ndarray, t_ev: np.ndarray, u_ev: np.ndarray,
                      held: np.ndarray, split: bool, sigma: float, n_null: int,
-                     rng: np.random.Generator, train_mask: np.ndarray | None = None) -> np.ndarray:
+                     rng: np.random.Generator, train_mask: np.ndarray | None = None,
+                     fit_offset: bool = False) -> np.ndarray:
     """Held-out shrinkage of a perfect model against the re-fit, re-fit linearized (Gauss-Newton step).
 
     ``split``: the training record is the start of the evaluated one; ``train_mask``: the training
-    samples that count in the fit's cost (default all).
+    samples that count in the fit's cost (default all); ``fit_offset``: both held-out residuals have
+    their mean removed (the offset re-estimated on held-out data).
     """
     J_ev = _sensitivity(refit.plant, t_ev, u_ev)
     J_tr = J_ev[:t_tr.size] if split else _sensitivity(refit.plant, t_tr, u_tr)
@@ -643,12 +663,14 @@ def _linearized_null(refit: AugmentedFit, t_tr: np.ndarray, u_tr: np.ndarray, t_
     delta = np.linalg.lstsq(J_tr / scale, n_tr, rcond=None)[0] / scale[:, None]
     noise = sigma * rng.standard_normal((int(held.sum()), n_null))
     e_fit = noise - J_ev[held] @ delta
+    if fit_offset:
+        noise, e_fit = noise - noise.mean(axis=0), e_fit - e_fit.mean(axis=0)
     return 1.0 - np.mean(noise**2, axis=0) / np.mean(e_fit**2, axis=0)
 
 
 def _refit_null(refit: AugmentedFit, t_tr: np.ndarray, u_tr: np.ndarray, t_ev: np.ndarray, u_ev: np.ndarray,
                 held: np.ndarray, split: bool, sigma: float, n_null: int, rng: np.random.Generator,
-                train_mask: np.ndarray | None = None) -> np.ndarray:
+                train_mask: np.ndarray | None = None, fit_offset: bool = False) -> np.ndarray:
     """The same with the casadi re-fit repeated on every replicate."""
     null = []
     y_ref = refit.predict(t_ev, u_ev)
@@ -659,8 +681,10 @@ def _refit_null(refit: AugmentedFit, t_tr: np.ndarray, u_tr: np.ndarray, t_ev: n
         noise = np.r_[n_tr, sigma * rng.standard_normal(t_ev.size - t_tr.size)] if split else \
             sigma * rng.standard_normal(t_ev.size)
         fit_b = fit_augmented(refit.plant, t_tr, u_tr, y_ref_tr + n_tr, weights=weights)
-        j_fit = float(np.mean((y_ref + noise - fit_b.predict(t_ev, u_ev))[held] ** 2))
-        j_true = float(np.mean(noise[held] ** 2))
+        e_fit, e_true = (y_ref + noise - fit_b.predict(t_ev, u_ev))[held], noise[held]
+        if fit_offset:
+            e_fit, e_true = e_fit - e_fit.mean(), e_true - e_true.mean()
+        j_fit, j_true = float(np.mean(e_fit**2)), float(np.mean(e_true**2))
         null.append(1.0 - j_true / j_fit)
     return np.asarray(null)
 

@@ -286,7 +286,7 @@ def diagnose(plant: Plant, record: Record, validate: Record | None = None,
              candidates: list[str] | tuple[str, ...] | None = None, *, offset: str | float = "fit",
              train_fraction: float = 0.5, n_null: int = 19, n_boot: int = 1000, level: float = 0.95,
              seed: int = 0, split: str = "tail", burn_in: float = 0.0, max_effects: int = 2,
-             workers: int = 1) -> Diagnosis:
+             workers: int = 1, heldout_offset: str = "auto") -> Diagnosis:
     """Localize the gap between ``plant`` and ``record`` and attribute it to one effect.
 
     Parameters
@@ -301,7 +301,7 @@ def diagnose(plant: Plant, record: Record, validate: Record | None = None,
         Effects to try (default: every effect of :mod:`synth.gap.effects`).
     offset : "fit", "none" or float
         Output offset of the localization (the operating point the linear model does not know).
-    train_fraction, n_null, n_boot, seed, split, burn_in, max_effects, workers
+    train_fraction, n_null, n_boot, seed, split, burn_in, max_effects, workers, heldout_offset
         See :func:`synth.gap.attribute.diagnose_effects`.
     level : float
         Confidence level of the localization's tests.
@@ -339,7 +339,7 @@ def diagnose(plant: Plant, record: Record, validate: Record | None = None,
     loc = localize_gap(plant, record, offset=offset, level=level)
     att = diagnose_effects(plant, record, validate, candidates=names, train_fraction=train_fraction,
                            n_null=n_null, n_boot=n_boot, seed=seed, split=split, burn_in=burn_in,
-                           max_effects=max_effects, workers=workers)
+                           max_effects=max_effects, workers=workers, heldout_offset=heldout_offset)
     clips = record_clipping(record) + (record_clipping(validate, "validate") if validate is not None else [])
     warnings = heldout_warnings(record, validate, split, train_fraction)
     return Diagnosis(plant, record, validate, loc, att, tuple(clips), tuple(warnings))
