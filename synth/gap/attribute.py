@@ -75,7 +75,7 @@ the sensor give the same output on a linear model; the candidate listed first
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
@@ -740,12 +740,17 @@ def _candidate_fits(plant: Plant, effects: list[Effect], refit: AugmentedFit, t_
         except ModelError:
             continue
     screened.sort(key=lambda es: es[1].ssr)
-    jobs = [(plant, t_tr, u_tr, y_tr, eff, refit.plant, weights, _seeded(eff, sc, u_tr))
-            for eff, sc in screened[:confirm]]
-    joints = _map(_joint_fit, jobs, workers)
+    chosen = _confirmed(screened, confirm)
+    jobs = []
+    for i in chosen:
+        eff, sc = screened[i]
+        if i >= (confirm or 0) and sc.params_held:  # confirmed for its held-denominator fit: start there
+            sc = replace(sc, params=sc.params_held)
+        jobs.append((plant, t_tr, u_tr, y_tr, eff, refit.plant, weights, _seeded(eff, sc, u_tr)))
+    joints = dict(zip(chosen, _map(_joint_fit, jobs, workers)))
     for rank, (eff, sc) in enumerate(screened):
         fit: AugmentedFit | ScreenedFit = sc
-        joint = joints[rank] if rank < len(joints) else None
+        joint = joints.get(rank)
         if joint is not None and np.isfinite(joint.ssr):  # the exact model (the screen's SSR is linearized)
             fit = joint
         if isinstance(fit, AugmentedFit):
@@ -753,6 +758,31 @@ def _candidate_fits(plant: Plant, effects: list[Effect], refit: AugmentedFit, t_
         else:
             out.append((eff, fit, sc.yhat_train, sc.yhat_eval))
     return out
+
+
+def _confirmed(screened: list[tuple[Effect, ScreenedFit]], confirm: int) -> list[int]:
+    """Which screened candidates (sorted by screened SSR) are re-fitted jointly: the best ``confirm``,
+    and the best with the denominator held exactly if it is not among them.
+
+    The screen's Gauss-Newton step in the denominator is linearized: when the gap is large it lets
+    every candidate reach about the same SSR, effect or no effect, and the ranking among them is
+    noise. With the denominator held, only an effect that explains the gap gets far; it is
+    confirmed too (one more joint fit at most).
+
+    Examples
+    --------
+    >>> from types import SimpleNamespace as S
+    >>> sc = [(None, S(ssr=1.0, ssr_held=9.0)), (None, S(ssr=1.1, ssr_held=8.0)), (None, S(ssr=1.2, ssr_held=2.0))]
+    >>> _confirmed(sc, 2), _confirmed(sc, 3), _confirmed(sc, 1)
+    ([0, 1, 2], [0, 1, 2], [0, 2])
+    """
+    chosen = list(range(min(confirm, len(screened))))
+    held = [i for i in range(len(screened)) if np.isfinite(screened[i][1].ssr_held)]
+    if held:
+        best = min(held, key=lambda i: screened[i][1].ssr_held)
+        if best not in chosen:
+            chosen.append(best)
+    return chosen
 
 
 def _joint_fit(job: tuple[Any, ...]) -> AugmentedFit | None:

@@ -69,6 +69,13 @@ class ScreenedFit:
         Parameter points evaluated.
     yhat_train, yhat_eval : numpy.ndarray
         Screened model output on the training and the evaluated record.
+    ssr_held : float
+        Lowest training SSR over the points searched with the base denominator held exactly (no
+        Gauss-Newton step). The step's linearization can let every candidate reach the same SSR (a
+        large pole change is mimicked by the step's columns, effect or no effect), which hides the one
+        effect that needs no step; this SSR does not.
+    params_held : dict
+        The effect's grid parameters at that point.
     """
 
     effect: Effect
@@ -80,6 +87,8 @@ class ScreenedFit:
     points: int
     yhat_train: np.ndarray = field(repr=False)
     yhat_eval: np.ndarray = field(repr=False)
+    ssr_held: float = np.inf
+    params_held: dict = field(default_factory=dict)
 
     def to_dict(self) -> dict[str, Any]:
         """JSON summary.
@@ -159,18 +168,26 @@ class _Design:
         cols.append(np.ones_like(t))
         return np.column_stack(cols), k_num
 
-    def fit(self, params: Params, y: np.ndarray) -> tuple[float, np.ndarray, int]:
+    def fit(self, params: Params, y: np.ndarray) -> tuple[float, np.ndarray, int, float]:
+        """Training SSR, coefficients, numerator columns, and the SSR with the denominator held (no step)."""
         t_tr, u_tr = self.records[0]
         X, k_num = self.columns(params, t_tr, u_tr)
         if self.mask is not None:  # only the fitted samples count
             X, y = X[self.mask], y[self.mask]
         if not np.all(np.isfinite(X)):
-            return np.inf, np.zeros(X.shape[1]), k_num
+            return np.inf, np.zeros(X.shape[1]), k_num, np.inf
         scale = np.maximum(np.sqrt(np.sum(X**2, axis=0)), 1e-300)
         coef, *_ = np.linalg.lstsq(X / scale, y, rcond=None)
         coef = coef / scale
         r = y - X @ coef
-        return float(r @ r), coef, k_num
+        n_dir = len(self.directions)
+        if not n_dir:
+            return float(r @ r), coef, k_num, float(r @ r)
+        held = np.r_[np.arange(X.shape[1] - 1 - n_dir), X.shape[1] - 1]  # every column but the directions
+        Xh = X[:, held] / scale[held]
+        coef_h, *_ = np.linalg.lstsq(Xh, y, rcond=None)
+        r_h = y - Xh @ coef_h
+        return float(r @ r), coef, k_num, float(r_h @ r_h)
 
     def evaluate(self, params: Params, coef: np.ndarray, t: np.ndarray, u: np.ndarray) -> np.ndarray:
         X, _ = self.columns(params, t, u)
@@ -416,6 +433,7 @@ def screen_effect(effect: Effect, bases: list[tuple[str, Plant]], t_tr: np.ndarr
     t_tr, u_tr, y_tr = (np.asarray(a, float) for a in (t_tr, u_tr, y_tr))
     best: tuple[float, Params, np.ndarray, int, str, _Design] | None = None
     points = 0
+    ssr_held, params_held = np.inf, {}
     for base_name, base in bases:
         design = _Design(effect, base, [(t_tr, u_tr), (t_ev, u_ev)], mask)
         try:
@@ -428,10 +446,13 @@ def screen_effect(effect: Effect, bases: list[tuple[str, Plant]], t_tr: np.ndarr
         tried: dict[tuple[tuple[str, float], ...], tuple[float, np.ndarray, int]] = {}
 
         def run(g: Params, design: _Design = design, tried: dict = tried) -> float:
+            nonlocal ssr_held, params_held
             key = tuple(sorted(g.items()))
             if key not in tried:
-                ssr, coef, k_num = design.fit(g, y_tr)
+                ssr, coef, k_num, held = design.fit(g, y_tr)
                 tried[key] = (ssr if np.isfinite(ssr) else np.inf, coef, k_num)
+                if np.isfinite(held) and held < ssr_held:
+                    ssr_held, params_held = held, {**effect.off(), **g}
             return tried[key][0]
 
         for g in grid:
@@ -466,7 +487,8 @@ def screen_effect(effect: Effect, bases: list[tuple[str, Plant]], t_tr: np.ndarr
             params[name] = params[name] / gain if gain != 0 else params[name]
     y_train = design.evaluate(g, coef, t_tr, u_tr)
     y_eval = design.evaluate(g, coef, np.asarray(t_ev, float), np.asarray(u_ev, float))
-    return ScreenedFit(effect, params, float(ssr), plant, float(coef[-1]), base_name, points, y_train, y_eval)
+    return ScreenedFit(effect, params, float(ssr), plant, float(coef[-1]), base_name, points, y_train, y_eval,
+                       float(ssr_held), params_held)
 
 
 def _golden(run: Any, grid: list[Params], g_best: Params, key: str) -> Params:
