@@ -75,6 +75,7 @@ the sensor give the same output on a linear model; the candidate listed first
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
 from typing import Any
 
@@ -85,6 +86,7 @@ from synth.errors import ModelError
 from synth.gap.effects import DelayEffect, Effect, Params, make_effect
 from synth.gap.refit import AugmentedFit, fit_augmented
 from synth.gap.screen import ScreenedFit, screen_effect
+from synth.gap.stitch import settle_time, stitch_runs
 from synth.ident.simulate import simulate_plant
 from synth.plant import Plant
 
@@ -126,6 +128,23 @@ def _noise_sigma(e: np.ndarray) -> float:
 def _block_ids(n_held: int, blocks: int) -> np.ndarray:
     edges = np.linspace(0, n_held, blocks + 1).round().astype(int)
     return np.repeat(np.arange(blocks), np.diff(edges))
+
+
+def _demean(x: np.ndarray, groups: np.ndarray | None = None) -> np.ndarray:
+    """``x`` (samples along the first axis) less its mean, per group (run) when ``groups`` is given.
+
+    Examples
+    --------
+    >>> _demean(np.array([1.0, 3.0, 10.0, 12.0]), np.array([0, 0, 1, 1])).tolist()
+    [-1.0, 1.0, -1.0, 1.0]
+    """
+    if groups is None:
+        return x - x.mean(axis=0)
+    out = np.array(x, float, copy=True)
+    for g in np.unique(groups):
+        sel = groups == g
+        out[sel] -= out[sel].mean(axis=0)
+    return out
 
 
 def _block_sums(e2: np.ndarray, ids: np.ndarray, blocks: int) -> np.ndarray:
@@ -193,6 +212,28 @@ class EffectResult:
 
 
 @dataclass(frozen=True, eq=False)
+class HeldoutSegments:
+    """The held-out cost of every model by bootstrap segment (what :mod:`synth.gap.roundrobin` pools).
+
+    Attributes
+    ----------
+    sums : dict
+        ``"nominal"``, ``"refit"`` and each candidate's label -> sum of squared held-out errors per segment.
+    counts : numpy.ndarray
+        Held-out samples per segment.
+    runs : numpy.ndarray
+        Validation run (index in the ``validate`` list, 0 for one record) of each segment.
+    predictions : dict
+        The same labels -> held-out output (offset re-estimated where it is).
+    """
+
+    sums: dict[str, np.ndarray]
+    counts: np.ndarray
+    runs: np.ndarray
+    predictions: dict[str, np.ndarray] = field(repr=False)
+
+
+@dataclass(frozen=True, eq=False)
 class EffectDiagnosis:
     """Which effect explains the gap and how far it shrinks on held-out data.
 
@@ -219,6 +260,8 @@ class EffectDiagnosis:
         Training / held-out samples, blocks, bootstrap sizes.
     t, y, y_nominal, y_refit, y_best, heldout
         Held-out-side arrays for the overlay figure (not in ``to_dict``).
+    segments : HeldoutSegments
+        Every model's held-out segment sums, for pooling several diagnoses (not in ``to_dict``).
     """
 
     effects: list[EffectResult]
@@ -237,6 +280,7 @@ class EffectDiagnosis:
     y_refit: np.ndarray = field(repr=False)
     y_best: np.ndarray | None = field(repr=False)
     heldout: np.ndarray = field(repr=False)
+    segments: HeldoutSegments | None = field(repr=False, default=None)
 
     def to_dict(self) -> dict[str, Any]:
         """JSON: ``effects``, ``verdict``, noise floor, re-fit, threshold, split.
@@ -270,7 +314,7 @@ def _experiment(a: str, b: str, t: np.ndarray, ya: np.ndarray, yb: np.ndarray) -
             f"difference {abs(ya[k] - yb[k]):.3g})")
 
 
-def diagnose_effects(plant: Plant, record: Record, validate: Record | None = None,
+def diagnose_effects(plant: Plant, record: Record, validate: Record | Sequence[Record] | None = None,
                      candidates: list[str | Effect] | tuple[str, ...] = DEFAULT_CANDIDATES,
                      train_fraction: float = 0.5, blocks: int = 10, n_null: int = 199, n_boot: int = 1000,
                      alpha: float = 0.05, relevance: float = 0.1, min_share: float = 0.25,
@@ -285,8 +329,11 @@ def diagnose_effects(plant: Plant, record: Record, validate: Record | None = Non
         The nominal model (exact delay), driven by the record's input.
     record : Record
         Measured command and output, starting at rest.
-    validate : Record, optional
-        Held-out record; without it the record is split (see the module text).
+    validate : Record or sequence of Record, optional
+        Held-out record; without it the record is split (see the module text). Several records
+        (runs of the same plant): each is simulated from rest at its own first input (joined by
+        settling bridges, :mod:`synth.gap.stitch`), keeps its own held-out offset where offsets are
+        fitted, and is cut into its own ``blocks`` segments, resampled within the run (stratified).
     candidates : sequence of str or Effect
         Effects to try (names of :data:`synth.gap.effects.EFFECTS`, or ``"lag(sensor)"``).
     train_fraction : float
@@ -366,6 +413,9 @@ def diagnose_effects(plant: Plant, record: Record, validate: Record | None = Non
         raise ModelError(f"must be >= 1, got {max_effects!r}", where="max_effects")
     if heldout_offset not in ("auto", "carry", "fit"):
         raise ModelError(f"must be 'auto', 'carry' or 'fit', got {heldout_offset!r}", where="heldout_offset")
+    runs: list[Record] | None = list(validate) if isinstance(validate, (list, tuple)) else None
+    if runs is not None and len(runs) < 2:
+        validate, runs = (runs[0] if runs else None), None
     fit_offset = heldout_offset == "fit" or (heldout_offset == "auto" and validate is not None)
     if split not in ("tail", "interleaved"):
         raise ModelError(f"must be 'tail' or 'interleaved', got {split!r}", where="split")
@@ -387,33 +437,55 @@ def diagnose_effects(plant: Plant, record: Record, validate: Record | None = Non
         t_ev, u_ev, y_ev = record.t, record.u, record.y
         held = _block_ids(record.n, 2 * blocks) % 2 == 1
         train_mask = ~held
-    else:
+    elif runs is None:
         t_tr, u_tr, y_tr = record.t, record.u, record.y
         t_ev, u_ev, y_ev = validate.t, validate.u, validate.y
         held = np.ones(validate.n, bool)
+    else:
+        t_tr, u_tr, y_tr = record.t, record.u, record.y
+        joined = stitch_runs(runs, settle_time(plant))
+        t_ev, u_ev, y_ev = joined.t, joined.u, joined.y
+        held = joined.run >= 0
     if burn_in > 0.0:
         settled_tr = t_tr >= t_tr[0] + burn_in
         train_mask = settled_tr if train_mask is None else train_mask & settled_tr
-        held = held & (t_ev >= t_ev[0] + burn_in)
+        held = held & ((t_ev >= t_ev[0] + burn_in) if runs is None else (np.nan_to_num(joined.since_start,
+                                                                                         nan=-1.0) >= burn_in))
         if int(train_mask.sum()) < 20:
             raise ModelError(f"a burn-in of {burn_in:g} s leaves too few training samples", where="burn_in")
     n_held = int(held.sum())
-    if n_held < 10 * blocks:
-        raise ModelError(f"{n_held} held-out samples are too few for {blocks} segments", where="record")
-    ids = _block_ids(n_held, blocks)
-    draws = rng.integers(0, blocks, size=(n_boot, blocks))
-    counts = np.bincount(ids, minlength=blocks).astype(float)
+    groups = None if runs is None else joined.run[held]  # the held-out run of each held-out sample
+    for r in range(1 if runs is None else len(runs)):
+        n_r = n_held if groups is None else int(np.sum(groups == r))
+        if n_r < 10 * blocks:
+            where = "record" if runs is None else f"validate run {r + 1}"
+            raise ModelError(f"{n_r} held-out samples are too few for {blocks} segments", where=where)
+    if groups is None:
+        ids = _block_ids(n_held, blocks)
+        draws = rng.integers(0, blocks, size=(n_boot, blocks))
+        n_blocks = blocks
+    else:  # each run its own segments, resampled within the run
+        ids = np.concatenate([_block_ids(int(np.sum(groups == r)), blocks) + r * blocks for r in range(len(runs))])
+        draws = np.concatenate([rng.integers(0, blocks, size=(n_boot, blocks)) + r * blocks
+                                for r in range(len(runs))], axis=1)
+        n_blocks = blocks * len(runs)
+    counts = np.bincount(ids, minlength=n_blocks).astype(float)
     boot_n = counts[draws].sum(axis=1)
 
     def sums(yhat: np.ndarray) -> np.ndarray:
         e = y_ev[held] - yhat[held]
-        return _block_sums((e - e.mean() if fit_offset else e) ** 2, ids, blocks)
+        return _block_sums(_demean(e, groups) ** 2 if fit_offset else e**2, ids, n_blocks)
 
     def shifted(yhat: np.ndarray | None) -> np.ndarray | None:
         """A prediction with its held-out offset re-estimated (as judged), for the figures."""
         if yhat is None or not fit_offset:
             return yhat
-        return yhat + float(np.mean((y_ev - yhat)[held]))
+        out = yhat.copy()
+        e = (y_ev - yhat)[held]
+        out[held] += e - _demean(e, groups)
+        if groups is None:
+            out[~held] += float(np.mean(e))
+        return out
 
     def boot(s: np.ndarray) -> np.ndarray:
         return s[draws].sum(axis=1) / boot_n
@@ -435,7 +507,7 @@ def diagnose_effects(plant: Plant, record: Record, validate: Record | None = Non
     y_ref = refit.predict(t_ev, u_ev)
     s_nom, s_ref = sums(y_nom), sums(y_ref)
     j_nom, j_ref = float(s_nom.sum() / n_held), float(s_ref.sum() / n_held)
-    settled = t_ev >= t_ev[0] + burn_in
+    settled = (t_ev >= t_ev[0] + burn_in) if runs is None else held
     sigma = _noise_sigma((y_ev - y_ref)[settled])  # every settled sample of the evaluated record (same white noise)
     floor = sigma**2
     pm_shrink = 1.0 - j_ref / j_nom if j_nom > 0 else 0.0
@@ -448,10 +520,10 @@ def diagnose_effects(plant: Plant, record: Record, validate: Record | None = Non
     # calibration: parametric bootstrap of the re-fit
     if calibration == "linearized":
         null = _linearized_null(refit, t_tr, u_tr, t_ev, u_ev, held, validate is None, sigma, n_null, rng,
-                                train_mask, fit_offset)
+                                train_mask, fit_offset, groups)
     else:
         null = _refit_null(refit, t_tr, u_tr, t_ev, u_ev, held, validate is None, sigma, n_null, rng, train_mask,
-                           fit_offset)
+                           fit_offset, groups)
     threshold = float(np.quantile(null, 1.0 - alpha, method="higher"))
 
     fits = _candidate_fits(plant, effects, refit, t_tr, u_tr, y_tr, t_ev, u_ev, confirm, train_mask, workers)
@@ -474,6 +546,10 @@ def diagnose_effects(plant: Plant, record: Record, validate: Record | None = Non
         res = EffectResult(eff.label, params, p_ci, shrink, ci, significant, float(share), relevant, j, nominal,
                            "joint" if joint else "screened")
         results.append((res, yhat, s))
+    segments = HeldoutSegments({"nominal": s_nom, "refit": s_ref, **{r.effect: s for r, _, s in results}}, counts,
+                               np.arange(n_blocks) // blocks,
+                               {"nominal": shifted(y_nom)[held], "refit": shifted(y_ref)[held],
+                                **{r.effect: shifted(y)[held] for r, y, _ in results}})
     results.sort(key=lambda r: (-r[0].shrinkage, r[0].fit != "joint"))
 
     relevant = [r for r in results if r[0].accepted]
@@ -497,7 +573,7 @@ def diagnose_effects(plant: Plant, record: Record, validate: Record | None = Non
             d_lo, d_hi = diff_ci(s, s_best)
             same_j = d_lo <= 0.0 <= d_hi
             gap_ab = (yhat - y_best)[held]
-            rms_diff = float(np.sqrt(np.mean((gap_ab - gap_ab.mean() if fit_offset else gap_ab) ** 2)))
+            rms_diff = float(np.sqrt(np.mean((_demean(gap_ab, groups) if fit_offset else gap_ab) ** 2)))
             close = rms_diff < sigma
             # outputs a tenth of the noise apart: any difference in J is the noise's, whatever the bootstrap says
             same_j = same_j or rms_diff < 0.1 * sigma
@@ -538,9 +614,10 @@ def diagnose_effects(plant: Plant, record: Record, validate: Record | None = Non
              "n_boot": n_boot, "alpha": alpha, "validation_record": validate is not None, "seed": seed,
              "calibration": calibration, "confirm": confirm, "split": mode,
              "burn_in": burn_in, "heldout_offset": "fit" if fit_offset else "carry",
+             "validation_runs": 1 if runs is None else len(runs),
              "joint_fits": [r.effect for r, _, _ in results if r.fit == "joint"]}
     return EffectDiagnosis([r for r, _, _ in results], verdict, floor, j_nom, j_ref, pm_shrink, pm_ci, threshold,
-                           refit, split, t_ev, y_ev, shifted(y_nom), shifted(y_ref), shifted(y_best), held)
+                           refit, split, t_ev, y_ev, shifted(y_nom), shifted(y_ref), shifted(y_best), held, segments)
 
 
 @dataclass(frozen=True)
@@ -647,12 +724,12 @@ def _sensitivity(plant: Plant, t: np.ndarray, u: np.ndarray) -> np.ndarray:
 def _linearized_null(refit: AugmentedFit, t_tr: np.ndarray, u_tr: np.ndarray, t_ev: np.ndarray, u_ev: np.ndarray,
                      held: np.ndarray, split: bool, sigma: float, n_null: int,
                      rng: np.random.Generator, train_mask: np.ndarray | None = None,
-                     fit_offset: bool = False) -> np.ndarray:
+                     fit_offset: bool = False, groups: np.ndarray | None = None) -> np.ndarray:
     """Held-out shrinkage of a perfect model against the re-fit, re-fit linearized (Gauss-Newton step).
 
     ``split``: the training record is the start of the evaluated one; ``train_mask``: the training
     samples that count in the fit's cost (default all); ``fit_offset``: both held-out residuals have
-    their mean removed (the offset re-estimated on held-out data).
+    their mean removed (the offset re-estimated on held-out data), per run with ``groups``.
     """
     J_ev = _sensitivity(refit.plant, t_ev, u_ev)
     J_tr = J_ev[:t_tr.size] if split else _sensitivity(refit.plant, t_tr, u_tr)
@@ -664,13 +741,14 @@ def _linearized_null(refit: AugmentedFit, t_tr: np.ndarray, u_tr: np.ndarray, t_
     noise = sigma * rng.standard_normal((int(held.sum()), n_null))
     e_fit = noise - J_ev[held] @ delta
     if fit_offset:
-        noise, e_fit = noise - noise.mean(axis=0), e_fit - e_fit.mean(axis=0)
+        noise, e_fit = _demean(noise, groups), _demean(e_fit, groups)
     return 1.0 - np.mean(noise**2, axis=0) / np.mean(e_fit**2, axis=0)
 
 
 def _refit_null(refit: AugmentedFit, t_tr: np.ndarray, u_tr: np.ndarray, t_ev: np.ndarray, u_ev: np.ndarray,
                 held: np.ndarray, split: bool, sigma: float, n_null: int, rng: np.random.Generator,
-                train_mask: np.ndarray | None = None, fit_offset: bool = False) -> np.ndarray:
+                train_mask: np.ndarray | None = None, fit_offset: bool = False,
+                groups: np.ndarray | None = None) -> np.ndarray:
     """The same with the casadi re-fit repeated on every replicate."""
     null = []
     y_ref = refit.predict(t_ev, u_ev)
@@ -683,7 +761,7 @@ def _refit_null(refit: AugmentedFit, t_tr: np.ndarray, u_tr: np.ndarray, t_ev: n
         fit_b = fit_augmented(refit.plant, t_tr, u_tr, y_ref_tr + n_tr, weights=weights)
         e_fit, e_true = (y_ref + noise - fit_b.predict(t_ev, u_ev))[held], noise[held]
         if fit_offset:
-            e_fit, e_true = e_fit - e_fit.mean(), e_true - e_true.mean()
+            e_fit, e_true = _demean(e_fit, groups), _demean(e_true, groups)
         j_fit, j_true = float(np.mean(e_fit**2)), float(np.mean(e_true**2))
         null.append(1.0 - j_true / j_fit)
     return np.asarray(null)
