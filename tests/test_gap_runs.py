@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import json
+
 import numpy as np
 import pytest
 
@@ -99,3 +101,39 @@ def test_round_robin_needs_two_runs_and_matching_names():
         diagnose_runs(G, [_run(0.0, 1.0, 0.0, 1)], ["delay"])
     with pytest.raises(ModelError, match="1 names for 2 runs"):
         diagnose_runs(G, [_run(0.0, 1.0, 0.0, 1), _run(0.0, 1.0, 0.0, 2)], ["delay"], names=["a"])
+
+
+def _csv(path, rec):
+    np.savetxt(path, np.c_[rec.t, rec.u, rec.y], delimiter=",", header="t,u,y", comments="")
+    return str(path)
+
+
+def test_cli_round_robin_writes_the_pooled_verdict_and_each_fold(run_cli, tmp_path):
+    files = [_csv(tmp_path / f"run{i}.csv", r) for i, r in
+             enumerate([_run(0.0, 1.0, 0.0, 31), _run(1.0, 2.0, 0.2, 32), _run(2.0, 0.5, -0.1, 33)])]
+    res = run_cli("diagnose", "--plant", "2/(0.2*s+1)", "--data", files[0], "--validate", files[1],
+                  "--validate", files[2], "--round-robin", "--candidates", "delay,lag",
+                  "--json", str(tmp_path / "rr.json"), "--out", str(tmp_path / "rep"))
+    assert res.code == 0, res.err
+    d = json.loads((tmp_path / "rr.json").read_text())
+    assert d["verdict"]["effects"] == ["delay"] and d["runs"] == ["run0.csv", "run1.csv", "run2.csv"]
+    assert [f["train"] for f in d["folds"]] == d["runs"] and d["runs_data"] == files
+    assert d["effects"][0]["parameters_by_run"][1]["delay"] == pytest.approx(0.05, abs=0.003)
+    assert res.out.splitlines()[1].startswith("verdict: delay")
+    for name in ("report.html", "result.json", "fold_1.png", "fold_3.png"):
+        assert (tmp_path / "rep" / name).stat().st_size > 1000, name
+    assert "Each fold" in (tmp_path / "rep" / "report.html").read_text()
+    # two validation runs without the round robin: one diagnosis, each run its own offset
+    two = run_cli("diagnose", "--plant", "2/(0.2*s+1)", "--data", files[0], "--validate", files[1],
+                  "--validate", files[2], "--candidates", "delay", "--json", "-", "--no-report")
+    assert two.code == 0, two.err
+    d2 = json.loads(two.out)
+    assert d2["validate_data"] == files[1:] and d2["attribution"]["split"]["validation_runs"] == 2
+    assert d2["verdict"]["effects"] == ["delay"] and len(d2["validate"]) == 2
+
+
+def test_cli_round_robin_without_a_second_run_is_refused(run_cli, tmp_path):
+    f = _csv(tmp_path / "one.csv", _run(0.0, 1.0, 0.0, 1))
+    res = run_cli("diagnose", "--plant", "2/(0.2*s+1)", "--data", f, "--round-robin", "--no-report")
+    assert res.code == 2 and len(res.err.strip().splitlines()) == 1
+    assert "--round-robin" in res.err and "--validate" in res.err

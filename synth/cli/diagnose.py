@@ -32,6 +32,15 @@ example:
       --time t --input pwm --output speed --aux current --json gap.json
   synth diagnose --plant identify.json --data run1.csv --validate run2.csv \\
       --candidates rate_limit,saturation,delay
+  synth diagnose --plant "246/((0.167*s+1)*(0.166*s+1))" --data open_loop.mat \\
+      --validate closed_1.mat --validate closed_2.mat --round-robin
+
+--validate may be given several times (runs of the same plant: each keeps its
+own output offset). With --round-robin, --data and every --validate run take
+turns: each is fitted once and the others are held out, and the evidence is
+pooled; this confirms an effect of the transients (a delay, a lag) from runs
+that hold one step each. The round robin writes result.json, report.html and
+each fold's overlay (fold_<k>.png).
 
 exit codes: 0 diagnosed (whatever the verdict), 2 bad input"""
 
@@ -42,8 +51,9 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--delay", type=float, metavar="S",
                    help="delay [s]: added to a transfer function, replaces a file's delay")
     p.add_argument("--data", required=True, metavar="FILE", help="measured record: CSV with a header row, or MAT")
-    p.add_argument("--validate", metavar="FILE", help="held-out record with the same columns (default: the second "
-                   "half of --data is held out)")
+    p.add_argument("--validate", metavar="FILE", action="append",
+                   help="held-out record with the same columns, repeatable: several runs (default: the second "
+                        "half of --data is held out)")
     p.add_argument("--time", metavar="COL", help="time column (default: the first)")
     p.add_argument("--input", metavar="COL", help="measured command column (default: the second)")
     p.add_argument("--output", metavar="COL", help="measured output column (default: the third)")
@@ -65,6 +75,9 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--heldout-offset", choices=("auto", "carry", "fit"), default="auto",
                    help="output offset on held-out data: re-estimated per model (fit), kept from the training "
                         "fit (carry), or auto: fit with --validate (another run, its own sensor zero), else carry")
+    p.add_argument("--round-robin", action="store_true",
+                   help="--data and every --validate run take turns: each fitted once, the others held out, "
+                        "the evidence pooled (at least one --validate)")
     p.add_argument("--max-effects", type=int, default=2, metavar="N",
                    help="effects a verdict may name (forward selection; default 2)")
     p.add_argument("--out", metavar="DIR", help="folder for the report (default reports/diagnose/<data file stem>)")
@@ -94,11 +107,15 @@ def run(args: argparse.Namespace) -> int:
     aux = _split(args.aux)
     kw: dict[str, Any] = {"aux": aux, "input_unit": args.input_unit, "output_unit": args.output_unit}
     record = load_record(args.data, args.time, args.input, args.output, **kw)
-    validate = load_record(args.validate, args.time, args.input, args.output, **kw) if args.validate else None
+    validates = [load_record(v, args.time, args.input, args.output, **kw) for v in args.validate or []]
+    if args.round_robin:
+        return _round_robin(args, plant, [record, *validates], candidates)
+    validate = validates if len(validates) > 1 else (validates[0] if validates else None)
     diag = diagnose(plant, record, validate, candidates, seed=args.seed, split=args.split, burn_in=args.burn_in,
                     max_effects=args.max_effects, workers=args.workers, heldout_offset=args.heldout_offset)
     data = diag.to_dict()
-    data = {"data": str(args.data), "validate_data": str(args.validate) if args.validate else None,
+    held = [str(v) for v in args.validate or []]
+    data = {"data": str(args.data), "validate_data": held if len(held) > 1 else (held[0] if held else None),
             "plant_argument": args.plant, **data}
     report = None
     if not args.no_report:
@@ -118,13 +135,54 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
+def _round_robin(args: argparse.Namespace, plant: Any, runs: list[Any], candidates: list[str] | None) -> int:
+    from synth.errors import SynthError
+    from synth.gap.attribute import DEFAULT_CANDIDATES
+    from synth.gap.roundrobin import diagnose_runs
+    from synth.outputs import dump_json, write_json
+
+    if len(runs) < 2:
+        raise SynthError("needs at least one --validate run besides --data", where="--round-robin")
+    files = [str(args.data), *(str(v) for v in args.validate or [])]
+    names = [Path(f).name for f in files]
+    rr = diagnose_runs(plant, runs, candidates or list(DEFAULT_CANDIDATES), names=names, seed=args.seed,
+                       burn_in=args.burn_in, workers=args.workers)
+    data = {"runs_data": files, "plant_argument": args.plant,
+            "units": {"input": runs[0].input.unit, "output": runs[0].output.unit}, **rr.to_dict()}
+    report = None
+    if not args.no_report:
+        from synth.gap.roundrobin_report import write_runs_report
+
+        out_dir = Path(args.out) if args.out else Path("reports") / "diagnose" / f"{Path(args.data).stem}_round_robin"
+        report = write_runs_report(rr, out_dir, units=data["units"], command=_command(args), force=args.force,
+                                   title=f"{', '.join(names)} against {plant.to_string()}",
+                                   extra={k: data[k] for k in ("runs_data", "plant_argument", "units")})
+    if args.json == "-":
+        sys.stdout.write(dump_json(data))
+    elif args.json:
+        write_json(args.json, data, force=args.force)
+    if not args.quiet and args.json != "-":
+        v = data["verdict"]
+        print(data["summary"])
+        print(f"verdict: {', '.join(v['effects']) if v['effects'] else 'none'} ({v['status']}): {v['headline']}")
+        for fold in data["folds"]:
+            fv = fold["verdict"]
+            print(f"  trained on {fold['train']}: {', '.join(fv['effects']) if fv['effects'] else 'none'} "
+                  f"({fv['status']})")
+        if report is not None:
+            print(f"\nreport: {report.html}")
+    return 0
+
+
 def _command(args: argparse.Namespace) -> str:
     parts = ["synth", "diagnose"]
     for opt in ("plant", "delay", "data", "validate", "time", "input", "output", "input_unit", "output_unit",
                 "candidates", "out"):
         value = getattr(args, opt)
-        if value not in (None, ""):
-            parts += [f"--{opt.replace('_', '-')}", shlex.quote(str(value))]
+        for item in (value if isinstance(value, list) else [value]):
+            if item not in (None, ""):
+                parts += [f"--{opt.replace('_', '-')}", shlex.quote(str(item))]
+    parts += ["--round-robin"] if args.round_robin else []
     for a in _split(args.aux):
         parts += ["--aux", shlex.quote(a)]
     extra = [f"--seed {args.seed}"] if args.seed else []

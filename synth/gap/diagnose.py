@@ -147,8 +147,8 @@ class Diagnosis:
         The nominal model.
     record : Record
         The record the gap is measured and localized on (and fitted on).
-    validate : Record or None
-        Held-out record, if one was given.
+    validate : Record, tuple of Record, or None
+        Held-out record (or runs), if given.
     localization : GapLocalization
     attribution : EffectDiagnosis
     clipping : tuple of Clipping
@@ -172,7 +172,7 @@ class Diagnosis:
 
     plant: Plant
     record: Record
-    validate: Record | None
+    validate: Record | tuple[Record, ...] | None
     localization: GapLocalization
     attribution: EffectDiagnosis
     clipping: tuple[Clipping, ...] = ()
@@ -251,7 +251,8 @@ class Diagnosis:
             "headline": loc["headline"], "summary": self.summary, "units": units,
             "noise_floor": {"variance": att["noise_floor"], "std": att["noise_std"]},
             "model": self.plant.to_dict(), "record": self.record.to_dict(),
-            "validate": self.validate.to_dict() if self.validate is not None else None,
+            "validate": (None if self.validate is None else [v.to_dict() for v in self.validate]
+                         if isinstance(self.validate, tuple) else self.validate.to_dict()),
             "attribution": {k: att[k] for k in ("j_nominal", "j_refit", "parameter_mismatch", "threshold", "split")},
         })
 
@@ -282,7 +283,7 @@ def check_candidates(candidates: list[str] | tuple[str, ...]) -> list[str]:
     return names
 
 
-def diagnose(plant: Plant, record: Record, validate: Record | None = None,
+def diagnose(plant: Plant, record: Record, validate: Record | list[Record] | tuple[Record, ...] | None = None,
              candidates: list[str] | tuple[str, ...] | None = None, *, offset: str | float = "fit",
              train_fraction: float = 0.5, n_null: int = 19, n_boot: int = 1000, level: float = 0.95,
              seed: int = 0, split: str = "tail", burn_in: float = 0.0, max_effects: int = 2,
@@ -295,8 +296,10 @@ def diagnose(plant: Plant, record: Record, validate: Record | None = None,
         The nominal model, driven by the record's input (the measured command).
     record : Record
         Measured command and output (aux channels become regime variables).
-    validate : Record, optional
-        Held-out record for the shrinkage; without it the record's second half is held out.
+    validate : Record or sequence of Record, optional
+        Held-out record for the shrinkage (several: runs of the same plant, each with its own
+        offset, see :func:`synth.gap.attribute.diagnose_effects`); without it the record's second
+        half is held out.
     candidates : sequence of str, optional
         Effects to try (default: every effect of :mod:`synth.gap.effects`).
     offset : "fit", "none" or float
@@ -331,17 +334,26 @@ def diagnose(plant: Plant, record: Record, validate: Record | None = None,
     (['delay'], 0.05)
     """
     names = check_candidates(list(DEFAULT_CANDIDATES if candidates is None else candidates))
-    if validate is not None:
+    if isinstance(validate, (list, tuple)):
+        validate = tuple(validate) if len(validate) > 1 else (validate[0] if validate else None)
+    held_out = validate if isinstance(validate, tuple) else (() if validate is None else (validate,))
+    for i, v in enumerate(held_out):
         for side in ("input", "output"):
-            a, b = getattr(record, side).unit, getattr(validate, side).unit
+            a, b = getattr(record, side).unit, getattr(v, side).unit
             if a and b and a != b:
-                raise DataError(f"{side} unit {b!r} differs from the record's {a!r}", where="validate")
+                where = "validate" if len(held_out) == 1 else f"validate run {i + 1}"
+                raise DataError(f"{side} unit {b!r} differs from the record's {a!r}", where=where)
     loc = localize_gap(plant, record, offset=offset, level=level)
-    att = diagnose_effects(plant, record, validate, candidates=names, train_fraction=train_fraction,
+    att = diagnose_effects(plant, record, list(validate) if isinstance(validate, tuple) else validate,
+                           candidates=names, train_fraction=train_fraction,
                            n_null=n_null, n_boot=n_boot, seed=seed, split=split, burn_in=burn_in,
                            max_effects=max_effects, workers=workers, heldout_offset=heldout_offset)
-    clips = record_clipping(record) + (record_clipping(validate, "validate") if validate is not None else [])
-    warnings = heldout_warnings(record, validate, split, train_fraction)
+    clips = record_clipping(record)
+    warnings: list[str] = [] if held_out else heldout_warnings(record, None, split, train_fraction)
+    for i, v in enumerate(held_out):
+        clips += record_clipping(v, "validate" if len(held_out) == 1 else f"validate {i + 1}")
+        warnings += [w.replace("the validation record", f"validation run {i + 1}") if len(held_out) > 1 else w
+                     for w in heldout_warnings(record, v)]
     return Diagnosis(plant, record, validate, loc, att, tuple(clips), tuple(warnings))
 
 

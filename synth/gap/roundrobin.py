@@ -124,15 +124,50 @@ class RunsDiagnosis:
     threshold: float
     folds: list[EffectDiagnosis] = field(repr=False)
 
+    @property
+    def summary(self) -> str:
+        """The pooled verdict in plain sentences, with the effect's parameters on each training run.
+
+        Examples
+        --------
+        >>> RunsDiagnosis(["a", "b"], [], {"effects": [], "status": "none"}, 1.0, 1.0, 1.0, 0.0, (0.0, 0.0), 0.0,
+        ...               []).summary[:39]
+        'No gap beyond the measurement noise in '
+        """
+        v, n = self.verdict, len(self.runs)
+        where = f"{n} runs, each fitted once and judged on the other {n - 1}"
+        if v["status"] == "none":
+            return f"No gap beyond the measurement noise in {where}."
+        if v["status"] != "effect":
+            text = f"No candidate effect is confirmed over {where}"
+            if v["effects"] == ["parameter_mismatch"]:
+                text += f"; re-fitting the nominal coefficients shrinks the gap by {self.refit_shrinkage:.2f}"
+            return text + "."
+        best = next(e for e in self.effects if e.effect == v["effects"][0])
+        lo, hi = best.shrinkage_ci
+        per_run = "; ".join(
+            f"{name}: " + (", ".join(f"{k} = {x:.4g}" for k, x in p.items()) if p is not None else "screened only")
+            for name, p in zip(self.runs, best.parameters))
+        text = (f"Over {where}, {best.effect.replace('_', ' ')} shrinks the held-out error by {best.shrinkage:.2f} "
+                f"[{lo:.2f}, {hi:.2f}] (threshold {self.threshold:.3g}). Fitted on each run: {per_run}.")
+        others = [e for e in self.effects if e.significant and e.effect != best.effect]
+        if others:
+            text += " Also significant: " + ", ".join(
+                f"{e.effect} {e.shrinkage:.2f} [{e.shrinkage_ci[0]:.2f}, {e.shrinkage_ci[1]:.2f}]" for e in others) + "."
+        if v["indistinguishable"]:
+            text += " The data cannot tell it from " + ", ".join(v["indistinguishable"][0][1:]) + "."
+        return text
+
     def to_dict(self) -> dict[str, Any]:
         """JSON: the pooled verdict and effects, and each fold's diagnosis.
 
         Examples
         --------
-        >>> RunsDiagnosis(["a", "b"], [], {"effects": []}, 1.0, 1.0, 1.0, 0.0, (0.0, 0.0), 0.0, []).to_dict()["runs"]
+        >>> RunsDiagnosis(["a", "b"], [], {"effects": [], "status": "none"}, 1.0, 1.0, 1.0, 0.0, (0.0, 0.0), 0.0,
+        ...               []).to_dict()["runs"]
         ['a', 'b']
         """
-        return {"runs": list(self.runs), "verdict": dict(self.verdict),
+        return {"runs": list(self.runs), "verdict": dict(self.verdict), "summary": self.summary,
                 "effects": [e.to_dict() for e in self.effects], "noise_floor": self.noise_floor,
                 "j_nominal": self.j_nominal, "j_refit": self.j_refit, "threshold": self.threshold,
                 "parameter_mismatch": {"shrinkage": self.refit_shrinkage,
