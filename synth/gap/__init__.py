@@ -21,6 +21,9 @@ resonance, rate limit, saturation, dead zone, backlash, quantization, supply
 sag, static nonlinearity, drift), :mod:`synth.gap.refit` (the nominal
 parameters re-fitted jointly with an effect), :mod:`synth.gap.attribute`
 (held-out shrinkage with bootstrap intervals, calibrated acceptance, the
-verdict) and :mod:`synth.gap.overlay` (the before/after figure).
+verdict) and :mod:`synth.gap.overlay` (the before/after figure). Several runs of
+one plant: :mod:`synth.gap.stitch` (held out together, each from rest with its
+own offset) and :mod:`synth.gap.roundrobin` (each run fitted once, the others
+held out, the evidence pooled; report: :mod:`synth.gap.roundrobin_report`).
 The modules are imported by their full path (this package imports nothing).
 """
