@@ -31,7 +31,7 @@ Examples
 True
 """
 
-__version__ = "0.1.0"
+from synth.version import __version__
 
 import os as _os
 

@@ -13,7 +13,7 @@ import json
 from pathlib import Path
 from typing import Any
 
-from synth import __version__
+from synth.version import __version__
 from synth.errors import OutputExistsError
 
 MANIFEST = ".synth-manifest.json"

@@ -16,7 +16,7 @@ import numpy as np
 
 from synth.ident.freqfit import FreqFit, StepVerification
 from synth.ident.spectra import FrequencyResponse
-from synth.report.png import save_figure
+from synth.figure_files import save_figure
 
 
 def bode_figure(resp: FrequencyResponse, path: str | Path, fit: FreqFit | None = None) -> Path:

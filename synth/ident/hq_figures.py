@@ -18,7 +18,7 @@ from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter
 
 from synth.errors import ModelError
 from synth.ident.hq import GAIN_MARGIN_DB, HQMetrics
-from synth.report.png import save_figure
+from synth.figure_files import save_figure
 
 
 def hq_bode(m: HQMetrics, path: str | Path, title: str = "") -> Path:

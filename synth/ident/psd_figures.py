@@ -14,7 +14,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 from synth.ident.psd import PsdAnalysis, unit_squared
-from synth.report.png import save_figure
+from synth.figure_files import save_figure
 
 
 def psd_plot(a: PsdAnalysis, path: str | Path, title: str = "") -> Path:

@@ -16,7 +16,7 @@ import numpy as np  # noqa: F401  (doctest namespace)
 
 from synth.data.record import Record
 from synth.ident.timefit import TimeFitResult
-from synth.report.png import save_figure
+from synth.figure_files import save_figure
 
 
 def _label(name: str, unit: str) -> str:

@@ -17,7 +17,7 @@ import numpy as np
 
 from synth.freqgrid import log_grid
 from synth.loop import Loop
-from synth.report.png import save_figure
+from synth.figure_files import save_figure
 from synth.requirements import Sensitivity, SlewRate, StaticSensitivity
 from synth.requirements.sensitivity import PeakSensitivity
 from synth.timeresp import default_horizon, step_response

@@ -12,7 +12,7 @@ from jinja2 import Environment, PackageLoader
 
 from synth.outputs import GENERATOR, OutputDir, dump_json
 from synth.report.figures import COLORS, plt
-from synth.report.png import save_figure
+from synth.figure_files import save_figure
 from synth.requirements.base import fmt
 from synth.synthesis.tradeoff import TradeoffResult
 
