@@ -31,8 +31,6 @@ Examples
 True
 """
 
-from synth.version import __version__
-
 import os as _os
 
 # synth's matrices are small (a few states, a few parameters): threaded BLAS only adds overhead, and on a
@@ -50,6 +48,7 @@ from synth.loop import Loop
 from synth.plant import Plant, Signal
 from synth.spec import Spec, load_spec, parse_spec
 from synth.stability import closed_loop_stability
+from synth.version import __version__
 
 
 def write_design_report(*args, **kwargs):

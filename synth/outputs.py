@@ -13,8 +13,8 @@ import json
 from pathlib import Path
 from typing import Any
 
-from synth.version import __version__
 from synth.errors import OutputExistsError
+from synth.version import __version__
 
 MANIFEST = ".synth-manifest.json"
 GENERATOR = f"synth {__version__}"

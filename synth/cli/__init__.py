@@ -16,8 +16,8 @@ import pkgutil
 import sys
 from collections.abc import Sequence
 
-from synth.version import __version__
 from synth.errors import SynthError
+from synth.version import __version__
 
 EXIT_OK, EXIT_NOT_MET, EXIT_BAD_INPUT = 0, 1, 2
 

@@ -93,9 +93,9 @@ def write_diagnosis_report(diag: Diagnosis, out_dir: str | Path, *, command: str
     html_path = out.claim("report.html")
     figs: dict[str, Path] = {}
     if figures:
+        from synth.figure_files import save_figure
         from synth.gap.gapmap import write_gap_map
         from synth.gap.overlay import overlay_figure
-        from synth.figure_files import save_figure
 
         figs["gap_map"] = write_gap_map(diag.localization, out.claim("gap_map.png"), diag.plant)
         figs["overlay"] = save_figure(overlay_figure(diag.attribution), out.claim("overlay.png"))

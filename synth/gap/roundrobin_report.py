@@ -51,8 +51,8 @@ def write_runs_report(rr: RunsDiagnosis, out_dir: str | Path, *, units: dict[str
     html_path = out.claim("report.html")
     figs: dict[str, Path] = {}
     if figures:
-        from synth.gap.overlay import overlay_figure
         from synth.figure_files import save_figure
+        from synth.gap.overlay import overlay_figure
 
         for k, fold in enumerate(rr.folds, start=1):
             figs[f"fold_{k}"] = save_figure(overlay_figure(fold), out.claim(f"fold_{k}.png"))

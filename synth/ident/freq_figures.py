@@ -14,9 +14,9 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
 
+from synth.figure_files import save_figure
 from synth.ident.freqfit import FreqFit, StepVerification
 from synth.ident.spectra import FrequencyResponse
-from synth.figure_files import save_figure
 
 
 def bode_figure(resp: FrequencyResponse, path: str | Path, fit: FreqFit | None = None) -> Path:

@@ -17,8 +17,8 @@ import numpy as np
 from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter
 
 from synth.errors import ModelError
-from synth.ident.hq import GAIN_MARGIN_DB, HQMetrics
 from synth.figure_files import save_figure
+from synth.ident.hq import GAIN_MARGIN_DB, HQMetrics
 
 
 def hq_bode(m: HQMetrics, path: str | Path, title: str = "") -> Path:

@@ -13,8 +13,8 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
 
-from synth.ident.psd import PsdAnalysis, unit_squared
 from synth.figure_files import save_figure
+from synth.ident.psd import PsdAnalysis, unit_squared
 
 
 def psd_plot(a: PsdAnalysis, path: str | Path, title: str = "") -> Path:

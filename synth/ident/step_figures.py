@@ -15,8 +15,8 @@ import matplotlib.pyplot as plt
 import numpy as np  # noqa: F401  (doctest namespace)
 
 from synth.data.record import Record
-from synth.ident.timefit import TimeFitResult
 from synth.figure_files import save_figure
+from synth.ident.timefit import TimeFitResult
 
 
 def _label(name: str, unit: str) -> str:

@@ -171,9 +171,9 @@ def write_design_report(spec: Spec, result: DesignResult, out_dir: str | Path, *
         figs.update(simulation_figures(spec, shown, ref, out, marks))
 
     if "diagnosis" in objects:  # the seed-1 gap case: gap map and before/after overlay of the simulated rig
+        from synth.figure_files import save_figure
         from synth.gap.gapmap import write_gap_map
         from synth.gap.overlay import overlay_figure
-        from synth.figure_files import save_figure
 
         diag = objects["diagnosis"]
         figs["gap_map"] = write_gap_map(diag.localization, out.claim("gap_map.png"), diag.plant)

@@ -15,9 +15,9 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
 
+from synth.figure_files import save_figure
 from synth.freqgrid import log_grid
 from synth.loop import Loop
-from synth.figure_files import save_figure
 from synth.requirements import Sensitivity, SlewRate, StaticSensitivity
 from synth.requirements.sensitivity import PeakSensitivity
 from synth.timeresp import default_horizon, step_response

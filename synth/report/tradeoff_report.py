@@ -10,9 +10,9 @@ from pathlib import Path
 import numpy as np
 from jinja2 import Environment, PackageLoader
 
+from synth.figure_files import save_figure
 from synth.outputs import GENERATOR, OutputDir, dump_json
 from synth.report.figures import COLORS, plt
-from synth.figure_files import save_figure
 from synth.requirements.base import fmt
 from synth.synthesis.tradeoff import TradeoffResult
 
