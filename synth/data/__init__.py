@@ -6,6 +6,7 @@ logged channels. Every problem with a file is a :class:`~synth.errors.DataError`
 naming the file and column.
 """
 
-from synth.data.record import Record, load_record, record_from_arrays
+from synth.data.coerce import RecordLike, as_record
+from synth.data.record import Record, load_record, record_from_arrays, record_from_columns
 
-__all__ = ["Record", "load_record", "record_from_arrays"]
+__all__ = ["Record", "RecordLike", "as_record", "load_record", "record_from_arrays", "record_from_columns"]

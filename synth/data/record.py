@@ -354,18 +354,47 @@ def load_record(
     synth.errors.DataError: ...r.csv: output column 'sped' not found; did you mean 'speed'?
     """
     path = Path(path)
-    columns = read_columns(path)
+    return record_from_columns(read_columns(path), str(path), time, input, output, aux, input_unit, output_unit, dt)
+
+
+def record_from_columns(
+    columns: Mapping[str, np.ndarray],
+    source: str = "columns",
+    time: str | None = None,
+    input: str | None = None,
+    output: str | None = None,
+    aux: Sequence[str] = (),
+    input_unit: str = "",
+    output_unit: str = "",
+    dt: float | None = None,
+) -> Record:
+    """Build a :class:`Record` from named columns (a file's, a dict's or a DataFrame's).
+
+    Columns not named are taken in order: time, input, output (time may instead come from ``dt``).
+
+    Examples
+    --------
+    >>> cols = {"t": np.arange(5) * 0.1, "cmd": np.array([0, 1, 1, 1, 1.0]), "speed": np.arange(5.0)}
+    >>> r = record_from_columns(cols, "lab.csv", input="cmd", output="speed", output_unit="rad/s")
+    >>> r.input.name, r.output.label(), r.n
+    ('cmd', 'speed [rad/s]', 5)
+    >>> record_from_columns(cols, "lab.csv", output="rpm")
+    Traceback (most recent call last):
+    synth.errors.DataError: lab.csv: column 'rpm' (output) not found; columns are t, cmd, speed
+    """
+    columns = {str(k): np.asarray(v, dtype=float).ravel() for k, v in columns.items()}
+    where = Path(source)
     if not columns:
-        raise DataError("no numeric columns found", where=str(path))
+        raise DataError("no numeric columns found", where=source)
     if time is None and dt is not None:
         n = max(a.size for a in columns.values())
         columns = {"__time__": np.arange(n) * float(dt), **columns}
         time = "__time__"
-    t_name = _pick(columns, time, "time", path, 0)
-    u_name = _pick(columns, input, "input", path, 1)
-    y_name = _pick(columns, output, "output", path, 2)
-    aux_cols = {_pick(columns, a, "aux", path, 0): columns[a] for a in aux}
+    t_name = _pick(columns, time, "time", where, 0)
+    u_name = _pick(columns, input, "input", where, 1)
+    y_name = _pick(columns, output, "output", where, 2)
+    aux_cols = {_pick(columns, a, "aux", where, 0): columns[a] for a in aux}
     return record_from_arrays(
         columns[t_name], columns[u_name], columns[y_name],
-        Signal(u_name, input_unit), Signal(y_name, output_unit), aux_cols, str(path), (t_name, u_name, y_name),
+        Signal(u_name, input_unit), Signal(y_name, output_unit), aux_cols, source, (t_name, u_name, y_name),
     )

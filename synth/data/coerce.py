@@ -1,0 +1,106 @@
+"""One entry for records in whatever form a user holds them: a Record, arrays, a table or a path."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from synth.data.record import Record, load_record, record_from_arrays, record_from_columns
+from synth.errors import DataError
+from synth.plant import Signal
+
+__all__ = ["RecordLike", "as_record"]
+
+RecordLike = Any
+"""What :func:`as_record` accepts: a Record, ``(t, u, y)`` arrays, an N x 3 array, a mapping of columns,
+a pandas DataFrame, or the path of a CSV/MAT file."""
+
+
+def _is_table(data: object) -> bool:
+    """A pandas (or pandas-like) DataFrame: named columns, each convertible to an array."""
+    return hasattr(data, "columns") and hasattr(data, "__getitem__") and not isinstance(data, np.ndarray)
+
+
+def as_record(
+    data: RecordLike,
+    *,
+    time: str | None = None,
+    input: str | None = None,
+    output: str | None = None,
+    aux: Sequence[str] = (),
+    input_unit: str = "",
+    output_unit: str = "",
+    dt: float | None = None,
+) -> Record:
+    """Turn what the user holds into a :class:`Record`, validated as a file would be.
+
+    Parameters
+    ----------
+    data : Record, tuple of arrays, ndarray, mapping, DataFrame, str or Path
+        ``(t, u, y)`` (or ``(u, y)`` with ``dt``); an N x 3 array of columns t, u, y; named columns
+        (a dict or a DataFrame, picked by ``time``/``input``/``output``, else taken in that order; a
+        DataFrame's index is the time when ``time`` is ``"index"``); or a CSV/MAT path.
+    time, input, output : str, optional
+        Column names, for named columns and files.
+    aux : sequence of str
+        Extra columns kept on the record.
+    input_unit, output_unit : str
+        Units of the input and output (kept if ``data`` is a Record).
+    dt : float, optional
+        Sample time [s] when the data has no time column.
+
+    Raises
+    ------
+    DataError
+        A form that is not a record, or columns that fail the record's checks (one line naming them).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> t = np.arange(0, 1, 0.1); u = (t >= 0.2).astype(float); y = np.cumsum(u)
+    >>> as_record((t, u, y)).n
+    10
+    >>> as_record(np.column_stack([t, u, y]), output_unit="rad/s").output.label()
+    'output [rad/s]'
+    >>> as_record({"time": t, "cmd": u, "speed": y}, input="cmd").input.name
+    'cmd'
+    >>> float(as_record((u, y), dt=0.1).t[-1].round(3))
+    0.9
+    >>> as_record(42)
+    Traceback (most recent call last):
+    synth.errors.DataError: int: not a record; give a Record, (t, u, y) arrays, columns or a CSV/MAT path
+    """
+    if isinstance(data, Record):
+        return data
+    if isinstance(data, str | Path):
+        return load_record(data, time, input, output, aux, input_unit, output_unit, dt)
+    if _is_table(data):
+        columns = {str(c): np.asarray(data[c], dtype=float) for c in data.columns}
+        if time == "index":
+            columns = {"index": np.asarray(data.index, dtype=float), **columns}
+        return record_from_columns(columns, "DataFrame", time, input, output, aux, input_unit, output_unit, dt)
+    if isinstance(data, Mapping):
+        return record_from_columns(data, "columns", time, input, output, aux, input_unit, output_unit, dt)
+    arrays = _as_arrays(data)
+    if arrays is not None:
+        if len(arrays) == 2 and dt is not None:
+            arrays = [np.arange(arrays[0].size) * float(dt), *arrays]
+        if len(arrays) == 3:
+            names = (time or "time", input or "input", output or "output")
+            return record_from_arrays(arrays[0], arrays[1], arrays[2], Signal(names[1], input_unit),
+                                      Signal(names[2], output_unit), source="arrays", names=names)
+        raise DataError(f"got {len(arrays)} arrays; give (t, u, y), or (u, y) with dt", where="arrays")
+    raise DataError("not a record; give a Record, (t, u, y) arrays, columns or a CSV/MAT path", where=type(data).__name__)
+
+
+def _as_arrays(data: object) -> list[np.ndarray] | None:
+    """``(t, u, y)`` or an N x 3 / 3 x N array as a list of 1-D arrays, else None."""
+    if isinstance(data, np.ndarray) and data.ndim == 2:
+        cols = data if data.shape[0] in (2, 3) and data.shape[1] > 3 else data.T
+        return [np.asarray(c, dtype=float) for c in cols]
+    if isinstance(data, tuple | list) and 2 <= len(data) <= 3 and all(np.ndim(a) == 1 for a in data):
+        return [np.asarray(a, dtype=float) for a in data]
+    return None
