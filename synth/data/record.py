@@ -380,7 +380,7 @@ def record_from_columns(
     ('cmd', 'speed [rad/s]', 5)
     >>> record_from_columns(cols, "lab.csv", output="rpm")
     Traceback (most recent call last):
-    synth.errors.DataError: lab.csv: column 'rpm' (output) not found; columns are t, cmd, speed
+    synth.errors.DataError: lab.csv: output column 'rpm' not found; columns are t, cmd, speed
     """
     columns = {str(k): np.asarray(v, dtype=float).ravel() for k, v in columns.items()}
     where = Path(source)
