@@ -9,6 +9,8 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 
+__all__ = ["METADATA", "save_figure"]
+
 METADATA = {"Software": "synth"}
 
 

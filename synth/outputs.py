@@ -16,6 +16,8 @@ from typing import Any
 from synth.errors import OutputExistsError
 from synth.version import __version__
 
+__all__ = ["GENERATOR", "MANIFEST", "OutputDir", "check_writable", "dump_json", "to_jsonable", "write_json"]
+
 MANIFEST = ".synth-manifest.json"
 GENERATOR = f"synth {__version__}"
 

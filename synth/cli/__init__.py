@@ -19,6 +19,8 @@ from collections.abc import Sequence
 from synth.errors import SynthError
 from synth.version import __version__
 
+__all__ = ["EXIT_BAD_INPUT", "EXIT_NOT_MET", "EXIT_OK", "build_parser", "main"]
+
 EXIT_OK, EXIT_NOT_MET, EXIT_BAD_INPUT = 0, 1, 2
 
 
