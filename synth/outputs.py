@@ -10,24 +10,57 @@ file (``--json FILE``) may be replaced only if synth wrote it (its JSON has
 from __future__ import annotations
 
 import json
+import os
+import shutil
+import tempfile
+import weakref
+from collections.abc import Iterable
 from pathlib import Path
 from typing import Any
 
 from synth.errors import OutputExistsError
 from synth.version import __version__
 
-__all__ = ["GENERATOR", "MANIFEST", "OutputDir", "check_writable", "dump_json", "to_jsonable", "write_json"]
+__all__ = ["GENERATOR", "MANIFEST", "OutputDir", "atomic_write_text", "check_writable", "dump_json", "to_jsonable",
+           "write_json", "written_by_synth"]
 
 MANIFEST = ".synth-manifest.json"
 GENERATOR = f"synth {__version__}"
 
 
-def _written_by_synth(path: Path) -> bool:
+def written_by_synth(path: str | Path) -> bool:
+    """Whether ``path`` is one of synth's own outputs, judged by its content.
+
+    JSON carries ``"generator": "synth ..."``; HTML a ``<meta name="generator" content="synth ...">``;
+    PNG a ``Software: synth`` text chunk; CSV a first line naming synth. Anything else is not synth's.
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> d = pathlib.Path(tempfile.mkdtemp())
+    >>> _ = (d / "a.json").write_text(dump_json({"x": 1})); _ = (d / "b.json").write_text('{"x": 1}')
+    >>> written_by_synth(d / "a.json"), written_by_synth(d / "b.json"), written_by_synth(d / "missing.png")
+    (True, False, False)
+    """
+    path = Path(path)
     try:
-        data = json.loads(path.read_text(encoding="utf-8"))
-    except (OSError, ValueError, UnicodeDecodeError):
+        head = path.read_bytes()[:4096]
+    except OSError:
         return False
-    return isinstance(data, dict) and str(data.get("generator", "")).startswith("synth")
+    suffix = path.suffix.lower()
+    if suffix == ".json":
+        try:
+            data = json.loads(path.read_text(encoding="utf-8"))
+        except (OSError, ValueError, UnicodeDecodeError):
+            return False
+        return isinstance(data, dict) and str(data.get("generator", "")).startswith("synth")
+    if suffix in (".html", ".htm"):
+        return b'<meta name="generator" content="synth' in head
+    if suffix == ".png":
+        return head.startswith(b"\x89PNG") and b"Software\x00synth" in head
+    if suffix == ".csv":
+        return head.lstrip(b"# ").startswith(b"synth")
+    return False
 
 
 def check_writable(path: Path, force: bool = False) -> None:
@@ -46,7 +79,7 @@ def check_writable(path: Path, force: bool = False) -> None:
     path = Path(path)
     if path.is_dir():
         raise OutputExistsError("is a directory", where=str(path))
-    if path.exists() and not force and not _written_by_synth(path):
+    if path.exists() and not force and not written_by_synth(path):
         raise OutputExistsError(
             "exists and was not written by synth; not overwriting it (use --force to replace it)",
             where=str(path),
@@ -95,51 +128,161 @@ def write_json(path: str | Path, data: dict[str, Any], force: bool = False) -> P
     """Write ``data`` as JSON to ``path`` (refusing to replace a file synth did not write)."""
     path = Path(path)
     check_writable(path, force)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    path.write_text(dump_json(data), encoding="utf-8")
-    return path
+    return atomic_write_text(path, dump_json(data))
 
 
 class OutputDir:
-    """A report folder whose synth-written files are tracked in a manifest.
+    """A report folder written all at once: files are staged, then moved into place by :meth:`commit`.
+
+    Writers :meth:`claim` a name and write to the path returned, which lies in a hidden staging folder
+    next to the report folder. :meth:`commit` first checks every claimed name (a file synth did not
+    write is never replaced unless ``force``), then moves each staged file into place and records the
+    names in the folder's manifest (``.synth-manifest.json``). A refused commit, an exception or an
+    interrupted run leaves nothing behind: the staging folder is removed. synth recognizes its own
+    earlier outputs by the manifest or by their content (:func:`written_by_synth`).
+
+    Parameters
+    ----------
+    path : str or Path
+        The report folder.
+    force : bool
+        Replace files synth did not write.
+    expect : iterable of str
+        Names the caller will write; checked at once (before any computation), so a refusal costs none.
 
     Examples
     --------
     >>> import tempfile, pathlib
-    >>> out = OutputDir(pathlib.Path(tempfile.mkdtemp()) / "report")
-    >>> p = out.claim("result.json"); _ = p.write_text("{}"); out.commit()
-    >>> OutputDir(out.path).claim("result.json").name  # ours: may be rewritten
-    'result.json'
+    >>> root = pathlib.Path(tempfile.mkdtemp())
+    >>> out = OutputDir(root / "report")
+    >>> p = out.claim("result.json"); _ = p.write_text("{}")
+    >>> (root / "report" / "result.json").exists()  # staged, not yet in place
+    False
+    >>> out.commit(); out.final(p) == root / "report" / "result.json", out.final(p).read_text()
+    (True, '{}')
+    >>> _ = (root / "report" / "notes.txt").write_text("mine")
+    >>> OutputDir(root / "report", expect=["notes.txt"])
+    Traceback (most recent call last):
+    synth.errors.OutputExistsError: ...notes.txt: exists and was not written by synth; not overwriting it ...
+    >>> sorted(q.name for q in root.iterdir())  # no staging folder left behind
+    ['report']
     """
 
-    def __init__(self, path: str | Path, force: bool = False) -> None:
+    def __init__(self, path: str | Path, force: bool = False, expect: Iterable[str] = ()) -> None:
         self.path = Path(path)
         self.force = force
         if self.path.exists() and not self.path.is_dir():
             raise OutputExistsError("exists and is not a directory", where=str(self.path))
-        self.known: set[str] = set()
-        manifest = self.path / MANIFEST
-        if manifest.exists():
-            try:
-                self.known = set(json.loads(manifest.read_text(encoding="utf-8")).get("files", []))
-            except (OSError, ValueError):
-                self.known = set()
+        self.known = _manifest_files(self.path)
         self.written: list[str] = []
+        for name in expect:
+            self._check(name)
+        _check_creatable(self.path)
+        self._staging: Path | None = None
+        self._earlier_staging: list[Path] = []
+        self._cleanup: weakref.finalize | None = None
 
-    def claim(self, name: str) -> Path:
-        """Path for ``name`` inside the folder; refuses a file synth did not write."""
+    def _check(self, name: str) -> None:
         target = self.path / name
-        if target.exists() and name not in self.known and not self.force:
+        if target.exists() and not self.force and name not in self.known and not written_by_synth(target):
             raise OutputExistsError(
                 "exists and was not written by synth; not overwriting it (use --force or another --out)",
                 where=str(target),
             )
-        self.path.mkdir(parents=True, exist_ok=True)
-        self.written.append(name)
+
+    @property
+    def staging(self) -> Path:
+        """The hidden folder next to :attr:`path` where files are written before :meth:`commit`."""
+        if self._staging is None:
+            parent = self.path.parent
+            parent.mkdir(parents=True, exist_ok=True)
+            self._staging = Path(tempfile.mkdtemp(prefix=f".{self.path.name}.", suffix=".synth-staging", dir=parent))
+            self._cleanup = weakref.finalize(self, shutil.rmtree, self._staging, ignore_errors=True)
+        return self._staging
+
+    def claim(self, name: str) -> Path:
+        """Staged path for ``name``; refuses at once a file in the folder that synth did not write."""
+        self._check(name)
+        if name not in self.written:
+            self.written.append(name)
+        target = self.staging / name
+        target.parent.mkdir(parents=True, exist_ok=True)
         return target
 
+    def final(self, staged: str | Path) -> Path:
+        """Where a claimed (staged) path ends up after :meth:`commit`."""
+        staged = Path(staged)
+        for root in (self._staging, *self._earlier_staging):
+            if root is not None and staged.is_relative_to(root):
+                return self.path / staged.relative_to(root)
+        return staged
+
+    def discard(self) -> None:
+        """Remove everything staged (nothing is moved into place)."""
+        if self._cleanup is not None:
+            self._cleanup()
+        if self._staging is not None:
+            self._earlier_staging.append(self._staging)
+        self._staging, self._cleanup, self.written = None, None, []
+
     def commit(self) -> None:
-        """Record the files written (plus earlier ones still present) in the manifest."""
-        files = sorted(set(self.written) | {f for f in self.known if (self.path / f).exists()})
-        (self.path / MANIFEST).write_text(json.dumps({"generator": GENERATOR, "files": files}, indent=2) + "\n",
-                                          encoding="utf-8")
+        """Check every claimed name, move the staged files into place, update the manifest.
+
+        Nothing is moved if any name is refused; the staging folder is removed either way.
+        """
+        try:
+            for name in self.written:
+                self._check(name)
+            self.path.mkdir(parents=True, exist_ok=True)
+            for name in self.written:
+                staged = self.staging / name
+                if staged.exists():
+                    (self.path / name).parent.mkdir(parents=True, exist_ok=True)
+                    os.replace(staged, self.path / name)
+            files = sorted({f for f in {*self.written, *self.known} if (self.path / f).exists()})
+            atomic_write_text(self.path / MANIFEST, json.dumps({"generator": GENERATOR, "files": files}, indent=2) + "\n")
+            self.known = set(files)
+        finally:
+            self.discard()
+
+
+def _manifest_files(folder: Path) -> set[str]:
+    manifest = folder / MANIFEST
+    if not manifest.exists():
+        return set()
+    try:
+        return set(json.loads(manifest.read_text(encoding="utf-8")).get("files", []))
+    except (OSError, ValueError, AttributeError):
+        return set()
+
+
+def _check_creatable(path: Path) -> None:
+    """Refuse at once a folder that cannot be created or written (before any computation)."""
+    probe = path
+    while not probe.exists():
+        probe = probe.parent
+    if not probe.is_dir() or not os.access(probe, os.W_OK | os.X_OK):
+        raise OutputExistsError(f"cannot write here ({probe} is not a writable folder)", where=str(path))
+
+
+def atomic_write_text(path: str | Path, text: str) -> Path:
+    """Write ``text`` to ``path`` through a temporary file in the same folder and an atomic rename.
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> p = atomic_write_text(pathlib.Path(tempfile.mkdtemp()) / "a.txt", "one")
+    >>> p.read_text(), [q.name for q in p.parent.iterdir()]
+    ('one', ['a.txt'])
+    """
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    try:
+        with os.fdopen(fd, "w", encoding="utf-8", newline="") as handle:
+            handle.write(text)
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+    return path

@@ -170,6 +170,8 @@ def run(args: argparse.Namespace) -> int:
     elif args.json:
         write_json(args.json, payload, force=args.force)
     _print_metrics(say, spec, loop, metrics, step)
+    if folder is not None:
+        csv_path, plot_path = folder.final(csv_path), folder.final(plot_path)
     say(f"\ntime series: {csv_path}\nplot: {plot_path}")
     lc = metrics.limit_cycle
     return 1 if (lc.present or lc.diverging) else 0
@@ -261,6 +263,6 @@ def _run_sweep(args: argparse.Namespace, spec: Any, sim: Any, loop: Any, step: t
     say(f"{spec.name}: sweep of {name} over {len(values)} values, step {fmt(step[0])} -> {fmt(step[1])}")
     say(table([name, "rise [s]", "overshoot [%]", "settling [s]", "rate-limited [s]", "saturated [s]",
                "limit cycle (amplitude / period)"], rows))
-    say(f"\ntime series: {csv_path}")
+    say(f"\ntime series: {folder.final(csv_path) if folder is not None else csv_path}")
     oscillating = [e for e in entries if e["limit_cycle"]["present"] or e["limit_cycle"]["diverging"]]
     return 1 if oscillating else 0

@@ -105,4 +105,4 @@ def write_diagnosis_report(diag: Diagnosis, out_dir: str | Path, *, command: str
     json_path.write_text(dump_json(data), encoding="utf-8")
     html_path.write_text(html, encoding="utf-8")
     out.commit()
-    return DiagnosisFiles(out.path, json_path, html_path, figs)
+    return DiagnosisFiles(out.path, out.final(json_path), out.final(html_path), {k: out.final(p) for k, p in figs.items()})

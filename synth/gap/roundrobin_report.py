@@ -64,4 +64,4 @@ def write_runs_report(rr: RunsDiagnosis, out_dir: str | Path, *, units: dict[str
     json_path.write_text(dump_json(data), encoding="utf-8")
     html_path.write_text(html, encoding="utf-8")
     out.commit()
-    return RunsFiles(out.path, json_path, html_path, figs)
+    return RunsFiles(out.path, out.final(json_path), out.final(html_path), {k: out.final(p) for k, p in figs.items()})

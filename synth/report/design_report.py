@@ -205,4 +205,4 @@ def write_design_report(spec: Spec, result: DesignResult, out_dir: str | Path, *
     json_path = out.claim("result.json")
     json_path.write_text(dump_json(data), encoding="utf-8")
     out.commit()
-    return ReportFiles(out.path, json_path, html_path, figs)
+    return ReportFiles(out.path, out.final(json_path), out.final(html_path), {k: out.final(p) for k, p in figs.items()})

@@ -124,4 +124,4 @@ def write_tradeoff_report(result: TradeoffResult, out_dir: str | Path, command: 
     html_path = out.claim("tradeoff.html")
     html_path.write_text(html, encoding="utf-8")
     out.commit()
-    return TradeoffFiles(out.path, csv_path, json_path, html_path, png)
+    return TradeoffFiles(out.path, out.final(csv_path), out.final(json_path), out.final(html_path), out.final(png))
