@@ -2,7 +2,7 @@
 
 The schema is documented in ``docs/spec-format.md``. The modules, along the spec's blocks:
 
-- :mod:`synth.spec.loading`: :func:`parse_spec` (text, path, stream or mapping) and :func:`load_spec`;
+- :mod:`synth.spec.loading`: :func:`parse_spec` (a mapping, YAML text, a path or a stream), :func:`load_spec`;
 - :mod:`synth.spec.document`: :class:`Spec`, the whole problem;
 - :mod:`synth.spec.plant_block`, :mod:`synth.spec.controller_block`, :mod:`synth.spec.objective`,
   :mod:`synth.spec.reference`: one block each, on the strict base of :mod:`synth.spec.strict`;
@@ -11,7 +11,7 @@ The schema is documented in ``docs/spec-format.md``. The modules, along the spec
 
 from synth.spec.controller_block import ControllerSpec
 from synth.spec.document import RequirementEntry, Spec
-from synth.spec.loading import load_spec, parse_spec
+from synth.spec.loading import load_spec, parse_spec, parse_text
 from synth.spec.objective import ObjectiveSpec, ObjectiveTerm
 from synth.spec.plant_block import IdentifySpec, PlantSpec, SignalSpec, VariantSpec
 from synth.spec.reference import AnalysisSpec, PublishedTF, ReferenceSpec
@@ -31,4 +31,5 @@ __all__ = [
     "VariantSpec",
     "load_spec",
     "parse_spec",
+    "parse_text",
 ]

@@ -162,12 +162,14 @@ class PlantSpec(StrictModel):
     @model_validator(mode="after")
     def _data_folder_from_context(self, info: ValidationInfo) -> PlantSpec:
         folder = (info.context or {}).get(DATA_FOLDER)
-        self._base = None if folder is None else Path(folder)
+        if self.identify is not None and folder is not None:  # a tf plant reads no data: specs compare equal
+            self._base = Path(folder)
         return self
 
     @property
     def data_folder(self) -> Path | None:
-        """Folder that ``identify.data`` is relative to (the spec file's folder; None: the working directory).
+        """Folder that ``identify.data`` is relative to (the spec file's folder; None: the working directory,
+        and always None for a ``tf:`` plant).
 
         It comes from the validation context (``context={DATA_FOLDER: folder}``), as
         :func:`synth.spec.parse_spec` passes it.
