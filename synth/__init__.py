@@ -3,7 +3,7 @@
 Public API
 ----------
 load_spec, parse_spec
-    Read and validate a spec file.
+    Read and validate a spec file (``parse_spec`` also takes YAML text, a mapping or a stream).
 check
     Evaluate a controller against every requirement of a spec.
 design
@@ -12,7 +12,9 @@ feasible_gain_set
     Exact feasible set of one controller parameter.
 Plant, Controller, Loop
     Models: rational transfer function times an exact delay; fixed-structure
-    controllers; the feedback loop.
+    controllers; the feedback loop. python-control models go in with
+    ``Plant.from_control(sys, delay=...)`` (``Loop`` takes them, and ``"P(3)"``, as they are)
+    and come back with ``Controller.to_control()`` and ``Plant.to_control(pade_order=...)``.
 closed_loop_stability
     Exact closed-loop stability with a delay.
 write_design_report

@@ -18,6 +18,18 @@ import numpy as np
 from synth.errors import ModelError
 from synth.polynomials import format_factored, trim
 
+__all__ = [
+    "CONTROLLER_TYPES",
+    "RATIONAL",
+    "Controller",
+    "ControllerType",
+    "Polys",
+    "as_controller",
+    "controller_type",
+    "rational_order",
+    "rational_type",
+]
+
 Polys = tuple[np.ndarray, np.ndarray]
 
 
@@ -319,6 +331,27 @@ class Controller:
             return float("inf")
         return float(num[-1] / den[-1])
 
+    def to_control(self) -> Any:
+        """The controller as a python-control ``TransferFunction`` (exact: a controller has no delay).
+
+        Returns
+        -------
+        control.TransferFunction
+            ``num/den`` of :meth:`tf`.
+
+        Examples
+        --------
+        >>> C = Controller.from_string("PI(kp=2, ki=4)").to_control()
+        >>> C.num[0][0].tolist(), C.den[0][0].tolist()
+        ([2.0, 4.0], [1.0, 0.0])
+        >>> abs(C(2j)).round(4)
+        np.float64(2.8284)
+        """
+        import control
+
+        num, den = self.tf()
+        return control.tf(num, den)
+
     def with_parameters(self, **values: float) -> Controller:
         """Copy with some parameters replaced.
 
@@ -359,6 +392,40 @@ class Controller:
             "tf": self.transfer_function_text(6),
             "text": str(self),
         }
+
+
+def as_controller(controller: Controller | str) -> Controller:
+    """A :class:`Controller` from a Controller or its text (``"P(3)"``, ``"PI(kp=1.2, ki=20)"``).
+
+    Parameters
+    ----------
+    controller : Controller or str
+        The controller, or text that :meth:`Controller.from_string` reads.
+
+    Returns
+    -------
+    Controller
+
+    Raises
+    ------
+    ModelError
+        Unreadable text or another type.
+
+    Examples
+    --------
+    >>> as_controller("PI(1.2, 20)").parameters
+    {'kp': 1.2, 'ki': 20.0}
+    >>> as_controller(3.0)
+    Traceback (most recent call last):
+    ...
+    synth.errors.ModelError: cannot make a controller from a float; give a Controller or text like 'P(3)' ...
+    """
+    if isinstance(controller, Controller):
+        return controller
+    if isinstance(controller, str):
+        return Controller.from_string(controller)
+    raise ModelError(f"cannot make a controller from a {type(controller).__name__}; give a Controller "
+                     "or text like 'P(3)' or 'PI(kp=1.2, ki=20)'")
 
 
 def _number(node: ast.AST, text: str) -> float:

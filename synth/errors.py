@@ -8,6 +8,8 @@ wrong, so the command line can print it as-is and exit with code 2.
 
 from __future__ import annotations
 
+__all__ = ["DataError", "ModelError", "OutputExistsError", "SpecError", "SynthError"]
+
 
 class SynthError(Exception):
     """Bad input, reported as one line: ``<where>: <what is wrong>``.

@@ -13,11 +13,13 @@ from typing import Any
 
 import numpy as np
 
-from synth.controllers import Controller
+from synth.controllers import Controller, as_controller
 from synth.freqgrid import characteristic_range, crossings, log_grid
-from synth.plant import Plant
+from synth.plant import Plant, as_plant
 from synth.polynomials import format_factored, magnitude_squared_in_w2, trim
 from synth.stability import StabilityResult, closed_loop_stability, gain_margin_factors
+
+__all__ = ["BANDWIDTH_LEVEL", "Loop", "Margins"]
 
 BANDWIDTH_LEVEL = 10 ** (-3 / 20)
 """|T| relative to |T(0)| that defines the closed-loop bandwidth (-3 dB)."""
@@ -60,6 +62,14 @@ class Margins:
 class Loop:
     """Plant and controller in unity negative feedback.
 
+    Parameters
+    ----------
+    plant : Plant, str, control.TransferFunction, control.StateSpace or (num, den)
+        Anything :func:`synth.plant.as_plant` takes. A python-control model has no delay: give
+        ``Plant.from_control(sys, delay=...)`` for one.
+    controller : Controller or str
+        A :class:`~synth.controllers.Controller` or its text, e.g. ``"P(3)"``.
+
     Examples
     --------
     >>> G = Plant.from_string("23*(s+0.43)/((s+9.6)*(s+0.54))")
@@ -68,10 +78,23 @@ class Loop:
     array([ 0.443, 78.697])
     >>> round(loop.bandwidth(), 2)
     83.16
+
+    A python-control model and a controller's text work as well:
+
+    >>> import control
+    >>> G = control.tf([23.0, 23.0 * 0.43], np.polymul([1.0, 9.6], [1.0, 0.54]))
+    >>> round(Loop(G, "P(3)").bandwidth(), 2)
+    83.16
+    >>> round(Loop(Plant.from_control(G, delay=0.02), "P(3)").margins().gain_margin_db, 2)
+    1.79
     """
 
     plant: Plant
     controller: Controller
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "plant", as_plant(self.plant))
+        object.__setattr__(self, "controller", as_controller(self.controller))
 
     # ----------------------------------------------------------- rational parts
     @cached_property

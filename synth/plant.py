@@ -15,6 +15,8 @@ from synth.errors import ModelError
 from synth.polynomials import format_factored, trim
 from synth.tfparse import parse_tf
 
+__all__ = ["Plant", "Signal", "as_plant"]
+
 
 @dataclass(frozen=True)
 class Signal:
@@ -112,38 +114,99 @@ class Plant:
         )
 
     @classmethod
-    def from_control(cls, sys: Any, delay: float = 0.0, **kwargs: Any) -> Plant:
-        """Build a plant from a SISO python-control ``TransferFunction`` or ``StateSpace``.
+    def from_control(
+        cls,
+        sys: Any,
+        delay: float = 0.0,
+        input: Signal | None = None,
+        output: Signal | None = None,
+        label: str = "",
+    ) -> Plant:
+        """Build a plant from a python-control ``TransferFunction`` or ``StateSpace``.
+
+        This is how a python-control model enters synth: ``Plant.from_control(sys, delay=...)``,
+        or pass ``sys`` straight to :class:`synth.loop.Loop` (which calls :func:`as_plant`).
+
+        Parameters
+        ----------
+        sys : control.TransferFunction or control.StateSpace
+            A continuous-time, single-input single-output, proper model.
+        delay : float
+            Exact input-output delay in seconds (python-control has no exact delay).
+        input, output : Signal, optional
+            Names and units of the input and output.
+        label : str
+            Free text used in reports.
+
+        Returns
+        -------
+        Plant
+
+        Raises
+        ------
+        ModelError
+            A discrete-time or multi-input/multi-output model, another type, a negative delay.
 
         Examples
         --------
         >>> import control
-        >>> Plant.from_control(control.tf([2.0], [1.0, 3.0]), delay=0.1).delay
-        0.1
+        >>> G = Plant.from_control(control.tf([2.0], [1.0, 3.0]), delay=0.1)
+        >>> G.to_string(), G.delay
+        ('exp(-0.1*s)*2/(s+3)', 0.1)
+        >>> Plant.from_control(control.ss([[-3.0]], [[1.0]], [[2.0]], [[0.0]])).to_string()
+        '2/(s+3)'
+        >>> Plant.from_control(control.tf([1.0], [1.0, -0.5], 0.01))
+        Traceback (most recent call last):
+        ...
+        synth.errors.ModelError: a discrete-time model (dt = 0.01) cannot be a plant; give a continuous-time one
         """
         import control
 
+        if not isinstance(sys, control.TransferFunction | control.StateSpace):
+            raise ModelError(f"expected a python-control TransferFunction or StateSpace, got {type(sys).__name__}")
+        if sys.ninputs != 1 or sys.noutputs != 1:
+            raise ModelError(f"only single-input single-output models can be a plant; this one has "
+                             f"{sys.ninputs} input(s) and {sys.noutputs} output(s)")
+        if control.isdtime(sys, strict=True):
+            raise ModelError(f"a discrete-time model (dt = {sys.dt}) cannot be a plant; give a continuous-time one")
         if isinstance(sys, control.StateSpace):
             sys = control.ss2tf(sys)
-        if not isinstance(sys, control.TransferFunction):
-            raise ModelError(f"expected a python-control TransferFunction, got {type(sys).__name__}")
-        if sys.ninputs != 1 or sys.noutputs != 1:
-            raise ModelError("only SISO systems are supported")
-        if not sys.isctime():
-            raise ModelError("only continuous-time systems are supported")
-        return cls(np.asarray(sys.num[0][0], float), np.asarray(sys.den[0][0], float), delay, **kwargs)
+        num = np.asarray(sys.num[0][0], dtype=float)
+        den = np.asarray(sys.den[0][0], dtype=float)
+        return cls(num, den, delay, input or Signal("u", ""), output or Signal("y", ""), label)
 
     def to_control(self, pade_order: int | None = None) -> Any:
         """Return a python-control ``TransferFunction``.
 
-        The delay has no exact rational form. With ``pade_order=None`` a plant
-        with a delay raises :class:`ModelError`; give an order to include a
-        Pade approximation explicitly.
+        The delay has no exact rational form. A plant without a delay is returned exactly; with a
+        delay, ``pade_order=None`` raises :class:`ModelError` (the delay is never dropped silently)
+        and ``pade_order=N`` multiplies by ``control.pade(delay, N)``.
+
+        Parameters
+        ----------
+        pade_order : int, optional
+            Order of the Pade approximation of the delay (needed when there is one).
+
+        Returns
+        -------
+        control.TransferFunction
+
+        Raises
+        ------
+        ModelError
+            A delay without ``pade_order``, or an order below 1.
 
         Examples
         --------
         >>> Plant.from_string("2/(s+3)").to_control().dcgain()
         np.float64(0.6666666666666666)
+        >>> G = Plant.from_string("2/(s+3)", delay=0.1)
+        >>> G.to_control()
+        Traceback (most recent call last):
+        ...
+        synth.errors.ModelError: plant has a 0.1 s delay, which python-control cannot hold exactly; pass pade_order=N ...
+        >>> G.to_control(pade_order=3).den[0][0].size  # 1 plant pole + 3 Pade poles
+        5
         """
         import control
 
@@ -154,7 +217,9 @@ class Plant:
                     f"plant has a {self.delay:g} s delay, which python-control cannot hold "
                     "exactly; pass pade_order=N for a Pade approximation"
                 )
-            pnum, pden = control.pade(self.delay, pade_order)
+            if isinstance(pade_order, bool) or not isinstance(pade_order, int | np.integer) or pade_order < 1:
+                raise ModelError(f"pade_order must be a whole number >= 1, got {pade_order!r}")
+            pnum, pden = control.pade(self.delay, int(pade_order))
             sys = sys * control.tf(pnum, pden)
         return sys
 
@@ -286,3 +351,50 @@ class Plant:
             "output": {"name": self.output.name, "unit": self.output.unit},
             "label": self.label,
         }
+
+
+def as_plant(model: Any, delay: float = 0.0) -> Plant:
+    """A :class:`Plant` from what a user holds: a Plant, transfer-function text, a python-control
+    ``TransferFunction``/``StateSpace`` or a ``(num, den)`` pair.
+
+    Parameters
+    ----------
+    model : Plant, str, control.TransferFunction, control.StateSpace or (num, den)
+        The plant. Text is read by :func:`synth.tfparse.parse_tf` (``exp(-0.02*s)`` is an exact delay).
+    delay : float
+        Exact delay in seconds added to the model's own (python-control models have none).
+
+    Returns
+    -------
+    Plant
+
+    Raises
+    ------
+    ModelError
+        A model of another type, or one :meth:`Plant.from_control` or :meth:`Plant.from_string` refuses.
+
+    Examples
+    --------
+    >>> import control
+    >>> as_plant(control.tf([23.0], [1.0, 10.0]), delay=0.02).to_string()
+    'exp(-0.02*s)*23/(s+10)'
+    >>> as_plant("23/(s+10)").dc_gain()
+    2.3
+    >>> as_plant(([23.0], [1.0, 10.0])).poles()
+    array([-10.])
+    >>> as_plant(2.0)
+    Traceback (most recent call last):
+    ...
+    synth.errors.ModelError: cannot make a plant from a float; give a Plant, transfer-function text like '23/(s+10)', ...
+    """
+    if isinstance(model, Plant):
+        return model if not delay else model.with_delay(model.delay + float(delay))
+    if isinstance(model, str):
+        return Plant.from_string(model, delay)
+    if isinstance(model, tuple) and len(model) == 2:
+        return Plant(np.atleast_1d(np.asarray(model[0], dtype=float)), np.atleast_1d(np.asarray(model[1], dtype=float)),
+                     delay)
+    if type(model).__module__.split(".")[0] == "control":
+        return Plant.from_control(model, delay)
+    raise ModelError(f"cannot make a plant from a {type(model).__name__}; give a Plant, transfer-function text "
+                     "like '23/(s+10)', a python-control TransferFunction or StateSpace, or (num, den)")

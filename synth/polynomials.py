@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
+__all__ = ["format_factored", "largest_crossing", "magnitude_squared_in_w2", "mirror", "trim"]
+
 
 def trim(p: np.ndarray) -> np.ndarray:
     """Drop leading zero coefficients (keep ``[0.]`` for the zero polynomial).

@@ -28,6 +28,18 @@ import numpy as np
 from synth.errors import ModelError
 from synth.polynomials import largest_crossing, trim
 
+__all__ = [
+    "GAIN_SEARCH_LIMIT",
+    "Rational",
+    "StabilityInterval",
+    "StabilityResult",
+    "affine_stability_intervals",
+    "bisect_roots",
+    "closed_loop_stability",
+    "gain_margin_factors",
+    "stability_boundaries",
+]
+
 _PHASE_STEP = np.pi / 8.0
 
 

@@ -17,6 +17,8 @@ import numpy as np
 
 from synth.errors import ModelError
 
+__all__ = ["ParsedTF", "parse_tf"]
+
 _ALLOWED_FUNCS = {"exp"}
 
 

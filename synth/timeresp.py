@@ -17,6 +17,8 @@ from scipy.signal import cont2discrete, lti, tf2ss
 from synth.loop import Loop
 from synth.polynomials import trim
 
+__all__ = ["StepMetrics", "default_horizon", "step_metrics", "step_response"]
+
 
 @dataclass(frozen=True)
 class StepMetrics:
