@@ -36,8 +36,9 @@ from synth.controllers import Controller  # noqa: E402
 from synth.plant import Plant  # noqa: E402
 from synth.sim.blocks import Quantizer, RateLimit, SampleHold, Saturation  # noqa: E402
 from synth.sim.discretize import delayed_zoh, tf_to_ss  # noqa: E402
+from synth.sim.loops import NonlinearLoop, OperatingPoint  # noqa: E402
 from synth.sim.signals import step_reference  # noqa: E402
-from synth.sim.simulator import NonlinearLoop, OperatingPoint, simulate, simulate_batch  # noqa: E402
+from synth.sim.simulator import simulate, simulate_batch  # noqa: E402
 
 PLANT = "23*(s+0.43)/((s+9.6)*(s+0.54))"
 T_END, DT = 10.0, 0.001

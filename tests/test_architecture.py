@@ -38,7 +38,7 @@ LAYERS: dict[str, int] = {
     # 7 what runs designs or models many times: trade-offs, published comparisons, the gap diagnosis
     "synth.tradeoff": 7, "synth.synthesis.tradeoff": 7, "synth.reference": 7, "synth.gap": 7,
     # 8 reports
-    "synth.report": 8, "synth.sim.report": 8, "synth.gap.report": 8, "synth.gap.roundrobin_report": 8,
+    "synth.report": 8, "synth.gap.report": 8, "synth.gap.roundrobin_report": 8,
     # 9 the command line, 10 the package's front door
     "synth.cli": 9, "synth.__main__": 10, "synth": 10,
 }

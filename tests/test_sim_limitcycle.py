@@ -14,8 +14,9 @@ from synth.sim.describing import (
     saturation_df,
 )
 from synth.sim.limitcycle import detect_oscillation
+from synth.sim.loops import NonlinearLoop
 from synth.sim.signals import step_reference
-from synth.sim.simulator import NonlinearLoop, simulate
+from synth.sim.simulator import simulate
 
 
 def _simulated_cycle(plant: str, k: float, block, step: float, t_end: float = 150.0):
@@ -117,7 +118,7 @@ def test_sampled_loop_response_equals_python_control_pulse_transfer():
     import control
 
     from synth.sim.describing import sampled_loop_response
-    from synth.sim.simulator import NonlinearLoop
+    from synth.sim.loops import NonlinearLoop
 
     G = Plant.from_string("23*(s+0.43)/((s+9.6)*(s+0.54))")
     loop = NonlinearLoop(G, Controller.from_string("PI(kp=2, ki=30)"), dt=0.001, loop_delay=0.004)

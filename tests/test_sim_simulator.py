@@ -9,11 +9,9 @@ from synth.controllers import Controller
 from synth.errors import ModelError
 from synth.plant import Plant
 from synth.sim.blocks import Backlash, DeadZone, Dynamics, Lag, RateLimit, SampleHold, Saturation, Static
+from synth.sim.loops import NonlinearLoop, OpenLoop, OperatingPoint
 from synth.sim.signals import StepDisturbance, step_reference
 from synth.sim.simulator import (
-    NonlinearLoop,
-    OpenLoop,
-    OperatingPoint,
     simulate,
     simulate_batch,
     simulate_open_loop,

@@ -7,6 +7,8 @@ import sys
 from pathlib import Path
 from typing import Any
 
+__all__ = ["COMMAND", "DESCRIPTION", "HELP", "ORDER", "add_arguments", "run"]
+
 COMMAND = "simulate"
 ORDER = 30
 HELP = "simulate the sampled nonlinear closed loop of a spec (rate limit, saturation, sensor, delay)"

@@ -56,7 +56,7 @@ def report_data(spec: Spec, result: DesignResult, keep: dict[str, Any] | None = 
              "uncertainty_plants": [p.label for p in spec.plants()[1:] if p.label.startswith("identified")],
              "sensor": spec.plant.identify.sensor}
     if spec.simulation is not None:  # nonlinear step check (issue 5): logic in synth.sim.report
-        from synth.sim.report import simulation_report
+        from synth.report.simulation_report import simulation_report
 
         data["simulation"] = simulation_report(spec, shown, reference_controller(spec)).data
         from synth.gap.x4_case import gap_case_applies, x4_gap_case
@@ -166,7 +166,7 @@ def write_design_report(spec: Spec, result: DesignResult, out_dir: str | Path, *
         figs["delay"] = figures.delay_chart(rows, marks, out.claim("critical_gain_vs_delay.png"))
 
     if spec.simulation is not None:
-        from synth.sim.report import simulation_figures
+        from synth.report.simulation_report import simulation_figures
 
         figs.update(simulation_figures(spec, shown, ref, out, marks))
 

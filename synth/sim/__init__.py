@@ -35,8 +35,10 @@ import importlib
 from typing import Any
 
 _WHERE = {
-    "synth.sim.simulator": ("NonlinearLoop", "OperatingPoint", "OpenLoop", "SimResult", "BatchResult", "simulate",
-                            "simulate_step", "simulate_batch", "simulate_open_loop", "simulate_open_loop_batch"),
+    "synth.sim.loops": ("NonlinearLoop", "OperatingPoint", "OpenLoop"),
+    "synth.sim.results": ("SimResult", "BatchResult"),
+    "synth.sim.simulator": ("simulate", "simulate_step", "simulate_batch", "simulate_open_loop",
+                            "simulate_open_loop_batch"),
     "synth.sim.blocks": ("Block", "RateLimit", "Saturation", "DeadZone", "Quantizer", "Backlash", "Static", "Lag",
                          "Dynamics", "SupplySag", "SampleHold", "Noise", "Delay", "apply_chain", "BLOCK_TYPES"),
     "synth.sim.signals": ("PsdDisturbance", "RecordDisturbance", "StepDisturbance", "step_reference",

@@ -14,7 +14,8 @@ One call simulates a batch of variants, padded to common sizes. Per step
    ``w_{k-m-1}``, ``w_{k-m}`` (exact fractional delay) and the disturbances.
 
 Block activity is recorded as bits of an int32 per step: bit ``i`` for
-actuator block ``i``, bit ``16 + i`` for sensor block ``i``.
+actuator block ``i``, bit ``SENSOR_BIT + i`` (16 + i) for sensor block ``i``
+(:mod:`synth.sim.layout`).
 """
 
 from __future__ import annotations
@@ -22,9 +23,8 @@ from __future__ import annotations
 import numpy as np
 
 from synth.sim._jit import jit
-from synth.sim._steps import NOISE, block_step
-
-SENSOR_BIT = 16
+from synth.sim._steps import block_step
+from synth.sim.layout import NOISE, SENSOR_BIT
 
 
 @jit

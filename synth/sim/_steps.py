@@ -1,8 +1,8 @@
 """Per-step block equations (numba), dispatched on each block's integer code.
 
-Parameter and state layouts are those of the block classes in
-:mod:`synth.sim.blocks`; each function updates the state in place and
-returns ``(output, active)``.
+Parameter and state layouts are those of :mod:`synth.sim.layout`, written by the block
+classes of :mod:`synth.sim.blocks`; each function updates the state in place and returns
+``(output, active)``.
 """
 
 from __future__ import annotations
@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 
 from synth.sim._jit import jit
-from synth.sim.blocks import (
+from synth.sim.layout import (
     BACKLASH,
     DEAD_ZONE,
     DYNAMICS,

@@ -33,6 +33,11 @@ from scipy.optimize import brentq
 
 from synth.errors import ModelError
 
+__all__ = [
+    "TRIANGLE_RHO", "LoopCyclePrediction", "PredictedCycle", "dead_zone_df", "harmonic_balance", "numeric_df",
+    "predict_loop_cycles", "rate_limiter_df", "sampled_loop_response", "saturation_df",
+]
+
 
 def saturation_df(A: Any, limit: float) -> np.ndarray:
     """Describing function of a symmetric saturation at ``+-limit`` (real, amplitude only).
@@ -255,7 +260,7 @@ def sampled_loop_response(loop: Any, w: Any) -> np.ndarray:
     Examples
     --------
     >>> from synth.plant import Plant; from synth.controllers import Controller
-    >>> from synth.sim.simulator import NonlinearLoop
+    >>> from synth.sim.loops import NonlinearLoop
     >>> loop = NonlinearLoop(Plant.from_string("10/(s+10)"), Controller("P", {"kp": 2}), dt=0.001)
     >>> abs(sampled_loop_response(loop, [1e-3])[0]).round(6)  # K G(0)
     np.float64(2.0)
@@ -267,14 +272,14 @@ def _loop_parts(loop: Any, w: Any) -> np.ndarray:
     """Rows: controller, plant core (actuator output to sensed output), sensor chain."""
     from synth.sim.blocks import Delay, Dynamics, SampleHold
     from synth.sim.discretize import delayed_zoh, discretize_controller, zoh
-    from synth.sim.simulator import _core, _fold_counts
+    from synth.sim.folding import fold_counts, plant_core
 
     w = np.atleast_1d(np.asarray(w, float))
     dt = loop.dt
     act = [b for b in loop.actuator if not isinstance(b, Delay)]
     sen = [b for b in loop.sensor if not isinstance(b, Delay)]
-    na, ns = _fold_counts(act, sen)
-    core = _core(loop.plant, act[len(act) - na:], sen[:ns], loop.operating_point)
+    na, ns = fold_counts(act, sen)
+    core = plant_core(loop.plant, act[len(act) - na:], sen[:ns], loop.operating_point)
     dz = delayed_zoh(core.A, core.B[:, 0], dt, loop.total_delay)
     n = core.A.shape[0]
     num, den = loop.controller.tf()
@@ -343,7 +348,7 @@ def predict_loop_cycles(loop: Any, bias: float, w_range: tuple[float, float] | N
     Examples
     --------
     >>> from synth.plant import Plant; from synth.controllers import Controller
-    >>> from synth.sim.simulator import NonlinearLoop
+    >>> from synth.sim.loops import NonlinearLoop
     >>> from synth.sim.blocks import Saturation
     >>> loop = NonlinearLoop(Plant.from_string("1/(s*(s+1)*(s+2))"), Controller("P", {"kp": 20}),
     ...                      actuator=[Saturation(-1, 1)], dt=0.001)

@@ -21,6 +21,8 @@ from scipy.signal import cont2discrete, tf2ss
 
 from synth.errors import ModelError
 
+__all__ = ["DISCRETIZATIONS", "DelayedZOH", "delayed_zoh", "discretize_controller", "tf_to_ss", "zoh"]
+
 DISCRETIZATIONS = {
     "tustin": "bilinear",
     "zoh": "zoh",

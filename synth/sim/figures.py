@@ -16,7 +16,9 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 from synth.figure_files import save_figure
-from synth.sim.simulator import SimResult
+from synth.sim.results import SimResult
+
+__all__ = ["COLORS", "onset_chart", "rise_vs_rate_chart", "step_comparison"]
 
 COLORS = ["#1f4e9c", "#c0392b", "#2e8b57", "#8e44ad", "#d35400", "#7f8c8d"]
 
@@ -40,7 +42,8 @@ def step_comparison(runs: dict[str, dict[str, SimResult]], path: Path, units: di
     --------
     >>> import tempfile, pathlib
     >>> from synth.plant import Plant; from synth.controllers import Controller
-    >>> from synth.sim.simulator import NonlinearLoop, simulate_step
+    >>> from synth.sim.loops import NonlinearLoop
+    >>> from synth.sim.simulator import simulate_step
     >>> from synth.sim.blocks import Saturation
     >>> loop = NonlinearLoop(Plant.from_string("10/(s+10)"), Controller("P", {"kp": 2}),
     ...                      actuator=[Saturation(-1, 1)])

@@ -19,6 +19,8 @@ import numpy as np
 
 from synth.sim._jit import jit
 
+__all__ = ["Oscillation", "detect_oscillation"]
+
 
 @dataclass(frozen=True)
 class Oscillation:

@@ -16,8 +16,10 @@ from typing import Any
 import numpy as np
 
 from synth.sim.limitcycle import Oscillation, detect_oscillation
-from synth.sim.simulator import SimResult
+from synth.sim.results import SimResult
 from synth.timeresp import StepMetrics, step_metrics
+
+__all__ = ["NonlinearStepMetrics", "nonlinear_step_metrics"]
 
 
 @dataclass(frozen=True)
@@ -100,7 +102,8 @@ def nonlinear_step_metrics(result: SimResult, t_step: float = 0.0, final_value: 
     --------
     >>> from synth.plant import Plant; from synth.controllers import Controller
     >>> from synth.sim.blocks import RateLimit, Saturation
-    >>> from synth.sim.simulator import NonlinearLoop, OperatingPoint, simulate
+    >>> from synth.sim.loops import NonlinearLoop, OperatingPoint
+    >>> from synth.sim.simulator import simulate
     >>> from synth.sim.signals import step_reference
     >>> loop = NonlinearLoop(Plant.from_string("23*(s+0.43)/((s+9.6)*(s+0.54))"), Controller("P", {"kp": 3}),
     ...                      actuator=[RateLimit(10000), Saturation(0, 255)],

@@ -20,8 +20,11 @@ import numpy as np
 from synth.errors import ModelError
 from synth.sim.blocks import RateLimit
 from synth.sim.limitcycle import Oscillation, detect_oscillation
+from synth.sim.loops import NonlinearLoop
 from synth.sim.signals import step_reference
-from synth.sim.simulator import NonlinearLoop, simulate_batch
+from synth.sim.simulator import simulate_batch
+
+__all__ = ["OnsetResult", "OnsetRow", "oscillation_onset", "rate_variants"]
 
 
 @dataclass(frozen=True)

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import csv
 import itertools
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -19,6 +20,14 @@ from typing import Any
 import numpy as np
 
 from synth.errors import DataError, ModelError
+
+__all__ = [
+    "PsdDisturbance", "RecordDisturbance", "Reference", "StepDisturbance", "psd_signal", "psd_value", "psd_variance",
+    "step_reference", "validate_psd",
+]
+
+Reference = float | np.ndarray | Callable[[np.ndarray], np.ndarray]
+"""A reference: a constant, one value per step, or a function of the time array (:func:`step_reference`)."""
 
 
 def validate_psd(table: Any, where: str = "psd") -> tuple[tuple[float, float], ...]:

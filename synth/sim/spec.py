@@ -27,6 +27,14 @@ from synth.sim.signals import PsdDisturbance, RecordDisturbance, StepDisturbance
 if TYPE_CHECKING:
     from synth.sim.blocks import Block
 
+__all__ = [
+    "BLOCK_SPECS", "BLOCK_TAGS", "DISTURBANCE_TAGS", "SIMULATION_TAGS", "BacklashSpec", "BlockEntry", "DeadZoneSpec",
+    "DelaySpec", "DisturbanceEntry", "DynamicsSpec", "LagSpec", "LimitCycleSpec", "NoiseSpec", "OnsetSpec",
+    "OperatingPointSpec", "PsdDisturbanceSpec", "PublishedSimSpec", "QuantizerSpec", "RateLimitSpec",
+    "RecordDisturbanceSpec", "SampleHoldSpec", "SaturationSpec", "SimulationSpec", "StaticSpec", "StepDisturbanceSpec",
+    "SupplySagSpec",
+]
+
 
 def _blocks() -> Any:
     """The blocks module, imported on first use (it loads numba; ``import synth`` stays fast)."""
@@ -347,7 +355,7 @@ class SimulationSpec(_Model):
         return [b.build() for b in self.sensor]
 
     def build_loop(self, plant: Any, controller: Any, label: str = "") -> Any:
-        """The :class:`~synth.sim.simulator.NonlinearLoop` of ``plant`` and ``controller``.
+        """The :class:`~synth.sim.loops.NonlinearLoop` of ``plant`` and ``controller``.
 
         Examples
         --------
@@ -356,7 +364,7 @@ class SimulationSpec(_Model):
         >>> sim.build_loop(Plant.from_string("1/(s+1)"), Controller("P", {"kp": 1})).total_delay
         0.01
         """
-        from synth.sim.simulator import NonlinearLoop, OperatingPoint
+        from synth.sim.loops import NonlinearLoop, OperatingPoint
 
         return NonlinearLoop(plant, controller, tuple(self.actuator_blocks()), tuple(self.sensor_blocks()),
                              self.dt, self.controller_rate, self.loop_delay,

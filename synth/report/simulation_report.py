@@ -22,12 +22,16 @@ from synth.controllers import Controller
 from synth.loop import Loop
 from synth.requirements.base import fmt
 from synth.sim.blocks import RateLimit
+from synth.sim.loops import OperatingPoint
 from synth.sim.metrics import nonlinear_step_metrics
 from synth.sim.onset import OnsetResult, oscillation_onset
-from synth.sim.simulator import OperatingPoint, SimResult, simulate_batch, simulate_open_loop, simulate_step
+from synth.sim.results import SimResult
+from synth.sim.simulator import simulate_batch, simulate_open_loop, simulate_step
 from synth.sim.spec import SimulationSpec
 from synth.spec import Spec
 from synth.timeresp import step_metrics, step_response
+
+__all__ = ["SimulationReport", "simulation_figures", "simulation_report"]
 
 
 @dataclass
