@@ -55,7 +55,7 @@ def report_data(spec: Spec, result: DesignResult, keep: dict[str, Any] | None = 
         } | {"in_loop_delay": spec.plant.identify.in_loop_delay, "confidence": spec.plant.identify.confidence,
              "uncertainty_plants": [p.label for p in spec.plants()[1:] if p.label.startswith("identified")],
              "sensor": spec.plant.identify.sensor}
-    if spec.simulation is not None:  # nonlinear step check (issue 5): logic in synth.sim.report
+    if spec.simulation is not None:  # nonlinear step check (issue 5): logic in synth.report.simulation_report
         from synth.report.simulation_report import simulation_report
 
         data["simulation"] = simulation_report(spec, shown, reference_controller(spec)).data
