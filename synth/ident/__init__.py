@@ -7,11 +7,13 @@ metrics (bandwidth, phase delay) and disturbance spectra. Modules:
 - :mod:`synth.ident.structure`: parametric transfer-function formulas (numpy and casadi).
 - :mod:`synth.ident.steps`: find, align and average the steps of a step train; SNR.
 - :mod:`synth.ident.timefit`: simulation-error fit of a structure (casadi + IPOPT), delay, sensor,
-  standard errors; :func:`identify` averages a step train first.
+  standard errors; :func:`identify` averages a step train first. Its casadi problem is in
+  :mod:`synth.ident.sim_error_problem`, its deterministic start (SRIVC) in :mod:`synth.ident.srivc`.
 - :mod:`synth.ident.x4_record`: the SYNTHETIC X-4 step-train record from the seed's model.
 - :mod:`synth.ident.sweep_design`, :mod:`synth.ident.spectra`, :mod:`synth.ident.freqfit`: sweep
   design, composite multi-window frequency response, NAVFIT-cost fit with an exact delay.
-- :mod:`synth.ident.hq`: handling-qualities bandwidth and phase delay.
+- :mod:`synth.ident.hq_metrics`, :mod:`synth.ident.hq`, :mod:`synth.ident.model_phase`: handling-qualities
+  bandwidth and phase delay (definitions; estimation from a model or measurements; a model's exact phase).
 - :mod:`synth.ident.psd`: disturbance spectra, noise floor, spikes, power-share frequency.
 - :mod:`synth.ident.from_spec`: a spec's ``plant: {identify: ...}`` and its uncertainty plants.
 
@@ -40,7 +42,7 @@ _EXPORTS = {
     "frequency_response": "spectra", "FrequencyResponse": "spectra", "rate_to_attitude": "spectra",
     "coherent_band": "spectra",
     "fit_frequency_response": "freqfit", "FreqFit": "freqfit", "fit_cost": "freqfit", "verify_step": "freqfit",
-    "hq_from_plant": "hq", "hq_from_frd": "hq", "HQMetrics": "hq",
+    "hq_from_plant": "hq", "hq_from_frd": "hq", "HQMetrics": "hq_metrics",
     "analyze_psd": "psd", "analyze_records": "psd", "PsdAnalysis": "psd", "suggest_bandwidth": "psd",
 }
 
