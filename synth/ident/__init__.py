@@ -14,7 +14,9 @@ metrics (bandwidth, phase delay) and disturbance spectra. Modules:
   design, composite multi-window frequency response, NAVFIT-cost fit with an exact delay.
 - :mod:`synth.ident.hq_metrics`, :mod:`synth.ident.hq`, :mod:`synth.ident.model_phase`: handling-qualities
   bandwidth and phase delay (definitions; estimation from a model or measurements; a model's exact phase).
-- :mod:`synth.ident.psd`: disturbance spectra, noise floor, spikes, power-share frequency.
+- :mod:`synth.ident.psd`: disturbance spectra (:mod:`synth.ident.welch`), noise floor, spikes, trend,
+  power-share frequency (:mod:`synth.ident.spectrum_features`), the bandwidth they suggest
+  (:mod:`synth.ident.bandwidth_suggestion`).
 - :mod:`synth.ident.from_spec`: a spec's ``plant: {identify: ...}`` and its uncertainty plants.
 
 Names are imported on first use (casadi and scipy load only when needed).
@@ -43,7 +45,7 @@ _EXPORTS = {
     "coherent_band": "spectra",
     "fit_frequency_response": "freqfit", "FreqFit": "freqfit", "fit_cost": "freqfit", "verify_step": "freqfit",
     "hq_from_plant": "hq", "hq_from_frd": "hq", "HQMetrics": "hq_metrics",
-    "analyze_psd": "psd", "analyze_records": "psd", "PsdAnalysis": "psd", "suggest_bandwidth": "psd",
+    "analyze_psd": "psd", "analyze_records": "psd", "PsdAnalysis": "psd", "suggest_bandwidth": "bandwidth_suggestion",
 }
 
 __all__ = sorted(_EXPORTS)

@@ -14,7 +14,8 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 from synth.figure_files import save_figure
-from synth.ident.psd import PsdAnalysis, unit_squared
+from synth.ident.psd import PsdAnalysis
+from synth.ident.welch import unit_squared
 
 
 def psd_plot(a: PsdAnalysis, path: str | Path, title: str = "") -> Path:
