@@ -6,6 +6,8 @@ import argparse
 import sys
 from pathlib import Path
 
+__all__ = ["COMMAND", "DESCRIPTION", "HELP", "ORDER", "add_arguments", "run"]
+
 COMMAND = "psd"
 ORDER = 45
 HELP = "disturbance spectrum: Welch PSD, trend, noise floor, spikes, bandwidth from the power share"

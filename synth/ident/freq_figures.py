@@ -18,6 +18,8 @@ from synth.figure_files import save_figure
 from synth.ident.freqfit import FreqFit, StepVerification
 from synth.ident.spectra import FrequencyResponse
 
+__all__ = ["bode_figure", "verification_figure"]
+
 
 def bode_figure(resp: FrequencyResponse, path: str | Path, fit: FreqFit | None = None) -> Path:
     """Magnitude, phase and coherence of the estimate (coherent band shaded), with the fit if given.

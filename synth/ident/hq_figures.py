@@ -20,6 +20,8 @@ from synth.errors import ModelError
 from synth.figure_files import save_figure
 from synth.ident.hq_metrics import GAIN_MARGIN_DB, HQMetrics
 
+__all__ = ["hq_bode"]
+
 
 def hq_bode(m: HQMetrics, path: str | Path, title: str = "") -> Path:
     """Bode plot (gain, phase and coherence when measured) with w180, 2 w180, both bandwidths and tau_p.

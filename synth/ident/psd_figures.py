@@ -17,6 +17,8 @@ from synth.figure_files import save_figure
 from synth.ident.psd import PsdAnalysis
 from synth.ident.welch import unit_squared
 
+__all__ = ["psd_plot"]
+
 
 def psd_plot(a: PsdAnalysis, path: str | Path, title: str = "") -> Path:
     """PSD [dB re 1 unit^2/(rad/s)] on a log frequency axis, with the analysis marked on it.

@@ -33,6 +33,8 @@ import numpy as np
 from synth.errors import DataError
 from synth.ident.spectral_windows import default_windows
 
+__all__ = ["MIN_PERIODS_PER_RUN", "SEED_RUN_LENGTH", "SweepDesign", "design_sweep"]
+
 #: run length the report recommends [s]
 SEED_RUN_LENGTH = 90.0
 #: least run length in periods of T_max (the report's heave sweeps: 90 s / 20 s)
