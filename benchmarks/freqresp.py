@@ -27,7 +27,8 @@ from scipy.signal import csd, welch
 
 from synth.data import record_from_arrays
 from synth.ident.simulate import simulate_plant
-from synth.ident.spectra import frequency_response, required_window
+from synth.ident.spectra import frequency_response
+from synth.ident.spectral_windows import required_window
 from synth.ident.sweep_design import design_sweep
 from synth.plant import Plant
 

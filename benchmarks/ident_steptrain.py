@@ -30,10 +30,11 @@ sys.path.insert(0, str(ROOT))
 
 from synth.data import load_record  # noqa: E402
 from synth.ident import x4_record as x4  # noqa: E402
+from synth.ident.sim_error_problem import SimulationErrorProblem  # noqa: E402
 from synth.ident.simulate import simulate_plant  # noqa: E402
 from synth.ident.steps import average_steps  # noqa: E402
 from synth.ident.structure import parse_structure  # noqa: E402
-from synth.ident.timefit import _Problem, fit_structure, identify  # noqa: E402
+from synth.ident.timefit import fit_structure, identify  # noqa: E402
 from synth.plant import Plant  # noqa: E402
 
 NAMES = ("k", "z", "p1", "p2", "delay")
@@ -108,7 +109,7 @@ def crb(periods: int) -> dict[str, float]:
     r = clean.record()
     st = parse_structure(x4.STRUCTURE)
     theta = np.array([x4.TRUTH[k] for k in ("k", "z", "p1", "p2")])
-    prob = _Problem(st, Plant.from_string(x4.SENSOR), r.n, r.dt, True, theta, True, r.y, False)
+    prob = SimulationErrorProblem(st, Plant.from_string(x4.SENSOR), r.n, r.dt, True, theta, True, r.y, False)
     m = int(np.floor(x4.DELAY / r.dt + 1e-9))
     f = x4.DELAY - m * r.dt
     x = np.r_[np.ones(4), f, 820.0]

@@ -19,11 +19,11 @@ closed_loop_stability
     Exact closed-loop stability with a delay.
 write_design_report
     ``result.json``, ``report.html`` and figures.
-load_record, Record
-    Measured records (CSV, MAT) with one-line errors naming file and column.
+load_record, Record, as_record, record_from_arrays
+    Measured records (CSV, MAT, arrays, a DataFrame) with one-line errors naming file and column.
 identify
-    Identify a structure such as ``k*(s+z)/((s+p1)*(s+p2))`` from a record
-    (step trains are averaged first); more in :mod:`synth.ident`.
+    Identify a structure such as ``k*(s+z)/((s+p1)*(s+p2))`` from a record or
+    ``(t, u, y)`` arrays (step trains are averaged first); more in :mod:`synth.ident`.
 
 Examples
 --------
@@ -42,7 +42,7 @@ _os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 from synth.check import CheckResult, check
 from synth.controllers import Controller
-from synth.data import Record, load_record
+from synth.data import Record, as_record, load_record, record_from_arrays
 from synth.design import DesignResult, design
 from synth.errors import DataError, ModelError, SpecError, SynthError
 from synth.gainset import GainSet, ScalarFamily, feasible_gain_set
@@ -64,18 +64,19 @@ def write_design_report(*args, **kwargs):
 
 
 def identify(*args, **kwargs):
-    """Identify a structure from a record (see :func:`synth.ident.timefit.identify`).
+    """Identify a structure from a record or arrays (see :func:`synth.ident.timefit.identify`).
 
+    The record may be ``(t, u, y)`` arrays, an N x 3 array, a DataFrame or mapping of
+    columns, a CSV/MAT path or a :class:`Record` (see :func:`as_record`).
     Imported on first use: casadi is not loaded by ``import synth``.
 
     Examples
     --------
     >>> import numpy as np
     >>> from synth.ident.simulate import simulate_plant
-    >>> from synth.data import record_from_arrays
     >>> t = np.arange(0, 3, 0.01); u = np.where(t >= 0.5, 1.0, 0.0)
     >>> y = simulate_plant(Plant.from_string("2/(s+3)"), t, u)
-    >>> identify(record_from_arrays(t, u, y), "k/(s+p)", average="none").plant.to_string(4)
+    >>> identify((t, u, y), "k/(s+p)", average="none").plant.to_string(4)
     '2/(s+3)'
     """
     from synth.ident.timefit import identify as _identify
@@ -99,6 +100,7 @@ __all__ = [
     "SpecError",
     "SynthError",
     "__version__",
+    "as_record",
     "check",
     "closed_loop_stability",
     "design",
@@ -107,5 +109,6 @@ __all__ = [
     "load_record",
     "load_spec",
     "parse_spec",
+    "record_from_arrays",
     "write_design_report",
 ]

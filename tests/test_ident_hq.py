@@ -7,14 +7,9 @@ import pytest
 from scipy.optimize import brentq
 
 from synth.errors import DataError, ModelError
-from synth.ident.hq import (
-    coherence_random_error,
-    continuous_phase,
-    find_crossings,
-    fit_phase_line,
-    hq_from_frd,
-    hq_from_plant,
-)
+from synth.ident.hq import coherence_random_error, fit_phase_line, hq_from_frd, hq_from_plant
+from synth.ident.hq_metrics import find_crossings
+from synth.ident.model_phase import continuous_phase
 from synth.plant import Plant
 
 # paper_checks.md, "Computed checks": plant, delay, w180, w_BW,phase, w_BW,gain, tau_p, each to the stated digits

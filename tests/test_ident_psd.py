@@ -7,17 +7,12 @@ import pytest
 from scipy import signal as sps
 from scipy.optimize import brentq
 
+from synth.data.disturbance import disturbance_from_arrays
 from synth.errors import DataError
-from synth.ident.psd import (
-    analyze_psd,
-    analyze_records,
-    disturbance_from_arrays,
-    fit_trend,
-    noise_floor,
-    share_frequency,
-    suggest_bandwidth,
-    welch_psd,
-)
+from synth.ident.bandwidth_suggestion import suggest_bandwidth
+from synth.ident.psd import analyze_psd, analyze_records
+from synth.ident.spectrum_features import fit_trend, noise_floor, share_frequency
+from synth.ident.welch import welch_psd
 from synth.sim.signals import psd_signal
 
 DT = 0.001

@@ -8,15 +8,10 @@ from scipy.signal import csd, welch
 
 from synth.data import record_from_arrays
 from synth.errors import DataError
+from synth.ident.coherence import coherent_band, random_error
 from synth.ident.simulate import simulate_plant
-from synth.ident.spectra import (
-    check_length,
-    coherent_band,
-    frequency_response,
-    random_error,
-    rate_to_attitude,
-    required_window,
-)
+from synth.ident.spectra import frequency_response, rate_to_attitude
+from synth.ident.spectral_windows import check_length, required_window
 from synth.ident.sweep_design import design_sweep
 from synth.plant import Plant
 

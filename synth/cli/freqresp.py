@@ -6,6 +6,8 @@ import argparse
 import sys
 from typing import Any
 
+__all__ = ["COMMAND", "DESCRIPTION", "HELP", "ORDER", "add_arguments", "run"]
+
 COMMAND = "freqresp"
 ORDER = 40
 HELP = "frequency response from sweep records (composite windows, coherence), transfer-function fit"

@@ -8,6 +8,8 @@ import sys
 from pathlib import Path
 from typing import Any
 
+__all__ = ["COMMAND", "DESCRIPTION", "HELP", "ORDER", "add_arguments", "read_frd", "run"]
+
 COMMAND = "hq"
 ORDER = 40
 HELP = "bandwidth and phase delay (seed 2, fig. 1) of a model or a measured frequency response"

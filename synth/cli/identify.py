@@ -7,6 +7,8 @@ import sys
 from pathlib import Path
 from typing import Any
 
+__all__ = ["COMMAND", "DESCRIPTION", "HELP", "ORDER", "add_arguments", "run"]
+
 COMMAND = "identify"
 ORDER = 5
 HELP = "identify a plant structure from a step train or any input/output record"

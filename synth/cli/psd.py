@@ -6,6 +6,8 @@ import argparse
 import sys
 from pathlib import Path
 
+__all__ = ["COMMAND", "DESCRIPTION", "HELP", "ORDER", "add_arguments", "run"]
+
 COMMAND = "psd"
 ORDER = 45
 HELP = "disturbance spectrum: Welch PSD, trend, noise floor, spikes, bandwidth from the power share"
@@ -49,7 +51,10 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from synth.cli._table import name_values
-    from synth.ident.psd import analyze_records, load_disturbance, suggest_bandwidth, unit_squared
+    from synth.data.disturbance import load_disturbance
+    from synth.ident.bandwidth_suggestion import suggest_bandwidth
+    from synth.ident.psd import analyze_records
+    from synth.ident.welch import unit_squared
     from synth.outputs import OutputDir, check_writable, dump_json, write_json
 
     records = [load_disturbance(f, args.time, args.signal, args.unit, args.dt) for f in args.data]

@@ -2,11 +2,14 @@
 
 A :class:`Record` is one experiment: time, the plant input (the command) and
 the plant output (the measurement), with names and units, plus any extra
-logged channels. Every problem with a file is a :class:`~synth.errors.DataError`
+logged channels; a :class:`DisturbanceRecord` is one measured channel without an
+input (for spectra). Every problem with a file is a :class:`~synth.errors.DataError`
 naming the file and column.
 """
 
 from synth.data.coerce import RecordLike, as_record
+from synth.data.disturbance import DisturbanceRecord, disturbance_from_arrays, load_disturbance
 from synth.data.record import Record, load_record, record_from_arrays, record_from_columns
 
-__all__ = ["Record", "RecordLike", "as_record", "load_record", "record_from_arrays", "record_from_columns"]
+__all__ = ["DisturbanceRecord", "Record", "RecordLike", "as_record", "disturbance_from_arrays", "load_disturbance",
+           "load_record", "record_from_arrays", "record_from_columns"]

@@ -40,9 +40,11 @@ def as_record(
     Parameters
     ----------
     data : Record, tuple of arrays, ndarray, mapping, DataFrame, str or Path
-        ``(t, u, y)`` (or ``(u, y)`` with ``dt``); an N x 3 array of columns t, u, y; named columns
+        ``(t, u, y)`` (or ``(u, y)`` with ``dt``); an N x 3 (or 3 x N) array of columns t, u, y, or a
+        list of ``[t, u, y]`` rows; named columns
         (a dict or a DataFrame, picked by ``time``/``input``/``output``, else taken in that order; a
-        DataFrame's index is the time when ``time`` is ``"index"``); or a CSV/MAT path.
+        DataFrame's index is the time when ``time`` is ``"index"``; columns that are not numbers are
+        left out when time, input and output are named); or a CSV/MAT path.
     time, input, output : str, optional
         Column names, for named columns and files.
     aux : sequence of str
@@ -77,13 +79,17 @@ def as_record(
         return data
     if isinstance(data, str | Path):
         return load_record(data, time, input, output, aux, input_unit, output_unit, dt)
+    named = [n for n in (time, input, output, *aux) if n is not None]
+    explicit = input is not None and output is not None and (time is not None or dt is not None)
     if _is_table(data):
-        columns = {str(c): np.asarray(data[c], dtype=float) for c in data.columns}
+        raw = {str(c): data[c] for c in data.columns}
         if time == "index":
-            columns = {"index": np.asarray(data.index, dtype=float), **columns}
+            raw = {"index": data.index, **raw}
+        columns = _numeric_columns(raw, "DataFrame", named, explicit)
         return record_from_columns(columns, "DataFrame", time, input, output, aux, input_unit, output_unit, dt)
     if isinstance(data, Mapping):
-        return record_from_columns(data, "columns", time, input, output, aux, input_unit, output_unit, dt)
+        columns = _numeric_columns({str(k): v for k, v in data.items()}, "columns", named, explicit)
+        return record_from_columns(columns, "columns", time, input, output, aux, input_unit, output_unit, dt)
     arrays = _as_arrays(data)
     if arrays is not None:
         if len(arrays) == 2 and dt is not None:
@@ -96,11 +102,32 @@ def as_record(
     raise DataError("not a record; give a Record, (t, u, y) arrays, columns or a CSV/MAT path", where=type(data).__name__)
 
 
+def _numeric_columns(raw: Mapping[str, Any], where: str, named: Sequence[str], explicit: bool) -> dict[str, np.ndarray]:
+    """The numeric columns of ``raw``; a column that is not numeric is left out unless it is needed.
+
+    It is needed when it is named, or when the columns are not all ``explicit`` (time, input and
+    output are then taken in column order, which a left-out column would shift).
+    """
+    out: dict[str, np.ndarray] = {}
+    for name, values in raw.items():
+        try:
+            out[name] = np.asarray(values, dtype=float)
+        except (TypeError, ValueError):
+            if name in named or not explicit:
+                raise DataError(f"column '{name}' is not numeric", where=where) from None
+    return out
+
+
 def _as_arrays(data: object) -> list[np.ndarray] | None:
-    """``(t, u, y)`` or an N x 3 / 3 x N array as a list of 1-D arrays, else None."""
-    if isinstance(data, np.ndarray) and data.ndim == 2:
-        cols = data if data.shape[0] in (2, 3) and data.shape[1] > 3 else data.T
-        return [np.asarray(c, dtype=float) for c in cols]
-    if isinstance(data, tuple | list) and 2 <= len(data) <= 3 and all(np.ndim(a) == 1 for a in data):
-        return [np.asarray(a, dtype=float) for a in data]
+    """``(t, u, y)``, an N x 3 / 3 x N array or a list of ``[t, u, y]`` rows as a list of 1-D arrays, else None."""
+    try:
+        if isinstance(data, tuple | list) and 2 <= len(data) <= 3 and all(np.ndim(a) == 1 for a in data):
+            return [np.asarray(a, dtype=float) for a in data]
+        if isinstance(data, tuple | list):
+            data = np.asarray(data, dtype=float)
+        if isinstance(data, np.ndarray) and data.ndim == 2:
+            cols = data if data.shape[0] in (2, 3) and data.shape[1] > 3 else data.T
+            return [np.asarray(c, dtype=float) for c in cols]
+    except (TypeError, ValueError):  # ragged or not numbers
+        return None
     return None

@@ -20,6 +20,11 @@ import numpy as np
 from synth.errors import DataError
 from synth.plant import Signal
 
+__all__ = [
+    "IRREGULAR_TOLERANCE", "Record", "load_record", "read_columns", "record_from_arrays", "record_from_columns",
+    "uniform_columns",
+]
+
 #: relative spread of the sample intervals above which a record counts as irregularly sampled
 IRREGULAR_TOLERANCE = 1e-3
 

@@ -7,12 +7,18 @@ metrics (bandwidth, phase delay) and disturbance spectra. Modules:
 - :mod:`synth.ident.structure`: parametric transfer-function formulas (numpy and casadi).
 - :mod:`synth.ident.steps`: find, align and average the steps of a step train; SNR.
 - :mod:`synth.ident.timefit`: simulation-error fit of a structure (casadi + IPOPT), delay, sensor,
-  standard errors; :func:`identify` averages a step train first.
+  standard errors; :func:`identify` averages a step train first. Its casadi problem is in
+  :mod:`synth.ident.sim_error_problem`, its deterministic start (SRIVC) in :mod:`synth.ident.srivc`.
 - :mod:`synth.ident.x4_record`: the SYNTHETIC X-4 step-train record from the seed's model.
 - :mod:`synth.ident.sweep_design`, :mod:`synth.ident.spectra`, :mod:`synth.ident.freqfit`: sweep
-  design, composite multi-window frequency response, NAVFIT-cost fit with an exact delay.
-- :mod:`synth.ident.hq`: handling-qualities bandwidth and phase delay.
-- :mod:`synth.ident.psd`: disturbance spectra, noise floor, spikes, power-share frequency.
+  design, composite multi-window frequency response (windows and averaging in
+  :mod:`synth.ident.spectral_windows`, coherence and the coherent band in :mod:`synth.ident.coherence`),
+  NAVFIT-cost fit with an exact delay.
+- :mod:`synth.ident.hq_metrics`, :mod:`synth.ident.hq`, :mod:`synth.ident.model_phase`: handling-qualities
+  bandwidth and phase delay (definitions; estimation from a model or measurements; a model's exact phase).
+- :mod:`synth.ident.psd`: disturbance spectra (:mod:`synth.ident.welch`), noise floor, spikes, trend,
+  power-share frequency (:mod:`synth.ident.spectrum_features`), the bandwidth they suggest
+  (:mod:`synth.ident.bandwidth_suggestion`).
 - :mod:`synth.ident.from_spec`: a spec's ``plant: {identify: ...}`` and its uncertainty plants.
 
 Names are imported on first use (casadi and scipy load only when needed).
@@ -38,10 +44,10 @@ _EXPORTS = {
     "x4_step_train": "x4_record", "x4_step_train_path": "x4_record",
     "design_sweep": "sweep_design", "SweepDesign": "sweep_design",
     "frequency_response": "spectra", "FrequencyResponse": "spectra", "rate_to_attitude": "spectra",
-    "coherent_band": "spectra",
+    "coherent_band": "coherence",
     "fit_frequency_response": "freqfit", "FreqFit": "freqfit", "fit_cost": "freqfit", "verify_step": "freqfit",
-    "hq_from_plant": "hq", "hq_from_frd": "hq", "HQMetrics": "hq",
-    "analyze_psd": "psd", "analyze_records": "psd", "PsdAnalysis": "psd", "suggest_bandwidth": "psd",
+    "hq_from_plant": "hq", "hq_from_frd": "hq", "HQMetrics": "hq_metrics",
+    "analyze_psd": "psd", "analyze_records": "psd", "PsdAnalysis": "psd", "suggest_bandwidth": "bandwidth_suggestion",
 }
 
 __all__ = sorted(_EXPORTS)

@@ -18,6 +18,8 @@ from synth.figure_files import save_figure
 from synth.ident.freqfit import FreqFit, StepVerification
 from synth.ident.spectra import FrequencyResponse
 
+__all__ = ["bode_figure", "verification_figure"]
+
 
 def bode_figure(resp: FrequencyResponse, path: str | Path, fit: FreqFit | None = None) -> Path:
     """Magnitude, phase and coherence of the estimate (coherent band shaded), with the fit if given.
@@ -25,7 +27,7 @@ def bode_figure(resp: FrequencyResponse, path: str | Path, fit: FreqFit | None =
     Examples
     --------
     >>> import tempfile, pathlib
-    >>> from synth.ident.spectra import coherent_band
+    >>> from synth.ident.coherence import coherent_band
     >>> w = np.geomspace(1, 10, 5); b = coherent_band(w, np.ones(5))
     >>> r = FrequencyResponse(w, 1 / (1j * w + 1), np.ones(5), np.full(5, .05), np.ones(5), np.ones(5),
     ...                       np.ones(5), np.ones(5, complex), b, (10.0,))

@@ -36,6 +36,11 @@ from synth.ident.structure import Structure, parse_structure
 from synth.plant import Plant
 from synth.polynomials import format_factored
 
+__all__ = [
+    "IPOPT_OPTIONS", "W_G", "W_P", "FreqFit", "StepVerification", "coherence_weight", "fit_cost",
+    "fit_frequency_response", "parse_orders", "verify_step",
+]
+
 W_G = 1.0
 W_P = 0.01745
 IPOPT_OPTIONS = {"ipopt.print_level": 0, "print_time": False, "ipopt.sb": "yes", "ipopt.max_iter": 500,

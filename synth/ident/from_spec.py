@@ -22,6 +22,8 @@ from scipy.stats import chi2
 from synth.errors import ModelError, SynthError
 from synth.plant import Plant, Signal
 
+__all__ = ["BUILTIN_RECORDS", "IdentifySettings", "identify_plant", "resolve_data", "uncertainty_plants"]
+
 #: data sources that synth generates itself; the name is written ``builtin:<name>`` in a spec
 BUILTIN_RECORDS = {"x4_step_train": "SYNTHETIC X-4 rotor step train (seed 1, sec. 4B model; synth.ident.x4_record)"}
 

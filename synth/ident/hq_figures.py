@@ -1,6 +1,6 @@
 """Figure of the handling-qualities metrics: Bode plot with the constructions of seed 2, fig. 1.
 
-Draws only what :class:`synth.ident.hq.HQMetrics` holds: its curve, ``w180`` and ``2 w180``, the
+Draws only what :class:`synth.ident.hq_metrics.HQMetrics` holds: its curve, ``w180`` and ``2 w180``, the
 -135 deg and -180 deg lines, the gain 6 dB above the gain at ``w180``, both bandwidths and the
 phase-delay chord (or the least-squares phase line) from ``w180`` to ``2 w180``.
 """
@@ -18,7 +18,9 @@ from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter
 
 from synth.errors import ModelError
 from synth.figure_files import save_figure
-from synth.ident.hq import GAIN_MARGIN_DB, HQMetrics
+from synth.ident.hq_metrics import GAIN_MARGIN_DB, HQMetrics
+
+__all__ = ["hq_bode"]
 
 
 def hq_bode(m: HQMetrics, path: str | Path, title: str = "") -> Path:

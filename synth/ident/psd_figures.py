@@ -14,7 +14,10 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 from synth.figure_files import save_figure
-from synth.ident.psd import PsdAnalysis, unit_squared
+from synth.ident.psd import PsdAnalysis
+from synth.ident.welch import unit_squared
+
+__all__ = ["psd_plot"]
 
 
 def psd_plot(a: PsdAnalysis, path: str | Path, title: str = "") -> Path:

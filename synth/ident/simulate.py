@@ -16,6 +16,8 @@ from synth.errors import DataError, ModelError
 from synth.plant import Plant
 from synth.sim.discretize import delayed_zoh, tf_to_ss
 
+__all__ = ["simulate_plant"]
+
 
 def _shift(x: np.ndarray, k: int) -> np.ndarray:
     """``x`` delayed by ``k`` samples, zero before the start."""

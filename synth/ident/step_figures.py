@@ -18,6 +18,8 @@ from synth.data.record import Record
 from synth.figure_files import save_figure
 from synth.ident.timefit import TimeFitResult
 
+__all__ = ["fit_figure", "train_figure"]
+
 
 def _label(name: str, unit: str) -> str:
     return f"{name} [{unit}]" if unit else name

@@ -45,6 +45,8 @@ from synth.data.record import Record, record_from_arrays
 from synth.errors import DataError
 from synth.plant import Signal
 
+__all__ = ["StepAverage", "Steps", "average_steps", "find_steps"]
+
 
 @dataclass(frozen=True)
 class Steps:

@@ -27,6 +27,8 @@ import numpy as np
 from synth.errors import ModelError
 from synth.plant import Plant
 
+__all__ = ["Structure", "parse_structure"]
+
 _TOKEN = re.compile(r"\s*(?:(?P<num>(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?)|(?P<name>[A-Za-z_]\w*)|(?P<op>\*\*|[-+*/^()]))")
 _RESERVED = {"s", "exp"}
 

@@ -16,7 +16,7 @@ The recipe (the NASA Bell 214ST sweep report, sections 2 and 6.1)
 What this module adds (design choices, not the report's): the run length is
 ``max(90 s, 4.5 T_max)``: the report's two cases have 90/15.7 = 5.7 and 90/20 =
 4.5 periods of ``T_max`` per run; the spectral analysis needs windows of
-``2 T_max`` (:func:`synth.ident.spectra.required_window`), which fit at least
+``2 T_max`` (:func:`synth.ident.spectral_windows.required_window`), which fit at least
 three times, overlapped by half, into such a run. The generated input is the
 exponential sweep ``w(t) = w_min + C2 (w_max - w_min)(exp(C1 t/T) - 1)`` with
 ``C1 = 4``, ``C2 = 1 / (exp(C1) - 1)`` after the two ``T_max`` cycles, with a
@@ -31,7 +31,9 @@ from typing import Any
 import numpy as np
 
 from synth.errors import DataError
-from synth.ident.spectra import default_windows
+from synth.ident.spectral_windows import default_windows
+
+__all__ = ["MIN_PERIODS_PER_RUN", "SEED_RUN_LENGTH", "SweepDesign", "design_sweep"]
 
 #: run length the report recommends [s]
 SEED_RUN_LENGTH = 90.0
@@ -60,7 +62,7 @@ class SweepDesign:
     sample_rate : float
         Suggested sample rate [Hz]: at least 25 samples per period of ``w_max``.
     windows : tuple of float
-        Composite analysis windows [s] (:func:`synth.ident.spectra.default_windows`).
+        Composite analysis windows [s] (:func:`synth.ident.spectral_windows.default_windows`).
 
     Examples
     --------

@@ -1,49 +1,18 @@
 """Simulation-error fit of a parametric structure to a sampled record, with casadi (IPOPT).
 
-Model
------
-``yhat(t_k) = b + [F(s; theta) H(s) exp(-d s)] (u - u_0)`` sampled at ``t_k``,
-with ``F`` the structure (:mod:`synth.ident.structure`), ``H`` an optional
-known sensor in series (fit ``F H``, report ``F``), ``d`` the delay and ``b``
-an output offset (the pre-step level; a nuisance parameter, so an affine
-static map such as a friction offset does not bias the gain). The input is
-held between samples (zero-order hold), so the sampled model is exact:
-``x_{k+1} = Ad x_k + B_early w_{k-m-1} + B_late w_{k-m}`` with ``d = m dt + f``,
-``Ad = e^{A dt}``, ``B_late = G(dt - f)``, ``B_early = e^{A (dt - f)} G(f)`` and
-``G(h) = int_0^h e^{A s} ds B`` (the same discretization as
-:func:`synth.ident.simulate.simulate_plant`). The matrix exponentials are
-written symbolically in casadi (Taylor series with scaling and squaring on a
-balanced companion realization), so IPOPT gets exact derivatives in the
-parameters *and* in the fractional delay ``f``, which is a bounded variable in
-``[0, dt]``. The whole-sample part ``m`` is searched outside: if ``f`` ends on
-a bound, ``m`` moves by one sample and the fit is repeated (at ``f = dt`` the
+The model, its exact zero-order-hold discretization with a fractional delay and the
+Gauss-Newton IPOPT problem are in :mod:`synth.ident.sim_error_problem`; the
+deterministic start (SRIVC on a delay grid, mapped onto the structure) in
+:mod:`synth.ident.srivc`. Here: the fit itself (the whole-sample delay search, the
+fallback starts), its uncertainty and :func:`identify` (a step train is averaged first).
+
+Delay search
+------------
+The fractional delay ``f`` is bounded in ``[0, dt]``; if it ends on a bound, the
+whole-sample part ``m`` moves by one sample and the fit is repeated (at ``f = dt`` the
 models for ``m`` and ``m + 1`` coincide, so the cost is continuous in ``d``).
-
-Initial state: at rest (``"steady"``: before the first sample the input was
-``u_0``) or periodic (the averaged period of a step train, ``"periodic"``:
-``x_0 = (I - Ad^N)^{-1} x_N`` with ``x_N`` the state after one period from
-zero, exact for a periodic input).
-
-Cost and solver
----------------
-``sum_k (y_k - yhat_k)^2``, minimized by IPOPT with the Gauss-Newton Hessian
-``J^T J`` (``J`` the casadi Jacobian of ``yhat``), which is what a
-least-squares problem needs and is much cheaper than the exact Hessian
-through the recursion.
-
-Deterministic initialization
-----------------------------
-1. A linear continuous-time model of the structure's orders is fitted by the
-   simplified refined instrumental-variable method (SRIVC: the
-   Sanathanan-Koerner / Steiglitz-McBride iteration with the prefilter
-   ``1/A(s)`` and instruments from the simulated noise-free output), first
-   with the state-variable filter ``1/(s + lambda)^n`` for a few ``lambda``,
-   then on a grid of delays up to the first visible response.
-2. That model is mapped onto the structure's parameters by a least-squares
-   fit of the frequency responses (relative error on a log grid around its
-   poles and zeros), from a fixed list of starting points.
-3. IPOPT starts there. Only if it fails, or ends worse than the initial
-   model, a fixed list of other starts is tried (multistart as a fallback).
+IPOPT starts at the deterministic initial model. Only if it fails, or ends worse
+than the initial model, a fixed list of other starts is tried (multistart as a fallback).
 
 Uncertainty
 -----------
@@ -64,76 +33,18 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
-from scipy.linalg import matrix_balance
-from scipy.optimize import least_squares
 from scipy.stats import t as student_t
 
+from synth.data.coerce import RecordLike, as_record
 from synth.data.record import Record
 from synth.errors import DataError, ModelError
+from synth.ident.sim_error_problem import SimulationErrorProblem
+from synth.ident.srivc import linear_initial_model, map_to_structure
 from synth.ident.steps import StepAverage, average_steps, find_steps
 from synth.ident.structure import Structure, parse_structure
 from synth.plant import Plant
 
-# ---------------------------------------------------------------- realization
-
-
-def _companion(num: list[Any], den: list[Any]) -> tuple[list[list[Any]], list[Any], Any]:
-    """Controllable canonical ``A`` (nested lists), ``C`` and ``D`` of ``num/den`` (any numeric type)."""
-    n = len(den) - 1
-    lead = den[0]
-    a = [d / lead for d in den[1:]]
-    b = [0.0] * (n + 1 - len(num)) + [c / lead for c in num]
-    D = b[0]
-    r = [b[i + 1] - D * a[i] for i in range(n)]
-    A = [[0.0] * n for _ in range(n)]
-    for i in range(n - 1):
-        A[i][i + 1] = 1.0
-    for j in range(n):
-        A[n - 1][j] = -a[n - 1 - j]
-    C = [r[n - 1 - j] for j in range(n)]
-    return A, C, D
-
-
-def _expm(M: Any, squarings: int, order: int = 12) -> Any:
-    import casadi as ca
-
-    n = M.shape[0]
-    X = M / float(2**squarings)
-    E = ca.MX.eye(n)
-    for k in range(order, 0, -1):
-        E = ca.MX.eye(n) + (X @ E) / k
-    for _ in range(squarings):
-        E = E @ E
-    return E
-
-
-def _matpow(M: Any, k: int) -> Any:
-    import casadi as ca
-
-    result = ca.MX.eye(M.shape[0])
-    base = M
-    while k:
-        if k & 1:
-            result = result @ base
-        k >>= 1
-        if k:
-            base = base @ base
-    return result
-
-
-def _series(num: list[Any], den: list[Any], sensor: Plant | None) -> tuple[list[Any], list[Any]]:
-    if sensor is None:
-        return list(num), list(den)
-
-    def mul(p: list[Any], q: np.ndarray) -> list[Any]:
-        out: list[Any] = [0.0] * (len(p) + q.size - 1)
-        for i, x in enumerate(p):
-            for j, y in enumerate(q):
-                out[i + j] = out[i + j] + x * float(y)
-        return out
-
-    return mul(list(num), sensor.num), mul(list(den), sensor.den)
-
+__all__ = ["IdentifyResult", "TimeFitResult", "fit_structure", "identify"]
 
 # ------------------------------------------------------------------- results
 
@@ -242,364 +153,6 @@ class TimeFitResult:
         }
 
 
-# ------------------------------------------------------------ initialization
-
-
-def _expm_np(M: np.ndarray) -> np.ndarray:
-    """Matrix exponential of a small matrix (Taylor series, scaling and squaring).
-
-    Used instead of :func:`scipy.linalg.expm` on the hot paths: for 2x2 to 6x6
-    matrices scipy's BLAS calls can cost milliseconds each when the machine is
-    busy (thread start-up), this costs microseconds.
-    """
-    norm = float(np.max(np.sum(np.abs(M), axis=0))) if M.size else 0.0
-    k = max(0, int(np.ceil(np.log2(norm))) + 2) if norm > 0 else 0
-    X = M / 2.0**k
-    E = np.eye(M.shape[0])
-    for j in range(16, 0, -1):
-        E = np.eye(M.shape[0]) + (X @ E) / j
-    for _ in range(k):
-        E = E @ E
-    return E
-
-
-def _delayed_zoh(A: np.ndarray, B: np.ndarray, dt: float, delay: float) -> Any:
-    """:func:`synth.sim.discretize.delayed_zoh` with :func:`_expm_np`."""
-    from synth.sim.discretize import DelayedZOH
-
-    n = A.shape[0]
-
-    def zoh(h: float) -> tuple[np.ndarray, np.ndarray]:
-        M = np.zeros((n + 1, n + 1))
-        M[:n, :n], M[:n, n] = A * h, B * h
-        E = _expm_np(M)
-        return E[:n, :n], E[:n, n]
-
-    steps = int(np.floor(delay / dt + 1e-9))
-    fraction = delay - steps * dt
-    Ad, G = zoh(dt)
-    if fraction < 1e-9 * dt:
-        return DelayedZOH(Ad, np.zeros(n), G, steps, 0.0)
-    A_rest, G_late = zoh(dt - fraction)
-    _, G_f = zoh(fraction)
-    return DelayedZOH(Ad, A_rest @ G_f, G_late, steps, fraction)
-
-
-def _filter_bank(den: np.ndarray, dt: float, x: np.ndarray, count: int, delay: float = 0.0) -> list[np.ndarray]:
-    """``s^k / den(s)`` applied to the held samples ``x`` (delayed), ``k = 0 .. count - 1``, zero initial state.
-
-    One exact ZOH discretization of the companion form of ``1/den`` serves every ``k``
-    (its states are ``s^k/den x``); ``k = deg(den)`` follows from ``den`` itself.
-    """
-    from scipy.signal import lfilter, ss2tf
-
-    den = np.asarray(den, float) / den[0]
-    n = den.size - 1
-    A = np.zeros((n, n))
-    A[:-1, 1:] = np.eye(n - 1)
-    A[-1, :] = -den[1:][::-1]
-    B = np.zeros(n)
-    B[-1] = 1.0
-    z = _delayed_zoh(A, B, dt, delay)
-
-    def shift(v: np.ndarray, k: int) -> np.ndarray:
-        out = np.zeros_like(v)
-        if k < v.size:
-            out[k:] = v[:v.size - k]
-        return out
-
-    late, early = shift(x, z.steps), shift(x, z.steps + 1)
-    out = []
-    for k in range(min(count, n)):
-        C = np.zeros((1, n))
-        C[0, k] = 1.0
-        y = np.zeros_like(x)
-        for Bk, xin in ((z.B_late, late), (z.B_early, early)):
-            if np.any(Bk):
-                num, dd = ss2tf(z.Ad, Bk[:, None], C, np.zeros((1, 1)))
-                y = y + lfilter(num[0], dd, xin)
-        out.append(y)
-    if count > n:
-        direct = shift(x, z.steps + (1 if z.fraction > 0 else 0))
-        out.append(direct - sum(den[n - k] * out[k] for k in range(n)))
-    return out
-
-
-def _bank(den: np.ndarray, t: np.ndarray, x: np.ndarray, count: int, delay: float, periodic: bool,
-          reps: int) -> list[np.ndarray]:
-    dt = float(t[1] - t[0])
-    if not periodic:
-        return _filter_bank(den, dt, x, count, delay)
-    n = x.size
-    return [v[-n:] for v in _filter_bank(den, dt, np.tile(x, reps), count, delay)]
-
-
-def _tile_filter(plant: Plant, t: np.ndarray, x: np.ndarray, periodic: bool, reps: int) -> np.ndarray:
-    """``plant`` applied to ``x`` from zero state (or its periodic response), through :func:`_filter_bank`."""
-    num = plant.num[::-1]
-    bank = _bank(plant.den, t, x, num.size, plant.delay, periodic, reps)
-    return sum(c * b for c, b in zip(num, bank))
-
-
-def _reps(den: np.ndarray, duration: float) -> int:
-    """Periods to simulate so the transient of ``1/den`` has decayed below 1e-6."""
-    slowest = float(np.min(np.abs(np.real(np.roots(den))))) if den.size > 1 else 1e9
-    if slowest <= 0:
-        return 10
-    return int(min(20, max(2, np.ceil(14.0 / (slowest * duration)) + 1)))
-
-
-def _stable(den: np.ndarray) -> np.ndarray:
-    roots = np.roots(den)
-    if roots.size == 0:
-        return den
-    roots = np.where(roots.real > 0, -roots.real + 1j * roots.imag, roots)
-    roots = np.where(np.abs(roots.real) < 1e-9, roots - 1e-6, roots)
-    return np.real(np.poly(roots)) * den[0]
-
-
-def _srivc(t: np.ndarray, v: np.ndarray, y: np.ndarray, na: int, nb: int, delay: float, lam: float,
-           periodic: bool, iterations: int = 8) -> tuple[np.ndarray, np.ndarray, float]:
-    """SRIVC estimate of ``B(s)/A(s) exp(-delay s)`` from ``v`` to ``y`` (deviation signals)."""
-    duration = t[-1] - t[0] + (t[1] - t[0])
-    den = np.poly(-lam * np.ones(na)) if na else np.array([1.0])
-    num = None
-    for it in range(iterations + 1):
-        reps = _reps(den, duration) if periodic else 1
-        yf = _bank(den, t, y, na + 1, 0.0, periodic, reps)
-        vf = _bank(den, t, v, nb + 1, delay, periodic, reps)
-        phi = np.column_stack([-yf[k] for k in range(na)] + vf)
-        if num is None:
-            zeta = phi
-        else:
-            xhat = _tile_filter(Plant(num, den, delay), t, v, periodic, reps)
-            xf = _bank(den, t, xhat, na, 0.0, periodic, reps)
-            zeta = np.column_stack([-xf[k] for k in range(na)] + vf)
-        try:
-            est = np.linalg.solve(zeta.T @ phi, zeta.T @ yf[na])
-        except np.linalg.LinAlgError:
-            est = np.linalg.lstsq(phi, yf[na], rcond=None)[0]
-        a = est[:na][::-1]
-        new_den = _stable(np.r_[1.0, a]) if na else np.array([1.0])
-        new_num = est[na:][::-1]
-        converged = num is not None and np.allclose(new_den, den, rtol=1e-7) and np.allclose(new_num, num, rtol=1e-7)
-        den, num = new_den, new_num
-        if converged and it > 0:
-            break
-    reps = _reps(den, duration) if periodic else 1
-    sim = _tile_filter(Plant(num, den, delay), t, v, periodic, reps)
-    return num, den, float(np.sum((y - sim) ** 2))
-
-
-def _first_response(t: np.ndarray, w: np.ndarray, y: np.ndarray) -> float:
-    """Time from the first input change to the first output change above the noise."""
-    k0 = int(np.flatnonzero(np.abs(np.diff(w)) > 0)[0]) + 1 if np.any(np.diff(w)) else 0
-    sigma = float(np.std(np.diff(y)) / np.sqrt(2.0)) + 1e-12 * (np.ptp(y) + 1.0)
-    base = float(np.mean(y[max(0, k0 - 20):k0 + 1]))
-    after = np.flatnonzero(np.abs(y[k0:] - base) > max(5 * sigma, 0.05 * np.ptp(y)))
-    return float(after[0] * (t[1] - t[0])) if after.size else 0.1 * float(t[-1] - t[0])
-
-
-def _linear_init(t: np.ndarray, w: np.ndarray, yd: np.ndarray, st: Structure, sensor: Plant | None, periodic: bool,
-                 delay: float | None) -> tuple[np.ndarray, np.ndarray, float]:
-    """Deterministic linear model (num, den of F) and delay from SRIVC on a delay grid."""
-    dt = t[1] - t[0]
-    duration = t[-1] - t[0] + dt
-    reps = _reps(sensor.den, duration) if (periodic and sensor is not None) else 1
-    v = _tile_filter(sensor.with_delay(0.0), t, w, periodic, reps) if sensor is not None else w
-    na, nb = st.den_degree, st.num_degree
-    if delay is None:
-        d_vis = max(_first_response(t, w, yd), 2 * dt)
-        grid = np.linspace(0.0, d_vis, 9)
-    else:
-        grid = np.array([delay])
-    lams = np.geomspace(20.0 / duration, 0.05 / dt, 5)
-    mid = grid[len(grid) // 2]
-    best_lam = min(lams, key=lambda lam: _srivc(t, v, yd, na, nb, mid, lam, periodic, 4)[2])
-    fits = [(_srivc(t, v, yd, na, nb, d, best_lam, periodic), d) for d in grid]
-    (num, den, ssr), d0 = min(fits, key=lambda f: f[0][2])
-    if grid.size > 1:  # refine the delay between the neighbouring grid points
-        from scipy.optimize import minimize_scalar
-
-        step = grid[1] - grid[0]
-        sol = minimize_scalar(lambda d: _srivc(t, v, yd, na, nb, d, best_lam, periodic, 4)[2],
-                              bounds=(max(0.0, d0 - step), d0 + step), method="bounded",
-                              options={"xatol": 0.1 * dt})
-        if sol.fun < ssr:
-            d0 = float(sol.x)
-            num, den, _ = _srivc(t, v, yd, na, nb, d0, best_lam, periodic)
-    return num, den, float(d0)
-
-
-def _map_to_structure(st: Structure, num: np.ndarray, den: np.ndarray) -> np.ndarray:
-    """Structure parameters whose frequency response best matches ``num/den`` (relative error)."""
-    roots = np.r_[np.roots(den), np.roots(num) if num.size > 1 else []]
-    mags = np.abs(roots[np.abs(roots) > 1e-9])
-    lo, hi = (float(mags.min()) / 10, float(mags.max()) * 10) if mags.size else (0.01, 100.0)
-    w = np.geomspace(lo, hi, 80)
-    s = 1j * w
-    target = np.polyval(num, s) / np.polyval(den, s)
-    weight = 1.0 / np.maximum(np.abs(target), 1e-300)
-
-    def resid(theta: np.ndarray) -> np.ndarray:
-        n_, d_ = st.coefficients(theta)
-        with np.errstate(all="ignore"):
-            g = np.polyval(n_, s) / np.polyval(d_, s)
-        r = (g - target) * weight
-        r = np.r_[r.real, r.imag]
-        return np.where(np.isfinite(r), r, 1e6)
-
-    num_t = np.r_[np.zeros(st.num_degree + 1 - num.size), num] / den[0]
-    den_t = den / den[0]
-    target_c = np.r_[num_t, den_t]
-    cscale = np.maximum(np.abs(target_c), 1e-9 * np.max(np.abs(target_c)))
-
-    def resid_coef(theta: np.ndarray) -> np.ndarray:
-        n_, d_ = st.coefficients(theta)
-        with np.errstate(all="ignore"):
-            r = (np.r_[n_, d_] / d_[0] - target_c) / cscale
-        return np.where(np.isfinite(r), r, 1e6)
-
-    p = len(st.parameters)
-    best: tuple[float, np.ndarray] | None = None
-    for c in (1.0, 0.1, 10.0, 0.01, 100.0, 1000.0):
-        x0 = c * (1.0 + 0.15 * np.arange(p))
-        try:  # coefficient matching first (polynomial equations, few local minima), then the frequency fit
-            sol = least_squares(resid_coef, x0, method="lm", max_nfev=400 * (p + 1))
-            sol = least_squares(resid, sol.x, method="lm", max_nfev=400 * (p + 1))
-        except (ValueError, np.linalg.LinAlgError):
-            continue
-        cost = float(np.sum(sol.fun**2))
-        if best is None or cost < best[0]:
-            best = (cost, sol.x)
-        if cost < 1e-16 * w.size:
-            break
-    if best is None:
-        raise ModelError(f"structure {st.formula!r}: could not map an initial linear model onto its parameters")
-    return best[1]
-
-
-# ------------------------------------------------------------------ the NLP
-
-
-class _Problem:
-    """The casadi simulation-error problem for fixed data length; the delayed inputs are NLP parameters."""
-
-    def __init__(self, st: Structure, sensor: Plant | None, n: int, dt: float, periodic: bool, theta0: np.ndarray,
-                 fit_delay: bool, y: np.ndarray, has_d: bool, weights: np.ndarray | None = None) -> None:
-        import casadi as ca
-
-        self.n, self.dt, self.periodic = n, dt, periodic
-        p = len(st.parameters)
-        self.scale = np.where(np.abs(theta0) > 1e-8, np.abs(theta0), 1.0)
-        xi = ca.MX.sym("xi", p)
-        f = ca.MX.sym("f") if fit_delay else ca.MX.sym("f_fixed")
-        b = ca.MX.sym("b")
-        W = ca.MX.sym("W", 2, n)
-        theta = xi * ca.DM(self.scale)
-        num, den = _series(*st.casadi_coefficients(theta), sensor)
-        num0, den0 = _series(*[list(c) for c in st.coefficients(theta0)], sensor)
-        A0, _, _ = _companion(num0, den0)
-        order = len(den) - 1
-        if order == 0:
-            raise ModelError(f"structure {st.formula!r}: a static gain needs no dynamic fit")
-        A0 = np.asarray(A0, float)
-        _, (scl, _) = matrix_balance(A0, permute=False, separate=True)
-        Tm, Ti = np.diag(scl), np.diag(1.0 / scl)
-        A_l, C_l, D = _companion(num, den)
-        A = ca.vertcat(*[ca.horzcat(*row) for row in A_l])
-        C = ca.horzcat(*C_l)
-        A = ca.DM(Ti) @ A @ ca.DM(Tm)
-        Bv = ca.DM(Ti[:, -1])
-        C = C @ ca.DM(Tm)
-        Mnum = np.zeros((order + 1, order + 1))
-        Mnum[:order, :order] = Ti @ A0 @ Tm
-        Mnum[:order, order] = Ti[:, -1]
-        norm = float(np.linalg.norm(Mnum * dt, 1))
-        squarings = int(max(0, np.ceil(np.log2(max(norm, 1e-12)))) + 4)
-        M = ca.vertcat(ca.horzcat(A, Bv), ca.DM.zeros(1, order + 1))
-        E_dt = _expm(M * dt, squarings)
-        E_rest = _expm(M * (dt - f), squarings)
-        E_f = _expm(M * f, squarings)
-        Ad = E_dt[:order, :order]
-        B_late = E_rest[:order, order]
-        B_early = E_rest[:order, :order] @ E_f[:order, order]
-        block = max(k for k in range(1, 17) if n % k == 0)  # samples per map step: fewer, larger steps are faster
-        x = ca.SX.sym("x", order)
-        wk = ca.SX.sym("wk", 2, block)
-        Adp, Blp, Bep, Cp = (ca.SX.sym("Ad", order, order), ca.SX.sym("Bl", order), ca.SX.sym("Be", order),
-                             ca.SX.sym("C", 1, order))
-        Dp = ca.SX.sym("D")
-        col = 1 if (fit_delay or has_d) else 0
-        xs, outs = x, []
-        for j in range(block):
-            outs.append(Cp @ xs + Dp * wk[col, j])
-            xs = Adp @ xs + Blp * wk[0, j] + Bep * wk[1, j]
-        step = ca.Function("step", [x, wk, Adp, Blp, Bep, Cp, Dp], [xs, ca.horzcat(*outs)])
-        acc = step.mapaccum("acc", n // block)
-        Dm = D if not isinstance(D, float) else ca.MX(D)
-        Wb = W  # 2 x n; the map reads it as n/block horizontal blocks of 2 x block
-        if periodic:
-            Xz, _ = acc(ca.MX.zeros(order), Wb, Ad, B_late, B_early, C, Dm)
-            x0 = ca.solve(ca.MX.eye(order) - _matpow(Ad, n), Xz[:, -1])
-        else:
-            x0 = ca.MX.zeros(order)
-        _, Y = acc(x0, Wb, Ad, B_late, B_early, C, Dm)
-        yhat = Y.T + b
-        dec = ca.vertcat(xi, f, b) if fit_delay else ca.vertcat(xi, b)
-        params = ca.vertcat(ca.vec(W), f) if not fit_delay else ca.vec(W)
-        self.fit_delay = fit_delay
-        self.yhat_fn = ca.Function("yhat", [dec, params], [yhat])
-        J = ca.jacobian(yhat, dec)
-        self.jac_fn = ca.Function("jacobian", [dec, params], [J])
-        s2 = float(np.var(y)) * n or 1.0
-        self.obj_scale = s2
-        if weights is None:
-            r = ca.DM(y) - yhat
-            Jw = J
-        else:  # samples outside the cost (held out, a start-up transient) weigh 0
-            wdm = ca.DM(np.asarray(weights, float))
-            r = wdm * (ca.DM(y) - yhat)
-            Jw = ca.jacobian(wdm * yhat, dec)
-        obj = 0.5 * ca.sumsqr(r) / s2
-        lam_f = ca.MX.sym("lam_f")
-        lam_g = ca.MX.sym("lam_g", 0)
-        H = lam_f * (Jw.T @ Jw) / s2
-        hess = ca.Function("nlp_hess_l", [dec, params, lam_f, lam_g], [ca.triu(H)],
-                           ["x", "p", "lam_f", "lam_g"], ["triu_hess_gamma_x_x"])
-        opts = {"print_time": False, "hess_lag": hess, "show_eval_warnings": False,  # diverging trial points: IPOPT recovers
-                "ipopt": {"print_level": 0, "sb": "yes", "tol": 1e-12, "acceptable_tol": 1e-9, "max_iter": 300}}
-        self.solver = ca.nlpsol("timefit", "ipopt", {"x": dec, "p": params, "f": obj}, opts)
-        self.p = p
-
-    def inputs(self, w: np.ndarray, m: int, fixed_f: float | None = None) -> np.ndarray:
-        n = self.n
-        if self.periodic:
-            late, early = np.roll(w, m), np.roll(w, m + 1)
-        else:
-            late = np.r_[np.zeros(min(m, n)), w[:max(0, n - m)]]
-            early = np.r_[np.zeros(min(m + 1, n)), w[:max(0, n - m - 1)]]
-        vec = np.column_stack([late, early]).ravel()  # column-major vec of the 2 x n matrix
-        return vec if fixed_f is None else np.r_[vec, fixed_f]
-
-    def solve(self, x0: np.ndarray, par: np.ndarray, nonnegative_f: bool = False,
-              lower: np.ndarray | None = None) -> tuple[np.ndarray, float, dict[str, Any]]:
-        lbx = -np.inf * np.ones(x0.size)
-        if lower is not None:  # bounds on the structure's parameters (scaled like them)
-            p = lower.size
-            lbx[:p] = lower / self.scale
-            x0 = x0.copy()
-            x0[:p] = np.maximum(x0[:p], lbx[:p])
-        if self.fit_delay and nonnegative_f:  # no delay below 0 (a predictor)
-            lbx[self.p] = 0.0
-            x0 = x0.copy()
-            x0[self.p] = max(x0[self.p], 0.1 * self.dt)
-        sol = self.solver(x0=x0, p=par, lbx=lbx)
-        stats = self.solver.stats()
-        return (np.asarray(sol["x"]).ravel(), float(sol["f"]) * 2 * self.obj_scale,
-                {"status": stats.get("return_status"), "iterations": int(stats.get("iter_count", 0)),
-                 "success": bool(stats.get("success"))})
-
 
 # ----------------------------------------------------------------- interface
 
@@ -707,8 +260,8 @@ def fit_structure(record: Record, structure: Structure | str, delay: str | float
         wd, yd = w, y - y_ref
     info: dict[str, Any] = {"method": "ipopt (casadi), Gauss-Newton Hessian", "starts": 0, "delay_shifts": 0}
     if initial is None:
-        lin_num, lin_den, d0 = _linear_init(t, wd, yd, st, sensor, periodic, None if fit_delay else fixed_delay)
-        theta0 = _map_to_structure(st, lin_num, lin_den)
+        lin_num, lin_den, d0 = linear_initial_model(t, wd, yd, st, sensor, periodic, None if fit_delay else fixed_delay)
+        theta0 = map_to_structure(st, lin_num, lin_den)
         info["initialization"] = "SRIVC linear fit on a delay grid, mapped to the structure"
     else:
         missing = [k for k in st.parameters if k not in initial]
@@ -733,7 +286,7 @@ def fit_structure(record: Record, structure: Structure | str, delay: str | float
         if int(mask.sum()) <= p_total + 1:
             raise DataError(f"{int(mask.sum())} weighted samples cannot determine {p_total} parameters",
                             where=record.source)
-    prob = _Problem(st, sensor, n, dt, periodic, theta0, fit_delay, y, has_d, weights)
+    prob = SimulationErrorProblem(st, sensor, n, dt, periodic, theta0, fit_delay, y, has_d, weights)
     b0 = y_ref if not periodic else y_ref - float(Plant(num_chk, den_chk).dc_gain()) * w_mean * (
         sensor.dc_gain() if sensor is not None else 1.0)
     initial_out = {**dict(zip(st.parameters, theta0.tolist())), delay_name: d0}
@@ -860,13 +413,15 @@ def _two_level(u: np.ndarray) -> bool:
     return bool(np.mean(near) >= 0.98)
 
 
-def identify(record: Record, structure: Structure | str, delay: str | float | None = None,
+def identify(record: RecordLike, structure: Structure | str, delay: str | float | None = None,
              sensor: Plant | str | None = None, average: str = "auto") -> IdentifyResult:
     """Identify a structure from a record: average a step train if there is one, then fit.
 
     Parameters
     ----------
-    record : Record
+    record : Record, tuple of arrays, ndarray, mapping, DataFrame, str or Path
+        What :func:`synth.data.as_record` accepts: ``(t, u, y)`` arrays, an N x 3 array,
+        columns (taken as time, input, output in that order), a CSV/MAT path or a Record.
     structure : Structure or str
     delay : {"fit", float, None}
         See :func:`fit_structure`.
@@ -879,7 +434,21 @@ def identify(record: Record, structure: Structure | str, delay: str | float | No
     Returns
     -------
     IdentifyResult
+
+    Raises
+    ------
+    DataError
+        ``record`` is not a record, or its columns fail the record's checks.
+
+    Examples
+    --------
+    >>> from synth.ident.simulate import simulate_plant
+    >>> t = np.arange(0, 3, 0.01); u = np.where(t >= 0.5, 1.0, 0.0)
+    >>> y = simulate_plant(Plant.from_string("2/(s+3)"), t, u)
+    >>> identify((t, u, y), "k/(s+p)", average="none").plant.to_string(4)
+    '2/(s+3)'
     """
+    record = as_record(record)
     if average not in ("auto", "cycle", "edge", "none"):
         raise ModelError(f"average must be 'auto', 'cycle', 'edge' or 'none', got {average!r}")
     avg = None

@@ -40,6 +40,12 @@ from synth.data.record import Record, record_from_arrays
 from synth.ident.simulate import simulate_plant
 from synth.plant import Plant, Signal
 
+__all__ = [
+    "COLUMNS", "DELAY", "FILENAME", "FS", "NOISE_STD", "PERIOD", "PERIODS", "PLANT", "SEED", "SENSOR",
+    "SPEED_AT_LOW", "STRUCTURE", "TRUTH", "VERSION", "cache_dir", "main", "write_x4_csv", "x4_step_train",
+    "x4_step_train_path",
+]
+
 PLANT = "23*(s+0.43)/((s+9.6)*(s+0.54))"
 SENSOR = "442/((s+45)*(s+9.7))"
 DELAY = 0.02

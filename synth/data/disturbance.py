@@ -1,0 +1,120 @@
+"""Disturbance (or noise) records: one measured channel, no input, validated like a record.
+
+A :class:`DisturbanceRecord` is what :func:`synth.ident.psd.analyze_records` takes; every problem
+with a file is a one-line :class:`~synth.errors.DataError` naming the file and column.
+"""
+
+from __future__ import annotations
+
+import difflib
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from synth.data.record import uniform_columns
+from synth.errors import DataError
+
+__all__ = ["DisturbanceRecord", "disturbance_from_arrays", "load_disturbance"]
+
+
+@dataclass(frozen=True, eq=False)
+class DisturbanceRecord:
+    """One uniformly sampled disturbance (or noise) signal: no input, just a measured channel.
+
+    Examples
+    --------
+    >>> r = disturbance_from_arrays(np.arange(100) * 0.01, np.sin(np.arange(100)))
+    >>> r.dt, r.x.size
+    (0.01, 100)
+    """
+
+    t: np.ndarray
+    x: np.ndarray
+    name: str = "y"
+    unit: str = ""
+    source: str = "arrays"
+    notes: tuple[str, ...] = ()
+
+    @property
+    def dt(self) -> float:
+        """Sample interval [s]."""
+        return float(round((self.t[-1] - self.t[0]) / (self.t.size - 1), 12))
+
+    @property
+    def duration(self) -> float:
+        """Record length [s]."""
+        return float(self.t[-1] - self.t[0])
+
+    def to_dict(self) -> dict[str, Any]:
+        """Summary for JSON (not the samples)."""
+        return {"source": self.source, "signal": self.name, "unit": self.unit, "samples": int(self.x.size),
+                "dt": self.dt, "duration": self.duration, "notes": list(self.notes)}
+
+
+def disturbance_from_arrays(t: Any, x: Any, name: str = "y", unit: str = "", source: str = "arrays",
+                            time_name: str = "time") -> DisturbanceRecord:
+    """Validate a time column and a signal column (irregular time is resampled linearly, with a note).
+
+    Raises
+    ------
+    DataError
+        NaN or inf, different lengths, fewer than 16 samples, non-increasing time, a constant signal.
+
+    Examples
+    --------
+    >>> t = np.arange(20.0); t[5] = t[4]
+    >>> disturbance_from_arrays(t, np.arange(20.0))
+    Traceback (most recent call last):
+    synth.errors.DataError: arrays: column 'time': time is not strictly increasing at sample 5 (t = 4 s)
+    """
+    tt, cols, notes = uniform_columns({time_name: t, name: x}, time_name, source, min_samples=16)
+    xx = cols[name]
+    if np.ptp(xx) == 0:
+        raise DataError(f"column '{name}': the signal is constant ({xx[0]:g}); it has no spectrum", where=source)
+    return DisturbanceRecord(tt, xx, name, unit, source, notes)
+
+
+def load_disturbance(path: str | Path, time: str | None, signal: str, unit: str = "",
+                     dt: float | None = None) -> DisturbanceRecord:
+    """Read one disturbance channel from a CSV or MAT file (see :func:`synth.data.record.read_columns`).
+
+    Parameters
+    ----------
+    path : str or Path
+    time : str or None
+        Time column [s]; ``None`` with ``dt`` for a file without one.
+    signal : str
+        The measured channel.
+    unit : str
+        Its unit (labels and JSON).
+    dt : float, optional
+        Sample interval [s] when there is no time column.
+
+    Examples
+    --------
+    >>> import pathlib, tempfile
+    >>> p = pathlib.Path(tempfile.mkdtemp()) / "d.csv"
+    >>> _ = p.write_text("t,speed\\n" + "".join(f"{k * 0.001},{(-1) ** k}\\n" for k in range(20)))
+    >>> load_disturbance(p, "t", "sped")
+    Traceback (most recent call last):
+    synth.errors.DataError: ...d.csv: signal column 'sped' not found; did you mean 'speed'?
+    """
+    from synth.data.record import read_columns
+
+    path = Path(path)
+    columns = read_columns(path)
+    for role, name in (("time", time), ("signal", signal)):
+        if name is not None and name not in columns:
+            close = difflib.get_close_matches(name, list(columns), n=1)
+            hint = f"; did you mean '{close[0]}'?" if close else f"; columns are {', '.join(columns) or 'none'}"
+            raise DataError(f"{role} column '{name}' not found{hint}", where=str(path))
+    x = columns[signal]
+    if time is None:
+        if dt is None or not (np.isfinite(dt) and dt > 0):
+            raise DataError("no time column given: give the sample interval dt > 0 s", where=str(path))
+        t = np.arange(x.size) * float(dt)
+    else:
+        t = columns[time]
+    return disturbance_from_arrays(t, x, signal, unit, str(path), time or "time")

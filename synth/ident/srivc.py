@@ -1,0 +1,309 @@
+"""Deterministic start of the simulation-error fit: an SRIVC linear model mapped onto a structure.
+
+1. A linear continuous-time model of the structure's orders is fitted by the
+   simplified refined instrumental-variable method (SRIVC: the
+   Sanathanan-Koerner / Steiglitz-McBride iteration with the prefilter
+   ``1/A(s)`` and instruments from the simulated noise-free output), first
+   with the state-variable filter ``1/(s + lambda)^n`` for a few ``lambda``,
+   then on a grid of delays up to the first visible response
+   (:func:`linear_initial_model`).
+2. That model is mapped onto the structure's parameters by a least-squares
+   fit of the frequency responses (relative error on a log grid around its
+   poles and zeros), from a fixed list of starting points (:func:`map_to_structure`).
+
+:func:`synth.ident.timefit.fit_structure` hands the result to IPOPT.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+from scipy.optimize import least_squares
+
+from synth.errors import ModelError
+from synth.ident.structure import Structure
+from synth.plant import Plant
+
+__all__ = ["linear_initial_model", "map_to_structure"]
+
+
+def _expm_np(M: np.ndarray) -> np.ndarray:
+    """Matrix exponential of a small matrix (Taylor series, scaling and squaring).
+
+    Used instead of :func:`scipy.linalg.expm` on the hot paths: for 2x2 to 6x6
+    matrices scipy's BLAS calls can cost milliseconds each when the machine is
+    busy (thread start-up), this costs microseconds.
+    """
+    norm = float(np.max(np.sum(np.abs(M), axis=0))) if M.size else 0.0
+    k = max(0, int(np.ceil(np.log2(norm))) + 2) if norm > 0 else 0
+    X = M / 2.0**k
+    E = np.eye(M.shape[0])
+    for j in range(16, 0, -1):
+        E = np.eye(M.shape[0]) + (X @ E) / j
+    for _ in range(k):
+        E = E @ E
+    return E
+
+
+def _delayed_zoh(A: np.ndarray, B: np.ndarray, dt: float, delay: float) -> Any:
+    """:func:`synth.sim.discretize.delayed_zoh` with :func:`_expm_np`."""
+    from synth.sim.discretize import DelayedZOH
+
+    n = A.shape[0]
+
+    def zoh(h: float) -> tuple[np.ndarray, np.ndarray]:
+        M = np.zeros((n + 1, n + 1))
+        M[:n, :n], M[:n, n] = A * h, B * h
+        E = _expm_np(M)
+        return E[:n, :n], E[:n, n]
+
+    steps = int(np.floor(delay / dt + 1e-9))
+    fraction = delay - steps * dt
+    Ad, G = zoh(dt)
+    if fraction < 1e-9 * dt:
+        return DelayedZOH(Ad, np.zeros(n), G, steps, 0.0)
+    A_rest, G_late = zoh(dt - fraction)
+    _, G_f = zoh(fraction)
+    return DelayedZOH(Ad, A_rest @ G_f, G_late, steps, fraction)
+
+
+def _filter_bank(den: np.ndarray, dt: float, x: np.ndarray, count: int, delay: float = 0.0) -> list[np.ndarray]:
+    """``s^k / den(s)`` applied to the held samples ``x`` (delayed), ``k = 0 .. count - 1``, zero initial state.
+
+    One exact ZOH discretization of the companion form of ``1/den`` serves every ``k``
+    (its states are ``s^k/den x``); ``k = deg(den)`` follows from ``den`` itself.
+    """
+    from scipy.signal import lfilter, ss2tf
+
+    den = np.asarray(den, float) / den[0]
+    n = den.size - 1
+    A = np.zeros((n, n))
+    A[:-1, 1:] = np.eye(n - 1)
+    A[-1, :] = -den[1:][::-1]
+    B = np.zeros(n)
+    B[-1] = 1.0
+    z = _delayed_zoh(A, B, dt, delay)
+
+    def shift(v: np.ndarray, k: int) -> np.ndarray:
+        out = np.zeros_like(v)
+        if k < v.size:
+            out[k:] = v[:v.size - k]
+        return out
+
+    late, early = shift(x, z.steps), shift(x, z.steps + 1)
+    out = []
+    for k in range(min(count, n)):
+        C = np.zeros((1, n))
+        C[0, k] = 1.0
+        y = np.zeros_like(x)
+        for Bk, xin in ((z.B_late, late), (z.B_early, early)):
+            if np.any(Bk):
+                num, dd = ss2tf(z.Ad, Bk[:, None], C, np.zeros((1, 1)))
+                y = y + lfilter(num[0], dd, xin)
+        out.append(y)
+    if count > n:
+        direct = shift(x, z.steps + (1 if z.fraction > 0 else 0))
+        out.append(direct - sum(den[n - k] * out[k] for k in range(n)))
+    return out
+
+
+def _bank(den: np.ndarray, t: np.ndarray, x: np.ndarray, count: int, delay: float, periodic: bool,
+          reps: int) -> list[np.ndarray]:
+    dt = float(t[1] - t[0])
+    if not periodic:
+        return _filter_bank(den, dt, x, count, delay)
+    n = x.size
+    return [v[-n:] for v in _filter_bank(den, dt, np.tile(x, reps), count, delay)]
+
+
+def _tile_filter(plant: Plant, t: np.ndarray, x: np.ndarray, periodic: bool, reps: int) -> np.ndarray:
+    """``plant`` applied to ``x`` from zero state (or its periodic response), through :func:`_filter_bank`."""
+    num = plant.num[::-1]
+    bank = _bank(plant.den, t, x, num.size, plant.delay, periodic, reps)
+    return sum(c * b for c, b in zip(num, bank))
+
+
+def _reps(den: np.ndarray, duration: float) -> int:
+    """Periods to simulate so the transient of ``1/den`` has decayed below 1e-6."""
+    slowest = float(np.min(np.abs(np.real(np.roots(den))))) if den.size > 1 else 1e9
+    if slowest <= 0:
+        return 10
+    return int(min(20, max(2, np.ceil(14.0 / (slowest * duration)) + 1)))
+
+
+def _stable(den: np.ndarray) -> np.ndarray:
+    roots = np.roots(den)
+    if roots.size == 0:
+        return den
+    roots = np.where(roots.real > 0, -roots.real + 1j * roots.imag, roots)
+    roots = np.where(np.abs(roots.real) < 1e-9, roots - 1e-6, roots)
+    return np.real(np.poly(roots)) * den[0]
+
+
+def _srivc(t: np.ndarray, v: np.ndarray, y: np.ndarray, na: int, nb: int, delay: float, lam: float,
+           periodic: bool, iterations: int = 8) -> tuple[np.ndarray, np.ndarray, float]:
+    """SRIVC estimate of ``B(s)/A(s) exp(-delay s)`` from ``v`` to ``y`` (deviation signals)."""
+    duration = t[-1] - t[0] + (t[1] - t[0])
+    den = np.poly(-lam * np.ones(na)) if na else np.array([1.0])
+    num = None
+    for it in range(iterations + 1):
+        reps = _reps(den, duration) if periodic else 1
+        yf = _bank(den, t, y, na + 1, 0.0, periodic, reps)
+        vf = _bank(den, t, v, nb + 1, delay, periodic, reps)
+        phi = np.column_stack([-yf[k] for k in range(na)] + vf)
+        if num is None:
+            zeta = phi
+        else:
+            xhat = _tile_filter(Plant(num, den, delay), t, v, periodic, reps)
+            xf = _bank(den, t, xhat, na, 0.0, periodic, reps)
+            zeta = np.column_stack([-xf[k] for k in range(na)] + vf)
+        try:
+            est = np.linalg.solve(zeta.T @ phi, zeta.T @ yf[na])
+        except np.linalg.LinAlgError:
+            est = np.linalg.lstsq(phi, yf[na], rcond=None)[0]
+        a = est[:na][::-1]
+        new_den = _stable(np.r_[1.0, a]) if na else np.array([1.0])
+        new_num = est[na:][::-1]
+        converged = num is not None and np.allclose(new_den, den, rtol=1e-7) and np.allclose(new_num, num, rtol=1e-7)
+        den, num = new_den, new_num
+        if converged and it > 0:
+            break
+    reps = _reps(den, duration) if periodic else 1
+    sim = _tile_filter(Plant(num, den, delay), t, v, periodic, reps)
+    return num, den, float(np.sum((y - sim) ** 2))
+
+
+def _first_response(t: np.ndarray, w: np.ndarray, y: np.ndarray) -> float:
+    """Time from the first input change to the first output change above the noise."""
+    k0 = int(np.flatnonzero(np.abs(np.diff(w)) > 0)[0]) + 1 if np.any(np.diff(w)) else 0
+    sigma = float(np.std(np.diff(y)) / np.sqrt(2.0)) + 1e-12 * (np.ptp(y) + 1.0)
+    base = float(np.mean(y[max(0, k0 - 20):k0 + 1]))
+    after = np.flatnonzero(np.abs(y[k0:] - base) > max(5 * sigma, 0.05 * np.ptp(y)))
+    return float(after[0] * (t[1] - t[0])) if after.size else 0.1 * float(t[-1] - t[0])
+
+
+def linear_initial_model(t: np.ndarray, w: np.ndarray, yd: np.ndarray, st: Structure, sensor: Plant | None, periodic: bool,
+                 delay: float | None) -> tuple[np.ndarray, np.ndarray, float]:
+    """Deterministic linear model (num, den of ``F``) and delay from SRIVC on a delay grid.
+
+    Parameters
+    ----------
+    t : numpy.ndarray
+        Uniform sample times [s].
+    w, yd : numpy.ndarray
+        Input and output as deviations from their reference levels.
+    st : Structure
+        Gives the orders of the linear model.
+    sensor : Plant or None
+        Known sensor in series (the input is filtered by it first).
+    periodic : bool
+        The record is one period of a periodic response.
+    delay : float or None
+        A fixed delay [s]; ``None`` searches a grid up to the first visible response.
+
+    Returns
+    -------
+    num, den : numpy.ndarray
+        Coefficients of ``F`` (highest power first).
+    delay : float
+
+    Examples
+    --------
+    >>> from synth.ident.simulate import simulate_plant
+    >>> from synth.ident.structure import parse_structure
+    >>> t = np.arange(0, 3, 0.01); u = np.where(t >= 0.5, 1.0, 0.0)
+    >>> y = simulate_plant(Plant.from_string("2/(s+3)"), t, u)
+    >>> num, den, d = linear_initial_model(t, u, y, parse_structure("k/(s+p)"), None, False, 0.0)
+    >>> (num / den[0]).round(4).tolist(), (den / den[0]).round(4).tolist(), d
+    ([2.0], [1.0, 3.0], 0.0)
+    """
+    dt = t[1] - t[0]
+    duration = t[-1] - t[0] + dt
+    reps = _reps(sensor.den, duration) if (periodic and sensor is not None) else 1
+    v = _tile_filter(sensor.with_delay(0.0), t, w, periodic, reps) if sensor is not None else w
+    na, nb = st.den_degree, st.num_degree
+    if delay is None:
+        d_vis = max(_first_response(t, w, yd), 2 * dt)
+        grid = np.linspace(0.0, d_vis, 9)
+    else:
+        grid = np.array([delay])
+    lams = np.geomspace(20.0 / duration, 0.05 / dt, 5)
+    mid = grid[len(grid) // 2]
+    best_lam = min(lams, key=lambda lam: _srivc(t, v, yd, na, nb, mid, lam, periodic, 4)[2])
+    fits = [(_srivc(t, v, yd, na, nb, d, best_lam, periodic), d) for d in grid]
+    (num, den, ssr), d0 = min(fits, key=lambda f: f[0][2])
+    if grid.size > 1:  # refine the delay between the neighbouring grid points
+        from scipy.optimize import minimize_scalar
+
+        step = grid[1] - grid[0]
+        sol = minimize_scalar(lambda d: _srivc(t, v, yd, na, nb, d, best_lam, periodic, 4)[2],
+                              bounds=(max(0.0, d0 - step), d0 + step), method="bounded",
+                              options={"xatol": 0.1 * dt})
+        if sol.fun < ssr:
+            d0 = float(sol.x)
+            num, den, _ = _srivc(t, v, yd, na, nb, d0, best_lam, periodic)
+    return num, den, float(d0)
+
+
+def map_to_structure(st: Structure, num: np.ndarray, den: np.ndarray) -> np.ndarray:
+    """Structure parameters whose frequency response best matches ``num/den`` (relative error).
+
+    Coefficient matching first (polynomial equations, few local minima), then the relative
+    frequency-response error on a log grid around the poles and zeros, from a fixed list of starts.
+
+    Raises
+    ------
+    ModelError
+        No start gives a finite fit.
+
+    Examples
+    --------
+    >>> from synth.ident.structure import parse_structure
+    >>> map_to_structure(parse_structure("k/(T*s+1)"), np.array([2.0]), np.array([1.0, 4.0])).round(4).tolist()
+    [0.5, 0.25]
+    """
+    roots = np.r_[np.roots(den), np.roots(num) if num.size > 1 else []]
+    mags = np.abs(roots[np.abs(roots) > 1e-9])
+    lo, hi = (float(mags.min()) / 10, float(mags.max()) * 10) if mags.size else (0.01, 100.0)
+    w = np.geomspace(lo, hi, 80)
+    s = 1j * w
+    target = np.polyval(num, s) / np.polyval(den, s)
+    weight = 1.0 / np.maximum(np.abs(target), 1e-300)
+
+    def resid(theta: np.ndarray) -> np.ndarray:
+        n_, d_ = st.coefficients(theta)
+        with np.errstate(all="ignore"):
+            g = np.polyval(n_, s) / np.polyval(d_, s)
+        r = (g - target) * weight
+        r = np.r_[r.real, r.imag]
+        return np.where(np.isfinite(r), r, 1e6)
+
+    num_t = np.r_[np.zeros(st.num_degree + 1 - num.size), num] / den[0]
+    den_t = den / den[0]
+    target_c = np.r_[num_t, den_t]
+    cscale = np.maximum(np.abs(target_c), 1e-9 * np.max(np.abs(target_c)))
+
+    def resid_coef(theta: np.ndarray) -> np.ndarray:
+        n_, d_ = st.coefficients(theta)
+        with np.errstate(all="ignore"):
+            r = (np.r_[n_, d_] / d_[0] - target_c) / cscale
+        return np.where(np.isfinite(r), r, 1e6)
+
+    p = len(st.parameters)
+    best: tuple[float, np.ndarray] | None = None
+    for c in (1.0, 0.1, 10.0, 0.01, 100.0, 1000.0):
+        x0 = c * (1.0 + 0.15 * np.arange(p))
+        try:  # coefficient matching first (polynomial equations, few local minima), then the frequency fit
+            sol = least_squares(resid_coef, x0, method="lm", max_nfev=400 * (p + 1))
+            sol = least_squares(resid, sol.x, method="lm", max_nfev=400 * (p + 1))
+        except (ValueError, np.linalg.LinAlgError):
+            continue
+        cost = float(np.sum(sol.fun**2))
+        if best is None or cost < best[0]:
+            best = (cost, sol.x)
+        if cost < 1e-16 * w.size:
+            break
+    if best is None:
+        raise ModelError(f"structure {st.formula!r}: could not map an initial linear model onto its parameters")
+    return best[1]
