@@ -136,6 +136,7 @@ def closed_loop_checks(gain: float = 3.0) -> list[PaperRow]:
     k14 = 68.85 / (k_hf / gain)
     fast14 = _real_poles(_loop(k14).closed_loop_poles())[0]
     eq15 = published_summary("eq. 15", EQ15)
+    k99 = float(-np.polyval(plant.den, -99.0) / np.polyval(plant.num, -99.0))  # 1 + K H(-99) = 0
     bw = loop.bandwidth()
     seen = _tf_rise_time(f"{SENSOR}*{k_hf:.6g}*(s+{zero:.6g})/((s+{fast:.6g})*(s+{slow:.6g}))")
     rows = [
@@ -145,12 +146,13 @@ def closed_loop_checks(gain: float = 3.0) -> list[PaperRow]:
                          f"root of (s+9.6)(s+0.54) + {k_hf:.4g}(s+0.43); with the gain 68.85 of eq. 14 itself the "
                          f"pole is {fast14:.4g}: eq. 14 is eq. 5 at K = {k14:.4f}"),
         PaperRow.compare("eq. 14 slow pole", "0.43", slow, "rad/s", "eq. 14",
-                         f"the model's slow pole is {slow:.4g}; eq. 14 prints the zero's value 0.43 here"),
+                         f"the model's slow pole is {slow:.4g} (0.44 to two digits) over the zero {zero:.3g}; eq. 14's "
+                         "pair 0.43 / 0.42 sits 0.01 lower"),
         PaperRow.compare("eq. 14 zero", "0.42", zero, "rad/s", "eq. 14",
                          "proportional feedback keeps the plant zero 0.43; eq. 14's 0.42 is a rounding or a slip"),
         PaperRow.compare("eq. 15 fast pole (measured)", "99", fast, "rad/s", "eq. 15",
-                         f"the rig's loop is faster than the model's: the model reaches 99 only at K = "
-                         f"{(99 - 10.14 + 0.443) / 23:.2f} (a higher loop gain, or a faster plant pole than 9.6)"),
+                         f"the rig's loop is faster than the model's: the model has a pole at 99 only for K = "
+                         f"{k99:.3f} (a higher loop gain, or a faster plant pole than 9.6)"),
         PaperRow.compare("eq. 15 slow pole (measured)", "0.0042", slow, "rad/s", "eq. 15",
                          f"two orders of magnitude below the model's {slow:.3g}; 0.42 (a slipped decimal) would "
                          "match it, or the battery pole-zero pair was not identifiable in the closed-loop test"),
