@@ -104,7 +104,7 @@ def onset_delay(plant: Plant, gain: float, hi: float = 0.1) -> float | None:
     Examples
     --------
     >>> round(onset_delay(Plant.from_string(PLANT), 5.0) * 1000, 1)
-    14.5
+    14.4
     """
     def crit(d: float) -> float:
         return critical_gains(plant, [d])[0]["critical_gain"]

@@ -31,7 +31,15 @@ import numpy as np
 from scipy.optimize import least_squares
 
 from synth.errors import DataError
-from synth.ident.psd import KNEE_DB, DisturbanceRecord, PsdAnalysis, analyze_records, find_spikes, suggest_bandwidth
+from synth.ident.psd import (
+    KNEE_DB,
+    DisturbanceRecord,
+    PsdAnalysis,
+    analyze_records,
+    find_spikes,
+    suggest_bandwidth,
+    unit_squared,
+)
 
 __all__ = ["DisturbanceFit", "DisturbanceRequirements", "Evidence", "fit_disturbance_shape",
            "quantization_floor", "requirements_from_disturbance", "requirements_from_records"]
@@ -289,11 +297,12 @@ def requirements_from_disturbance(analysis: PsdAnalysis, resolution: float | Non
     ideal = fit.frequency_at(sensor_db)
     minimum = fit.frequency_at(sensor_db + margin_db)
     D = np.where(mask, 0.0, S - analysis.floor)
+    level = f"dB re 1 {unit_squared(analysis.unit)}/(rad/s)"
     share_below = float(np.sum(D[w <= fit.corner]) / np.sum(D)) if np.sum(D) > 0 else float("nan")
     ev = [
-        Evidence("plateau level", fit.plateau_db, "dB re 1 unit^2/(rad/s)",
+        Evidence("plateau level", fit.plateau_db, level,
                  "fitted disturbance level below the corner; sets max_db = sensor floor - plateau"),
-        Evidence("sensor floor", sensor_db, "dB re 1 unit^2/(rad/s)", "largest of: " + ", ".join(
+        Evidence("sensor floor", sensor_db, level, "largest of: " + ", ".join(
             f"{k} {10 * math.log10(v):.3g} dB" for k, v in floors.items())),
         Evidence("corner", fit.corner, "rad/s", "end of the plateau; sets the sensitivity band [0, corner]"),
         Evidence("share of disturbance power below the corner", share_below, "1",
