@@ -24,7 +24,7 @@ from typing import Any
 from synth.errors import ModelError
 from synth.paper_row import PaperRow
 
-__all__ = ["G_STANDARD", "RHO_SEA_LEVEL", "RotorSizing", "density_for_power", "isa_altitude", "rotor_sizing",
+__all__ = ["G_STANDARD", "RHO_SEA_LEVEL", "UNITS", "RotorSizing", "density_for_power", "induced_power", "isa_altitude", "rotor_sizing",
            "sizing_checks", "thrust_for_power"]
 
 #: standard gravity [m/s^2]
@@ -96,7 +96,13 @@ def _positive(name: str, value: float) -> float:
 
 
 def induced_power(thrust: float, radius: float, rho: float) -> float:
-    """Ideal induced power in hover, eq. 1: ``T^1.5 / sqrt(2 rho pi R^2)`` [W]."""
+    """Ideal induced power in hover, eq. 1: ``T^1.5 / sqrt(2 rho pi R^2)`` [W].
+
+    Examples
+    --------
+    >>> round(induced_power(12.7, 0.165, RHO_SEA_LEVEL), 2)
+    98.87
+    """
     return thrust**1.5 / math.sqrt(2 * rho * math.pi * radius**2)
 
 
