@@ -24,8 +24,8 @@ from typing import Any
 from synth.errors import ModelError
 from synth.paper_row import PaperRow
 
-__all__ = ["G_STANDARD", "RHO_SEA_LEVEL", "UNITS", "RotorSizing", "density_for_power", "induced_power", "isa_altitude", "rotor_sizing",
-           "sizing_checks", "thrust_for_power"]
+__all__ = ["G_STANDARD", "RHO_SEA_LEVEL", "UNITS", "RotorSizing", "density_for_power", "induced_power", "isa_altitude",
+           "rotor_sizing", "sizing_checks", "thrust_for_power"]
 
 #: standard gravity [m/s^2]
 G_STANDARD = 9.80665
