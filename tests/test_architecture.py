@@ -37,6 +37,7 @@ LAYERS: dict[str, int] = {
     "synth.design": 6,
     # 7 what runs designs or models many times: trade-offs, published comparisons, the gap diagnosis
     "synth.tradeoff": 7, "synth.synthesis.tradeoff": 7, "synth.reference": 7, "synth.gap": 7,
+    "synth.sizing": 7, "synth.paper_row": 7, "synth.paper_checks": 7,
     # 8 reports
     "synth.report": 8, "synth.gap.report": 8, "synth.gap.roundrobin_report": 8,
     # 9 the command line, 10 the package's front door
