@@ -30,16 +30,12 @@ from typing import Any
 import numpy as np
 from scipy.optimize import least_squares
 
+from synth.data.disturbance import DisturbanceRecord
 from synth.errors import DataError
-from synth.ident.psd import (
-    KNEE_DB,
-    DisturbanceRecord,
-    PsdAnalysis,
-    analyze_records,
-    find_spikes,
-    suggest_bandwidth,
-    unit_squared,
-)
+from synth.ident.bandwidth_suggestion import suggest_bandwidth
+from synth.ident.psd import KNEE_DB, PsdAnalysis, analyze_records
+from synth.ident.spectrum_features import find_spikes
+from synth.ident.welch import unit_squared
 
 __all__ = ["DisturbanceFit", "DisturbanceRequirements", "Evidence", "fit_disturbance_shape",
            "quantization_floor", "requirements_from_disturbance", "requirements_from_records"]

@@ -12,7 +12,8 @@ import numpy as np
 
 from synth.figure_files import save_figure
 from synth.ident.disturbance_requirements import DisturbanceRequirements
-from synth.ident.psd import PsdAnalysis, unit_squared
+from synth.ident.psd import PsdAnalysis
+from synth.ident.welch import unit_squared
 
 __all__ = ["disturbance_requirements_plot"]
 

@@ -26,8 +26,8 @@ from typing import Any
 
 import numpy as np
 
+from synth.data.disturbance import DisturbanceRecord, disturbance_from_arrays
 from synth.errors import ModelError
-from synth.ident.psd import DisturbanceRecord, disturbance_from_arrays
 from synth.sim.signals import psd_signal
 
 __all__ = ["X4_SEED", "X4_SYNTHETIC_SHAPE", "DisturbanceShape", "synthetic_disturbance_record",
