@@ -10,14 +10,15 @@ import numpy as np
 from jinja2 import Environment, PackageLoader
 
 from synth.controllers import Controller
-from synth.design import DesignResult, reference_controller, scalar_family
 from synth.loop import Loop
 from synth.outputs import GENERATOR, OutputDir, dump_json, to_jsonable
 from synth.reference import compare
 from synth.report import figures
 from synth.requirements import SlewRate
 from synth.requirements.base import fmt
+from synth.results import DesignResult, reference_controller
 from synth.spec import Spec
+from synth.synthesis.scalar import scalar_family
 
 
 @dataclass

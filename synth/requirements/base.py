@@ -163,3 +163,20 @@ def db(x: float) -> float:
     """
     with np.errstate(divide="ignore"):
         return float(20.0 * np.log10(abs(x)))
+
+
+def unique_names(requirements: list[Requirement]) -> list[str]:
+    """One name per requirement, in order: its label or type, with ``#2``, ``#3`` ... on repeats.
+
+    Examples
+    --------
+    >>> from synth.requirements import PeakSensitivity
+    >>> unique_names([PeakSensitivity(max_db=6), PeakSensitivity(max_db=4, label="Ms")] * 2)
+    ['peak_sensitivity', 'Ms', 'peak_sensitivity#2', 'Ms#2']
+    """
+    names, seen = [], {}
+    for r in requirements:
+        base = r.name()
+        seen[base] = seen.get(base, 0) + 1
+        names.append(base if seen[base] == 1 else f"{base}#{seen[base]}")
+    return names

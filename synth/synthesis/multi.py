@@ -27,7 +27,13 @@ import numpy as np
 
 from synth.check import CheckResult, check
 from synth.controllers import Controller
-from synth.design import (
+from synth.errors import SynthError
+from synth.loop import Loop
+from synth.objectives import score
+from synth.requirements import PeakComplementary, PeakSensitivity, Sensitivity, SlewRate
+from synth.requirements.base import fmt, unique_names
+from synth.requirements.control_sensitivity import PeakControlSensitivity
+from synth.results import (
     CERTIFICATE_PER_DECADE,
     Certificate,
     DesignResult,
@@ -35,17 +41,11 @@ from synth.design import (
     reference_check,
     reference_verdict,
 )
-from synth.errors import SynthError
-from synth.gainset import _unique_names
-from synth.loop import Loop
-from synth.objectives import score
-from synth.requirements import PeakComplementary, PeakSensitivity, Sensitivity, SlewRate
-from synth.requirements.base import fmt
-from synth.requirements.control_sensitivity import PeakControlSensitivity
 from synth.spec import Spec
 from synth.synthesis.convex import ConvexDesigner, ConvexResult, ConvexSettings
 from synth.synthesis.nlp import polish
 from synth.synthesis.parametrization import parametrize
+from synth.synthesis.scalar import design_scalar
 
 STRUCTURAL = {"PID": "tf", "leadlag": "p"}
 
@@ -80,9 +80,7 @@ def design_convex(spec: Spec, settings: ConvexSettings | None = None, nlp: bool 
         return main  # without integral action these objectives are 0 (or finite): never better
     without = spec.model_copy(update={"controller": spec.controller.model_copy(
         update={"bounds": {**bounds, "ki": (0.0, 0.0)}})})
-    from synth.design import design
-
-    alt = design(without)
+    alt = design_scalar(without) if len(without.controller.free_parameters()) == 1 else design_convex(without)
     if alt.feasible and (not main.feasible or _better(alt, main)):
         alt.method = (main.method + "; the same structure without integral action (ki = 0) did better: "
                       + alt.method)
@@ -114,7 +112,7 @@ def _convex_runs(spec: Spec, settings: ConvexSettings) -> list[tuple[ConvexDesig
     key = STRUCTURAL.get(ctype)
     values = _structural_values(*bounds[key]) if key else [None]
     requirements = list(spec.requirements)
-    names = _unique_names(requirements)
+    names = unique_names(requirements)
     name, sense, _ = _objective_terms(spec)[0]
     runs = []
     w0 = _reference_frequency(spec)
@@ -173,7 +171,7 @@ def polish_redundant(spec: Spec, runs: list[ConvexResult]) -> str | None:
 def certificate_density(settings: ConvexSettings, grids: list[np.ndarray]) -> int:
     """Points per decade of the certificate: at least 20 times the densest grid the design used (the
     band grids at ``settings.per_decade``, the design grid, with its refinement points, on average over
-    its span), and at least :data:`synth.design.CERTIFICATE_PER_DECADE`.
+    its span), and at least :data:`synth.results.CERTIFICATE_PER_DECADE`.
 
     Examples
     --------
@@ -298,7 +296,7 @@ def conflict_set(spec: Spec, settings: ConvexSettings) -> list[str]:
     is one whose removal let it find a design).
     """
     requirements = list(spec.requirements)
-    names = _unique_names(requirements)
+    names = unique_names(requirements)
     keep = list(range(len(requirements)))
     key = STRUCTURAL.get(spec.controller.type)
     bounds = spec.controller.all_bounds()
