@@ -20,7 +20,6 @@ readings) and the better certified design wins.
 
 from __future__ import annotations
 
-from dataclasses import replace
 from typing import Any
 
 import numpy as np
@@ -30,9 +29,7 @@ from synth.controllers import Controller
 from synth.errors import SynthError
 from synth.loop import Loop
 from synth.objectives import score
-from synth.requirements import PeakComplementary, PeakSensitivity, Sensitivity, SlewRate
-from synth.requirements.base import fmt, unique_names
-from synth.requirements.control_sensitivity import PeakControlSensitivity
+from synth.requirements.base import Requirement, fmt, unique_names
 from synth.results import (
     CERTIFICATE_PER_DECADE,
     Certificate,
@@ -43,11 +40,16 @@ from synth.results import (
 )
 from synth.spec import Spec
 from synth.synthesis.convex import ConvexDesigner, ConvexResult, ConvexSettings
-from synth.synthesis.nlp import polish
+from synth.synthesis.convex_forms import CONVEX_FORMS
+from synth.synthesis.nlp import NLP_FORMS, polish
 from synth.synthesis.parametrization import parametrize
 from synth.synthesis.scalar import design_scalar
 
+__all__ = ["STRUCTURAL", "certificate_density", "conflict_set", "design_convex", "exact_forms", "infeasible_verdict",
+           "polish_redundant"]
+
 STRUCTURAL = {"PID": "tf", "leadlag": "p"}
+"""The structural parameter of each controller type that the convex stage holds at a few fixed values."""
 
 
 def design_convex(spec: Spec, settings: ConvexSettings | None = None, nlp: bool | str = True) -> DesignResult:
@@ -138,8 +140,18 @@ def _reference_frequency(spec: Spec) -> float:
     return float(np.sqrt(lo * hi))
 
 
-EXACT_FORMS = (Sensitivity, PeakSensitivity, PeakComplementary, PeakControlSensitivity, SlewRate)
-"""Requirements whose convex form and NLP constraint are the same set on the same frequencies."""
+def exact_forms(requirement: Requirement) -> bool:
+    """Whether the requirement's convex form and NLP form are both registered as exact: the same set on
+    the same frequencies (:data:`~synth.synthesis.convex_forms.CONVEX_FORMS`,
+    :data:`~synth.synthesis.nlp.NLP_FORMS`).
+
+    Examples
+    --------
+    >>> from synth.requirements import Bandwidth, PeakSensitivity
+    >>> exact_forms(PeakSensitivity(max_db=6)), exact_forms(Bandwidth(min=10))
+    (True, False)
+    """
+    return CONVEX_FORMS.entry(requirement).exact and NLP_FORMS.entry(requirement).exact
 
 
 def polish_redundant(spec: Spec, runs: list[ConvexResult]) -> str | None:
@@ -147,7 +159,7 @@ def polish_redundant(spec: Spec, runs: list[ConvexResult]) -> str | None:
 
     The polish is redundant when the convex stage ended at a KKT point of the problem the polish
     would solve: one convex run (no structural parameter to vary) of a P, PI or PID controller, whose
-    parameters are then exactly the NLP's variables; every requirement among :data:`EXACT_FORMS`, whose
+    parameters are then exactly the NLP's variables; every requirement with :func:`exact_forms`, whose
     inner approximations touch the exact constraints at the linearization point with the same gradient
     (the NLP imposes them on the same design and band grids, squared); a linear objective (the integral
     or low-frequency gain), solved directly; and a converged phase 2 (the last convex problem, built
@@ -160,7 +172,7 @@ def polish_redundant(spec: Spec, runs: list[ConvexResult]) -> str | None:
         return None
     if spec.controller.type not in ("P", "PI", "PID"):
         return None
-    if not all(isinstance(r, EXACT_FORMS) for r in spec.requirements):
+    if not all(exact_forms(r) for r in spec.requirements):
         return None
     if len(terms) != 1 or terms[0][0] not in ("integral_gain", "low_frequency_gain"):
         return None
@@ -342,6 +354,3 @@ def infeasible_verdict(convex: ConvexResult, compromise: CheckResult | None = No
     parts.append("Conflicting requirements (a minimal set that cannot be met together): "
                  + ", ".join(diag.conflicting()) + ".")
     return " ".join(parts)
-
-
-__all__ = ["design_convex", "infeasible_verdict", "replace"]

@@ -33,6 +33,7 @@ certificate.
 from __future__ import annotations
 
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -52,9 +53,10 @@ from synth.requirements import (
     SlewRate,
     StaticSensitivity,
 )
-from synth.requirements.base import Requirement
+from synth.requirements.base import Requirement, magnitude
 from synth.requirements.control_sensitivity import PeakControlSensitivity
 from synth.synthesis.cxcomplex import Cx, delay_jw, polyval_jw
+from synth.synthesis.form_registry import FormRegistry
 
 SYM = ca.MX
 """Symbol type of the NLP. Matrix expressions: a requirement on n frequencies is a handful of vector
@@ -238,46 +240,93 @@ def _band(req: Any, grid: np.ndarray, extra: np.ndarray, per_decade: int) -> np.
     return np.unique(np.concatenate([w, inside]))
 
 
-def _add_requirement(b: _Builder, req: Requirement, plants: list[Plant], grid: np.ndarray,
-                     start: Controller, per_decade: int, extra: np.ndarray) -> None:
-    ctrl = b.ctrl
-    tight = 1.0 - 2 * BACKOFF  # on squared magnitudes
-    for plant in plants:
-        if isinstance(req, (Sensitivity, PeakSensitivity)):
-            m2 = 10 ** (req.max_db / 10) * tight
-            _, L = _loop(ctrl, plant, _band(req, grid, extra, per_decade))
-            b.geq(m2 * (1.0 + L).abs2() - 1.0)
-        elif isinstance(req, StaticSensitivity):
-            dc = ctrl.dc()
-            if dc is not None:
-                g = req.plant_gain if req.plant_gain is not None else plant.dc_gain()
-                b.geq(10 ** (-req.max_db / 10) * tight * (1.0 + g * dc) ** 2 - 1.0)
-        elif isinstance(req, (PeakComplementary, PeakControlSensitivity)):
-            inv = 10 ** (-req.max_db / 10) / tight
-            C, L = _loop(ctrl, plant, _band(req, grid, extra, per_decade))
-            top = L if isinstance(req, PeakComplementary) else C
-            b.geq((1.0 + L).abs2() - inv * top.abs2())
-        elif isinstance(req, SlewRate):
-            w = _band(req, grid, extra, per_decade)
-            C, _ = _loop(ctrl, plant, w)
-            b.geq(tight - (req.max_error * w / req.rate_limit) ** 2 * C.abs2())
-        elif isinstance(req, Bandwidth):
-            t02 = _t0_squared(ctrl, plant)
-            if req.min is not None:
-                pts = np.concatenate([grid[grid < req.min], extra[extra < req.min], [req.min]])
-                _, L = _loop(ctrl, plant, np.unique(pts))
-                b.geq(tight * L.abs2() - BANDWIDTH_LEVEL**2 * t02 * (1.0 + L).abs2())
-            if req.max is not None:
-                _, L = _loop(ctrl, plant, float(req.max))
-                b.geq(tight * BANDWIDTH_LEVEL**2 * t02 * (1.0 + L).abs2() - L.abs2())
-        elif isinstance(req, MarginsRequirement):
-            _add_margins(b, req, plant, start)
-        else:
-            raise TypeError(f"no NLP form for requirement type {req.type}")
+NLP_FORMS = FormRegistry("NLP")
+"""The NLP form of each requirement type (filled by :func:`nlp_form` below)."""
 
 
-def _add_margins(b: _Builder, req: MarginsRequirement, plant: Plant, start: Controller) -> None:
-    loop = Loop(plant, start)
+def nlp_form(requirement: type[Requirement], *, exact: bool) -> Callable[[Callable], Callable]:
+    """Decorator: register ``build(b, req, plant, ctx)`` as the NLP form of ``requirement`` (it adds the
+    requirement's constraints on one plant to the problem being built).
+
+    Examples
+    --------
+    >>> from synth.requirements import MarginsRequirement
+    >>> NLP_FORMS.entry(MarginsRequirement).exact
+    True
+    """
+    return NLP_FORMS.register(requirement, exact=exact)
+
+
+@dataclass
+class NLPContext:
+    """What every NLP form is built from: the design grid, the extra frequencies found between its
+    points, the band density and the design the problem starts from."""
+
+    grid: np.ndarray
+    extra: np.ndarray
+    per_decade: int
+    start: Controller
+
+    def points(self, req: Any) -> np.ndarray:
+        """The requirement's band (the design grid without one), with the extra frequencies inside it."""
+        return _band(req, self.grid, self.extra, self.per_decade)
+
+
+TIGHT = 1.0 - 2 * BACKOFF
+"""Tightening of squared magnitudes."""
+
+
+@nlp_form(Sensitivity, exact=True)
+@nlp_form(PeakSensitivity, exact=True)
+def _sensitivity(b: _Builder, req: Sensitivity | PeakSensitivity, plant: Plant, ctx: NLPContext) -> None:
+    m2 = req.linear_bound("max_db") ** 2 * TIGHT
+    _, L = _loop(b.ctrl, plant, ctx.points(req))
+    b.geq(m2 * (1.0 + L).abs2() - 1.0)
+
+
+@nlp_form(StaticSensitivity, exact=True)
+def _static_sensitivity(b: _Builder, req: StaticSensitivity, plant: Plant, ctx: NLPContext) -> None:
+    dc = b.ctrl.dc()
+    if dc is not None:
+        g = req.plant_gain if req.plant_gain is not None else plant.dc_gain()
+        b.geq(TIGHT / req.linear_bound("max_db") ** 2 * (1.0 + g * dc) ** 2 - 1.0)
+
+
+@nlp_form(PeakComplementary, exact=True)
+def _peak_complementary(b: _Builder, req: PeakComplementary, plant: Plant, ctx: NLPContext) -> None:
+    _, L = _loop(b.ctrl, plant, ctx.points(req))
+    b.geq((1.0 + L).abs2() - L.abs2() / (req.linear_bound("max_db") ** 2 * TIGHT))
+
+
+@nlp_form(PeakControlSensitivity, exact=True)
+def _peak_control_sensitivity(b: _Builder, req: PeakControlSensitivity, plant: Plant, ctx: NLPContext) -> None:
+    C, L = _loop(b.ctrl, plant, ctx.points(req))
+    b.geq((1.0 + L).abs2() - C.abs2() / (req.linear_bound("max_db") ** 2 * TIGHT))
+
+
+@nlp_form(SlewRate, exact=True)
+def _slew_rate(b: _Builder, req: SlewRate, plant: Plant, ctx: NLPContext) -> None:
+    w = ctx.points(req)
+    C, _ = _loop(b.ctrl, plant, w)
+    b.geq(TIGHT - (req.max_error * w / req.rate_limit) ** 2 * C.abs2())
+
+
+@nlp_form(Bandwidth, exact=True)
+def _bandwidth(b: _Builder, req: Bandwidth, plant: Plant, ctx: NLPContext) -> None:
+    t02 = _t0_squared(b.ctrl, plant)
+    grid, extra = ctx.grid, ctx.extra
+    if req.min is not None:
+        pts = np.concatenate([grid[grid < req.min], extra[extra < req.min], [req.min]])
+        _, L = _loop(b.ctrl, plant, np.unique(pts))
+        b.geq(TIGHT * L.abs2() - BANDWIDTH_LEVEL**2 * t02 * (1.0 + L).abs2())
+    if req.max is not None:
+        _, L = _loop(b.ctrl, plant, float(req.max))
+        b.geq(TIGHT * BANDWIDTH_LEVEL**2 * t02 * (1.0 + L).abs2() - L.abs2())
+
+
+@nlp_form(MarginsRequirement, exact=True)
+def _margins(b: _Builder, req: MarginsRequirement, plant: Plant, ctx: NLPContext) -> None:
+    loop = Loop(plant, ctx.start)
     ctrl = b.ctrl
     for wc in loop.gain_crossovers():
         v = b.var("wc", float(wc), wc / 3.0, 3.0 * wc)
@@ -292,7 +341,7 @@ def _add_margins(b: _Builder, req: MarginsRequirement, plant: Plant, start: Cont
             v = b.var("wp", float(wp), wp / 3.0, 3.0 * wp)
             _, L = _loop(ctrl, plant, v)
             b.eq(L.im)
-            b.geq(L.re + 10 ** (-req.gain_margin_db * (1 + BACKOFF) / 20))
+            b.geq(L.re + 1.0 / magnitude(req.gain_margin_db * (1 + BACKOFF)))
 
 
 def _phase_crossovers(loop: Loop) -> np.ndarray:
@@ -403,8 +452,11 @@ def polish(requirements: list[Requirement], plants: list[Plant], start: Controll
     for rnd in range(rounds):
         ctrl = SymbolicController(current.type, current, bounds)
         b = _Builder(ctrl)
+        ctx = NLPContext(grid, extra, per_decade, current)
         for req in requirements:
-            _add_requirement(b, req, plants, grid, current, per_decade, extra)
+            build = NLP_FORMS.entry(req).build
+            for plant in plants:
+                build(b, req, plant, ctx)
         for p in plants:  # keep |1 + L| away from zero: no closed-loop pole crosses the axis on the grid
             _, L = _loop(ctrl, p, grid)
             b.geq((1.0 + L).abs2() - stability_level**2)
