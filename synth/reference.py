@@ -20,6 +20,8 @@ from synth.spec import Spec
 from synth.synthesis.gainset import critical_gains
 from synth.timeresp import step_metrics, step_response
 
+__all__ = ["compare", "loop_summary", "published_summary", "slew_reconciliation"]
+
 
 def _poles_text(poles: np.ndarray) -> list[str]:
     out = []

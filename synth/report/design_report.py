@@ -20,6 +20,8 @@ from synth.results import DesignResult, reference_controller
 from synth.spec import Spec
 from synth.synthesis.scalar import scalar_family
 
+__all__ = ["ReportFiles", "report_data", "write_design_report"]
+
 
 @dataclass
 class ReportFiles:

@@ -64,6 +64,24 @@ from synth.requirements.control_sensitivity import PeakControlSensitivity
 from synth.synthesis.form_registry import FormRegistry
 from synth.synthesis.parametrization import Affine, Parametrization
 
+__all__ = [
+    "BACKOFF",
+    "CONVEX_FORMS",
+    "T0",
+    "Form",
+    "FormContext",
+    "HalfPlane",
+    "Kappa",
+    "Points",
+    "RatioBound",
+    "bandwidth_floor",
+    "build_forms",
+    "convex_form",
+    "make_points",
+    "sensitivity_form",
+    "without_implied",
+]
+
 BACKOFF = 1e-4
 """Relative tightening of every convex bound (about 0.001 dB)."""
 

@@ -24,6 +24,16 @@ from synth.plant import Plant
 from synth.requirements.base import Requirement, unique_names
 from synth.stability import affine_stability_intervals
 
+__all__ = [
+    "GainInterval",
+    "GainSet",
+    "ScalarFamily",
+    "critical_gains",
+    "feasible_gain_set",
+    "requirement_set",
+    "stability_set",
+]
+
 _MET_TOL = 1e-12
 
 

@@ -39,8 +39,10 @@ from synth.results import (
     reference_verdict,
 )
 from synth.spec import Spec
-from synth.synthesis.convex import ConvexDesigner, ConvexResult, ConvexSettings
+from synth.synthesis.convex import ConvexDesigner
 from synth.synthesis.convex_forms import CONVEX_FORMS
+from synth.synthesis.convex_results import ConvexResult
+from synth.synthesis.convex_settings import ConvexSettings
 from synth.synthesis.nlp import NLP_FORMS, polish
 from synth.synthesis.parametrization import parametrize
 from synth.synthesis.scalar import design_scalar

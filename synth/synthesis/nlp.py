@@ -58,6 +58,19 @@ from synth.requirements.control_sensitivity import PeakControlSensitivity
 from synth.synthesis.cxcomplex import Cx, delay_jw, polyval_jw
 from synth.synthesis.form_registry import FormRegistry
 
+__all__ = [
+    "BACKOFF",
+    "IPOPT_OPTIONS",
+    "NLP_FORMS",
+    "SYM",
+    "TIGHT",
+    "NLPContext",
+    "NLPResult",
+    "SymbolicController",
+    "nlp_form",
+    "polish",
+]
+
 SYM = ca.MX
 """Symbol type of the NLP. Matrix expressions: a requirement on n frequencies is a handful of vector
 operations on numeric columns, not n scalar graphs, so building the solver (derivatives included) costs
