@@ -22,7 +22,8 @@ from synth.requirements import REQUIREMENT_TYPES, Bound, Requirement, register
 from synth.requirements.base import RequirementResult
 from synth.spec import parse_spec
 from synth.synthesis.convex_forms import CONVEX_FORMS, build_forms
-from synth.synthesis.nlp import NLP_FORMS, polish
+from synth.synthesis.nlp import polish
+from synth.synthesis.nlp_forms import NLP_FORMS
 from synth.synthesis.parametrization import parametrize
 
 TYPES = sorted(REQUIREMENT_TYPES)
@@ -40,7 +41,7 @@ def _example(name: str) -> Requirement:
 def test_every_type_has_a_convex_and_an_nlp_form(name):
     cls = REQUIREMENT_TYPES[name]
     assert cls in CONVEX_FORMS, f"{cls.__name__}: no @convex_form in synth/synthesis/convex_forms.py"
-    assert cls in NLP_FORMS, f"{cls.__name__}: no @nlp_form in synth/synthesis/nlp.py"
+    assert cls in NLP_FORMS, f"{cls.__name__}: no @nlp_form in synth/synthesis/nlp_forms.py"
     assert isinstance(CONVEX_FORMS.entry(cls).exact, bool) and isinstance(NLP_FORMS.entry(cls).exact, bool)
 
 

@@ -182,7 +182,7 @@ def register(cls: type[Requirement]) -> type[Requirement]:
     """Class decorator: make a requirement available under its ``type`` name.
 
     The solver forms are registered beside their solvers (``convex_form`` in
-    :mod:`synth.synthesis.convex_forms`, ``nlp_form`` in :mod:`synth.synthesis.nlp`);
+    :mod:`synth.synthesis.convex_forms`, ``nlp_form`` in :mod:`synth.synthesis.nlp_forms`);
     docs/extending-requirements.md gives the recipe.
 
     Examples

@@ -2,8 +2,8 @@
 ``isinstance`` ladder.
 
 :mod:`synth.synthesis.convex_forms` keeps :data:`~synth.synthesis.convex_forms.CONVEX_FORMS` (filled by
-its ``@convex_form(Type, exact=...)`` entries) and :mod:`synth.synthesis.nlp` keeps
-:data:`~synth.synthesis.nlp.NLP_FORMS` (``@nlp_form(Type, exact=...)``). A requirement type with no
+its ``@convex_form(Type, exact=...)`` entries) and :mod:`synth.synthesis.nlp_forms` keeps
+:data:`~synth.synthesis.nlp_forms.NLP_FORMS` (``@nlp_form(Type, exact=...)``). A requirement type with no
 entry is a :class:`~synth.errors.SpecError` naming it.
 """
 

@@ -43,7 +43,8 @@ from synth.synthesis.convex import ConvexDesigner
 from synth.synthesis.convex_forms import CONVEX_FORMS
 from synth.synthesis.convex_results import ConvexResult
 from synth.synthesis.convex_settings import ConvexSettings
-from synth.synthesis.nlp import NLP_FORMS, polish
+from synth.synthesis.nlp import polish
+from synth.synthesis.nlp_forms import NLP_FORMS
 from synth.synthesis.parametrization import parametrize
 from synth.synthesis.scalar import design_scalar
 
@@ -145,7 +146,7 @@ def _reference_frequency(spec: Spec) -> float:
 def exact_forms(requirement: Requirement) -> bool:
     """Whether the requirement's convex form and NLP form are both registered as exact: the same set on
     the same frequencies (:data:`~synth.synthesis.convex_forms.CONVEX_FORMS`,
-    :data:`~synth.synthesis.nlp.NLP_FORMS`).
+    :data:`~synth.synthesis.nlp_forms.NLP_FORMS`).
 
     Examples
     --------
