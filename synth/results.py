@@ -51,6 +51,14 @@ class Certificate:
         of every peak and crossing).
     check : CheckResult
         The re-check itself.
+
+    Examples
+    --------
+    >>> from synth.spec import load_spec
+    >>> spec = load_spec("specs/x4_rotor.yaml")
+    >>> cert = Certificate(True, CERTIFICATE_PER_DECADE, check(spec, "P(3)", CERTIFICATE_PER_DECADE))
+    >>> cert.to_dict()["grid"]
+    'log grid, 1600 points per decade, peaks and crossings refined'
     """
 
     passed: bool
@@ -98,6 +106,15 @@ class DesignResult:
         How the design was found.
     verdict : str
         Plain-language summary.
+    extras : dict
+        Method-specific records (the convex and NLP stages, a diagnosis), merged into :meth:`to_dict`.
+
+    Examples
+    --------
+    >>> from synth.controllers import Controller
+    >>> r = DesignResult("demo", True, Controller("P", {"kp": 3.0}), None, None, None, None, verdict="ok")
+    >>> sorted(r.to_dict())
+    ['controller', 'feasible', 'method', 'objective', 'requirements', 'spec', 'verdict']
     """
 
     spec: str
@@ -140,7 +157,16 @@ class DesignResult:
 
 
 def objective_label(spec: Spec, loop: Loop) -> dict[str, Any]:
-    """``{"name", "sense", "unit", "description", "value"}`` of the spec's objective at ``loop``."""
+    """``{"name", "sense", "unit", "description", "value"}`` of the spec's objective at ``loop``.
+
+    Examples
+    --------
+    >>> from synth.spec import load_spec
+    >>> spec = load_spec("specs/x4_rotor.yaml")
+    >>> label = objective_label(spec, Loop(spec.nominal_plant(), reference_controller(spec)))
+    >>> label["name"], label["sense"], round(label["value"], 2), label["unit"]
+    ('bandwidth', 'maximize', 83.16, 'rad/s')
+    """
     obj = spec.objective
     assert obj is not None
     if obj.weighted is None:
@@ -153,7 +179,15 @@ def objective_label(spec: Spec, loop: Loop) -> dict[str, Any]:
 
 
 def reference_verdict(spec: Spec, ref: CheckResult | None, gain_set: GainSet | None = None) -> str:
-    """One or two sentences on the spec's reference controller (empty without one)."""
+    """One or two sentences on the spec's reference controller (empty without one).
+
+    Examples
+    --------
+    >>> from synth.spec import load_spec
+    >>> spec = load_spec("specs/x4_rotor.yaml")
+    >>> reference_verdict(spec, reference_check(spec))[:50]
+    ' The reference P(kp=3) (Seed 1, X-4 Flyer rotor dr'
+    """
     if ref is None:
         return ""
     source = f" ({spec.reference.source})" if spec.reference and spec.reference.source else ""
@@ -169,13 +203,27 @@ def reference_verdict(spec: Spec, ref: CheckResult | None, gain_set: GainSet | N
 
 
 def reference_controller(spec: Spec) -> Controller | None:
-    """The spec's reference controller (e.g. the paper's P(3)), if any."""
+    """The spec's reference controller (e.g. the paper's P(3)), if any.
+
+    Examples
+    --------
+    >>> from synth.spec import load_spec
+    >>> str(reference_controller(load_spec("specs/x4_rotor.yaml")))
+    'P(kp=3)'
+    """
     if spec.reference is None or spec.reference.controller is None:
         return None
     return Controller.from_string(spec.reference.controller)
 
 
 def reference_check(spec: Spec) -> CheckResult | None:
-    """Requirements evaluated at the spec's reference controller."""
+    """Requirements evaluated at the spec's reference controller (None without one).
+
+    Examples
+    --------
+    >>> from synth.spec import load_spec
+    >>> reference_check(load_spec("specs/x4_rotor.yaml")).feasible
+    True
+    """
     c = reference_controller(spec)
     return check(spec, c) if c is not None else None

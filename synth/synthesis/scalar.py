@@ -73,7 +73,15 @@ def _inside(x: float, gain_set: GainSet) -> float:
 
 
 def scalar_family(spec: Spec) -> tuple[ScalarFamily, tuple[float, float]]:
-    """The one-parameter family a spec designs over (error if it has several free parameters)."""
+    """The one-parameter family a spec designs over, and its bounds (error if it has several free parameters).
+
+    Examples
+    --------
+    >>> from synth.spec import load_spec
+    >>> family, bounds = scalar_family(load_spec("specs/x4_rotor.yaml"))
+    >>> family.parameter, bounds
+    ('kp', (0.0, 20.0))
+    """
     bounds = spec.controller.all_bounds()
     free = spec.controller.free_parameters()
     if len(free) != 1:
@@ -163,7 +171,15 @@ def _ends(names: list[str]) -> str:
 
 
 def feasible_verdict(result: DesignResult, family: ScalarFamily) -> str:
-    """Plain-language summary of a successful scalar design."""
+    """Plain-language summary of a successful scalar design.
+
+    Examples
+    --------
+    >>> from synth.spec import load_spec
+    >>> spec = load_spec("specs/x4_rotor.yaml")
+    >>> feasible_verdict(design_scalar(spec), scalar_family(spec)[0])[:44]
+    'P(kp=20) meets all 3 requirements and keeps '
+    """
     p = family.parameter
     gs = result.gain_set
     assert result.controller is not None and gs is not None and result.objective is not None
@@ -178,7 +194,15 @@ def feasible_verdict(result: DesignResult, family: ScalarFamily) -> str:
 
 
 def infeasible_verdict(result: DesignResult, family: ScalarFamily) -> str:
-    """Plain-language explanation of why no value works."""
+    """Plain-language explanation of why no value works.
+
+    Examples
+    --------
+    >>> from synth.spec import load_spec
+    >>> spec = load_spec("specs/x4_rotor_strict.yaml")
+    >>> infeasible_verdict(design_scalar(spec), scalar_family(spec)[0])[:40]
+    'No kp in [0, 5] meets every requirement.'
+    """
     p = family.parameter
     gs = result.gain_set
     assert gs is not None
