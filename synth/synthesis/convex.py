@@ -33,7 +33,7 @@ import numpy as np
 from synth.check import evaluate_all
 from synth.errors import SynthError
 from synth.plant import Plant
-from synth.requirements.base import Requirement
+from synth.requirements.base import Requirement, magnitude
 from synth.stability import closed_loop_stability
 from synth.synthesis.convex_forms import (
     T0,
@@ -379,7 +379,7 @@ class ConvexDesigner:
         elif maximize:
             lo, hi = np.log(max(best, self.grid[0])), np.log(self.grid[-1])
         else:
-            cap = 10 ** (best / 20) if name in ("peak_complementary", "control_effort") else best
+            cap = magnitude(best) if name in ("peak_complementary", "control_effort") else best
             lo, hi = np.log(cap), np.log(cap) - np.log(1e3)
         if self._bracket is not None:  # a refinement round: the optimum moved little, search near it
             width = max(abs(self._bracket[1] - self._bracket[0]), 1e-3) * 20
