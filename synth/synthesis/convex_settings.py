@@ -52,8 +52,8 @@ def design_grid(plants: list[Plant], requirements: list[Requirement], settings: 
         if band is not None:
             lo = min(lo, band[0] / 10 if band[0] > 0 else lo)
             hi = max(hi, band[1] * 10)
-        for key in ("min", "max"):
-            v = getattr(r, key, None) if r.type == "bandwidth" else None
+        for key, bound in r.bounds.items():  # frequency bounds (a bandwidth's min and max)
+            v = getattr(r, key, None) if bound.unit == "rad/s" else None
             if v:
                 lo, hi = min(lo, v / 100), max(hi, v * 100)
     if settings.n_points:
