@@ -30,11 +30,11 @@ from scipy.optimize import differential_evolution
 
 from synth.check import check
 from synth.controllers import Controller
-from synth.design import DesignResult
 from synth.loop import Loop
+from synth.results import DesignResult
 from synth.spec import parse_spec
 from synth.stability import closed_loop_stability
-from synth.synthesis.convex import ConvexSettings
+from synth.synthesis.convex_settings import ConvexSettings
 from synth.synthesis.multi import design_convex
 
 SPEC = """

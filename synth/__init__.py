@@ -43,13 +43,14 @@ _os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 from synth.check import CheckResult, check
 from synth.controllers import Controller
 from synth.data import Record, as_record, load_record, record_from_arrays
-from synth.design import DesignResult, design
+from synth.design import design
 from synth.errors import DataError, ModelError, SpecError, SynthError
-from synth.gainset import GainSet, ScalarFamily, feasible_gain_set
 from synth.loop import Loop
 from synth.plant import Plant, Signal
+from synth.results import DesignResult
 from synth.spec import Spec, load_spec, parse_spec
 from synth.stability import closed_loop_stability
+from synth.synthesis.gainset import GainSet, ScalarFamily, feasible_gain_set
 from synth.version import __version__
 
 

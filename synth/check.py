@@ -13,6 +13,8 @@ from synth.plant import Plant
 from synth.requirements.base import Requirement, RequirementResult, fmt
 from synth.spec import Spec
 
+__all__ = ["CheckResult", "check", "evaluate_all", "stability_result"]
+
 
 @dataclass
 class CheckResult:

@@ -15,6 +15,8 @@ from scipy.optimize import minimize_scalar
 
 from synth.stability import bisect_roots
 
+__all__ = ["DEFAULT_PER_DECADE", "Curve", "band_grid", "characteristic_range", "crossings", "log_grid", "peak"]
+
 Curve = Callable[[np.ndarray], np.ndarray]
 
 DEFAULT_PER_DECADE = 80

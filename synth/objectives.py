@@ -13,6 +13,8 @@ from synth.freqgrid import log_grid, peak
 if TYPE_CHECKING:
     from synth.loop import Loop
 
+__all__ = ["Measure", "measure", "score"]
+
 
 @dataclass(frozen=True)
 class Measure:

@@ -5,7 +5,7 @@ Every synth value is computed by synth's own functions from the paper's model (e
 :meth:`synth.loop.Loop.closed_loop_poles`, bandwidth by :meth:`~synth.loop.Loop.bandwidth`, rise times by
 :func:`synth.timeresp.step_metrics`, the slew-rate crossing by
 :meth:`synth.requirements.SlewRate.crossing_frequency`, the sensitivity band by
-:class:`synth.requirements.Sensitivity`, the limit-cycle onset by :func:`synth.gainset.critical_gains`,
+:class:`synth.requirements.Sensitivity`, the limit-cycle onset by :func:`synth.synthesis.gainset.critical_gains`,
 the sizing by :func:`synth.sizing.sizing_checks`. Nothing is typed in but the paper's printed values.
 """
 
@@ -18,13 +18,13 @@ from typing import Any
 import numpy as np
 
 from synth.controllers import Controller
-from synth.gainset import critical_gains
 from synth.loop import Loop
 from synth.paper_row import DISAGREES, PaperRow, rows_table
 from synth.plant import Plant
 from synth.reference import published_summary
 from synth.requirements import Sensitivity, SlewRate, StaticSensitivity
 from synth.sizing import RHO_SEA_LEVEL, sizing_checks
+from synth.synthesis.gainset import critical_gains
 from synth.timeresp import step_metrics, step_response
 
 __all__ = ["EQ14", "EQ15", "PLANT", "SENSOR", "PaperTable", "closed_loop_checks", "identification_checks",
@@ -99,7 +99,7 @@ def _tf_rise_time(tf: str, horizon: float = 20.0) -> float:
 
 def onset_delay(plant: Plant, gain: float, hi: float = 0.1) -> float | None:
     """Smallest in-loop delay [s] at which the proportional ``gain`` is critical (bisection on
-    :func:`synth.gainset.critical_gains`); ``None`` if even ``hi`` seconds leave it stable.
+    :func:`synth.synthesis.gainset.critical_gains`); ``None`` if even ``hi`` seconds leave it stable.
 
     Examples
     --------

@@ -12,13 +12,15 @@ from typing import Any
 import numpy as np
 
 from synth.controllers import Controller
-from synth.gainset import critical_gains
 from synth.loop import BANDWIDTH_LEVEL, Loop
 from synth.plant import Plant
 from synth.requirements import SlewRate
 from synth.requirements.base import fmt
 from synth.spec import Spec
+from synth.synthesis.gainset import critical_gains
 from synth.timeresp import step_metrics, step_response
+
+__all__ = ["compare", "loop_summary", "published_summary", "slew_reconciliation"]
 
 
 def _poles_text(poles: np.ndarray) -> list[str]:

@@ -32,7 +32,7 @@ LAYERS: dict[str, int] = {
     # 4 evaluation against the spec, and the result types
     "synth.check": 4, "synth.results": 4,
     # 5 solvers: one-parameter sets, convex, NLP, multi-parameter design
-    "synth.gainset": 5, "synth.synthesis": 5,
+    "synth.synthesis": 5,
     # 6 the design dispatcher
     "synth.design": 6,
     # 7 what runs designs or models many times: trade-offs, published comparisons, the gap diagnosis

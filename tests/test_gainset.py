@@ -5,9 +5,9 @@ import pytest
 
 from synth.check import check
 from synth.design import design
-from synth.gainset import ScalarFamily, critical_gains, feasible_gain_set
 from synth.plant import Plant
 from synth.spec import load_spec, parse_spec
+from synth.synthesis.gainset import ScalarFamily, critical_gains, feasible_gain_set
 
 from .conftest import X4_PLANT
 

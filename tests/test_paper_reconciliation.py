@@ -65,7 +65,7 @@ def test_onset_delay_is_where_the_gain_turns_critical():
     plant = Plant.from_string(PLANT)
     d = onset_delay(plant, 5.0)
     assert 0.013 < d < 0.016
-    from synth.gainset import critical_gains
+    from synth.synthesis.gainset import critical_gains
 
     assert critical_gains(plant, [d])[0]["critical_gain"] == pytest.approx(5.0, rel=1e-3)
     assert onset_delay(plant, 1e-3, hi=0.01) is None  # a tiny gain stays stable

@@ -9,7 +9,7 @@ every admitted requirement type, one and several plants; and that the polish sti
 import pytest
 
 from synth.spec import parse_spec
-from synth.synthesis.convex import ConvexSettings
+from synth.synthesis.convex_settings import ConvexSettings
 from synth.synthesis.multi import _convex_runs, _objective_terms, design_convex, polish_redundant
 from synth.synthesis.nlp import polish
 

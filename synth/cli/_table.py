@@ -5,7 +5,7 @@ from __future__ import annotations
 from collections.abc import Iterable
 from typing import Any
 
-from synth.requirements.base import RequirementResult, fmt
+from synth.requirements.base import Requirement, RequirementResult, fmt
 
 
 def table(headers: list[str], rows: Iterable[list[str]]) -> str:
@@ -26,15 +26,26 @@ def table(headers: list[str], rows: Iterable[list[str]]) -> str:
     return "\n".join(lines)
 
 
-def requirement_rows(results: list[RequirementResult]) -> list[list[str]]:
-    """Rows ``requirement, value, bound, slack, binding frequency, met`` for a table."""
+def requirement_rows(results: list[RequirementResult], requirements: list[Requirement]) -> list[list[str]]:
+    """Rows ``requirement, value, bound, slack, binding frequency, met`` for a table.
+
+    ``results`` are the check's rows (stability first, then one per requirement in spec order);
+    each row's bound reads as its requirement's class writes it.
+
+    Examples
+    --------
+    >>> from synth.spec import load_spec; from synth.check import check
+    >>> spec = load_spec("specs/x4_rotor.yaml")
+    >>> [row[2] for row in requirement_rows(check(spec, "P(3)").requirements, list(spec.requirements))]
+    ['stable', '<= -15 dB', '>= 60 rad/s', '<= 10000 PWM/s']
+    """
     rows = []
+    reqs = iter(requirements)
     for r in results:
         if r.type == "stability":
             value, bound = ("stable" if r.met else f"{int(r.value)} unstable root(s)"), "stable"
         else:
-            rel = ">=" if r.type in ("bandwidth", "margins") else "<="
-            value, bound = f"{fmt(r.value)} {r.unit}", f"{rel} {fmt(r.bound)} {r.unit}"
+            value, bound = f"{fmt(r.value)} {r.unit}", next(reqs).report_row(r).bound_text()
         plant = f" [{r.plant}]" if r.plant and r.plant != "nominal" else ""
         rows.append([r.label + plant, value, bound, f"{r.slack:+.4g}",
                      fmt(r.binding_frequency), "met" if r.met else "NOT MET"])
@@ -44,9 +55,9 @@ def requirement_rows(results: list[RequirementResult]) -> list[list[str]]:
 REQUIREMENT_HEADERS = ["requirement", "value", "bound", "slack [Np]", "binding w [rad/s]", ""]
 
 
-def print_requirements(results: list[RequirementResult], out: Any) -> None:
+def print_requirements(results: list[RequirementResult], requirements: list[Requirement], out: Any) -> None:
     """Print the requirement table and each requirement's plain-language line."""
-    print(table(REQUIREMENT_HEADERS, requirement_rows(results)), file=out)
+    print(table(REQUIREMENT_HEADERS, requirement_rows(results, requirements)), file=out)
     print(file=out)
     for r in results:
         print(f"- {r.message}", file=out)

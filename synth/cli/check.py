@@ -5,6 +5,8 @@ from __future__ import annotations
 import argparse
 import sys
 
+__all__ = ["COMMAND", "DESCRIPTION", "HELP", "ORDER", "add_arguments", "run"]
+
 COMMAND = "check"
 ORDER = 10
 HELP = "check a controller against every requirement of a spec"
@@ -49,7 +51,7 @@ def run(args: argparse.Namespace) -> int:
         write_json(args.json, result.to_dict(), force=args.force)
     if not args.quiet and args.json != "-":
         print(f"{spec.name}: {controller}  [{controller.transfer_function_text()}]")
-        print_requirements(result.requirements, sys.stdout)
+        print_requirements(result.requirements, list(spec.requirements), sys.stdout)
         print()
         print("all requirements met" if result.feasible else
               f"NOT met: {', '.join(r.label for r in result.failed())}")

@@ -7,6 +7,8 @@ import shlex
 import sys
 from pathlib import Path
 
+__all__ = ["COMMAND", "DESCRIPTION", "HELP", "ORDER", "add_arguments", "run"]
+
 COMMAND = "design"
 ORDER = 20
 HELP = "design the spec's controller and write reports/<name>/"
@@ -76,7 +78,7 @@ def run(args: argparse.Namespace) -> int:
         print()
         if result.compromise is not None:
             print(f"best compromise (NOT a solution): {result.compromise.controller}")
-        print_requirements(shown.requirements, sys.stdout)
+        print_requirements(shown.requirements, list(spec.requirements), sys.stdout)
     if not args.no_report:
         say(f"\nreport: {out_dir / 'report.html'}")
     return 0 if result.feasible else 1

@@ -7,6 +7,8 @@ import shlex
 import sys
 from pathlib import Path
 
+__all__ = ["COMMAND", "DESCRIPTION", "HELP", "ORDER", "add_arguments", "run"]
+
 COMMAND = "tradeoff"
 ORDER = 30
 HELP = "sweep one or two spec values and report the Pareto front"

@@ -10,14 +10,17 @@ import numpy as np
 from jinja2 import Environment, PackageLoader
 
 from synth.controllers import Controller
-from synth.design import DesignResult, reference_controller, scalar_family
 from synth.loop import Loop
 from synth.outputs import GENERATOR, OutputDir, dump_json, to_jsonable
 from synth.reference import compare
 from synth.report import figures
 from synth.requirements import SlewRate
-from synth.requirements.base import fmt
+from synth.requirements.base import Requirement, fmt
+from synth.results import DesignResult, reference_controller
 from synth.spec import Spec
+from synth.synthesis.scalar import scalar_family
+
+__all__ = ["ReportFiles", "report_data", "write_design_report"]
 
 
 @dataclass
@@ -77,7 +80,9 @@ def _slack_curves(spec: Spec) -> dict[str, tuple[np.ndarray, np.ndarray]]:
     return curves
 
 
-def _columns(data: dict[str, Any]) -> tuple[list[dict], list[dict]]:
+def _columns(data: dict[str, Any], requirements: list[Requirement]) -> tuple[list[dict], list[dict]]:
+    """Table columns (design, compromise, reference) and rows: stability, then the spec's requirements in
+    order, each row's relation to its bound from the requirement's own class."""
     cols = []
     if data.get("controller"):
         cols.append(("design " + data["controller"]["text"], data["requirements"]))
@@ -96,8 +101,11 @@ def _columns(data: dict[str, Any]) -> tuple[list[dict], list[dict]]:
             value = "stable" if r["type"] == "stability" and r["met"] else (
                 "UNSTABLE" if r["type"] == "stability" else f"{fmt(_num(r['value']))} {r['unit']}")
             cells.append({"value": value, "slack": fmt(_num(r["slack"]), 3), "met": r["met"]})
-        bound = "all roots in the left half-plane" if r0["type"] == "stability" else (
-            f"{'>=' if r0['type'] in ('bandwidth', 'margins') else '<='} {fmt(_num(r0['bound']))} {r0['unit']}")
+        if r0["type"] == "stability":  # the check's own first row, not a spec requirement
+            bound = "all roots in the left half-plane"
+        else:
+            relation = requirements[i - 1].bound_of(_num(r0["bound"])).relation
+            bound = f"{relation} {fmt(_num(r0['bound']))} {r0['unit']}"
         rows.append({"label": r0["label"], "cells": cells, "bound": bound})
     return columns, rows
 
@@ -179,7 +187,7 @@ def write_design_report(spec: Spec, result: DesignResult, out_dir: str | Path, *
         figs["gap_map"] = write_gap_map(diag.localization, out.claim("gap_map.png"), diag.plant)
         figs["gap_overlay"] = save_figure(overlay_figure(diag.attribution), out.claim("gap_overlay.png"))
 
-    columns, rows = _columns(data)
+    columns, rows = _columns(data, list(spec.requirements))
     ref_line = ""
     env = Environment(loader=PackageLoader("synth.report", "templates"), autoescape=True)
     html = env.get_template("design.html.j2").render(

@@ -11,6 +11,16 @@ from typing import Any
 
 import matplotlib
 
+__all__ = [
+    "COLORS",
+    "bode_with_slew_bound",
+    "delay_chart",
+    "feasibility_map",
+    "gain_set_plot",
+    "sensitivity_plot",
+    "step_plot",
+]
+
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np

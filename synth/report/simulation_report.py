@@ -171,7 +171,7 @@ def _verdict(data: dict[str, Any], y: str) -> str:
 
 
 def _continuous_critical(plant: Any, loop_delay: float, delays: list[float]) -> list[dict[str, Any]]:
-    from synth.gainset import critical_gains
+    from synth.synthesis.gainset import critical_gains
 
     rows = critical_gains(plant, [loop_delay + d for d in delays])
     return [{"delay": d, "critical_gain": r["critical_gain"], "frequency": r["frequency"]}

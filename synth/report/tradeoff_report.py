@@ -16,6 +16,8 @@ from synth.report.figures import COLORS, plt
 from synth.requirements.base import fmt
 from synth.synthesis.tradeoff import TradeoffResult
 
+__all__ = ["TradeoffFiles", "tradeoff_csv", "tradeoff_figure", "write_tradeoff_report"]
+
 
 @dataclass
 class TradeoffFiles:

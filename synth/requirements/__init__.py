@@ -6,14 +6,19 @@ Importing this package registers every built-in type in :data:`REQUIREMENT_TYPES
 from synth.requirements.bandwidth import Bandwidth
 from synth.requirements.base import (
     REQUIREMENT_TYPES,
+    Bound,
+    ReportRow,
     Requirement,
     RequirementResult,
+    magnitude,
     register,
+    unique_names,
 )
 from synth.requirements.control_sensitivity import PeakControlSensitivity
 from synth.requirements.margins import MarginsRequirement
 from synth.requirements.sensitivity import (
     PeakComplementary,
+    PeakRequirement,
     PeakSensitivity,
     Sensitivity,
     StaticSensitivity,
@@ -23,14 +28,19 @@ from synth.requirements.slew_rate import SlewRate
 __all__ = [
     "REQUIREMENT_TYPES",
     "Bandwidth",
+    "Bound",
     "MarginsRequirement",
     "PeakComplementary",
     "PeakControlSensitivity",
+    "PeakRequirement",
     "PeakSensitivity",
+    "ReportRow",
     "Requirement",
     "RequirementResult",
     "Sensitivity",
     "SlewRate",
     "StaticSensitivity",
+    "magnitude",
     "register",
+    "unique_names",
 ]

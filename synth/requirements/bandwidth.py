@@ -2,15 +2,17 @@
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, ClassVar, Literal
+from typing import TYPE_CHECKING, Any, ClassVar, Literal
 
 import numpy as np
 from pydantic import PositiveFloat, model_validator
 
-from synth.requirements.base import Requirement, RequirementResult, fmt, register
+from synth.requirements.base import Bound, Requirement, RequirementResult, fmt, register
 
 if TYPE_CHECKING:
     from synth.loop import Loop
+
+__all__ = ["Bandwidth"]
 
 
 @register
@@ -32,6 +34,8 @@ class Bandwidth(Requirement):
     min: PositiveFloat | None = None
     max: PositiveFloat | None = None
     title: ClassVar[str] = "closed-loop bandwidth"
+    bounds: ClassVar[dict[str, Bound]] = {"min": Bound("lower", "rad/s"), "max": Bound("upper", "rad/s")}
+    example: ClassVar[dict[str, Any]] = {"type": "bandwidth", "min": 60.0}
 
     @model_validator(mode="after")
     def _one_bound(self) -> Bandwidth:

@@ -16,15 +16,113 @@ a 1-neper magnitude slack and a 1-radian phase slack weigh the same.
 from __future__ import annotations
 
 from dataclasses import asdict, dataclass, field
-from typing import TYPE_CHECKING, Any, ClassVar
+from typing import TYPE_CHECKING, Any, ClassVar, Literal
 
 import numpy as np
 from pydantic import BaseModel, ConfigDict, field_validator
 
+from synth.errors import SpecError
+
 if TYPE_CHECKING:
     from synth.loop import Loop
 
+__all__ = [
+    "NEPER_PER_DB",
+    "REQUIREMENT_TYPES",
+    "BandMixin",
+    "Bound",
+    "ReportRow",
+    "Requirement",
+    "RequirementResult",
+    "check_band",
+    "db",
+    "fmt",
+    "magnitude",
+    "register",
+    "unique_names",
+]
+
 NEPER_PER_DB = np.log(10.0) / 20.0
+
+
+def magnitude(value_db: float) -> float:
+    """Magnitude of a level in dB, ``10^(value_db / 20)``: the one dB-to-magnitude conversion of the
+    package (requirements, convex forms and NLP forms all use it).
+
+    Examples
+    --------
+    >>> magnitude(20.0), round(magnitude(-6.0), 4)
+    (10.0, 0.5012)
+    """
+    return float(10.0 ** (value_db / 20.0))
+
+
+@dataclass(frozen=True)
+class Bound:
+    """One bound field of a requirement: which side it bounds and in which unit.
+
+    Attributes
+    ----------
+    direction : {"upper", "lower"}
+        ``"upper"``: the measured value must stay at or below the bound (``max_db``);
+        ``"lower"``: at or above it (``min``, margins).
+    unit : str
+        Unit of the spec value; ``"dB"`` bounds are read as magnitudes by :meth:`Requirement.linear_bound`.
+
+    Examples
+    --------
+    >>> Bound("upper", "dB").relation, Bound("lower", "rad/s").stricter_when
+    ('<=', 1)
+    """
+
+    direction: Literal["upper", "lower"]
+    unit: str
+
+    @property
+    def relation(self) -> str:
+        """``"<="`` for an upper bound, ``">="`` for a lower bound."""
+        return "<=" if self.direction == "upper" else ">="
+
+    @property
+    def stricter_when(self) -> int:
+        """+1 when a larger bound is stricter (lower bounds), -1 when a smaller one is (upper bounds)."""
+        return -1 if self.direction == "upper" else +1
+
+
+@dataclass
+class ReportRow:
+    """One requirement's row in a report: measured value, relation to its bound, slack.
+
+    Examples
+    --------
+    >>> row = ReportRow("Ms", 4.2, "<=", 6.0, "dB", 0.2, True)
+    >>> row.bound_text(), row.consistent()
+    ('<= 6 dB', True)
+    """
+
+    label: str
+    value: float
+    relation: str
+    bound: float
+    unit: str
+    slack: float
+    met: bool
+
+    def bound_text(self) -> str:
+        """``"<= 6 dB"``, ``">= 60 rad/s"``."""
+        return f"{self.relation} {fmt(self.bound)} {self.unit}".rstrip()
+
+    def consistent(self) -> bool:
+        """The slack's sign agrees with the value's side of the bound (a met lower bound has
+        ``value >= bound`` and ``slack >= 0``, a violated upper bound ``value > bound`` and ``slack < 0``)."""
+        if not (np.isfinite(self.value) and np.isfinite(self.bound)) or self.value == self.bound:
+            return True
+        on_side = self.value > self.bound if self.relation == ">=" else self.value < self.bound
+        return on_side == (self.slack >= 0) == self.met
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready dict."""
+        return asdict(self)
 
 
 @dataclass
@@ -81,7 +179,17 @@ REQUIREMENT_TYPES: dict[str, type[Requirement]] = {}
 
 
 def register(cls: type[Requirement]) -> type[Requirement]:
-    """Class decorator: make a requirement available under its ``type`` name."""
+    """Class decorator: make a requirement available under its ``type`` name.
+
+    The solver forms are registered beside their solvers (``convex_form`` in
+    :mod:`synth.synthesis.convex_forms`, ``nlp_form`` in :mod:`synth.synthesis.nlp_forms`);
+    docs/extending-requirements.md gives the recipe.
+
+    Examples
+    --------
+    >>> REQUIREMENT_TYPES["peak_sensitivity"].__name__
+    'PeakSensitivity'
+    """
     name = cls.model_fields["type"].default
     REQUIREMENT_TYPES[name] = cls
     return cls
@@ -96,6 +204,12 @@ class Requirement(BaseModel):
     label: str | None = None
 
     title: ClassVar[str] = "requirement"
+    bounds: ClassVar[dict[str, Bound]] = {}
+    """The bound fields: name -> :class:`Bound` (direction and unit)."""
+    stricter: ClassVar[dict[str, int]] = {}
+    """Other swept fields and their direction: +1 when a larger value makes the requirement stricter."""
+    example: ClassVar[dict[str, Any]] = {}
+    """A spec-file block of this type (docs, the registry test's round trip)."""
 
     def evaluate(self, loop: Loop, per_decade: int = 80) -> RequirementResult:  # pragma: no cover
         """Evaluate on ``loop``; ``per_decade`` sets the density of the frequency grid."""
@@ -104,6 +218,77 @@ class Requirement(BaseModel):
     def name(self) -> str:
         """Label given in the spec, or the type name."""
         return self.label or self.type
+
+    @classmethod
+    def stricter_when(cls, field: str, index: int | None = None) -> int:
+        """+1 when a larger value of ``field`` (item ``index`` of a pair such as ``band``) makes the
+        requirement stricter, -1 when a smaller one does; a field with no known direction is a
+        :class:`SpecError` naming the type and the field.
+
+        Examples
+        --------
+        >>> from synth.requirements import Bandwidth, SlewRate
+        >>> Bandwidth.stricter_when("min"), Bandwidth.stricter_when("max"), SlewRate.stricter_when("max_error")
+        (1, -1, 1)
+        >>> SlewRate.stricter_when("band", 0), SlewRate.stricter_when("band", 1)
+        (-1, 1)
+        """
+        name = cls.model_fields["type"].default
+        if field in cls.bounds:
+            return cls.bounds[field].stricter_when
+        if field in cls.stricter:
+            return cls.stricter[field]
+        if field == "band" and "band" in cls.model_fields and index in (0, 1):
+            return -1 if index == 0 else +1  # a wider band is stricter
+        raise SpecError(f"requirement type {name!r} has no direction for {field!r}: "
+                        "sweep one of " + ", ".join([*cls.bounds, *cls.stricter]), where=f"requirements.{name}")
+
+    def linear_bound(self, field: str) -> float | None:
+        """The bound ``field`` in linear units (a dB bound as a magnitude); None when not given.
+
+        Examples
+        --------
+        >>> from synth.requirements import PeakSensitivity
+        >>> round(PeakSensitivity(max_db=6).linear_bound("max_db"), 4)
+        1.9953
+        """
+        value = getattr(self, field)
+        if value is None:
+            return None
+        return magnitude(value) if self.bounds[field].unit == "dB" else float(value)
+
+    def bound_of(self, value: float) -> Bound:
+        """The bound a result quotes as ``value`` (for requirements with several bounds, the one with
+        that value; else the first given).
+
+        Examples
+        --------
+        >>> from synth.requirements import Bandwidth
+        >>> Bandwidth(min=60, max=80).bound_of(80.0).direction
+        'upper'
+        """
+        given = [(f, b) for f, b in self.bounds.items() if getattr(self, f, None) is not None]
+        if not given:
+            raise SpecError(f"requirement type {self.type!r} declares no bound fields", where="requirements")
+        for f, b in given:
+            if getattr(self, f) == value:
+                return b
+        return given[0][1]
+
+    def report_row(self, result: RequirementResult) -> ReportRow:
+        """The report's row for ``result`` (this requirement evaluated on a loop).
+
+        Examples
+        --------
+        >>> from synth.loop import Loop; from synth.plant import Plant; from synth.controllers import Controller
+        >>> from synth.requirements import Bandwidth
+        >>> req = Bandwidth(min=100)
+        >>> row = req.report_row(req.evaluate(Loop(Plant.from_string("1/(s+1)"), Controller("P", {"kp": 9.0}))))
+        >>> row.bound_text(), row.met, row.slack < 0
+        ('>= 100 rad/s', False, True)
+        """
+        return ReportRow(result.label, result.value, self.bound_of(result.bound).relation, result.bound, result.unit,
+                         result.slack, result.met)
 
     def result(self, *, value: float, bound: float, unit: str, slack: float, margin: float,
                binding_frequency: float | None, message: str, **details: Any) -> RequirementResult:
@@ -125,14 +310,25 @@ class BandMixin(BaseModel):
     @field_validator("band")
     @classmethod
     def _check_band(cls, band: tuple[float, float]) -> tuple[float, float]:
-        lo, hi = band
-        if not (np.isfinite(lo) and np.isfinite(hi)):
-            raise ValueError(f"band must be finite, got [{lo:g}, {hi:g}]")
-        if lo < 0 or hi <= 0:
-            raise ValueError(f"band must be non-negative frequencies in rad/s, got [{lo:g}, {hi:g}]")
-        if hi <= lo:
-            raise ValueError(f"band must be [low, high] with low < high, got [{lo:g}, {hi:g}]")
-        return band
+        return check_band(band)
+
+
+def check_band(band: tuple[float, float]) -> tuple[float, float]:
+    """``band`` if it is ``[low, high]`` with ``0 <= low < high`` finite (rad/s), else ValueError.
+
+    Examples
+    --------
+    >>> check_band((0.0, 30.0))
+    (0.0, 30.0)
+    """
+    lo, hi = band
+    if not (np.isfinite(lo) and np.isfinite(hi)):
+        raise ValueError(f"band must be finite, got [{lo:g}, {hi:g}]")
+    if lo < 0 or hi <= 0:
+        raise ValueError(f"band must be non-negative frequencies in rad/s, got [{lo:g}, {hi:g}]")
+    if hi <= lo:
+        raise ValueError(f"band must be [low, high] with low < high, got [{lo:g}, {hi:g}]")
+    return band
 
 
 def fmt(x: float | None, digits: int = 4) -> str:
@@ -163,3 +359,20 @@ def db(x: float) -> float:
     """
     with np.errstate(divide="ignore"):
         return float(20.0 * np.log10(abs(x)))
+
+
+def unique_names(requirements: list[Requirement]) -> list[str]:
+    """One name per requirement, in order: its label or type, with ``#2``, ``#3`` ... on repeats.
+
+    Examples
+    --------
+    >>> from synth.requirements import PeakSensitivity
+    >>> unique_names([PeakSensitivity(max_db=6), PeakSensitivity(max_db=4, label="Ms")] * 2)
+    ['peak_sensitivity', 'Ms', 'peak_sensitivity#2', 'Ms#2']
+    """
+    names, seen = [], {}
+    for r in requirements:
+        base = r.name()
+        seen[base] = seen.get(base, 0) + 1
+        names.append(base if seen[base] == 1 else f"{base}#{seen[base]}")
+    return names

@@ -2,19 +2,22 @@
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, ClassVar, Literal
+from collections.abc import Callable
+from typing import TYPE_CHECKING, Any, ClassVar, Literal
 
 import numpy as np
 
 from synth.requirements.base import register
-from synth.requirements.sensitivity import _PeakRequirement
+from synth.requirements.sensitivity import PeakRequirement
 
 if TYPE_CHECKING:
     from synth.loop import Loop
 
+__all__ = ["PeakControlSensitivity"]
+
 
 @register
-class PeakControlSensitivity(_PeakRequirement):
+class PeakControlSensitivity(PeakRequirement):
     """Peak ``|C S|`` at most ``max_db`` (dB of plant-input units per output unit).
 
     Examples
@@ -29,6 +32,8 @@ class PeakControlSensitivity(_PeakRequirement):
     type: Literal["peak_control_sensitivity"] = "peak_control_sensitivity"
     symbol: ClassVar[str] = "|KS|"
     title: ClassVar[str] = "peak control sensitivity"
+    example: ClassVar[dict[str, Any]] = {"type": "peak_control_sensitivity", "max_db": 20.0}
 
-    def curve(self, loop: Loop):
+    def curve(self, loop: Loop) -> Callable[[np.ndarray], np.ndarray]:
+        """``|C S|`` as a function of ``w``."""
         return lambda w: np.abs(loop.KS(w))

@@ -2,15 +2,17 @@
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, ClassVar, Literal
+from typing import TYPE_CHECKING, Any, ClassVar, Literal
 
 import numpy as np
 from pydantic import PositiveFloat, model_validator
 
-from synth.requirements.base import NEPER_PER_DB, Requirement, RequirementResult, fmt, register
+from synth.requirements.base import NEPER_PER_DB, Bound, Requirement, RequirementResult, fmt, register
 
 if TYPE_CHECKING:
     from synth.loop import Loop
+
+__all__ = ["MarginsRequirement"]
 
 
 @register
@@ -32,6 +34,10 @@ class MarginsRequirement(Requirement):
     phase_margin_deg: PositiveFloat | None = None
     delay_margin: PositiveFloat | None = None
     title: ClassVar[str] = "stability margins"
+    bounds: ClassVar[dict[str, Bound]] = {"gain_margin_db": Bound("lower", "dB"),
+                                          "phase_margin_deg": Bound("lower", "deg"),
+                                          "delay_margin": Bound("lower", "s")}
+    example: ClassVar[dict[str, Any]] = {"type": "margins", "gain_margin_db": 6.0, "phase_margin_deg": 45.0}
 
     @model_validator(mode="after")
     def _something(self) -> MarginsRequirement:

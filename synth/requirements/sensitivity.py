@@ -2,7 +2,8 @@
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, ClassVar, Literal
+from collections.abc import Callable
+from typing import TYPE_CHECKING, Any, ClassVar, Literal
 
 import numpy as np
 from pydantic import Field
@@ -11,8 +12,10 @@ from synth.freqgrid import band_grid, crossings, log_grid, peak
 from synth.requirements.base import (
     NEPER_PER_DB,
     BandMixin,
+    Bound,
     Requirement,
     RequirementResult,
+    check_band,
     db,
     fmt,
     register,
@@ -21,8 +24,21 @@ from synth.requirements.base import (
 if TYPE_CHECKING:
     from synth.loop import Loop
 
+__all__ = ["MAX_DB", "PeakComplementary", "PeakRequirement", "PeakSensitivity", "Sensitivity", "StaticSensitivity",
+           "band_text"]
 
-def _band_text(band: tuple[float, float]) -> str:
+MAX_DB = {"max_db": Bound("upper", "dB")}
+"""The bound of every requirement here: a magnitude at most ``max_db``."""
+
+
+def band_text(band: tuple[float, float]) -> str:
+    """Where a band is, in words.
+
+    Examples
+    --------
+    >>> band_text((0, 30)), band_text((1, 10))
+    ('below 30 rad/s', 'from 1 to 10 rad/s')
+    """
     lo, hi = band
     return f"below {fmt(hi)} rad/s" if lo == 0 else f"from {fmt(lo)} to {fmt(hi)} rad/s"
 
@@ -43,20 +59,22 @@ class Sensitivity(BandMixin, Requirement):
     type: Literal["sensitivity"] = "sensitivity"
     max_db: float
     title: ClassVar[str] = "sensitivity over a band"
+    bounds: ClassVar[dict[str, Bound]] = MAX_DB
+    example: ClassVar[dict[str, Any]] = {"type": "sensitivity", "max_db": -15.0, "band": (0.0, 30.0)}
 
     def evaluate(self, loop: Loop, per_decade: int = 80) -> RequirementResult:
         grid = band_grid(self.band, loop.frequency_range, per_decade)
         value, w_peak = peak(lambda w: np.abs(loop.S(w)), grid)
         value_db = db(value)
         margin = self.max_db - value_db
-        limit = 10 ** (self.max_db / 20)
+        limit = self.linear_bound("max_db")
         up_to = None
         if margin < 0:
             mags = np.abs(loop.S(grid))
             if mags[0] <= limit:
                 cross = crossings(lambda w: np.abs(loop.S(w)), limit, grid)
                 up_to = float(cross[0]) if cross.size else None
-        where = _band_text(self.band)
+        where = band_text(self.band)
         if margin >= 0:
             msg = (f"|S| stays at or below {fmt(self.max_db)} dB {where}: met, "
                    f"peak {value_db:.2f} dB at {fmt(w_peak)} rad/s ({margin:.2f} dB to spare)")
@@ -90,6 +108,9 @@ class StaticSensitivity(Requirement):
     max_db: float
     plant_gain: float | None = Field(default=None, description="low-frequency plant gain")
     title: ClassVar[str] = "static sensitivity"
+    bounds: ClassVar[dict[str, Bound]] = MAX_DB
+    stricter: ClassVar[dict[str, int]] = {"plant_gain": -1}
+    example: ClassVar[dict[str, Any]] = {"type": "sensitivity_static", "max_db": -15.0, "plant_gain": 1.8}
 
     def gain(self, loop: Loop) -> float:
         """Plant gain used: the stated one or the model's DC gain."""
@@ -110,24 +131,34 @@ class StaticSensitivity(Requirement):
                    f"{'met' if margin >= 0 else 'NOT met'} ({source} plant gain {fmt(g)}, C(0) = {fmt(c0)})")
         return self.result(value=value_db, bound=self.max_db, unit="dB", slack=margin * NEPER_PER_DB,
                            margin=margin, binding_frequency=0.0, message=msg, plant_gain=g,
-                           controller_dc_gain=c0, minimum_dc_gain=(10 ** (-self.max_db / 20) - 1) / g)
+                           controller_dc_gain=c0, minimum_dc_gain=(1.0 / self.linear_bound("max_db") - 1) / g)
 
 
-class _PeakRequirement(Requirement):
-    """Peak of a closed-loop magnitude over a band (default: all frequencies)."""
+class PeakRequirement(Requirement):
+    """Peak of a closed-loop magnitude over a band (default: all frequencies): the base of the peak types.
+
+    A subclass names its ``type``, ``symbol`` and ``title`` and its :meth:`curve`.
+
+    Examples
+    --------
+    >>> PeakSensitivity(max_db=6).linear_bound("max_db") > 1.99
+    True
+    """
 
     max_db: float
     band: tuple[float, float] | None = None
     symbol: ClassVar[str] = "|S|"
+    bounds: ClassVar[dict[str, Bound]] = MAX_DB
 
-    def curve(self, loop: Loop):  # pragma: no cover - overridden
+    def curve(self, loop: Loop) -> Callable[[np.ndarray], np.ndarray]:  # pragma: no cover - overridden
+        """The magnitude whose peak is bounded, as a function of ``w``."""
         raise NotImplementedError
 
     def evaluate(self, loop: Loop, per_decade: int = 80) -> RequirementResult:
         if self.band is not None:
-            BandMixin._check_band(self.band)
+            check_band(self.band)
             grid = band_grid(self.band, loop.frequency_range, per_decade)
-            where = _band_text(self.band)
+            where = band_text(self.band)
         else:
             lo, hi = loop.frequency_range
             grid = log_grid(lo, hi * 10, per_decade)
@@ -142,7 +173,7 @@ class _PeakRequirement(Requirement):
 
 
 @register
-class PeakSensitivity(_PeakRequirement):
+class PeakSensitivity(PeakRequirement):
     """Peak ``|S|`` (Ms) at most ``max_db``.
 
     Examples
@@ -156,13 +187,15 @@ class PeakSensitivity(_PeakRequirement):
 
     type: Literal["peak_sensitivity"] = "peak_sensitivity"
     title: ClassVar[str] = "peak sensitivity"
+    example: ClassVar[dict[str, Any]] = {"type": "peak_sensitivity", "max_db": 6.0}
 
-    def curve(self, loop: Loop):
+    def curve(self, loop: Loop) -> Callable[[np.ndarray], np.ndarray]:
+        """``|S|`` as a function of ``w``."""
         return lambda w: np.abs(loop.S(w))
 
 
 @register
-class PeakComplementary(_PeakRequirement):
+class PeakComplementary(PeakRequirement):
     """Peak ``|T|`` (Mt) at most ``max_db``.
 
     Examples
@@ -176,9 +209,8 @@ class PeakComplementary(_PeakRequirement):
     type: Literal["peak_complementary"] = "peak_complementary"
     symbol: ClassVar[str] = "|T|"
     title: ClassVar[str] = "peak complementary sensitivity"
+    example: ClassVar[dict[str, Any]] = {"type": "peak_complementary", "max_db": 3.0}
 
-    def curve(self, loop: Loop):
+    def curve(self, loop: Loop) -> Callable[[np.ndarray], np.ndarray]:
+        """``|T|`` as a function of ``w``."""
         return lambda w: np.abs(loop.T(w))
-
-
-

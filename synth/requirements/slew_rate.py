@@ -2,16 +2,18 @@
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, ClassVar, Literal
+from typing import TYPE_CHECKING, Any, ClassVar, Literal
 
 import numpy as np
 from pydantic import PositiveFloat
 
 from synth.freqgrid import band_grid, crossings, log_grid, peak
-from synth.requirements.base import BandMixin, Requirement, RequirementResult, fmt, register
+from synth.requirements.base import BandMixin, Bound, Requirement, RequirementResult, fmt, register
 
 if TYPE_CHECKING:
     from synth.loop import Loop
+
+__all__ = ["SlewRate"]
 
 
 @register
@@ -36,6 +38,10 @@ class SlewRate(BandMixin, Requirement):
     rate_limit: PositiveFloat
     max_error: PositiveFloat
     title: ClassVar[str] = "slew-rate Bode bound"
+    bounds: ClassVar[dict[str, Bound]] = {"rate_limit": Bound("upper", "input units/s")}
+    stricter: ClassVar[dict[str, int]] = {"max_error": +1}
+    example: ClassVar[dict[str, Any]] = {"type": "slew_rate", "rate_limit": 10000.0, "max_error": 5.0,
+                                         "band": (0.1, 100.0)}
 
     def demand(self, loop: Loop):
         """Rate demand ``max_error |C(jw)| w`` as a function of ``w`` (input units/s)."""

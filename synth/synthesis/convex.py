@@ -25,18 +25,15 @@ from __future__ import annotations
 import itertools
 import time
 from collections.abc import Iterator
-from dataclasses import dataclass, field
 from typing import Any
 
 import cvxpy as cp
 import numpy as np
 
 from synth.check import evaluate_all
-from synth.controllers import Controller
 from synth.errors import SynthError
-from synth.freqgrid import characteristic_range, log_grid
 from synth.plant import Plant
-from synth.requirements.base import Requirement
+from synth.requirements.base import Requirement, magnitude
 from synth.stability import closed_loop_stability
 from synth.synthesis.convex_forms import (
     T0,
@@ -47,139 +44,18 @@ from synth.synthesis.convex_forms import (
     make_points,
     without_implied,
 )
+from synth.synthesis.convex_results import ConvexResult, Diagnosis, RequirementConflict
+from synth.synthesis.convex_settings import ConvexSettings, design_grid
+from synth.synthesis.objective_forms import CoefficientRatioFloor, Level, ReturnDifferenceFloor
 from synth.synthesis.parametrization import Parametrization
+
+__all__ = ["GRID_TOLERANCE", "SOLVER", "ConvexDesigner"]
 
 SOLVER = cp.CLARABEL
 _OK = {cp.OPTIMAL, cp.OPTIMAL_INACCURATE}
 GRID_TOLERANCE = 1e-9
 """Largest relative violation of a (backed-off) form on the design grid that still counts as met: the
 solver meets the linearized cones to its own accuracy, and every form is tightened by 1e-4."""
-
-
-@dataclass
-class ConvexSettings:
-    """Settings of the convex-concave procedure.
-
-    Attributes
-    ----------
-    per_decade : int
-        Design-grid density (points per decade) when ``n_points`` is not given.
-    n_points : int or None
-        Exact number of design-grid frequencies (log-spaced), overriding ``per_decade``.
-    max_iterations : int
-        Convex solves per phase.
-    tolerance : float
-        Relative objective change that ends a phase.
-    stability_level : float
-        Every iterate keeps ``|1 + L| >= stability_level`` on the grid (|S| <= 26 dB
-        for 0.05), which keeps the closed loop stable along each step.
-    """
-
-    per_decade: int = 40
-    n_points: int | None = None
-    max_iterations: int = 60
-    tolerance: float = 1e-6
-    stability_level: float = 0.05
-    bisection_steps: int = 18
-
-
-@dataclass
-class RequirementConflict:
-    """One requirement in an infeasibility diagnosis."""
-
-    name: str
-    elastic_slack: float
-    price: float
-    violated: bool
-    exact_slack: float
-    message: str
-
-    def to_dict(self) -> dict[str, Any]:
-        return dict(self.__dict__)
-
-
-@dataclass
-class Diagnosis:
-    """Why a spec cannot be met: the elastic solution, slacks and prices."""
-
-    total_slack: float
-    conflicts: list[RequirementConflict]
-    bounds_active: list[str]
-    controller: Controller
-    conflict_set: list[str] | None = None
-
-    def conflicting(self) -> list[str]:
-        """A minimal set of requirements that cannot be met together (deletion filter) when computed;
-        otherwise those violated at the elastic solution or pushing against them (price >= 1 % of the
-        largest)."""
-        if self.conflict_set is not None:
-            return list(self.conflict_set)
-        top = max((c.price for c in self.conflicts), default=0.0)
-        return [c.name for c in self.conflicts if c.violated or (top > 0 and c.price >= 0.01 * top)]
-
-    def to_dict(self) -> dict[str, Any]:
-        return {
-            "total_elastic_slack": self.total_slack,
-            "conflicting": self.conflicting(),
-            "conflict_set_method": "deletion filter: each requirement dropped in turn; kept if the rest "
-                                   "became feasible" if self.conflict_set is not None else "elastic prices",
-            "requirements": [c.to_dict() for c in self.conflicts],
-            "bounds_active": self.bounds_active,
-            "elastic_controller": self.controller.to_dict(),
-        }
-
-
-@dataclass
-class ConvexResult:
-    """Outcome of :meth:`ConvexDesigner.run`."""
-
-    status: str
-    controller: Controller
-    rho: np.ndarray
-    objective_value: float | None
-    iterations: int
-    solves: int
-    solve_time: float
-    history: list[dict[str, float]] = field(default_factory=list)
-    diagnosis: Diagnosis | None = None
-    grid_points: int = 0
-    starts_tried: int = 1
-    converged: bool = False
-
-    def to_dict(self) -> dict[str, Any]:
-        return {
-            "status": self.status,
-            "controller": self.controller.to_dict(),
-            "objective_value": self.objective_value,
-            "converged": self.converged,
-            "iterations": self.iterations,
-            "convex_solves": self.solves,
-            "solve_time": self.solve_time,
-            "grid_points": self.grid_points,
-            "starts_tried": self.starts_tried,
-            "history": self.history,
-            "diagnosis": self.diagnosis.to_dict() if self.diagnosis else None,
-        }
-
-
-def design_grid(plants: list[Plant], requirements: list[Requirement], settings: ConvexSettings) -> np.ndarray:
-    """Log grid covering every plant's dynamics and every requirement's band."""
-    lo, hi = np.inf, 0.0
-    for p in plants:
-        a, b = characteristic_range(p.num, p.den, delay=p.delay)
-        lo, hi = min(lo, a), max(hi, b)
-    for r in requirements:
-        band = getattr(r, "band", None)
-        if band is not None:
-            lo = min(lo, band[0] / 10 if band[0] > 0 else lo)
-            hi = max(hi, band[1] * 10)
-        for key in ("min", "max"):
-            v = getattr(r, key, None) if r.type == "bandwidth" else None
-            if v:
-                lo, hi = min(lo, v / 100), max(hi, v * 100)
-    if settings.n_points:
-        return np.geomspace(lo, hi, settings.n_points)
-    return log_grid(lo, hi, settings.per_decade)
 
 
 class ConvexDesigner:
@@ -240,8 +116,8 @@ class ConvexDesigner:
         self._goal: np.ndarray | None = None
         self._objective_form: Form | None = None
         self._gamma: cp.Variable | None = None
-        self._gamma_form: _ReturnDifferenceFloor | None = None
-        self._level = _Level()
+        self._gamma_form: ReturnDifferenceFloor | None = None
+        self._level = Level()
         self._level_slack = cp.Variable(nonneg=True)
         self._bracket = getattr(self, "_bracket", None)
 
@@ -274,7 +150,7 @@ class ConvexDesigner:
             goal = cp.Maximize(expr) if sense == "maximize" else cp.Minimize(expr)
         elif name == "peak_sensitivity" and sense == "minimize" and linear:
             self._gamma = cp.Variable()
-            self._gamma_form = _ReturnDifferenceFloor(make_points(self.plants, self.par, self.grid), self.par.size)
+            self._gamma_form = ReturnDifferenceFloor(make_points(self.plants, self.par, self.grid), self.par.size)
             cons += self._gamma_form.constraints(self.rho, self._gamma)
             goal = cp.Maximize(self._gamma)
         else:
@@ -303,7 +179,7 @@ class ConvexDesigner:
         level = self._level
         if self.par.ctype == "rational" and name in ("integral_gain", "low_frequency_gain") \
                 and sense == "maximize":
-            return _CoefficientRatioFloor(self.par, level)
+            return CoefficientRatioFloor(self.par, level)
         if name == "bandwidth" and sense == "maximize":
             return bandwidth_floor(name, pts, self.par.size, T0(self.plants, self.par), below=lambda: level.value)
         if name == "crossover" and sense == "maximize":
@@ -498,12 +374,12 @@ class ConvexDesigner:
         problem = self._problems["objective"]
         best_rho, best = rho_c, self.measure(rho_c)
         maximize = sense == "maximize"
-        if maximize and isinstance(self._objective_form, _CoefficientRatioFloor):
+        if maximize and isinstance(self._objective_form, CoefficientRatioFloor):
             lo, hi = np.log(max(best, 1e-12)), np.log(self._objective_form.upper())
         elif maximize:
             lo, hi = np.log(max(best, self.grid[0])), np.log(self.grid[-1])
         else:
-            cap = 10 ** (best / 20) if name in ("peak_complementary", "control_effort") else best
+            cap = magnitude(best) if name in ("peak_complementary", "control_effort") else best
             lo, hi = np.log(cap), np.log(cap) - np.log(1e3)
         if self._bracket is not None:  # a refinement round: the optimum moved little, search near it
             width = max(abs(self._bracket[1] - self._bracket[0]), 1e-3) * 20
@@ -601,73 +477,3 @@ class ConvexDesigner:
             self._build()
         return ConvexResult("optimal", self.par.controller(rho), rho, value, len(history), self.solves,
                             self.solve_time, history, None, self.grid.size, self.starts_tried, self.converged)
-
-
-class _Level:
-    """The level an objective form is bisected on (a frequency or a magnitude)."""
-
-    value: float = 1.0
-
-
-class _ReturnDifferenceFloor(Form):
-    """``Re{(1 + L) conj(1 + L_c)}/|1 + L_c| >= gamma``: the largest lower bound on ``|1 + L|`` (linear
-    parametrizations), maximized to minimize peak |S|."""
-
-    name = "peak sensitivity objective"
-    elastic = False
-
-    def __init__(self, points, n_rho: int) -> None:
-        self.points = points
-        self.R = cp.Parameter((points.n, n_rho))
-        self.c = cp.Parameter(points.n)
-
-    def constraints(self, rho, gamma):
-        return [self.R @ rho + self.c >= gamma]
-
-    def update(self, rho_c):
-        P = self.points.P
-        u = P(rho_c)
-        mag = np.maximum(np.abs(u), 1e-300)
-        self.R.value = np.real(np.conj(u)[:, None] * P.Q) / mag[:, None]
-        self.c.value = np.real(np.conj(u) * P.q0) / mag
-
-
-class _CoefficientRatioFloor(Form):
-    """``X(0)/D'(0) >= t`` for a rational controller: the integral gain ``b0/a1`` with an integrator
-    (``a0 = 0``), else the DC gain ``b0/a0``; linear in ``rho`` for a fixed level ``t``:
-    ``b0 - t a_k >= 0``."""
-
-    name = "objective"
-
-    def __init__(self, par, level: _Level) -> None:
-        self.par, self.level = par, level
-        m, n = par.m, par.n
-        scale = par._scale()
-        self.num = np.zeros(par.size)
-        self.num[0] = scale[0]
-        k = 1 if par.has_integrator() else 0  # the denominator coefficient the ratio divides by
-        self.den = np.zeros(par.size)
-        self.den_const = 0.0
-        if k < n:
-            self.den[m + 1 + k] = scale[m + 1 + k]
-        else:
-            self.den_const = 1.0  # D = s^n exactly: the ratio is b0 itself
-        self.t = cp.Parameter(nonneg=True)
-
-    def constraints(self, rho, slack):
-        self._cons = [self.num @ rho - self.t * (self.den @ rho + self.den_const) >= -slack]
-        return self._cons
-
-    def update(self, rho_c):
-        self.t.value = float(self.level.value)
-
-    def violation(self, rho):
-        return float(self.level.value * (self.den @ rho + self.den_const) - self.num @ rho)
-
-    def upper(self) -> float:
-        """A level above any value the bounds allow."""
-        lo, hi = self.par.box()
-        top = float(np.max(np.abs(self.num * np.where(self.num != 0, np.maximum(np.abs(lo), np.abs(hi)), 0))))
-        den_lo = float(np.min((self.den * np.where(self.den != 0, np.maximum(lo, 0), 0))[self.den != 0],
-                              initial=np.inf)) if np.any(self.den) else self.den_const
-        return top / den_lo if den_lo > 0 else top * 1e6

@@ -14,6 +14,8 @@ from typing import Any
 import casadi as ca
 import numpy as np
 
+__all__ = ["Cx", "delay_jw", "polyval_jw"]
+
 
 @dataclass
 class Cx:

@@ -20,14 +20,17 @@ readings) and the better certified design wins.
 
 from __future__ import annotations
 
-from dataclasses import replace
 from typing import Any
 
 import numpy as np
 
 from synth.check import CheckResult, check
 from synth.controllers import Controller
-from synth.design import (
+from synth.errors import SynthError
+from synth.loop import Loop
+from synth.objectives import score
+from synth.requirements.base import Requirement, fmt, unique_names
+from synth.results import (
     CERTIFICATE_PER_DECADE,
     Certificate,
     DesignResult,
@@ -35,19 +38,21 @@ from synth.design import (
     reference_check,
     reference_verdict,
 )
-from synth.errors import SynthError
-from synth.gainset import _unique_names
-from synth.loop import Loop
-from synth.objectives import score
-from synth.requirements import PeakComplementary, PeakSensitivity, Sensitivity, SlewRate
-from synth.requirements.base import fmt
-from synth.requirements.control_sensitivity import PeakControlSensitivity
 from synth.spec import Spec
-from synth.synthesis.convex import ConvexDesigner, ConvexResult, ConvexSettings
+from synth.synthesis.convex import ConvexDesigner
+from synth.synthesis.convex_forms import CONVEX_FORMS
+from synth.synthesis.convex_results import ConvexResult
+from synth.synthesis.convex_settings import ConvexSettings
 from synth.synthesis.nlp import polish
+from synth.synthesis.nlp_forms import NLP_FORMS
 from synth.synthesis.parametrization import parametrize
+from synth.synthesis.scalar import design_scalar
+
+__all__ = ["STRUCTURAL", "certificate_density", "conflict_set", "design_convex", "exact_forms", "infeasible_verdict",
+           "polish_redundant"]
 
 STRUCTURAL = {"PID": "tf", "leadlag": "p"}
+"""The structural parameter of each controller type that the convex stage holds at a few fixed values."""
 
 
 def design_convex(spec: Spec, settings: ConvexSettings | None = None, nlp: bool | str = True) -> DesignResult:
@@ -80,9 +85,7 @@ def design_convex(spec: Spec, settings: ConvexSettings | None = None, nlp: bool 
         return main  # without integral action these objectives are 0 (or finite): never better
     without = spec.model_copy(update={"controller": spec.controller.model_copy(
         update={"bounds": {**bounds, "ki": (0.0, 0.0)}})})
-    from synth.design import design
-
-    alt = design(without)
+    alt = design_scalar(without) if len(without.controller.free_parameters()) == 1 else design_convex(without)
     if alt.feasible and (not main.feasible or _better(alt, main)):
         alt.method = (main.method + "; the same structure without integral action (ki = 0) did better: "
                       + alt.method)
@@ -114,7 +117,7 @@ def _convex_runs(spec: Spec, settings: ConvexSettings) -> list[tuple[ConvexDesig
     key = STRUCTURAL.get(ctype)
     values = _structural_values(*bounds[key]) if key else [None]
     requirements = list(spec.requirements)
-    names = _unique_names(requirements)
+    names = unique_names(requirements)
     name, sense, _ = _objective_terms(spec)[0]
     runs = []
     w0 = _reference_frequency(spec)
@@ -140,8 +143,18 @@ def _reference_frequency(spec: Spec) -> float:
     return float(np.sqrt(lo * hi))
 
 
-EXACT_FORMS = (Sensitivity, PeakSensitivity, PeakComplementary, PeakControlSensitivity, SlewRate)
-"""Requirements whose convex form and NLP constraint are the same set on the same frequencies."""
+def exact_forms(requirement: Requirement) -> bool:
+    """Whether the requirement's convex form and NLP form are both registered as exact: the same set on
+    the same frequencies (:data:`~synth.synthesis.convex_forms.CONVEX_FORMS`,
+    :data:`~synth.synthesis.nlp_forms.NLP_FORMS`).
+
+    Examples
+    --------
+    >>> from synth.requirements import Bandwidth, PeakSensitivity
+    >>> exact_forms(PeakSensitivity(max_db=6)), exact_forms(Bandwidth(min=10))
+    (True, False)
+    """
+    return CONVEX_FORMS.entry(requirement).exact and NLP_FORMS.entry(requirement).exact
 
 
 def polish_redundant(spec: Spec, runs: list[ConvexResult]) -> str | None:
@@ -149,7 +162,7 @@ def polish_redundant(spec: Spec, runs: list[ConvexResult]) -> str | None:
 
     The polish is redundant when the convex stage ended at a KKT point of the problem the polish
     would solve: one convex run (no structural parameter to vary) of a P, PI or PID controller, whose
-    parameters are then exactly the NLP's variables; every requirement among :data:`EXACT_FORMS`, whose
+    parameters are then exactly the NLP's variables; every requirement with :func:`exact_forms`, whose
     inner approximations touch the exact constraints at the linearization point with the same gradient
     (the NLP imposes them on the same design and band grids, squared); a linear objective (the integral
     or low-frequency gain), solved directly; and a converged phase 2 (the last convex problem, built
@@ -162,7 +175,7 @@ def polish_redundant(spec: Spec, runs: list[ConvexResult]) -> str | None:
         return None
     if spec.controller.type not in ("P", "PI", "PID"):
         return None
-    if not all(isinstance(r, EXACT_FORMS) for r in spec.requirements):
+    if not all(exact_forms(r) for r in spec.requirements):
         return None
     if len(terms) != 1 or terms[0][0] not in ("integral_gain", "low_frequency_gain"):
         return None
@@ -173,7 +186,7 @@ def polish_redundant(spec: Spec, runs: list[ConvexResult]) -> str | None:
 def certificate_density(settings: ConvexSettings, grids: list[np.ndarray]) -> int:
     """Points per decade of the certificate: at least 20 times the densest grid the design used (the
     band grids at ``settings.per_decade``, the design grid, with its refinement points, on average over
-    its span), and at least :data:`synth.design.CERTIFICATE_PER_DECADE`.
+    its span), and at least :data:`synth.results.CERTIFICATE_PER_DECADE`.
 
     Examples
     --------
@@ -298,7 +311,7 @@ def conflict_set(spec: Spec, settings: ConvexSettings) -> list[str]:
     is one whose removal let it find a design).
     """
     requirements = list(spec.requirements)
-    names = _unique_names(requirements)
+    names = unique_names(requirements)
     keep = list(range(len(requirements)))
     key = STRUCTURAL.get(spec.controller.type)
     bounds = spec.controller.all_bounds()
@@ -344,6 +357,3 @@ def infeasible_verdict(convex: ConvexResult, compromise: CheckResult | None = No
     parts.append("Conflicting requirements (a minimal set that cannot be met together): "
                  + ", ".join(diag.conflicting()) + ".")
     return " ".join(parts)
-
-
-__all__ = ["design_convex", "infeasible_verdict", "replace"]

@@ -30,8 +30,6 @@ rounds), and the result is only accepted by the caller after the dense
 certificate.
 """
 
-from __future__ import annotations
-
 import time
 from dataclasses import dataclass, field
 from typing import Any
@@ -39,31 +37,14 @@ from typing import Any
 import casadi as ca
 import numpy as np
 
-from synth.controllers import RATIONAL, Controller, rational_order
-from synth.freqgrid import band_grid
+from synth.controllers import Controller
 from synth.loop import BANDWIDTH_LEVEL, Loop
 from synth.plant import Plant
-from synth.requirements import (
-    Bandwidth,
-    MarginsRequirement,
-    PeakComplementary,
-    PeakSensitivity,
-    Sensitivity,
-    SlewRate,
-    StaticSensitivity,
-)
 from synth.requirements.base import Requirement
-from synth.requirements.control_sensitivity import PeakControlSensitivity
-from synth.synthesis.cxcomplex import Cx, delay_jw, polyval_jw
+from synth.synthesis.nlp_forms import NLP_FORMS, NLPContext
+from synth.synthesis.nlp_problem import NLPBuilder, SymbolicController, loop_response, phase_crossovers, t0_squared
 
-SYM = ca.MX
-"""Symbol type of the NLP. Matrix expressions: a requirement on n frequencies is a handful of vector
-operations on numeric columns, not n scalar graphs, so building the solver (derivatives included) costs
-milliseconds instead of a tenth of a second for a few thousand constraints."""
-
-IPOPT_OPTIONS = {"ipopt.print_level": 0, "print_time": False, "ipopt.sb": "yes", "ipopt.max_iter": 1500,
-                 "ipopt.hessian_approximation": "limited-memory",
-                 "ipopt.tol": 1e-9, "ipopt.constr_viol_tol": 1e-9}
+__all__ = ["NLPResult", "polish"]
 
 
 @dataclass
@@ -85,229 +66,7 @@ class NLPResult:
                 "solve_time": self.solve_time, "history": self.history}
 
 
-class SymbolicController:
-    """A controller whose free parameters are casadi symbols, scaled by their starting magnitudes."""
-
-    def __init__(self, ctype: str, start: Controller, bounds: dict[str, tuple[float, float]]) -> None:
-        self.ctype = ctype
-        kind = start.kind
-        self.free = [p for p in kind.parameters if bounds[p][0] < bounds[p][1]]
-        self.fixed = {p: bounds[p][0] for p in kind.parameters if bounds[p][0] == bounds[p][1]}
-        self.bounds = bounds
-        x0 = np.array([start.parameters[p] for p in self.free], float)
-        span = np.array([bounds[p][1] - bounds[p][0] for p in self.free], float)
-        # variables of order one: scaled by their start value, or by 1 % of their range when that is larger
-        self.scale = np.maximum(np.abs(x0), np.where(np.isfinite(span), 1e-2 * span, 1.0))
-        self.scale = np.where(self.scale > 0, self.scale, 1.0)
-        self.u = SYM.sym("u", len(self.free))
-        self.u0 = x0 / self.scale
-        self.values = {**{p: self.u[i] * self.scale[i] for i, p in enumerate(self.free)}, **self.fixed}
-
-    def lbx(self) -> np.ndarray:
-        return np.array([self.bounds[p][0] for p in self.free]) / self.scale
-
-    def ubx(self) -> np.ndarray:
-        return np.array([self.bounds[p][1] for p in self.free]) / self.scale
-
-    def response(self, w: Any) -> Cx:
-        """``C(j w)`` for a numeric or symbolic ``w`` (> 0)."""
-        v = self.values
-        jw = Cx(0.0, w)
-        if self.ctype == "P":
-            return Cx(v["kp"], 0.0)
-        if self.ctype == "PI":
-            return Cx(v["kp"], -v["ki"] / w)
-        if self.ctype == "PID":
-            return Cx(v["kp"], -v["ki"] / w) + v["kd"] * jw / (v["tf"] * jw + 1.0)
-        if self.ctype == "leadlag":
-            return v["k"] * (jw + v["z"]) / (jw + v["p"])
-        if self.ctype == RATIONAL:
-            m, n = rational_order(v)
-            num = polyval_jw([v[f"b{i}"] for i in range(m, -1, -1)], w)
-            den = polyval_jw([1.0] + [v[f"a{i}"] for i in range(n - 1, -1, -1)], w)
-            return num / den
-        raise NotImplementedError(self.ctype)
-
-    def dc(self) -> Any | None:
-        """``C(0)`` (None with integral action)."""
-        v = self.values
-        if self.ctype == "P":
-            return v["kp"]
-        if self.ctype == "leadlag":
-            return v["k"] * v["z"] / v["p"]
-        if self.ctype == RATIONAL and not (self.fixed.get("a0") == 0.0):
-            return v["b0"] / v["a0"]
-        return None
-
-    def integral_gain(self) -> Any:
-        if self.ctype == RATIONAL:
-            return self.values["b0"] / self.values["a1"] if "a1" in self.values else self.values["b0"]
-        return self.values["ki"]
-
-    def controller(self, u: np.ndarray) -> Controller:
-        vals = {**{p: float(u[i] * self.scale[i]) for i, p in enumerate(self.free)}, **self.fixed}
-        return Controller(self.ctype, vals)
-
-
-class _Builder:
-    """Collects variables, constraints and the objective of one NLP."""
-
-    def __init__(self, ctrl: SymbolicController) -> None:
-        self.ctrl = ctrl
-        self.x = [ctrl.u]
-        self.x0 = [ctrl.u0]
-        self.lbx = [ctrl.lbx()]
-        self.ubx = [ctrl.ubx()]
-        self.g: list[Any] = []
-        self.lbg: list[float] = []
-        self.ubg: list[float] = []
-        self.f: Any = 0.0
-
-    def var(self, name: str, x0: float, lo: float, hi: float) -> Any:
-        v = SYM.sym(name)
-        self.x.append(v)
-        self.x0.append(np.array([x0]))
-        self.lbx.append(np.array([lo]))
-        self.ubx.append(np.array([hi]))
-        return v
-
-    def geq(self, expr: Any) -> None:
-        """``expr >= 0`` (a scalar or one entry per frequency)."""
-        self._add(expr, np.inf)
-
-    def eq(self, expr: Any) -> None:
-        """``expr == 0``."""
-        self._add(expr, 0.0)
-
-    def _add(self, expr: Any, upper: float) -> None:
-        expr = expr if isinstance(expr, (ca.SX, ca.MX)) else SYM(expr)
-        self.g.append(expr)
-        self.lbg.extend([0.0] * expr.numel())
-        self.ubg.extend([upper] * expr.numel())
-
-    def solve(self) -> tuple[np.ndarray, dict[str, Any]]:
-        x = ca.vertcat(*self.x)
-        g = ca.vertcat(*self.g) if self.g else SYM(0, 1)
-        solver = ca.nlpsol("polish", "ipopt", {"x": x, "f": self.f, "g": g}, IPOPT_OPTIONS)
-        res = solver(x0=np.concatenate(self.x0), lbx=np.concatenate(self.lbx), ubx=np.concatenate(self.ubx),
-                     lbg=np.array(self.lbg), ubg=np.array(self.ubg))
-        return np.asarray(res["x"]).ravel(), solver.stats()
-
-
-def _loop(ctrl: SymbolicController, plant: Plant, w: Any) -> tuple[Cx, Cx]:
-    """``(C(jw), L(jw))`` with the plant exact (delay included).
-
-    ``w`` is a casadi symbol, a number, or an array of frequencies: then every
-    part is a column with one entry per frequency (one vectorized expression
-    instead of one per frequency, which keeps building the NLP cheap).
-    """
-    C = ctrl.response(w)
-    if isinstance(w, (ca.SX, ca.MX)):
-        G = polyval_jw(plant.num, w) / polyval_jw(plant.den, w) * delay_jw(plant.delay, w)
-    elif np.ndim(w):
-        g = plant.freqresp(np.asarray(w, float))
-        G = Cx(np.real(g), np.imag(g))
-    else:
-        G = Cx.of(complex(plant.freqresp(np.array([w]))[0]))
-    return C, C * G
-
-
-def _t0_squared(ctrl: SymbolicController, plant: Plant) -> Any:
-    dc = ctrl.dc()
-    if dc is None:
-        return 1.0
-    l0 = dc * plant.dc_gain()
-    return (l0 / (1.0 + l0)) ** 2
-
-
-def _positive(w: np.ndarray) -> np.ndarray:
-    return w[w > 0]
-
-
-BACKOFF = 1e-4
-"""Relative tightening of magnitude bounds (as in the convex stage): about 0.001 dB."""
-
-
-def _band(req: Any, grid: np.ndarray, extra: np.ndarray, per_decade: int) -> np.ndarray:
-    auto = (float(grid[0]), float(grid[-1]))
-    band = getattr(req, "band", None)
-    if band is None:
-        return np.unique(np.concatenate([grid, extra]))
-    w = _positive(band_grid(band, auto, per_decade))
-    inside = extra[(extra >= band[0]) & (extra <= band[1])]
-    return np.unique(np.concatenate([w, inside]))
-
-
-def _add_requirement(b: _Builder, req: Requirement, plants: list[Plant], grid: np.ndarray,
-                     start: Controller, per_decade: int, extra: np.ndarray) -> None:
-    ctrl = b.ctrl
-    tight = 1.0 - 2 * BACKOFF  # on squared magnitudes
-    for plant in plants:
-        if isinstance(req, (Sensitivity, PeakSensitivity)):
-            m2 = 10 ** (req.max_db / 10) * tight
-            _, L = _loop(ctrl, plant, _band(req, grid, extra, per_decade))
-            b.geq(m2 * (1.0 + L).abs2() - 1.0)
-        elif isinstance(req, StaticSensitivity):
-            dc = ctrl.dc()
-            if dc is not None:
-                g = req.plant_gain if req.plant_gain is not None else plant.dc_gain()
-                b.geq(10 ** (-req.max_db / 10) * tight * (1.0 + g * dc) ** 2 - 1.0)
-        elif isinstance(req, (PeakComplementary, PeakControlSensitivity)):
-            inv = 10 ** (-req.max_db / 10) / tight
-            C, L = _loop(ctrl, plant, _band(req, grid, extra, per_decade))
-            top = L if isinstance(req, PeakComplementary) else C
-            b.geq((1.0 + L).abs2() - inv * top.abs2())
-        elif isinstance(req, SlewRate):
-            w = _band(req, grid, extra, per_decade)
-            C, _ = _loop(ctrl, plant, w)
-            b.geq(tight - (req.max_error * w / req.rate_limit) ** 2 * C.abs2())
-        elif isinstance(req, Bandwidth):
-            t02 = _t0_squared(ctrl, plant)
-            if req.min is not None:
-                pts = np.concatenate([grid[grid < req.min], extra[extra < req.min], [req.min]])
-                _, L = _loop(ctrl, plant, np.unique(pts))
-                b.geq(tight * L.abs2() - BANDWIDTH_LEVEL**2 * t02 * (1.0 + L).abs2())
-            if req.max is not None:
-                _, L = _loop(ctrl, plant, float(req.max))
-                b.geq(tight * BANDWIDTH_LEVEL**2 * t02 * (1.0 + L).abs2() - L.abs2())
-        elif isinstance(req, MarginsRequirement):
-            _add_margins(b, req, plant, start)
-        else:
-            raise TypeError(f"no NLP form for requirement type {req.type}")
-
-
-def _add_margins(b: _Builder, req: MarginsRequirement, plant: Plant, start: Controller) -> None:
-    loop = Loop(plant, start)
-    ctrl = b.ctrl
-    for wc in loop.gain_crossovers():
-        v = b.var("wc", float(wc), wc / 3.0, 3.0 * wc)
-        _, L = _loop(ctrl, plant, v)
-        b.eq(L.abs2() - 1.0)
-        if req.phase_margin_deg is not None:
-            b.geq((1.0 + L).abs2() - 4 * np.sin(np.radians(req.phase_margin_deg * (1 + BACKOFF)) / 2) ** 2)
-        if req.delay_margin is not None:
-            b.geq((1.0 + L).abs2() - 4 * ca.sin(ca.fmin(v * req.delay_margin, np.pi) / 2) ** 2)
-    if req.gain_margin_db is not None:
-        for wp in _phase_crossovers(loop):
-            v = b.var("wp", float(wp), wp / 3.0, 3.0 * wp)
-            _, L = _loop(ctrl, plant, v)
-            b.eq(L.im)
-            b.geq(L.re + 10 ** (-req.gain_margin_db * (1 + BACKOFF) / 20))
-
-
-def _phase_crossovers(loop: Loop) -> np.ndarray:
-    """Frequencies where ``L`` crosses the negative real axis inside the unit circle."""
-    from synth.freqgrid import crossings, log_grid
-
-    lo, hi = loop.frequency_range
-    grid = log_grid(lo, hi * 10, 200)
-    imag = crossings(lambda w: np.imag(loop.L(w)), 0.0, grid)
-    L = loop.L(imag)
-    keep = (np.real(L) < 0) & (np.abs(L) < 1.0)
-    return imag[keep]
-
-
-def _term(b: _Builder, name: str, plants: list[Plant], grid: np.ndarray, start: Controller) -> Any:
+def _term(b: NLPBuilder, name: str, plants: list[Plant], grid: np.ndarray, start: Controller) -> Any:
     """The measure ``name`` as a casadi expression in its natural unit (adds helper variables)."""
     ctrl = b.ctrl
     plant = plants[0]
@@ -320,9 +79,9 @@ def _term(b: _Builder, name: str, plants: list[Plant], grid: np.ndarray, start: 
     if name in ("bandwidth", "crossover"):
         w0 = loop0.bandwidth() if name == "bandwidth" else (loop0.crossover() or grid[0])
         v = b.var(name, float(w0), float(grid[0]), float(grid[-1]))
-        t02 = _t0_squared(ctrl, plant)
+        t02 = t0_squared(ctrl, plant)
         for r in np.geomspace(1e-3, 1.0, 80):
-            _, L = _loop(ctrl, plant, v * r)
+            _, L = loop_response(ctrl, plant, v * r)
             if name == "bandwidth":
                 b.geq(L.abs2() - BANDWIDTH_LEVEL**2 * t02 * (1.0 + L).abs2())
             else:
@@ -332,7 +91,7 @@ def _term(b: _Builder, name: str, plants: list[Plant], grid: np.ndarray, start: 
         ms0 = float(np.max(np.abs(loop0.S(grid))))
         gamma = b.var("gamma", 1.0 / ms0, 1e-6, 1.0)
         for p in plants:
-            _, L = _loop(ctrl, p, grid)
+            _, L = loop_response(ctrl, p, grid)
             b.geq((1.0 + L).abs2() - gamma**2)
         return -20 * ca.log10(gamma)
     if name in ("peak_complementary", "control_effort"):
@@ -340,14 +99,14 @@ def _term(b: _Builder, name: str, plants: list[Plant], grid: np.ndarray, start: 
         m0 = float(np.max(np.abs(curve(grid))))
         M = b.var("M", m0, 1e-9, 1e3 * m0)
         for p in plants:
-            C, L = _loop(ctrl, p, grid)
+            C, L = loop_response(ctrl, p, grid)
             top = L if name == "peak_complementary" else C
             b.geq(M**2 * (1.0 + L).abs2() - top.abs2())
         return 20 * ca.log10(M)
     raise ValueError(f"no NLP objective {name}")
 
 
-def _add_objective(b: _Builder, terms: list[tuple[str, str, float]], plants: list[Plant], grid: np.ndarray,
+def _add_objective(b: NLPBuilder, terms: list[tuple[str, str, float]], plants: list[Plant], grid: np.ndarray,
                    start: Controller) -> None:
     """Minimize ``-sum(w s f)`` scaled by its value at the start (``s`` = +1 maximize, -1 minimize)."""
     from synth.objectives import score
@@ -402,11 +161,14 @@ def polish(requirements: list[Requirement], plants: list[Plant], start: Controll
     success = False
     for rnd in range(rounds):
         ctrl = SymbolicController(current.type, current, bounds)
-        b = _Builder(ctrl)
+        b = NLPBuilder(ctrl)
+        ctx = NLPContext(grid, extra, per_decade, current)
         for req in requirements:
-            _add_requirement(b, req, plants, grid, current, per_decade, extra)
+            build = NLP_FORMS.entry(req).build
+            for plant in plants:
+                build(b, req, plant, ctx)
         for p in plants:  # keep |1 + L| away from zero: no closed-loop pole crosses the axis on the grid
-            _, L = _loop(ctrl, p, grid)
+            _, L = loop_response(ctrl, p, grid)
             b.geq((1.0 + L).abs2() - stability_level**2)
         _add_objective(b, objective, plants, grid, current)
         x, stats = b.solve()
@@ -453,6 +215,6 @@ def _crossovers_changed(a: Controller, b: Controller, plants: list[Plant]) -> bo
     for p in plants:
         if Loop(p, a).gain_crossovers().size != Loop(p, b).gain_crossovers().size:
             return True
-        if _phase_crossovers(Loop(p, a)).size != _phase_crossovers(Loop(p, b)).size:
+        if phase_crossovers(Loop(p, a)).size != phase_crossovers(Loop(p, b)).size:
             return True
     return False

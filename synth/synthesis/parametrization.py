@@ -32,6 +32,8 @@ import numpy as np
 from synth.controllers import RATIONAL, Controller
 from synth.errors import SynthError
 
+__all__ = ["Affine", "LinearParametrization", "Parametrization", "RationalParametrization", "parametrize"]
+
 
 @dataclass
 class Affine:
@@ -246,7 +248,7 @@ class RationalParametrization:
     def size(self) -> int:
         return self.m + 1 + self.n
 
-    def _scale(self) -> np.ndarray:
+    def scale(self) -> np.ndarray:
         """True coefficient = rho * scale (b_i and a_i both scale with w0^(n - i))."""
         return np.array([self.w0 ** (self.n - i) for i in range(self.m + 1)]
                         + [self.w0 ** (self.n - i) for i in range(self.n)])
@@ -276,14 +278,14 @@ class RationalParametrization:
         return rho[self.m + 1] == 0.0
 
     def controller(self, rho: np.ndarray) -> Controller:
-        true = np.asarray(rho, float) * self._scale()
+        true = np.asarray(rho, float) * self.scale()
         return Controller(RATIONAL, {name: float(v) for name, v in zip(self.names, true)})
 
     def rho(self, controller: Controller) -> np.ndarray:
-        return np.array([controller.parameters[n] for n in self.names], float) / self._scale()
+        return np.array([controller.parameters[n] for n in self.names], float) / self.scale()
 
     def box(self) -> tuple[np.ndarray, np.ndarray]:
-        scale = self._scale()
+        scale = self.scale()
         lo = np.array([self.bounds[n][0] for n in self.names]) / scale
         hi = np.array([self.bounds[n][1] for n in self.names]) / scale
         return lo, hi

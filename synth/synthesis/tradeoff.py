@@ -29,9 +29,11 @@ import numpy as np
 from synth.errors import SpecError, SynthError
 from synth.spec import Spec
 
-# how each swept key tightens the spec when it grows (+1) or shrinks (-1)
-STRICTER_WHEN = {"min": +1, "max": -1, "max_db": -1, "rate_limit": -1, "max_error": +1, "gain_margin_db": +1,
-                 "phase_margin_deg": +1, "delay_margin": +1, "delay": +1, "plant_gain": -1}
+__all__ = ["Sweep", "TradeoffPoint", "TradeoffResult", "design_chunk", "design_point", "mark_pareto", "set_value",
+           "stricter_when", "tradeoff"]
+
+PLANT_STRICTER_WHEN = {"delay": +1}
+"""Swept plant values and their direction: +1 when a larger value makes the design harder."""
 
 
 @dataclass
@@ -122,6 +124,44 @@ def _index(items: list, key: str, where: str, parent: str) -> int:
     if not match:
         raise SpecError(f"no {parent or 'item'} with label or type {key!r}", where=f"--sweep {where}")
     raise SpecError(f"{len(match)} requirements of type {key!r}: give a label or an index", where=f"--sweep {where}")
+
+
+def stricter_when(data: dict[str, Any], path: str) -> int:
+    """+1 when a larger value at ``path`` makes the spec stricter, -1 when a smaller one does.
+
+    A requirement's value is asked of its class (:meth:`synth.requirements.Requirement.stricter_when`);
+    ``plant.delay`` grows stricter; a controller bound ``controller.bounds.P.0`` (lower) grows stricter,
+    ``.1`` (upper) shrinks stricter. Anything else is a :class:`SpecError` naming the path.
+
+    Examples
+    --------
+    >>> d = {"requirements": [{"type": "bandwidth", "min": 60}, {"type": "peak_sensitivity", "max_db": 6}]}
+    >>> stricter_when(d, "requirements.bandwidth.min"), stricter_when(d, "requirements.1.max_db")
+    (1, -1)
+    >>> stricter_when(d, "plant.delay"), stricter_when(d, "controller.bounds.kp.1")
+    (1, -1)
+    """
+    from synth.requirements import REQUIREMENT_TYPES
+
+    parts = path.split(".")
+    where = f"--sweep {path}"
+    if parts[0] == "requirements" and len(parts) >= 3:
+        items = data.get("requirements", [])
+        item = items[_index(items, parts[1], ".".join(parts[:2]), "requirements")]
+        cls = REQUIREMENT_TYPES.get(item.get("type")) if isinstance(item, dict) else None
+        if cls is None:
+            raise SpecError(f"requirement {parts[1]!r} has no known type", where=where)
+        index = int(parts[3]) if len(parts) == 4 and parts[3].isdigit() else None
+        try:
+            return cls.stricter_when(parts[2], index)
+        except SpecError as exc:
+            raise SpecError(exc.message, where=where) from None
+    if parts[0] == "plant" and len(parts) == 2 and parts[1] in PLANT_STRICTER_WHEN:
+        return PLANT_STRICTER_WHEN[parts[1]]
+    if parts[:2] == ["controller", "bounds"] and len(parts) == 4 and parts[3] in ("0", "1"):
+        return +1 if parts[3] == "0" else -1
+    raise SpecError("no known direction (stricter when larger or smaller) for this value: sweep a requirement's "
+                    "value, plant.delay or controller.bounds.P.0/1", where=where)
 
 
 @dataclass
@@ -236,11 +276,14 @@ def _chunks(points: list, n: int) -> list[list]:
     return [list(c) for c in np.array_split(np.array(points, dtype=object), n) if len(c)]
 
 
-def mark_pareto(points: list[TradeoffPoint], sweeps: list[Sweep], sense: str) -> None:
-    """Flag feasible points that no other feasible point beats on both the swept demand and the objective."""
+def mark_pareto(points: list[TradeoffPoint], sweeps: list[Sweep], sense: str, sign_x: int = +1) -> None:
+    """Flag feasible points that no other feasible point beats on both the swept demand and the objective.
+
+    ``sign_x`` is +1 when a larger swept value is the stricter demand, -1 when a smaller one is
+    (:func:`stricter_when`).
+    """
     if len(sweeps) != 1:
         return
-    sign_x = STRICTER_WHEN.get(sweeps[0].key, +1)
     sign_y = 1.0 if sense == "maximize" else -1.0
     feas = [p for p in points if p.feasible and p.objective is not None]
     scale = max((abs(p.objective) for p in feas), default=1.0) or 1.0
@@ -290,6 +333,7 @@ def tradeoff(spec: Spec, sweeps: list[Sweep], scheduler: str | Any | None = None
     data = spec.model_dump(mode="json", exclude_none=True)
     for sw in sweeps:  # fail early on a bad path
         set_value(data, sw.path, sw.values[0])
+    sign_x = stricter_when(data, sweeps[0].path) if len(sweeps) == 1 else +1
     grid = _grid(sweeps)
     t0 = time.perf_counter()
     results: list[TradeoffPoint] = []
@@ -328,7 +372,7 @@ def tradeoff(spec: Spec, sweeps: list[Sweep], scheduler: str | Any | None = None
     objective = {"name": spec.objective.name, "sense": spec.objective.sense,
                  "description": spec.objective.describe()} if spec.objective else {
         "name": "default", "sense": "maximize", "description": "no objective in the spec"}
-    mark_pareto(results, sweeps, objective["sense"])
+    mark_pareto(results, sweeps, objective["sense"], sign_x)
     return TradeoffResult(spec.name, sweeps, objective, results, label, len(chunks),
                           time.perf_counter() - t0)
 

@@ -21,8 +21,18 @@ from scipy.optimize import brentq
 from synth.controllers import Controller
 from synth.loop import Loop
 from synth.plant import Plant
-from synth.requirements.base import Requirement
+from synth.requirements.base import Requirement, unique_names
 from synth.stability import affine_stability_intervals
+
+__all__ = [
+    "GainInterval",
+    "GainSet",
+    "ScalarFamily",
+    "critical_gains",
+    "feasible_gain_set",
+    "requirement_set",
+    "stability_set",
+]
 
 _MET_TOL = 1e-12
 
@@ -269,7 +279,7 @@ def feasible_gain_set(
     ([[2.5686, 20.0]], ['sensitivity_static'])
     """
     lo, hi = float(bounds[0]), float(bounds[1])
-    names = _unique_names(requirements)
+    names = unique_names(requirements)
     sets: dict[str, list[tuple[float, float]]] = {"stability": stability_set(family, plants, lo, hi)}
 
     def slack_fn(req: Requirement) -> Callable[[float], float]:
@@ -296,15 +306,6 @@ def feasible_gain_set(
             wide_lo = lo if lo <= 0 else lo / 10.0
             outside[name] = requirement_set(slack_fns[name], wide_lo, hi * 10 if hi > 0 else hi + 10, n_bracket)
     return GainSet(family.parameter, (lo, hi), intervals, sets, outside)
-
-
-def _unique_names(requirements: list[Requirement]) -> list[str]:
-    names, seen = [], {}
-    for r in requirements:
-        base = r.name()
-        seen[base] = seen.get(base, 0) + 1
-        names.append(base if seen[base] == 1 else f"{base}#{seen[base]}")
-    return names
 
 
 def _binding(x: float, sets: dict[str, list[tuple[float, float]]], lo: float, hi: float,

@@ -1,0 +1,91 @@
+"""What the convex stage returns: the design, its history, and for infeasible specs the diagnosis."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from synth.controllers import Controller
+
+__all__ = ["ConvexResult", "Diagnosis", "RequirementConflict"]
+
+
+@dataclass
+class RequirementConflict:
+    """One requirement in an infeasibility diagnosis."""
+
+    name: str
+    elastic_slack: float
+    price: float
+    violated: bool
+    exact_slack: float
+    message: str
+
+    def to_dict(self) -> dict[str, Any]:
+        return dict(self.__dict__)
+
+
+@dataclass
+class Diagnosis:
+    """Why a spec cannot be met: the elastic solution, slacks and prices."""
+
+    total_slack: float
+    conflicts: list[RequirementConflict]
+    bounds_active: list[str]
+    controller: Controller
+    conflict_set: list[str] | None = None
+
+    def conflicting(self) -> list[str]:
+        """A minimal set of requirements that cannot be met together (deletion filter) when computed;
+        otherwise those violated at the elastic solution or pushing against them (price >= 1 % of the
+        largest)."""
+        if self.conflict_set is not None:
+            return list(self.conflict_set)
+        top = max((c.price for c in self.conflicts), default=0.0)
+        return [c.name for c in self.conflicts if c.violated or (top > 0 and c.price >= 0.01 * top)]
+
+    def to_dict(self) -> dict[str, Any]:
+        return {
+            "total_elastic_slack": self.total_slack,
+            "conflicting": self.conflicting(),
+            "conflict_set_method": "deletion filter: each requirement dropped in turn; kept if the rest "
+                                   "became feasible" if self.conflict_set is not None else "elastic prices",
+            "requirements": [c.to_dict() for c in self.conflicts],
+            "bounds_active": self.bounds_active,
+            "elastic_controller": self.controller.to_dict(),
+        }
+
+
+@dataclass
+class ConvexResult:
+    """Outcome of :meth:`ConvexDesigner.run`."""
+
+    status: str
+    controller: Controller
+    rho: np.ndarray
+    objective_value: float | None
+    iterations: int
+    solves: int
+    solve_time: float
+    history: list[dict[str, float]] = field(default_factory=list)
+    diagnosis: Diagnosis | None = None
+    grid_points: int = 0
+    starts_tried: int = 1
+    converged: bool = False
+
+    def to_dict(self) -> dict[str, Any]:
+        return {
+            "status": self.status,
+            "controller": self.controller.to_dict(),
+            "objective_value": self.objective_value,
+            "converged": self.converged,
+            "iterations": self.iterations,
+            "convex_solves": self.solves,
+            "solve_time": self.solve_time,
+            "grid_points": self.grid_points,
+            "starts_tried": self.starts_tried,
+            "history": self.history,
+            "diagnosis": self.diagnosis.to_dict() if self.diagnosis else None,
+        }

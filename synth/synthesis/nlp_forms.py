@@ -1,0 +1,157 @@
+"""The NLP form of each requirement type, registered with ``@nlp_form(Type, exact=...)``.
+
+Each form adds the requirement's constraints on one plant (``b.geq(expr)``: ``expr >= 0``, one entry
+per frequency); the table of :mod:`synth.synthesis.nlp` lists them. A requirement type without a form
+is a :class:`~synth.errors.SpecError` naming it (docs/extending-requirements.md).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any
+
+import casadi as ca
+import numpy as np
+
+from synth.controllers import Controller
+from synth.freqgrid import band_grid
+from synth.loop import BANDWIDTH_LEVEL, Loop
+from synth.plant import Plant
+from synth.requirements import (
+    Bandwidth,
+    MarginsRequirement,
+    PeakComplementary,
+    PeakControlSensitivity,
+    PeakSensitivity,
+    Sensitivity,
+    SlewRate,
+    StaticSensitivity,
+)
+from synth.requirements.base import Requirement, magnitude
+from synth.synthesis.form_registry import FormRegistry
+from synth.synthesis.nlp_problem import (
+    BACKOFF,
+    TIGHT,
+    NLPBuilder,
+    loop_response,
+    phase_crossovers,
+    t0_squared,
+)
+
+__all__ = ["NLP_FORMS", "NLPContext", "nlp_form"]
+
+def _positive(w: np.ndarray) -> np.ndarray:
+    return w[w > 0]
+
+
+def _band(req: Any, grid: np.ndarray, extra: np.ndarray, per_decade: int) -> np.ndarray:
+    auto = (float(grid[0]), float(grid[-1]))
+    band = getattr(req, "band", None)
+    if band is None:
+        return np.unique(np.concatenate([grid, extra]))
+    w = _positive(band_grid(band, auto, per_decade))
+    inside = extra[(extra >= band[0]) & (extra <= band[1])]
+    return np.unique(np.concatenate([w, inside]))
+
+
+NLP_FORMS = FormRegistry("NLP")
+"""The NLP form of each requirement type (filled by :func:`nlp_form` below)."""
+
+
+def nlp_form(requirement: type[Requirement], *, exact: bool) -> Callable[[Callable], Callable]:
+    """Decorator: register ``build(b, req, plant, ctx)`` as the NLP form of ``requirement`` (it adds the
+    requirement's constraints on one plant to the problem being built).
+
+    Examples
+    --------
+    >>> from synth.requirements import MarginsRequirement
+    >>> NLP_FORMS.entry(MarginsRequirement).exact
+    True
+    """
+    return NLP_FORMS.register(requirement, exact=exact)
+
+
+@dataclass
+class NLPContext:
+    """What every NLP form is built from: the design grid, the extra frequencies found between its
+    points, the band density and the design the problem starts from."""
+
+    grid: np.ndarray
+    extra: np.ndarray
+    per_decade: int
+    start: Controller
+
+    def points(self, req: Any) -> np.ndarray:
+        """The requirement's band (the design grid without one), with the extra frequencies inside it."""
+        return _band(req, self.grid, self.extra, self.per_decade)
+
+
+@nlp_form(Sensitivity, exact=True)
+@nlp_form(PeakSensitivity, exact=True)
+def _sensitivity(b: NLPBuilder, req: Sensitivity | PeakSensitivity, plant: Plant, ctx: NLPContext) -> None:
+    m2 = req.linear_bound("max_db") ** 2 * TIGHT
+    _, L = loop_response(b.ctrl, plant, ctx.points(req))
+    b.geq(m2 * (1.0 + L).abs2() - 1.0)
+
+
+@nlp_form(StaticSensitivity, exact=True)
+def _static_sensitivity(b: NLPBuilder, req: StaticSensitivity, plant: Plant, ctx: NLPContext) -> None:
+    dc = b.ctrl.dc()
+    if dc is not None:
+        g = req.plant_gain if req.plant_gain is not None else plant.dc_gain()
+        b.geq(TIGHT / req.linear_bound("max_db") ** 2 * (1.0 + g * dc) ** 2 - 1.0)
+
+
+@nlp_form(PeakComplementary, exact=True)
+def _peak_complementary(b: NLPBuilder, req: PeakComplementary, plant: Plant, ctx: NLPContext) -> None:
+    _, L = loop_response(b.ctrl, plant, ctx.points(req))
+    b.geq((1.0 + L).abs2() - L.abs2() / (req.linear_bound("max_db") ** 2 * TIGHT))
+
+
+@nlp_form(PeakControlSensitivity, exact=True)
+def _peak_control_sensitivity(b: NLPBuilder, req: PeakControlSensitivity, plant: Plant, ctx: NLPContext) -> None:
+    C, L = loop_response(b.ctrl, plant, ctx.points(req))
+    b.geq((1.0 + L).abs2() - C.abs2() / (req.linear_bound("max_db") ** 2 * TIGHT))
+
+
+@nlp_form(SlewRate, exact=True)
+def _slew_rate(b: NLPBuilder, req: SlewRate, plant: Plant, ctx: NLPContext) -> None:
+    w = ctx.points(req)
+    C, _ = loop_response(b.ctrl, plant, w)
+    b.geq(TIGHT - (req.max_error * w / req.rate_limit) ** 2 * C.abs2())
+
+
+@nlp_form(Bandwidth, exact=True)
+def _bandwidth(b: NLPBuilder, req: Bandwidth, plant: Plant, ctx: NLPContext) -> None:
+    t02 = t0_squared(b.ctrl, plant)
+    grid, extra = ctx.grid, ctx.extra
+    if req.min is not None:
+        pts = np.concatenate([grid[grid < req.min], extra[extra < req.min], [req.min]])
+        _, L = loop_response(b.ctrl, plant, np.unique(pts))
+        b.geq(TIGHT * L.abs2() - BANDWIDTH_LEVEL**2 * t02 * (1.0 + L).abs2())
+    if req.max is not None:
+        _, L = loop_response(b.ctrl, plant, float(req.max))
+        b.geq(TIGHT * BANDWIDTH_LEVEL**2 * t02 * (1.0 + L).abs2() - L.abs2())
+
+
+@nlp_form(MarginsRequirement, exact=True)
+def _margins(b: NLPBuilder, req: MarginsRequirement, plant: Plant, ctx: NLPContext) -> None:
+    loop = Loop(plant, ctx.start)
+    ctrl = b.ctrl
+    for wc in loop.gain_crossovers():
+        v = b.var("wc", float(wc), wc / 3.0, 3.0 * wc)
+        _, L = loop_response(ctrl, plant, v)
+        b.eq(L.abs2() - 1.0)
+        if req.phase_margin_deg is not None:
+            b.geq((1.0 + L).abs2() - 4 * np.sin(np.radians(req.phase_margin_deg * (1 + BACKOFF)) / 2) ** 2)
+        if req.delay_margin is not None:
+            b.geq((1.0 + L).abs2() - 4 * ca.sin(ca.fmin(v * req.delay_margin, np.pi) / 2) ** 2)
+    if req.gain_margin_db is not None:
+        for wp in phase_crossovers(loop):
+            v = b.var("wp", float(wp), wp / 3.0, 3.0 * wp)
+            _, L = loop_response(ctrl, plant, v)
+            b.eq(L.im)
+            b.geq(L.re + 1.0 / magnitude(req.gain_margin_db * (1 + BACKOFF)))
+
+

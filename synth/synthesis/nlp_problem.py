@@ -1,0 +1,184 @@
+"""The pieces an NLP is written with: the controller as casadi symbols, the problem builder, and the
+loop's frequency response in those symbols (the plant exact, its delay as ``cos(w tau) - j sin(w tau)``)."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import casadi as ca
+import numpy as np
+
+from synth.controllers import RATIONAL, Controller, rational_order
+from synth.loop import Loop
+from synth.plant import Plant
+from synth.synthesis.cxcomplex import Cx, delay_jw, polyval_jw
+
+__all__ = ["BACKOFF", "IPOPT_OPTIONS", "SYM", "TIGHT", "NLPBuilder", "SymbolicController", "loop_response",
+           "phase_crossovers", "t0_squared"]
+
+SYM = ca.MX
+"""Symbol type of the NLP. Matrix expressions: a requirement on n frequencies is a handful of vector
+operations on numeric columns, not n scalar graphs, so building the solver (derivatives included) costs
+milliseconds instead of a tenth of a second for a few thousand constraints."""
+
+IPOPT_OPTIONS = {"ipopt.print_level": 0, "print_time": False, "ipopt.sb": "yes", "ipopt.max_iter": 1500,
+                 "ipopt.hessian_approximation": "limited-memory",
+                 "ipopt.tol": 1e-9, "ipopt.constr_viol_tol": 1e-9}
+
+
+BACKOFF = 1e-4
+"""Relative tightening of magnitude bounds (as in the convex stage): about 0.001 dB."""
+
+
+TIGHT = 1.0 - 2 * BACKOFF
+"""Tightening of squared magnitudes."""
+
+
+class SymbolicController:
+    """A controller whose free parameters are casadi symbols, scaled by their starting magnitudes."""
+
+    def __init__(self, ctype: str, start: Controller, bounds: dict[str, tuple[float, float]]) -> None:
+        self.ctype = ctype
+        kind = start.kind
+        self.free = [p for p in kind.parameters if bounds[p][0] < bounds[p][1]]
+        self.fixed = {p: bounds[p][0] for p in kind.parameters if bounds[p][0] == bounds[p][1]}
+        self.bounds = bounds
+        x0 = np.array([start.parameters[p] for p in self.free], float)
+        span = np.array([bounds[p][1] - bounds[p][0] for p in self.free], float)
+        # variables of order one: scaled by their start value, or by 1 % of their range when that is larger
+        self.scale = np.maximum(np.abs(x0), np.where(np.isfinite(span), 1e-2 * span, 1.0))
+        self.scale = np.where(self.scale > 0, self.scale, 1.0)
+        self.u = SYM.sym("u", len(self.free))
+        self.u0 = x0 / self.scale
+        self.values = {**{p: self.u[i] * self.scale[i] for i, p in enumerate(self.free)}, **self.fixed}
+
+    def lbx(self) -> np.ndarray:
+        return np.array([self.bounds[p][0] for p in self.free]) / self.scale
+
+    def ubx(self) -> np.ndarray:
+        return np.array([self.bounds[p][1] for p in self.free]) / self.scale
+
+    def response(self, w: Any) -> Cx:
+        """``C(j w)`` for a numeric or symbolic ``w`` (> 0)."""
+        v = self.values
+        jw = Cx(0.0, w)
+        if self.ctype == "P":
+            return Cx(v["kp"], 0.0)
+        if self.ctype == "PI":
+            return Cx(v["kp"], -v["ki"] / w)
+        if self.ctype == "PID":
+            return Cx(v["kp"], -v["ki"] / w) + v["kd"] * jw / (v["tf"] * jw + 1.0)
+        if self.ctype == "leadlag":
+            return v["k"] * (jw + v["z"]) / (jw + v["p"])
+        if self.ctype == RATIONAL:
+            m, n = rational_order(v)
+            num = polyval_jw([v[f"b{i}"] for i in range(m, -1, -1)], w)
+            den = polyval_jw([1.0] + [v[f"a{i}"] for i in range(n - 1, -1, -1)], w)
+            return num / den
+        raise NotImplementedError(self.ctype)
+
+    def dc(self) -> Any | None:
+        """``C(0)`` (None with integral action)."""
+        v = self.values
+        if self.ctype == "P":
+            return v["kp"]
+        if self.ctype == "leadlag":
+            return v["k"] * v["z"] / v["p"]
+        if self.ctype == RATIONAL and not (self.fixed.get("a0") == 0.0):
+            return v["b0"] / v["a0"]
+        return None
+
+    def integral_gain(self) -> Any:
+        if self.ctype == RATIONAL:
+            return self.values["b0"] / self.values["a1"] if "a1" in self.values else self.values["b0"]
+        return self.values["ki"]
+
+    def controller(self, u: np.ndarray) -> Controller:
+        vals = {**{p: float(u[i] * self.scale[i]) for i, p in enumerate(self.free)}, **self.fixed}
+        return Controller(self.ctype, vals)
+
+
+class NLPBuilder:
+    """Collects variables, constraints and the objective of one NLP."""
+
+    def __init__(self, ctrl: SymbolicController) -> None:
+        self.ctrl = ctrl
+        self.x = [ctrl.u]
+        self.x0 = [ctrl.u0]
+        self.lbx = [ctrl.lbx()]
+        self.ubx = [ctrl.ubx()]
+        self.g: list[Any] = []
+        self.lbg: list[float] = []
+        self.ubg: list[float] = []
+        self.f: Any = 0.0
+
+    def var(self, name: str, x0: float, lo: float, hi: float) -> Any:
+        v = SYM.sym(name)
+        self.x.append(v)
+        self.x0.append(np.array([x0]))
+        self.lbx.append(np.array([lo]))
+        self.ubx.append(np.array([hi]))
+        return v
+
+    def geq(self, expr: Any) -> None:
+        """``expr >= 0`` (a scalar or one entry per frequency)."""
+        self._add(expr, np.inf)
+
+    def eq(self, expr: Any) -> None:
+        """``expr == 0``."""
+        self._add(expr, 0.0)
+
+    def _add(self, expr: Any, upper: float) -> None:
+        expr = expr if isinstance(expr, (ca.SX, ca.MX)) else SYM(expr)
+        self.g.append(expr)
+        self.lbg.extend([0.0] * expr.numel())
+        self.ubg.extend([upper] * expr.numel())
+
+    def solve(self) -> tuple[np.ndarray, dict[str, Any]]:
+        x = ca.vertcat(*self.x)
+        g = ca.vertcat(*self.g) if self.g else SYM(0, 1)
+        solver = ca.nlpsol("polish", "ipopt", {"x": x, "f": self.f, "g": g}, IPOPT_OPTIONS)
+        res = solver(x0=np.concatenate(self.x0), lbx=np.concatenate(self.lbx), ubx=np.concatenate(self.ubx),
+                     lbg=np.array(self.lbg), ubg=np.array(self.ubg))
+        return np.asarray(res["x"]).ravel(), solver.stats()
+
+
+def loop_response(ctrl: SymbolicController, plant: Plant, w: Any) -> tuple[Cx, Cx]:
+    """``(C(jw), L(jw))`` with the plant exact (delay included).
+
+    ``w`` is a casadi symbol, a number, or an array of frequencies: then every
+    part is a column with one entry per frequency (one vectorized expression
+    instead of one per frequency, which keeps building the NLP cheap).
+    """
+    C = ctrl.response(w)
+    if isinstance(w, (ca.SX, ca.MX)):
+        G = polyval_jw(plant.num, w) / polyval_jw(plant.den, w) * delay_jw(plant.delay, w)
+    elif np.ndim(w):
+        g = plant.freqresp(np.asarray(w, float))
+        G = Cx(np.real(g), np.imag(g))
+    else:
+        G = Cx.of(complex(plant.freqresp(np.array([w]))[0]))
+    return C, C * G
+
+
+def t0_squared(ctrl: SymbolicController, plant: Plant) -> Any:
+    """``|T(0)|^2`` in the symbols (1 with integral action)."""
+    dc = ctrl.dc()
+    if dc is None:
+        return 1.0
+    l0 = dc * plant.dc_gain()
+    return (l0 / (1.0 + l0)) ** 2
+
+
+def phase_crossovers(loop: Loop) -> np.ndarray:
+    """Frequencies where ``L`` crosses the negative real axis inside the unit circle."""
+    from synth.freqgrid import crossings, log_grid
+
+    lo, hi = loop.frequency_range
+    grid = log_grid(lo, hi * 10, 200)
+    imag = crossings(lambda w: np.imag(loop.L(w)), 0.0, grid)
+    L = loop.L(imag)
+    keep = (np.real(L) < 0) & (np.abs(L) < 1.0)
+    return imag[keep]
+
+

@@ -1,0 +1,230 @@
+"""Design over one free parameter (a P gain, or any one parameter with the others fixed).
+
+The exact feasible set is computed (:mod:`synth.synthesis.gainset`) and the objective is optimized
+over it; the design is re-checked on a grid 20 times denser than the search grid, plus exact
+stability, and a design that fails that certificate is not reported as a solution.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import numpy as np
+from scipy.optimize import minimize_scalar
+
+from synth.check import check
+from synth.errors import SynthError
+from synth.loop import Loop
+from synth.objectives import score as objective_score
+from synth.requirements.base import fmt
+from synth.results import (
+    CERTIFICATE_PER_DECADE,
+    SEARCH_PER_DECADE,
+    Certificate,
+    DesignResult,
+    objective_label,
+    reference_check,
+    reference_verdict,
+)
+from synth.spec import Spec
+from synth.synthesis.gainset import GainSet, ScalarFamily, feasible_gain_set
+
+__all__ = ["INWARD", "design_scalar", "feasible_verdict", "infeasible_verdict", "scalar_family"]
+
+
+def _optimize_scalar(f: Callable[[float], float], intervals: list[tuple[float, float]]) -> tuple[float, float]:
+    """Maximize ``f`` over a union of intervals: grid, then bounded Brent around the best point."""
+    best_x, best_v = None, -np.inf
+    for lo, hi in intervals:
+        if hi <= lo:
+            cand = [lo]
+        else:
+            cand = list(np.linspace(lo, hi, 61))
+        vals = [f(x) for x in cand]
+        i = int(np.nanargmax(vals))
+        x, v = cand[i], vals[i]
+        if hi > lo and np.all(np.isfinite(vals[max(i - 1, 0):i + 2])):  # Brent needs finite values around the best
+            a, b = cand[max(i - 1, 0)], cand[min(i + 1, len(cand) - 1)]
+            res = minimize_scalar(lambda t: -f(t), bounds=(a, b), method="bounded",
+                                  options={"xatol": 1e-10 * max(1.0, abs(b))})
+            if -res.fun > v:
+                x, v = float(res.x), float(-res.fun)
+        if v > best_v:
+            best_x, best_v = x, v
+    return float(best_x), float(best_v)
+
+
+INWARD = 1e-6
+"""Relative step by which a design at an end set by a requirement is moved into the feasible set
+(the end itself has zero slack up to rounding)."""
+
+
+def _inside(x: float, gain_set: GainSet) -> float:
+    for iv in gain_set.intervals:
+        step = INWARD * max(1.0, abs(x), iv.hi - iv.lo)
+        lo_req = any(not b.startswith("bounds") for b in iv.lo_binding)
+        hi_req = any(not b.startswith("bounds") for b in iv.hi_binding)
+        if lo_req and abs(x - iv.lo) <= step and iv.hi - iv.lo > 2 * step:
+            return iv.lo + step
+        if hi_req and abs(x - iv.hi) <= step and iv.hi - iv.lo > 2 * step and not any(
+                b.startswith("bounds") for b in iv.hi_binding):
+            return iv.hi - step
+    return x
+
+
+def scalar_family(spec: Spec) -> tuple[ScalarFamily, tuple[float, float]]:
+    """The one-parameter family a spec designs over, and its bounds (error if it has several free parameters).
+
+    Examples
+    --------
+    >>> from synth.spec import load_spec
+    >>> family, bounds = scalar_family(load_spec("specs/x4_rotor.yaml"))
+    >>> family.parameter, bounds
+    ('kp', (0.0, 20.0))
+    """
+    bounds = spec.controller.all_bounds()
+    free = spec.controller.free_parameters()
+    if len(free) != 1:
+        raise SynthError(
+            f"{spec.controller.type} design over {len(free)} free parameters "
+            f"({', '.join(free) or 'none'}) needs the optimizer; the exact gain set handles one",
+            where="controller.bounds",
+        )
+    name = free[0]
+    fixed = {p: lo for p, (lo, hi) in bounds.items() if p != name}
+    return ScalarFamily(spec.controller.type, name, fixed), bounds[name]
+
+
+def design_scalar(spec: Spec) -> DesignResult:
+    """Design the controller of ``spec`` over its one free parameter: exact feasible set, then the objective.
+
+    Parameters
+    ----------
+    spec : Spec
+        Loaded spec (see :func:`synth.load_spec`).
+
+    Returns
+    -------
+    DesignResult
+        ``feasible`` is False (and ``controller`` None) when no controller in
+        the bounds meets every requirement; ``gain_set`` then names the
+        conflicting requirements.
+
+    Examples
+    --------
+    >>> from synth.spec import load_spec
+    >>> result = design_scalar(load_spec("specs/x4_rotor.yaml"))
+    >>> result.feasible, result.controller.parameters["kp"], result.gain_set.contains(3.0)
+    (True, 20.0, True)
+    """
+    family, bounds = scalar_family(spec)
+    requirements = list(spec.requirements)
+    plants = spec.plants()
+    gain_set = feasible_gain_set(requirements, plants, family, bounds)
+    method = f"exact feasible set of {family.parameter} ({gain_set.method}); objective maximized over it"
+    objective = spec.objective
+    nominal = spec.nominal_plant()
+
+    if not gain_set.intervals:
+        def min_slack(x: float) -> float:
+            c = family.controller(x)
+            return min(r.slack for r in check(spec, c).requirements)
+
+        x, _ = _optimize_scalar(min_slack, [bounds])
+        compromise = check(spec, family.controller(x))
+        result = DesignResult(spec.name, False, None, None, None, gain_set, None, compromise, method,
+                              reference=reference_check(spec))
+        result.verdict = infeasible_verdict(result, family) + reference_verdict(spec, result.reference)
+        return result
+
+    if objective is None:
+        def score(x: float) -> float:
+            return min(r.slack for r in check(spec, family.controller(x)).requirements)
+    else:
+        terms = objective.terms()
+
+        def score(x: float) -> float:
+            return objective_score(Loop(nominal, family.controller(x)), terms)
+    x, _ = _optimize_scalar(score, [(iv.lo, iv.hi) for iv in gain_set.intervals])
+    x = _inside(x, gain_set)
+    controller = family.controller(x)
+    if objective is None:
+        label = {"name": "smallest slack", "sense": "maximize", "unit": "Np", "value": float(score(x)),
+                 "description": "no objective in the spec: the largest smallest slack"}
+    else:
+        label = objective_label(spec, Loop(nominal, controller))
+    final = check(spec, controller, SEARCH_PER_DECADE)
+    cert_check = check(spec, controller, CERTIFICATE_PER_DECADE)
+    certificate = Certificate(cert_check.feasible, CERTIFICATE_PER_DECADE, cert_check)
+    feasible = certificate.passed
+    result = DesignResult(spec.name, feasible, controller if feasible else None, final, label,
+                          gain_set, certificate, None, method, reference=reference_check(spec))
+    result.verdict = (feasible_verdict(result, family) if feasible else (
+        f"The optimum {controller} failed the dense re-check ("
+        + "; ".join(r.message for r in cert_check.failed()) + "): not reported as a solution.")
+    ) + reference_verdict(spec, result.reference, gain_set)
+    return result
+
+
+def _ends(names: list[str]) -> str:
+    return " and ".join(names) if names else "nothing"
+
+
+def feasible_verdict(result: DesignResult, family: ScalarFamily) -> str:
+    """Plain-language summary of a successful scalar design.
+
+    Examples
+    --------
+    >>> from synth.spec import load_spec
+    >>> spec = load_spec("specs/x4_rotor.yaml")
+    >>> feasible_verdict(design_scalar(spec), scalar_family(spec)[0])[:44]
+    'P(kp=20) meets all 3 requirements and keeps '
+    """
+    p = family.parameter
+    gs = result.gain_set
+    assert result.controller is not None and gs is not None and result.objective is not None
+    sets = "; ".join(
+        f"{fmt(iv.lo)} <= {p} <= {fmt(iv.hi)} (lower end set by {_ends(iv.lo_binding)}, "
+        f"upper end by {_ends(iv.hi_binding)})" for iv in gs.intervals
+    )
+    obj = result.objective
+    return (f"{result.controller} meets all {len(result.check.requirements) - 1} requirements and keeps the "
+            f"loop stable ({obj['sense']} {obj['name']}: {fmt(obj['value'])} {obj['unit']}). "
+            f"Feasible {p}: {sets}.")
+
+
+def infeasible_verdict(result: DesignResult, family: ScalarFamily) -> str:
+    """Plain-language explanation of why no value works.
+
+    Examples
+    --------
+    >>> from synth.spec import load_spec
+    >>> spec = load_spec("specs/x4_rotor_strict.yaml")
+    >>> infeasible_verdict(design_scalar(spec), scalar_family(spec)[0])[:40]
+    'No kp in [0, 5] meets every requirement.'
+    """
+    p = family.parameter
+    gs = result.gain_set
+    assert gs is not None
+    lo, hi = gs.bounds
+    parts = [f"No {p} in [{fmt(lo)}, {fmt(hi)}] meets every requirement."]
+    for name in gs.never_met():
+        wide = gs.outside_bounds.get(name) or []
+        if wide:
+            where = ", ".join(f"[{fmt(a)}, {fmt(b)}]" for a, b in wide)
+            parts.append(f"{name} is met by no {p} within the bounds; it would need {p} in {where} "
+                         "(searched up to ten times the upper bound).")
+        else:
+            parts.append(f"{name} is met by no {p} within the bounds nor ten times beyond.")
+    for a, b in gs.conflicts():
+        parts.append(f"{a} and {b} conflict: {a} needs {p} in "
+                     f"{_ivs(gs.per_requirement[a])}, {b} needs {_ivs(gs.per_requirement[b])}.")
+    if result.compromise is not None:
+        failed = result.compromise.failed()
+        parts.append(f"Best compromise {result.compromise.controller} (not a solution): "
+                     + "; ".join(r.message for r in failed) + ".")
+    return " ".join(parts)
+
+
+def _ivs(ivs: list[tuple[float, float]]) -> str:
+    return ", ".join(f"[{fmt(a)}, {fmt(b)}]" for a, b in ivs)
