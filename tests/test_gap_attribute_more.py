@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 from synth.data import record_from_arrays
-from synth.gap.attribute import DEFAULT_CANDIDATES, _linearized_null, _refit_null, diagnose_effects
-from synth.gap.effects import make_effect
+from synth.gap.attribute import _linearized_null, _refit_null, diagnose_effects
+from synth.gap.effects import DEFAULT_CANDIDATES, make_effect
 from synth.gap.refit import fit_augmented
 from synth.gap.screen import screen_effect
 

@@ -8,8 +8,8 @@ import pytest
 from synth.data import record_from_arrays
 from synth.gap.attribute import diagnose_effects
 from synth.gap.effects import QuantizationEffect, ResonanceEffect
+from synth.gap.effects.quantization import quantizer_grid
 from synth.gap.refit import fit_augmented
-from synth.gap.screen import quantizer_grid
 from synth.ident.simulate import simulate_plant
 from synth.plant import Plant
 from synth.sim.blocks import Quantizer

@@ -1,7 +1,7 @@
 """Score :func:`synth.gap.attribute.diagnose_effects` on the withheld-effect benchmark.
 
 Every case of :mod:`benchmarks.gap.generate` is diagnosed with the full candidate list
-(:data:`synth.gap.attribute.DEFAULT_CANDIDATES`) and the defaults; the diagnosis sees only the
+(:data:`synth.gap.effects.registry.DEFAULT_CANDIDATES`) and the defaults; the diagnosis sees only the
 record and the mismatched nominal model. What is counted:
 
 * **top-1** (cases with an effect): the first entry of ``verdict["effects"]`` is the true effect. An

@@ -3,7 +3,7 @@
 Case: the X-4 rotor drive (eq. 5 plant, 2-5 % mismatch in every coefficient of the nominal handed to
 the diagnosis), a hidden rate limit of 300 PWM/s, a 16-level step train of several amplitudes sampled
 at 500 Hz for 40 s (20,000 samples; the first half trains), noise 1 rad/s. Every candidate of
-:data:`synth.gap.attribute.DEFAULT_CANDIDATES` (12).
+:data:`synth.gap.effects.registry.DEFAULT_CANDIDATES` (12).
 
 Rows:
   * synth: ``diagnose_effects`` with its defaults (every candidate screened with the denominator fixed,

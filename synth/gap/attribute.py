@@ -83,17 +83,13 @@ import numpy as np
 
 from synth.data.record import Record
 from synth.errors import ModelError
-from synth.gap.effects import DelayEffect, Effect, Params, make_effect
+from synth.gap.effects.base import Effect, Params
+from synth.gap.effects.registry import DEFAULT_CANDIDATES, make_effect
 from synth.gap.refit import AugmentedFit, fit_augmented
 from synth.gap.screen import ScreenedFit, screen_effect
 from synth.gap.stitch import settle_time, stitch_runs
 from synth.ident.simulate import simulate_plant
 from synth.plant import Plant
-
-DEFAULT_CANDIDATES: tuple[str, ...] = (
-    "delay", "lag", "lag(sensor)", "resonance", "rate_limit", "saturation", "deadzone", "backlash",
-    "quantization", "supply_sag", "static_nonlinearity", "drift")
-"""Every effect of :mod:`synth.gap.effects` (both placements of the lag)."""
 
 SEPARATING_EXPERIMENTS: dict[frozenset[str], str] = {
     frozenset({"delay", "lag"}): "a sweep to higher frequency: a delay's phase keeps falling linearly with "
@@ -651,7 +647,7 @@ class _Chain:
 
         fixed = {k: float(v) for k, v in fit_a.params.items()}
         base_plant = fit_a.plant
-        folded = type(eff_a) is DelayEffect  # an extra delay folds into the linear model: B alone on top of it
+        folded = eff_a.folds_into_plant  # an extra delay folds into the linear model: B alone on top of it
         if folded:
             base_plant = fit_a.plant.with_delay(fit_a.plant.delay + fixed.get("delay", 0.0))
         screened: list[tuple[Effect, ScreenedFit | None]] = []
@@ -770,18 +766,7 @@ def _refit_null(refit: AugmentedFit, t_tr: np.ndarray, u_tr: np.ndarray, t_ev: n
 def _seeded(effect: Effect, screened: ScreenedFit, u_train: np.ndarray | None = None) -> list[Params]:
     """The joint fit's search grid: the screened point and its neighbours (+-15 % in the key)."""
     point = {k: v for k, v in screened.params.items() if k not in effect.basis_names}
-    keys = [k for k in effect.grid_names if k in point and np.isfinite(point[k]) and point[k] > 0]
-    grid = [point] if not keys else [{**point, keys[0]: point[keys[0]] * f} for f in (1 / 1.15, 1.0, 1.15)]
-    if effect.name == "quantization":  # the screen searched step and offset jointly and densely (piecewise-constant cost)
-        grid = [point]
-    if effect.name == "saturation":  # one limit at a time, as the effect's own grid
-        side = "upper" if np.isfinite(point.get("upper", np.inf)) else "lower"
-        other = "lower" if side == "upper" else "upper"
-        span = float(np.ptp(u_train)) if u_train is not None and np.ptp(u_train) > 0 else abs(point[side]) or 1.0
-        # the screen held the denominator fixed, which biases the limit: bracket it by +-5 % of the command span
-        grid = [{side: point[side] + f * span} for f in (-0.05, -0.02, 0.0, 0.02, 0.05)]
-        grid = [{k: v for k, v in g.items() if k != other} for g in grid]
-    return [dict(g) for g in grid]
+    return effect.seed_grid(point, u_train)
 
 
 def _candidate_fits(plant: Plant, effects: list[Effect], refit: AugmentedFit, t_tr: np.ndarray, u_tr: np.ndarray,

@@ -46,7 +46,8 @@ from typing import Any
 import numpy as np
 
 from synth.errors import ModelError
-from synth.gap.effects import DelayEffect, Effect, Params, SaturationEffect, make_effect
+from synth.gap.effects.base import Effect, Params
+from synth.gap.effects.registry import make_effect
 from synth.plant import Plant
 
 _UNIT = Plant(np.array([1.0]), np.array([1.0]))
@@ -86,31 +87,8 @@ def numeric_factor(plant: Plant) -> str | None:
     return f"(({_poly(num)})/({_poly(den)}))"
 
 
-def _has_output_map(e: Effect) -> bool:
-    if isinstance(e, NestedEffect):
-        return _has_output_map(e.first) or _has_output_map(e.second)
-    if isinstance(e, SaturationEffect):
-        return e.placement == "output"
-    return type(e).output_map is not Effect.output_map
-
-
-def _has_input_side(e: Effect) -> bool:
-    if isinstance(e, NestedEffect):
-        return _has_input_side(e.first) or _has_input_side(e.second)
-    if e.needs_plant:
-        return True
-    if isinstance(e, SaturationEffect):
-        return e.placement == "input"
-    return type(e).input_map is not Effect.input_map or type(e).input_basis is not Effect.input_basis
-
-
 def _output_basis_count(e: Effect) -> int:
     return len(e.output_basis(np.array([0.0, 1.0])))
-
-
-def _changes_rational(e: Effect) -> bool:
-    """Whether a free effect may change the rational part of the linear model (a lag, a resonance)."""
-    return type(e).augment_plant is not Effect.augment_plant and not isinstance(e, DelayEffect)
 
 
 @dataclass(frozen=True)
@@ -175,7 +153,7 @@ class NestedEffect(Effect):
                 parts = [make_effect(given[k]) for k in ("first", "second")]
             except (KeyError, ModelError):
                 parts = []  # __init__ reports it
-            if any(_has_output_map(e) for e in parts):
+            if any(e.has_output_map for e in parts):
                 cls = _OutputMapNestedEffect
         return super().__new__(cls)
 
@@ -207,14 +185,14 @@ class NestedEffect(Effect):
         if _output_basis_count(first):
             return (f"{first.label}'s fixed output terms cannot be held in the re-fit; subtract them from the "
                     f"measured output and fit {second.label} alone")
-        if _has_output_map(first) and _output_basis_count(second):
+        if first.has_output_map and _output_basis_count(second):
             return f"{second.label}'s output terms would follow {first.label}'s output map, which gets no time"
         first_rational = numeric_factor(h) is not None
         if first.needs_plant and second.needs_plant:
             return "both need the linear model"
-        if first.needs_plant and (_changes_rational(second) or _has_input_side(second)):
+        if first.needs_plant and (second.changes_rational or second.has_input_side):
             return (f"{first.label}'s force would be computed without {second.label}'s "
-                    f"{'linear factor' if _changes_rational(second) else 'input block'}")
+                    f"{'linear factor' if second.changes_rational else 'input block'}")
         if second.needs_plant and first_rational:
             return f"{second.label}'s force would be computed on a velocity model including {first.label}'s factor"
         return None
@@ -264,6 +242,22 @@ class NestedEffect(Effect):
     @property
     def screenable(self) -> bool:
         return bool(self.first.screenable and self.second.screenable and not self.needs_plant)
+
+    @property
+    def has_output_map(self) -> bool:
+        return bool(self.first.has_output_map or self.second.has_output_map)
+
+    @property
+    def has_input_side(self) -> bool:
+        return bool(self.first.has_input_side or self.second.has_input_side)
+
+    def screen_points(self, grid: list[Params], t: np.ndarray, plant: Plant) -> list[Params]:
+        """``second``'s screen points on this effect's grid."""
+        return self.second.screen_points(grid, t, plant)
+
+    def seed_grid(self, point: Params, u_train: np.ndarray | None = None) -> list[Params]:
+        """``second``'s seeded grid."""
+        return self.second.seed_grid(point, u_train)
 
     @property
     def label(self) -> str:

@@ -32,9 +32,9 @@ import numpy as np
 
 from synth.data.record import Record
 from synth.errors import DataError, ModelError
-from synth.gap.attribute import DEFAULT_CANDIDATES, EffectDiagnosis, diagnose_effects
+from synth.gap.attribute import EffectDiagnosis, diagnose_effects
 from synth.gap.clipping import Clipping, record_clipping
-from synth.gap.effects import make_effect
+from synth.gap.effects.registry import DEFAULT_CANDIDATES, make_effect
 from synth.gap.localize import GapLocalization, localize_gap
 from synth.plant import Plant, Signal
 

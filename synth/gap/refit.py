@@ -45,7 +45,7 @@ import numpy as np
 
 from synth.data.record import record_from_arrays
 from synth.errors import DataError, ModelError
-from synth.gap.effects import Effect, Params
+from synth.gap.effects.base import Effect, Params
 from synth.gap.golden import golden_section, log_bracket
 from synth.ident.simulate import simulate_plant
 from synth.ident.timefit import fit_structure

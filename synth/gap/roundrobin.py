@@ -36,7 +36,6 @@ import numpy as np
 from synth.data.record import Record
 from synth.errors import ModelError
 from synth.gap.attribute import (
-    DEFAULT_CANDIDATES,
     EffectDiagnosis,
     _experiment,
     _free_parameters,
@@ -44,7 +43,7 @@ from synth.gap.attribute import (
     _share_of_excess,
     diagnose_effects,
 )
-from synth.gap.effects import make_effect
+from synth.gap.effects.registry import DEFAULT_CANDIDATES, make_effect
 from synth.plant import Plant
 
 
