@@ -137,8 +137,8 @@ def run(args: argparse.Namespace) -> int:
 
 def _round_robin(args: argparse.Namespace, plant: Any, runs: list[Any], candidates: list[str] | None) -> int:
     from synth.errors import SynthError
+    from synth.gap.attribution.roundrobin import diagnose_runs
     from synth.gap.effects.registry import DEFAULT_CANDIDATES
-    from synth.gap.roundrobin import diagnose_runs
     from synth.outputs import dump_json, write_json
 
     if len(runs) < 2:

@@ -94,8 +94,8 @@ def write_diagnosis_report(diag: Diagnosis, out_dir: str | Path, *, command: str
     figs: dict[str, Path] = {}
     if figures:
         from synth.figure_files import save_figure
-        from synth.gap.gapmap import write_gap_map
         from synth.gap.overlay import overlay_figure
+        from synth.gap.where.gapmap import write_gap_map
 
         figs["gap_map"] = write_gap_map(diag.localization, out.claim("gap_map.png"), diag.plant)
         figs["overlay"] = save_figure(overlay_figure(diag.attribution), out.claim("overlay.png"))

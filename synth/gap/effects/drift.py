@@ -32,6 +32,7 @@ class DriftEffect(Effect):
     Examples
     --------
     >>> import numpy as np
+    >>> from synth.plant import Plant
     >>> t = np.arange(0, 3, 1.0)
     >>> DriftEffect().apply(Plant.from_string("1"), t, np.zeros(3), {"slope": 0.5}).tolist()
     [0.0, 0.5, 1.0]

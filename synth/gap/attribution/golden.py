@@ -1,6 +1,6 @@
 """Golden-section search in the log of a grid parameter, between the best grid point's neighbours.
 
-The effect searches (:mod:`synth.gap.screen`, :mod:`synth.gap.refit`) first evaluate a deterministic
+The effect searches (:mod:`synth.gap.attribution.screen`, :mod:`synth.gap.attribution.refit`) first evaluate a deterministic
 grid, then refine the best point's parameter by a golden-section search in its logarithm (rates,
 limits, widths and time constants are scale parameters).
 """

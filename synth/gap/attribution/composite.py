@@ -5,7 +5,7 @@ which effect ``B`` the model *augmented by A* still misses. :class:`NestedEffect
 is that augmented model as one :class:`synth.gap.effects.Effect`: its free
 parameters are ``B``'s (grid, factor and basis parameters, fitted as ``B``'s own),
 ``A``'s parameters of every kind are fixed numbers inside it, so
-:func:`synth.gap.refit.fit_augmented` and :func:`synth.gap.screen.screen_effect`
+:func:`synth.gap.attribution.refit.fit_augmented` and :func:`synth.gap.attribution.screen.screen_effect`
 fit it unchanged, re-fitting the nominal coefficients jointly with ``B``.
 
 The model is the physical chain, each side in the order ``A`` then ``B``::
@@ -22,7 +22,7 @@ Combinations the re-fit's hooks cannot represent exactly raise
 :class:`synth.errors.ModelError` (never a silently wrong fit):
 
 - ``A`` adds a delay (``delay`` with a nonzero value): the re-fit's linear fit fixes the
-  delay at the nominal's (:func:`synth.gap.refit.fit_augmented` would fit the wrong
+  delay at the nominal's (:func:`synth.gap.attribution.refit.fit_augmented` would fit the wrong
   delay); fold it into the nominal instead (``plant.with_delay(plant.delay + d)``, then
   fit ``B`` alone: the same model);
 - ``A`` has output basis terms (``drift``): no hook subtracts a fixed time signal from the
@@ -55,7 +55,7 @@ _UNIT = Plant(np.array([1.0]), np.array([1.0]))
 
 def _poly(coeffs: np.ndarray) -> str:
     """A polynomial in ``s`` with numeric coefficients, as the structure parser reads it."""
-    from synth.gap.refit import monomial
+    from synth.gap.attribution.refit import monomial
 
     deg = coeffs.size - 1
     terms = [f"({float(c)!r})" + (f"*{monomial(deg - i)}" if deg - i else "") for i, c in enumerate(coeffs) if c != 0.0]
@@ -122,7 +122,7 @@ class NestedEffect(Effect):
     Examples
     --------
     >>> import numpy as np
-    >>> from synth.gap.refit import fit_augmented
+    >>> from synth.gap.attribution.refit import fit_augmented
     >>> t = np.arange(0, 8, 0.01); u = np.where((t % 2) >= 1, 1.5, 0.0)
     >>> G = Plant.from_string("2/(0.2*s+1)")
     >>> e = NestedEffect("saturation", {"upper": 1.2}, "drift")  # accepted: the actuator's limit

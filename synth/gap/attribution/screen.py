@@ -15,7 +15,7 @@ their own here. The denominator is tried at two places, the nominal model's and
 the re-fit's, since the re-fit alone may have moved its poles to mimic the
 effect (a slower plant for a rate limit) and the nominal has not.
 
-The screened training SSR ranks the candidates; :func:`synth.gap.attribute.diagnose_effects`
+The screened training SSR ranks the candidates; :func:`synth.gap.attribution.heldout.diagnose_effects`
 re-fits only the best few jointly (nominal coefficients and effect, casadi),
 started at the screened parameters. A screened fit is never better than the joint
 fit of the same effect could be (it is the same model with fewer free
@@ -36,8 +36,8 @@ from typing import Any
 import numpy as np
 
 from synth.errors import ModelError
+from synth.gap.attribution.golden import golden_section, log_bracket
 from synth.gap.effects.base import Effect, Params, unit_numerators
-from synth.gap.golden import golden_section, log_bracket
 from synth.ident.simulate import simulate_plant
 from synth.plant import Plant
 

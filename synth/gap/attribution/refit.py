@@ -45,8 +45,8 @@ import numpy as np
 
 from synth.data.record import record_from_arrays
 from synth.errors import DataError, ModelError
+from synth.gap.attribution.golden import golden_section, log_bracket
 from synth.gap.effects.base import Effect, Params
-from synth.gap.golden import golden_section, log_bracket
 from synth.ident.simulate import simulate_plant
 from synth.ident.timefit import fit_structure
 from synth.plant import Plant
