@@ -9,6 +9,8 @@ import sys
 from pathlib import Path
 from typing import Any
 
+__all__ = ["COMMAND", "DESCRIPTION", "HELP", "ORDER", "add_arguments", "run"]
+
 COMMAND = "diagnose"
 ORDER = 50
 HELP = "sim-to-real gap: where the model and a measured record disagree, and which effect explains it"

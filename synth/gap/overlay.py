@@ -16,6 +16,8 @@ import numpy as np
 
 from synth.gap.attribution.verdict import EffectDiagnosis
 
+__all__ = ["overlay_figure"]
+
 
 def overlay_figure(dg: EffectDiagnosis) -> plt.Figure:
     """Draw the before/after overlay of a :class:`~synth.gap.attribution.verdict.EffectDiagnosis`.

@@ -12,6 +12,8 @@ from synth.gap.diagnose import Diagnosis
 from synth.outputs import GENERATOR, OutputDir, dump_json
 from synth.requirements.base import fmt
 
+__all__ = ["DiagnosisFiles", "render_diagnosis_html", "write_diagnosis_report"]
+
 
 @dataclass(frozen=True)
 class DiagnosisFiles:

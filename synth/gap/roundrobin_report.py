@@ -12,6 +12,8 @@ from synth.gap.attribution.roundrobin import RunsDiagnosis
 from synth.outputs import GENERATOR, OutputDir, dump_json
 from synth.requirements.base import fmt
 
+__all__ = ["RunsFiles", "write_runs_report"]
+
 
 @dataclass(frozen=True)
 class RunsFiles:

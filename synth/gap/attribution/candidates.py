@@ -28,7 +28,8 @@ def seeded_grid(effect: Effect, screened: ScreenedFit, u_train: np.ndarray | Non
     --------
     >>> from types import SimpleNamespace
     >>> from synth.gap.effects import make_effect
-    >>> [round(g["tau"], 4) for g in seeded_grid(make_effect("supply_sag"), SimpleNamespace(params={"tau": 0.5, "sag": 0.1}))]
+    >>> screened = SimpleNamespace(params={"tau": 0.5, "sag": 0.1})
+    >>> [round(g["tau"], 4) for g in seeded_grid(make_effect("supply_sag"), screened)]
     [0.4348, 0.5, 0.575]
     """
     point = {k: v for k, v in screened.params.items() if k not in effect.basis_names}

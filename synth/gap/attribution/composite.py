@@ -50,6 +50,8 @@ from synth.gap.effects.base import Effect, Params
 from synth.gap.effects.registry import make_effect
 from synth.plant import Plant
 
+__all__ = ["NestedEffect", "numeric_factor"]
+
 _UNIT = Plant(np.array([1.0]), np.array([1.0]))
 
 

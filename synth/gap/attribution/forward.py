@@ -39,7 +39,26 @@ class _Folded:
 
 
 class ForwardSelection:
-    """Forward selection: the best further effect on top of the accepted ones, judged on held-out data."""
+    """Forward selection: the best further effect on top of the accepted ones, judged on held-out data.
+
+    Built by :func:`synth.gap.attribution.heldout.diagnose_effects` with the training and evaluated
+    records, the held-out segment sums ``sums(yhat)``, the bootstrap interval ``ratio_ci(s_a, s_b)`` and
+    the acceptance rule (calibrated ``threshold``, ``min_share`` of the excess over the noise ``floor``).
+    :meth:`next` returns ``(nested effect, fit, EffectResult, held-out output, segment sums)`` of the best
+    further effect, or ``None`` when none can be fitted.
+
+    Examples
+    --------
+    >>> from synth.gap.attribution.refit import fit_augmented
+    >>> from synth.gap.effects import make_effect
+    >>> from synth.ident.simulate import simulate_plant
+    >>> t = np.arange(0, 4, 0.01); u = np.where((t % 2) >= 1, 1.0, 0.0); G = Plant.from_string("2/(0.2*s+1)")
+    >>> y = simulate_plant(G.with_delay(0.05), t, u)
+    >>> fs = ForwardSelection(G, t, u, y, t, u, None, None, lambda yh: np.array([np.sum((y - yh) ** 2)]),
+    ...                       lambda a, b: (0.0, 0.0), 0.1, 0.25, 1e-6, t.size)
+    >>> fs.next(make_effect("delay"), fit_augmented(G, t, u, y, make_effect("delay")), np.array([1.0]), []) is None
+    True
+    """
 
     def __init__(self, plant: Plant, t_tr: np.ndarray, u_tr: np.ndarray, y_tr: np.ndarray, t_ev: np.ndarray,
                  u_ev: np.ndarray, weights: np.ndarray | None, train_mask: np.ndarray | None, sums: Any,

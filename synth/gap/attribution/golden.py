@@ -11,6 +11,8 @@ from collections.abc import Callable
 
 import numpy as np
 
+__all__ = ["GOLDEN", "golden_section", "log_bracket"]
+
 GOLDEN = (np.sqrt(5.0) - 1.0) / 2.0
 
 

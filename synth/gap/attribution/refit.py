@@ -51,6 +51,8 @@ from synth.ident.simulate import simulate_plant
 from synth.ident.timefit import fit_structure
 from synth.plant import Plant
 
+__all__ = ["AugmentedFit", "fit_augmented", "monomial", "nominal_structure"]
+
 _CHI2_1_95 = 3.841458820694124
 _ROUNDS = 12  # most alternations of the casadi fit and the least-squares basis step
 _ROUNDS_TOL = 1e-6  # ... stopped when the training SSR changes less than this (relative)

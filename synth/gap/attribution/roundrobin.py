@@ -41,6 +41,8 @@ from synth.gap.attribution.verdict import EffectDiagnosis, separating_experiment
 from synth.gap.effects.registry import DEFAULT_CANDIDATES, make_effect
 from synth.plant import Plant
 
+__all__ = ["PooledEffect", "RunsDiagnosis", "diagnose_runs"]
+
 
 @dataclass(frozen=True)
 class PooledEffect:

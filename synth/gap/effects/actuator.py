@@ -156,7 +156,13 @@ class SaturationEffect(Effect):
         return [{k: v for k, v in g.items() if k != other} for g in grid]
 
     def clip(self, x: np.ndarray, params: Params) -> np.ndarray:
-        """``x`` limited to ``[lower, upper]`` (unchanged when neither limit is finite)."""
+        """``x`` limited to ``[lower, upper]`` (unchanged when neither limit is finite).
+
+        Examples
+        --------
+        >>> SaturationEffect("output").clip(np.array([-2.0, 0.5, 3.0]), {"lower": -1.0, "upper": 1.0}).tolist()
+        [-1.0, 0.5, 1.0]
+        """
         lo, hi = params.get("lower", -np.inf), params.get("upper", np.inf)
         if not (np.isfinite(lo) or np.isfinite(hi)):
             return x

@@ -205,6 +205,13 @@ class Effect:
         The screen holds the denominator fixed and has no smooth search of its own: an effect whose
         joint fit treats a parameter as smooth (the extra delay, a resonance's damping) gives it a
         grid here.
+
+        Examples
+        --------
+        >>> from synth.gap.effects.dynamics import ResonanceEffect
+        >>> g = ResonanceEffect().screen_points([{"wn": 20.0, "zeta": 0.2}], np.arange(3.0), Plant.from_string("1"))
+        >>> [p["zeta"] for p in g]
+        [0.05, 0.1, 0.2, 0.4, 0.7]
         """
         return grid
 
@@ -299,7 +306,18 @@ class Effect:
 
     @property
     def has_output_map(self) -> bool:
-        """Whether a static map acts on the output (:meth:`output_map` is not the identity)."""
+        """Whether a static map acts on the output (:meth:`output_map` is not the identity).
+
+        Examples
+        --------
+        >>> from synth.gap.effects import make_effect
+        >>> [make_effect(n).has_output_map for n in ("saturation", "saturation(output)", "drift")]
+        [False, True, False]
+        >>> [make_effect(n).has_input_side for n in ("saturation", "friction", "lag")]
+        [True, True, False]
+        >>> [make_effect(n).changes_rational for n in ("lag", "resonance", "delay")]
+        [True, True, False]
+        """
         return type(self).output_map is not Effect.output_map
 
     @property

@@ -89,7 +89,17 @@ class QuantizationEffect(Effect):
     def screen_grid(self, t: np.ndarray, u: np.ndarray, y: np.ndarray, plant: Plant,
                     mask: np.ndarray | None = None) -> list[Params]:
         """The best points of the dense joint search :func:`quantizer_grid` (no golden section: the cost is flat
-        between the points where a sample changes level)."""
+        between the points where a sample changes level).
+
+        Examples
+        --------
+        >>> t = np.arange(0, 8, 0.01); u = 1.0 + 0.8 * np.sin(2.3 * t) * np.sin(0.37 * t)
+        >>> G = Plant.from_string("2/(0.2*s+1)")
+        >>> y = QuantizationEffect().apply(G, t, u, {"step": 0.25, "offset": 0.07})
+        >>> g = QuantizationEffect().screen_grid(t, u, y, G)
+        >>> len(g), round(g[0]["step"], 2)
+        (5, 0.25)
+        """
         return quantizer_grid(plant, t, u, y, mask=mask)
 
     def seed_grid(self, point: Params, u_train: np.ndarray | None = None) -> list[Params]:

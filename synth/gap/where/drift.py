@@ -38,6 +38,8 @@ from scipy.stats import kstwobign
 
 from synth.errors import DataError
 
+__all__ = ["DriftResult", "cusum_drift"]
+
 
 @dataclass(frozen=True)
 class DriftResult:

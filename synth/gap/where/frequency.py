@@ -28,6 +28,8 @@ from synth.gap.where.residual import ModelResidual
 from synth.gap.where.xcorr import CrossCorrelation, prewhitened_xcorr
 from synth.plant import Plant
 
+__all__ = ["FrequencyBand", "FrequencyLocalization", "localize_frequency", "significant_bands"]
+
 
 @dataclass(frozen=True)
 class FrequencyBand:

@@ -20,6 +20,8 @@ import numpy as np
 from synth.gap.where.localize import GapLocalization
 from synth.plant import Plant
 
+__all__ = ["SHADE", "gap_map_figure", "write_gap_map"]
+
 SHADE = "#f4a261"
 
 

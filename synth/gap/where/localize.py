@@ -21,6 +21,8 @@ from synth.gap.where.residual import ModelResidual, model_residual
 from synth.gap.where.time import TimeLocalization, localize_time
 from synth.plant import Plant
 
+__all__ = ["REGIME_WORDS", "GapLocalization", "WhereResult", "headline", "localize_gap"]
+
 REGIME_WORDS = {"amplitude": "input amplitude", "rate": "input rate", "operating_point": "output level",
                 "direction": "direction of motion"}
 

@@ -41,6 +41,9 @@ from synth.gap.where.residual import ModelResidual
 from synth.ident.simulate import simulate_plant
 from synth.plant import Plant
 
+__all__ = ["MIN_BIN", "RegimeBin", "RegimeVariable", "bin_residual", "direction_of_motion", "input_rate", "localize_regime",
+           "response_time"]
+
 MIN_BIN = 10
 
 

@@ -21,6 +21,8 @@ from synth.gap.where.drift import DriftResult, cusum_drift
 from synth.gap.where.residual import ModelResidual
 from synth.gap.where.steps import StepResult, analyze_steps, phase_shares
 
+__all__ = ["TimeLocalization", "TimeWindow", "energy_windows", "localize_time"]
+
 
 @dataclass(frozen=True)
 class TimeWindow:
