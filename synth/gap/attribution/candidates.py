@@ -12,6 +12,7 @@ from typing import Any
 
 import numpy as np
 
+from synth.data.record import Record
 from synth.errors import ModelError
 from synth.gap.attribution.refit import AugmentedFit, fit_augmented
 from synth.gap.attribution.screen import ScreenedFit, screen_effect
@@ -36,11 +37,12 @@ def seeded_grid(effect: Effect, screened: ScreenedFit, u_train: np.ndarray | Non
     return effect.seed_grid(point, u_train)
 
 
-def candidate_fits(plant: Plant, effects: list[Effect], refit: AugmentedFit, t_tr: np.ndarray, u_tr: np.ndarray,
-                    y_tr: np.ndarray, t_ev: np.ndarray, u_ev: np.ndarray, confirm: int | None,
-                    train_mask: np.ndarray | None = None, workers: int = 1,
-                    ) -> list[tuple[Effect, AugmentedFit | ScreenedFit, np.ndarray, np.ndarray]]:
-    """Every candidate's fit: joint for all (``confirm=None``) or screened, the best ``confirm`` then joint.
+def candidate_fits(plant: Plant, effects: list[Effect], refit: AugmentedFit, train: Record, evaluated: Record,
+                   confirm: int | None, train_mask: np.ndarray | None = None, workers: int = 1,
+                   ) -> list[tuple[Effect, AugmentedFit | ScreenedFit, np.ndarray, np.ndarray]]:
+    """Every candidate's fit on ``train``: joint for all (``confirm=None``) or screened, the best ``confirm`` then joint.
+
+    Each fit is also simulated on ``evaluated`` (the held-out side).
 
     Effects the screen cannot represent (``Effect.screenable`` false: friction, output-side clipping) are
     always fitted jointly.
@@ -57,10 +59,13 @@ def candidate_fits(plant: Plant, effects: list[Effect], refit: AugmentedFit, t_t
     >>> from synth.ident.simulate import simulate_plant
     >>> t = np.arange(0, 4, 0.01); u = np.where((t % 2) >= 1, 1.0, 0.0); G = Plant.from_string("2/(0.2*s+1)")
     >>> y = simulate_plant(G.with_delay(0.05), t, u)
-    >>> fits = candidate_fits(G, [make_effect("delay")], fit_augmented(G, t, u, y), t, u, y, t, u, confirm=1)
+    >>> from synth.data import record_from_arrays
+    >>> rec = record_from_arrays(t, u, y)
+    >>> fits = candidate_fits(G, [make_effect("delay")], fit_augmented(G, t, u, y), rec, rec, confirm=1)
     >>> [(e.label, type(f).__name__, round(f.params["delay"], 3)) for e, f, _, _ in fits]
     [('delay', 'AugmentedFit', 0.05)]
     """
+    t_tr, u_tr, y_tr, t_ev, u_ev = train.t, train.u, train.y, evaluated.t, evaluated.u
     out: list[tuple[Effect, AugmentedFit | ScreenedFit, np.ndarray, np.ndarray]] = []
     weights = None if train_mask is None else train_mask.astype(float)
     if confirm is None:

@@ -14,6 +14,7 @@ from typing import Any
 
 import numpy as np
 
+from synth.data.record import Record
 from synth.errors import ModelError
 from synth.gap.attribution.candidates import joint_fit, map_jobs, seeded_grid
 from synth.gap.attribution.parsimony import share_of_excess
@@ -54,17 +55,19 @@ class ForwardSelection:
     >>> from synth.ident.simulate import simulate_plant
     >>> t = np.arange(0, 4, 0.01); u = np.where((t % 2) >= 1, 1.0, 0.0); G = Plant.from_string("2/(0.2*s+1)")
     >>> y = simulate_plant(G.with_delay(0.05), t, u)
-    >>> fs = ForwardSelection(G, t, u, y, t, u, None, None, lambda yh: np.array([np.sum((y - yh) ** 2)]),
+    >>> from synth.data import record_from_arrays
+    >>> rec = record_from_arrays(t, u, y)
+    >>> fs = ForwardSelection(G, rec, rec, None, None, lambda yh: np.array([np.sum((y - yh) ** 2)]),
     ...                       lambda a, b: (0.0, 0.0), 0.1, 0.25, 1e-6, t.size)
     >>> fs.next(make_effect("delay"), fit_augmented(G, t, u, y, make_effect("delay")), np.array([1.0]), []) is None
     True
     """
 
-    def __init__(self, plant: Plant, t_tr: np.ndarray, u_tr: np.ndarray, y_tr: np.ndarray, t_ev: np.ndarray,
-                 u_ev: np.ndarray, weights: np.ndarray | None, train_mask: np.ndarray | None, sums: Any,
-                 ratio_ci: Any, threshold: float, min_share: float, floor: float, n_held: int,
-                 workers: int = 1) -> None:
-        self.plant, self.t_tr, self.u_tr, self.y_tr, self.t_ev, self.u_ev = plant, t_tr, u_tr, y_tr, t_ev, u_ev
+    def __init__(self, plant: Plant, train: Record, evaluated: Record, weights: np.ndarray | None,
+                 train_mask: np.ndarray | None, sums: Any, ratio_ci: Any, threshold: float, min_share: float,
+                 floor: float, n_held: int, workers: int = 1) -> None:
+        self.plant, self.t_tr, self.u_tr, self.y_tr = plant, train.t, train.u, train.y
+        self.t_ev, self.u_ev = evaluated.t, evaluated.u
         self.weights, self.train_mask, self.sums, self.ratio_ci = weights, train_mask, sums, ratio_ci
         self.threshold, self.min_share, self.floor, self.n_held = threshold, min_share, floor, n_held
         self.workers = workers

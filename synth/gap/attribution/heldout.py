@@ -88,7 +88,7 @@ from synth.gap.attribution.candidates import candidate_fits, screened_coefficien
 from synth.gap.attribution.forward import ForwardSelection
 from synth.gap.attribution.parsimony import free_parameters, parsimonious_lead, share_of_excess
 from synth.gap.attribution.refit import AugmentedFit, fit_augmented
-from synth.gap.attribution.stitch import settle_time, stitch_runs
+from synth.gap.attribution.split import block_ids, split_heldout
 from synth.gap.attribution.verdict import (
     EffectDiagnosis,
     EffectResult,
@@ -102,11 +102,6 @@ from synth.ident.simulate import simulate_plant
 from synth.plant import Plant
 
 __all__ = ["DiagnoseOptions", "diagnose_effects"]
-
-
-def _block_ids(n_held: int, blocks: int) -> np.ndarray:
-    edges = np.linspace(0, n_held, blocks + 1).round().astype(int)
-    return np.repeat(np.arange(blocks), np.diff(edges))
 
 
 def _block_sums(e2: np.ndarray, ids: np.ndarray, blocks: int) -> np.ndarray:
@@ -275,58 +270,25 @@ def diagnose_effects(plant: Plant, record: Record, validate: Record | Sequence[R
         options.train_fraction, options.blocks, options.n_null, options.n_boot, options.alpha, options.relevance,
         options.min_share, options.seed, options.calibration, options.confirm, options.split, options.burn_in,
         options.max_effects, options.workers, options.heldout_offset)
-    runs: list[Record] | None = list(validate) if isinstance(validate, (list, tuple)) else None
-    if runs is not None and len(runs) < 2:
-        validate, runs = (runs[0] if runs else None), None
-    fit_offset = heldout_offset == "fit" or (heldout_offset == "auto" and validate is not None)
     effects = [make_effect(c) for c in options.candidates]
     labels = [e.label for e in effects]
     if len(set(labels)) != len(labels):
         raise ModelError(f"repeated candidates in {labels}", where="candidates")
     rng = np.random.default_rng(seed)
-    train_mask: np.ndarray | None = None
-    if validate is None and split == "tail":
-        k = round(train_fraction * record.n)
-        t_tr, u_tr, y_tr = record.t[:k], record.u[:k], record.y[:k]
-        t_ev, u_ev, y_ev = record.t, record.u, record.y
-        held = np.arange(record.n) >= k
-    elif validate is None:  # interleaved: odd segments held out, the fits count the even ones
-        t_tr, u_tr, y_tr = record.t, record.u, record.y
-        t_ev, u_ev, y_ev = record.t, record.u, record.y
-        held = _block_ids(record.n, 2 * blocks) % 2 == 1
-        train_mask = ~held
-    elif runs is None:
-        t_tr, u_tr, y_tr = record.t, record.u, record.y
-        t_ev, u_ev, y_ev = validate.t, validate.u, validate.y
-        held = np.ones(validate.n, bool)
-    else:
-        t_tr, u_tr, y_tr = record.t, record.u, record.y
-        joined = stitch_runs(runs, settle_time(plant))
-        t_ev, u_ev, y_ev = joined.t, joined.u, joined.y
-        held = joined.run >= 0
-    if burn_in > 0.0:
-        settled_tr = t_tr >= t_tr[0] + burn_in
-        train_mask = settled_tr if train_mask is None else train_mask & settled_tr
-        held = held & ((t_ev >= t_ev[0] + burn_in) if runs is None else (np.nan_to_num(joined.since_start,
-                                                                                         nan=-1.0) >= burn_in))
-        if int(train_mask.sum()) < 20:
-            raise ModelError(f"a burn-in of {burn_in:g} s leaves too few training samples", where="burn_in")
-    n_held = int(held.sum())
-    groups = None if runs is None else joined.run[held]  # the held-out run of each held-out sample
-    for r in range(1 if runs is None else len(runs)):
-        n_r = n_held if groups is None else int(np.sum(groups == r))
-        if n_r < 10 * blocks:
-            where = "record" if runs is None else f"validate run {r + 1}"
-            raise ModelError(f"{n_r} held-out samples are too few for {blocks} segments", where=where)
+    sp = split_heldout(plant, record, validate, split, train_fraction, blocks, burn_in)
+    fit_offset = heldout_offset == "fit" or (heldout_offset == "auto" and sp.validation)
+    t_tr, u_tr, y_tr = sp.train.t, sp.train.u, sp.train.y
+    t_ev, u_ev, y_ev = sp.evaluated.t, sp.evaluated.u, sp.evaluated.y
+    held, train_mask, groups, n_held = sp.held, sp.train_mask, sp.groups, sp.n_held
     if groups is None:
-        ids = _block_ids(n_held, blocks)
+        ids = block_ids(n_held, blocks)
         draws = rng.integers(0, blocks, size=(n_boot, blocks))
         n_blocks = blocks
     else:  # each run its own segments, resampled within the run
-        ids = np.concatenate([_block_ids(int(np.sum(groups == r)), blocks) + r * blocks for r in range(len(runs))])
+        ids = np.concatenate([block_ids(int(np.sum(groups == r)), blocks) + r * blocks for r in range(sp.runs)])
         draws = np.concatenate([rng.integers(0, blocks, size=(n_boot, blocks)) + r * blocks
-                                for r in range(len(runs))], axis=1)
-        n_blocks = blocks * len(runs)
+                                for r in range(sp.runs)], axis=1)
+        n_blocks = blocks * sp.runs
     counts = np.bincount(ids, minlength=n_blocks).astype(float)
     boot_n = counts[draws].sum(axis=1)
 
@@ -365,8 +327,7 @@ def diagnose_effects(plant: Plant, record: Record, validate: Record | Sequence[R
     y_ref = refit.predict(t_ev, u_ev)
     s_nom, s_ref = sums(y_nom), sums(y_ref)
     j_nom, j_ref = float(s_nom.sum() / n_held), float(s_ref.sum() / n_held)
-    settled = (t_ev >= t_ev[0] + burn_in) if runs is None else held
-    sigma = noise_sigma((y_ev - y_ref)[settled])  # every settled sample of the evaluated record (same white noise)
+    sigma = noise_sigma((y_ev - y_ref)[sp.settled])  # every settled sample of the evaluated record (same white noise)
     floor = sigma**2
     pm_shrink = 1.0 - j_ref / j_nom if j_nom > 0 else 0.0
     pm_ci = ratio_ci(s_ref, s_nom)
@@ -377,14 +338,14 @@ def diagnose_effects(plant: Plant, record: Record, validate: Record | Sequence[R
 
     # calibration: parametric bootstrap of the re-fit
     if calibration == "linearized":
-        null = linearized_null(refit, t_tr, u_tr, t_ev, u_ev, held, validate is None, sigma, n_null, rng,
+        null = linearized_null(refit, t_tr, u_tr, t_ev, u_ev, held, not sp.validation, sigma, n_null, rng,
                                 train_mask, fit_offset, groups)
     else:
-        null = refit_null(refit, t_tr, u_tr, t_ev, u_ev, held, validate is None, sigma, n_null, rng, train_mask,
+        null = refit_null(refit, t_tr, u_tr, t_ev, u_ev, held, not sp.validation, sigma, n_null, rng, train_mask,
                            fit_offset, groups)
     threshold = float(np.quantile(null, 1.0 - alpha, method="higher"))
 
-    fits = candidate_fits(plant, effects, refit, t_tr, u_tr, y_tr, t_ev, u_ev, confirm, train_mask, workers)
+    fits = candidate_fits(plant, effects, refit, sp.train, sp.evaluated, confirm, train_mask, workers)
 
     by_label = {eff.label: (eff, fit) for eff, fit, _, _ in fits}
     results: list[tuple[EffectResult, np.ndarray, np.ndarray]] = []
@@ -441,7 +402,7 @@ def diagnose_effects(plant: Plant, record: Record, validate: Record | Sequence[R
         if len(group) > 1:
             indist.append(group)
         results = [(r if r.effect == best.effect else replace(r, accepted=False), y, s) for r, y, s in results]
-        chain = ForwardSelection(plant, t_tr, u_tr, y_tr, t_ev, u_ev, weights, train_mask, sums, ratio_ci, threshold,
+        chain = ForwardSelection(plant, sp.train, sp.evaluated, weights, train_mask, sums, ratio_ci, threshold,
                                  min_share, floor, n_held, workers)
         eff_best, fit_best = by_label[best.effect]
         tried = {best.effect, *group}
@@ -467,12 +428,11 @@ def diagnose_effects(plant: Plant, record: Record, validate: Record | Sequence[R
                "status": status, "headline": headline(status, verdict_effects, indist, results, pm_shrink, j_nom, floor),
                "parsimony": parsimony}
     n_train = int(t_tr.size if train_mask is None else train_mask.sum())
-    mode = split if validate is None else "validation"
     split = {"train_samples": n_train, "heldout_samples": n_held, "blocks": blocks, "n_null": n_null,
-             "n_boot": n_boot, "alpha": alpha, "validation_record": validate is not None, "seed": seed,
-             "calibration": calibration, "confirm": confirm, "split": mode,
+             "n_boot": n_boot, "alpha": alpha, "validation_record": sp.validation, "seed": seed,
+             "calibration": calibration, "confirm": confirm, "split": sp.mode,
              "burn_in": burn_in, "heldout_offset": "fit" if fit_offset else "carry",
-             "validation_runs": 1 if runs is None else len(runs),
+             "validation_runs": sp.runs,
              "joint_fits": [r.effect for r, _, _ in results if r.fit == "joint"]}
     return EffectDiagnosis([r for r, _, _ in results], verdict, floor, j_nom, j_ref, pm_shrink, pm_ci, threshold,
                            refit, split, t_ev, y_ev, shifted(y_nom), shifted(y_ref), shifted(y_best), held, segments)
