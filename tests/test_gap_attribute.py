@@ -7,7 +7,7 @@ import pytest
 
 from synth.data import record_from_arrays
 from synth.errors import ModelError
-from synth.gap.attribute import diagnose_effects
+from synth.gap.attribution.heldout import DiagnoseOptions, diagnose_effects
 from synth.gap.effects import make_effect
 from synth.plant import Plant
 
@@ -33,7 +33,7 @@ def _true_shrinkage(dg, rec, clean: np.ndarray) -> float:
 
 def test_rate_limit_is_found_with_its_rate_and_shrinkage():
     rec, clean = _record("rate_limit", {"rate": 300.0})
-    dg = diagnose_effects(NOMINAL, rec, candidates=["rate_limit", "delay"], n_null=9)
+    dg = diagnose_effects(NOMINAL, rec, options=DiagnoseOptions(candidates=["rate_limit", "delay"], n_null=9))
     assert dg.verdict["effects"] == ["rate_limit"]
     best = dg.effects[0]
     assert best.effect == "rate_limit" and best.accepted
@@ -52,7 +52,7 @@ def test_rate_limit_is_found_with_its_rate_and_shrinkage():
 
 def test_saturation_is_found_with_its_limit():
     rec, clean = _record("saturation", {"upper": 215.0})
-    dg = diagnose_effects(NOMINAL, rec, candidates=["saturation", "rate_limit"], n_null=9)
+    dg = diagnose_effects(NOMINAL, rec, options=DiagnoseOptions(candidates=["saturation", "rate_limit"], n_null=9))
     assert dg.verdict["effects"] == ["saturation"]
     best = dg.effects[0]
     assert best.parameters["upper"] == pytest.approx(215.0, abs=1.0)
@@ -62,7 +62,7 @@ def test_saturation_is_found_with_its_limit():
 
 def test_extra_delay_is_found_or_grouped_with_a_lag():
     rec, clean = _record("delay", {"delay": 0.03})
-    dg = diagnose_effects(NOMINAL, rec, candidates=["delay", "lag"], n_null=9)
+    dg = diagnose_effects(NOMINAL, rec, options=DiagnoseOptions(candidates=["delay", "lag"], n_null=9))
     assert dg.verdict["effects"] == ["delay"]
     best = dg.effects[0]
     assert best.parameters["delay"] == pytest.approx(0.03, abs=0.003)
@@ -73,7 +73,7 @@ def test_extra_delay_is_found_or_grouped_with_a_lag():
 
 def test_pure_parameter_mismatch():
     rec, _ = _record(None, {})
-    dg = diagnose_effects(NOMINAL, rec, candidates=["delay", "rate_limit"], n_null=9)
+    dg = diagnose_effects(NOMINAL, rec, options=DiagnoseOptions(candidates=["delay", "rate_limit"], n_null=9))
     assert dg.verdict["effects"] == ["parameter_mismatch"]
     assert dg.verdict["status"] == "parameter_mismatch"
     assert dg.refit_shrinkage_ci[0] > 0.2
@@ -83,7 +83,7 @@ def test_pure_parameter_mismatch():
 
 def test_noise_only_is_no_gap():
     rec, _ = _record(None, {}, seed=3)
-    dg = diagnose_effects(TRUE, rec, candidates=["delay", "rate_limit"], n_null=9)
+    dg = diagnose_effects(TRUE, rec, options=DiagnoseOptions(candidates=["delay", "rate_limit"], n_null=9))
     assert dg.verdict["effects"] == [] and dg.verdict["status"] == "none"
     assert np.sqrt(dg.noise_floor) == pytest.approx(NOISE, rel=0.15)
 
@@ -91,6 +91,6 @@ def test_noise_only_is_no_gap():
 def test_bad_options_raise():
     rec, _ = _record(None, {})
     with pytest.raises(ModelError, match="train_fraction"):
-        diagnose_effects(NOMINAL, rec, train_fraction=0.95)
+        diagnose_effects(NOMINAL, rec, options=DiagnoseOptions(train_fraction=0.95))
     with pytest.raises(ModelError, match="unknown effect"):
-        diagnose_effects(NOMINAL, rec, candidates=["gremlins"])
+        diagnose_effects(NOMINAL, rec, options=DiagnoseOptions(candidates=["gremlins"]))

@@ -6,10 +6,11 @@ import numpy as np
 import pytest
 
 from synth.data import record_from_arrays
-from synth.gap.attribute import DEFAULT_CANDIDATES, _linearized_null, _refit_null, diagnose_effects
-from synth.gap.effects import make_effect
-from synth.gap.refit import fit_augmented
-from synth.gap.screen import screen_effect
+from synth.gap.attribution.calibration import linearized_null, refit_null
+from synth.gap.attribution.heldout import DiagnoseOptions, diagnose_effects
+from synth.gap.attribution.refit import fit_augmented
+from synth.gap.attribution.screen import screen_effect
+from synth.gap.effects import DEFAULT_CANDIDATES, make_effect
 
 TRUE_TF = "23*(s+0.43)/((s+9.6)*(s+0.54))"
 NOMINAL_TF = "22*(s+0.45)/((s+9.3)*(s+0.56))"
@@ -51,8 +52,8 @@ def test_screen_ranks_the_true_effect_first_and_recovers_its_parameter():
 def test_confirming_one_candidate_gives_the_full_joint_answer():
     rec, clean = _record("saturation", {"upper": 215.0})
     _, nominal = _plants()
-    fast = diagnose_effects(nominal, rec, confirm=1, n_null=49)
-    full = diagnose_effects(nominal, rec, candidates=["saturation"], confirm=None, n_null=49)
+    fast = diagnose_effects(nominal, rec, options=DiagnoseOptions(confirm=1, n_null=49))
+    full = diagnose_effects(nominal, rec, options=DiagnoseOptions(candidates=["saturation"], confirm=None, n_null=49))
     assert fast.verdict["effects"] == full.verdict["effects"] == ["saturation"]
     a = next(e for e in fast.effects if e.effect == "saturation")
     b = full.effects[0]
@@ -74,8 +75,8 @@ def test_linearized_calibration_matches_the_repeated_refit():
     held = np.arange(rec.n) >= k
     refit = fit_augmented(nominal, rec.t[:k], rec.u[:k], rec.y[:k])
     args = (refit, rec.t[:k], rec.u[:k], rec.t, rec.u, held, True, 1.0)
-    lin = _linearized_null(*args, 400, np.random.default_rng(0))
-    ref = _refit_null(*args, 40, np.random.default_rng(1))
+    lin = linearized_null(*args, 400, np.random.default_rng(0))
+    ref = refit_null(*args, 40, np.random.default_rng(1))
     # a perfect model beats an estimated one by about p / N on held-out data (p = 5 coefficients here)
     assert np.mean(lin) == pytest.approx(np.mean(ref), abs=0.004)
     assert 0.0 < np.mean(lin) < 0.02
@@ -86,7 +87,7 @@ def test_validation_record_is_the_held_out_data():
     rec, _ = _record("rate_limit", {"rate": 300.0}, seed=2)
     val, clean = _record("rate_limit", {"rate": 300.0}, seed=3, u=np.roll(U, 300))
     _, nominal = _plants()
-    dg = diagnose_effects(nominal, rec, validate=val, candidates=["rate_limit", "delay", "lag"])
+    dg = diagnose_effects(nominal, rec, validate=val, options=DiagnoseOptions(candidates=["rate_limit", "delay", "lag"]))
     assert dg.verdict["effects"] == ["rate_limit"]
     assert dg.heldout.all() and dg.split["heldout_samples"] == val.n and dg.split["train_samples"] == rec.n
     best = dg.effects[0]
@@ -115,14 +116,14 @@ def test_bad_new_options_raise():
     rec, _ = _record(None, {})
     _, nominal = _plants()
     with pytest.raises(ModelError, match="calibration"):
-        diagnose_effects(nominal, rec, calibration="exact")
+        diagnose_effects(nominal, rec, options=DiagnoseOptions(calibration="exact"))
     with pytest.raises(ModelError, match="confirm"):
-        diagnose_effects(nominal, rec, confirm=0)
+        diagnose_effects(nominal, rec, options=DiagnoseOptions(confirm=0))
 
 
 def test_unstable_refit_is_ruled_out_for_a_stable_nominal():
     """The re-fit of a stable nominal keeps its denominator coefficients >= 0 (stable for second order)."""
-    from synth.gap.refit import _stable_bounds
+    from synth.gap.attribution.refit import _stable_bounds
     from synth.plant import Plant
 
     _, nominal = _plants()
@@ -140,7 +141,7 @@ def test_interleaved_split_holds_out_segments_of_the_one_transient():
     clean = make_effect("rate_limit").apply(true, T, u, {"rate": 150.0})
     rec = record_from_arrays(T, u, clean + np.random.default_rng(4).normal(size=T.size))
     kw = dict(candidates=["rate_limit", "lag", "delay"], n_null=49)
-    inter = diagnose_effects(nominal, rec, split="interleaved", **kw)
+    inter = diagnose_effects(nominal, rec, options=DiagnoseOptions(split="interleaved", **kw))
     assert inter.heldout[(T >= 2.0) & (T < 3.0)].any() and inter.heldout[(T >= 9.0) & (T < 10.0)].any()
     assert inter.split["split"] == "interleaved" and inter.effects[0].effect == "rate_limit"
     best = inter.effects[0]
@@ -156,14 +157,14 @@ def test_burn_in_hides_an_unknown_initial_state():
     start = 40.0 * np.exp(-T / 0.5)  # the plant settling from a different initial state (fast mode)
     clean = make_effect("delay").apply(true, T, U, {"delay": 0.06}) + start
     rec = record_from_arrays(T, U, clean + np.random.default_rng(5).normal(size=T.size))
-    dg = diagnose_effects(nominal, rec, candidates=["delay", "drift"], n_null=49, burn_in=3.0)
+    dg = diagnose_effects(nominal, rec, options=DiagnoseOptions(candidates=["delay", "drift"], n_null=49, burn_in=3.0))
     assert dg.verdict["effects"] == ["delay"] and dg.split["burn_in"] == 3.0
     assert dg.effects[0].parameters["delay"] == pytest.approx(0.06, abs=0.01)
     assert not dg.heldout[T < 3.0].any()
     with pytest.raises(Exception, match="burn_in"):
-        diagnose_effects(nominal, rec, burn_in=-1.0)
+        diagnose_effects(nominal, rec, options=DiagnoseOptions(burn_in=-1.0))
     with pytest.raises(Exception, match="split"):
-        diagnose_effects(nominal, rec, split="random")
+        diagnose_effects(nominal, rec, options=DiagnoseOptions(split="random"))
 
 
 def test_dead_zone_at_the_bottom_level_is_not_separable_from_a_lower_limit():
@@ -171,7 +172,8 @@ def test_dead_zone_at_the_bottom_level_is_not_separable_from_a_lower_limit():
     a one-sided limit predicts the same held-out output to a small fraction of the noise; the verdict says so."""
     rec, _ = _record("deadzone", {"width": 6.0, "center": 175.0})
     _, nominal = _plants()
-    dg = diagnose_effects(nominal, rec, candidates=["deadzone", "saturation", "rate_limit"], n_null=49)
+    dg = diagnose_effects(nominal, rec,
+                          options=DiagnoseOptions(candidates=["deadzone", "saturation", "rate_limit"], n_null=49))
     group = dg.verdict["indistinguishable"]
     assert dg.verdict["effects"][0] in ("deadzone", "saturation")
     assert group and set(group[0]) == {"deadzone", "saturation"}
@@ -183,14 +185,14 @@ def test_dead_zone_at_the_bottom_level_is_not_separable_from_a_lower_limit():
 def test_forward_selection_names_a_second_effect_on_top_of_the_first():
     """Rate limit and a slow drift together: the verdict names both, the larger first, each shrinking the held-out
     error of the model before it; with max_effects=1 only the first."""
-    from synth.gap.composite import NestedEffect
+    from synth.gap.attribution.composite import NestedEffect
 
     true, nominal = _plants()
     both = NestedEffect("rate_limit", {"rate": 150.0}, "drift")
     clean = both.apply(true, T, U, {"slope": 0.3})
     rec = record_from_arrays(T, U, clean + np.random.default_rng(6).normal(size=T.size))
     kw = dict(candidates=["rate_limit", "lag", "drift", "delay"], n_null=49)
-    dg = diagnose_effects(nominal, rec, **kw)
+    dg = diagnose_effects(nominal, rec, options=DiagnoseOptions(**kw))
     assert dg.verdict["effects"] == ["rate_limit", "drift"] and dg.verdict["status"] == "effect"
     second = next(e for e in dg.effects if e.effect == "rate_limit+drift")
     # the first effect stays at its stage-1 fit (made without the drift): the slope trades with the slow pole
@@ -199,7 +201,7 @@ def test_forward_selection_names_a_second_effect_on_top_of_the_first():
     true_j = np.mean((rec.y - clean)[dg.heldout] ** 2)
     first = next(e for e in dg.effects if e.effect == "rate_limit")
     assert second.j_heldout - true_j < 0.5 * (first.j_heldout - true_j)  # most of what the first left is gone
-    one = diagnose_effects(nominal, rec, max_effects=1, **kw)
+    one = diagnose_effects(nominal, rec, options=DiagnoseOptions(max_effects=1, **kw))
     assert one.verdict["effects"] == ["rate_limit"]
     assert not any("+" in e.effect for e in one.effects)
 
@@ -208,8 +210,8 @@ def test_two_worker_processes_give_the_same_diagnosis():
     rec, _ = _record("rate_limit", {"rate": 300.0}, seed=7)
     _, nominal = _plants()
     kw = dict(candidates=["rate_limit", "lag", "delay"], confirm=2, n_null=19)
-    one = diagnose_effects(nominal, rec, **kw)
-    two = diagnose_effects(nominal, rec, workers=2, **kw)
+    one = diagnose_effects(nominal, rec, options=DiagnoseOptions(**kw))
+    two = diagnose_effects(nominal, rec, options=DiagnoseOptions(workers=2, **kw))
     assert one.verdict == two.verdict
     for a, b in zip(one.effects, two.effects):
         assert (a.effect, a.fit) == (b.effect, b.fit)
@@ -219,7 +221,7 @@ def test_two_worker_processes_give_the_same_diagnosis():
 def test_screen_moves_the_denominator_one_gauss_newton_step():
     """With the denominator 10 % off and no effect at all, the screen's step in it takes the SSR down to the
     noise, and the reported denominator moves toward the truth; held fixed it could not."""
-    from synth.gap import screen as screen_module
+    from synth.gap.attribution import screen as screen_module
     from synth.plant import Plant
 
     true, _ = _plants()

@@ -5,11 +5,12 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-import synth.gap.attribute as attribute
+import synth.gap.attribution.heldout as heldout
 from synth.data import record_from_arrays
-from synth.gap.attribute import _free_parameters, _parsimonious_lead, _share_of_excess, diagnose_effects
+from synth.gap.attribution.heldout import DiagnoseOptions, diagnose_effects
+from synth.gap.attribution.parsimony import free_parameters, parsimonious_lead, share_of_excess
+from synth.gap.attribution.screen import screen_effect
 from synth.gap.effects import make_effect
-from synth.gap.screen import screen_effect
 from synth.ident.simulate import simulate_plant
 from synth.plant import Plant
 
@@ -45,7 +46,7 @@ def _by_label(dg):
     ("drift", {"slope": 0.5}, 1),
 ])
 def test_free_parameters_count_what_the_fit_chose(effect, params, count):
-    assert _free_parameters(make_effect(effect), params) == count
+    assert free_parameters(make_effect(effect), params) == count
 
 
 def test_parsimonious_lead_needs_a_significant_advantage_against_each_simpler_candidate():
@@ -56,21 +57,21 @@ def test_parsimonious_lead_needs_a_significant_advantage_against_each_simpler_ca
     three = ("three", np.array([100.0]))
     two = ("two", np.array([101.0]))  # the best is 1 % better: not above a threshold of 0.02
     one = ("one", np.array([110.0]))  # 9 % better: significant
-    lead, info = _parsimonious_lead([three, two, one], [3, 2, 1], ci, 0.02)
+    lead, info = parsimonious_lead([three, two, one], [3, 2, 1], ci, 0.02)
     assert lead == 1 and info["lead"] == "two" and info["best"] == "three"
     assert info["advantage_ci"] == pytest.approx([0.0, 0.02], abs=1e-2)
     # a simpler candidate that the best beats significantly never leads; an equal count never moves the lead
-    assert _parsimonious_lead([three, one], [3, 1], ci, 0.02) == (0, None)
-    assert _parsimonious_lead([three, two], [2, 2], ci, 0.02) == (0, None)
+    assert parsimonious_lead([three, one], [3, 1], ci, 0.02) == (0, None)
+    assert parsimonious_lead([three, two], [2, 2], ci, 0.02) == (0, None)
     # among candidates the best does not beat, the fewest parameters lead, whatever their order in J
-    lead, _ = _parsimonious_lead([three, two, ("one", np.array([100.5]))], [3, 2, 1], ci, 0.02)
+    lead, _ = parsimonious_lead([three, two, ("one", np.array([100.5]))], [3, 2, 1], ci, 0.02)
     assert lead == 2
 
 
 # ------------------------------------------------------------------------------------------------ end to end
 def test_a_true_lag_leads_a_resonance_that_is_better_on_held_out_data_but_not_significantly():
-    dg = diagnose_effects(NOMINAL, _record("lag", {"tau": 0.0144}, seed=3), candidates=["lag", "resonance"],
-                          confirm=None, max_effects=1)
+    dg = diagnose_effects(NOMINAL, _record("lag", {"tau": 0.0144}, seed=3),
+                          options=DiagnoseOptions(candidates=["lag", "resonance"], confirm=None, max_effects=1))
     res = _by_label(dg)
     # the premise: the two-parameter resonance has the lower held-out J (it led before the rule)
     assert res["resonance"].j_heldout < res["lag"].j_heldout
@@ -86,7 +87,7 @@ def test_a_true_lag_leads_a_resonance_that_is_better_on_held_out_data_but_not_si
 
 def test_a_lightly_damped_resonance_is_still_named_resonance():
     dg = diagnose_effects(NOMINAL, _record("resonance", {"wn": 60.0, "zeta": 0.15}, seed=0),
-                          candidates=["lag", "delay", "resonance"], confirm=None, max_effects=1)
+                          options=DiagnoseOptions(candidates=["lag", "delay", "resonance"], confirm=None, max_effects=1))
     res = _by_label(dg)
     assert res["delay"].significant and res["lag"].significant  # simpler contenders were there
     assert dg.verdict["effects"] == ["resonance"]
@@ -97,17 +98,17 @@ def test_a_lightly_damped_resonance_is_still_named_resonance():
 
 # ------------------------------------------------------------------------------ relevance against the floor
 def test_share_of_excess_takes_the_floor_as_at_most_the_judged_models_error():
-    assert _share_of_excess(2.0, 1.5, 1.0) == pytest.approx(0.5)  # the floor below both: unchanged
-    assert _share_of_excess(0.95, 0.85, 1.0) == 1.0  # below the floor's estimate: all that can be measured
-    assert _share_of_excess(0.95, 0.97, 1.0) == 0.0  # no better than the model before: nothing removed
-    assert _share_of_excess(1.0, 1.0, 1.0) == 0.0
+    assert share_of_excess(2.0, 1.5, 1.0) == pytest.approx(0.5)  # the floor below both: unchanged
+    assert share_of_excess(0.95, 0.85, 1.0) == 1.0  # below the floor's estimate: all that can be measured
+    assert share_of_excess(0.95, 0.97, 1.0) == 0.0  # no better than the model before: nothing removed
+    assert share_of_excess(1.0, 1.0, 1.0) == 0.0
 
 
 def test_an_effect_that_beats_an_overestimated_noise_floor_is_relevant(monkeypatch):
     rec = _record("lag", {"tau": 0.0144}, seed=3)
     # a floor estimate 20 % (in sigma) above the re-fit's error: the re-fit alone looks within the noise
-    monkeypatch.setattr(attribute, "_noise_sigma", lambda e: 1.2 * float(np.sqrt(np.mean(np.square(e)))))
-    dg = diagnose_effects(NOMINAL, rec, candidates=["lag"], confirm=None, max_effects=1)
+    monkeypatch.setattr(heldout, "noise_sigma", lambda e: 1.2 * float(np.sqrt(np.mean(np.square(e)))))
+    dg = diagnose_effects(NOMINAL, rec, options=DiagnoseOptions(candidates=["lag"], confirm=None, max_effects=1))
     lag = dg.effects[0]
     assert dg.j_refit < dg.noise_floor  # the premise: no excess over this floor by its estimate
     assert lag.significant and lag.j_heldout < dg.j_refit

@@ -1,4 +1,4 @@
-"""Clipping seen directly in a record (synth.gap.clipping) and how the diagnosis reports it."""
+"""Clipping seen directly in a record (synth.gap.where.clipping) and how the diagnosis reports it."""
 
 from __future__ import annotations
 
@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 
 from synth.data import record_from_arrays
-from synth.gap.clipping import find_clipping, record_clipping
 from synth.gap.diagnose import diagnose
+from synth.gap.where.clipping import find_clipping, record_clipping
 from synth.ident.simulate import simulate_plant
 from synth.plant import Plant
 

@@ -1,4 +1,5 @@
-"""Two effects in series (synth.gap.composite): the chain, the factor, the joint re-fit of the second on top of the first."""
+"""Two effects in series (synth.gap.attribution.composite): the chain, the factor, the joint re-fit of the second on top
+of the first."""
 
 from __future__ import annotations
 
@@ -6,10 +7,10 @@ import numpy as np
 import pytest
 
 from synth.errors import ModelError
-from synth.gap.composite import NestedEffect, numeric_factor
+from synth.gap.attribution.composite import NestedEffect, numeric_factor
+from synth.gap.attribution.refit import fit_augmented
+from synth.gap.attribution.screen import screen_effect
 from synth.gap.effects import Effect, Params, coulomb_force, make_effect
-from synth.gap.refit import fit_augmented
-from synth.gap.screen import screen_effect
 from synth.ident.simulate import simulate_plant
 from synth.ident.structure import parse_structure
 from synth.plant import Plant

@@ -119,3 +119,28 @@ def test_candidates_validated():
         check_candidates(["delay", "delay"])
     with pytest.raises(ModelError, match="at least one"):
         check_candidates([])
+
+
+def test_diagnose_takes_arrays_columns_and_records_alike():
+    """What users hold: (t, u, y) arrays, a mapping of columns or a Record, for the data and the validation data."""
+    t = np.arange(0, 8, 0.01)
+    u = np.where((t % 2) >= 1, 1.0, 0.0)
+    G = Plant.from_string("2/(0.2*s+1)")
+    rng = np.random.default_rng(3)
+    y = simulate_plant(G.with_delay(0.05), t, u) + 0.005 * rng.normal(size=t.size)
+    y_val = simulate_plant(G.with_delay(0.05), t, u) + 0.005 * rng.normal(size=t.size)
+    kw = {"candidates": ["delay", "lag"], "n_null": 3}
+    by_record = diagnose(G, record_from_arrays(t, u, y), record_from_arrays(t, u, y_val), **kw)
+    by_arrays = diagnose(G, (t, u, y), (t, u, y_val), **kw)
+    by_columns = diagnose(G, {"time": t, "input": u, "output": y}, np.column_stack([t, u, y_val]), **kw)
+    assert by_record.verdict["effects"] == ["delay"]
+    for other in (by_arrays, by_columns):
+        assert other.verdict == by_record.verdict
+        assert other.attribution.effects[0].parameters == by_record.attribution.effects[0].parameters
+    runs = diagnose(G, (t, u, y), [(t, u, y_val), record_from_arrays(t, u, y_val)], **kw)
+    assert isinstance(runs.validate, tuple) and len(runs.validate) == 2
+
+
+def test_diagnose_names_a_form_that_is_not_a_record():
+    with pytest.raises(DataError, match="not a record"):
+        diagnose(Plant.from_string("2/(0.2*s+1)"), 42, candidates=["delay"])

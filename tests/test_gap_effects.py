@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 from synth.errors import ModelError
+from synth.gap.attribution.refit import fit_augmented, nominal_structure
 from synth.gap.effects import EFFECTS, make_effect
-from synth.gap.refit import fit_augmented, nominal_structure
 from synth.ident.simulate import simulate_plant
 from synth.plant import Plant
 from synth.sim.blocks import RateLimit

@@ -6,10 +6,10 @@ import numpy as np
 import pytest
 
 from synth.data import record_from_arrays
-from synth.gap.attribute import diagnose_effects
+from synth.gap.attribution.heldout import DiagnoseOptions, diagnose_effects
+from synth.gap.attribution.refit import fit_augmented
 from synth.gap.effects import QuantizationEffect, ResonanceEffect
-from synth.gap.refit import fit_augmented
-from synth.gap.screen import quantizer_grid
+from synth.gap.effects.quantization import quantizer_grid
 from synth.ident.simulate import simulate_plant
 from synth.plant import Plant
 from synth.sim.blocks import Quantizer
@@ -57,7 +57,7 @@ def test_joint_refit_from_the_mismatched_nominal_finds_the_step():
 
 def test_noisy_record_is_diagnosed_as_quantization_with_the_step_within_5_percent():
     rec = _record(noise=0.01)
-    dg = diagnose_effects(G_OFF, rec, n_null=49)
+    dg = diagnose_effects(G_OFF, rec, options=DiagnoseOptions(n_null=49))
     assert dg.verdict["effects"][:1] == ["quantization"], dg.verdict
     q = next(e for e in dg.effects if e.effect == "quantization")
     assert q.accepted and q.fit == "joint"
@@ -66,7 +66,8 @@ def test_noisy_record_is_diagnosed_as_quantization_with_the_step_within_5_percen
 
 def test_effect_free_record_does_not_name_quantization():
     y = simulate_plant(G, T, U) + 0.01 * np.random.default_rng(1).standard_normal(T.size)
-    dg = diagnose_effects(G_OFF, record_from_arrays(T, U, y), candidates=["quantization"], n_null=49)
+    dg = diagnose_effects(G_OFF, record_from_arrays(T, U, y),
+                          options=DiagnoseOptions(candidates=["quantization"], n_null=49))
     assert "quantization" not in dg.verdict["effects"]
 
 

@@ -8,11 +8,11 @@ from scipy.signal import lfilter
 
 from synth.data import record_from_arrays
 from synth.errors import DataError
-from synth.gap.coherence import input_residual_coherence
-from synth.gap.error_model import fit_error_model
-from synth.gap.residual import model_residual
-from synth.gap.where_frequency import localize_frequency
-from synth.gap.xcorr import prewhitened_xcorr
+from synth.gap.where.coherence import input_residual_coherence
+from synth.gap.where.error_model import fit_error_model
+from synth.gap.where.frequency import localize_frequency
+from synth.gap.where.residual import model_residual
+from synth.gap.where.xcorr import prewhitened_xcorr
 from synth.ident.simulate import simulate_plant
 from synth.plant import Plant
 

@@ -30,13 +30,13 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from synth.gap.attribute import diagnose_effects
+from synth.gap.attribution.heldout import DiagnoseOptions, diagnose_effects
+from synth.gap.attribution.roundrobin import diagnose_runs
 from synth.gap.diagnose import diagnose
-from synth.gap.realdata import EMPS_DRIVE_GAIN, dcmotor_controller_output, dcmotor_record, emps_record, tanks_record
-from synth.gap.roundrobin import diagnose_runs
 from synth.ident.timefit import fit_structure, identify
 from synth.plant import Plant
 from tests.conftest import shared_path
+from tests.gap_realdata_helpers import EMPS_DRIVE_GAIN, dcmotor_controller_output, dcmotor_record, emps_record, tanks_record
 
 DC = ("data", "dcmotor_speed_lab")
 AUTHORS_NO_LOAD = Plant.from_string("245.5/(0.1468*s+1)^2", delay=0.035)  # rpm/V, 09/pid_kuhn.tex
@@ -46,7 +46,7 @@ def test_emps_linear_model_leaves_coulomb_friction():
     rec = emps_record(shared_path("data", "emps_friction_drive", "DATA_EMPS.mat"))
     fit = identify(rec, "b/(s+a)", delay=0.0).fit
     nominal = Plant.from_string(f"{fit.parameters['b']!r}/(s+{fit.parameters['a']!r})")
-    dg = diagnose_effects(nominal, rec, candidates=["friction", "deadzone", "saturation", "drift"])
+    dg = diagnose_effects(nominal, rec, options=DiagnoseOptions(candidates=["friction", "deadzone", "saturation", "drift"]))
     assert dg.verdict["effects"] == ["friction"] and dg.verdict["status"] == "effect"
     best = dg.effects[0]
     assert best.effect == "friction" and best.shrinkage_ci[0] > 0.5
@@ -61,8 +61,9 @@ def test_emps_linear_model_leaves_coulomb_friction():
 
 def test_dcmotor_brake_is_a_gain_change_against_the_no_load_model():
     rec = dcmotor_record(shared_path(*DC, "06_dc_step_5_15_05.mat"))
-    dg = diagnose_effects(AUTHORS_NO_LOAD, rec, n_null=19,
-                          candidates=["delay", "lag", "saturation", "deadzone", "static_nonlinearity", "drift"])
+    dg = diagnose_effects(AUTHORS_NO_LOAD, rec,
+                          options=DiagnoseOptions(n_null=19, candidates=["delay", "lag", "saturation", "deadzone",
+                                                                         "static_nonlinearity", "drift"]))
     assert dg.verdict["effects"] == ["parameter_mismatch"]
     assert not any(e.accepted for e in dg.effects)
     assert dg.refit_shrinkage_ci[0] > 0.9

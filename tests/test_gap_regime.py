@@ -10,10 +10,10 @@ from scipy.signal import lfilter
 
 from synth.data import load_record, record_from_arrays
 from synth.errors import DataError
-from synth.gap.gapmap import write_gap_map
-from synth.gap.localize import localize_gap
-from synth.gap.residual import model_residual
-from synth.gap.where_regime import localize_regime
+from synth.gap.where.gapmap import write_gap_map
+from synth.gap.where.localize import localize_gap
+from synth.gap.where.regime import localize_regime
+from synth.gap.where.residual import model_residual
 from synth.ident.simulate import simulate_plant
 from synth.plant import Plant
 from tests.conftest import shared_path

@@ -10,9 +10,9 @@ import pytest
 from synth.data import record_from_arrays
 from synth.data.record import Signal
 from synth.errors import DataError, ModelError
-from synth.gap.attribute import diagnose_effects
-from synth.gap.roundrobin import diagnose_runs
-from synth.gap.stitch import settle_time, stitch_runs
+from synth.gap.attribution.heldout import DiagnoseOptions, diagnose_effects
+from synth.gap.attribution.roundrobin import diagnose_runs
+from synth.gap.attribution.stitch import settle_time, stitch_runs
 from synth.ident.simulate import simulate_plant
 from synth.plant import Plant
 
@@ -59,7 +59,7 @@ def test_runs_that_cannot_be_joined_are_refused():
 def test_several_validation_runs_each_keep_their_own_offset():
     train = _run(0.0, 1.0, 0.0, 1)
     runs = [_run(1.0, 2.0, 0.3, 2), _run(2.0, 0.5, -0.2, 3)]  # other operating points and sensor zeros
-    dg = diagnose_effects(G, train, runs, candidates=["delay", "lag"], n_null=19)
+    dg = diagnose_effects(G, train, runs, options=DiagnoseOptions(candidates=["delay", "lag"], n_null=19))
     assert dg.verdict["effects"] == ["delay"] and dg.split["validation_runs"] == 2
     assert dg.effects[0].parameters["delay"] == pytest.approx(0.05, abs=0.003)
     # independent: each run simulated alone, its own offset removed, the squared errors pooled
@@ -70,7 +70,7 @@ def test_several_validation_runs_each_keep_their_own_offset():
     assert dg.j_refit == pytest.approx(float(np.mean(np.concatenate(sq))), rel=1e-6)
     assert dg.segments.counts.size == 20 and dg.segments.runs.tolist() == [0] * 10 + [1] * 10
     # one offset for both runs would leave (0.3 - (-0.2))^2 / 4 of error in every model
-    one = diagnose_effects(G, train, runs, candidates=["delay"], n_null=5, heldout_offset="carry")
+    one = diagnose_effects(G, train, runs, options=DiagnoseOptions(candidates=["delay"], n_null=5, heldout_offset="carry"))
     assert one.j_refit > dg.j_refit + 0.05
 
 

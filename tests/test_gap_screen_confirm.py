@@ -6,10 +6,11 @@ import numpy as np
 import pytest
 
 from synth.data import record_from_arrays
-from synth.gap.attribute import _confirmed, diagnose_effects
+from synth.gap.attribution.candidates import confirmed_candidates
+from synth.gap.attribution.heldout import DiagnoseOptions, diagnose_effects
+from synth.gap.attribution.refit import fit_augmented
+from synth.gap.attribution.screen import screen_effect
 from synth.gap.effects import make_effect
-from synth.gap.refit import fit_augmented
-from synth.gap.screen import screen_effect
 from synth.plant import Plant
 
 # a DC-motor drive (two poles near 6.8 rad/s), its nominal model a few % off, and an extra lag of 0.136 s (close to
@@ -38,9 +39,9 @@ def test_the_held_denominator_ranking_is_confirmed_when_the_step_ranking_misses_
         return (None, s)
 
     ranked = [sc(1.0, 50.0), sc(1.0, 40.0), sc(1.0, 45.0), sc(1.0, 1.1), sc(2.0, np.inf)]
-    assert _confirmed(ranked, 3) == [0, 1, 2, 3]
-    assert _confirmed(ranked[:3], 3) == [0, 1, 2]  # already among the first: nothing added
-    assert _confirmed([sc(1.0, np.inf)], 3) == [0]
+    assert confirmed_candidates(ranked, 3) == [0, 1, 2, 3]
+    assert confirmed_candidates(ranked[:3], 3) == [0, 1, 2]  # already among the first: nothing added
+    assert confirmed_candidates([sc(1.0, np.inf)], 3) == [0]
 
 
 def test_a_large_lag_the_step_screen_cannot_rank_is_still_found(record):
@@ -55,8 +56,9 @@ def test_a_large_lag_the_step_screen_cannot_rank_is_still_found(record):
     assert lag.ssr > 0.9 * drift.ssr
     assert lag.ssr_held < 0.2 * drift.ssr_held
     assert lag.params_held["tau"] == pytest.approx(TAU, rel=0.3)
-    dg = diagnose_effects(NOMINAL, record, candidates=["drift", "static_nonlinearity", "backlash", "delay", "lag"],
-                          n_null=9, confirm=1, max_effects=1)
+    dg = diagnose_effects(NOMINAL, record,
+                          options=DiagnoseOptions(candidates=["drift", "static_nonlinearity", "backlash", "delay", "lag"],
+                                                  n_null=9, confirm=1, max_effects=1))
     assert dg.verdict["effects"][0] == "lag"
     best = dg.effects[0] if dg.effects[0].effect == "lag" else next(e for e in dg.effects if e.effect == "lag")
     assert best.fit == "joint" and best.parameters["tau"] == pytest.approx(TAU, rel=0.3)

@@ -8,11 +8,11 @@ from scipy.signal import lfilter
 
 from synth.data import record_from_arrays
 from synth.errors import ModelError
-from synth.gap.drift import cusum_drift
-from synth.gap.localize import localize_gap
-from synth.gap.residual import model_residual
-from synth.gap.steps import detect_steps
-from synth.gap.where_time import energy_windows
+from synth.gap.where.drift import cusum_drift
+from synth.gap.where.localize import localize_gap
+from synth.gap.where.residual import model_residual
+from synth.gap.where.steps import detect_steps
+from synth.gap.where.time import energy_windows
 from synth.ident.simulate import simulate_plant
 from synth.plant import Plant
 

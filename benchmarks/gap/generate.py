@@ -17,8 +17,8 @@ Every case is reproducible from ``(seed, index)``:
   amplitudes);
 * **truth**: the effect's output and the *true shrinkage* ``1 - J_true / J_refit`` on the held-out
   half (``J_true`` of the true model with the true effect, ``J_refit`` of the nominal re-fitted alone on
-  the training half by :func:`synth.gap.refit.fit_augmented`), as :func:`synth.gap.attribute.diagnose_effects`
-  computes them.
+  the training half by :func:`synth.gap.attribution.refit.fit_augmented`), as
+  :func:`synth.gap.attribution.heldout.diagnose_effects` computes them.
 
 Run ``python benchmarks/gap/generate.py --list`` to print the case list.
 """
@@ -33,8 +33,8 @@ import numpy as np
 
 from synth.data import record_from_arrays
 from synth.data.record import Record
+from synth.gap.attribution.refit import fit_augmented
 from synth.gap.effects import make_effect
-from synth.gap.refit import fit_augmented
 from synth.ident.simulate import simulate_plant
 from synth.plant import Plant
 

@@ -1,7 +1,7 @@
-"""Score :func:`synth.gap.attribute.diagnose_effects` on the withheld-effect benchmark.
+"""Score :func:`synth.gap.attribution.heldout.diagnose_effects` on the withheld-effect benchmark.
 
 Every case of :mod:`benchmarks.gap.generate` is diagnosed with the full candidate list
-(:data:`synth.gap.attribute.DEFAULT_CANDIDATES`) and the defaults; the diagnosis sees only the
+(:data:`synth.gap.effects.registry.DEFAULT_CANDIDATES`) and the defaults; the diagnosis sees only the
 record and the mismatched nominal model. What is counted:
 
 * **top-1** (cases with an effect): the first entry of ``verdict["effects"]`` is the true effect. An
@@ -47,7 +47,7 @@ def run_case(args: tuple[int, int]) -> dict[str, Any]:
     """Generate case ``index`` and diagnose it; one JSON-ready row."""
     import contextlib
 
-    from synth.gap.attribute import diagnose_effects
+    from synth.gap.attribution.heldout import diagnose_effects
 
     seed, index = args
     with open(os.devnull, "w") as null, contextlib.redirect_stderr(null):

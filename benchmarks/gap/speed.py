@@ -3,7 +3,7 @@
 Case: the X-4 rotor drive (eq. 5 plant, 2-5 % mismatch in every coefficient of the nominal handed to
 the diagnosis), a hidden rate limit of 300 PWM/s, a 16-level step train of several amplitudes sampled
 at 500 Hz for 40 s (20,000 samples; the first half trains), noise 1 rad/s. Every candidate of
-:data:`synth.gap.attribute.DEFAULT_CANDIDATES` (12).
+:data:`synth.gap.effects.registry.DEFAULT_CANDIDATES` (12).
 
 Rows:
   * synth: ``diagnose_effects`` with its defaults (every candidate screened with the denominator fixed,
@@ -32,7 +32,7 @@ sys.path.insert(0, str(ROOT))
 import numpy as np  # noqa: E402
 
 from synth.data import record_from_arrays  # noqa: E402
-from synth.gap.attribute import diagnose_effects  # noqa: E402
+from synth.gap.attribution.heldout import DiagnoseOptions, diagnose_effects  # noqa: E402
 from synth.gap.effects import make_effect  # noqa: E402
 from synth.plant import Plant  # noqa: E402
 
@@ -76,7 +76,7 @@ def main(argv: list[str] | None = None) -> None:
                      {"confirm": None, "calibration": "refit", "n_null": 19}))
     for label, kw in runs:
         t0 = time.perf_counter()
-        dg = _quiet(lambda kw=kw: diagnose_effects(NOMINAL, rec, **kw))
+        dg = _quiet(lambda kw=kw: diagnose_effects(NOMINAL, rec, options=DiagnoseOptions(**kw)))
         dt = time.perf_counter() - t0
         best = next((e for e in dg.effects if e.accepted), None)
         true_shrink = 1.0 - float(np.mean((rec.y - clean)[dg.heldout] ** 2)) / dg.j_refit

@@ -9,6 +9,8 @@ import sys
 from pathlib import Path
 from typing import Any
 
+__all__ = ["COMMAND", "DESCRIPTION", "HELP", "ORDER", "add_arguments", "run"]
+
 COMMAND = "diagnose"
 ORDER = 50
 HELP = "sim-to-real gap: where the model and a measured record disagree, and which effect explains it"
@@ -137,8 +139,8 @@ def run(args: argparse.Namespace) -> int:
 
 def _round_robin(args: argparse.Namespace, plant: Any, runs: list[Any], candidates: list[str] | None) -> int:
     from synth.errors import SynthError
-    from synth.gap.attribute import DEFAULT_CANDIDATES
-    from synth.gap.roundrobin import diagnose_runs
+    from synth.gap.attribution.roundrobin import diagnose_runs
+    from synth.gap.effects.registry import DEFAULT_CANDIDATES
     from synth.outputs import dump_json, write_json
 
     if len(runs) < 2:

@@ -1,8 +1,8 @@
 """The whole sim-to-real diagnosis in one call: where the gap lies, which effect explains it, how far.
 
-:func:`diagnose` runs :func:`synth.gap.localize.localize_gap` (size of the gap
+:func:`diagnose` runs :func:`synth.gap.where.localize.localize_gap` (size of the gap
 and where it lies, on the record) and
-:func:`synth.gap.attribute.diagnose_effects` (nested augmentations judged on
+:func:`synth.gap.attribution.heldout.diagnose_effects` (nested augmentations judged on
 held-out data) and returns one :class:`Diagnosis` whose ``to_dict()`` is the
 JSON contract of ``synth diagnose --json``::
 
@@ -24,19 +24,25 @@ when there is no gap (or none of the candidates explains it) and
 from __future__ import annotations
 
 import json
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from synth.data.coerce import RecordLike, as_record
 from synth.data.record import Record
 from synth.errors import DataError, ModelError
-from synth.gap.attribute import DEFAULT_CANDIDATES, EffectDiagnosis, diagnose_effects
-from synth.gap.clipping import Clipping, record_clipping
-from synth.gap.effects import make_effect
-from synth.gap.localize import GapLocalization, localize_gap
+from synth.gap.attribution.heldout import DiagnoseOptions, diagnose_effects
+from synth.gap.attribution.verdict import EffectDiagnosis
+from synth.gap.effects.registry import DEFAULT_CANDIDATES, make_effect
+from synth.gap.where.clipping import Clipping, record_clipping
+from synth.gap.where.localize import GapLocalization, localize_gap
 from synth.plant import Plant, Signal
+
+__all__ = ["MODEL_FILE_SUFFIXES", "Diagnosis", "as_validation", "check_candidates", "diagnose", "heldout_warnings",
+           "load_model"]
 
 MODEL_FILE_SUFFIXES = (".json", ".yaml", ".yml")
 
@@ -153,7 +159,7 @@ class Diagnosis:
     attribution : EffectDiagnosis
     clipping : tuple of Clipping
         Signals of the record (and the validation record) resting on their extreme value:
-        direct evidence of a saturation (:mod:`synth.gap.clipping`).
+        direct evidence of a saturation (:mod:`synth.gap.where.clipping`).
     warnings : tuple of str
         What limits the held-out test (:func:`heldout_warnings`).
 
@@ -283,7 +289,43 @@ def check_candidates(candidates: list[str] | tuple[str, ...]) -> list[str]:
     return names
 
 
-def diagnose(plant: Plant, record: Record, validate: Record | list[Record] | tuple[Record, ...] | None = None,
+def as_validation(validate: RecordLike | Sequence[RecordLike] | None) -> Record | tuple[Record, ...] | None:
+    """The held-out data as records: one record, several runs (a tuple), or ``None``.
+
+    A list or tuple of one-dimensional arrays is one record (``(t, u, y)``); any other list or tuple
+    holds runs, each in any form :func:`synth.data.coerce.as_record` takes; a single run is one record.
+
+    Parameters
+    ----------
+    validate : record-like, sequence of record-like, or None
+
+    Returns
+    -------
+    Record, tuple of Record, or None
+
+    Raises
+    ------
+    DataError
+        A form that is not a record.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> t = np.arange(0, 1, 0.1); u = (t >= 0.3).astype(float)
+    >>> as_validation((t, u, 2 * u)).n
+    10
+    >>> len(as_validation([(t, u, u), (t, u, 2 * u)])), as_validation(None) is None
+    (2, True)
+    """
+    if validate is None or (isinstance(validate, list | tuple) and not validate):
+        return None
+    if isinstance(validate, list | tuple) and not all(np.ndim(v) == 1 for v in validate):
+        runs = tuple(as_record(v) for v in validate)
+        return runs if len(runs) > 1 else (runs[0] if runs else None)
+    return as_record(validate)
+
+
+def diagnose(plant: Plant, record: RecordLike, validate: RecordLike | Sequence[RecordLike] | None = None,
              candidates: list[str] | tuple[str, ...] | None = None, *, offset: str | float = "fit",
              train_fraction: float = 0.5, n_null: int = 19, n_boot: int = 1000, level: float = 0.95,
              seed: int = 0, split: str = "tail", burn_in: float = 0.0, max_effects: int = 2,
@@ -294,18 +336,19 @@ def diagnose(plant: Plant, record: Record, validate: Record | list[Record] | tup
     ----------
     plant : Plant
         The nominal model, driven by the record's input (the measured command).
-    record : Record
-        Measured command and output (aux channels become regime variables).
-    validate : Record or sequence of Record, optional
+    record : Record, (t, u, y) arrays, N x 3 array, mapping of columns, DataFrame or path
+        Measured command and output (aux channels become regime variables); anything
+        :func:`synth.data.coerce.as_record` takes.
+    validate : record-like or sequence of record-like, optional
         Held-out record for the shrinkage (several: runs of the same plant, each with its own
-        offset, see :func:`synth.gap.attribute.diagnose_effects`); without it the record's second
-        half is held out.
+        offset, see :func:`synth.gap.attribution.heldout.diagnose_effects`); without it the record's second
+        half is held out. Each in any form of ``record`` (see :func:`as_validation`).
     candidates : sequence of str, optional
         Effects to try (default: every effect of :mod:`synth.gap.effects`).
     offset : "fit", "none" or float
         Output offset of the localization (the operating point the linear model does not know).
     train_fraction, n_null, n_boot, seed, split, burn_in, max_effects, workers, heldout_offset
-        See :func:`synth.gap.attribute.diagnose_effects`.
+        See :func:`synth.gap.attribution.heldout.diagnose_effects`.
     level : float
         Confidence level of the localization's tests.
 
@@ -332,10 +375,12 @@ def diagnose(plant: Plant, record: Record, validate: Record | list[Record] | tup
     ...               candidates=["delay", "lag"], n_null=3)
     >>> dg.verdict["effects"], round(dg.attribution.effects[0].parameters["delay"], 3)
     (['delay'], 0.05)
+    >>> diagnose(Plant.from_string("2/(0.2*s+1)"), (t, u, y), candidates=["delay"], n_null=3).verdict["effects"]
+    ['delay']
     """
     names = check_candidates(list(DEFAULT_CANDIDATES if candidates is None else candidates))
-    if isinstance(validate, (list, tuple)):
-        validate = tuple(validate) if len(validate) > 1 else (validate[0] if validate else None)
+    record = as_record(record)
+    validate = as_validation(validate)
     held_out = validate if isinstance(validate, tuple) else (() if validate is None else (validate,))
     for i, v in enumerate(held_out):
         for side in ("input", "output"):
@@ -345,9 +390,9 @@ def diagnose(plant: Plant, record: Record, validate: Record | list[Record] | tup
                 raise DataError(f"{side} unit {b!r} differs from the record's {a!r}", where=where)
     loc = localize_gap(plant, record, offset=offset, level=level)
     att = diagnose_effects(plant, record, list(validate) if isinstance(validate, tuple) else validate,
-                           candidates=names, train_fraction=train_fraction,
-                           n_null=n_null, n_boot=n_boot, seed=seed, split=split, burn_in=burn_in,
-                           max_effects=max_effects, workers=workers, heldout_offset=heldout_offset)
+                           options=DiagnoseOptions(candidates=names, train_fraction=train_fraction, n_null=n_null,
+                                                   n_boot=n_boot, seed=seed, split=split, burn_in=burn_in,
+                                                   max_effects=max_effects, workers=workers, heldout_offset=heldout_offset))
     clips = record_clipping(record)
     warnings: list[str] = [] if held_out else heldout_warnings(record, None, split, train_fraction)
     for i, v in enumerate(held_out):

@@ -14,23 +14,25 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
 
-from synth.gap.attribute import EffectDiagnosis
+from synth.gap.attribution.verdict import EffectDiagnosis
+
+__all__ = ["overlay_figure"]
 
 
 def overlay_figure(dg: EffectDiagnosis) -> plt.Figure:
-    """Draw the before/after overlay of a :class:`~synth.gap.attribute.EffectDiagnosis`.
+    """Draw the before/after overlay of a :class:`~synth.gap.attribution.verdict.EffectDiagnosis`.
 
     Examples
     --------
     >>> import numpy as np
     >>> from synth.data import record_from_arrays
-    >>> from synth.gap.attribute import diagnose_effects
+    >>> from synth.gap.attribution.heldout import DiagnoseOptions, diagnose_effects
     >>> from synth.ident.simulate import simulate_plant
     >>> from synth.plant import Plant
     >>> t = np.arange(0, 8, 0.02); u = np.where((t % 2) >= 1, 1.0, 0.0)
     >>> y = simulate_plant(Plant.from_string("2/(0.2*s+1)", delay=0.06), t, u)
     >>> dg = diagnose_effects(Plant.from_string("2/(0.2*s+1)"), record_from_arrays(t, u, y + 0.01 * np.sin(40 * t)),
-    ...                       candidates=["delay"], n_null=3)
+    ...                       options=DiagnoseOptions(candidates=("delay",), n_null=3))
     >>> fig = overlay_figure(dg)
     >>> len(fig.axes), dg.verdict["effects"]
     (2, ['delay'])

@@ -12,6 +12,8 @@ from synth.gap.diagnose import Diagnosis
 from synth.outputs import GENERATOR, OutputDir, dump_json
 from synth.requirements.base import fmt
 
+__all__ = ["DiagnosisFiles", "render_diagnosis_html", "write_diagnosis_report"]
+
 
 @dataclass(frozen=True)
 class DiagnosisFiles:
@@ -94,8 +96,8 @@ def write_diagnosis_report(diag: Diagnosis, out_dir: str | Path, *, command: str
     figs: dict[str, Path] = {}
     if figures:
         from synth.figure_files import save_figure
-        from synth.gap.gapmap import write_gap_map
         from synth.gap.overlay import overlay_figure
+        from synth.gap.where.gapmap import write_gap_map
 
         figs["gap_map"] = write_gap_map(diag.localization, out.claim("gap_map.png"), diag.plant)
         figs["overlay"] = save_figure(overlay_figure(diag.attribution), out.claim("overlay.png"))

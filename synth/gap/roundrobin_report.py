@@ -8,9 +8,11 @@ from typing import Any
 
 from jinja2 import Environment, PackageLoader
 
-from synth.gap.roundrobin import RunsDiagnosis
+from synth.gap.attribution.roundrobin import RunsDiagnosis
 from synth.outputs import GENERATOR, OutputDir, dump_json
 from synth.requirements.base import fmt
+
+__all__ = ["RunsFiles", "write_runs_report"]
 
 
 @dataclass(frozen=True)
@@ -35,7 +37,7 @@ def write_runs_report(rr: RunsDiagnosis, out_dir: str | Path, *, units: dict[str
     --------
     >>> import numpy as np, tempfile
     >>> from synth.data import record_from_arrays
-    >>> from synth.gap.roundrobin import diagnose_runs
+    >>> from synth.gap.attribution.roundrobin import diagnose_runs
     >>> from synth.ident.simulate import simulate_plant
     >>> from synth.plant import Plant
     >>> G = Plant.from_string("2/(0.2*s+1)")

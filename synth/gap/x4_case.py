@@ -35,6 +35,8 @@ from synth.data.record import record_from_arrays
 from synth.gap.diagnose import diagnose
 from synth.plant import Plant, Signal
 
+__all__ = ["CANDIDATES", "gap_case_applies", "x4_gap_case"]
+
 CANDIDATES = ("rate_limit", "saturation")
 """Candidates of the case: the two actuator limits the spec's simulation holds (kept short: the case runs
 inside ``synth design``)."""

@@ -17,9 +17,11 @@ from typing import Any
 import numpy as np
 
 from synth.errors import DataError
-from synth.gap.drift import DriftResult, cusum_drift
-from synth.gap.residual import ModelResidual
-from synth.gap.steps import StepResult, analyze_steps, phase_shares
+from synth.gap.where.drift import DriftResult, cusum_drift
+from synth.gap.where.residual import ModelResidual
+from synth.gap.where.steps import StepResult, analyze_steps, phase_shares
+
+__all__ = ["TimeLocalization", "TimeWindow", "energy_windows", "localize_time"]
 
 
 @dataclass(frozen=True)
@@ -99,7 +101,7 @@ class TimeLocalization:
     --------
     >>> import numpy as np
     >>> from synth.data import record_from_arrays
-    >>> from synth.gap.residual import model_residual
+    >>> from synth.gap.where.residual import model_residual
     >>> from synth.plant import Plant
     >>> from synth.ident.simulate import simulate_plant
     >>> t = np.arange(0, 6, 0.01)
@@ -141,19 +143,19 @@ def localize_time(residual: ModelResidual, n_bins: int = 100, factor: float = 4.
     Parameters
     ----------
     residual : ModelResidual
-        From :func:`synth.gap.residual.model_residual`.
+        From :func:`synth.gap.where.residual.model_residual`.
     n_bins, factor : int, float
         Energy-window bins and the factor above the median bin energy.
     min_fraction, settle_band : float
-        Step detection and settling band (see :mod:`synth.gap.steps`).
+        Step detection and settling band (see :mod:`synth.gap.where.steps`).
     false_alarm : float
-        CUSUM false-alarm chance per record (see :mod:`synth.gap.drift`).
+        CUSUM false-alarm chance per record (see :mod:`synth.gap.where.drift`).
 
     Examples
     --------
     >>> import numpy as np
     >>> from synth.data import record_from_arrays
-    >>> from synth.gap.residual import model_residual
+    >>> from synth.gap.where.residual import model_residual
     >>> from synth.plant import Plant
     >>> t = np.arange(0, 20, 0.01)
     >>> u = np.sin(t)

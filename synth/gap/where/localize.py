@@ -15,11 +15,13 @@ from dataclasses import dataclass
 from typing import Any
 
 from synth.data.record import Record
-from synth.gap.residual import ModelResidual, model_residual
-from synth.gap.where_frequency import FrequencyLocalization, localize_frequency
-from synth.gap.where_regime import RegimeVariable, localize_regime
-from synth.gap.where_time import TimeLocalization, localize_time
+from synth.gap.where.frequency import FrequencyLocalization, localize_frequency
+from synth.gap.where.regime import RegimeVariable, localize_regime
+from synth.gap.where.residual import ModelResidual, model_residual
+from synth.gap.where.time import TimeLocalization, localize_time
 from synth.plant import Plant
+
+__all__ = ["REGIME_WORDS", "GapLocalization", "WhereResult", "headline", "localize_gap"]
 
 REGIME_WORDS = {"amplitude": "input amplitude", "rate": "input rate", "operating_point": "output level",
                 "direction": "direction of motion"}
@@ -162,13 +164,13 @@ def localize_gap(plant: Plant, record: Record, initial: str = "steady", offset: 
     record : Record
         The measured record (its ``aux`` channels become regime variables).
     initial, offset
-        See :func:`synth.gap.residual.model_residual`.
+        See :func:`synth.gap.where.residual.model_residual`.
     n_bins : int
         Bins per regime variable.
     level : float
         Confidence level of the frequency and regime tests.
     max_lag, n_segments, na, nb : int
-        Cross-correlation lags, Welch segments, error-model orders (see :mod:`synth.gap.where_frequency`).
+        Cross-correlation lags, Welch segments, error-model orders (see :mod:`synth.gap.where.frequency`).
 
     Examples
     --------

@@ -37,6 +37,8 @@ import numpy as np
 
 from synth.data.record import Record
 
+__all__ = ["Clipping", "find_clipping", "record_clipping"]
+
 
 @dataclass(frozen=True)
 class Clipping:

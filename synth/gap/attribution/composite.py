@@ -5,7 +5,7 @@ which effect ``B`` the model *augmented by A* still misses. :class:`NestedEffect
 is that augmented model as one :class:`synth.gap.effects.Effect`: its free
 parameters are ``B``'s (grid, factor and basis parameters, fitted as ``B``'s own),
 ``A``'s parameters of every kind are fixed numbers inside it, so
-:func:`synth.gap.refit.fit_augmented` and :func:`synth.gap.screen.screen_effect`
+:func:`synth.gap.attribution.refit.fit_augmented` and :func:`synth.gap.attribution.screen.screen_effect`
 fit it unchanged, re-fitting the nominal coefficients jointly with ``B``.
 
 The model is the physical chain, each side in the order ``A`` then ``B``::
@@ -22,7 +22,7 @@ Combinations the re-fit's hooks cannot represent exactly raise
 :class:`synth.errors.ModelError` (never a silently wrong fit):
 
 - ``A`` adds a delay (``delay`` with a nonzero value): the re-fit's linear fit fixes the
-  delay at the nominal's (:func:`synth.gap.refit.fit_augmented` would fit the wrong
+  delay at the nominal's (:func:`synth.gap.attribution.refit.fit_augmented` would fit the wrong
   delay); fold it into the nominal instead (``plant.with_delay(plant.delay + d)``, then
   fit ``B`` alone: the same model);
 - ``A`` has output basis terms (``drift``): no hook subtracts a fixed time signal from the
@@ -46,15 +46,18 @@ from typing import Any
 import numpy as np
 
 from synth.errors import ModelError
-from synth.gap.effects import DelayEffect, Effect, Params, SaturationEffect, make_effect
+from synth.gap.effects.base import Effect, Params
+from synth.gap.effects.registry import make_effect
 from synth.plant import Plant
+
+__all__ = ["NestedEffect", "numeric_factor"]
 
 _UNIT = Plant(np.array([1.0]), np.array([1.0]))
 
 
 def _poly(coeffs: np.ndarray) -> str:
     """A polynomial in ``s`` with numeric coefficients, as the structure parser reads it."""
-    from synth.gap.refit import monomial
+    from synth.gap.attribution.refit import monomial
 
     deg = coeffs.size - 1
     terms = [f"({float(c)!r})" + (f"*{monomial(deg - i)}" if deg - i else "") for i, c in enumerate(coeffs) if c != 0.0]
@@ -86,31 +89,8 @@ def numeric_factor(plant: Plant) -> str | None:
     return f"(({_poly(num)})/({_poly(den)}))"
 
 
-def _has_output_map(e: Effect) -> bool:
-    if isinstance(e, NestedEffect):
-        return _has_output_map(e.first) or _has_output_map(e.second)
-    if isinstance(e, SaturationEffect):
-        return e.placement == "output"
-    return type(e).output_map is not Effect.output_map
-
-
-def _has_input_side(e: Effect) -> bool:
-    if isinstance(e, NestedEffect):
-        return _has_input_side(e.first) or _has_input_side(e.second)
-    if e.needs_plant:
-        return True
-    if isinstance(e, SaturationEffect):
-        return e.placement == "input"
-    return type(e).input_map is not Effect.input_map or type(e).input_basis is not Effect.input_basis
-
-
 def _output_basis_count(e: Effect) -> int:
     return len(e.output_basis(np.array([0.0, 1.0])))
-
-
-def _changes_rational(e: Effect) -> bool:
-    """Whether a free effect may change the rational part of the linear model (a lag, a resonance)."""
-    return type(e).augment_plant is not Effect.augment_plant and not isinstance(e, DelayEffect)
 
 
 @dataclass(frozen=True)
@@ -144,7 +124,7 @@ class NestedEffect(Effect):
     Examples
     --------
     >>> import numpy as np
-    >>> from synth.gap.refit import fit_augmented
+    >>> from synth.gap.attribution.refit import fit_augmented
     >>> t = np.arange(0, 8, 0.01); u = np.where((t % 2) >= 1, 1.5, 0.0)
     >>> G = Plant.from_string("2/(0.2*s+1)")
     >>> e = NestedEffect("saturation", {"upper": 1.2}, "drift")  # accepted: the actuator's limit
@@ -175,7 +155,7 @@ class NestedEffect(Effect):
                 parts = [make_effect(given[k]) for k in ("first", "second")]
             except (KeyError, ModelError):
                 parts = []  # __init__ reports it
-            if any(_has_output_map(e) for e in parts):
+            if any(e.has_output_map for e in parts):
                 cls = _OutputMapNestedEffect
         return super().__new__(cls)
 
@@ -207,14 +187,14 @@ class NestedEffect(Effect):
         if _output_basis_count(first):
             return (f"{first.label}'s fixed output terms cannot be held in the re-fit; subtract them from the "
                     f"measured output and fit {second.label} alone")
-        if _has_output_map(first) and _output_basis_count(second):
+        if first.has_output_map and _output_basis_count(second):
             return f"{second.label}'s output terms would follow {first.label}'s output map, which gets no time"
         first_rational = numeric_factor(h) is not None
         if first.needs_plant and second.needs_plant:
             return "both need the linear model"
-        if first.needs_plant and (_changes_rational(second) or _has_input_side(second)):
+        if first.needs_plant and (second.changes_rational or second.has_input_side):
             return (f"{first.label}'s force would be computed without {second.label}'s "
-                    f"{'linear factor' if _changes_rational(second) else 'input block'}")
+                    f"{'linear factor' if second.changes_rational else 'input block'}")
         if second.needs_plant and first_rational:
             return f"{second.label}'s force would be computed on a velocity model including {first.label}'s factor"
         return None
@@ -264,6 +244,22 @@ class NestedEffect(Effect):
     @property
     def screenable(self) -> bool:
         return bool(self.first.screenable and self.second.screenable and not self.needs_plant)
+
+    @property
+    def has_output_map(self) -> bool:
+        return bool(self.first.has_output_map or self.second.has_output_map)
+
+    @property
+    def has_input_side(self) -> bool:
+        return bool(self.first.has_input_side or self.second.has_input_side)
+
+    def screen_points(self, grid: list[Params], t: np.ndarray, plant: Plant) -> list[Params]:
+        """``second``'s screen points on this effect's grid."""
+        return self.second.screen_points(grid, t, plant)
+
+    def seed_grid(self, point: Params, u_train: np.ndarray | None = None) -> list[Params]:
+        """``second``'s seeded grid."""
+        return self.second.seed_grid(point, u_train)
 
     @property
     def label(self) -> str:

@@ -19,6 +19,8 @@ from scipy.signal import coherence as welch_coherence
 
 from synth.errors import DataError
 
+__all__ = ["Coherence", "coherence_threshold", "input_residual_coherence"]
+
 
 def coherence_threshold(n_segments: int, alpha: float = 0.05) -> float:
     """Level-``alpha`` threshold of the coherence estimated from ``n_segments`` independent averages.

@@ -21,6 +21,8 @@ from synth.data.record import Record
 from synth.errors import DataError, ModelError
 from synth.plant import Plant
 
+__all__ = ["SETTLE_TIME_CONSTANTS", "Stitched", "settle_time", "stitch_runs"]
+
 SETTLE_TIME_CONSTANTS = 20.0
 """Bridge length in time constants of the slowest pole (``exp(-20)`` of the start-up transient is left)."""
 

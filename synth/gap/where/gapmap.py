@@ -17,14 +17,16 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
 
-from synth.gap.localize import GapLocalization
+from synth.gap.where.localize import GapLocalization
 from synth.plant import Plant
+
+__all__ = ["SHADE", "gap_map_figure", "write_gap_map"]
 
 SHADE = "#f4a261"
 
 
 def gap_map_figure(loc: GapLocalization, plant: Plant | None = None, max_regimes: int = 4) -> plt.Figure:
-    """Draw the gap map of a :class:`~synth.gap.localize.GapLocalization`.
+    """Draw the gap map of a :class:`~synth.gap.where.localize.GapLocalization`.
 
     Parameters
     ----------
@@ -38,7 +40,7 @@ def gap_map_figure(loc: GapLocalization, plant: Plant | None = None, max_regimes
     --------
     >>> import numpy as np
     >>> from synth.data import record_from_arrays
-    >>> from synth.gap.localize import localize_gap
+    >>> from synth.gap.where.localize import localize_gap
     >>> t = np.arange(0, 10, 0.01)
     >>> u = np.where((t % 4) >= 2, 1.0, 0.0)
     >>> G = Plant.from_string("1/(0.1*s+1)")
@@ -128,7 +130,7 @@ def write_gap_map(loc: GapLocalization, path: str | Path, plant: Plant | None = 
     --------
     >>> import numpy as np, tempfile, pathlib
     >>> from synth.data import record_from_arrays
-    >>> from synth.gap.localize import localize_gap
+    >>> from synth.gap.where.localize import localize_gap
     >>> t = np.arange(0, 10, 0.01)
     >>> u = np.where((t % 4) >= 2, 1.0, 0.0)
     >>> G = Plant.from_string("1/(0.1*s+1)")

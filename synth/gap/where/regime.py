@@ -37,9 +37,12 @@ import numpy as np
 from scipy.stats import f as f_dist
 
 from synth.errors import DataError
-from synth.gap.residual import ModelResidual
+from synth.gap.where.residual import ModelResidual
 from synth.ident.simulate import simulate_plant
 from synth.plant import Plant
+
+__all__ = ["MIN_BIN", "RegimeBin", "RegimeVariable", "bin_residual", "direction_of_motion", "input_rate", "localize_regime",
+           "response_time"]
 
 MIN_BIN = 10
 
@@ -283,7 +286,7 @@ def localize_regime(residual: ModelResidual, plant: Plant, aux: dict[str, np.nda
     --------
     >>> import numpy as np
     >>> from synth.data import record_from_arrays
-    >>> from synth.gap.residual import model_residual
+    >>> from synth.gap.where.residual import model_residual
     >>> t = np.arange(0, 50, 0.01)
     >>> rng = np.random.default_rng(0)
     >>> u = np.repeat(rng.uniform(-3, 3, 50), 100)

@@ -31,6 +31,9 @@ import numpy as np
 
 from synth.errors import DataError
 
+__all__ = ["PHASES", "StepEdge", "StepMetrics", "StepResult", "analyze_steps", "detect_steps", "phase_shares",
+           "step_metrics"]
+
 PHASES = ("rise", "overshoot", "settle")
 
 

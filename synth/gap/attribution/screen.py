@@ -8,27 +8,24 @@ terms). For a fixed denominator and fixed non-smooth parameters the output is
 linear in those, so each point of the effect's parameter search costs a few
 linear simulations (:func:`synth.ident.simulate.simulate_plant`, milliseconds)
 instead of an IPOPT solve on the whole record. The search runs the effect's own
-grid (:meth:`synth.gap.effects.Effect.grid`) plus a golden-section search in the
+grid (:meth:`synth.gap.effects.base.Effect.grid`) plus a golden-section search in the
 log of the grid parameter between the best point's neighbours; the extra delay
 and a resonance's damping, which the joint fit treats as smooth, get a grid of
 their own here. The denominator is tried at two places, the nominal model's and
 the re-fit's, since the re-fit alone may have moved its poles to mimic the
 effect (a slower plant for a rate limit) and the nominal has not.
 
-The screened training SSR ranks the candidates; :func:`synth.gap.attribute.diagnose_effects`
+The screened training SSR ranks the candidates; :func:`synth.gap.attribution.heldout.diagnose_effects`
 re-fits only the best few jointly (nominal coefficients and effect, casadi),
 started at the screened parameters. A screened fit is never better than the joint
 fit of the same effect could be (it is the same model with fewer free
 coefficients), so the ranking errs against an effect only when a pole shift
 the screen cannot make is what the effect needs.
 
-A quantizer is searched differently (:func:`quantizer_grid`): for a fixed
-denominator its training SSR depends on ``(step, offset)`` only through which
-lattice level each command sample rounds to (the level values themselves are
-absorbed by the least-squares gain and constant), so the cost is piecewise
-constant and a golden-section search is meaningless. Both parameters are
-searched densely and jointly instead, every point by superposition of the
-unit numerators' step responses (one FFT convolution per point, batched).
+A quantizer's step and offset are searched densely and jointly instead
+(:func:`synth.gap.effects.quantization.quantizer_grid`): each effect gives its own search points
+(:meth:`synth.gap.effects.base.Effect.screen_grid`) and says whether a golden-section search refines
+them (``golden_search``).
 """
 
 from __future__ import annotations
@@ -39,13 +36,14 @@ from typing import Any
 import numpy as np
 
 from synth.errors import ModelError
-from synth.gap.effects import Effect, Params, QuantizationEffect
-from synth.gap.golden import golden_section, log_bracket
+from synth.gap.attribution.golden import golden_section, log_bracket
+from synth.gap.effects.base import Effect, Params, unit_numerators
 from synth.ident.simulate import simulate_plant
 from synth.plant import Plant
 
+__all__ = ["ScreenedFit", "screen_effect"]
+
 _GOLDEN_STEPS = 14
-_ZETAS = (0.05, 0.1, 0.2, 0.4, 0.7)
 
 
 @dataclass(frozen=True, eq=False)
@@ -109,17 +107,6 @@ class ScreenedFit:
                 "points": self.points}
 
 
-def _unit_numerators(plant: Plant) -> list[Plant]:
-    """One plant per nonzero numerator coefficient of ``plant`` (that coefficient 1, the others 0)."""
-    out = []
-    for i, c in enumerate(plant.num):
-        if c != 0.0:
-            e = np.zeros_like(plant.num, dtype=float)
-            e[i] = 1.0
-            out.append(Plant(e, plant.den, plant.delay, plant.input, plant.output, plant.label))
-    return out
-
-
 def _denominator_directions(plant: Plant) -> list[Plant]:
     """``dG/dd_k = -N s^k / D^2`` for every nonzero non-leading denominator coefficient ``d_k`` of ``G = N/D``.
 
@@ -151,7 +138,7 @@ class _Design:
     def __init__(self, effect: Effect, base: Plant, records: list[tuple[np.ndarray, np.ndarray]],
                  mask: np.ndarray | None = None) -> None:
         self.effect, self.base, self.records, self.mask = effect, base, records, mask
-        self.units = _unit_numerators(base)
+        self.units = unit_numerators(base)
         self.directions = _denominator_directions(base)
 
     def columns(self, params: Params, t: np.ndarray, u: np.ndarray) -> tuple[np.ndarray, int]:
@@ -192,199 +179,6 @@ class _Design:
     def evaluate(self, params: Params, coef: np.ndarray, t: np.ndarray, u: np.ndarray) -> np.ndarray:
         X, _ = self.columns(params, t, u)
         return X @ coef
-
-
-def _extra_grid(effect: Effect, t: np.ndarray, u: np.ndarray, plant: Plant) -> list[Params] | None:
-    """Screening grids for parameters the joint fit treats as smooth (delay, damping)."""
-    dt = float(t[1] - t[0])
-    if effect.name == "delay":
-        p = np.abs(plant.poles())
-        slow = float(np.min(p[p > 0])) if np.any(p > 0) else 1.0
-        top = min(0.25 * float(t[-1] - t[0]), 1.0 / slow)
-        return [{"delay": float(d)} for d in np.geomspace(0.25 * dt, max(top, dt), 16)]
-    if effect.name == "resonance":
-        return [{**g, "zeta": z} for g in effect.grid(t, u, plant) for z in _ZETAS]
-    return None
-
-
-def _step_responses(plant: Plant, t: np.ndarray) -> tuple[list[np.ndarray], list[np.ndarray]]:
-    """Per unit numerator of ``plant``: the response to a unit step at ``t[0]`` from rest, and to a held 1 (steady).
-
-    (The quantizer's dense search holds the denominator: a Gauss-Newton step in it would double the work of
-    every one of its thousands of points; the best points are then screened like every other effect.)"""
-    units = _unit_numerators(plant)
-    ones = np.ones_like(t)
-    return ([simulate_plant(g, t, ones, initial="zero") for g in units],
-            [simulate_plant(g, t, ones) for g in units])
-
-
-def _batch_ssr(v: np.ndarray, y: np.ndarray, steps: list[np.ndarray], consts: list[np.ndarray],
-               mask: np.ndarray | None = None) -> np.ndarray:
-    """Least-squares SSR of ``y`` on the unit-numerator responses to each column of ``v`` plus a constant.
-
-    ``v`` is ``(N, M)``: M candidate plant inputs. The response of a linear model started at the
-    steady state of ``v[0]`` is ``v[0] c + sum_k (v[k] - v[k-1]) s[n - k]`` (``s`` the step response from
-    rest, ``c`` the steady response to a held 1), so every column costs one FFT convolution per unit.
-    """
-    n, m = v.shape
-    dv = np.diff(v, axis=0)
-    size = 1 << int(np.ceil(np.log2(2 * n)))
-    fdv = np.fft.rfft(dv, size, axis=0)
-    cols = []
-    for s, c in zip(steps, consts):
-        conv = np.fft.irfft(fdv * np.fft.rfft(s, size)[:, None], size, axis=0)[: n - 1]
-        x = np.empty((n, m))
-        x[0] = 0.0
-        x[1:] = conv
-        cols.append(x + v[0][None, :] * c[:, None])
-    cols.append(np.ones((n, m)))
-    X = np.stack(cols, axis=2)  # (N, M, k)
-    if mask is not None:
-        X, y = X[mask], y[mask]
-    scale = np.maximum(np.sqrt(np.einsum("nmk,nmk->mk", X, X)), 1e-300)
-    X = X / scale[None]
-    gram = np.einsum("nmi,nmj->mij", X, X)
-    xty = np.einsum("nmi,n->mi", X, y)
-    coef = np.einsum("mij,mj->mi", np.linalg.pinv(gram, rcond=1e-10, hermitian=True), xty)
-    return np.maximum(float(y @ y) - np.einsum("mi,mi->m", coef, xty), 0.0)
-
-
-def quantizer_grid(plant: Plant, t: np.ndarray, u: np.ndarray, y: np.ndarray, keep: int = 5,
-                   mask: np.ndarray | None = None) -> list[Params]:
-    """Dense joint search of a command quantizer's ``step`` and ``offset`` with ``plant``'s denominator fixed.
-
-    The lattice is written as ``c + (phase + k) step`` with ``c`` the command's mid-range, so changing the
-    step at a fixed phase scales the lattice about the middle of the data instead of about zero. Steps run
-    on a log grid from 0.005 to 0.5 of the command's span, spaced so that the lattice moves by at most an
-    eighth of a step at the edges of the data between neighbours (relative spacing ``step / (4 span)``);
-    phases on eight points in [0, 1). The best ``keep`` points are then searched again on a grid four times
-    finer in both directions around each. Every point's SSR is the least-squares fit of the unit numerators
-    and a constant (:func:`_batch_ssr`).
-
-    Parameters
-    ----------
-    plant : Plant
-        Linear model whose denominator and delay are held fixed.
-    t, u, y : numpy.ndarray
-        Training record.
-    keep : int
-        Points refined, and returned, best first.
-    mask : numpy.ndarray of bool, optional
-        Samples that count in the SSR (default all).
-
-    Returns
-    -------
-    list of dict
-        ``{"step", "offset"}`` with ``offset`` in ``[0, step)`` (the :class:`synth.sim.blocks.Quantizer` offset).
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> t = np.arange(0, 8, 0.01); u = 1.0 + 0.8 * np.sin(2.3 * t) * np.sin(0.37 * t)
-    >>> G = Plant.from_string("2/(0.2*s+1)")
-    >>> y = QuantizationEffect().apply(G, t, u, {"step": 0.25, "offset": 0.07})
-    >>> g = quantizer_grid(G, t, u, y)[0]
-    >>> abs(g["step"] / 0.25 - 1) < 0.01, abs(g["offset"] - 0.07) < 0.01
-    (True, True)
-    """
-    t, u, y = (np.asarray(a, float) for a in (t, u, y))
-    span = float(np.max(u) - np.min(u))
-    if span <= 0:
-        raise ModelError("the input is constant; no quantizer can be fitted", where="record.u")
-    center = 0.5 * float(np.max(u) + np.min(u))
-    steps_r, consts = _step_responses(plant, t)
-    q_lo, q_hi = 0.005 * span, 0.5 * span
-    steps = [q_lo]
-    while steps[-1] < q_hi:
-        steps.append(steps[-1] * (1.0 + steps[-1] / (4.0 * span)))
-    n_phase = 8
-
-    # the quantized command depends only on the levels the command's distinct values round to: on a step
-    # train (few distinct values) many (step, phase) points give the same input, whose SSR is computed once
-    u_values, u_index = np.unique(u, return_inverse=True)
-
-    chunk = max(512, int(2e7 // u_values.size))  # points per pass: bounds the (values x points) level table
-    # the SSR is unchanged by v -> a v + b when the steady responses are constant (gain in the numerator fit, the
-    # offset in the constant column): then only the integer rounding pattern, less its first entry, matters
-    affine = all(np.ptp(c) <= 1e-9 * max(np.max(np.abs(c)), 1e-300) for c in consts)
-
-    def ssr(points: np.ndarray) -> np.ndarray:  # points (M, 2): step, phase
-        out = np.empty(len(points))
-        for start in range(0, len(points), chunk):
-            q, ph = points[start:start + chunk, 0], points[start:start + chunk, 1]
-            lat = center + ph * q
-            k = np.floor((u_values[:, None] - lat[None, :]) / q[None, :] + 0.5)  # as the block rounds, per value
-            levels = k - k[:1] if affine else lat[None, :] + q[None, :] * k
-            distinct, which = np.unique(levels, axis=1, return_inverse=True)
-            cost = np.empty(distinct.shape[1])
-            for i in range(0, distinct.shape[1], 512):
-                cost[i:i + 512] = _batch_ssr(distinct[:, i:i + 512][u_index], y, steps_r, consts, mask)
-            out[start:start + chunk] = cost[np.ravel(which)]
-        return out
-
-    coarse = np.array([(q, (j + 0.5) / n_phase) for q in steps for j in range(n_phase)])
-    cost = ssr(coarse)
-    best = coarse[np.argsort(cost, kind="stable")[:keep]]
-    fine = [coarse[np.argsort(cost, kind="stable")[:keep]]]
-    for q, ph in best:
-        dq = q / (4.0 * span)  # the coarse relative spacing
-        fq = q * np.exp(np.linspace(-dq, dq, 9))
-        fp = ph + np.linspace(-0.5, 0.5, 9) / n_phase
-        fine.append(np.array([(a, b) for a in fq for b in fp]))
-    pts = np.vstack(fine)
-    cost = ssr(pts)
-    order = np.argsort(cost, kind="stable")
-    levels = np.unique(u)
-    out: list[Params] = []
-    for i in order:
-        q, ph = pts[i]
-        g = _max_margin(levels, float(q), float(center + ph * q))
-        if g not in out:
-            out.append(g)
-        if len(out) == keep:
-            break
-    return out
-
-
-def _max_margin(levels: np.ndarray, step: float, lattice: float) -> Params:
-    """The point of the quantizer's cell farthest from rounding any of ``levels`` differently.
-
-    Every ``(step, offset)`` that rounds each level to the same lattice index ``n_i`` fits the
-    training data equally well; the data do not tell them apart, and the one with the largest margin
-    ``m`` (in steps) to the rounding boundaries is the least likely to round unseen levels wrongly. With
-    ``a = 1/step``, ``b = offset/step`` the cell is ``n_i - 1/2 + m <= a u_i - b <= n_i + 1/2 - m``: a linear
-    program in ``(a, b, m)``. Returns the given point when the program fails.
-
-    Examples
-    --------
-    >>> g = _max_margin(np.array([0.0, 1.0, 2.0]), 1.1, 0.3)  # rounds to 0, 1, 2: the cell's centre is step 1, offset 0
-    >>> round(g["step"], 6), round(g["offset"], 6) % 1.0
-    (1.0, 0.0)
-    """
-    from scipy.optimize import linprog
-
-    n = np.floor((levels - lattice) / step + 0.5)
-    ones = np.ones_like(levels)
-    # a u - b - m >= n - 1/2  ->  -a u + b + m <= 1/2 - n ;  a u - b + m <= n + 1/2
-    a_ub = np.vstack([np.column_stack([-levels, ones, ones]), np.column_stack([levels, -ones, ones])])
-    b_ub = np.concatenate([0.5 - n, n + 0.5])
-    fallback = {"step": float(step), "offset": float(lattice % step)}
-    bounds = [(1e-12 / step, None), (None, None), (0.0, 0.5)]
-    try:
-        res = linprog([0.0, 0.0, -1.0], A_ub=a_ub, b_ub=b_ub, bounds=bounds, method="highs")
-        if not res.success:
-            return fallback
-        # the largest margin may be reached on a segment: take the middle of its ends in 1/step
-        m = float(res.x[2]) * (1.0 - 1e-9)
-        ends = [linprog([c, 0.0, 0.0], A_ub=a_ub, b_ub=b_ub, bounds=[*bounds[:2], (m, 0.5)], method="highs")
-                for c in (1.0, -1.0)]
-    except ValueError:
-        return fallback
-    x = 0.5 * (ends[0].x + ends[1].x) if all(e.success for e in ends) else res.x
-    if x[0] <= 0:
-        return fallback
-    q = 1.0 / float(x[0])
-    return {"step": q, "offset": float((x[1] * q) % q)}
 
 
 def _search_key(effect: Effect, grid: list[Params]) -> str | None:
@@ -437,10 +231,7 @@ def screen_effect(effect: Effect, bases: list[tuple[str, Plant]], t_tr: np.ndarr
     for base_name, base in bases:
         design = _Design(effect, base, [(t_tr, u_tr), (t_ev, u_ev)], mask)
         try:
-            if isinstance(effect, QuantizationEffect):
-                grid = quantizer_grid(base, t_tr, u_tr, y_tr, mask=mask)
-            else:
-                grid = _extra_grid(effect, t_tr, u_tr, base) or effect.grid(t_tr, u_tr, base)
+            grid = effect.screen_grid(t_tr, u_tr, y_tr, base, mask)
         except ModelError:
             continue
         tried: dict[tuple[tuple[str, float], ...], tuple[float, np.ndarray, int]] = {}
@@ -457,7 +248,7 @@ def screen_effect(effect: Effect, bases: list[tuple[str, Plant]], t_tr: np.ndarr
 
         for g in grid:
             run(g)
-        key_name = None if isinstance(effect, QuantizationEffect) else _search_key(effect, grid)
+        key_name = _search_key(effect, grid) if effect.golden_search else None
         g_best = min(grid, key=lambda g: run(g))
         if key_name is not None:
             g_best = _golden(run, grid, g_best, key_name)

@@ -28,6 +28,8 @@ from synth.errors import ModelError
 from synth.ident.simulate import simulate_plant
 from synth.plant import Plant
 
+__all__ = ["ModelResidual", "gap_size", "model_residual"]
+
 
 @dataclass(frozen=True, eq=False)
 class ModelResidual:

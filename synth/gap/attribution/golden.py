@@ -1,6 +1,6 @@
 """Golden-section search in the log of a grid parameter, between the best grid point's neighbours.
 
-The effect searches (:mod:`synth.gap.screen`, :mod:`synth.gap.refit`) first evaluate a deterministic
+The effect searches (:mod:`synth.gap.attribution.screen`, :mod:`synth.gap.attribution.refit`) first evaluate a deterministic
 grid, then refine the best point's parameter by a golden-section search in its logarithm (rates,
 limits, widths and time constants are scale parameters).
 """
@@ -10,6 +10,8 @@ from __future__ import annotations
 from collections.abc import Callable
 
 import numpy as np
+
+__all__ = ["GOLDEN", "golden_section", "log_bracket"]
 
 GOLDEN = (np.sqrt(5.0) - 1.0) / 2.0
 

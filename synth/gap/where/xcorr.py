@@ -27,6 +27,8 @@ from scipy.stats import norm
 
 from synth.errors import DataError
 
+__all__ = ["CrossCorrelation", "fit_ar", "prewhitened_xcorr"]
+
 
 def fit_ar(x: np.ndarray, max_order: int = 20) -> np.ndarray:
     """Whitening filter ``[1, a_1, ..., a_p]`` of ``x`` (Yule-Walker by Levinson-Durbin, order by AIC).

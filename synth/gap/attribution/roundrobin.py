@@ -6,7 +6,7 @@ interval of the shrinkage reaches down to "no step at all". Several runs of the
 same plant (a lab's open-loop step and its closed-loop steps) can. Procedure
 (:func:`diagnose_runs`):
 
-1. **Folds.** For each run, :func:`synth.gap.attribute.diagnose_effects` fits the
+1. **Folds.** For each run, :func:`synth.gap.attribution.heldout.diagnose_effects` fits the
    re-fit and every candidate on that run and judges them on all the other runs
    (each simulated from rest at its own first input, with its own held-out offset,
    cut into its own segments).
@@ -14,7 +14,7 @@ same plant (a lab's open-loop step and its closed-loop steps) can. Procedure
    resamples the segments of each run with replacement; a run held out in several
    folds is drawn the same way in all of them (its segments are the unit, whichever
    model predicted them), so the folds' shared data are not counted as independent.
-3. **Verdict** as for one record (:mod:`synth.gap.attribute`): significant when the
+3. **Verdict** as for one record (:mod:`synth.gap.attribution.heldout`): significant when the
    lower end of the pooled interval exceeds the largest of the folds' calibrated
    thresholds (conservative), relevant when it also removes ``min_share`` of the
    re-fit's pooled excess over the noise floor and it was fitted jointly in every
@@ -28,24 +28,20 @@ same plant (a lab's open-loop step and its closed-loop steps) can. Procedure
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
 
 from synth.data.record import Record
 from synth.errors import ModelError
-from synth.gap.attribute import (
-    DEFAULT_CANDIDATES,
-    EffectDiagnosis,
-    _experiment,
-    _free_parameters,
-    _parsimonious_lead,
-    _share_of_excess,
-    diagnose_effects,
-)
-from synth.gap.effects import make_effect
+from synth.gap.attribution.heldout import DiagnoseOptions, diagnose_effects
+from synth.gap.attribution.parsimony import free_parameters, parsimonious_lead, share_of_excess
+from synth.gap.attribution.verdict import EffectDiagnosis, separating_experiment
+from synth.gap.effects.registry import DEFAULT_CANDIDATES, make_effect
 from synth.plant import Plant
+
+__all__ = ["PooledEffect", "RunsDiagnosis", "diagnose_runs"]
 
 
 @dataclass(frozen=True)
@@ -103,7 +99,7 @@ class RunsDiagnosis:
         Every candidate fitted in all folds, largest pooled shrinkage first.
     verdict : dict
         ``effects``, ``indistinguishable``, ``experiments``, ``status``, ``headline``, ``parsimony``
-        (as :class:`synth.gap.attribute.EffectDiagnosis`).
+        (as :class:`synth.gap.attribution.verdict.EffectDiagnosis`).
     noise_floor, j_nominal, j_refit, threshold : float
         Pooled noise floor and held-out errors (output units squared); the threshold is the largest
         of the folds' calibrated thresholds.
@@ -193,7 +189,7 @@ def diagnose_runs(plant: Plant, runs: Sequence[Record], candidates: Sequence[str
     names : sequence of str, optional
         Run names for the report (default ``run 1``, ``run 2``, ...).
     blocks, n_null, n_boot, alpha, relevance, min_share, seed, confirm, burn_in, workers
-        As :func:`synth.gap.attribute.diagnose_effects` (``blocks``: segments per held-out run).
+        As :func:`synth.gap.attribution.heldout.diagnose_effects` (``blocks``: segments per held-out run).
 
     Returns
     -------
@@ -223,10 +219,10 @@ def diagnose_runs(plant: Plant, runs: Sequence[Record], candidates: Sequence[str
     names = [f"run {i + 1}" for i in range(len(runs))] if names is None else list(names)
     if len(names) != len(runs):
         raise ModelError(f"{len(names)} names for {len(runs)} runs", where="names")
-    folds = [diagnose_effects(plant, runs[i], [r for j, r in enumerate(runs) if j != i], candidates,
-                              blocks=blocks, n_null=n_null, n_boot=n_boot, alpha=alpha, relevance=relevance,
-                              min_share=min_share, seed=seed + i, confirm=confirm, burn_in=burn_in, max_effects=1,
-                              workers=workers, heldout_offset="fit")
+    options = DiagnoseOptions(candidates=tuple(candidates), blocks=blocks, n_null=n_null, n_boot=n_boot, alpha=alpha,
+                              relevance=relevance, min_share=min_share, seed=seed, confirm=confirm, burn_in=burn_in,
+                              max_effects=1, workers=workers, heldout_offset="fit")
+    folds = [diagnose_effects(plant, runs[i], [r for j, r in enumerate(runs) if j != i], replace(options, seed=seed + i))
              for i in range(len(runs))]
     return _pool(folds, names, blocks, n_boot, alpha, relevance, min_share, seed)
 
@@ -273,7 +269,7 @@ def _pool(folds: list[EffectDiagnosis], names: list[str], blocks: int, n_boot: i
         ci = ratio_ci(sums[label], sums["refit"])
         significant = bool(gap_present and ci[0] > threshold)
         joint = all(b[label].fit == "joint" for b in by_fold)
-        share = _share_of_excess(j_ref, j, floor)
+        share = share_of_excess(j_ref, j, floor)
         params = [dict(b[label].parameters) if b[label].fit == "joint" else None for b in by_fold]
         pooled.append(PooledEffect(label, params, 1.0 - j / j_ref if j_ref > 0 else 0.0, ci, significant,
                                    float(share), bool(significant and joint and share >= min_share), j))
@@ -285,9 +281,9 @@ def _pool(folds: list[EffectDiagnosis], names: list[str], blocks: int, n_boot: i
     if not gap_present:
         effects, status = [], "none"
     elif relevant:
-        counts_p = [_free_parameters(make_effect(e.effect), next(p for p in e.parameters if p is not None))
+        counts_p = [free_parameters(make_effect(e.effect), next(p for p in e.parameters if p is not None))
                     for e in relevant]
-        lead, parsimony = _parsimonious_lead([(e.effect, sums[e.effect]) for e in relevant], counts_p, ratio_ci,
+        lead, parsimony = parsimonious_lead([(e.effect, sums[e.effect]) for e in relevant], counts_p, ratio_ci,
                                              threshold)
         best = relevant[lead]
         effects, status = [best.effect], "effect"
@@ -302,7 +298,7 @@ def _pool(folds: list[EffectDiagnosis], names: list[str], blocks: int, n_boot: i
             rms = float(np.sqrt(np.mean((y_e - y_best) ** 2)))
             if (same_j and rms < sigma) or rms < 0.1 * sigma:
                 group.append(e.effect)
-                experiments.append(_experiment(best.effect, e.effect, np.arange(y_best.size), y_best, y_e))
+                experiments.append(separating_experiment(best.effect, e.effect, np.arange(y_best.size), y_best, y_e))
         if len(group) > 1:
             indist.append(group)
         pooled = [e if e.effect == best.effect else _unaccepted(e) for e in pooled]

@@ -1,7 +1,7 @@
 """Where in frequency the residual lies: bands where the model-error model is significant.
 
 A band is a run of neighbouring grid frequencies where the error model's
-confidence region excludes zero (see :mod:`synth.gap.error_model`) and,
+confidence region excludes zero (see :mod:`synth.gap.where.error_model`) and,
 when the model is given, the error is also relevant: ``|E| >= relevance |G|``
 (default 10 % of the model's own response; with little noise a 0.2 % error
 is significant too, but it is not where the gap is); runs
@@ -22,11 +22,13 @@ import numpy as np
 from scipy.integrate import cumulative_trapezoid
 from scipy.signal import welch
 
-from synth.gap.coherence import Coherence, input_residual_coherence
-from synth.gap.error_model import ErrorModel, fit_error_model
-from synth.gap.residual import ModelResidual
-from synth.gap.xcorr import CrossCorrelation, prewhitened_xcorr
+from synth.gap.where.coherence import Coherence, input_residual_coherence
+from synth.gap.where.error_model import ErrorModel, fit_error_model
+from synth.gap.where.residual import ModelResidual
+from synth.gap.where.xcorr import CrossCorrelation, prewhitened_xcorr
 from synth.plant import Plant
+
+__all__ = ["FrequencyBand", "FrequencyLocalization", "localize_frequency", "significant_bands"]
 
 
 @dataclass(frozen=True)
@@ -109,7 +111,7 @@ class FrequencyLocalization:
     --------
     >>> import numpy as np
     >>> from synth.data import record_from_arrays
-    >>> from synth.gap.residual import model_residual
+    >>> from synth.gap.where.residual import model_residual
     >>> from synth.ident.simulate import simulate_plant
     >>> from synth.plant import Plant
     >>> t = np.arange(0, 40, 0.01)
@@ -160,7 +162,7 @@ def localize_frequency(residual: ModelResidual, max_lag: int = 50, n_segments: i
     --------
     >>> import numpy as np
     >>> from synth.data import record_from_arrays
-    >>> from synth.gap.residual import model_residual
+    >>> from synth.gap.where.residual import model_residual
     >>> from synth.plant import Plant
     >>> t = np.arange(0, 20, 0.01)
     >>> rng = np.random.default_rng(0)

@@ -4,7 +4,7 @@ The residual is cut into ``n_blocks`` blocks of equal length and each block
 is summarized by the median of its samples, so a fast transient that fills
 less than half a block does not move it, while a slow drift does; samples
 marked out by ``mask`` (the rise and overshoot of each step, see
-:func:`synth.gap.where_time.localize_time`) are left out, and blocks left
+:func:`synth.gap.where.time.localize_time`) are left out, and blocks left
 with fewer than a quarter of their samples are skipped.
 
 Noise level: ``sigma`` of the block medians is estimated from their
@@ -37,6 +37,8 @@ import numpy as np
 from scipy.stats import kstwobign
 
 from synth.errors import DataError
+
+__all__ = ["DriftResult", "cusum_drift"]
 
 
 @dataclass(frozen=True)

@@ -45,11 +45,13 @@ import numpy as np
 
 from synth.data.record import record_from_arrays
 from synth.errors import DataError, ModelError
-from synth.gap.effects import Effect, Params
-from synth.gap.golden import golden_section, log_bracket
+from synth.gap.attribution.golden import golden_section, log_bracket
+from synth.gap.effects.base import Effect, Params
 from synth.ident.simulate import simulate_plant
 from synth.ident.timefit import fit_structure
 from synth.plant import Plant
+
+__all__ = ["AugmentedFit", "fit_augmented", "monomial", "nominal_structure"]
 
 _CHI2_1_95 = 3.841458820694124
 _ROUNDS = 12  # most alternations of the casadi fit and the least-squares basis step

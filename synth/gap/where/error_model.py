@@ -33,6 +33,8 @@ from scipy.stats import chi2
 
 from synth.errors import DataError
 
+__all__ = ["ErrorModel", "fit_error_model"]
+
 
 @dataclass(frozen=True)
 class ErrorModel:

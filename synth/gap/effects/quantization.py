@@ -1,0 +1,313 @@
+"""Command quantization, and the dense joint search of its step and offset.
+
+=====================  ========  ===========================================================  ==============
+effect                 side      augmented model                                             parameters
+=====================  ========  ===========================================================  ==============
+``quantization``       input     :class:`synth.sim.blocks.Quantizer` before ``G``             ``step, offset``
+=====================  ========  ===========================================================  ==============
+
+A quantizer is searched differently from the other effects (:func:`quantizer_grid`): for a fixed
+denominator its training SSR depends on ``(step, offset)`` only through which lattice level each
+command sample rounds to (the level values themselves are absorbed by the least-squares gain and
+constant), so the cost is piecewise constant and a golden-section search is meaningless. Both
+parameters are searched densely and jointly instead, every point by superposition of the unit
+numerators' step responses (one FFT convolution per point, batched).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import ClassVar
+
+import numpy as np
+
+from synth.errors import ModelError
+from synth.gap.effects.base import Effect, Params, command_span, log_grid, unit_numerators
+from synth.ident.simulate import simulate_plant
+from synth.plant import Plant
+from synth.sim.blocks import Quantizer
+
+__all__ = ["QuantizationEffect", "quantizer_grid"]
+
+
+@dataclass(frozen=True)
+class QuantizationEffect(Effect):
+    """Command resolution ``step`` with the lattice at ``offset + k step`` (:class:`synth.sim.blocks.Quantizer`).
+
+    ``offset`` in ``[0, step)`` places the lattice relative to the signal (a converter's zero, a
+    PWM's bias). For a fixed linear model the output depends on ``(step, offset)`` only through which
+    level each sample rounds to, so the error is piecewise constant in both: they are searched densely
+    and jointly on the record with the linear model's denominator fixed
+    (:func:`quantizer_grid`, :meth:`data_grid`), never by a one-dimensional golden search.
+    :meth:`grid` (no output data) is a coarse joint grid.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> QuantizationEffect().input_map(np.array([0.4, 0.6, 1.7]), 1.0, {"step": 1.0}).tolist()
+    [0.0, 1.0, 2.0]
+    >>> QuantizationEffect().input_map(np.array([0.4, 0.6, 1.7]), 1.0, {"step": 1.0, "offset": 0.5}).tolist()
+    [0.5, 0.5, 1.5]
+    """
+
+    name: ClassVar[str] = "quantization"
+    parameter_names: ClassVar[tuple[str, ...]] = ("step", "offset")
+    grid_names: ClassVar[tuple[str, ...]] = ("step", "offset")
+    default_candidates: ClassVar[tuple[str, ...]] = ("quantization",)
+    golden_search: ClassVar[bool] = False  # the cost is piecewise constant in step and offset
+
+    def off(self) -> Params:
+        return {"step": 0.0, "offset": 0.0}
+
+    def bounds(self, t: np.ndarray, u: np.ndarray, plant: Plant) -> dict[str, tuple[float, float]]:
+        return {"step": (0.0, 0.5 * command_span(u)), "offset": (0.0, 0.5 * command_span(u))}
+
+    def grid(self, t: np.ndarray, u: np.ndarray, plant: Plant) -> list[Params]:
+        span = command_span(u)
+        return [{**g, "offset": float(f * g["step"])} for g in log_grid(0.005 * span, 0.3 * span, 8, "step")
+                for f in (0.0, 0.25, 0.5, 0.75)]
+
+    def data_grid(self, t: np.ndarray, u: np.ndarray, y: np.ndarray, plant: Plant) -> list[Params]:
+        """The best point of the dense joint search of :func:`quantizer_grid` on ``plant``.
+
+        A subclass's own :meth:`grid` (a seeded search) wins.
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> t = np.arange(0, 8, 0.01); u = 1.0 + 0.8 * np.sin(2.3 * t) * np.sin(0.37 * t)
+        >>> G = Plant.from_string("2/(0.2*s+1)")
+        >>> y = QuantizationEffect().apply(G, t, u, {"step": 0.25, "offset": 0.07})
+        >>> g = QuantizationEffect().data_grid(t, u, y, G)[0]
+        >>> round(g["step"], 2), round(g["offset"], 2)
+        (0.25, 0.07)
+        """
+        if type(self).grid is not QuantizationEffect.grid:
+            return self.grid(t, u, plant)
+        return quantizer_grid(plant, t, u, y, keep=1)
+
+    def screen_grid(self, t: np.ndarray, u: np.ndarray, y: np.ndarray, plant: Plant,
+                    mask: np.ndarray | None = None) -> list[Params]:
+        """The best points of the dense joint search :func:`quantizer_grid` (no golden section: the cost is flat
+        between the points where a sample changes level).
+
+        Examples
+        --------
+        >>> t = np.arange(0, 8, 0.01); u = 1.0 + 0.8 * np.sin(2.3 * t) * np.sin(0.37 * t)
+        >>> G = Plant.from_string("2/(0.2*s+1)")
+        >>> y = QuantizationEffect().apply(G, t, u, {"step": 0.25, "offset": 0.07})
+        >>> g = QuantizationEffect().screen_grid(t, u, y, G)
+        >>> len(g), round(g[0]["step"], 2)
+        (5, 0.25)
+        """
+        return quantizer_grid(plant, t, u, y, mask=mask)
+
+    def seed_grid(self, point: Params, u_train: np.ndarray | None = None) -> list[Params]:
+        """The screened point alone: the screen searched step and offset jointly and densely.
+
+        Examples
+        --------
+        >>> QuantizationEffect().seed_grid({"step": 0.25, "offset": 0.07})
+        [{'step': 0.25, 'offset': 0.07}]
+        """
+        return [dict(point)]
+
+    def input_map(self, u: np.ndarray, dt: float, params: Params) -> np.ndarray:
+        q = params.get("step", 0.0)
+        return u if q <= 0 else Quantizer(q, float(params.get("offset", 0.0)) % q).apply(u, dt)
+
+
+def _step_responses(plant: Plant, t: np.ndarray) -> tuple[list[np.ndarray], list[np.ndarray]]:
+    """Per unit numerator of ``plant``: the response to a unit step at ``t[0]`` from rest, and to a held 1 (steady).
+
+    (The quantizer's dense search holds the denominator: a Gauss-Newton step in it would double the work of
+    every one of its thousands of points; the best points are then screened like every other effect.)
+
+    Examples
+    --------
+    >>> steps, consts = _step_responses(Plant.from_string("2/(s+1)"), np.arange(0, 3, 1.0))
+    >>> steps[0].round(3).tolist(), consts[0].round(3).tolist()
+    ([0.0, 0.632, 0.865], [1.0, 1.0, 1.0])
+    """
+    units = unit_numerators(plant)
+    ones = np.ones_like(t)
+    return ([simulate_plant(g, t, ones, initial="zero") for g in units],
+            [simulate_plant(g, t, ones) for g in units])
+
+
+def _batch_ssr(v: np.ndarray, y: np.ndarray, steps: list[np.ndarray], consts: list[np.ndarray],
+               mask: np.ndarray | None = None) -> np.ndarray:
+    """Least-squares SSR of ``y`` on the unit-numerator responses to each column of ``v`` plus a constant.
+
+    ``v`` is ``(N, M)``: M candidate plant inputs. The response of a linear model started at the
+    steady state of ``v[0]`` is ``v[0] c + sum_k (v[k] - v[k-1]) s[n - k]`` (``s`` the step response from
+    rest, ``c`` the steady response to a held 1), so every column costs one FFT convolution per unit.
+
+    Examples
+    --------
+    >>> t = np.arange(0, 5, 0.1); G = Plant.from_string("1/(s+1)")
+    >>> steps, consts = _step_responses(G, t)
+    >>> v = np.column_stack([np.ones_like(t), np.where(t > 1, 1.0, 0.0)])
+    >>> y = simulate_plant(G, t, v[:, 1], initial="zero")
+    >>> _batch_ssr(v, y, steps, consts).round(6).tolist()[1]
+    0.0
+    """
+    n, m = v.shape
+    dv = np.diff(v, axis=0)
+    size = 1 << int(np.ceil(np.log2(2 * n)))
+    fdv = np.fft.rfft(dv, size, axis=0)
+    cols = []
+    for s, c in zip(steps, consts):
+        conv = np.fft.irfft(fdv * np.fft.rfft(s, size)[:, None], size, axis=0)[: n - 1]
+        x = np.empty((n, m))
+        x[0] = 0.0
+        x[1:] = conv
+        cols.append(x + v[0][None, :] * c[:, None])
+    cols.append(np.ones((n, m)))
+    X = np.stack(cols, axis=2)  # (N, M, k)
+    if mask is not None:
+        X, y = X[mask], y[mask]
+    scale = np.maximum(np.sqrt(np.einsum("nmk,nmk->mk", X, X)), 1e-300)
+    X = X / scale[None]
+    gram = np.einsum("nmi,nmj->mij", X, X)
+    xty = np.einsum("nmi,n->mi", X, y)
+    coef = np.einsum("mij,mj->mi", np.linalg.pinv(gram, rcond=1e-10, hermitian=True), xty)
+    return np.maximum(float(y @ y) - np.einsum("mi,mi->m", coef, xty), 0.0)
+
+
+def quantizer_grid(plant: Plant, t: np.ndarray, u: np.ndarray, y: np.ndarray, keep: int = 5,
+                   mask: np.ndarray | None = None) -> list[Params]:
+    """Dense joint search of a command quantizer's ``step`` and ``offset`` with ``plant``'s denominator fixed.
+
+    The lattice is written as ``c + (phase + k) step`` with ``c`` the command's mid-range, so changing the
+    step at a fixed phase scales the lattice about the middle of the data instead of about zero. Steps run
+    on a log grid from 0.005 to 0.5 of the command's span, spaced so that the lattice moves by at most an
+    eighth of a step at the edges of the data between neighbours (relative spacing ``step / (4 span)``);
+    phases on eight points in [0, 1). The best ``keep`` points are then searched again on a grid four times
+    finer in both directions around each. Every point's SSR is the least-squares fit of the unit numerators
+    and a constant (:func:`_batch_ssr`).
+
+    Parameters
+    ----------
+    plant : Plant
+        Linear model whose denominator and delay are held fixed.
+    t, u, y : numpy.ndarray
+        Training record.
+    keep : int
+        Points refined, and returned, best first.
+    mask : numpy.ndarray of bool, optional
+        Samples that count in the SSR (default all).
+
+    Returns
+    -------
+    list of dict
+        ``{"step", "offset"}`` with ``offset`` in ``[0, step)`` (the :class:`synth.sim.blocks.Quantizer` offset).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> t = np.arange(0, 8, 0.01); u = 1.0 + 0.8 * np.sin(2.3 * t) * np.sin(0.37 * t)
+    >>> G = Plant.from_string("2/(0.2*s+1)")
+    >>> y = QuantizationEffect().apply(G, t, u, {"step": 0.25, "offset": 0.07})
+    >>> g = quantizer_grid(G, t, u, y)[0]
+    >>> abs(g["step"] / 0.25 - 1) < 0.01, abs(g["offset"] - 0.07) < 0.01
+    (True, True)
+    """
+    t, u, y = (np.asarray(a, float) for a in (t, u, y))
+    span = float(np.max(u) - np.min(u))
+    if span <= 0:
+        raise ModelError("the input is constant; no quantizer can be fitted", where="record.u")
+    center = 0.5 * float(np.max(u) + np.min(u))
+    steps_r, consts = _step_responses(plant, t)
+    q_lo, q_hi = 0.005 * span, 0.5 * span
+    steps = [q_lo]
+    while steps[-1] < q_hi:
+        steps.append(steps[-1] * (1.0 + steps[-1] / (4.0 * span)))
+    n_phase = 8
+
+    # the quantized command depends only on the levels the command's distinct values round to: on a step
+    # train (few distinct values) many (step, phase) points give the same input, whose SSR is computed once
+    u_values, u_index = np.unique(u, return_inverse=True)
+
+    chunk = max(512, int(2e7 // u_values.size))  # points per pass: bounds the (values x points) level table
+    # the SSR is unchanged by v -> a v + b when the steady responses are constant (gain in the numerator fit, the
+    # offset in the constant column): then only the integer rounding pattern, less its first entry, matters
+    affine = all(np.ptp(c) <= 1e-9 * max(np.max(np.abs(c)), 1e-300) for c in consts)
+
+    def ssr(points: np.ndarray) -> np.ndarray:  # points (M, 2): step, phase
+        out = np.empty(len(points))
+        for start in range(0, len(points), chunk):
+            q, ph = points[start:start + chunk, 0], points[start:start + chunk, 1]
+            lat = center + ph * q
+            k = np.floor((u_values[:, None] - lat[None, :]) / q[None, :] + 0.5)  # as the block rounds, per value
+            levels = k - k[:1] if affine else lat[None, :] + q[None, :] * k
+            distinct, which = np.unique(levels, axis=1, return_inverse=True)
+            cost = np.empty(distinct.shape[1])
+            for i in range(0, distinct.shape[1], 512):
+                cost[i:i + 512] = _batch_ssr(distinct[:, i:i + 512][u_index], y, steps_r, consts, mask)
+            out[start:start + chunk] = cost[np.ravel(which)]
+        return out
+
+    coarse = np.array([(q, (j + 0.5) / n_phase) for q in steps for j in range(n_phase)])
+    cost = ssr(coarse)
+    best = coarse[np.argsort(cost, kind="stable")[:keep]]
+    fine = [coarse[np.argsort(cost, kind="stable")[:keep]]]
+    for q, ph in best:
+        dq = q / (4.0 * span)  # the coarse relative spacing
+        fq = q * np.exp(np.linspace(-dq, dq, 9))
+        fp = ph + np.linspace(-0.5, 0.5, 9) / n_phase
+        fine.append(np.array([(a, b) for a in fq for b in fp]))
+    pts = np.vstack(fine)
+    cost = ssr(pts)
+    order = np.argsort(cost, kind="stable")
+    levels = np.unique(u)
+    out: list[Params] = []
+    for i in order:
+        q, ph = pts[i]
+        g = _max_margin(levels, float(q), float(center + ph * q))
+        if g not in out:
+            out.append(g)
+        if len(out) == keep:
+            break
+    return out
+
+
+def _max_margin(levels: np.ndarray, step: float, lattice: float) -> Params:
+    """The point of the quantizer's cell farthest from rounding any of ``levels`` differently.
+
+    Every ``(step, offset)`` that rounds each level to the same lattice index ``n_i`` fits the
+    training data equally well; the data do not tell them apart, and the one with the largest margin
+    ``m`` (in steps) to the rounding boundaries is the least likely to round unseen levels wrongly. With
+    ``a = 1/step``, ``b = offset/step`` the cell is ``n_i - 1/2 + m <= a u_i - b <= n_i + 1/2 - m``: a linear
+    program in ``(a, b, m)``. Returns the given point when the program fails.
+
+    Examples
+    --------
+    >>> g = _max_margin(np.array([0.0, 1.0, 2.0]), 1.1, 0.3)  # rounds to 0, 1, 2: the cell's centre is step 1, offset 0
+    >>> round(g["step"], 6), round(g["offset"], 6) % 1.0
+    (1.0, 0.0)
+    """
+    from scipy.optimize import linprog
+
+    n = np.floor((levels - lattice) / step + 0.5)
+    ones = np.ones_like(levels)
+    # a u - b - m >= n - 1/2  ->  -a u + b + m <= 1/2 - n ;  a u - b + m <= n + 1/2
+    a_ub = np.vstack([np.column_stack([-levels, ones, ones]), np.column_stack([levels, -ones, ones])])
+    b_ub = np.concatenate([0.5 - n, n + 0.5])
+    fallback = {"step": float(step), "offset": float(lattice % step)}
+    bounds = [(1e-12 / step, None), (None, None), (0.0, 0.5)]
+    try:
+        res = linprog([0.0, 0.0, -1.0], A_ub=a_ub, b_ub=b_ub, bounds=bounds, method="highs")
+        if not res.success:
+            return fallback
+        # the largest margin may be reached on a segment: take the middle of its ends in 1/step
+        m = float(res.x[2]) * (1.0 - 1e-9)
+        ends = [linprog([c, 0.0, 0.0], A_ub=a_ub, b_ub=b_ub, bounds=[*bounds[:2], (m, 0.5)], method="highs")
+                for c in (1.0, -1.0)]
+    except ValueError:
+        return fallback
+    x = 0.5 * (ends[0].x + ends[1].x) if all(e.success for e in ends) else res.x
+    if x[0] <= 0:
+        return fallback
+    q = 1.0 / float(x[0])
+    return {"step": q, "offset": float((x[1] * q) % q)}
