@@ -180,8 +180,8 @@ def write_design_report(spec: Spec, result: DesignResult, out_dir: str | Path, *
 
     if "diagnosis" in objects:  # the seed-1 gap case: gap map and before/after overlay of the simulated rig
         from synth.figure_files import save_figure
-        from synth.gap.where.gapmap import write_gap_map
         from synth.gap.overlay import overlay_figure
+        from synth.gap.where.gapmap import write_gap_map
 
         diag = objects["diagnosis"]
         figs["gap_map"] = write_gap_map(diag.localization, out.claim("gap_map.png"), diag.plant)
