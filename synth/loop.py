@@ -58,17 +58,19 @@ class Margins:
         return dict(self.__dict__)
 
 
-@dataclass(frozen=True, eq=False)
+@dataclass(frozen=True, eq=False, init=False)
 class Loop:
     """Plant and controller in unity negative feedback.
 
     Parameters
     ----------
     plant : Plant, str, control.TransferFunction, control.StateSpace or (num, den)
-        Anything :func:`synth.plant.as_plant` takes. A python-control model has no delay: give
-        ``Plant.from_control(sys, delay=...)`` for one.
+        Anything :func:`synth.plant.as_plant` takes.
     controller : Controller or str
         A :class:`~synth.controllers.Controller` or its text, e.g. ``"P(3)"``.
+    delay : float, keyword only
+        Exact delay [s] added to the plant's own (a python-control model has none); not stored
+        apart: it becomes part of :attr:`plant`.
 
     Examples
     --------
@@ -85,16 +87,18 @@ class Loop:
     >>> G = control.tf([23.0, 23.0 * 0.43], np.polymul([1.0, 9.6], [1.0, 0.54]))
     >>> round(Loop(G, "P(3)").bandwidth(), 2)
     83.16
-    >>> round(Loop(Plant.from_control(G, delay=0.02), "P(3)").margins().gain_margin_db, 2)
+    >>> round(Loop(G, "P(3)", delay=0.02).margins().gain_margin_db, 2)
     1.79
+    >>> Loop(G, "P(3)", delay=0.02).plant.delay
+    0.02
     """
 
     plant: Plant
     controller: Controller
 
-    def __post_init__(self) -> None:
-        object.__setattr__(self, "plant", as_plant(self.plant))
-        object.__setattr__(self, "controller", as_controller(self.controller))
+    def __init__(self, plant: Any, controller: Controller | str, *, delay: float = 0.0) -> None:
+        object.__setattr__(self, "plant", as_plant(plant, delay))
+        object.__setattr__(self, "controller", as_controller(controller))
 
     # ----------------------------------------------------------- rational parts
     @cached_property
