@@ -224,3 +224,15 @@ def test_every_module_has_a_layer_and_the_test_sees_imports():
         layer_of(module)
     # the reader resolves a submodule imported by name, so the graph is not empty of real edges
     assert "synth.errors" in _graph()["synth.plant"]
+
+
+def test_tests_and_benchmarks_use_only_public_names():
+    """The rule holds outside the package too: tests and benchmarks go through public names."""
+    crossing = []
+    for folder in (ROOT / "tests", ROOT / "benchmarks"):
+        for path in sorted(folder.rglob("*.py")):
+            for node in ast.walk(ast.parse(path.read_text())):
+                if isinstance(node, ast.ImportFrom) and (node.module or "").startswith("synth"):
+                    crossing += [f"{path.relative_to(ROOT)}:{node.lineno} imports {a.name} from {node.module}"
+                                 for a in node.names if a.name.startswith("_") and not a.name.startswith("__")]
+    assert crossing == []

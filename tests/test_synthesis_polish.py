@@ -10,7 +10,7 @@ import pytest
 
 from synth.spec import parse_spec
 from synth.synthesis.convex_settings import ConvexSettings
-from synth.synthesis.multi import _convex_runs, _objective_terms, design_convex, polish_redundant
+from synth.synthesis.multi import convex_runs, design_convex, objective_terms, polish_redundant
 from synth.synthesis.nlp import polish
 
 X4 = "23*(s+0.43)/((s+9.6)*(s+0.54))"
@@ -51,10 +51,10 @@ objective: {{maximize: {obj}}}""")
 def test_polish_from_a_converged_convex_answer_finds_nothing_better(case):
     spec = _spec(*case)
     settings = ConvexSettings()
-    runs = _convex_runs(spec, settings)
+    runs = convex_runs(spec, settings)
     designer, conv = runs[0]
     assert polish_redundant(spec, [r for _, r in runs]) is not None
-    terms = _objective_terms(spec)
+    terms = objective_terms(spec)
     res = polish(list(spec.requirements), spec.plants(), conv.controller, spec.controller.all_bounds(), terms,
                  designer.grid, settings.per_decade, settings.stability_level)
     assert res.success

@@ -48,8 +48,8 @@ from synth.synthesis.nlp_forms import NLP_FORMS
 from synth.synthesis.parametrization import parametrize
 from synth.synthesis.scalar import design_scalar
 
-__all__ = ["STRUCTURAL", "certificate_density", "conflict_set", "design_convex", "exact_forms", "infeasible_verdict",
-           "polish_redundant"]
+__all__ = ["STRUCTURAL", "certificate_density", "conflict_set", "convex_runs", "design_convex", "exact_forms",
+           "infeasible_verdict", "objective_terms", "polish_redundant"]
 
 STRUCTURAL = {"PID": "tf", "leadlag": "p"}
 """The structural parameter of each controller type that the convex stage holds at a few fixed values."""
@@ -79,7 +79,7 @@ def design_convex(spec: Spec, settings: ConvexSettings | None = None, nlp: bool 
     bounds = spec.controller.all_bounds()
     if "ki" not in bounds or bounds["ki"][0] != 0.0 or bounds["ki"][1] == 0.0:
         return main
-    terms = _objective_terms(spec)
+    terms = objective_terms(spec)
     if main.feasible and all(n in ("integral_gain", "low_frequency_gain") and s == "maximize"
                              for n, s, _ in terms):
         return main  # without integral action these objectives are 0 (or finite): never better
@@ -99,7 +99,17 @@ def _better(a: DesignResult, b: DesignResult) -> bool:
     return va > vb if a.objective["sense"] == "maximize" else va < vb
 
 
-def _objective_terms(spec: Spec) -> list[tuple[str, str, float]]:
+def objective_terms(spec: Spec) -> list[tuple[str, str, float]]:
+    """The spec's objective as ``(measure, sense, weight)`` terms; minimum peak |S| when it has none.
+
+    Examples
+    --------
+    >>> from synth.spec import parse_spec
+    >>> spec = parse_spec({"name": "pi", "plant": {"tf": "1/(s+1)"}, "controller": {"type": "PI"},
+    ...                    "requirements": [{"type": "bandwidth", "min": 1.0}]})
+    >>> objective_terms(spec)
+    [('peak_sensitivity', 'minimize', 1.0)]
+    """
     return spec.objective.terms() if spec.objective else [("peak_sensitivity", "minimize", 1.0)]
 
 
@@ -111,14 +121,25 @@ def _structural_values(lo: float, hi: float) -> list[float]:
     return list(np.linspace(lo, hi, 3))
 
 
-def _convex_runs(spec: Spec, settings: ConvexSettings) -> list[tuple[ConvexDesigner, ConvexResult]]:
+def convex_runs(spec: Spec, settings: ConvexSettings) -> list[tuple[ConvexDesigner, ConvexResult]]:
+    """The convex-concave design from each structural start (e.g. three filter constants of a PID).
+
+    Examples
+    --------
+    >>> from synth.spec import parse_spec
+    >>> spec = parse_spec({"name": "pi", "plant": {"tf": "23*(s+0.43)/((s+9.6)*(s+0.54))"},
+    ...                    "controller": {"type": "PI"}, "objective": {"maximize": "integral_gain"},
+    ...                    "requirements": [{"type": "peak_sensitivity", "max_db": 6.0}]})
+    >>> [result.status for _, result in convex_runs(spec, ConvexSettings())]
+    ['optimal']
+    """
     bounds = spec.controller.all_bounds()
     ctype = spec.controller.type
     key = STRUCTURAL.get(ctype)
     values = _structural_values(*bounds[key]) if key else [None]
     requirements = list(spec.requirements)
     names = unique_names(requirements)
-    name, sense, _ = _objective_terms(spec)[0]
+    name, sense, _ = objective_terms(spec)[0]
     runs = []
     w0 = _reference_frequency(spec)
     start = spec.controller.initial_controller()
@@ -170,7 +191,7 @@ def polish_redundant(spec: Spec, runs: list[ConvexResult]) -> str | None:
     between the grid points). IPOPT started at a KKT point stays there: the polish would return the
     same design to its tolerance (tests/test_synthesis_polish.py compares both).
     """
-    terms = _objective_terms(spec)
+    terms = objective_terms(spec)
     if len(runs) != 1 or runs[0].status != "optimal" or not runs[0].converged:
         return None
     if spec.controller.type not in ("P", "PI", "PID"):
@@ -230,8 +251,8 @@ def _certify_best(spec: Spec, found: list[tuple[str, Controller]], terms: list[t
 
 
 def _design(spec: Spec, settings: ConvexSettings, nlp: bool | str) -> DesignResult:
-    terms = _objective_terms(spec)
-    runs = _convex_runs(spec, settings)
+    terms = objective_terms(spec)
+    runs = convex_runs(spec, settings)
     per_decade = certificate_density(settings, [d.grid for d, _ in runs])
     nominal = spec.nominal_plant()
     found: list[tuple[str, Controller]] = [("convex", conv.controller) for _, conv in runs
