@@ -392,20 +392,18 @@ def record_from_columns(
     table = columns if isinstance(columns, Table) else table_from_columns(columns, source)
     if not table.columns:
         raise DataError("no numeric columns found", where=table.source)
-    cols = dict(table.columns)
-    if time is None and dt is not None:
-        n = max(a.size for a in cols.values())
-        table = Table({"__time__": np.arange(n) * float(dt), **cols}, {**table.units, "__time__": "s"},
-                      table.source, table.problems, table.notes)
-    t_name = _pick(table, "__time__" if time is None and dt is not None else time, "time", 0)
-    u_name = _pick(table, input, "input", 1)
-    y_name = _pick(table, output, "output", 2)
+    from_dt = time is None and dt is not None
+    t_name = "time" if from_dt else _pick(table, time, "time", 0)
+    shift = 1 if from_dt else 0  # without a time column, input and output default to the first two columns
+    u_name = _pick(table, input, "input", 1 - shift)
+    y_name = _pick(table, output, "output", 2 - shift)
     aux_cols = {key: table.columns[key] for key in (_pick(table, a, "aux", 0) for a in aux)}
-    t = table.columns[t_name]
-    scale = TIME_UNITS.get(table.units.get(t_name, ""), 1.0)
-    notes = table.notes + ((f"time column '{t_name}' converted to s",) if scale != 1.0 else ())
+    scale = 1.0 if from_dt else TIME_UNITS.get(table.units.get(t_name, ""), 1.0)
+    t = np.arange(table.columns[u_name].size) * float(dt or 0) if from_dt else table.columns[t_name] * scale
+    scaled = scale != 1.0
+    notes = table.notes + ((f"time column '{t_name}' converted from {table.units[t_name]} to s",) if scaled else ())
     record = record_from_arrays(
-        t * scale, table.columns[u_name], table.columns[y_name], table.signal(u_name, input_unit),
+        t, table.columns[u_name], table.columns[y_name], table.signal(u_name, input_unit),
         table.signal(y_name, output_unit), aux_cols, table.source, (t_name, u_name, y_name),
     )
     return replace(record, notes=notes + record.notes) if notes else record
