@@ -149,6 +149,13 @@ def test_time_in_ms_is_converted_and_noted(tmp_path):
     assert r.dt == 0.01 and r.notes == ("time column 'Time (ms)' converted from ms to s",)
 
 
+def test_single_column_with_a_unit_in_its_header(tmp_path):
+    p = tmp_path / "d.csv"
+    p.write_text("# hover\nmotor speed (rad/s)\n" + "".join(f"{(-1) ** k * k}\n" for k in range(40)))
+    r = load_disturbance(p, None, "motor speed", dt=0.01)
+    assert (r.name, r.unit, r.x.size) == ("motor speed", "rad/s", 40)
+
+
 def test_repeated_time_stamp_keeps_the_last_sample(tmp_path):
     p = tmp_path / "r.csv"
     p.write_text("t,u,y\n0,1000,0\n0,1010,1\n0.05,1020,2\n0.1,1030,3\n0.15,1040,4\n")

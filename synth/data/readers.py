@@ -263,6 +263,8 @@ def _read_csv(path: Path) -> Table:
         raise DataError("file is empty", where=str(path))
     delimiter = _delimiter(lines[0][1], lines[1][1] if len(lines) > 1 else None)
     header = _cells(lines[0][1], delimiter)
+    if delimiter is None and len(lines) > 1 and len(_cells(lines[1][1], None)) == 1:
+        header = [lines[0][1].strip('"')]  # one column: its header may hold spaces ("speed (rad/s)")
     keep = [i for i, h in enumerate(header) if h]
     names = [header[i] for i in keep]
     values: dict[str, list[float]] = {h: [] for h in names}
