@@ -164,6 +164,14 @@ def test_repeated_time_stamp_keeps_the_last_sample(tmp_path):
     assert r.notes[0].startswith("repeated time stamps: 1 sample(s)")
 
 
+def test_rounded_time_column_is_an_error(tmp_path):
+    p = tmp_path / "r.csv"
+    p.write_text("t,u,y\n" + "".join(f"{round(k * 0.001, 2)},{int(k > 50)},{k}\n" for k in range(100)))
+    with pytest.raises(DataError, match=r"column 't': 89 of 100 samples repeat the time stamp before them \(first "
+                                        r"at sample 1\); is the time rounded\? give the sample interval \(dt\) instead"):
+        load_record(p)
+
+
 def test_text_column_stops_only_when_used(tmp_path):
     p = tmp_path / "r.csv"
     p.write_text("t,u,y,msg\n0,0,0,\n1,1,1,started\n2,1,2,\n")

@@ -22,12 +22,14 @@ from synth.errors import DataError
 from synth.plant import Signal
 
 __all__ = [
-    "IRREGULAR_TOLERANCE", "Record", "load_record", "read_columns", "record_from_arrays", "record_from_columns",
-    "uniform_columns",
+    "IRREGULAR_TOLERANCE", "REPEATED_LIMIT", "Record", "load_record", "read_columns", "record_from_arrays",
+    "record_from_columns", "uniform_columns",
 ]
 
 #: relative spread of the sample intervals above which a record counts as irregularly sampled
 IRREGULAR_TOLERANCE = 1e-3
+#: share of samples that may repeat a time stamp (a logger's occasional double row); more (and more than 2) is an error
+REPEATED_LIMIT = 0.05
 
 
 @dataclass(frozen=True, eq=False)
@@ -140,7 +142,8 @@ def uniform_columns(
     """Check columns of numbers on one time base and put them on a uniform grid.
 
     Returns the time, the other columns (by name) and notes on what was done.
-    Samples sharing a time stamp keep the last of them. Irregular sampling
+    Samples sharing a time stamp keep the last of them (at most ``REPEATED_LIMIT`` of
+    them: more means a rounded time column). Irregular sampling
     (intervals spread by more than 0.1 %) is resampled onto a uniform grid from
     the first to the last time stamp: the columns in ``held`` (commands) keep
     their last value between samples (zero-order hold, so a step stays a step),
@@ -153,7 +156,7 @@ def uniform_columns(
     ------
     DataError
         Values that are not numbers, NaN or inf, different lengths, fewer than
-        ``min_samples`` samples, decreasing time; the column is named.
+        ``min_samples`` samples, decreasing time, many repeated time stamps; the column is named.
 
     Examples
     --------
@@ -191,6 +194,10 @@ def uniform_columns(
     if np.any(steps == 0):
         keep = np.r_[steps > 0, True]  # the last sample of each run of equal time stamps
         first = int(np.flatnonzero(steps == 0)[0])
+        if np.sum(~keep) > max(2.0, REPEATED_LIMIT * tt.size):
+            raise DataError(f"column '{time}': {int(np.sum(~keep))} of {tt.size} samples repeat the time stamp "
+                            f"before them (first at sample {first + 1}); is the time rounded? give the sample "
+                            "interval (dt) instead", where=source)
         notes += (f"repeated time stamps: {int(np.sum(~keep))} sample(s) share a time stamp with the next "
                   f"(first at t = {tt[first]:g} s); kept the last of each",)
         tt, arrays = tt[keep], {k: v[keep] for k, v in arrays.items()}
