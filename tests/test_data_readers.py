@@ -228,6 +228,8 @@ def test_missing_mat_column_lists_the_columns(tmp_path):
         load_record(p, "run.t", "run.cmd", "acc[3]")
     with pytest.raises(DataError, match=r"columns map: column 'acc\[7\]' not found"):
         load_record(p, "run.t", "run.cmd", "x", columns={"acc[7]": "x"})
+    with pytest.raises(DataError, match=r"sweep.mat: columns map: two columns would be named 'run.t'$"):
+        load_record(p, "run.t", "run.cmd", "acc[1]", columns={"acc[0]": "run.t"})
 
 
 def test_column_map_parsing():

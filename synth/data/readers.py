@@ -161,6 +161,10 @@ class Table:
         if not mapping:
             return self
         new = {self.find(old, "columns map:"): str(new).strip() for old, new in mapping.items()}
+        kept = [k for k in self.names() if k not in new]
+        clash = [v for v in new.values() if v in kept] or [v for v in set(new.values()) if list(new.values()).count(v) > 1]
+        if clash:
+            raise DataError(f"columns map: two columns would be named '{clash[0]}'", where=self.source)
         columns = {new.get(k, k): v for k, v in self.columns.items()}
         units = {new.get(k, k): self.units.get(k, "") or split_unit(new.get(k, k))[1] for k in self.columns}
         problems = {new.get(k, k): v for k, v in self.problems.items()}
