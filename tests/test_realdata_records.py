@@ -106,6 +106,24 @@ def test_hsm150_run_to_run_plateaus(run, plateau):
     assert r.y[(r.t >= 8) & (r.t < 10)].mean() == pytest.approx(plateau, abs=1)
 
 
+# README: file name -> torque levels [N m]; first plateau [rad/s]; incremental gain [rad/s per 0.010 N m]
+HSM_RUNS = {"neg_0.04": ((-0.030, -0.040), (-170, -143), (40, 46)), "neg_0.045": ((-0.030, -0.045), (-170, -143), None),
+            "pos_0.06": ((0.050, 0.060), (139, 147), (71, 97)), "pos_0.065": ((0.050, 0.065), (139, 147), None)}
+
+
+@pytest.mark.parametrize("run", [1, 2, 3])
+@pytest.mark.parametrize("kind", list(HSM_RUNS))
+def test_hsm150_levels_plateaus_and_direction_gains(kind, run):
+    levels, plateau, gain = HSM_RUNS[kind]
+    r = load_record(shared_path("data", HSM, f"idf_{kind}_{run}.mat"), "data[0]", "data[4]", "data[3]")
+    assert (r.u[0], r.u[-1]) == levels and r.t[np.flatnonzero(np.diff(r.u)) + 1].tolist() == [10.0]
+    first = r.y[(r.t >= 8) & (r.t < 10)].mean()
+    assert plateau[0] - 1 <= first <= plateau[1] + 1  # "-0.030 N m gives about -143..-170 rad/s", "+139..+147"
+    if gain:  # "negative runs ~ -40..-46 rad/s per -0.010 N m, positive runs ~ +71..+97 rad/s per +0.010 N m"
+        second = r.y[r.t >= 18].mean()
+        assert gain[0] - 1 <= (second - first) / ((levels[1] - levels[0]) / 0.010) <= gain[1] + 1
+
+
 def test_hsm150_columns_map_on_the_cli(run_cli):
     path = shared_path("data", HSM, "idf_pos_0.06_1.mat")
     res = run_cli("psd", "--data", str(path), "--columns", "data[0]=t,data[3]=speed", "--time", "t",
