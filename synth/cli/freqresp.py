@@ -31,9 +31,12 @@ exit codes: 0 done, 1 no coherent band, 2 bad input"""
 def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--data", action="append", required=True, metavar="FILE",
                    help="sweep run (CSV or MAT); repeat for several runs")
-    p.add_argument("--time", help="time column (default: the first)")
+    p.add_argument("--time", help="time column, with or without its unit (default: the first)")
     p.add_argument("--input", help="input column (default: the second)")
     p.add_argument("--output", help="output column (default: the third)")
+    p.add_argument("--columns", metavar="OLD=NEW,...", action="append", default=[],
+                   help="rename columns before picking them, e.g. acc[0]=accel_x (a MAT matrix gives acc[0], "
+                        "acc[1], ...; a struct s.field); repeatable")
     p.add_argument("--dt", type=float, metavar="S", help="sample interval when the files have no time column")
     p.add_argument("--wmin", type=float, metavar="RAD_S", help="lowest frequency (default: what the runs support)")
     p.add_argument("--wmax", type=float, metavar="RAD_S", help="highest frequency (default: a fifth of Nyquist)")
@@ -65,8 +68,9 @@ def _floats(text: str, where: str, count: int | None = None, sep: str = ",") -> 
 
 def _load(path: str, args: argparse.Namespace) -> Any:
     from synth.data import load_record
+    from synth.data.readers import parse_column_map
 
-    return load_record(path, args.time, args.input, args.output, dt=args.dt)
+    return load_record(path, args.time, args.input, args.output, dt=args.dt, columns=parse_column_map(args.columns))
 
 
 def run(args: argparse.Namespace) -> int:

@@ -35,6 +35,9 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     src = p.add_mutually_exclusive_group(required=True)
     src.add_argument("--tf", help='attitude response model, e.g. "1/(s^2+s+1)"')
     src.add_argument("--frd", metavar="FILE", help="measured frequency response (CSV or synth freqresp JSON)")
+    p.add_argument("--columns", metavar="OLD=NEW,...", action="append", default=[],
+                   help="rename the --frd file's columns to w, mag_db, phase_deg, coherence, e.g. omega=w; "
+                        "headers may carry units ('w (rad/s)')")
     p.add_argument("--delay", type=float, default=0.0, help="delay added to --tf [s]")
     p.add_argument("--response-type", choices=["auto", "rate", "attitude"], default="auto",
                    help="rate: bandwidth is the lesser of phase and gain bandwidths; attitude: the phase "
@@ -49,10 +52,11 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--force", action="store_true", help="overwrite files synth did not write")
 
 
-def read_frd(path: str | Path) -> dict[str, Any]:
+def read_frd(path: str | Path, columns: dict[str, str] | None = None) -> dict[str, Any]:
     """Read a measured frequency response: ``synth freqresp`` JSON or CSV ``w, mag_db, phase_deg[, coherence]``.
 
-    Returns ``{"w", "H", "coherence", "averages"}`` (``H`` complex).
+    Returns ``{"w", "H", "coherence", "averages"}`` (``H`` complex). CSV headers may carry units
+    (``w (rad/s)``, ``mag_db [dB]``); ``columns`` renames CSV columns first (``{"omega": "w"}``).
 
     Examples
     --------
@@ -65,7 +69,7 @@ def read_frd(path: str | Path) -> dict[str, Any]:
     """
     import numpy as np
 
-    from synth.data.record import read_columns
+    from synth.data.readers import read_table
     from synth.errors import DataError
 
     path = Path(path)
@@ -79,7 +83,15 @@ def read_frd(path: str | Path) -> dict[str, Any]:
         keys = {"w": "w", "mag_db": "magnitude_db", "phase_deg": "phase_deg", "coherence": "coherence"}
         averages = data.get("averages") if isinstance(data, dict) else None
     else:
-        data = read_columns(path)
+        table = read_table(path, columns)
+        data = {}
+        for name in ("w", "mag_db", "phase_deg", "coherence"):
+            key = table.get(name)
+            if key is None and name != "coherence":
+                raise DataError(f"column '{name}' not found; found {', '.join(table.names()) or 'nothing'}",
+                                where=str(path))
+            if key is not None:
+                data[name] = table.columns[table.find(key)]
         keys = {"w": "w", "mag_db": "mag_db", "phase_deg": "phase_deg", "coherence": "coherence"}
         averages = None
     if not isinstance(data, dict):
@@ -113,6 +125,7 @@ def _fmt(value: Any, unit: str, sigma: Any = None, digits: int = 4) -> str:
 
 def run(args: argparse.Namespace) -> int:
     from synth.cli._table import name_values
+    from synth.data.readers import parse_column_map
     from synth.errors import DataError, ModelError
     from synth.ident.hq import hq_from_frd, hq_from_plant
     from synth.outputs import OutputDir, check_writable, dump_json, write_json
@@ -126,7 +139,7 @@ def run(args: argparse.Namespace) -> int:
         m = hq_from_plant(plant, args.response_type)
         title = plant.to_string()
     else:
-        frd = read_frd(args.frd)
+        frd = read_frd(args.frd, parse_column_map(args.columns))
         averages = args.averages if args.averages is not None else frd["averages"]
         try:
             m = hq_from_frd(frd["w"], frd["H"], frd["coherence"], averages, args.response_type, args.phase_fit,

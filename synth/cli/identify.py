@@ -30,6 +30,14 @@ example:
       --structure "k*(s+z)/((s+p1)*(s+p2))" --delay fit --sensor "442/((s+45)*(s+9.7))"
   synth identify --data 06_dc_step_5_15_00.mat --time Zeit --input Motorspannung \\
       --output Geschwindigkeit --structure "K/(T1*s+1)^2" --delay fit --json dc.json
+  synth identify --data stand.csv --time "Time (s)" --input "ESC signal" --output Thrust \\
+      --structure "K/(T*s+1)" --delay fit
+  synth identify --data runs.mat --columns "data[0]=t,data[4]=torque,data[3]=speed" \\
+      --time t --input torque --output speed --structure "K/(T*s+1)"
+
+Records: '#' comment lines anywhere; units in headers ('Time (s)', 'Voltage [V]') become the
+signals' units and columns may be named with or without them; uneven time stamps are resampled
+with the input held between samples (a step stays a step) and the output interpolated.
 
 --x4-demo uses a SYNTHETIC X-4 step train generated from the seed paper's model
 (not measured data; see synth.ident.x4_record).
@@ -39,11 +47,16 @@ exit codes: 0 identified, 2 bad input"""
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--data", metavar="FILE", help="record: CSV with a header row, or MAT")
-    p.add_argument("--time", metavar="COL", help="time column (default: the first)")
-    p.add_argument("--input", metavar="COL", help="input column (default: the second)")
+    p.add_argument("--time", metavar="COL", help="time column, with or without its unit (default: the first)")
+    p.add_argument("--input", metavar="COL", help="input column (the command; default: the second)")
     p.add_argument("--output", metavar="COL", help="output column (default: the third)")
-    p.add_argument("--input-unit", default="", metavar="UNIT", help="unit of the input, e.g. PWM or V")
-    p.add_argument("--output-unit", default="", metavar="UNIT", help="unit of the output, e.g. rad/s")
+    p.add_argument("--columns", metavar="OLD=NEW,...", action="append", default=[],
+                   help="rename columns before picking them, e.g. acc[0]=accel_x (a MAT matrix gives acc[0], "
+                        "acc[1], ...; a struct s.field); repeatable")
+    p.add_argument("--input-unit", default="", metavar="UNIT",
+                   help="unit of the input, e.g. PWM or V (default: the header's, as in 'pwm (us)')")
+    p.add_argument("--output-unit", default="", metavar="UNIT",
+                   help="unit of the output, e.g. rad/s (default: the header's)")
     p.add_argument("--structure", metavar="FORMULA",
                    help='plant structure; names other than s are parameters, e.g. "k*(s+z)/((s+p1)*(s+p2))"')
     p.add_argument("--delay", metavar="fit|SECONDS",
@@ -77,6 +90,7 @@ def _demo_defaults(args: argparse.Namespace) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from synth.data import load_record
+    from synth.data.readers import parse_column_map
     from synth.errors import ModelError, SynthError
     from synth.ident.structure import parse_structure
     from synth.ident.timefit import identify
@@ -92,8 +106,8 @@ def run(args: argparse.Namespace) -> int:
         structure = parse_structure(args.structure)
     except ModelError as exc:
         raise exc.located("--structure") from None
-    record = load_record(args.data, args.time, args.input, args.output,
-                         input_unit=args.input_unit, output_unit=args.output_unit)
+    record = load_record(args.data, args.time, args.input, args.output, input_unit=args.input_unit,
+                         output_unit=args.output_unit, columns=parse_column_map(args.columns))
     try:
         result = identify(record, structure, args.delay, args.sensor, args.average)
     except ModelError as exc:

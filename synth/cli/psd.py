@@ -28,9 +28,12 @@ exit codes: 0 computed, 2 bad input"""
 def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--data", action="append", required=True, metavar="FILE",
                    help="CSV or MAT record (repeat for several; same sample rate)")
-    p.add_argument("--time", help="time column [s] (omit with --dt)")
+    p.add_argument("--time", help="time column [s], with or without its unit (omit with --dt)")
     p.add_argument("--signal", required=True, help="disturbance column")
-    p.add_argument("--unit", default="", help="unit of the signal (labels)")
+    p.add_argument("--columns", metavar="OLD=NEW,...", action="append", default=[],
+                   help="rename columns before picking them, e.g. acc[0]=accel_x (a MAT matrix gives acc[0], "
+                        "acc[1], ...; a struct s.field); repeatable")
+    p.add_argument("--unit", default="", help="unit of the signal (labels; default: the header's)")
     p.add_argument("--dt", type=float, help="sample interval [s] for files without a time column")
     p.add_argument("--noise-data", action="append", default=[], metavar="FILE",
                    help="noise-only record (e.g. motor stopped) whose level is the noise floor")
@@ -52,13 +55,15 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace) -> int:
     from synth.cli._table import name_values
     from synth.data.disturbance import load_disturbance
+    from synth.data.readers import parse_column_map
     from synth.ident.bandwidth_suggestion import suggest_bandwidth
     from synth.ident.psd import analyze_records
     from synth.ident.welch import unit_squared
     from synth.outputs import OutputDir, check_writable, dump_json, write_json
 
-    records = [load_disturbance(f, args.time, args.signal, args.unit, args.dt) for f in args.data]
-    noise = [load_disturbance(f, args.time, args.signal, args.unit, args.dt) for f in args.noise_data]
+    columns = parse_column_map(args.columns)
+    records = [load_disturbance(f, args.time, args.signal, args.unit, args.dt, columns) for f in args.data]
+    noise = [load_disturbance(f, args.time, args.signal, args.unit, args.dt, columns) for f in args.noise_data]
     a = analyze_records(records, noise, share=args.share, band=tuple(args.band) if args.band else None,
                         segment=args.segment, w_min=args.w_min,
                         floor_band=tuple(args.floor_band) if args.floor_band else None, spike_db=args.spike_db,

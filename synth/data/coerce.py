@@ -8,6 +8,7 @@ from typing import Any
 
 import numpy as np
 
+from synth.data.readers import table_from_columns
 from synth.data.record import Record, load_record, record_from_arrays, record_from_columns
 from synth.errors import DataError
 from synth.plant import Signal
@@ -34,6 +35,7 @@ def as_record(
     input_unit: str = "",
     output_unit: str = "",
     dt: float | None = None,
+    columns: Mapping[str, str] | None = None,
 ) -> Record:
     """Turn what the user holds into a :class:`Record`, validated as a file would be.
 
@@ -53,6 +55,9 @@ def as_record(
         Units of the input and output (kept if ``data`` is a Record).
     dt : float, optional
         Sample time [s] when the data has no time column.
+    columns : mapping of str to str, optional
+        Renames named columns (a file's, a dict's, a DataFrame's) before they are picked, e.g.
+        ``{"acc[0]": "accel_x"}``.
 
     Raises
     ------
@@ -78,18 +83,20 @@ def as_record(
     if isinstance(data, Record):
         return data
     if isinstance(data, str | Path):
-        return load_record(data, time, input, output, aux, input_unit, output_unit, dt)
+        return load_record(data, time, input, output, aux, input_unit, output_unit, dt, columns)
     named = [n for n in (time, input, output, *aux) if n is not None]
     explicit = input is not None and output is not None and (time is not None or dt is not None)
     if _is_table(data):
         raw = {str(c): data[c] for c in data.columns}
         if time == "index":
             raw = {"index": data.index, **raw}
-        columns = _numeric_columns(raw, "DataFrame", named, explicit)
-        return record_from_columns(columns, "DataFrame", time, input, output, aux, input_unit, output_unit, dt)
+        table = table_from_columns(_numeric_columns(raw, "DataFrame", named, explicit), "DataFrame")
+        return record_from_columns(table.renamed(columns or {}), "DataFrame", time, input, output, aux, input_unit,
+                                   output_unit, dt)
     if isinstance(data, Mapping):
-        columns = _numeric_columns({str(k): v for k, v in data.items()}, "columns", named, explicit)
-        return record_from_columns(columns, "columns", time, input, output, aux, input_unit, output_unit, dt)
+        table = table_from_columns(_numeric_columns({str(k): v for k, v in data.items()}, "columns", named, explicit))
+        return record_from_columns(table.renamed(columns or {}), "columns", time, input, output, aux, input_unit,
+                                   output_unit, dt)
     arrays = _as_arrays(data)
     if arrays is not None:
         if len(arrays) == 2 and dt is not None:

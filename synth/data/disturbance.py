@@ -6,13 +6,14 @@ with a file is a one-line :class:`~synth.errors.DataError` naming the file and c
 
 from __future__ import annotations
 
-import difflib
-from dataclasses import dataclass
+from collections.abc import Mapping
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from synth.data.readers import TIME_UNITS, read_table
 from synth.data.record import uniform_columns
 from synth.errors import DataError
 
@@ -60,14 +61,14 @@ def disturbance_from_arrays(t: Any, x: Any, name: str = "y", unit: str = "", sou
     Raises
     ------
     DataError
-        NaN or inf, different lengths, fewer than 16 samples, non-increasing time, a constant signal.
+        NaN or inf, different lengths, fewer than 16 samples, decreasing time, a constant signal.
 
     Examples
     --------
-    >>> t = np.arange(20.0); t[5] = t[4]
+    >>> t = np.arange(20.0); t[5] = 3.5
     >>> disturbance_from_arrays(t, np.arange(20.0))
     Traceback (most recent call last):
-    synth.errors.DataError: arrays: column 'time': time is not strictly increasing at sample 5 (t = 4 s)
+    synth.errors.DataError: arrays: column 'time': time is not strictly increasing at sample 5 (t = 3.5 s)
     """
     tt, cols, notes = uniform_columns({time_name: t, name: x}, time_name, source, min_samples=16)
     xx = cols[name]
@@ -77,20 +78,23 @@ def disturbance_from_arrays(t: Any, x: Any, name: str = "y", unit: str = "", sou
 
 
 def load_disturbance(path: str | Path, time: str | None, signal: str, unit: str = "",
-                     dt: float | None = None) -> DisturbanceRecord:
-    """Read one disturbance channel from a CSV or MAT file (see :func:`synth.data.record.read_columns`).
+                     dt: float | None = None, columns: Mapping[str, str] | None = None) -> DisturbanceRecord:
+    """Read one disturbance channel from a CSV or MAT file (see :func:`synth.data.readers.read_table`).
 
     Parameters
     ----------
     path : str or Path
     time : str or None
-        Time column [s]; ``None`` with ``dt`` for a file without one.
+        Time column [s] (with or without the header's unit; ``Time (ms)`` is converted); ``None``
+        with ``dt`` for a file without one.
     signal : str
         The measured channel.
     unit : str
-        Its unit (labels and JSON).
+        Its unit (labels and JSON); default the header's.
     dt : float, optional
         Sample interval [s] when there is no time column.
+    columns : mapping of str to str, optional
+        Renames columns first, e.g. ``{"acc[2]": "accel_z"}``.
 
     Examples
     --------
@@ -99,22 +103,19 @@ def load_disturbance(path: str | Path, time: str | None, signal: str, unit: str 
     >>> _ = p.write_text("t,speed\\n" + "".join(f"{k * 0.001},{(-1) ** k}\\n" for k in range(20)))
     >>> load_disturbance(p, "t", "sped")
     Traceback (most recent call last):
-    synth.errors.DataError: ...d.csv: signal column 'sped' not found; did you mean 'speed'?
+    synth.errors.DataError: ...d.csv: signal column 'sped' not found; did you mean 'speed'? columns are t, speed
     """
-    from synth.data.record import read_columns
-
     path = Path(path)
-    columns = read_columns(path)
-    for role, name in (("time", time), ("signal", signal)):
-        if name is not None and name not in columns:
-            close = difflib.get_close_matches(name, list(columns), n=1)
-            hint = f"; did you mean '{close[0]}'?" if close else f"; columns are {', '.join(columns) or 'none'}"
-            raise DataError(f"{role} column '{name}' not found{hint}", where=str(path))
-    x = columns[signal]
-    if time is None:
+    table = read_table(path, columns)
+    t_key = table.find(time, "time") if time is not None else None
+    x_key = table.find(signal, "signal")
+    x = table.columns[x_key]
+    if t_key is None:
         if dt is None or not (np.isfinite(dt) and dt > 0):
             raise DataError("no time column given: give the sample interval dt > 0 s", where=str(path))
         t = np.arange(x.size) * float(dt)
     else:
-        t = columns[time]
-    return disturbance_from_arrays(t, x, signal, unit, str(path), time or "time")
+        t = table.columns[t_key] * TIME_UNITS.get(table.units.get(t_key, ""), 1.0)
+    sig = table.signal(x_key, unit)
+    record = disturbance_from_arrays(t, x, x_key, sig.unit, str(path), t_key or "time")
+    return replace(record, name=sig.name, notes=table.notes + record.notes)

@@ -1,32 +1,35 @@
 """One measured experiment: time, input, output (and extra channels), validated.
 
-Loading is strict and says what it did: NaN or inf, non-increasing time,
+Loading is strict and says what it did: NaN or inf, decreasing time,
 columns of different length, a missing column, a constant input or an output
 that never responds raise a :class:`~synth.errors.DataError` naming the file
-and the column; irregular sampling is resampled onto a uniform grid by linear
-interpolation and the record's ``notes`` say so.
+and the column; irregular sampling is resampled onto a uniform grid (the
+input held between samples, the other columns interpolated linearly) and the
+record's ``notes`` say so. Files are read by :mod:`synth.data.readers`.
 """
 
 from __future__ import annotations
 
-import csv
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from synth.data.readers import TIME_UNITS, Table, read_table, table_from_columns
 from synth.errors import DataError
 from synth.plant import Signal
 
 __all__ = [
-    "IRREGULAR_TOLERANCE", "Record", "load_record", "read_columns", "record_from_arrays", "record_from_columns",
-    "uniform_columns",
+    "IRREGULAR_TOLERANCE", "REPEATED_LIMIT", "Record", "load_record", "read_columns", "record_from_arrays",
+    "record_from_columns", "uniform_columns",
 ]
 
 #: relative spread of the sample intervals above which a record counts as irregularly sampled
 IRREGULAR_TOLERANCE = 1e-3
+#: share of samples that may repeat a time stamp (a logger's occasional double row); more (and more than 2) is an error
+REPEATED_LIMIT = 0.05
 
 
 @dataclass(frozen=True, eq=False)
@@ -134,24 +137,35 @@ class Record:
 
 def uniform_columns(
     columns: Mapping[str, Sequence[float] | np.ndarray], time: str, source: str = "arrays", min_samples: int = 3,
+    held: Sequence[str] = (),
 ) -> tuple[np.ndarray, dict[str, np.ndarray], tuple[str, ...]]:
     """Check columns of numbers on one time base and put them on a uniform grid.
 
     Returns the time, the other columns (by name) and notes on what was done.
-    Irregular sampling (intervals spread by more than 0.1 %) is resampled by
-    linear interpolation onto the median interval, and a note says so.
+    Samples sharing a time stamp keep the last of them (at most ``REPEATED_LIMIT`` of
+    them: more means a rounded time column). Irregular sampling
+    (intervals spread by more than 0.1 %) is resampled onto a uniform grid from
+    the first to the last time stamp: the columns in ``held`` (commands) keep
+    their last value between samples (zero-order hold, so a step stays a step),
+    the others are interpolated linearly. The grid interval is the median
+    interval, or the shortest time a held column stays at one value if that is
+    shorter (down to a quarter of the median), so that no command level is
+    skipped; the notes say what was done.
 
     Raises
     ------
     DataError
         Values that are not numbers, NaN or inf, different lengths, fewer than
-        ``min_samples`` samples, non-increasing time; the column is named.
+        ``min_samples`` samples, decreasing time, many repeated time stamps; the column is named.
 
     Examples
     --------
     >>> t, cols, notes = uniform_columns({"t": [0, 0.1, 0.25, 0.3], "x": [0, 1, 2, 3]}, "t")
     >>> t.round(3).tolist(), cols["x"].round(3).tolist(), notes[0].split(":")[0]
     ([0.0, 0.1, 0.2, 0.3], [0.0, 1.0, 1.667, 3.0], 'resampled')
+    >>> t, cols, notes = uniform_columns({"t": [0, 0.1, 0.25, 0.3], "u": [0, 1, 2, 3]}, "t", held=["u"])
+    >>> t.round(3).tolist(), cols["u"].tolist()
+    ([0.0, 0.05, 0.1, 0.15, 0.2, 0.25, 0.3], [0.0, 0.0, 1.0, 1.0, 1.0, 2.0, 3.0])
     """
     arrays: dict[str, np.ndarray] = {}
     for name, values in columns.items():
@@ -172,20 +186,57 @@ def uniform_columns(
     if tt.size < min_samples:
         raise DataError(f"column '{time}': needs at least {min_samples} samples, got {tt.size}", where=source)
     steps = np.diff(tt)
-    if np.any(steps <= 0):
-        k = int(np.flatnonzero(steps <= 0)[0]) + 1
+    if np.any(steps < 0):
+        k = int(np.flatnonzero(steps < 0)[0]) + 1
         raise DataError(f"column '{time}': time is not strictly increasing at sample {k} (t = {tt[k]:g} s)",
                         where=source)
     notes: tuple[str, ...] = ()
+    if np.any(steps == 0):
+        keep = np.r_[steps > 0, True]  # the last sample of each run of equal time stamps
+        first = int(np.flatnonzero(steps == 0)[0])
+        if np.sum(~keep) > max(2.0, REPEATED_LIMIT * tt.size):
+            raise DataError(f"column '{time}': {int(np.sum(~keep))} of {tt.size} samples repeat the time stamp "
+                            f"before them (first at sample {first + 1}); is the time rounded? give the sample "
+                            "interval (dt) instead", where=source)
+        notes += (f"repeated time stamps: {int(np.sum(~keep))} sample(s) share a time stamp with the next "
+                  f"(first at t = {tt[first]:g} s); kept the last of each",)
+        tt, arrays = tt[keep], {k: v[keep] for k, v in arrays.items()}
+        if tt.size < min_samples:
+            raise DataError(f"column '{time}': needs at least {min_samples} distinct time stamps, got {tt.size}",
+                            where=source)
+        steps = np.diff(tt)
     spread = (steps.max() - steps.min()) / np.median(steps)
     if spread > IRREGULAR_TOLERANCE:
-        dt = float(np.median(steps))
-        grid = tt[0] + dt * np.arange(int(np.floor((tt[-1] - tt[0]) / dt + 1e-9)) + 1)
-        notes = (f"resampled: sample intervals ranged {steps.min():.4g}-{steps.max():.4g} s; linearly "
-                 f"interpolated onto a uniform {dt:.4g} s grid ({tt.size} -> {grid.size} samples)",)
-        arrays = {k: np.interp(grid, tt, v) for k, v in arrays.items()}
-        tt = grid
+        tt, arrays, note = _resample(tt, arrays, [h for h in held if h in arrays])
+        notes += (f"resampled: sample intervals ranged {steps.min():.4g}-{steps.max():.4g} s; {note}",)
     return tt, arrays, notes
+
+
+def _resample(tt: np.ndarray, arrays: dict[str, np.ndarray], held: list[str]
+              ) -> tuple[np.ndarray, dict[str, np.ndarray], str]:
+    """Uniform grid from ``tt[0]`` to ``tt[-1]``: ``held`` columns zero-order held, the others linear."""
+    median = float(np.median(np.diff(tt)))
+    target = median
+    for h in held:
+        changes = tt[np.flatnonzero(np.diff(arrays[h]) != 0) + 1]
+        if changes.size > 1:
+            target = min(target, max(float(np.min(np.diff(changes))), median / 4))
+    span = float(tt[-1] - tt[0])
+    n = max(1, int(np.ceil(span / target - 1e-9)))
+    grid = np.linspace(tt[0], tt[-1], n + 1)
+    dt = span / n
+    index = np.clip(np.searchsorted(tt, grid + 1e-9 * dt, side="right") - 1, 0, tt.size - 1)
+    out = {k: (v[index] if k in held else np.interp(grid, tt, v)) for k, v in arrays.items()}
+    note = f"onto a uniform {dt:.4g} s grid ({tt.size} -> {grid.size} samples)"
+    for h in held:
+        runs = int(np.count_nonzero(np.diff(arrays[h]))) + 1
+        kept = int(np.count_nonzero(np.diff(out[h]))) + 1
+        lost = f"; {runs - kept} of its {runs} levels were shorter than the grid and dropped" if kept < runs else ""
+        note += f"; '{h}' held at its last value between samples (zero-order hold){lost}"
+    others = [k for k in out if k not in held]
+    if others:
+        note += f"; {', '.join(repr(k) for k in others)} linearly interpolated"
+    return grid, out, note
 
 
 def record_from_arrays(
@@ -199,6 +250,9 @@ def record_from_arrays(
     names: tuple[str, str, str] = ("time", "input", "output"),
 ) -> Record:
     """Validate arrays and build a :class:`Record` (resampling irregular time explicitly).
+
+    On irregular time the input (a command) is held between samples and the
+    output and ``aux`` are interpolated linearly (see :func:`uniform_columns`).
 
     Parameters
     ----------
@@ -222,15 +276,16 @@ def record_from_arrays(
     Examples
     --------
     >>> r = record_from_arrays([0, 0.1, 0.25, 0.3], [0, 1, 1, 1], [0, 1, 2, 3])
-    >>> r.t.round(3).tolist(), r.notes[0].split(":")[0]
-    ([0.0, 0.1, 0.2, 0.3], 'resampled')
-    >>> record_from_arrays([0, 1, 1], [0, 1, 2], [0, 1, 2])
+    >>> r.t.round(3).tolist(), r.u.tolist(), r.notes[0].split(":")[0]
+    ([0.0, 0.1, 0.2, 0.3], [0.0, 1.0, 1.0, 1.0], 'resampled')
+    >>> record_from_arrays([0, 1, 0.5], [0, 1, 2], [0, 1, 2])
     Traceback (most recent call last):
-    synth.errors.DataError: arrays: column 'time': time is not strictly increasing at sample 2 (t = 1 s)
+    synth.errors.DataError: arrays: column 'time': time is not strictly increasing at sample 2 (t = 0.5 s)
     """
     input = input or Signal(names[1], "")
     output = output or Signal(names[2], "")
-    tt, arrays, notes = uniform_columns({names[0]: t, names[1]: u, names[2]: y, **dict(aux or {})}, names[0], source)
+    tt, arrays, notes = uniform_columns({names[0]: t, names[1]: u, names[2]: y, **dict(aux or {})}, names[0], source,
+                                        held=(names[1],))
     uu, yy = arrays.pop(names[1]), arrays.pop(names[2])
     if np.ptp(uu) == 0:
         raise DataError(f"column '{names[1]}': the input is constant ({uu[0]:g}); nothing excites the plant",
@@ -240,54 +295,8 @@ def record_from_arrays(
     return Record(tt, uu, yy, input, output, arrays, source, notes)
 
 
-def _read_csv(path: Path) -> dict[str, np.ndarray]:
-    try:
-        with path.open(newline="", encoding="utf-8-sig") as fh:
-            sample = fh.read(4096)
-            fh.seek(0)
-            try:
-                dialect = csv.Sniffer().sniff(sample, delimiters=",;\t ")
-            except csv.Error:
-                dialect = csv.excel
-            reader = csv.reader(fh, dialect)
-            header = [h.strip() for h in next(reader, [])]
-            if not header:
-                raise DataError("file is empty", where=str(path))
-            rows = [row for row in reader if any(cell.strip() for cell in row)]
-    except OSError as exc:
-        raise DataError(f"cannot read: {exc.strerror or exc}", where=str(path)) from None
-    except UnicodeDecodeError:
-        raise DataError("not a text CSV file", where=str(path)) from None
-    columns: dict[str, list[float]] = {h: [] for h in header}
-    for i, row in enumerate(rows, start=2):
-        for h, cell in zip(header, row):
-            text = cell.strip()
-            try:
-                columns[h].append(float(text) if text else np.nan)
-            except ValueError:
-                raise DataError(f"line {i}: column '{h}': '{text}' is not a number", where=str(path)) from None
-    return {h: np.asarray(v, float) for h, v in columns.items()}
-
-
-def _read_mat(path: Path) -> dict[str, np.ndarray]:
-    from scipy.io import loadmat
-
-    try:
-        raw = loadmat(str(path), squeeze_me=True)
-    except (OSError, ValueError, NotImplementedError) as exc:  # NotImplementedError: v7.3 (HDF5) files
-        raise DataError(f"cannot read as a MATLAB file: {exc}", where=str(path)) from None
-    out: dict[str, np.ndarray] = {}
-    for key, value in raw.items():
-        if key.startswith("__"):
-            continue
-        a = np.asarray(value)
-        if a.dtype.kind in "iuf" and a.ndim == 1 and a.size > 1:
-            out[key] = a.astype(float)
-    return out
-
-
 def read_columns(path: str | Path) -> dict[str, np.ndarray]:
-    """All numeric columns of a CSV file (header row) or of a MAT file (1-D variables).
+    """All numeric columns of a CSV file (header row) or of a MAT file (see :func:`synth.data.readers.read_table`).
 
     Examples
     --------
@@ -297,27 +306,7 @@ def read_columns(path: str | Path) -> dict[str, np.ndarray]:
     >>> sorted(read_columns(p))
     ['t', 'u', 'y']
     """
-    path = Path(path)
-    if not path.exists():
-        raise DataError("file not found", where=str(path))
-    if path.suffix.lower() == ".mat":
-        return _read_mat(path)
-    return _read_csv(path)
-
-
-def _pick(columns: dict[str, np.ndarray], name: str | None, role: str, path: Path, fallback: int) -> str:
-    if name is None:
-        keys = list(columns)
-        if len(keys) <= fallback:
-            raise DataError(f"no {role} column given and the file has only {len(keys)} column(s)", where=str(path))
-        return keys[fallback]
-    if name not in columns:
-        import difflib
-
-        close = difflib.get_close_matches(name, list(columns), n=1)
-        hint = f"; did you mean '{close[0]}'?" if close else f"; columns are {', '.join(columns)}"
-        raise DataError(f"{role} column '{name}' not found{hint}", where=str(path))
-    return name
+    return read_table(path).columns
 
 
 def load_record(
@@ -329,41 +318,58 @@ def load_record(
     input_unit: str = "",
     output_unit: str = "",
     dt: float | None = None,
+    columns: Mapping[str, str] | None = None,
 ) -> Record:
     """Load one record from a CSV (header row) or MAT file.
 
     Parameters
     ----------
     path : str or Path
-        ``.csv`` (any of ``, ; tab space`` as separator) or ``.mat`` (MATLAB v5).
+        ``.csv`` (any of ``, ; tab space`` as separator, ``#`` comment lines anywhere, units in the
+        header such as ``Time (s)`` or ``Voltage [V]``) or ``.mat`` (MATLAB v5: vectors, matrix
+        columns ``acc[0]``, ..., struct fields ``s.field``); see :mod:`synth.data.readers`.
     time, input, output : str, optional
-        Column names; default the first, second and third column. ``time`` may be
-        omitted for a file without a time column if ``dt`` is given.
+        Column names, with or without the header's unit; default the first, second and third column.
+        ``time`` may be omitted for a file without a time column if ``dt`` is given. A time column
+        in ms (``Time (ms)``) is converted to seconds.
     aux : sequence of str
         Extra channels to carry along (current, voltage, ...).
     input_unit, output_unit : str
-        Units of the input and output, carried into reports.
+        Units of the input and output, carried into reports (default: the header's unit).
     dt : float, optional
         Sample interval [s] when the file has no time column.
+    columns : mapping of str to str, optional
+        Renames columns before they are picked, e.g. ``{"acc[0]": "accel_x"}``.
 
     Examples
     --------
     >>> import pathlib, tempfile
     >>> p = pathlib.Path(tempfile.mkdtemp()) / "r.csv"
-    >>> _ = p.write_text("t,pwm,speed\\n0,175,820\\n0.001,225,821\\n0.002,225,825\\n")
-    >>> r = load_record(p, "t", "pwm", "speed", input_unit="PWM", output_unit="rad/s")
-    >>> r.input.label(), r.y.tolist()
-    ('pwm [PWM]', [820.0, 821.0, 825.0])
+    >>> _ = p.write_text("t,pwm,speed (rad/s)\\n0,175,820\\n0.001,225,821\\n0.002,225,825\\n# end\\n")
+    >>> r = load_record(p, "t", "pwm", "speed", input_unit="PWM")
+    >>> r.input.label(), r.output.label(), r.y.tolist()
+    ('pwm [PWM]', 'speed [rad/s]', [820.0, 821.0, 825.0])
     >>> load_record(p, "t", "pwm", "sped")
     Traceback (most recent call last):
-    synth.errors.DataError: ...r.csv: output column 'sped' not found; did you mean 'speed'?
+    synth.errors.DataError: ...r.csv: output column 'sped' not found; did you mean 'speed (rad/s)'? columns are t, pwm, ...
     """
     path = Path(path)
-    return record_from_columns(read_columns(path), str(path), time, input, output, aux, input_unit, output_unit, dt)
+    return record_from_columns(read_table(path, columns), str(path), time, input, output, aux, input_unit,
+                               output_unit, dt)
+
+
+def _pick(table: Table, name: str | None, role: str, fallback: int) -> str:
+    if name is None:
+        keys = list(table.columns)
+        if len(keys) <= fallback:
+            raise DataError(f"no {role} column given and the file has only {len(keys)} column(s)",
+                            where=table.source)
+        return keys[fallback]
+    return table.find(name, role)
 
 
 def record_from_columns(
-    columns: Mapping[str, np.ndarray],
+    columns: Mapping[str, np.ndarray] | Table,
     source: str = "columns",
     time: str | None = None,
     input: str | None = None,
@@ -373,9 +379,12 @@ def record_from_columns(
     output_unit: str = "",
     dt: float | None = None,
 ) -> Record:
-    """Build a :class:`Record` from named columns (a file's, a dict's or a DataFrame's).
+    """Build a :class:`Record` from named columns (a file's :class:`~synth.data.readers.Table`, a dict's or a
+    DataFrame's).
 
     Columns not named are taken in order: time, input, output (time may instead come from ``dt``).
+    Names are found with or without the unit a header carries (``Time (s)``); that unit becomes the
+    signal's unit unless ``input_unit``/``output_unit`` is given.
 
     Examples
     --------
@@ -387,19 +396,21 @@ def record_from_columns(
     Traceback (most recent call last):
     synth.errors.DataError: lab.csv: output column 'rpm' not found; columns are t, cmd, speed
     """
-    columns = {str(k): np.asarray(v, dtype=float).ravel() for k, v in columns.items()}
-    where = Path(source)
-    if not columns:
-        raise DataError("no numeric columns found", where=source)
-    if time is None and dt is not None:
-        n = max(a.size for a in columns.values())
-        columns = {"__time__": np.arange(n) * float(dt), **columns}
-        time = "__time__"
-    t_name = _pick(columns, time, "time", where, 0)
-    u_name = _pick(columns, input, "input", where, 1)
-    y_name = _pick(columns, output, "output", where, 2)
-    aux_cols = {_pick(columns, a, "aux", where, 0): columns[a] for a in aux}
-    return record_from_arrays(
-        columns[t_name], columns[u_name], columns[y_name],
-        Signal(u_name, input_unit), Signal(y_name, output_unit), aux_cols, source, (t_name, u_name, y_name),
+    table = columns if isinstance(columns, Table) else table_from_columns(columns, source)
+    if not table.columns:
+        raise DataError("no numeric columns found", where=table.source)
+    from_dt = time is None and dt is not None
+    t_name = "time" if from_dt else _pick(table, time, "time", 0)
+    shift = 1 if from_dt else 0  # without a time column, input and output default to the first two columns
+    u_name = _pick(table, input, "input", 1 - shift)
+    y_name = _pick(table, output, "output", 2 - shift)
+    aux_cols = {key: table.columns[key] for key in (_pick(table, a, "aux", 0) for a in aux)}
+    scale = 1.0 if from_dt else TIME_UNITS.get(table.units.get(t_name, ""), 1.0)
+    t = np.arange(table.columns[u_name].size) * float(dt or 0) if from_dt else table.columns[t_name] * scale
+    scaled = scale != 1.0
+    notes = table.notes + ((f"time column '{t_name}' converted from {table.units[t_name]} to s",) if scaled else ())
+    record = record_from_arrays(
+        t, table.columns[u_name], table.columns[y_name], table.signal(u_name, input_unit),
+        table.signal(y_name, output_unit), aux_cols, table.source, (t_name, u_name, y_name),
     )
+    return replace(record, notes=notes + record.notes) if notes else record

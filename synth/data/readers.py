@@ -1,0 +1,342 @@
+"""Reading records as they come: CSV with comments and units in the header, MAT with matrices and structs.
+
+:func:`read_table` turns a file into a :class:`Table`: named columns of numbers,
+the unit each header carries (``Time (s)``, ``Voltage [V]``), and why a column
+is not numbers (told only when that column is asked for, so a text column such as
+``App message`` never stops a load). A column is found by the name the user sees,
+with or without its unit (:meth:`Table.find`); a missing column lists the columns
+found.
+
+CSV: lines starting with ``#`` are comments wherever they stand (before the
+header, among the rows, at the end); the separator is ``,`` ``;`` tab or
+whitespace; empty cells are NaN; a header cell left empty by a trailing separator
+is dropped; with ``;`` as separator a decimal comma is read. MAT (v5): 1-D
+variables by name, the columns of a matrix as ``name[0]``, ``name[1]``, ... (a
+k x N or N x k matrix: the longer side is time), the fields of a struct as
+``struct.field``.
+"""
+
+from __future__ import annotations
+
+import csv
+import difflib
+import re
+from collections.abc import Iterable, Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from synth.errors import DataError
+from synth.plant import Signal
+
+__all__ = ["TIME_UNITS", "Table", "parse_column_map", "read_table", "split_unit", "table_from_columns"]
+
+#: seconds per unit of a time column, by the unit its header states
+TIME_UNITS: dict[str, float] = {"s": 1.0, "sec": 1.0, "ms": 1e-3, "us": 1e-6, "µs": 1e-6, "μs": 1e-6,
+                                "ns": 1e-9, "min": 60.0, "h": 3600.0}
+
+_UNIT = re.compile(r"^(?P<name>.*?)\s*(?:\((?P<p>[^()]*)\)|\[(?P<b>[^\[\]]*)\])\s*$")
+_LISTED = 30  # names listed in a "not found" message
+
+
+def split_unit(header: str) -> tuple[str, str]:
+    """Split a column header into its name and the unit in trailing parentheses or brackets.
+
+    A bracket holding only digits is an index (``acc[0]``), not a unit.
+
+    Examples
+    --------
+    >>> split_unit("Time (s)"), split_unit("Voltage [V]"), split_unit("acc[0]"), split_unit("speed")
+    (('Time', 's'), ('Voltage', 'V'), ('acc[0]', ''), ('speed', ''))
+    """
+    text = header.strip()
+    m = _UNIT.match(text)
+    if not m or not m.group("name"):
+        return text, ""
+    unit = (m.group("p") if m.group("p") is not None else m.group("b")).strip()
+    if not unit or unit.isdigit():
+        return text, ""
+    return m.group("name").strip(), unit
+
+
+def _norm(text: str) -> str:
+    return " ".join(text.split()).casefold()
+
+
+@dataclass(frozen=True, eq=False)
+class Table:
+    """Named columns read from one file (or given as a mapping), with the units their headers state.
+
+    Parameters
+    ----------
+    columns : dict of str to numpy.ndarray
+        Header (as written, unit included) -> values; empty cells are NaN.
+    units : dict of str to str
+        Header -> unit parsed from it (``""`` when none).
+    source : str
+        The file, named in every error.
+    problems : dict of str to str
+        Columns that are not numbers -> the first offending cell (raised when the column is asked for).
+    notes : tuple of str
+        What reading did (comment lines skipped, decimal commas read).
+
+    Examples
+    --------
+    >>> tab = table_from_columns({"Time (s)": [0, 1], "Voltage [V]": [3.9, 3.8]}, "log.csv")
+    >>> tab.find("voltage", "input"), tab.signal("Voltage [V]").label()
+    ('Voltage [V]', 'Voltage [V]')
+    """
+
+    columns: dict[str, np.ndarray]
+    units: dict[str, str] = field(default_factory=dict)
+    source: str = "columns"
+    problems: dict[str, str] = field(default_factory=dict)
+    notes: tuple[str, ...] = ()
+
+    def names(self) -> list[str]:
+        """All column names: the numeric ones and those that are not numbers, in file order."""
+        return list(self.columns) + [k for k in self.problems if k not in self.columns]
+
+    def get(self, name: str) -> str | None:
+        """The header that ``name`` means (as written, or without/with its unit, any case), else None.
+
+        Raises
+        ------
+        DataError
+            ``name`` without a unit matches several headers that differ only in their unit.
+        """
+        names = self.names()
+        if name in names:
+            return name
+        bare, unit = split_unit(name)
+        hits = [k for k in names if _norm(split_unit(k)[0]) == _norm(bare)
+                and (not unit or _norm(split_unit(k)[1]) == _norm(unit))]
+        if not hits:
+            hits = [k for k in names if _norm(k) == _norm(name)]
+        if len(hits) > 1:
+            listed = ", ".join(f"'{k}'" for k in hits)
+            raise DataError(f"column '{name}' is ambiguous ({listed}); give the unit too", where=self.source)
+        return hits[0] if hits else None
+
+    def find(self, name: str, role: str = "") -> str:
+        """The header ``name`` means; a missing column or one that is not numbers is a one-line error.
+
+        Examples
+        --------
+        >>> tab = table_from_columns({"t": [0, 1], "pwm": [1, 2], "speed": [3, 4]}, "run.csv")
+        >>> tab.find("sped", "output")
+        Traceback (most recent call last):
+        synth.errors.DataError: run.csv: output column 'sped' not found; did you mean 'speed'? columns are t, pwm, speed
+        """
+        key = self.get(name)
+        what = f"{role} column" if role else "column"
+        if key is None:
+            names = self.names()
+            pool = {**{k: k for k in names}, **{split_unit(k)[0]: k for k in names}}
+            close = difflib.get_close_matches(name, list(pool), n=1)
+            hint = f"; did you mean '{pool[close[0]]}'?" if close else ";"
+            listed = ", ".join(names[:_LISTED]) + (f" (+{len(names) - _LISTED} more)" if len(names) > _LISTED else "")
+            raise DataError(f"{what} '{name}' not found{hint} columns are {listed or 'none'}", where=self.source)
+        if key in self.problems:
+            raise DataError(self.problems[key], where=self.source)
+        return key
+
+    def signal(self, key: str, unit: str = "") -> Signal:
+        """The column ``key`` as a :class:`~synth.plant.Signal`: its name without the unit, and the unit
+        (``unit`` when given, else the header's)."""
+        bare, header_unit = split_unit(key)
+        return Signal(bare, unit or self.units.get(key, header_unit))
+
+    def renamed(self, mapping: Mapping[str, str]) -> Table:
+        """The table with columns renamed (``{"acc[0]": "accel_x"}``), found as :meth:`find` finds them.
+
+        Examples
+        --------
+        >>> tab = table_from_columns({"acc[0]": [0, 1], "acc[1]": [2, 3]}, "sweep.mat")
+        >>> list(tab.renamed({"acc[1]": "accel_y"}).columns)
+        ['acc[0]', 'accel_y']
+        """
+        if not mapping:
+            return self
+        new = {self.find(old, "columns map:"): str(new).strip() for old, new in mapping.items()}
+        kept = [k for k in self.names() if k not in new]
+        clash = [v for v in new.values() if v in kept] or [v for v in set(new.values()) if list(new.values()).count(v) > 1]
+        if clash:
+            raise DataError(f"columns map: two columns would be named '{clash[0]}'", where=self.source)
+        columns = {new.get(k, k): v for k, v in self.columns.items()}
+        units = {new.get(k, k): self.units.get(k, "") or split_unit(new.get(k, k))[1] for k in self.columns}
+        problems = {new.get(k, k): v for k, v in self.problems.items()}
+        return Table(columns, units, self.source, problems, self.notes)
+
+
+def table_from_columns(columns: Mapping[Any, Any], source: str = "columns") -> Table:
+    """A :class:`Table` from named columns (a dict or a DataFrame's columns), units parsed from the names.
+
+    Examples
+    --------
+    >>> table_from_columns({"Time (s)": [0, 0.1]}).units
+    {'Time (s)': 's'}
+    """
+    cols: dict[str, np.ndarray] = {}
+    problems: dict[str, str] = {}
+    for k, v in columns.items():
+        try:
+            cols[str(k)] = np.asarray(v, dtype=float).ravel()
+        except (TypeError, ValueError):
+            problems[str(k)] = f"column '{k}': values are not numbers"
+    return Table(cols, {k: split_unit(k)[1] for k in cols}, source, problems)
+
+
+def parse_column_map(items: str | Iterable[str] | None) -> dict[str, str]:
+    """``"acc[0]=accel_x, acc[1]=accel_y"`` (or several such strings) as ``{old: new}``.
+
+    Examples
+    --------
+    >>> parse_column_map(["acc[0]=accel_x,acc[1]=accel_y", "Time (s)=t"])
+    {'acc[0]': 'accel_x', 'acc[1]': 'accel_y', 'Time (s)': 't'}
+    >>> parse_column_map("acc[0]")
+    Traceback (most recent call last):
+    synth.errors.DataError: --columns: expected OLD=NEW pairs separated by commas, got 'acc[0]'
+    """
+    if items is None:
+        return {}
+    out: dict[str, str] = {}
+    for text in [items] if isinstance(items, str) else items:
+        for pair in filter(str.strip, text.split(",")):
+            old, sep, new = pair.partition("=")
+            if not sep or not old.strip() or not new.strip():
+                raise DataError(f"expected OLD=NEW pairs separated by commas, got {text!r}", where="--columns")
+            out[old.strip()] = new.strip()
+    return out
+
+
+def read_table(path: str | Path, columns: Mapping[str, str] | None = None) -> Table:
+    """Read a CSV (header row) or MAT (v5) file into a :class:`Table`, columns renamed by ``columns``.
+
+    Examples
+    --------
+    >>> import pathlib, tempfile
+    >>> p = pathlib.Path(tempfile.mkdtemp()) / "log.csv"
+    >>> _ = p.write_text("# stand log\\nTime (s);Thrust [gf]\\n0;1,5\\n0,02;2,5\\n# a-> Type: end\\n")
+    >>> tab = read_table(p)
+    >>> tab.units, tab.columns["Thrust [gf]"].tolist(), tab.notes[0]
+    ({'Time (s)': 's', 'Thrust [gf]': 'gf'}, [1.5, 2.5], 'skipped 2 comment line(s) starting with #')
+    """
+    path = Path(path)
+    if not path.exists():
+        raise DataError("file not found", where=str(path))
+    table = _read_mat(path) if path.suffix.lower() == ".mat" else _read_csv(path)
+    return table.renamed(columns or {})
+
+
+def _delimiter(header: str, first: str | None) -> str | None:
+    """The separator of a header line (checked against the first row), or None for whitespace."""
+    best = None
+    for d in (",", ";", "\t"):
+        n = len(next(csv.reader([header], delimiter=d)))
+        if n > 1 and (best is None or n > best[1]):
+            if first is None or len(next(csv.reader([first], delimiter=d))) >= n - 1:
+                best = (d, n)
+    return best[0] if best else None
+
+
+def _cells(line: str, delimiter: str | None) -> list[str]:
+    if delimiter is None:
+        return [c.strip('"') for c in line.split()]
+    return [c.strip() for c in next(csv.reader([line], delimiter=delimiter))]
+
+
+def _read_csv(path: Path) -> Table:
+    try:
+        text = path.read_text(encoding="utf-8-sig")
+    except OSError as exc:
+        raise DataError(f"cannot read: {exc.strerror or exc}", where=str(path)) from None
+    except UnicodeDecodeError:
+        raise DataError("not a text CSV file", where=str(path)) from None
+    lines: list[tuple[int, str]] = []
+    comments = 0
+    for number, line in enumerate(text.splitlines(), start=1):
+        stripped = line.strip()
+        if stripped.startswith("#"):
+            comments += 1
+        elif stripped:
+            lines.append((number, stripped))
+    if not lines:
+        raise DataError("file is empty", where=str(path))
+    delimiter = _delimiter(lines[0][1], lines[1][1] if len(lines) > 1 else None)
+    header = _cells(lines[0][1], delimiter)
+    if delimiter is None and len(lines) > 1 and len(_cells(lines[1][1], None)) == 1:
+        header = [lines[0][1].strip('"')]  # one column: its header may hold spaces ("speed (rad/s)")
+    keep = [i for i, h in enumerate(header) if h]
+    names = [header[i] for i in keep]
+    values: dict[str, list[float]] = {h: [] for h in names}
+    problems: dict[str, str] = {}
+    decimal_comma = 0
+    for number, line in lines[1:]:
+        cells = _cells(line, delimiter)
+        for i, h in zip(keep, names):
+            if i >= len(cells):  # a short row leaves its columns short (a "different lengths" error if used)
+                continue
+            cell = cells[i]
+            try:
+                values[h].append(float(cell) if cell else np.nan)
+            except ValueError:
+                x = _decimal_comma(cell, delimiter)
+                if x is None:
+                    problems.setdefault(h, f"line {number}: column '{h}': '{cell}' is not a number")
+                    values[h].append(np.nan)
+                else:
+                    decimal_comma += 1
+                    values[h].append(x)
+    notes = ((f"skipped {comments} comment line(s) starting with #",) if comments else ()) + (
+        (f"read {decimal_comma} decimal comma(s)",) if decimal_comma else ())
+    columns = {h: np.asarray(v, float) for h, v in values.items() if h not in problems}
+    return Table(columns, {h: split_unit(h)[1] for h in names}, str(path), problems, notes)
+
+
+def _decimal_comma(cell: str, delimiter: str | None) -> float | None:
+    if delimiter == "," or cell.count(",") != 1:
+        return None
+    try:
+        return float(cell.replace(",", "."))
+    except ValueError:
+        return None
+
+
+def _read_mat(path: Path) -> Table:
+    from scipy.io import loadmat
+
+    try:
+        raw = loadmat(str(path), squeeze_me=True)
+    except (OSError, ValueError, NotImplementedError) as exc:  # NotImplementedError: v7.3 (HDF5) files
+        raise DataError(f"cannot read as a MATLAB file: {exc}", where=str(path)) from None
+    out: dict[str, np.ndarray] = {}
+    for key, value in raw.items():
+        if not key.startswith("__"):
+            _flatten(key, value, out)
+    return Table(out, {k: "" for k in out}, str(path))
+
+
+def _flatten(name: str, value: Any, out: dict[str, np.ndarray]) -> None:
+    """Columns of one MAT variable: a vector, a matrix's columns ``name[i]``, a struct's fields ``name.field``."""
+    a = np.asarray(value)
+    if a.dtype.names:  # a struct (a struct array of one element after squeeze_me)
+        if a.size == 1:
+            item = a.reshape(-1)[0]
+            for f in a.dtype.names:
+                _flatten(f"{name}.{f}", item[f], out)
+        return
+    if a.dtype.kind == "O":  # a cell, or a struct field holding one
+        if a.size == 1:
+            _flatten(name, a.reshape(-1)[0], out)
+        return
+    if a.dtype.kind not in "iufb" or a.size < 2:
+        return
+    if a.ndim == 1:
+        out[name] = a.astype(float)
+    elif a.ndim == 2:
+        cols = a.T if a.shape[0] >= a.shape[1] else a  # the longer side is time
+        for i, c in enumerate(cols):
+            out[f"{name}[{i}]"] = c.astype(float)
