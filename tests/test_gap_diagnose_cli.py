@@ -102,3 +102,16 @@ def test_cli_prints_and_reports_a_clipped_output(run_cli, tmp_path):
     assert clip["level"] == 180.0 and clip["samples"] == int(np.sum(y == 180.0)) and clip["runs"] == 4
     html = (tmp_path / "report" / "report.html").read_text()
     assert "clipped signal" in html and "Seen directly in the data: saturation(output)" in html
+
+
+def test_columns_map_renames_before_picking(csv, run_cli, tmp_path):
+    """--columns renames the record's columns (as for identify); the rebuilt command repeats it."""
+    res = run_cli("diagnose", "--plant", PLANT, "--data", str(csv), "--columns", "pwm=command,speed=rate",
+                  "--time", "t", "--input", "command", "--output", "rate", "--candidates", "rate_limit",
+                  "--json", str(tmp_path / "gap.json"), "--no-report", "--quiet")
+    assert res.code == 0, res.err
+    d = json.loads((tmp_path / "gap.json").read_text())
+    assert d["effects"][0]["parameters"]["rate"] == pytest.approx(400.0, rel=0.03)
+    bad = run_cli("diagnose", "--plant", PLANT, "--data", str(csv), "--columns", "pwm=command",
+                  "--time", "t", "--input", "pwm", "--output", "speed", "--no-report")
+    assert bad.code == 2 and len(bad.err.strip().splitlines()) == 1 and "pwm" in bad.err

@@ -61,6 +61,9 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--output", metavar="COL", help="measured output column (default: the third)")
     p.add_argument("--aux", metavar="COL", action="append", default=[],
                    help="extra logged channel (current, voltage, ...); repeat or separate by commas")
+    p.add_argument("--columns", metavar="OLD=NEW,...", action="append", default=[],
+                   help="rename columns before picking them, e.g. acc[0]=accel_x (a MAT matrix gives acc[0], "
+                        "acc[1], ...); applies to --data and every --validate record")
     p.add_argument("--input-unit", default="", metavar="UNIT", help="unit of the input, e.g. PWM or V")
     p.add_argument("--output-unit", default="", metavar="UNIT", help="unit of the output, e.g. rad/s")
     p.add_argument("--candidates", metavar="A,B,...",
@@ -95,6 +98,7 @@ def _split(values: list[str]) -> list[str]:
 
 def run(args: argparse.Namespace) -> int:
     from synth.data import load_record
+    from synth.data.readers import parse_column_map
     from synth.errors import SynthError
     from synth.gap.diagnose import check_candidates, diagnose, load_model
     from synth.outputs import check_writable, dump_json, write_json
@@ -107,7 +111,8 @@ def run(args: argparse.Namespace) -> int:
         check_writable(Path(args.json), args.force)  # refuse before the slow part
     plant = load_model(args.plant, args.delay, where="--plant")
     aux = _split(args.aux)
-    kw: dict[str, Any] = {"aux": aux, "input_unit": args.input_unit, "output_unit": args.output_unit}
+    kw: dict[str, Any] = {"aux": aux, "input_unit": args.input_unit, "output_unit": args.output_unit,
+                          "columns": parse_column_map(args.columns)}
     record = load_record(args.data, args.time, args.input, args.output, **kw)
     validates = [load_record(v, args.time, args.input, args.output, **kw) for v in args.validate or []]
     if args.round_robin:
@@ -187,6 +192,8 @@ def _command(args: argparse.Namespace) -> str:
     parts += ["--round-robin"] if args.round_robin else []
     for a in _split(args.aux):
         parts += ["--aux", shlex.quote(a)]
+    for c in args.columns:
+        parts += ["--columns", shlex.quote(c)]
     extra = [f"--seed {args.seed}"] if args.seed else []
     extra += [f"--split {args.split}"] if args.split != "tail" else []
     extra += [f"--burn-in {args.burn_in:g}"] if args.burn_in else []
