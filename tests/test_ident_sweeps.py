@@ -158,17 +158,22 @@ def _quality_runs():
     rng = np.random.default_rng(8)
     t = np.arange(n) / fs
     runs = []
+    w = 2 * np.pi * np.fft.rfftfreq(n, 1 / fs)
+
+    def pink(cut: float = np.inf) -> np.ndarray:
+        """Equal power per decade (as a sweep: Gxx ~ 1/w) from 1 rad/s, none above ``cut`` rad/s."""
+        U = np.fft.rfft(rng.standard_normal(n)) / np.sqrt(np.maximum(w, 1.0))
+        U[(w < 1.0) | (w > cut)] = 0.0
+        x = np.fft.irfft(U, n)
+        return x / np.std(x)
+
     for kind in ("good", "under", "asym", "offaxis"):
-        u = rng.standard_normal(n)
-        if kind == "under":
-            U = np.fft.rfft(u)
-            U[2 * np.pi * np.fft.rfftfreq(n, 1 / fs) > 10 ** 1.5] = 0.0
-            u = np.fft.irfft(U, n)
+        u = pink(10 ** 1.5 if kind == "under" else np.inf)
         if kind == "asym":
             u = np.where(u > 0, u, 0.5 * u)
         u[:trim] = 0.0
         y = 2.0 * u + 0.02 * rng.standard_normal(n)
-        aux = {"v": 0.5 * rng.standard_normal(n) * (kind == "offaxis")}
+        aux = {"v": 0.5 * pink() * (kind == "offaxis")}
         runs.append(record_from_arrays(t, u, y, aux=aux, source=kind))
     return runs
 
@@ -184,12 +189,12 @@ def test_run_quality_figures_and_ranking_on_runs_built_with_known_answers():
     assert q["under"].coherent_share == pytest.approx(0.75, abs=0.02)
     # negative half of the input (and of y = 2u) scaled by 0.5: (P - N) / (P + N) = 1/3
     assert q["asym"].output_asymmetry == pytest.approx(1 / 3, abs=0.02)
-    # off-axis white noise of half the amplitude: 0.25 / 1.25 of the input power
+    # off-axis input of the same spectrum and half the amplitude: 0.25 / 1.25 of the input power
     assert q["offaxis"].off_axis_share == pytest.approx(0.2, abs=0.02) and q["good"].off_axis_share == 0.0
     ranked = rank_runs([q["under"], q["asym"], q["good"]])
     assert [r.source for r in ranked][-1] == "under" and [r.keep for r in ranked] == [True, True, False]
     assert "under-excited over 25 %" in ranked[-1].reason
-    assert "output asymmetric (0.33 > 0.3)" in next(r.reason for r in ranked if r.source == "asym")
+    assert "output asymmetric (0.34 > 0.3)" in next(r.reason for r in ranked if r.source == "asym")
 
 
 def test_freqresp_reports_quality_per_run(tmp_path, run_cli):

@@ -30,7 +30,7 @@ percent with a coherence near 0.9) within a few periods of their limit. At each 
 the combined ``n_d`` is the weighted mean of the windows' ``n_d`` (the windows reuse
 the same data, so their averages do not add). A shorter window is also left out wherever its
 ``H`` differs from the longest window's by more than :data:`CONSISTENCY` times their combined
-random error: near a lightly damped mode a short window's leakage flattens the peak (by 4 dB for a
+random error: near a lightly damped mode a short window's leakage flattens the peak (by about 5 dB for a
 7 Hz mode of 1 % damping seen through an 11 s window) while its many averages would otherwise
 give it the larger weight.
 

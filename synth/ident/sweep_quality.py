@@ -8,9 +8,11 @@ band of the composite estimate:
 
 - ``coherent_share``: share of the band (in decades: the grid is logarithmic) where the
   run's own coherence is at least 0.8; ``mean_coherence`` its mean there.
-- input autospectrum: ``input_db_spread``, the 90th minus the 10th percentile of
-  ``10 log10 Gxx`` over the band [dB], and ``under_excited_share``, the share of the band
-  where ``Gxx`` lies more than :data:`UNDER_EXCITED_DB` below its 90th percentile.
+- input autospectrum, as power per decade ``w Gxx`` (flat for a sweep that spends equal time in
+  every decade, as :mod:`synth.ident.sweep_design`'s does; ``Gxx`` itself falls 10 dB per decade
+  there): ``input_db_spread``, the 90th minus the 10th percentile of ``10 log10 (w Gxx)`` over
+  the band [dB], and ``under_excited_share``, the share of the band where it lies more than
+  :data:`UNDER_EXCITED_DB` below its 90th percentile.
 - ``output_asymmetry``: ``(P - N) / (P + N)``, ``P`` and ``N`` the RMS of the positive
   and the negative excursions of the output from trim (the median output before the input
   first moves by 2 % of its range); 0 for a symmetric response, +-1 for one-sided.
@@ -139,8 +141,9 @@ def run_quality(run: Record, w: np.ndarray, band: tuple[float, float], windows: 
     Examples
     --------
     >>> from synth.data import record_from_arrays
-    >>> rng = np.random.default_rng(0); t = np.arange(0, 60, 0.01); u = rng.standard_normal(t.size)
-    >>> q = run_quality(record_from_arrays(t, u, 2 * u), np.geomspace(1, 100, 41), (1, 100), [5.0])
+    >>> from synth.ident.sweep_design import design_sweep
+    >>> t, u = design_sweep(1.0, 30.0).signal(sample_rate=100)           # equal time in every decade
+    >>> q = run_quality(record_from_arrays(t, u, 2 * u), np.geomspace(1, 30, 41), (1, 30), [12.0])
     >>> round(q.coherent_share, 2), q.under_excited_share, round(q.output_asymmetry, 1)
     (1.0, 0.0, 0.0)
     """
@@ -151,7 +154,7 @@ def run_quality(run: Record, w: np.ndarray, band: tuple[float, float], windows: 
     gxx, gyy, gxy = _run_spectra(run, windows, w, overlap)
     coh = np.nan_to_num(coherence_from_spectra(gxx, gyy, gxy))[inside]
     good = coh >= threshold
-    db = 10.0 * np.log10(np.maximum(gxx[inside], 1e-300))
+    db = 10.0 * np.log10(np.maximum(w[inside] * gxx[inside], 1e-300))     # power per decade
     top = float(np.percentile(db, 90))
     off = None
     if off_axis is not None:
