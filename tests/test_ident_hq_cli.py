@@ -133,3 +133,4 @@ def test_frd_from_freqresp_uses_its_recorded_averaging_count(run_cli, tmp_path):
     assert recorded["w180"] == single["w180"] and nd_w180 > 9
     assert recorded["uncertainty"]["w180"] == pytest.approx(single["uncertainty"]["w180"] / np.sqrt(nd_w180), rel=1e-9)
     assert not any("n_d = 1 assumed" in note for note in recorded["notes"])
+    assert f"averaging count per frequency: n_d = {nd_w180:.3g} at w180" in recorded["notes"]

@@ -317,6 +317,8 @@ def hq_from_frd(w: Any, H: Any, coherence: Any = None, averages: Any = None,
     coh_at = _interp_log(w, g2) if g2 is not None else None
     n_d = nd if nd is not None else np.ones(w.shape)
     nd_at = _interp_log(w, n_d)
+    if nd is not None and np.ptp(nd) > 0 and w180 is not None:
+        notes.append(f"averaging count per frequency: n_d = {nd_at(w180):.3g} at w180")
     if g2 is not None and averages is None:
         notes.append("number of averages not given: n_d = 1 assumed, so the uncertainties are upper bounds")
     sig_phase_pts = coherence_random_error(g2, n_d) * DEG if g2 is not None else None
