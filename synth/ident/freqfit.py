@@ -414,7 +414,7 @@ def _checked(st: Any, theta: np.ndarray, tau: float, text: str, w: np.ndarray, H
              fit_delay: bool, status: str, own_delay: Any, min_fit_percent: float) -> FreqFit:
     """The fit as a result, or :class:`FrequencyFitError` saying what failed and what to try."""
     band = f"{w[0]:.4g}-{w[-1]:.4g} rad/s"
-    hint = ("try another structure (fewer modes, or orders such as 0/2), a fixed --delay, or a shorter band "
+    hint = ("try another structure (fewer modes or lower orders), a fixed --delay, or a shorter band "
             "(--fit-range) where the coherence is high")
     if not (np.all(np.isfinite(theta)) and np.isfinite(tau)):
         raise FrequencyFitError(f"fit of {text!r} over {band} failed: IPOPT {status}, parameters not finite; {hint}",
