@@ -106,3 +106,31 @@ def test_missing_file_and_refuses_to_overwrite(run_cli, tmp_path):
     mine.write_text("my notes")
     r = run_cli("hq", "--tf", "1/(s*(s+1))", "--delay", "0.1", "--json", str(mine))
     assert r.code == 2 and "not overwriting" in r.err and mine.read_text() == "my notes"
+
+
+def test_frd_from_freqresp_uses_its_recorded_averaging_count(run_cli, tmp_path):
+    """The issue: hq read freqresp's JSON with n_d = 1 (w180 +- 3.2 instead of +- 0.71)."""
+    from synth.ident.simulate import simulate_plant
+    from synth.ident.sweep_design import design_sweep
+
+    G = Plant.from_string("31.6*s/((s+0.49)*(s+2.30))", delay=0.041)   # roll rate; hq reads the attitude p/s
+    rng = np.random.default_rng(11)
+    runs = []
+    for k in range(2):
+        t, u = design_sweep(0.4, 12.0).signal(1.0, 50.0)
+        y = simulate_plant(G, t, u, "zero")
+        y = y + 0.2 * np.std(y) * rng.standard_normal(t.size)
+        p = tmp_path / f"run{k}.csv"
+        np.savetxt(p, np.c_[t, u, y], delimiter=",", header="t,lat,p", comments="")
+        runs += ["--data", str(p)]
+    fr = tmp_path / "roll.json"
+    assert run_cli("freqresp", *runs, "--wmin", "0.4", "--wmax", "12", "--rate-to-attitude", "--json", str(fr)).code == 0
+    saved = json.loads(fr.read_text())
+    recorded = json.loads(run_cli("hq", "--frd", str(fr), "--json", "-").out)
+    single = json.loads(run_cli("hq", "--frd", str(fr), "--averages", "1", "--json", "-").out)
+    w, n_d = np.array(saved["w"]), np.array(saved["n_averages"])
+    nd_w180 = np.interp(np.log(recorded["w180"]), np.log(w), n_d)      # the count at w180, interpolated in log w
+    assert recorded["w180"] == single["w180"] and nd_w180 > 9
+    assert recorded["uncertainty"]["w180"] == pytest.approx(single["uncertainty"]["w180"] / np.sqrt(nd_w180), rel=1e-9)
+    assert not any("n_d = 1 assumed" in note for note in recorded["notes"])
+    assert f"averaging count per frequency: n_d = {nd_w180:.3g} at w180" in recorded["notes"]

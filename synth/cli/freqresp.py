@@ -25,7 +25,13 @@ example:
       --wmin 0.4 --wmax 12 --rate-to-attitude --fit "k*exp(-Td*s)/((s+p1)*(s+p2))" --out reports/roll
   synth freqresp --data sweep.csv --fit 0/2 --delay 0.02 --verify step.csv --json -
 
-exit codes: 0 done, 1 no coherent band, 2 bad input"""
+Quality: per run, the coherence share over the band, the input autospectrum's spread, the
+output's symmetry about trim and (--off-axis) the off-axis share of the input power, ranked
+with the runs to keep (the NASA report keeps the best 2 of 3). --divide-by removes known
+sensor/filter dynamics, --skew a known lag of the output channel behind the input channel.
+
+exit codes: 0 done, 1 no coherent band or a failed fit (one line says what failed and what
+to try; nothing written), 2 bad input"""
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
@@ -42,6 +48,12 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--wmax", type=float, metavar="RAD_S", help="highest frequency (default: a fifth of Nyquist)")
     p.add_argument("--windows", metavar="S,S,...", help="window lengths in s (default: 5, composite)")
     p.add_argument("--coherence", type=float, default=0.8, metavar="G2", help="coherence threshold (default 0.8)")
+    p.add_argument("--points-per-decade", type=int, default=40, metavar="N",
+                   help="density of the frequency grid (default 40; a lightly damped mode needs more)")
+    p.add_argument("--divide-by", metavar="TF", help='known sensor/filter dynamics to remove, e.g. "50/(s+50)"')
+    p.add_argument("--skew", type=float, default=0.0, metavar="S",
+                   help="the output channel lags the input channel by S seconds (removed; default 0)")
+    p.add_argument("--off-axis", metavar="COLUMN", help="off-axis control column: its share of the input power per run")
     p.add_argument("--rate-to-attitude", action="store_true", help="integrate the response by 1/s")
     p.add_argument("--fit", metavar="ORDERS|FORMULA", help='"0/2" or "k*exp(-Td*s)/((s+p1)*(s+p2))"')
     p.add_argument("--fit-range", metavar="LO:HI", help="fit range in rad/s (default: the coherent band)")
@@ -66,22 +78,48 @@ def _floats(text: str, where: str, count: int | None = None, sep: str = ",") -> 
     return values
 
 
-def _load(path: str, args: argparse.Namespace) -> Any:
+def _load(path: str, args: argparse.Namespace, off_axis: bool = False) -> Any:
     from synth.data import load_record
     from synth.data.readers import parse_column_map
 
-    return load_record(path, args.time, args.input, args.output, dt=args.dt, columns=parse_column_map(args.columns))
+    aux = (args.off_axis,) if off_axis and args.off_axis else ()
+    return load_record(path, args.time, args.input, args.output, aux=aux, dt=args.dt,
+                       columns=parse_column_map(args.columns))
+
+
+def _quality(runs: list[Any], resp: Any, args: argparse.Namespace) -> list[Any]:
+    """Per-run quality figures over the coherent band (the whole grid if it has none, or one point), ranked."""
+    from synth.ident.sweep_quality import rank_runs, run_quality
+
+    band = (float(resp.w[0]), float(resp.w[-1]))
+    if resp.band.found and resp.band.w_max > resp.band.w_min:
+        band = (resp.band.w_min, resp.band.w_max)
+    return rank_runs([run_quality(r, resp.w, band, resp.windows, args.off_axis, threshold=args.coherence)
+                      for r in runs])
 
 
 def run(args: argparse.Namespace) -> int:
     from pathlib import Path
 
-    from synth.errors import SynthError
-    from synth.ident.freqfit import fit_frequency_response, verify_step
-    from synth.ident.spectra import frequency_response, rate_to_attitude
-    from synth.outputs import OutputDir, dump_json, write_json
+    import numpy as np
 
-    runs = [_load(p, args) for p in args.data]
+    from synth.errors import ModelError, SynthError
+    from synth.ident.freqfit import FrequencyFitError, fit_frequency_response, verify_step
+    from synth.ident.spectra import correct_response, frequency_response, rate_to_attitude
+    from synth.outputs import OutputDir, dump_json, write_json
+    from synth.plant import Plant
+
+    runs = [_load(p, args, off_axis=True) for p in args.data]
+    if not 1 <= args.points_per_decade <= 2000:
+        raise SynthError(f"must be between 1 and 2000, got {args.points_per_decade}", where="--points-per-decade")
+    if not np.isfinite(args.skew):
+        raise SynthError(f"must be a finite number of seconds, got {args.skew}", where="--skew")
+    sensor = None
+    if args.divide_by:
+        try:
+            sensor = Plant.from_string(args.divide_by)
+        except ModelError as exc:
+            raise exc.located("--divide-by") from None
     windows = _floats(args.windows, "--windows") if args.windows else None
     for name in ("wmin", "wmax"):
         value = getattr(args, name)
@@ -93,10 +131,18 @@ def run(args: argparse.Namespace) -> int:
     if args.delay != "fit":
         delay = _floats(args.delay, "--delay", 1)[0] if args.delay not in ("0", "0.0") else 0.0
     fit_range = tuple(_floats(args.fit_range, "--fit-range", 2, ":")) if args.fit_range else None
-    resp = frequency_response(runs, args.wmin, args.wmax, windows=windows, coherence_threshold=args.coherence)
+    resp = frequency_response(runs, args.wmin, args.wmax, windows=windows, coherence_threshold=args.coherence,
+                              points_per_decade=args.points_per_decade)
+    if sensor is not None or args.skew:
+        try:
+            resp = correct_response(resp, sensor, args.skew)
+        except SynthError as exc:
+            raise exc.located("--divide-by") from None
     if args.rate_to_attitude:
         resp = rate_to_attitude(resp)
-    result: dict[str, Any] = {"kind": "frequency_response", **resp.to_dict(), "records": [r.to_dict() for r in runs]}
+    quality = _quality(runs, resp, args)
+    result: dict[str, Any] = {"kind": "frequency_response", **resp.to_dict(), "records": [r.to_dict() for r in runs],
+                              "run_quality": [q.to_dict() for q in quality]}
     fit = verification = None
     if args.fit:
         if not resp.band.found and fit_range is None:
@@ -105,6 +151,9 @@ def run(args: argparse.Namespace) -> int:
             fit = fit_frequency_response(resp, args.fit, fit_range, delay)  # type: ignore[arg-type]
         except SynthError as exc:
             raise exc.located("--fit") from None
+        except FrequencyFitError as exc:
+            print(f"synth freqresp: error: --fit: {exc}", file=sys.stderr)
+            return 1
         result["fit"] = fit.to_dict()
         if args.verify:
             verification = verify_step(fit.plant, _load(args.verify, args))
@@ -134,6 +183,14 @@ def run(args: argparse.Namespace) -> int:
               f"{resp.w[0]:.4g}-{resp.w[-1]:.4g} rad/s ({resp.kind})")
         print(f"coherent band (gamma^2 >= {b.threshold:g}, not oscillating): "
               + (f"{b.w_min:.4g}-{b.w_max:.4g} rad/s" if b.found else "none"))
+        for note in resp.corrections:
+            print(f"correction: {note}")
+        if len(quality) > 1 or args.off_axis:
+            print("runs, best first (" + ("keep " + ", ".join(q.source for q in quality if q.keep)) + "):")
+            for q in quality:
+                off = f", off-axis {100 * q.off_axis_share:.0f} %" if q.off_axis_share is not None else ""
+                print(f"  {q.rank}. {q.source}{'' if q.keep else ' (drop)'}: {q.reason}; input spread "
+                      f"{q.input_db_spread:.1f} dB, output asymmetry {q.output_asymmetry:+.2f}{off}")
         if fit is not None:
             print(f"fit {fit.structure} over {fit.w_range[0]:.4g}-{fit.w_range[1]:.4g} rad/s: {fit.tf_text()}")
             print("  " + ", ".join(f"{k} = {v:.6g}" for k, v in fit.parameters.items()) + f"; J = {fit.J:.4g}")

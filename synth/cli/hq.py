@@ -22,7 +22,8 @@ through a least-squares line between w180 and 2 w180; the coherence gives each m
 uncertainty.
 
 --frd FILE is a CSV with columns w, mag_db, phase_deg[, coherence] (rad/s, dB, deg) or the JSON
-of `synth freqresp` (keys w, magnitude_db, phase_deg, coherence, and optionally averages).
+of `synth freqresp` (keys w, magnitude_db, phase_deg, coherence, and the per-frequency averaging
+count n_averages that freqresp records; a JSON key averages or --averages overrides it).
 
 example:
   synth hq --tf "1/(s^2+s+1)" --delay 0.1
@@ -55,8 +56,10 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 def read_frd(path: str | Path, columns: dict[str, str] | None = None) -> dict[str, Any]:
     """Read a measured frequency response: ``synth freqresp`` JSON or CSV ``w, mag_db, phase_deg[, coherence]``.
 
-    Returns ``{"w", "H", "coherence", "averages"}`` (``H`` complex). CSV headers may carry units
-    (``w (rad/s)``, ``mag_db [dB]``); ``columns`` renames CSV columns first (``{"omega": "w"}``).
+    Returns ``{"w", "H", "coherence", "averages"}`` (``H`` complex). ``averages`` is the JSON's
+    ``averages`` (one number) or, in a ``synth freqresp`` result, its ``n_averages`` (one per
+    frequency); ``None`` for a CSV. CSV headers may carry units (``w (rad/s)``, ``mag_db [dB]``);
+    ``columns`` renames CSV columns first (``{"omega": "w"}``).
 
     Examples
     --------
@@ -81,7 +84,9 @@ def read_frd(path: str | Path, columns: dict[str, str] | None = None) -> dict[st
         except ValueError as exc:
             raise DataError(f"not valid JSON: {exc}", where=str(path)) from None
         keys = {"w": "w", "mag_db": "magnitude_db", "phase_deg": "phase_deg", "coherence": "coherence"}
-        averages = data.get("averages") if isinstance(data, dict) else None
+        averages = None
+        if isinstance(data, dict):   # a number given by hand, else the per-frequency count synth freqresp records
+            averages = data.get("averages", data.get("n_averages"))
     else:
         table = read_table(path, columns)
         data = {}

@@ -13,7 +13,8 @@ metrics (bandwidth, phase delay) and disturbance spectra. Modules:
 - :mod:`synth.ident.sweep_design`, :mod:`synth.ident.spectra`, :mod:`synth.ident.freqfit`: sweep
   design, composite multi-window frequency response (windows and averaging in
   :mod:`synth.ident.spectral_windows`, coherence and the coherent band in :mod:`synth.ident.coherence`),
-  NAVFIT-cost fit with an exact delay.
+  NAVFIT-cost fit with an exact delay; per-run quality and which runs to keep in
+  :mod:`synth.ident.sweep_quality`.
 - :mod:`synth.ident.hq_metrics`, :mod:`synth.ident.hq`, :mod:`synth.ident.model_phase`: handling-qualities
   bandwidth and phase delay (definitions; estimation from a model or measurements; a model's exact phase).
 - :mod:`synth.ident.psd`: disturbance spectra (:mod:`synth.ident.welch`), noise floor, spikes, trend,
@@ -44,6 +45,8 @@ _EXPORTS = {
     "x4_step_train": "x4_record", "x4_step_train_path": "x4_record",
     "design_sweep": "sweep_design", "SweepDesign": "sweep_design",
     "frequency_response": "spectra", "FrequencyResponse": "spectra", "rate_to_attitude": "spectra",
+    "correct_response": "spectra", "run_quality": "sweep_quality", "rank_runs": "sweep_quality",
+    "RunQuality": "sweep_quality", "FrequencyFitError": "freqfit",
     "coherent_band": "coherence",
     "fit_frequency_response": "freqfit", "FreqFit": "freqfit", "fit_cost": "freqfit", "verify_step": "freqfit",
     "hq_from_plant": "hq", "hq_from_frd": "hq", "HQMetrics": "hq_metrics",

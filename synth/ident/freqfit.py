@@ -37,14 +37,70 @@ from synth.plant import Plant
 from synth.polynomials import format_factored
 
 __all__ = [
-    "IPOPT_OPTIONS", "W_G", "W_P", "FreqFit", "StepVerification", "coherence_weight", "fit_cost",
-    "fit_frequency_response", "parse_orders", "verify_step",
+    "IPOPT_OPTIONS", "MIN_FIT_PERCENT", "SOLVED", "W_G", "W_P", "FreqFit", "FrequencyFitError", "StepVerification",
+    "coherence_weight", "fit_cost", "fit_frequency_response", "fit_percent", "parse_orders", "verify_step",
 ]
 
 W_G = 1.0
 W_P = 0.01745
 IPOPT_OPTIONS = {"ipopt.print_level": 0, "print_time": False, "ipopt.sb": "yes", "ipopt.max_iter": 500,
                  "ipopt.tol": 1e-10, "show_eval_warnings": False}
+
+
+#: IPOPT return statuses that count as a solution
+SOLVED = ("Solve_Succeeded", "Solved_To_Acceptable_Level")
+#: a fit below this percentage (see :func:`fit_percent`) is a failure, not a result
+MIN_FIT_PERCENT = 50.0
+
+
+class FrequencyFitError(RuntimeError):
+    """A structure fit that failed: the solver did not converge, or the fit is too poor to be a result.
+
+    Not a :class:`synth.errors.SynthError` (the input was valid): ``synth freqresp``
+    prints its one-line message and exits 1.
+
+    Parameters
+    ----------
+    message : str
+        What failed and what to try.
+    status : str
+        IPOPT's return status.
+    fit_percent : float
+        :func:`fit_percent` over the fitted range.
+    fit_percent : float
+        The fit reached (:func:`fit_percent`).
+    structure : str
+        The structure that was fitted.
+
+    Examples
+    --------
+    >>> e = FrequencyFitError("fit 1.2 % < 50 %", "Maximum_Iterations_Exceeded", 1.2, "0/4")
+    >>> e.status, str(e)
+    ('Maximum_Iterations_Exceeded', 'fit 1.2 % < 50 %')
+    """
+
+    def __init__(self, message: str, status: str, fit_percent: float, structure: str) -> None:
+        super().__init__(" ".join(str(message).split()))
+        self.status = status
+        self.fit_percent = fit_percent
+        self.structure = structure
+
+
+def fit_percent(H_model: Any, H_data: Any, coherence: Any) -> float:
+    """Fit of a model to a frequency response [%]: ``100 (1 - sqrt(sum W_gamma |G/H - 1|^2 / sum W_gamma))``.
+
+    100 % is a perfect fit; 0 % a relative error as large as the response itself
+    (a model of zero scores 0 %); a model worse than that scores below 0 %.
+
+    Examples
+    --------
+    >>> H = np.array([1.0, 1j, -1.0])
+    >>> fit_percent(H, H, np.ones(3)), fit_percent(0.9 * H, H, np.ones(3)), fit_percent(0 * H, H, np.ones(3))
+    (100.0, 90.0, 0.0)
+    """
+    wg = coherence_weight(coherence)
+    rel = np.abs(np.asarray(H_model, complex) / np.asarray(H_data, complex) - 1.0) ** 2
+    return float(100.0 * (1.0 - np.sqrt(np.sum(wg * rel) / np.sum(wg))))
 
 
 def coherence_weight(coherence: Any) -> np.ndarray:
@@ -130,6 +186,8 @@ class FreqFit:
     delay_fitted : bool
     status : str
         IPOPT's return status.
+    fit_percent : float
+        :func:`fit_percent` over the fitted range.
 
     Examples
     --------
@@ -150,6 +208,7 @@ class FreqFit:
     status: str
     w: np.ndarray = field(repr=False)
     H_model: np.ndarray = field(repr=False)
+    fit_percent: float = float("nan")
 
     def tf_text(self) -> str:
         """The fitted model in factored form (with ``exp(-tau*s)``)."""
@@ -171,7 +230,8 @@ class FreqFit:
                 "tf": self.tf_text(), "num": self.plant.num, "den": self.plant.den, "delay_s": self.plant.delay,
                 "poles": [[float(p.real), float(p.imag)] for p in self.plant.poles()],
                 "w_range": list(self.w_range), "n_points": self.n_points, "delay_fitted": self.delay_fitted,
-                "status": self.status, "cost": "J = (20/n) sum W_gamma [W_g dB^2 + W_p deg^2], W_g = 1, W_p = 0.01745"}
+                "status": self.status, "fit_percent": self.fit_percent,
+                "cost": "J = (20/n) sum W_gamma [W_g dB^2 + W_p deg^2], W_g = 1, W_p = 0.01745"}
 
 
 def _power_matrices(w: np.ndarray, degree: int) -> tuple[np.ndarray, np.ndarray]:
@@ -254,6 +314,7 @@ def fit_frequency_response(
     structure: str | Structure = "0/2",
     w_range: tuple[float, float] | None = None,
     delay: str | float = "fit",
+    min_fit_percent: float = MIN_FIT_PERCENT,
 ) -> FreqFit:
     """Fit a transfer function with an exact delay to a frequency response, minimizing ``J``.
 
@@ -269,6 +330,8 @@ def fit_frequency_response(
     delay : "fit" or float
         Fit the delay, or hold it at this value [s]. A formula with its own
         ``exp(...)`` factor uses that instead.
+    min_fit_percent : float
+        A fit below this (:func:`fit_percent`) is a failure.
 
     Returns
     -------
@@ -280,6 +343,9 @@ def fit_frequency_response(
         A bad structure or delay, or fewer points than parameters.
     DataError
         An empty range or no coherent band.
+    FrequencyFitError
+        IPOPT did not converge (its status is not in :data:`SOLVED`), the result
+        is not finite, or the fit is below ``min_fit_percent``; never returned as a result.
 
     Examples
     --------
@@ -341,14 +407,36 @@ def fit_frequency_response(
             raise ModelError(f"structure {text!r}: no start converged")
         theta = min(results, key=lambda r: r[0] if np.isfinite(r[0]) else np.inf)[1]
         theta, tau, status = _ipopt(st, w, H, coh, theta, tau0, fit_delay, delay_max)
+    return _checked(st, theta, float(tau), text, w, H, coh, bool(fit_delay), status, own_delay, min_fit_percent)
+
+
+def _checked(st: Any, theta: np.ndarray, tau: float, text: str, w: np.ndarray, H: np.ndarray, coh: np.ndarray,
+             fit_delay: bool, status: str, own_delay: Any, min_fit_percent: float) -> FreqFit:
+    """The fit as a result, or :class:`FrequencyFitError` saying what failed and what to try."""
+    band = f"{w[0]:.4g}-{w[-1]:.4g} rad/s"
+    hint = ("try another structure (fewer modes or lower orders), a fixed --delay, or a shorter band "
+            "(--fit-range) where the coherence is high")
+    if not (np.all(np.isfinite(theta)) and np.isfinite(tau)):
+        raise FrequencyFitError(f"fit of {text!r} over {band} failed: IPOPT {status}, parameters not finite; {hint}",
+                                status, float("nan"), text)
     num, den = st.coefficients(theta)
-    plant = Plant(num, den, float(tau))
+    try:
+        plant = Plant(num, den, tau)
+    except ModelError as exc:
+        raise FrequencyFitError(f"fit of {text!r} over {band} failed: IPOPT {status}, {exc.message}; {hint}",
+                                status, float("nan"), text) from None
     H_model = plant.freqresp(w)
+    percent = fit_percent(H_model, H, coh) if np.all(np.isfinite(H_model)) else float("-inf")
+    if status not in SOLVED:
+        raise FrequencyFitError(f"fit of {text!r} over {band} failed: IPOPT {status} (fit {percent:.1f} %); {hint}",
+                                status, percent, text)
+    if not percent >= min_fit_percent:
+        raise FrequencyFitError(f"fit of {text!r} over {band} failed: fit {percent:.1f} % < {min_fit_percent:g} % "
+                                f"(IPOPT {status}); {hint}", status, percent, text)
     params = {name: float(v) for name, v in zip(st.parameters, theta)}
-    delay_name = own_delay if isinstance(own_delay, str) else "delay"
-    params[delay_name] = float(tau)
+    params[own_delay if isinstance(own_delay, str) else "delay"] = tau
     return FreqFit(plant, params, fit_cost(H_model, H, coh), text, (float(w[0]), float(w[-1])), int(w.size),
-                   bool(fit_delay), status, w, H_model)
+                   fit_delay, status, w, H_model, percent)
 
 
 @dataclass(frozen=True)

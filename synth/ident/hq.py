@@ -111,7 +111,7 @@ def hq_from_plant(plant: Plant, response_type: str = "auto") -> HQMetrics:
 
 
 # --------------------------------------------------------------------------- measured frequency response
-def _validate_frd(w: Any, H: Any, coherence: Any, averages: float | None) -> tuple[np.ndarray, ...]:
+def _validate_frd(w: Any, H: Any, coherence: Any, averages: Any) -> tuple[Any, ...]:
     try:
         w = np.asarray(w, float).ravel()
         H = np.asarray(H, complex).ravel()
@@ -138,9 +138,21 @@ def _validate_frd(w: Any, H: Any, coherence: Any, averages: float | None) -> tup
             raise DataError(f"coherence has {g2.size} points, w has {w.size}", where="frequency response: coherence")
         if not np.all(np.isfinite(g2)) or np.any(g2 < 0) or np.any(g2 > 1):
             raise DataError("coherence must lie in [0, 1]", where="frequency response: coherence")
-    if averages is not None and not (np.isfinite(averages) and averages >= 1):
-        raise DataError(f"averages must be >= 1, got {averages!r}", where="frequency response: averages")
-    return w, H, g2
+    nd = None
+    if averages is not None:
+        try:
+            nd = np.asarray(averages, float)
+        except (TypeError, ValueError):
+            raise DataError(f"averages must be numbers, got {averages!r}", where="frequency response: averages") from None
+        if nd.ndim == 0:
+            nd = np.full(w.shape, float(nd))
+        if nd.shape != w.shape:
+            raise DataError(f"averages has {nd.size} values, w has {w.size} (give one number or one per frequency)",
+                            where="frequency response: averages")
+        if not np.all(np.isfinite(nd)) or np.any(nd < 1):
+            bad = averages if np.ndim(averages) == 0 else float(nd[~(np.isfinite(nd) & (nd >= 1))][0])
+            raise DataError(f"averages must be >= 1, got {bad!r}", where="frequency response: averages")
+    return w, H, g2, nd
 
 
 def _interp_log(w: np.ndarray, y: np.ndarray) -> Callable[[float], float]:
@@ -208,17 +220,18 @@ def fit_phase_line(w: np.ndarray, phase_deg: np.ndarray, band: tuple[float, floa
     return coef, cov, rms, n
 
 
-def _uncertainties(w: np.ndarray, mag: np.ndarray, phase: np.ndarray, g2: np.ndarray, n_d: float,
+def _uncertainties(w: np.ndarray, mag: np.ndarray, phase: np.ndarray, g2: np.ndarray, n_d: np.ndarray,
                    found: dict[str, Any], tau: float | None, phase2: float | None, sig_phi2: float | None,
                    slope2: float | None, limit: str) -> tuple[dict[str, float | None], dict[str, float | None]]:
     """1-sigma uncertainty of each metric: the random error at the crossing over the curve's slope there."""
     coh_at = _interp_log(w, g2)
+    nd_at = _interp_log(w, n_d)
 
     def sig_phase(x: float) -> float:  # deg
-        return float(coherence_random_error(coh_at(x), n_d)) * DEG
+        return float(coherence_random_error(coh_at(x), nd_at(x))) * DEG
 
     def sig_db(x: float) -> float:
-        return float(coherence_random_error(coh_at(x), n_d)) * 20 / np.log(10)
+        return float(coherence_random_error(coh_at(x), nd_at(x))) * 20 / np.log(10)
 
     w180, w135, wg = found["w180"], found["w135"], found["wg"]
     unc: dict[str, float | None] = dict.fromkeys(("w180", "bandwidth_phase", "bandwidth_gain", "bandwidth",
@@ -243,7 +256,7 @@ def _uncertainties(w: np.ndarray, mag: np.ndarray, phase: np.ndarray, g2: np.nda
     return unc, coh
 
 
-def hq_from_frd(w: Any, H: Any, coherence: Any = None, averages: float | None = None,
+def hq_from_frd(w: Any, H: Any, coherence: Any = None, averages: Any = None,
                 response_type: str = "auto", phase_fit: str = "auto", fit_band: tuple[float, float] | None = None,
                 rough_deg: float = 5.0) -> HQMetrics:
     """Bandwidth and phase delay from a measured attitude frequency response.
@@ -257,9 +270,11 @@ def hq_from_frd(w: Any, H: Any, coherence: Any = None, averages: float | None = 
         360 deg so that the first point lies in (-270, 90] deg.
     coherence : array_like, optional
         Coherence ``gamma^2`` at ``w``; gives every metric a 1-sigma uncertainty.
-    averages : float, optional
-        Number of averages ``n_d`` behind the estimate; without it ``n_d = 1`` is assumed (the
-        largest error; stated in ``notes``).
+    averages : float or array_like, optional
+        Number of averages ``n_d`` behind the estimate: one number, or one per frequency (the
+        ``n_averages`` that :func:`synth.ident.spectra.frequency_response` reports, interpolated
+        in log w at each crossing); without it ``n_d = 1`` is assumed (the largest error; stated
+        in ``notes``).
     response_type : {"auto", "rate", "attitude"}
         ``"auto"`` reads the median phase of the lowest frequencies: near -90 deg a rate type,
         near 0 deg an attitude type, otherwise the rate rule.
@@ -288,7 +303,7 @@ def hq_from_frd(w: Any, H: Any, coherence: Any = None, averages: float | None = 
     """
     check_choice(response_type, RESPONSE_TYPES, "response_type")
     check_choice(phase_fit, PHASE_FITS, "phase_fit")
-    w, H, g2 = _validate_frd(w, H, coherence, averages)
+    w, H, g2, nd = _validate_frd(w, H, coherence, averages)
     notes: list[str] = []
     phase = np.unwrap(np.angle(H)) * DEG
     phase -= 360.0 * np.ceil((phase[0] - 90.0) / 360.0)
@@ -300,7 +315,10 @@ def hq_from_frd(w: Any, H: Any, coherence: Any = None, averages: float | None = 
     found = crossing_metrics(curve, notes)
     w180, w135, wg = found["w180"], found["w135"], found["wg"]
     coh_at = _interp_log(w, g2) if g2 is not None else None
-    n_d = float(averages) if averages is not None else 1.0
+    n_d = nd if nd is not None else np.ones(w.shape)
+    nd_at = _interp_log(w, n_d)
+    if nd is not None and np.ptp(nd) > 0 and w180 is not None:
+        notes.append(f"averaging count per frequency: n_d = {nd_at(w180):.3g} at w180")
     if g2 is not None and averages is None:
         notes.append("number of averages not given: n_d = 1 assumed, so the uncertainties are upper bounds")
     sig_phase_pts = coherence_random_error(g2, n_d) * DEG if g2 is not None else None
@@ -340,7 +358,7 @@ def hq_from_frd(w: Any, H: Any, coherence: Any = None, averages: float | None = 
         else:
             phase2 = curve.phase_at(w2)
             if coh_at:
-                sig_phi2 = float(coherence_random_error(coh_at(w2), n_d)) * DEG
+                sig_phi2 = float(coherence_random_error(coh_at(w2), nd_at(w2))) * DEG
             slope2 = _local_slope(w, phase, w2)
         tau = -(phase2 + 180.0) / (DEG * w2)
 

@@ -28,7 +28,7 @@ from synth.ident.spectral_windows import (
     window_spectra,
 )
 
-__all__ = ["FrequencyResponse", "frequency_response", "rate_to_attitude"]
+__all__ = ["FrequencyResponse", "correct_response", "frequency_response", "rate_to_attitude"]
 
 
 @dataclass(frozen=True)
@@ -60,6 +60,8 @@ class FrequencyResponse:
         Signal labels.
     sources : tuple of str
         The runs.
+    corrections : tuple of str
+        Corrections applied (:func:`correct_response`), in words.
 
     Examples
     --------
@@ -85,6 +87,7 @@ class FrequencyResponse:
     input: str = "u"
     output: str = "y"
     sources: tuple[str, ...] = ()
+    corrections: tuple[str, ...] = ()
 
     @property
     def magnitude_db(self) -> np.ndarray:
@@ -112,6 +115,7 @@ class FrequencyResponse:
                 "coherence": self.coherence, "random_error": self.random_error, "n_averages": self.n_averages,
                 "coherent_band": self.band.to_dict(), "windows_s": list(self.windows), "kind": self.kind,
                 "input": self.input, "output": self.output, "sources": list(self.sources),
+                "corrections": list(self.corrections),
                 "units": {"w": "rad/s", "magnitude_db": "dB", "phase_deg": "deg"}}
 
 
@@ -187,6 +191,8 @@ def frequency_response(
     check_length(runs, w_min, overlap)
     if windows is None:
         lengths = default_windows(w_min, longest=required_window(lowest_frequency(runs, overlap)) * (1 - 1e-9))
+        # near Nyquist the shortest default windows would hold fewer than 8 samples: lengthen them (and merge)
+        lengths = tuple(dict.fromkeys(max(float(x), 8.0 / fs) for x in lengths))
     else:
         lengths = tuple(windows)
     grid = log_grid(w_min, w_max, points_per_decade)
@@ -226,3 +232,57 @@ def rate_to_attitude(resp: FrequencyResponse) -> FrequencyResponse:
     """
     return replace(resp, H=resp.H / (1j * resp.w), gxy=resp.gxy / (1j * resp.w), gyy=resp.gyy / resp.w ** 2,
                    kind="integrated (1/s)")
+
+
+def correct_response(resp: FrequencyResponse, divide_by: Any = None, skew: float = 0.0) -> FrequencyResponse:
+    """Remove known sensor/filter dynamics and a channel time skew from a measured response.
+
+    The NASA report (sec. 2, 4.2) asks for the sensors' and filters' dynamics to be
+    known "so that their effect can be incorporated", and its recorder skewed adjacent
+    channels by up to 15 ms. Here ``H`` and ``Gxy`` are divided by ``divide_by(jw)``
+    (``Gyy`` by its squared magnitude) and multiplied by ``exp(+j w skew)``; the
+    coherence and random error do not change.
+
+    Parameters
+    ----------
+    resp : FrequencyResponse
+    divide_by : Plant, optional
+        The known dynamics between the true output and the recorded one (a sensor, an
+        anti-aliasing filter), with its delay if it has one.
+    skew : float
+        How much the output channel lags the input channel [s]: the recorded output is
+        ``y(t - skew)``, so the measured response carries an extra phase lag ``w skew``
+        (negative: the output channel leads).
+
+    Returns
+    -------
+    FrequencyResponse
+        With ``corrections`` saying what was removed.
+
+    Examples
+    --------
+    >>> from synth.ident.coherence import coherent_band
+    >>> from synth.plant import Plant
+    >>> w = np.array([10.0, 20.0]); b = coherent_band(w, np.ones(2))
+    >>> meas = np.exp(-1j * w * 0.015) * 50 / (1j * w + 50)       # a 50 rad/s filter and a 15 ms skew
+    >>> r = FrequencyResponse(w, meas, np.ones(2), np.zeros(2), np.ones(2), np.ones(2), np.ones(2), meas, b, (1.0,))
+    >>> c = correct_response(r, Plant.from_string("50/(s+50)"), skew=0.015)
+    >>> np.round(c.H, 12).tolist(), c.corrections[1]
+    ([(1+0j), (1+0j)], 'output channel skew 0.015 s removed (phase + w * 0.015 s)')
+    """
+    if not np.isfinite(skew):
+        raise DataError(f"skew must be a finite number of seconds, got {skew!r}")
+    factor = np.exp(1j * resp.w * skew)
+    notes = list(resp.corrections)
+    gyy = resp.gyy
+    if divide_by is not None:
+        F = np.asarray(divide_by.freqresp(resp.w), complex)
+        if not np.all(np.isfinite(F)) or np.any(np.abs(F) == 0):
+            raise DataError(f"the correction {divide_by.to_string()} is zero or infinite inside "
+                            f"{resp.w[0]:.4g}-{resp.w[-1]:.4g} rad/s")
+        factor = factor / F
+        gyy = gyy / np.abs(F) ** 2
+        notes.append(f"divided by {divide_by.to_string()} (known sensor/filter dynamics)")
+    if skew:
+        notes.append(f"output channel skew {skew:g} s removed (phase + w * {skew:g} s)")
+    return replace(resp, H=resp.H * factor, gxy=resp.gxy * factor, gyy=gyy, corrections=tuple(notes))
