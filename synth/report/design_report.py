@@ -14,6 +14,7 @@ from synth.loop import Loop
 from synth.outputs import GENERATOR, OutputDir, dump_json, to_jsonable
 from synth.reference import compare
 from synth.report import figures
+from synth.report.paper_section import add_paper_section
 from synth.requirements import SlewRate
 from synth.requirements.base import Requirement, fmt
 from synth.results import DesignResult, reference_controller
@@ -133,7 +134,8 @@ def write_design_report(spec: Spec, result: DesignResult, out_dir: str | Path, *
     >>> spec = load_spec("specs/x4_rotor.yaml")
     >>> files = write_design_report(spec, design(spec), tempfile.mkdtemp())
     >>> sorted(files.figures)
-    ['bode', 'delay', 'gain_set', 'gap_map', 'gap_overlay', 'sensitivity', 'sim_onset', 'sim_rise', 'sim_step', 'step']
+    ['bode', 'delay', 'gain_set', 'gap_map', 'gap_overlay', 'paper_disturbance', 'sensitivity', 'sim_onset', 'sim_rise',
+     'sim_step', 'step']
     """
     out = OutputDir(out_dir, force)
     objects: dict[str, Any] = {}
@@ -186,6 +188,8 @@ def write_design_report(spec: Spec, result: DesignResult, out_dir: str | Path, *
         diag = objects["diagnosis"]
         figs["gap_map"] = write_gap_map(diag.localization, out.claim("gap_map.png"), diag.plant)
         figs["gap_overlay"] = save_figure(overlay_figure(diag.attribution), out.claim("gap_overlay.png"))
+
+    figs.update(add_paper_section(spec, data, out))  # the seed paper's own section (issue 19), if the spec asks
 
     columns, rows = _columns(data, list(spec.requirements))
     ref_line = ""
