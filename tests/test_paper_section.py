@@ -100,5 +100,5 @@ def test_no_section_unless_asked(tmp_path):
 
 
 def test_unknown_paper_is_a_spec_error():
-    with pytest.raises(SpecError, match="analysis.paper: Input should be 'x4'"):
+    with pytest.raises(SpecError, match=r"analysis\.paper: Input should be 'x4'"):
         _spec("x5")
