@@ -14,7 +14,7 @@ from synth.loop import Loop
 from synth.outputs import GENERATOR, OutputDir, dump_json, to_jsonable
 from synth.reference import compare
 from synth.report import figures
-from synth.report.paper_section import add_paper_section
+from synth.report.paper_section import paper_section_data, paper_section_figures
 from synth.requirements import SlewRate
 from synth.requirements.base import Requirement, fmt
 from synth.results import DesignResult, reference_controller
@@ -67,6 +67,7 @@ def report_data(spec: Spec, result: DesignResult, keep: dict[str, Any] | None = 
 
         if gap_case_applies(spec):  # seed 1's gap diagnosed on the simulated rig (issue 6): synth.gap.x4_case
             data["sim_to_real_gap"] = x4_gap_case(spec, objects=keep)
+    data |= paper_section_data(spec)  # the seed paper's own section (issue 19): synth.report.paper_section
     return to_jsonable(data)
 
 
@@ -189,7 +190,7 @@ def write_design_report(spec: Spec, result: DesignResult, out_dir: str | Path, *
         figs["gap_map"] = write_gap_map(diag.localization, out.claim("gap_map.png"), diag.plant)
         figs["gap_overlay"] = save_figure(overlay_figure(diag.attribution), out.claim("gap_overlay.png"))
 
-    figs.update(add_paper_section(spec, data, out))  # the seed paper's own section (issue 19), if the spec asks
+    figs.update(paper_section_figures(spec, out))  # the seed paper's own section (issue 19), if the spec asks
 
     columns, rows = _columns(data, list(spec.requirements))
     ref_line = ""

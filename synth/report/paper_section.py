@@ -13,7 +13,8 @@ A spec asks for it with ``analysis: {paper: x4}`` (``docs/spec-format.md``). For
 - **one table of every paper number that does not reconcile** (paper value, synth value, what would
   reconcile it; :func:`synth.paper_checks.x4_paper_checks`), eq. 15's slow pole pair included.
 
-:func:`add_paper_section` is the design report's hook; the HTML is ``templates/paper_section.html.j2``.
+:func:`paper_section_data` (into ``result.json``) and :func:`paper_section_figures` are the design report's
+hooks; the HTML is ``templates/paper_section.html.j2``.
 """
 
 from __future__ import annotations
@@ -33,8 +34,8 @@ from synth.paper_row import PaperRow
 from synth.sizing import RHO_SEA_LEVEL, RotorSizing, rotor_sizing, sizing_checks
 from synth.spec import Spec
 
-__all__ = ["SIZING_SHOWN", "X4_RESOLUTION", "ChainStep", "PaperSection", "add_paper_section", "paper_figures",
-           "x4_paper_section"]
+__all__ = ["SIZING_SHOWN", "X4_RESOLUTION", "ChainStep", "PaperSection", "paper_figures", "paper_section_data",
+           "paper_section_figures", "x4_paper_section"]
 
 #: the speed sensor's resolution the paper states (sec. 4B) [rad/s]
 X4_RESOLUTION = 1.2
@@ -192,28 +193,36 @@ def paper_figures(section: PaperSection, out: OutputDir) -> dict[str, Path]:
     return {"paper_disturbance": path}
 
 
-def add_paper_section(spec: Spec, data: dict[str, Any], out: OutputDir) -> dict[str, Path]:
-    """The design report's hook: when the spec asks (``analysis: {paper: x4}``), put the section into
-    ``data["paper_section"]`` and draw its figure into ``out``; otherwise do nothing.
+def paper_section_data(spec: Spec) -> dict[str, Any]:
+    """The design report's data hook: ``{"paper_section": ...}`` when the spec asks (``analysis: {paper: x4}``),
+    ``{}`` otherwise (merged into ``result.json``).
 
-    Returns
-    -------
-    dict
-        Figure key -> staged path (empty when the spec does not ask).
+    Examples
+    --------
+    >>> from synth.spec import load_spec
+    >>> spec = load_spec("specs/x4_rotor.yaml")
+    >>> sorted(paper_section_data(spec)["paper_section"])[:3], len(paper_section_data(spec)["paper_section"]["chain"])
+    (['chain', 'checked', 'disagreements'], 6)
+    >>> paper_section_data(spec.model_copy(update={"analysis": spec.analysis.model_copy(update={"paper": None})}))
+    {}
+    """
+    if spec.analysis.paper != "x4":
+        return {}
+    return {"paper_section": x4_paper_section().to_dict()}
+
+
+def paper_section_figures(spec: Spec, out: OutputDir) -> dict[str, Path]:
+    """The design report's figure hook: the section's figures drawn into ``out`` when the spec asks, else ``{}``.
 
     Examples
     --------
     >>> import tempfile
     >>> from synth.spec import load_spec
-    >>> data = {}
-    >>> add_paper_section(load_spec("specs/x4_rotor.yaml").model_copy(update={"analysis": load_spec(
-    ...     "specs/x4_rotor.yaml").analysis.model_copy(update={"paper": None})}), data, OutputDir(tempfile.mkdtemp()))
-    {}
-    >>> data
+    >>> spec = load_spec("specs/x4_rotor.yaml")
+    >>> paper_section_figures(spec.model_copy(update={"analysis": spec.analysis.model_copy(update={"paper": None})}),
+    ...                       OutputDir(tempfile.mkdtemp()))
     {}
     """
     if spec.analysis.paper != "x4":
         return {}
-    section = x4_paper_section()
-    data["paper_section"] = section.to_dict()
-    return paper_figures(section, out)
+    return paper_figures(x4_paper_section(), out)
