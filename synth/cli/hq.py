@@ -28,6 +28,10 @@ count n_averages that freqresp records; a JSON key averages or --averages overri
 example:
   synth hq --tf "1/(s^2+s+1)" --delay 0.1
   synth hq --frd roll.csv --averages 20 --json hq.json --out reports/roll_hq
+  synth hq --tf "1/(s^2+s+1)" --delay 0.1 --w1 20      # the report's example: tau_p at w1 = 20 rad/s
+
+--w1 W also gives tau_p = -(phi(W) + 180 deg)/W (seed 2, eq. 2) at that frequency, beside the value at
+2 w180 (values compare only at the same w1).
 
 exit codes: 0 computed, 2 bad input"""
 
@@ -48,6 +52,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    help="measured data: how the phase at 2 w180 is read (default auto)")
     p.add_argument("--fit-band", nargs=2, type=float, metavar=("W1", "W2"),
                    help="band of the least-squares phase line [rad/s] (default w180 to 2 w180)")
+    p.add_argument("--w1", type=float, metavar="W", help="also the phase delay at this frequency [rad/s] (seed 2, eq. 2)")
     p.add_argument("--json", metavar="FILE", help="write the metrics as JSON ('-' for standard output)")
     p.add_argument("--out", metavar="DIR", help="folder for hq.json and hq_bode.png")
     p.add_argument("--force", action="store_true", help="overwrite files synth did not write")
@@ -153,11 +158,17 @@ def run(args: argparse.Namespace) -> int:
             raise exc.located(args.frd) if exc.where == "frequency response" else exc from None
         title = str(args.frd)
     data = m.to_dict()
+    at_w1 = None
+    if args.w1 is not None:  # phase delay at a stated w1 (issue 19): synth.ident.phase_delay
+        from synth.ident.phase_delay import phase_delay_at
+
+        at_w1 = phase_delay_at(m, args.w1, plant if args.tf is not None else None)
+        data["phase_delay_at_w1"] = at_w1.to_dict()
     if args.json and args.json != "-":
         check_writable(Path(args.json), args.force)
     out = OutputDir(args.out, args.force) if args.out else None
     if out:
-        write_json(out.claim("hq.json"), m.to_dict(curves=True), force=True)
+        write_json(out.claim("hq.json"), {**m.to_dict(curves=True), **data}, force=True)
         from synth.ident.hq_figures import hq_bode
 
         hq_bode(m, out.claim("hq_bode.png"), title)
@@ -176,7 +187,10 @@ def run(args: argparse.Namespace) -> int:
             ("phase delay tau_p", _fmt(m.phase_delay, "s", u.get("phase_delay"), 3)
              + (f"  (phase at 2 w180: {m.phase_2w180:.1f} deg, {m.phase_method})" if m.phase_2w180 is not None else ""))]
     print(f"{title}: {m.response_type} response type ({m.response_type_reason})")
-    print(name_values(rows, m.notes))
+    if at_w1 is not None:
+        rows.append((f"phase delay at w1 = {at_w1.w1:g}", f"{at_w1.phase_delay:.3g} s  (phase {at_w1.phase_deg:.1f} deg "
+                                                          f"at {at_w1.w1:g} rad/s, {at_w1.method})"))
+    print(name_values(rows, m.notes + (at_w1.notes if at_w1 is not None else ())))
     if out:
         print(f"wrote {out.path}/hq.json and {out.path}/hq_bode.png")
     return 0

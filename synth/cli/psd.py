@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import sys
 from pathlib import Path
+from typing import Any
 
 __all__ = ["COMMAND", "DESCRIPTION", "HELP", "ORDER", "add_arguments", "run"]
 
@@ -21,6 +22,15 @@ feedback attenuates a disturbance only below the loop's bandwidth.
 example:
   synth psd --data env.csv --data env2.csv --time t --signal speed --unit rad/s
   synth psd --data hover.mat --time t --signal speed --noise-data stopped.mat --share 0.9 --out reports/psd
+  synth psd --data hover.csv --time t --signal speed --noise-data stopped.csv --requirements --resolution 1.2 \
+            --out reports/disturbance
+
+--requirements (implied by --resolution) derives the sensitivity level, its band and the bandwidth
+floor from the disturbance (synth.ident.disturbance_requirements): the level brings the spectrum's
+plateau down to the sensor floor (the noise record's level, or the resolution's quantization noise,
+whichever is larger), the band ends at the plateau's corner, the bandwidth floor is where the
+disturbance falls to --margin-db above the sensor floor. It prints the ready `requirements:` block and
+its evidence; with --out it also writes requirements.yaml and disturbance_requirements.png.
 
 exit codes: 0 computed, 2 bad input"""
 
@@ -47,6 +57,14 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--spike-db", type=float, default=10.0, help="spike threshold above the running median [dB]")
     p.add_argument("--detrend", choices=["constant", "linear"], default="constant",
                    help="removed from each segment (linear for battery drift)")
+    req = p.add_argument_group("requirements from the disturbance (issue 19)")
+    req.add_argument("--requirements", action="store_true",
+                     help="derive the sensitivity level and band and the bandwidth floor; print the requirements block")
+    req.add_argument("--resolution", type=float, metavar="Q",
+                     help="sensor resolution in signal units: its quantization noise joins the sensor floor "
+                          "(implies --requirements)")
+    req.add_argument("--margin-db", type=float, metavar="DB",
+                     help="bandwidth floor: where the disturbance falls to this far above the sensor floor (default 3)")
     p.add_argument("--json", metavar="FILE", help="write the analysis as JSON ('-' for standard output)")
     p.add_argument("--out", metavar="DIR", help="folder for psd.json and psd.png")
     p.add_argument("--force", action="store_true", help="overwrite files synth did not write")
@@ -71,6 +89,9 @@ def run(args: argparse.Namespace) -> int:
     suggestion = suggest_bandwidth(a, args.factor) if a.share_frequency is not None else None
     data = {**a.to_dict(), "records": [r.to_dict() for r in records], "noise_records": [r.to_dict() for r in noise],
             "bandwidth_suggestion": suggestion.to_dict() if suggestion else None}
+    derived = _derive_requirements(args, a, records[0].dt)
+    if derived is not None:
+        data["requirements"] = derived.to_dict()
     if args.json and args.json != "-":
         check_writable(Path(args.json), args.force)
     out = OutputDir(args.out, args.force) if args.out else None
@@ -79,6 +100,12 @@ def run(args: argparse.Namespace) -> int:
         from synth.ident.psd_figures import psd_plot
 
         psd_plot(a, out.claim("psd.png"), f"{args.signal}: " + ", ".join(Path(f).name for f in args.data))
+        if derived is not None:
+            from synth.ident.disturbance_requirements_figure import disturbance_requirements_plot
+
+            out.claim("requirements.yaml").write_text(derived.yaml() + "\n", encoding="utf-8")
+            disturbance_requirements_plot(a, derived, out.claim("disturbance_requirements.png"),
+                                          f"{args.signal}: requirements from the disturbance")
         out.commit()
     if args.json == "-":
         sys.stdout.write(dump_json(data))
@@ -102,6 +129,31 @@ def run(args: argparse.Namespace) -> int:
         rows.append(("suggested requirement", f"{suggestion.spec_entry()}  (bandwidth >= {suggestion.factor:g} x "
                                               f"{suggestion.share_frequency:.4g} rad/s)"))
     print(name_values(rows, a.notes))
+    if derived is not None:
+        print("\nrequirements from the disturbance:\n" + derived.yaml())
+        print(name_values([(e.name, f"{e.value:.4g} {e.unit}  ({e.feature})") for e in derived.evidence],
+                          derived.notes))
     if out:
-        print(f"wrote {out.path}/psd.json and {out.path}/psd.png")
+        extra = ", requirements.yaml and disturbance_requirements.png" if derived is not None else ""
+        print(f"wrote {out.path}/psd.json, {out.path}/psd.png{extra}")
     return 0
+
+
+def _derive_requirements(args: argparse.Namespace, analysis: Any, dt: float) -> Any:
+    """The requirements block from the disturbance when --requirements or --resolution asks for it, else None."""
+    if not (args.requirements or args.resolution is not None):
+        if args.margin_db is not None:
+            from synth.errors import SynthError
+
+            raise SynthError("used only with --requirements (or --resolution)", where="--margin-db")
+        return None
+    from synth.errors import DataError
+    from synth.ident.disturbance_requirements import requirements_from_disturbance
+    from synth.ident.psd import KNEE_DB
+
+    try:
+        return requirements_from_disturbance(analysis, args.resolution, dt,
+                                             KNEE_DB if args.margin_db is None else args.margin_db)
+    except DataError as exc:
+        flag = "--resolution" if "resolution" in exc.message else "--margin-db" if "margin" in exc.message else None
+        raise exc.located(flag) if flag else exc from None

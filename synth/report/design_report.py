@@ -14,6 +14,7 @@ from synth.loop import Loop
 from synth.outputs import GENERATOR, OutputDir, dump_json, to_jsonable
 from synth.reference import compare
 from synth.report import figures
+from synth.report.paper_section import paper_section_data, paper_section_figures
 from synth.requirements import SlewRate
 from synth.requirements.base import Requirement, fmt
 from synth.results import DesignResult, reference_controller
@@ -66,6 +67,7 @@ def report_data(spec: Spec, result: DesignResult, keep: dict[str, Any] | None = 
 
         if gap_case_applies(spec):  # seed 1's gap diagnosed on the simulated rig (issue 6): synth.gap.x4_case
             data["sim_to_real_gap"] = x4_gap_case(spec, objects=keep)
+    data |= paper_section_data(spec)  # the seed paper's own section (issue 19): synth.report.paper_section
     return to_jsonable(data)
 
 
@@ -133,7 +135,8 @@ def write_design_report(spec: Spec, result: DesignResult, out_dir: str | Path, *
     >>> spec = load_spec("specs/x4_rotor.yaml")
     >>> files = write_design_report(spec, design(spec), tempfile.mkdtemp())
     >>> sorted(files.figures)
-    ['bode', 'delay', 'gain_set', 'gap_map', 'gap_overlay', 'sensitivity', 'sim_onset', 'sim_rise', 'sim_step', 'step']
+    ['bode', 'delay', 'gain_set', 'gap_map', 'gap_overlay', 'paper_disturbance', 'sensitivity', 'sim_onset', 'sim_rise',
+     'sim_step', 'step']
     """
     out = OutputDir(out_dir, force)
     objects: dict[str, Any] = {}
@@ -186,6 +189,8 @@ def write_design_report(spec: Spec, result: DesignResult, out_dir: str | Path, *
         diag = objects["diagnosis"]
         figs["gap_map"] = write_gap_map(diag.localization, out.claim("gap_map.png"), diag.plant)
         figs["gap_overlay"] = save_figure(overlay_figure(diag.attribution), out.claim("gap_overlay.png"))
+
+    figs.update(paper_section_figures(spec, out))  # the seed paper's own section (issue 19), if the spec asks
 
     columns, rows = _columns(data, list(spec.requirements))
     ref_line = ""

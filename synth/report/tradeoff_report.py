@@ -100,6 +100,10 @@ def tradeoff_figure(result: TradeoffResult, path: Path) -> Path:
                        linewidths=0.8)
         for bind in binders:
             ax.scatter([], [], color=color[bind], label=f"binding: {bind}")
+        front = [p for p in result.points if p.pareto]  # non-dominated over both swept values and the objective
+        if front:
+            ax.scatter([p.values[b.path] for p in front], [p.values[a.path] for p in front], facecolors="none",
+                       edgecolors="black", s=140, lw=1.5, zorder=3, label=f"Pareto front ({len(front)} points)")
         ax.set_xlabel(b.path)
         ax.set_ylabel(a.path)
     ax.set_title(f"Trade-off: {result.spec}")

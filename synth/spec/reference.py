@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from typing import Literal
+
 from pydantic import Field, NonNegativeFloat, field_validator
 
 from synth.controllers import Controller
@@ -49,5 +51,8 @@ class AnalysisSpec(StrictModel):
     """Extra analyses for the report."""
 
     loop_delays: list[NonNegativeFloat] = Field(default_factory=lambda: [0.0, 0.005, 0.01, 0.015, 0.02])
+    #: a seed paper whose numbers the report reconciles (``x4``: sizing, the disturbance chain on a
+    #: SYNTHETIC record, every number that does not reconcile; :mod:`synth.report.paper_section`)
+    paper: Literal["x4"] | None = None
 
 

@@ -19,7 +19,7 @@ import copy
 import json
 import os
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import asdict, dataclass, field
 from typing import Any
@@ -29,8 +29,8 @@ import numpy as np
 from synth.errors import SpecError, SynthError
 from synth.spec import Spec
 
-__all__ = ["Sweep", "TradeoffPoint", "TradeoffResult", "design_chunk", "design_point", "mark_pareto", "set_value",
-           "stricter_when", "tradeoff"]
+__all__ = ["Sweep", "TradeoffPoint", "TradeoffResult", "design_chunk", "design_point", "mark_pareto", "non_dominated",
+           "set_value", "stricter_when", "tradeoff"]
 
 PLANT_STRICTER_WHEN = {"delay": +1}
 """Swept plant values and their direction: +1 when a larger value makes the design harder."""
@@ -276,29 +276,72 @@ def _chunks(points: list, n: int) -> list[list]:
     return [list(c) for c in np.array_split(np.array(points, dtype=object), n) if len(c)]
 
 
-def mark_pareto(points: list[TradeoffPoint], sweeps: list[Sweep], sense: str, sign_x: int = +1) -> None:
-    """Flag feasible points that no other feasible point beats on both the swept demand and the objective.
+def non_dominated(demands: np.ndarray, objective: np.ndarray, tol: float = 0.0) -> np.ndarray:
+    """Mask of the points no other point beats: at least as strict on every demand and at least as good on
+    the objective, strictly better on one of them (all columns oriented so that larger is stricter/better).
 
-    ``sign_x`` is +1 when a larger swept value is the stricter demand, -1 when a smaller one is
-    (:func:`stricter_when`).
+    Objectives within ``tol`` of each other tie (solver noise must not decide the front).
+
+    Parameters
+    ----------
+    demands : array of shape (n, k)
+        The swept values, each multiplied by its direction (+1 stricter when larger, -1 when smaller).
+    objective : array of shape (n,)
+        The objective, multiplied by +1 (maximize) or -1 (minimize).
+    tol : float
+        Tie tolerance of the objective.
+
+    Returns
+    -------
+    numpy.ndarray of bool
+
+    Examples
+    --------
+    >>> d = np.array([[1.0, 1.0], [2.0, 1.0], [1.0, 2.0], [2.0, 2.0], [3.0, 0.0]])
+    >>> non_dominated(d, np.array([5.0, 4.0, 4.0, 1.0, 0.0])).tolist()
+    [True, True, True, True, True]
+    >>> non_dominated(d, np.array([5.0, 5.0, 4.0, 4.0, 0.0])).tolist()
+    [False, True, False, True, True]
     """
-    if len(sweeps) != 1:
-        return
+    X = np.asarray(demands, float).reshape(len(objective), -1)
+    y = np.asarray(objective, float)
+    ge = np.all(X[:, None, :] >= X[None, :, :], axis=2) & (y[:, None] >= y[None, :] - tol)  # [q, p]: q >= p
+    gt = np.any(X[:, None, :] > X[None, :, :], axis=2) | (y[:, None] > y[None, :] + tol)
+    return ~np.any(ge & gt, axis=0)
+
+
+def mark_pareto(points: list[TradeoffPoint], sweeps: list[Sweep], sense: str,
+                sign_x: int | Sequence[int] = +1) -> None:
+    """Flag feasible points that no other feasible point beats on the swept demands and the objective.
+
+    With two sweeps the front is the non-dominated set over both swept values and the objective
+    (:func:`non_dominated`). ``sign_x`` gives each sweep's direction, +1 when a larger swept value is the
+    stricter demand, -1 when a smaller one is (:func:`stricter_when`); one int applies to every sweep.
+
+    Examples
+    --------
+    >>> pts = [TradeoffPoint({"a": a, "b": b}, True, a + b, None, [], {}, "", 0.0) for a in (1, 2) for b in (1, 2)]
+    >>> mark_pareto(pts, [Sweep("a", [1, 2]), Sweep("b", [1, 2])], "maximize", (-1, -1))
+    >>> [(p.values["a"], p.values["b"]) for p in pts if p.pareto]
+    [(1, 1), (1, 2), (2, 1), (2, 2)]
+    >>> mark_pareto(pts, [Sweep("a", [1, 2]), Sweep("b", [1, 2])], "maximize", (+1, +1))
+    >>> [(p.values["a"], p.values["b"]) for p in pts if p.pareto]
+    [(2, 2)]
+    """
+    signs = [int(sign_x)] * len(sweeps) if isinstance(sign_x, int) else [int(s) for s in sign_x]
+    if len(signs) != len(sweeps):
+        raise ValueError(f"{len(signs)} directions for {len(sweeps)} sweeps")
     sign_y = 1.0 if sense == "maximize" else -1.0
+    for p in points:
+        p.pareto = False
     feas = [p for p in points if p.feasible and p.objective is not None]
+    if not feas:
+        return
     scale = max((abs(p.objective) for p in feas), default=1.0) or 1.0
-    tol = 1e-6 * scale  # objectives equal to this tolerance tie (solver noise must not decide the front)
-
-    def at_least(a: float, b: float) -> bool:
-        return a >= b - tol
-
-    for p in feas:
-        x, y = sign_x * p.values[sweeps[0].path], sign_y * p.objective
-        p.pareto = not any(
-            (sign_x * q.values[sweeps[0].path] >= x and at_least(sign_y * q.objective, y))
-            and (sign_x * q.values[sweeps[0].path] > x or sign_y * q.objective > y + tol)
-            for q in feas
-        )
+    demands = np.array([[s * p.values[sw.path] for s, sw in zip(signs, sweeps)] for p in feas], float)
+    front = non_dominated(demands, np.array([sign_y * p.objective for p in feas]), 1e-6 * scale)
+    for p, on in zip(feas, front):
+        p.pareto = bool(on)
 
 
 def tradeoff(spec: Spec, sweeps: list[Sweep], scheduler: str | Any | None = None, workers: int | None = None,
@@ -333,7 +376,13 @@ def tradeoff(spec: Spec, sweeps: list[Sweep], scheduler: str | Any | None = None
     data = spec.model_dump(mode="json", exclude_none=True)
     for sw in sweeps:  # fail early on a bad path
         set_value(data, sw.path, sw.values[0])
-    sign_x = stricter_when(data, sweeps[0].path) if len(sweeps) == 1 else +1
+    if len(sweeps) == 1:  # a one-value sweep needs its direction: fail early
+        signs = [stricter_when(data, sweeps[0].path)]
+    else:
+        try:
+            signs = [stricter_when(data, sw.path) for sw in sweeps]
+        except SpecError:  # a map over any two values still designs; it just has no front
+            signs = []
     grid = _grid(sweeps)
     t0 = time.perf_counter()
     results: list[TradeoffPoint] = []
@@ -372,9 +421,14 @@ def tradeoff(spec: Spec, sweeps: list[Sweep], scheduler: str | Any | None = None
     objective = {"name": spec.objective.name, "sense": spec.objective.sense,
                  "description": spec.objective.describe()} if spec.objective else {
         "name": "default", "sense": "maximize", "description": "no objective in the spec"}
-    mark_pareto(results, sweeps, objective["sense"], sign_x)
+    extras: dict[str, Any] = {}
+    if signs:
+        mark_pareto(results, sweeps, objective["sense"], signs)
+        extras["stricter_when"] = {sw.path: s for sw, s in zip(sweeps, signs)}
+    else:
+        extras["pareto_note"] = "no Pareto front: a swept value has no known direction (stricter when larger or smaller)"
     return TradeoffResult(spec.name, sweeps, objective, results, label, len(chunks),
-                          time.perf_counter() - t0)
+                          time.perf_counter() - t0, extras)
 
 
 def _dask_client(scheduler: Any) -> tuple[Any, str, int]:
