@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import itertools
 import json
 
 import numpy as np
@@ -93,3 +94,27 @@ def test_bad_input_one_line_exit_2(run_cli, tmp_path, args, words):
 def test_missing_folder(run_cli, tmp_path):
     r = run_cli("sweep-design", "--w-min", "0.4", "--w-max", "12", "--out", str(tmp_path / "no" / "x.csv"))
     assert r.code == 2 and "folder does not exist" in r.err
+
+
+def test_amplitude_reduced_above_a_frequency_as_the_reports_pilots_did(run_cli, tmp_path):
+    """Roll sweep with the amplitude halved from 1.5 Hz on (the report: pylon mode above 2 Hz)."""
+    out = tmp_path / "roll.csv"
+    r = run_cli("sweep-design", "--w-min", "0.4", "--w-max", "12", "--amplitude", "1.5", "--reduce-above", "1.5",
+                "--reduce-to", "0.5", "--out", str(out), "--json", str(tmp_path / "plan.json"))
+    assert r.code == 0, r.err
+    first, _, t, u = _read(out)
+    assert "amplitude x 0.5 above 1.5 Hz" in first
+    # instantaneous frequency from the zero crossings: half a period between neighbours
+    z = _zero_crossings(t, u)
+    w_mid = np.pi / np.diff(z)
+    peaks = np.array([np.max(np.abs(u[(t >= a) & (t < b)])) for a, b in itertools.pairwise(z)])
+    below = peaks[(w_mid < 2 * np.pi * 1.5 / np.sqrt(2) * 0.9) & (z[:-1] > 10)]
+    above = peaks[w_mid > 2 * np.pi * 1.5 * 1.1]
+    assert below.size > 10 and above.size > 5
+    assert np.min(below[:-3]) == pytest.approx(1.5, rel=0.05) and np.max(above) <= 0.75 * 1.02
+    assert np.max(np.abs(np.diff(u))) < 0.5  # no step: the change is smooth
+    plan = json.loads((tmp_path / "plan.json").read_text())
+    assert plan["reduce_above_hz"] == 1.5 and plan["reduce_to"] == 0.5
+    bad = run_cli("sweep-design", "--w-min", "0.4", "--w-max", "12", "--reduce-above", "1.5", "--reduce-to", "2",
+                  "--out", str(tmp_path / "x.csv"))
+    assert bad.code == 2 and "--reduce-to" in bad.err and len(bad.err.strip().splitlines()) == 1

@@ -41,6 +41,11 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--fade", type=float, metavar="S", help="raised-cosine fade-in and fade-out [s] (default T_max/4)")
     p.add_argument("--sample-rate", type=float, metavar="HZ",
                    help="samples per second (default: 25 per period of w_max, rounded up)")
+    p.add_argument("--reduce-above", type=float, metavar="HZ",
+                   help="reduce the amplitude from this input frequency on [Hz] (the report's pilots did above 1.5 Hz "
+                        "to spare the rotor pylon mode); the change is smooth over the half octave below it")
+    p.add_argument("--reduce-to", type=float, default=0.5, metavar="FRACTION",
+                   help="the reduced amplitude as a fraction of --amplitude (default 0.5)")
     p.add_argument("--runs", type=int, default=2, help="runs to concatenate for the analysis (one more is flown)")
     p.add_argument("--name", default="input", help="input column name (default 'input')")
     p.add_argument("--out", required=True, metavar="FILE", help="the CSV to write (time_s, input)")
@@ -85,6 +90,9 @@ def run(args: argparse.Namespace) -> int:
                         (args.amplitude, "--amplitude"), (args.sample_rate, "--sample-rate")):
         _positive(value, flag)
     _positive(args.fade, "--fade", allow_zero=True)
+    _positive(args.reduce_above, "--reduce-above")
+    if args.reduce_above is not None and not (0 < args.reduce_to <= 1):
+        raise SynthError(f"must be a fraction in (0, 1], got {args.reduce_to:g}", where="--reduce-to")
     if args.runs < 1:
         raise SynthError(f"must be at least 1, got {args.runs}", where="--runs")
     if not args.name.strip() or "," in args.name or "\n" in args.name:
@@ -112,7 +120,9 @@ def run(args: argparse.Namespace) -> int:
                      "is mostly faded out")
     rate = args.sample_rate or plan.sample_rate
     try:
-        t, u = plan.signal(amplitude=args.amplitude, sample_rate=rate, fade=fade)
+        reduce_above = None if args.reduce_above is None else 2.0 * math.pi * args.reduce_above
+        t, u = plan.signal(amplitude=args.amplitude, sample_rate=rate, fade=fade, reduce_above=reduce_above,
+                           reduce_to=args.reduce_to)
     except DataError as exc:
         raise SynthError(exc.message, where="--sample-rate" if "sample rate" in exc.message else "--amplitude") from None
     out = Path(args.out)
@@ -121,11 +131,17 @@ def run(args: argparse.Namespace) -> int:
         check_writable(Path(args.json), args.force)
     header = (f"{GENERATOR}: frequency sweep {plan.w_min:g}-{plan.w_max:g} rad/s, {plan.run_length:g} s, amplitude "
               f"{args.amplitude:g}, fade {fade:.4g} s, {rate:g} Hz")
+    if args.reduce_above is not None:
+        header += f", amplitude x {args.reduce_to:g} above {args.reduce_above:g} Hz"
+        if 2.0 * math.pi * args.reduce_above >= plan.w_max:
+            notes.append(f"--reduce-above {args.reduce_above:g} Hz is at or above w_max: the sweep never gets there")
     if not out.parent.exists():
         raise SynthError("folder does not exist", where=str(out.parent))
     atomic_write_text(out, sweep_csv_text(t, u, args.name, header))
     data = {"generator": GENERATOR, **plan.to_dict(), "duration_s": plan.run_length, "amplitude": args.amplitude,
-            "fade_s": fade, "sample_rate_hz": rate, "samples": int(t.size), "recommended_run_length_s": recommended,
+            "fade_s": fade, "reduce_above_hz": args.reduce_above,
+            "reduce_to": args.reduce_to if args.reduce_above is not None else None, "sample_rate_hz": rate,
+            "samples": int(t.size), "recommended_run_length_s": recommended,
             "csv": str(out), "column": args.name, "notes": notes}
     if args.json == "-":
         sys.stdout.write(dump_json(data))

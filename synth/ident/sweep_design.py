@@ -96,7 +96,8 @@ class SweepDesign:
                 "sample_rate_hz": self.sample_rate, "windows_s": list(self.windows)}
 
     def signal(self, amplitude: float = 1.0, sample_rate: float | None = None, fade: float | None = None,
-               c1: float = 4.0) -> tuple[np.ndarray, np.ndarray]:
+               c1: float = 4.0, reduce_above: float | None = None,
+               reduce_to: float = 0.5) -> tuple[np.ndarray, np.ndarray]:
         """Generate one run of the sweep input.
 
         Parameters
@@ -110,6 +111,12 @@ class SweepDesign:
         c1 : float
             Exponential rate of the sweep (4 in the common recipe; larger dwells
             longer at low frequency).
+        reduce_above : float, optional
+            [rad/s] From this instantaneous frequency on, the amplitude is reduced to ``reduce_to`` of
+            its value (the report's pilots did so above 1.5 Hz to spare a structural mode); the change is
+            a raised cosine over the half octave below it, so no step enters the input.
+        reduce_to : float
+            The reduced amplitude as a fraction (0 < reduce_to <= 1).
 
         Returns
         -------
@@ -121,6 +128,9 @@ class SweepDesign:
         >>> t, u = design_sweep(0.4, 12.0).signal(amplitude=1.5, sample_rate=50)
         >>> float(t[-1]), round(float(abs(u).max()), 2), float(u[0]), round(abs(float(u[-1])), 12)
         (90.0, 1.5, 0.0, 0.0)
+        >>> t, u = design_sweep(0.4, 12.0).signal(sample_rate=50, reduce_above=2 * np.pi * 1.5, reduce_to=0.4)
+        >>> round(float(abs(u[t < 40]).max()), 2), round(float(abs(u[t > 88]).max()), 2) <= 0.4  # above 9.4 rad/s
+        (1.0, True)
         """
         fs = float(sample_rate or self.sample_rate)
         if not fs > 2.0 * self.f_max:
@@ -135,11 +145,19 @@ class SweepDesign:
         dw = self.w_max - self.w_min
         phase = self.w_min * t + c2 * dw * (sweep / c1 * np.expm1(c1 * tau / sweep) - tau)
         u = np.sin(phase)
+        if reduce_above is not None:
+            if not (np.isfinite(reduce_above) and reduce_above > 0 and 0 < reduce_to <= 1):
+                raise DataError(f"amplitude reduction needs a frequency > 0 and a fraction in (0, 1], got "
+                                f"{reduce_above!r} rad/s and {reduce_to!r}")
+            w_now = self.w_min + c2 * dw * np.expm1(c1 * tau / sweep)   # instantaneous frequency d(phase)/dt
+            x = np.clip(np.log2(np.maximum(w_now, 1e-300) / reduce_above) / 0.5 + 1.0, 0.0, 1.0)
+            u = u * (1.0 - (1.0 - reduce_to) * 0.5 * (1.0 - np.cos(np.pi * x)))
         fade = 0.25 * self.t_max if fade is None else float(fade)
         if fade > 0:
             ramp = np.clip(np.minimum(t, t[-1] - t) / fade, 0.0, 1.0)
             u = u * 0.5 * (1.0 - np.cos(np.pi * ramp))
-        return t, amplitude * u / np.max(np.abs(u))
+        peak = np.max(np.abs(u[: max(1, np.searchsorted(t, t_low + 1e-9))])) if reduce_above is not None else 0.0
+        return t, amplitude * u / (peak if peak > 0 else np.max(np.abs(u)))
 
 
 def design_sweep(w_min: float, w_max: float, runs_used: int = 2) -> SweepDesign:
