@@ -72,11 +72,13 @@ def _load(path: str, args: argparse.Namespace) -> Any:
 def run(args: argparse.Namespace) -> int:
     from pathlib import Path
 
+    from synth.cli._outputs import check_outputs
     from synth.errors import SynthError
     from synth.ident.freqfit import fit_frequency_response, verify_step
     from synth.ident.spectra import frequency_response, rate_to_attitude
     from synth.outputs import OutputDir, dump_json, write_json
 
+    check_outputs(args.out, ["result.json", "bode.png"], [args.json], args.force)  # before any computation
     runs = [_load(p, args) for p in args.data]
     windows = _floats(args.windows, "--windows") if args.windows else None
     for name in ("wmin", "wmax"):

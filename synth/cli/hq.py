@@ -112,12 +112,14 @@ def _fmt(value: Any, unit: str, sigma: Any = None, digits: int = 4) -> str:
 
 
 def run(args: argparse.Namespace) -> int:
+    from synth.cli._outputs import check_outputs
     from synth.cli._table import name_values
     from synth.errors import DataError, ModelError
     from synth.ident.hq import hq_from_frd, hq_from_plant
     from synth.outputs import OutputDir, check_writable, dump_json, write_json
     from synth.plant import Plant
 
+    check_outputs(args.out, ["hq.json", "hq_bode.png"], [args.json], args.force)  # before any computation
     if args.tf is not None:
         try:
             plant = Plant.from_string(args.tf, delay=args.delay)

@@ -50,6 +50,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    from synth.cli._outputs import check_outputs
     from synth.cli._table import name_values
     from synth.data.disturbance import load_disturbance
     from synth.ident.bandwidth_suggestion import suggest_bandwidth
@@ -57,6 +58,7 @@ def run(args: argparse.Namespace) -> int:
     from synth.ident.welch import unit_squared
     from synth.outputs import OutputDir, check_writable, dump_json, write_json
 
+    check_outputs(args.out, ["psd.json", "psd.png"], [args.json], args.force)  # before any computation
     records = [load_disturbance(f, args.time, args.signal, args.unit, args.dt) for f in args.data]
     noise = [load_disturbance(f, args.time, args.signal, args.unit, args.dt) for f in args.noise_data]
     a = analyze_records(records, noise, share=args.share, band=tuple(args.band) if args.band else None,
