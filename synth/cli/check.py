@@ -33,12 +33,14 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from synth.check import check
+    from synth.cli._outputs import check_outputs
     from synth.cli._table import print_requirements
     from synth.controllers import Controller
     from synth.errors import ModelError
     from synth.outputs import dump_json, write_json
     from synth.spec import load_spec
 
+    check_outputs(None, files=[args.json], force=args.force)  # before any computation
     spec = load_spec(args.spec)
     try:
         controller = Controller.from_string(args.controller)

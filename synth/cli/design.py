@@ -36,12 +36,16 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    from synth.cli._outputs import check_outputs, spec_name
     from synth.cli._table import print_requirements
     from synth.design import design
     from synth.outputs import dump_json, write_json
     from synth.requirements.base import fmt
     from synth.spec import load_spec
 
+    name = args.out or spec_name(args.spec)  # refuse before any computation (the spec's plant may be identified)
+    folder = None if args.no_report or not name else (Path(args.out) if args.out else Path("reports") / name)
+    check_outputs(folder, ["result.json", "report.html"], [args.json], args.force)
     spec = load_spec(args.spec)
     result = design(spec)
     say = (lambda *a: None) if args.quiet or args.json == "-" else print

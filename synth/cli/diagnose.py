@@ -101,14 +101,17 @@ def run(args: argparse.Namespace) -> int:
     from synth.data.readers import parse_column_map
     from synth.errors import SynthError
     from synth.gap.diagnose import check_candidates, diagnose, load_model
-    from synth.outputs import check_writable, dump_json, write_json
+    from synth.outputs import dump_json, write_json
 
     try:
         candidates = check_candidates(_split([args.candidates])) if args.candidates is not None else None
     except SynthError as exc:
         raise SynthError(exc.message, where="--candidates") from None
-    if args.json and args.json != "-":
-        check_writable(Path(args.json), args.force)  # refuse before the slow part
+    from synth.cli._outputs import check_outputs
+
+    stem = Path(args.data).stem + ("_round_robin" if args.round_robin else "")
+    check_outputs(None if args.no_report else Path(args.out or Path("reports") / "diagnose" / stem),
+                  ["result.json", "report.html"], [args.json], args.force)  # refuse before the slow part
     plant = load_model(args.plant, args.delay, where="--plant")
     aux = _split(args.aux)
     kw: dict[str, Any] = {"aux": aux, "input_unit": args.input_unit, "output_unit": args.output_unit,

@@ -103,12 +103,14 @@ def run(args: argparse.Namespace) -> int:
 
     import numpy as np
 
+    from synth.cli._outputs import check_outputs
     from synth.errors import ModelError, SynthError
     from synth.ident.freqfit import FrequencyFitError, fit_frequency_response, verify_step
     from synth.ident.spectra import correct_response, frequency_response, rate_to_attitude
     from synth.outputs import OutputDir, dump_json, write_json
     from synth.plant import Plant
 
+    check_outputs(args.out, ["result.json", "bode.png"], [args.json], args.force)  # before any computation
     runs = [_load(p, args, off_axis=True) for p in args.data]
     if not 1 <= args.points_per_decade <= 2000:
         raise SynthError(f"must be between 1 and 2000, got {args.points_per_decade}", where="--points-per-decade")

@@ -134,6 +134,7 @@ def _fmt(value: Any, unit: str, sigma: Any = None, digits: int = 4) -> str:
 
 
 def run(args: argparse.Namespace) -> int:
+    from synth.cli._outputs import check_outputs
     from synth.cli._table import name_values
     from synth.data.readers import parse_column_map
     from synth.errors import DataError, ModelError
@@ -141,6 +142,7 @@ def run(args: argparse.Namespace) -> int:
     from synth.outputs import OutputDir, check_writable, dump_json, write_json
     from synth.plant import Plant
 
+    check_outputs(args.out, ["hq.json", "hq_bode.png"], [args.json], args.force)  # before any computation
     if args.tf is not None:
         try:
             plant = Plant.from_string(args.tf, delay=args.delay)

@@ -102,6 +102,10 @@ def run(args: argparse.Namespace) -> int:
         raise SynthError("give the record, e.g. --data run.csv (or --x4-demo)", where="--data")
     if not args.structure:
         raise SynthError('give the plant structure, e.g. --structure "k/(s+p)"', where="--structure")
+    from synth.cli._outputs import check_outputs
+
+    check_outputs(Path(args.out) if args.out else Path("reports") / "identify" / Path(args.data).stem,
+                  ["identify.json"] + ([] if args.no_figures else ["fit.png", "train.png"]), [args.json], args.force)
     try:
         structure = parse_structure(args.structure)
     except ModelError as exc:

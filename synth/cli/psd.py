@@ -71,6 +71,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    from synth.cli._outputs import check_outputs
     from synth.cli._table import name_values
     from synth.data.disturbance import load_disturbance
     from synth.data.readers import parse_column_map
@@ -79,6 +80,7 @@ def run(args: argparse.Namespace) -> int:
     from synth.ident.welch import unit_squared
     from synth.outputs import OutputDir, check_writable, dump_json, write_json
 
+    check_outputs(args.out, ["psd.json", "psd.png"], [args.json], args.force)  # before any computation
     columns = parse_column_map(args.columns)
     records = [load_disturbance(f, args.time, args.signal, args.unit, args.dt, columns) for f in args.data]
     noise = [load_disturbance(f, args.time, args.signal, args.unit, args.dt, columns) for f in args.noise_data]

@@ -115,12 +115,19 @@ def _write_csv(path: Path, columns: dict[str, Any], header: str) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    from synth.cli._outputs import check_outputs, spec_name
     from synth.controllers import Controller
     from synth.errors import ModelError, SynthError
     from synth.outputs import GENERATOR, OutputDir, dump_json, to_jsonable, write_json
     from synth.sim.spec import SimulationSpec
     from synth.spec import load_spec
 
+    name = args.out or spec_name(args.spec)  # refuse before any computation
+    folder_names = (["sweep.json"] + ([] if args.csv else ["sweep.csv"]) if args.sweep else
+                    ["metrics.json"] + ([] if args.csv else ["timeseries.csv"]) + ([] if args.plot else ["step.png"]))
+    uses_folder = not args.csv if args.sweep else not (args.csv and args.plot)
+    check_outputs((Path(args.out) if args.out else Path("reports") / name / "simulate") if name and uses_folder
+                  else None, folder_names, [args.json, args.csv, None if args.sweep else args.plot], args.force)
     spec = load_spec(args.spec)
     sim = spec.simulation or SimulationSpec()
     text = args.controller or (spec.reference.controller if spec.reference else None)

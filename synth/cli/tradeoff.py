@@ -42,6 +42,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    from synth.cli._outputs import check_outputs, spec_name
     from synth.cli._table import table
     from synth.errors import SpecError
     from synth.outputs import dump_json, write_json
@@ -50,6 +51,9 @@ def run(args: argparse.Namespace) -> int:
     from synth.spec import load_spec
     from synth.synthesis.tradeoff import Sweep, tradeoff
 
+    name = args.out or spec_name(args.spec)  # refuse before any computation
+    check_outputs((Path(args.out) if args.out else Path("reports") / name) if name else None,
+                  ["tradeoff.csv", "tradeoff.json", "tradeoff.html", "tradeoff.png"], [args.json], args.force)
     spec = load_spec(args.spec)
     sweeps = [Sweep.parse(s) for s in args.sweep]
     if len(sweeps) > 2:

@@ -7,7 +7,6 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from jinja2 import Environment, PackageLoader
 
 from synth.controllers import Controller
 from synth.loop import Loop
@@ -15,6 +14,7 @@ from synth.outputs import GENERATOR, OutputDir, dump_json, to_jsonable
 from synth.reference import compare
 from synth.report import figures
 from synth.report.paper_section import paper_section_data, paper_section_figures
+from synth.report.templating import render, reproducible, unit_text
 from synth.requirements import SlewRate
 from synth.requirements.base import Requirement, fmt
 from synth.results import DesignResult, reference_controller
@@ -36,7 +36,8 @@ class ReportFiles:
 
 def report_data(spec: Spec, result: DesignResult, keep: dict[str, Any] | None = None) -> dict[str, Any]:
     """Everything ``result.json`` holds: the design result, the reference controller's check and
-    the comparisons with published numbers.
+    the comparisons with published numbers; floats to 12 significant digits, no wall-clock times (the same
+    inputs give the same bytes).
 
     Examples
     --------
@@ -68,7 +69,7 @@ def report_data(spec: Spec, result: DesignResult, keep: dict[str, Any] | None = 
         if gap_case_applies(spec):  # seed 1's gap diagnosed on the simulated rig (issue 6): synth.gap.x4_case
             data["sim_to_real_gap"] = x4_gap_case(spec, objects=keep)
     data |= paper_section_data(spec)  # the seed paper's own section (issue 19): synth.report.paper_section
-    return to_jsonable(data)
+    return reproducible(to_jsonable(data))
 
 
 def _slack_curves(spec: Spec) -> dict[str, tuple[np.ndarray, np.ndarray]]:
@@ -84,30 +85,32 @@ def _slack_curves(spec: Spec) -> dict[str, tuple[np.ndarray, np.ndarray]]:
 
 def _columns(data: dict[str, Any], requirements: list[Requirement]) -> tuple[list[dict], list[dict]]:
     """Table columns (design, compromise, reference) and rows: stability, then the spec's requirements in
-    order, each row's relation to its bound from the requirement's own class."""
+    order, each row's relation to its bound from the requirement's own class. Each cell keeps the JSON
+    pointer of its entry in ``result.json`` and the plant its value is on."""
     cols = []
     if data.get("controller"):
-        cols.append(("design " + data["controller"]["text"], data["requirements"]))
+        cols.append(("design " + data["controller"]["text"], "/requirements", data["requirements"]))
     elif data.get("compromise"):
         cols.append(("best compromise " + data["compromise"]["controller"]["text"] + " (not a solution)",
-                     data["compromise"]["requirements"]))
+                     "/compromise/requirements", data["compromise"]["requirements"]))
     if data.get("reference_check"):
-        cols.append(("reference " + data["reference_check"]["controller"]["text"],
+        cols.append(("reference " + data["reference_check"]["controller"]["text"], "/reference_check/requirements",
                      data["reference_check"]["requirements"]))
-    columns = [{"title": t, "messages": [r["message"] for r in reqs]} for t, reqs in cols]
+    columns = [{"title": t, "messages": [(f"{ptr}/{i}/message", r["message"]) for i, r in enumerate(reqs)]}
+               for t, ptr, reqs in cols]
     rows = []
-    for i, r0 in enumerate(cols[0][1] if cols else []):
+    for i, r0 in enumerate(cols[0][2] if cols else []):
         cells = []
-        for _, reqs in cols:
+        for _, ptr, reqs in cols:
             r = reqs[i]
-            value = "stable" if r["type"] == "stability" and r["met"] else (
-                "UNSTABLE" if r["type"] == "stability" else f"{fmt(_num(r['value']))} {r['unit']}")
-            cells.append({"value": value, "slack": fmt(_num(r["slack"]), 3), "met": r["met"]})
+            word = None if r["type"] != "stability" else ("stable" if r["met"] else "UNSTABLE")
+            cells.append({"ptr": f"{ptr}/{i}", "word": word, "value": r["value"], "unit": unit_text(r["unit"]),
+                          "slack": r["slack"], "met": r["met"], "plant": r.get("plant", "nominal")})
         if r0["type"] == "stability":  # the check's own first row, not a spec requirement
-            bound = "all roots in the left half-plane"
+            bound = None
         else:
-            relation = requirements[i - 1].bound_of(_num(r0["bound"])).relation
-            bound = f"{relation} {fmt(_num(r0['bound']))} {r0['unit']}"
+            bound = {"relation": requirements[i - 1].bound_of(_num(r0["bound"])).relation, "value": r0["bound"],
+                     "unit": unit_text(r0["unit"]), "ptr": f"{cols[0][1]}/{i}/bound"}
         rows.append({"label": r0["label"], "cells": cells, "bound": bound})
     return columns, rows
 
@@ -151,12 +154,14 @@ def write_design_report(spec: Spec, result: DesignResult, out_dir: str | Path, *
     if ref is not None:
         loops.append(("reference " + str(ref), Loop(plant, ref)))
     figs: dict[str, Path] = {}
+    bounds: dict[str, list[dict[str, Any]]] = {}  # figure -> the requirement bounds it draws
     slew = [r for r in spec.requirements if isinstance(r, SlewRate)]
     if slew and loops:
-        figs["bode"] = figures.bode_with_slew_bound(loops, slew, out.claim("bode_slew_bound.png"))
+        figs["bode"] = figures.bode_with_slew_bound(loops, slew, out.claim("bode_slew_bound.png"),
+                                                    drawn=bounds.setdefault("bode", []))
     if loops:
-        figs["sensitivity"] = figures.sensitivity_plot(loops, list(spec.requirements),
-                                                       out.claim("sensitivity.png"))
+        figs["sensitivity"] = figures.sensitivity_plot(loops, list(spec.requirements), out.claim("sensitivity.png"),
+                                                       drawn=bounds.setdefault("sensitivity", []))
         figs["step"] = figures.step_plot(loops, out.claim("step_response.png"))
     marks: dict[str, float] = {}
     for name, loop in loops:
@@ -194,8 +199,8 @@ def write_design_report(spec: Spec, result: DesignResult, out_dir: str | Path, *
 
     columns, rows = _columns(data, list(spec.requirements))
     ref_line = ""
-    env = Environment(loader=PackageLoader("synth.report", "templates"), autoescape=True)
-    html = env.get_template("design.html.j2").render(
+    html = render(
+        "design.html.j2",
         r=data | {"generator": GENERATOR},
         description=spec.description,
         command=command or f"synth design SPEC --out {out.path}",
@@ -212,6 +217,7 @@ def write_design_report(spec: Spec, result: DesignResult, out_dir: str | Path, *
         marks=marks, certificate=data.get("certificate"), ref_line=ref_line, sim=data.get("simulation"),
         synthesis=data.get("synthesis"), diagnosis=data.get("diagnosis"), ident=data.get("identification"),
         f=lambda x, d=4: fmt(None if x is None else float(x), d), gap=data.get("sim_to_real_gap"),
+        bounds=bounds, plants=[p.label for p in spec.plants()], unit=unit_text,
     )
     html_path = out.claim("report.html")
     html_path.write_text(html, encoding="utf-8")

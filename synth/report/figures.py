@@ -14,6 +14,7 @@ import matplotlib
 __all__ = [
     "COLORS",
     "bode_with_slew_bound",
+    "bound_drawn",
     "delay_chart",
     "feasibility_map",
     "gain_set_plot",
@@ -49,8 +50,12 @@ def _range(loops: list[tuple[str, Loop]], extra: list[float]) -> np.ndarray:
     return log_grid(lo, hi, 100)
 
 
-def bode_with_slew_bound(loops: list[tuple[str, Loop]], slew: list[SlewRate], path: Path) -> Path:
-    """Open-loop plant and compensated loop magnitudes with the slew-rate bound of eq. 12."""
+def bode_with_slew_bound(loops: list[tuple[str, Loop]], slew: list[SlewRate], path: Path,
+                         drawn: list[dict[str, Any]] | None = None) -> Path:
+    """Open-loop plant and compensated loop magnitudes with the slew-rate bound of eq. 12.
+
+    ``drawn``, if given, receives one entry per bound drawn (see :func:`bound_drawn`).
+    """
     extra = [w for r in slew for w in r.band]
     w = _range(loops, extra)
     fig, ax = plt.subplots(figsize=(8, 4.8))
@@ -61,9 +66,11 @@ def bode_with_slew_bound(loops: list[tuple[str, Loop]], slew: list[SlewRate], pa
                     ls=["-", "--", ":"][i % 3], lw=1.8, label=f"compensated |C G|, {name}")
     for j, r in enumerate(slew):
         bound = r.rate_limit / r.max_error * np.abs(plant.freqresp(w)) / w
-        ax.semilogx(w, _db(bound), color="#c0392b", lw=1.6,
-                    label=f"rate bound B|G|/(De w), B/De = {r.rate_limit / r.max_error:.4g} 1/s")
+        (line,) = ax.semilogx(w, _db(bound), color="#c0392b", lw=1.6,
+                              label=f"rate bound B|G|/(De w), B/De = {r.rate_limit / r.max_error:.4g} 1/s")
         ax.axvspan(*r.band, color="#c0392b", alpha=0.06 if j == 0 else 0.03)
+        if drawn is not None:
+            drawn.append(bound_drawn(line, r.name(), "slew-rate Bode bound B|G|/(De w) [dB]"))
     ax.set_xlabel("frequency [rad/s]")
     ax.set_ylabel("magnitude [dB]")
     ax.set_title("Compensated loop against the slew-rate bound (seed eq. 12); shaded: bound's band")
@@ -72,23 +79,58 @@ def bode_with_slew_bound(loops: list[tuple[str, Loop]], slew: list[SlewRate], pa
     return save_figure(fig, path)
 
 
-def sensitivity_plot(loops: list[tuple[str, Loop]], requirements: list[Any], path: Path) -> Path:
-    """|S| in dB with every sensitivity bound drawn."""
+def bound_drawn(artist: Any, requirement: str, what: str) -> dict[str, Any]:
+    """What a drawn bound covers, read back from the matplotlib artist: its requirement, the x range and the
+    y range of the artist's data (for a horizontal bound both y ends are the bound).
+
+    Examples
+    --------
+    >>> fig, ax = plt.subplots(); lines = ax.hlines(-15.0, 0.01, 30.0)
+    >>> bound_drawn(lines, "sensitivity", "|S| bound [dB]")
+    {'requirement': 'sensitivity', 'what': '|S| bound [dB]', 'x': [0.01, 30.0], 'y': [-15.0, -15.0]}
+    >>> plt.close(fig)
+    """
+    if hasattr(artist, "get_segments"):
+        xy = np.concatenate([np.asarray(s, float) for s in artist.get_segments()])
+    else:
+        xy = np.asarray(artist.get_xydata(), float)
+    xy = xy[np.all(np.isfinite(xy), axis=1)]
+    return {"requirement": requirement, "what": what,
+            "x": [float(f"{xy[:, 0].min():.6g}"), float(f"{xy[:, 0].max():.6g}")],
+            "y": [float(f"{xy[:, 1].min():.6g}"), float(f"{xy[:, 1].max():.6g}")]}
+
+
+def sensitivity_plot(loops: list[tuple[str, Loop]], requirements: list[Any], path: Path,
+                     drawn: list[dict[str, Any]] | None = None) -> Path:
+    """|S| in dB with every sensitivity bound drawn: a band's bound over its band, the static (DC) bound over the
+    lowest decade shown, the peak bound across the plot.
+
+    ``drawn``, if given, receives one entry per bound drawn, read back from the artists (:func:`bound_drawn`).
+    """
     bands = [w for r in requirements if isinstance(r, Sensitivity) for w in r.band if w > 0]
     w = _range(loops, bands)
     fig, ax = plt.subplots(figsize=(8, 4.5))
     for i, (name, loop) in enumerate(loops):
         ax.semilogx(w, _db(loop.S(w)), color=COLORS[i % len(COLORS)], lw=1.8, label=f"|S|, {name}")
+    found = []
     for r in requirements:
         if isinstance(r, Sensitivity):
             lo = r.band[0] if r.band[0] > 0 else w[0]
-            ax.hlines(r.max_db, lo, r.band[1], color="#c0392b", lw=2.5,
-                      label=f"bound {r.max_db:g} dB, {r.band[0]:g}-{r.band[1]:g} rad/s")
+            artist = ax.hlines(r.max_db, lo, r.band[1], color="#c0392b", lw=2.5,
+                               label=f"bound {r.max_db:g} dB, {r.band[0]:g}-{r.band[1]:g} rad/s")
+            found.append((artist, r.name(), "|S| bound over its band [dB]"))
         elif isinstance(r, StaticSensitivity):
-            ax.plot([w[0]], [r.max_db], marker="v", color="#c0392b", ms=10, ls="none",
-                    label=f"static bound {r.max_db:g} dB (plant gain {r.plant_gain if r.plant_gain else 'DC'})")
+            gain = f"plant gain {r.plant_gain:g}" if r.plant_gain else "the plant's DC gain"
+            artist = ax.hlines(r.max_db, w[0], 10 * w[0], color="#c0392b", lw=2.5, linestyles="dashed",
+                               label=f"static bound {r.max_db:g} dB on S(0) with {gain} (drawn over the lowest decade)")
+            ax.plot([w[0]], [r.max_db], marker="v", color="#c0392b", ms=10, ls="none")
+            found.append((artist, r.name(), "static |S(0)| bound [dB]"))
         elif isinstance(r, PeakSensitivity):
-            ax.axhline(r.max_db, color="#8e44ad", ls="--", lw=1.2, label=f"peak |S| bound {r.max_db:g} dB")
+            artist = ax.hlines(r.max_db, w[0], w[-1], color="#8e44ad", linestyles="dashed", lw=1.2,
+                               label=f"peak |S| bound {r.max_db:g} dB")
+            found.append((artist, r.name(), "peak |S| bound [dB]"))
+    if drawn is not None:
+        drawn.extend(bound_drawn(artist, name, what) for artist, name, what in found)
     ax.axhline(0, color="grey", lw=0.8)
     ax.set_xlabel("frequency [rad/s]")
     ax.set_ylabel("|S| [dB]")

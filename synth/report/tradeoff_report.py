@@ -8,11 +8,11 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-from jinja2 import Environment, PackageLoader
 
 from synth.figure_files import save_figure
 from synth.outputs import GENERATOR, OutputDir, dump_json
 from synth.report.figures import COLORS, plt
+from synth.report.templating import render, reproducible
 from synth.requirements.base import fmt
 from synth.synthesis.tradeoff import TradeoffResult
 
@@ -114,18 +114,21 @@ def tradeoff_figure(result: TradeoffResult, path: Path) -> Path:
 
 def write_tradeoff_report(result: TradeoffResult, out_dir: str | Path, command: str = "",
                           force: bool = False) -> TradeoffFiles:
-    """Write the trade-off files into ``out_dir`` (never over a file synth did not write)."""
+    """Write the trade-off files into ``out_dir`` (never over a file synth did not write).
+
+    The files hold no wall-clock time and floats to 12 significant digits: the same study gives the same bytes.
+    """
     out = OutputDir(out_dir, force)
     csv_path = out.claim("tradeoff.csv")
     csv_path.write_text(tradeoff_csv(result), encoding="utf-8")
     json_path = out.claim("tradeoff.json")
-    json_path.write_text(dump_json(result.to_dict()), encoding="utf-8")
+    data = reproducible(result.to_dict())
+    json_path.write_text(dump_json(data), encoding="utf-8")
     png = tradeoff_figure(result, out.claim("tradeoff.png"))
     feasible = [p for p in result.points if p.feasible]
-    env = Environment(loader=PackageLoader("synth.report", "templates"), autoescape=True)
-    html = env.get_template("tradeoff.html.j2").render(
-        r=result, generator=GENERATOR, command=command, feasible=len(feasible), total=len(result.points),
-        front=[p for p in result.points if p.pareto], f=lambda x, d=4: fmt(None if x is None else float(x), d),
+    html = render(
+        "tradeoff.html.j2", r=data, generator=GENERATOR, command=command, feasible=len(feasible), total=len(result.points),
+        front=[p for p in data["points"] if p["pareto"]], f=lambda x, d=4: fmt(None if x is None else float(x), d),
     )
     html_path = out.claim("tradeoff.html")
     html_path.write_text(html, encoding="utf-8")
