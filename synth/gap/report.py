@@ -6,10 +6,9 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from jinja2 import Environment, PackageLoader
-
 from synth.gap.diagnose import Diagnosis
 from synth.outputs import GENERATOR, OutputDir, dump_json
+from synth.report.templating import render
 from synth.requirements.base import fmt
 
 __all__ = ["DiagnosisFiles", "render_diagnosis_html", "write_diagnosis_report"]
@@ -44,8 +43,7 @@ def render_diagnosis_html(data: dict[str, Any], figures: dict[str, str] | None =
     >>> "No gap beyond the measurement noise" in html
     True
     """
-    env = Environment(loader=PackageLoader("synth.report", "templates"), autoescape=True)
-    return env.get_template("diagnose.html.j2").render(
+    return render("diagnose.html.j2",
         d=data, figures=figures or {}, title=title or data.get("record", {}).get("source", ""), command=command,
         notes=notes or [], generator=GENERATOR, f=lambda x, digits=4: fmt(None if x is None else float(x), digits))
 

@@ -6,10 +6,9 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from jinja2 import Environment, PackageLoader
-
 from synth.gap.attribution.roundrobin import RunsDiagnosis
 from synth.outputs import GENERATOR, OutputDir, dump_json
+from synth.report.templating import render
 from synth.requirements.base import fmt
 
 __all__ = ["RunsFiles", "write_runs_report"]
@@ -59,8 +58,7 @@ def write_runs_report(rr: RunsDiagnosis, out_dir: str | Path, *, units: dict[str
         for k, fold in enumerate(rr.folds, start=1):
             figs[f"fold_{k}"] = save_figure(overlay_figure(fold), out.claim(f"fold_{k}.png"))
     data = {**rr.to_dict(), **(extra or {})}
-    env = Environment(loader=PackageLoader("synth.report", "templates"), autoescape=True)
-    html = env.get_template("roundrobin.html.j2").render(
+    html = render("roundrobin.html.j2",
         d=data, units=units or {}, figures={k: p.name for k, p in figs.items()}, title=title or ", ".join(rr.runs),
         command=command, generator=GENERATOR, f=lambda x, digits=4: fmt(None if x is None else float(x), digits))
     json_path.write_text(dump_json(data), encoding="utf-8")
