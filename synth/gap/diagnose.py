@@ -399,7 +399,7 @@ def diagnose(plant: Plant, record: RecordLike, validate: RecordLike | Sequence[R
     names = check_candidates(list(default if candidates is None else candidates))
     validate = as_validation(validate)
     held_out = validate if isinstance(validate, tuple) else (() if validate is None else (validate,))
-    effects = [make_effect(n).bind([record, *held_out]) for n in names]
+    effects = [make_effect(n).bind([record, *held_out], plant) for n in names]
     check_model(plant, record, effects, train_fraction if split == "tail" else 0.5, bool(held_out))
     progress = {} if progress is None else progress
     progress["stage"] = "localization"

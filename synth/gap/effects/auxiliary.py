@@ -33,6 +33,7 @@ from synth.gap.effects.base import Effect, Params
 
 if TYPE_CHECKING:
     from synth.data.record import Record
+    from synth.plant import Plant
 
 __all__ = ["AuxEffect", "AuxInputEffect", "MeasuredSagEffect"]
 
@@ -62,7 +63,7 @@ class AuxEffect(Effect):
     def aux_channel(self) -> str | None:
         return self.channel
 
-    def bind(self, records: Sequence[Record]) -> AuxEffect:
+    def bind(self, records: Sequence[Record], plant: Plant | None = None) -> AuxEffect:
         """The effect reading its channel from ``records`` (the record first, then validation records).
 
         Raises

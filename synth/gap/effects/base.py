@@ -306,8 +306,9 @@ class Effect:
         """The measured channel that drives the effect (``None``: the command alone)."""
         return None
 
-    def bind(self, records: Any) -> Effect:
-        """The effect reading what it needs from the records (default: itself; see the aux-driven effects)."""
+    def bind(self, records: Any, plant: Plant | None = None) -> Effect:
+        """The effect reading what it needs from the records and the nominal model (default: itself; see the
+        aux-driven effects and the cubic spring)."""
         return self
 
     def required_samples(self, nominal_coefficients: int) -> int:
@@ -395,8 +396,9 @@ class Effect:
             v = self.base_input(plant, u, dt, params)
         else:
             v = self.input_map(u, dt, params)
-        for name, phi in zip(self.basis_names, self.input_basis(u, dt, params)):
-            v = v + params.get(name, 0.0) * phi
+        if any(params.get(name, 0.0) != 0.0 for name in self.basis_names):  # switched off: no basis needed
+            for name, phi in zip(self.basis_names, self.input_basis(u, dt, params)):
+                v = v + params.get(name, 0.0) * phi
         return v
 
     def apply(self, plant: Plant, t: np.ndarray, u: np.ndarray, params: Params, offset: float = 0.0,

@@ -4,14 +4,17 @@
 effect                 side      augmented model                                             parameters
 =====================  ========  ===========================================================  ==============
 ``direction``          input     each command change waits ``delay_up`` or ``delay_down``,    ``gain_down,
-                                 then a lag with ``tau_up`` or ``tau_down``; while the         tau_up, tau_down,
-                                 command last fell the drive's gain is ``1 + gain_down``       delay_up, delay_down``
+                                 then a lag with ``tau_up`` or ``tau_down``; while the         offset_down,
+                                 command last fell the drive's gain is ``1 + gain_down``       tau_up, tau_down,
+                                 and ``offset_down`` is added (a friction of that direction)  delay_up, delay_down``
 =====================  ========  ===========================================================  ==============
 
 Real drives show it: a BLDC motor whose up-steps wait about 105 ms and then rise in 15 ms while its
 down-steps start after 30 ms; a load cell with 38-45 ms time constants up and 23-26 ms down; a drive
 whose torque-to-speed gain differs between the directions. The gain of the rising direction is the
-nominal gain (re-fitted), so only the ratio of the falling direction's to it is a parameter.
+nominal gain (re-fitted), so only the ratio of the falling direction's to it is a parameter; likewise
+the rising direction's input offset is the output constant's, and ``offset_down`` is the falling
+direction's difference to it (a drive whose friction differs by direction).
 Not a default candidate (:attr:`DirectionEffect.excluded_because`).
 """
 
@@ -89,9 +92,9 @@ def directional_block(u: np.ndarray, dt: float, params: Params) -> tuple[np.ndar
 class DirectionEffect(Effect):
     """Separate latency, time constant and gain for rising and falling commands (:func:`directional_block`).
 
-    The plant is driven by ``v (1 + gain_down d)``, ``v`` the block's output and ``d`` 1 where the
-    command last fell: ``gain_down`` (a basis parameter) is the falling direction's gain relative to
-    the rising one, minus 1; the time constants and latencies are searched on a grid of pairs (one
+    The plant is driven by ``v (1 + gain_down d) + offset_down d``, ``v`` the block's output and ``d`` 1
+    where the command last fell: ``gain_down`` (a basis parameter) is the falling direction's gain
+    relative to the rising one, minus 1, ``offset_down`` (basis) its input offset; the time constants and latencies are searched on a grid of pairs (one
     direction at a time, then both).
 
     Examples
@@ -104,19 +107,22 @@ class DirectionEffect(Effect):
     """
 
     name: ClassVar[str] = "direction"
-    parameter_names: ClassVar[tuple[str, ...]] = ("gain_down", "tau_up", "tau_down", "delay_up", "delay_down")
+    parameter_names: ClassVar[tuple[str, ...]] = ("gain_down", "offset_down", "tau_up", "tau_down", "delay_up",
+                                                  "delay_down")
     grid_names: ClassVar[tuple[str, ...]] = ("tau_up", "tau_down", "delay_up", "delay_down")
-    basis_names: ClassVar[tuple[str, ...]] = ("gain_down",)
+    basis_names: ClassVar[tuple[str, ...]] = ("gain_down", "offset_down")
     excluded_because: ClassVar[str] = (
         "five parameters searched on a grid of pairs, and a command that moves both ways on its own time scale "
         "(steps, not noise) to tell them apart: name it with candidates for a step record of a drive")
 
     def off(self) -> Params:
-        return {"gain_down": 0.0, "tau_up": 0.0, "tau_down": 0.0, "delay_up": 0.0, "delay_down": 0.0}
+        return {"gain_down": 0.0, "offset_down": 0.0, "tau_up": 0.0, "tau_down": 0.0, "delay_up": 0.0,
+                "delay_down": 0.0}
 
     def bounds(self, t: np.ndarray, u: np.ndarray, plant: Plant) -> dict[str, tuple[float, float]]:
         span = float(t[-1] - t[0])
-        return {"gain_down": (-0.9, 9.0), "tau_up": (0.0, span), "tau_down": (0.0, span), "delay_up": (0.0, span),
+        span_u = float(np.ptp(u))
+        return {"gain_down": (-0.9, 9.0), "offset_down": (-span_u, span_u), "tau_up": (0.0, span), "tau_down": (0.0, span), "delay_up": (0.0, span),
                 "delay_down": (0.0, span)}
 
     def grid(self, t: np.ndarray, u: np.ndarray, plant: Plant) -> list[Params]:
@@ -134,7 +140,7 @@ class DirectionEffect(Effect):
 
     def input_basis(self, u: np.ndarray, dt: float, params: Params) -> list[np.ndarray]:
         v, down = directional_block(u, dt, params)
-        return [v * down]
+        return [v * down, down]
 
     def required_samples(self, nominal_coefficients: int) -> int:
         """Rises and falls each need their own samples: twice the default."""
