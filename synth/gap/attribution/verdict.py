@@ -294,8 +294,10 @@ def not_carried(diagnosis: EffectDiagnosis, confirm: int | None, min_share: floa
     >>> r = EffectResult("deadzone", {}, {}, 0.52, (0.36, 0.67), True, 0.5, False, 1.0, {}, "screened")
     >>> dg = S(effects=[r], verdict={"effects": ["parameter_mismatch"], "indistinguishable": []},
     ...        split={"joint_fits": ["lag", "delay", "drift"]}, threshold=0.05, j_refit=2.0, noise_floor=0.5)
-    >>> not_carried(dg, 3)[0]["reason"][:74]
-    'screened only: not among the 3 best by screened training error, which were'
+    >>> not_carried(dg, 3)[0]["reason"][:60]  # the only candidate: it was sent to the joint fit
+    'screened, but its joint re-fit with the nominal coefficients'
+    >>> not_carried(dg, None)[0]["reason"][:50]
+    'screened only: not among the None best by screened'
     """
     from synth.gap.attribution.parsimony import share_of_excess
 
@@ -304,16 +306,22 @@ def not_carried(diagnosis: EffectDiagnosis, confirm: int | None, min_share: floa
     grouped = {e for g in verdict.get("indistinguishable", []) for e in g[1:]}
     joint = list(diagnosis.split.get("joint_fits", []))
     ranked = sorted(diagnosis.effects, key=lambda r: -r.shrinkage)
+    screened_only = sum(1 for r in diagnosis.effects if r.fit != "joint")
+    n_joint = sum(1 for r in diagnosis.effects if r.fit == "joint" and "+" not in r.effect)
     out = []
     for i, r in enumerate(ranked):
         label = r.effect.split("+")[-1]
         if label in named or r.effect in named or not (r.significant or i < top) or r.shrinkage <= 0:
             continue
         lo, hi = r.shrinkage_ci
-        if r.fit != "joint":
+        if r.fit != "joint" and confirm is not None and screened_only + n_joint <= confirm:
+            reason = ("screened, but its joint re-fit with the nominal coefficients failed (e.g. the least squares "
+                      "lost the plant's gain: the signal is collinear with the command); a screened fit (denominator "
+                      "held) cannot be the verdict")
+        elif r.fit != "joint":
             reason = (f"screened only: not among the {confirm} best by screened training error, which were "
-                      f"re-fitted jointly ({', '.join(joint) or 'none'}); a screened fit (denominator held) cannot be "
-                      "the verdict: name it alone with --candidates to fit it jointly")
+                      f"re-fitted jointly ({', '.join(joint) or 'none'}), or its joint re-fit failed; a screened fit "
+                      "(denominator held) cannot be the verdict: name it alone with --candidates to fit it jointly")
         elif not r.significant:
             reason = (f"fitted jointly; its held-out shrinkage interval [{lo:.2f}, {hi:.2f}] does not clear the "
                       f"calibrated threshold {diagnosis.threshold:.3f}")

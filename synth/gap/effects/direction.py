@@ -94,7 +94,8 @@ class DirectionEffect(Effect):
 
     The plant is driven by ``v (1 + gain_down d) + offset_down d``, ``v`` the block's output and ``d`` 1
     where the command last fell: ``gain_down`` (a basis parameter) is the falling direction's gain
-    relative to the rising one, minus 1, ``offset_down`` (basis) its input offset; the time constants and latencies are searched on a grid of pairs (one
+    relative to the rising one, minus 1, ``offset_down`` (basis) its input offset; the time constants
+    and latencies are searched on a grid of pairs (one
     direction at a time, then both).
 
     Examples
@@ -122,8 +123,8 @@ class DirectionEffect(Effect):
     def bounds(self, t: np.ndarray, u: np.ndarray, plant: Plant) -> dict[str, tuple[float, float]]:
         span = float(t[-1] - t[0])
         span_u = float(np.ptp(u))
-        return {"gain_down": (-0.9, 9.0), "offset_down": (-span_u, span_u), "tau_up": (0.0, span), "tau_down": (0.0, span), "delay_up": (0.0, span),
-                "delay_down": (0.0, span)}
+        return {"gain_down": (-0.9, 9.0), "offset_down": (-span_u, span_u), "tau_up": (0.0, span),
+                "tau_down": (0.0, span), "delay_up": (0.0, span), "delay_down": (0.0, span)}
 
     def grid(self, t: np.ndarray, u: np.ndarray, plant: Plant) -> list[Params]:
         dt = float(t[1] - t[0])
