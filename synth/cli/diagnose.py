@@ -175,11 +175,14 @@ class _SignalsRaise:
 
     def __enter__(self) -> None:
         import signal
+        import threading
 
         def handler(signum: int, frame: Any) -> None:
             raise Interrupted(signum)
 
-        self.old = {s: signal.signal(s, handler) for s in (signal.SIGTERM, signal.SIGINT)}
+        self.old = {}
+        if threading.current_thread() is threading.main_thread():  # handlers can only be set there
+            self.old = {s: signal.signal(s, handler) for s in (signal.SIGTERM, signal.SIGINT)}
 
     def __exit__(self, *exc: Any) -> None:
         import signal
