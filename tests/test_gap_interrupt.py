@@ -73,18 +73,19 @@ def survivors(pids: list[int], timeout: float = 10.0) -> list[int]:
     return alive
 
 
-def test_sigterm_leaves_no_worker_and_writes_partial_json(big_csv, tmp_path):
+@pytest.mark.parametrize("sig", [signal.SIGTERM, signal.SIGINT])
+def test_sigterm_or_sigint_leaves_no_worker_and_writes_partial_json(big_csv, tmp_path, sig):
     out = tmp_path / "gap.json"
     proc = start(big_csv, out)
     kids = wait_for_workers(proc)
-    proc.send_signal(signal.SIGTERM)
+    proc.send_signal(sig)
     _, err = proc.communicate(timeout=60)
-    assert proc.returncode == 128 + signal.SIGTERM
+    assert proc.returncode == 128 + sig
     assert survivors(kids) == []
     lines = [ln for ln in err.strip().splitlines() if ln.strip()]
-    assert len(lines) == 1 and "interrupted by SIGTERM" in lines[0] and "kept gap, where" in lines[0], err
+    assert len(lines) == 1 and f"interrupted by {sig.name}" in lines[0] and "kept gap, where" in lines[0], err
     data = json.loads(out.read_text())
-    assert data["partial"] is True and data["interrupted_by"] == "SIGTERM"
+    assert data["partial"] is True and data["interrupted_by"] == sig.name
     assert data["kept"] == ["gap", "where"] and data["missing"] == ["effects", "verdict"]
     assert data["gap"]["nrmse"] > 0.0 and data["stage"] == "attribution"
 

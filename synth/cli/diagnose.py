@@ -237,8 +237,18 @@ def _round_robin(args: argparse.Namespace, plant: Any, runs: list[Any], candidat
         raise SynthError("needs at least one --validate run besides --data", where="--round-robin")
     files = [str(args.data), *(str(v) for v in args.validate or [])]
     names = [Path(f).name for f in files]
-    rr = diagnose_runs(plant, runs, candidates or list(DEFAULT_CANDIDATES), names=names, seed=args.seed,
-                       burn_in=args.burn_in, workers=args.workers)
+    from synth.gap.effects.registry import make_effect
+    from synth.gap.preflight import check_model
+
+    effects = [make_effect(c) for c in candidates or DEFAULT_CANDIDATES]
+    for run in runs:  # every run is fitted once, whole: refuse before any fit
+        check_model(plant, run, effects, validated=True)
+    try:
+        with _SignalsRaise():
+            rr = diagnose_runs(plant, runs, candidates or list(DEFAULT_CANDIDATES), names=names, seed=args.seed,
+                               burn_in=args.burn_in, workers=args.workers)
+    except Interrupted as exc:
+        return _interrupted(args, exc, {"stage": "round robin"})
     data = {"runs_data": files, "plant_argument": args.plant,
             "units": {"input": runs[0].input.unit, "output": runs[0].output.unit}, **rr.to_dict()}
     report = None
