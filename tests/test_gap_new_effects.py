@@ -62,3 +62,21 @@ def test_measured_voltage_drives_the_sag_and_the_verdict_says_how_much():
     assert "measured_sag(V)" in dg.to_dict()["verdict"]["effects"]
     with pytest.raises(Exception, match="no column 'W'"):
         diagnose(G, rec, candidates=["measured_sag(W)"], n_null=3)
+
+
+def test_cli_aux_drives_the_sag_and_prints_what_it_explained(run_cli, tmp_path):
+    t = np.arange(0, 24, 0.01)
+    u = np.array([0.0, 1.0, 0.4, 1.5, 0.2, 1.1, 0.0, 0.8])[(t // 1.5).astype(int) % 8]
+    v = 12.0 - 1.5 * (np.sin(0.37 * t) > 0.3)
+    y = simulate_plant(G, t, u * v / 12.0) + 0.005 * np.random.default_rng(2).normal(size=t.size)
+    path = tmp_path / "run.csv"
+    np.savetxt(path, np.c_[t, u, y, v], delimiter=",", header="t,u,y,V", comments="")
+    r = run_cli("diagnose", "--plant", "2/(0.2*s+1)", "--data", str(path), "--aux", "V", "--candidates",
+                "measured_sag(V),delay", "--no-report", "--json", str(tmp_path / "gap.json"))
+    assert r.code == 0, r.err
+    assert "aux V: measured_sag(V) shrinkage" in r.out and "accepted" in r.out
+    import json
+
+    data = json.loads((tmp_path / "gap.json").read_text())
+    assert data["verdict"]["effects"] == ["measured_sag(V)"] and data["verdict"]["aux"][0]["channel"] == "V"
+    assert "not_carried" in data["verdict"]
