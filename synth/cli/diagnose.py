@@ -9,7 +9,7 @@ import sys
 from pathlib import Path
 from typing import Any
 
-__all__ = ["COMMAND", "DESCRIPTION", "HELP", "ORDER", "add_arguments", "run"]
+__all__ = ["COMMAND", "DESCRIPTION", "HELP", "ORDER", "Interrupted", "add_arguments", "partial_result", "run"]
 
 COMMAND = "diagnose"
 ORDER = 50
@@ -44,7 +44,27 @@ pooled; this confirms an effect of the transients (a delay, a lag) from runs
 that hold one step each. The round robin writes result.json, report.html and
 each fold's overlay (fold_<k>.png).
 
-exit codes: 0 diagnosed (whatever the verdict), 2 bad input"""
+Before any fitting the model is checked: an unstable or non-simulable model,
+a delay longer than the record, or a record too short for a candidate is one
+line and exit 2. --aux columns may drive effects: measured_sag(COL) (the drive
+scales with a measured supply) and aux_input(COL) (a measured disturbance at
+the input) join the default candidates, and the verdict says which channel
+explained how much. On SIGTERM or SIGINT the worker processes are terminated
+and, with --json, what was finished is written there marked "partial".
+
+exit codes: 0 diagnosed (whatever the verdict), 2 bad input, 128 + the signal
+number when interrupted (143 SIGTERM, 130 SIGINT)"""
+
+
+class Interrupted(BaseException):
+    """Raised in the main thread by the SIGTERM/SIGINT handler of ``synth diagnose`` (not an ``Exception``:
+    no library ``except Exception`` swallows it)."""
+
+    def __init__(self, signum: int) -> None:
+        import signal
+
+        super().__init__(signal.Signals(signum).name)
+        self.signum = signum
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
@@ -67,8 +87,10 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--input-unit", default="", metavar="UNIT", help="unit of the input, e.g. PWM or V")
     p.add_argument("--output-unit", default="", metavar="UNIT", help="unit of the output, e.g. rad/s")
     p.add_argument("--candidates", metavar="A,B,...",
-                   help="effects to try (default: all: delay, lag, lag(sensor), resonance, rate_limit, saturation, "
-                        "deadzone, backlash, quantization, supply_sag, static_nonlinearity, drift)")
+                   help="effects to try (default: delay, lag, lag(sensor), resonance, rate_limit, saturation, "
+                        "deadzone, backlash, quantization, supply_sag, static_nonlinearity, drift, and with --aux COL "
+                        "measured_sag(COL), aux_input(COL); by name only: direction, duffing, friction, "
+                        "saturation(output))")
     p.add_argument("--seed", type=int, default=0, help="seed of the bootstrap (default 0)")
     p.add_argument("--split", choices=("tail", "interleaved"), default="tail",
                    help="without --validate: hold out the second half (tail, default) or every second of "
@@ -121,8 +143,14 @@ def run(args: argparse.Namespace) -> int:
     if args.round_robin:
         return _round_robin(args, plant, [record, *validates], candidates)
     validate = validates if len(validates) > 1 else (validates[0] if validates else None)
-    diag = diagnose(plant, record, validate, candidates, seed=args.seed, split=args.split, burn_in=args.burn_in,
-                    max_effects=args.max_effects, workers=args.workers, heldout_offset=args.heldout_offset)
+    progress: dict[str, Any] = {}
+    try:
+        with _SignalsRaise():
+            diag = diagnose(plant, record, validate, candidates, seed=args.seed, split=args.split,
+                            burn_in=args.burn_in, max_effects=args.max_effects, workers=args.workers,
+                            heldout_offset=args.heldout_offset, progress=progress)
+    except Interrupted as exc:
+        return _interrupted(args, exc, progress)
     data = diag.to_dict()
     held = [str(v) for v in args.validate or []]
     data = {"data": str(args.data), "validate_data": held if len(held) > 1 else (held[0] if held else None),
@@ -145,6 +173,63 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
+class _SignalsRaise:
+    """Within the block, SIGTERM and SIGINT raise :class:`Interrupted` in the main thread (handlers restored after)."""
+
+    def __enter__(self) -> None:
+        import signal
+        import threading
+
+        def handler(signum: int, frame: Any) -> None:
+            raise Interrupted(signum)
+
+        self.old = {}
+        if threading.current_thread() is threading.main_thread():  # handlers can only be set there
+            self.old = {s: signal.signal(s, handler) for s in (signal.SIGTERM, signal.SIGINT)}
+
+    def __exit__(self, *exc: Any) -> None:
+        import signal
+
+        for s, h in self.old.items():
+            signal.signal(s, h)
+
+
+def partial_result(progress: dict[str, Any], signal_name: str, data: str) -> dict[str, Any]:
+    """What an interrupted diagnosis kept: ``partial``, ``interrupted_by``, ``kept``, ``missing`` and the kept parts.
+
+    Examples
+    --------
+    >>> d = partial_result({"stage": "localization"}, "SIGTERM", "run.csv")
+    >>> d["partial"], d["kept"], d["missing"]
+    (True, [], ['gap', 'where', 'effects', 'verdict'])
+    """
+    out: dict[str, Any] = {"partial": True, "interrupted_by": signal_name, "data": data,
+                           "stage": progress.get("stage", "start")}
+    loc = progress.get("localization")
+    if loc is not None:
+        d = loc.to_dict()
+        out.update(gap=d["gap"], where=d["where"], headline=d["headline"])
+    out["kept"] = [k for k in ("gap", "where") if k in out]
+    out["missing"] = [k for k in ("gap", "where", "effects", "verdict") if k not in out]
+    return out
+
+
+def _interrupted(args: argparse.Namespace, exc: Interrupted, progress: dict[str, Any]) -> int:
+    from synth.outputs import dump_json, write_json
+
+    data = partial_result(progress, str(exc), str(args.data))
+    kept = ", ".join(data["kept"]) or "nothing"
+    where = ""
+    if args.json == "-":
+        sys.stdout.write(dump_json(data))
+    elif args.json:
+        write_json(args.json, data, force=args.force)
+        where = f" to {args.json}"
+    print(f"synth diagnose: interrupted by {exc} during the {data['stage']}; kept {kept}{where if data['kept'] else ''}"
+          f" (partial; missing: {', '.join(data['missing'])})", file=sys.stderr)
+    return 128 + exc.signum
+
+
 def _round_robin(args: argparse.Namespace, plant: Any, runs: list[Any], candidates: list[str] | None) -> int:
     from synth.errors import SynthError
     from synth.gap.attribution.roundrobin import diagnose_runs
@@ -155,8 +240,18 @@ def _round_robin(args: argparse.Namespace, plant: Any, runs: list[Any], candidat
         raise SynthError("needs at least one --validate run besides --data", where="--round-robin")
     files = [str(args.data), *(str(v) for v in args.validate or [])]
     names = [Path(f).name for f in files]
-    rr = diagnose_runs(plant, runs, candidates or list(DEFAULT_CANDIDATES), names=names, seed=args.seed,
-                       burn_in=args.burn_in, workers=args.workers)
+    from synth.gap.effects.registry import make_effect
+    from synth.gap.preflight import check_model
+
+    effects = [make_effect(c) for c in candidates or DEFAULT_CANDIDATES]
+    for run in runs:  # every run is fitted once, whole: refuse before any fit
+        check_model(plant, run, effects, validated=True)
+    try:
+        with _SignalsRaise():
+            rr = diagnose_runs(plant, runs, candidates or list(DEFAULT_CANDIDATES), names=names, seed=args.seed,
+                               burn_in=args.burn_in, workers=args.workers)
+    except Interrupted as exc:
+        return _interrupted(args, exc, {"stage": "round robin"})
     data = {"runs_data": files, "plant_argument": args.plant,
             "units": {"input": runs[0].input.unit, "output": runs[0].output.unit}, **rr.to_dict()}
     report = None
@@ -216,6 +311,12 @@ def _print(d: dict[str, Any], report: Any) -> None:
         print(f"seen in the data: {', '.join(v['observed'])} (clipped signals: see the summary)")
     for group, experiment in zip(v["indistinguishable"], v["experiments"] or [""] * len(v["indistinguishable"])):
         print(f"indistinguishable: {' / '.join(group)}{'; separate by ' + experiment if experiment else ''}")
+    for a in v.get("aux", []):
+        lo, hi = a["shrinkage_ci"]
+        print(f"aux {a['channel']}: {a['effect']} shrinkage {a['shrinkage']:+.3f} [{lo:+.3f}, {hi:+.3f}]"
+              f"{'  accepted' if a['accepted'] else ''}")
+    for nc in v.get("not_carried", []):
+        print(f"not in the verdict: {nc['effect']} ({nc['shrinkage']:+.2f}): {nc['reason']}")
     for e in d["effects"][:3]:
         lo, hi = e["shrinkage_ci"]
         params = ", ".join(f"{k} = {x:.4g}" if isinstance(x, float) else f"{k} = {x}" for k, x in e["parameters"].items()

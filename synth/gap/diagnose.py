@@ -35,8 +35,9 @@ from synth.data.coerce import RecordLike, as_record
 from synth.data.record import Record
 from synth.errors import DataError, ModelError
 from synth.gap.attribution.heldout import DiagnoseOptions, diagnose_effects
-from synth.gap.attribution.verdict import EffectDiagnosis
-from synth.gap.effects.registry import DEFAULT_CANDIDATES, make_effect
+from synth.gap.attribution.verdict import EffectDiagnosis, aux_explained, not_carried
+from synth.gap.effects.registry import DEFAULT_CANDIDATES, aux_candidates, make_effect
+from synth.gap.preflight import check_model
 from synth.gap.where.clipping import Clipping, record_clipping
 from synth.gap.where.localize import GapLocalization, localize_gap
 from synth.plant import Plant, Signal
@@ -198,7 +199,13 @@ class Diagnosis:
     @property
     def summary(self) -> str:
         """The verdict in plain sentences (what to tell a person first), then any clipping seen in the data."""
-        return self._verdict_sentence() + self._clipping_sentence()
+        return self._verdict_sentence() + self._aux_sentence() + self._clipping_sentence()
+
+    def _aux_sentence(self) -> str:
+        """Which measured aux channel explained how much (its best effect's held-out shrinkage)."""
+        parts = [f"{a['channel']} {a['shrinkage']:.2f} [{a['shrinkage_ci'][0]:.2f}, {a['shrinkage_ci'][1]:.2f}] "
+                 f"({a['effect']}{', accepted' if a['accepted'] else ''})" for a in self.verdict.get("aux", [])]
+        return f" Measured channels, held-out shrinkage beyond the re-fit: {'; '.join(parts)}." if parts else ""
 
     def _verdict_sentence(self) -> str:
         v = self.verdict
@@ -329,7 +336,7 @@ def diagnose(plant: Plant, record: RecordLike, validate: RecordLike | Sequence[R
              candidates: list[str] | tuple[str, ...] | None = None, *, offset: str | float = "fit",
              train_fraction: float = 0.5, n_null: int = 19, n_boot: int = 1000, level: float = 0.95,
              seed: int = 0, split: str = "tail", burn_in: float = 0.0, max_effects: int = 2,
-             workers: int = 1, heldout_offset: str = "auto") -> Diagnosis:
+             workers: int = 1, heldout_offset: str = "auto", progress: dict[str, Any] | None = None) -> Diagnosis:
     """Localize the gap between ``plant`` and ``record`` and attribute it to one effect.
 
     Parameters
@@ -344,13 +351,20 @@ def diagnose(plant: Plant, record: RecordLike, validate: RecordLike | Sequence[R
         offset, see :func:`synth.gap.attribution.heldout.diagnose_effects`); without it the record's second
         half is held out. Each in any form of ``record`` (see :func:`as_validation`).
     candidates : sequence of str, optional
-        Effects to try (default: every effect of :mod:`synth.gap.effects`).
+        Effects to try (default: the default candidates of :mod:`synth.gap.effects`, and for each aux
+        channel of the record the effects it may drive, :func:`synth.gap.effects.registry.aux_candidates`).
+        An aux-driven effect (``measured_sag(Voltage)``) reads its channel from the record and the
+        validation records.
     offset : "fit", "none" or float
         Output offset of the localization (the operating point the linear model does not know).
     train_fraction, n_null, n_boot, seed, split, burn_in, max_effects, workers, heldout_offset
         See :func:`synth.gap.attribution.heldout.diagnose_effects`.
     level : float
         Confidence level of the localization's tests.
+    progress : dict, optional
+        Filled as the diagnosis goes: ``"localization"`` (a :class:`GapLocalization`) once the gap is
+        localized, ``"stage"`` the stage running (``"localization"``, ``"attribution"``, ``"done"``):
+        what an interrupted run can still write.
 
     Returns
     -------
@@ -359,9 +373,11 @@ def diagnose(plant: Plant, record: RecordLike, validate: RecordLike | Sequence[R
     Raises
     ------
     ModelError
-        Unknown candidates, bad options.
+        Unknown candidates, bad options; before any fitting, a model the record cannot judge
+        (unstable, not simulable, a delay longer than the record: :func:`synth.gap.preflight.check_model`).
     DataError
-        Input and output units of the validation record differ from the record's.
+        Input and output units of the validation record differ from the record's; an aux-driven
+        candidate whose channel is missing; a record too short for a candidate.
 
     Examples
     --------
@@ -378,10 +394,15 @@ def diagnose(plant: Plant, record: RecordLike, validate: RecordLike | Sequence[R
     >>> diagnose(Plant.from_string("2/(0.2*s+1)"), (t, u, y), candidates=["delay"], n_null=3).verdict["effects"]
     ['delay']
     """
-    names = check_candidates(list(DEFAULT_CANDIDATES if candidates is None else candidates))
     record = as_record(record)
+    default = list(DEFAULT_CANDIDATES) + list(aux_candidates(sorted(record.aux)))
+    names = check_candidates(list(default if candidates is None else candidates))
     validate = as_validation(validate)
     held_out = validate if isinstance(validate, tuple) else (() if validate is None else (validate,))
+    effects = [make_effect(n).bind([record, *held_out], plant) for n in names]
+    check_model(plant, record, effects, train_fraction if split == "tail" else 0.5, bool(held_out))
+    progress = {} if progress is None else progress
+    progress["stage"] = "localization"
     for i, v in enumerate(held_out):
         for side in ("input", "output"):
             a, b = getattr(record, side).unit, getattr(v, side).unit
@@ -389,10 +410,16 @@ def diagnose(plant: Plant, record: RecordLike, validate: RecordLike | Sequence[R
                 where = "validate" if len(held_out) == 1 else f"validate run {i + 1}"
                 raise DataError(f"{side} unit {b!r} differs from the record's {a!r}", where=where)
     loc = localize_gap(plant, record, offset=offset, level=level)
+    progress.update(localization=loc, stage="attribution")
     att = diagnose_effects(plant, record, list(validate) if isinstance(validate, tuple) else validate,
-                           options=DiagnoseOptions(candidates=names, train_fraction=train_fraction, n_null=n_null,
+                           options=DiagnoseOptions(candidates=effects, train_fraction=train_fraction, n_null=n_null,
                                                    n_boot=n_boot, seed=seed, split=split, burn_in=burn_in,
                                                    max_effects=max_effects, workers=workers, heldout_offset=heldout_offset))
+    att.verdict["not_carried"] = not_carried(att, DiagnoseOptions().confirm)
+    channels = {e.label: e.aux_channel for e in effects if e.aux_channel}
+    if channels:
+        att.verdict["aux"] = aux_explained(att, channels)
+    progress["stage"] = "done"
     clips = record_clipping(record)
     warnings: list[str] = [] if held_out else heldout_warnings(record, None, split, train_fraction)
     for i, v in enumerate(held_out):

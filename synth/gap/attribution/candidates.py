@@ -19,7 +19,8 @@ from synth.gap.attribution.screen import ScreenedFit, screen_effect
 from synth.gap.effects.base import Effect, Params
 from synth.plant import Plant
 
-__all__ = ["candidate_fits", "confirmed_candidates", "joint_fit", "map_jobs", "screened_coefficients", "seeded_grid"]
+__all__ = ["candidate_fits", "confirmed_candidates", "joint_fit", "map_jobs", "screened_coefficients", "seeded_grid",
+           "watch_parent"]
 
 
 def seeded_grid(effect: Effect, screened: ScreenedFit, u_train: np.ndarray | None = None) -> list[Params]:
@@ -157,8 +158,59 @@ def joint_fit(job: tuple[Any, ...]) -> AugmentedFit | None:
         return None
 
 
+def watch_parent(parent: int) -> None:
+    """Make this (worker) process die with its parent ``parent``; leave signals to the parent.
+
+    On Linux the kernel sends SIGKILL when the parent dies (``prctl(PR_SET_PDEATHSIG)``, even when the
+    parent is killed by SIGKILL); elsewhere a daemon thread checks the parent's pid every second. SIGINT
+    is ignored (a Ctrl-C reaches the whole process group: the parent handles it and terminates the
+    workers) and SIGTERM has its default action.
+
+    Examples
+    --------
+    It runs first in every worker of :func:`map_jobs`:
+
+    >>> map_jobs(abs, [-1, -2], workers=2)
+    [1, 2]
+    """
+    import os
+    import signal
+    import sys
+    import threading
+
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    armed = False
+    if sys.platform.startswith("linux"):
+        try:
+            import ctypes
+
+            libc = ctypes.CDLL(None, use_errno=True)
+            armed = libc.prctl(1, int(signal.SIGKILL), 0, 0, 0) == 0  # PR_SET_PDEATHSIG = 1
+        except (OSError, AttributeError):
+            armed = False
+    if os.getppid() != parent:  # the parent died before the watch was set
+        os._exit(1)
+    if armed:
+        return
+
+    def check() -> None:
+        import time
+
+        while True:
+            time.sleep(1.0)
+            if os.getppid() != parent:
+                os._exit(1)
+
+    threading.Thread(target=check, daemon=True).start()
+
+
 def map_jobs(fn: Any, jobs: list[Any], workers: int) -> list[Any]:
     """``[fn(j) for j in jobs]``, on ``workers`` processes when there are several jobs.
+
+    The workers die with this process (:func:`watch_parent`: a SIGKILL of the parent leaves none
+    behind), and any exception here, a KeyboardInterrupt or the exception a signal handler raises
+    included, terminates them before it propagates.
 
     Examples
     --------
@@ -167,10 +219,20 @@ def map_jobs(fn: Any, jobs: list[Any], workers: int) -> list[Any]:
     """
     if workers <= 1 or len(jobs) <= 1:
         return [fn(j) for j in jobs]
-    from concurrent.futures import ProcessPoolExecutor
+    import multiprocessing
+    import os
 
-    with ProcessPoolExecutor(max_workers=min(workers, len(jobs))) as pool:
-        return list(pool.map(fn, jobs))
+    pool = multiprocessing.get_context().Pool(min(workers, len(jobs)), initializer=watch_parent,
+                                              initargs=(os.getpid(),))
+    try:
+        out = pool.map(fn, jobs, chunksize=1)
+        pool.close()
+        return out
+    except BaseException:
+        pool.terminate()
+        raise
+    finally:
+        pool.join()
 
 
 def screened_coefficients(plant: Plant) -> dict[str, float]:

@@ -16,8 +16,8 @@ import numpy as np
 
 from synth.gap.attribution.refit import AugmentedFit
 
-__all__ = ["SEPARATING_EXPERIMENTS", "EffectDiagnosis", "EffectResult", "HeldoutSegments", "headline",
-           "separating_experiment"]
+__all__ = ["SEPARATING_EXPERIMENTS", "EffectDiagnosis", "EffectResult", "HeldoutSegments", "aux_explained",
+           "headline", "not_carried", "separating_experiment"]
 
 SEPARATING_EXPERIMENTS: dict[frozenset[str], str] = {
     frozenset({"delay", "lag"}): "a sweep to higher frequency: a delay's phase keeps falling linearly with "
@@ -262,3 +262,113 @@ def headline(status: str, effects: list[str], indist: list[list[str]], results: 
         return f"parameter mismatch: re-fitting the nominal coefficients shrinks the held-out error by {pm:.2f}"
     return "gap not explained by the candidate effects" + (
         f" (the re-fit shrinks it by {pm:.2f})" if effects else "")
+
+
+def not_carried(diagnosis: EffectDiagnosis, confirm: int | None, min_share: float = 0.25,
+                top: int = 3) -> list[dict[str, Any]]:
+    """Why each promising candidate is not in the verdict: the significant ones and the ``top`` by shrinkage.
+
+    A candidate the screen ranked below the ``confirm`` best (by screened training error) is never
+    re-fitted jointly, and a screened fit cannot be the verdict; a joint fit may fall short of the
+    calibrated threshold, of ``min_share`` of the re-fit's excess over noise, or be grouped with or
+    displaced by the leader.
+
+    Parameters
+    ----------
+    diagnosis : EffectDiagnosis
+    confirm : int or None
+        Screened candidates re-fitted jointly (:class:`synth.gap.attribution.heldout.DiagnoseOptions`).
+    min_share : float
+        Share of the re-fit's excess over noise an accepted effect must remove.
+    top : int
+        Candidates by held-out shrinkage always explained.
+
+    Returns
+    -------
+    list of dict
+        ``{"effect", "shrinkage", "shrinkage_ci", "fit", "reason"}``, best shrinkage first.
+
+    Examples
+    --------
+    >>> from types import SimpleNamespace as S
+    >>> r = EffectResult("deadzone", {}, {}, 0.52, (0.36, 0.67), True, 0.5, False, 1.0, {}, "screened")
+    >>> dg = S(effects=[r], verdict={"effects": ["parameter_mismatch"], "indistinguishable": []},
+    ...        split={"joint_fits": ["lag", "delay", "drift"]}, threshold=0.05, j_refit=2.0, noise_floor=0.5)
+    >>> not_carried(dg, 3)[0]["reason"][:60]  # the only candidate: it was sent to the joint fit
+    'screened, but its joint re-fit with the nominal coefficients'
+    >>> not_carried(dg, None)[0]["reason"][:50]
+    'screened only: not among the None best by screened'
+    """
+    from synth.gap.attribution.parsimony import share_of_excess
+
+    verdict = diagnosis.verdict
+    named = set(verdict.get("effects", []))
+    grouped = {e for g in verdict.get("indistinguishable", []) for e in g[1:]}
+    joint = list(diagnosis.split.get("joint_fits", []))
+    ranked = sorted(diagnosis.effects, key=lambda r: -r.shrinkage)
+    screened_only = sum(1 for r in diagnosis.effects if r.fit != "joint")
+    n_joint = sum(1 for r in diagnosis.effects if r.fit == "joint" and "+" not in r.effect)
+    out = []
+    for i, r in enumerate(ranked):
+        label = r.effect.split("+")[-1]
+        if label in named or r.effect in named or not (r.significant or i < top) or r.shrinkage <= 0:
+            continue
+        lo, hi = r.shrinkage_ci
+        if r.fit != "joint" and confirm is not None and screened_only + n_joint <= confirm:
+            reason = ("screened, but its joint re-fit with the nominal coefficients failed (e.g. the least squares "
+                      "lost the plant's gain: the signal is collinear with the command); a screened fit (denominator "
+                      "held) cannot be the verdict")
+        elif r.fit != "joint":
+            reason = (f"screened only: not among the {confirm} best by screened training error, which were "
+                      f"re-fitted jointly ({', '.join(joint) or 'none'}), or its joint re-fit failed; a screened fit "
+                      "(denominator held) cannot be the verdict: name it alone with --candidates to fit it jointly")
+        elif not r.significant:
+            reason = (f"fitted jointly; its held-out shrinkage interval [{lo:.2f}, {hi:.2f}] does not clear the "
+                      f"calibrated threshold {diagnosis.threshold:.3f}")
+        elif r.effect in grouped:
+            reason = "fitted jointly and significant, but indistinguishable from the leader (see the group)"
+        else:
+            share = share_of_excess(diagnosis.j_refit, r.j_heldout, diagnosis.noise_floor)
+            if share < min_share:
+                reason = (f"fitted jointly and significant, but removes only {100 * share:.0f} % of the re-fit's "
+                          f"excess over noise (needs {100 * min_share:.0f} %)")
+            elif "+" in r.effect:
+                reason = "tried on top of the first effect; not accepted against the model before it"
+            else:
+                reason = "fitted jointly and accepted, but a simpler or better effect leads (see parsimony)"
+        out.append({"effect": r.effect, "shrinkage": r.shrinkage, "shrinkage_ci": [float(lo), float(hi)],
+                    "fit": r.fit, "reason": reason})
+    return out
+
+
+def aux_explained(diagnosis: EffectDiagnosis, channels: dict[str, str]) -> list[dict[str, Any]]:
+    """How much each measured aux channel explained: its best effect's held-out shrinkage and share of the gap.
+
+    Parameters
+    ----------
+    diagnosis : EffectDiagnosis
+    channels : dict
+        Effect label -> the aux channel that drives it.
+
+    Returns
+    -------
+    list of dict
+        ``{"channel", "effect", "shrinkage", "shrinkage_ci", "share_of_gap", "accepted"}`` per channel,
+        the best-explaining first.
+
+    Examples
+    --------
+    >>> from types import SimpleNamespace as S
+    >>> r = EffectResult("measured_sag(V)", {"sag": 1.0}, {}, 0.8, (0.7, 0.9), True, 0.9, True, 1.0, {})
+    >>> aux_explained(S(effects=[r]), {"measured_sag(V)": "V"})[0]["channel"]
+    'V'
+    """
+    best: dict[str, EffectResult] = {}
+    for r in diagnosis.effects:
+        ch = channels.get(r.effect.split("+")[-1])
+        if ch is not None and (ch not in best or r.shrinkage > best[ch].shrinkage):
+            best[ch] = r
+    rows = [{"channel": ch, "effect": r.effect, "shrinkage": r.shrinkage,
+             "shrinkage_ci": [float(x) for x in r.shrinkage_ci], "share_of_gap": r.share_of_gap,
+             "accepted": r.accepted} for ch, r in best.items()]
+    return sorted(rows, key=lambda d: -d["shrinkage"])

@@ -298,6 +298,42 @@ class Effect:
 
     #: the input side depends on the linear model (re-fit alternates it with the linear fit)
     needs_plant: ClassVar[bool] = False
+    #: driven by a measured aux channel (spelled ``name(channel)``, bound to the records before fitting)
+    aux_driven: ClassVar[bool] = False
+
+    @property
+    def aux_channel(self) -> str | None:
+        """The measured channel that drives the effect (``None``: the command alone)."""
+        return None
+
+    def bind(self, records: Any, plant: Plant | None = None) -> Effect:
+        """The effect reading what it needs from the records and the nominal model (default: itself; see the
+        aux-driven effects and the cubic spring)."""
+        return self
+
+    def required_samples(self, nominal_coefficients: int) -> int:
+        """Training samples the joint fit needs: 10 per free parameter (the nominal coefficients, the
+        effect's parameters and the output constant).
+
+        Examples
+        --------
+        >>> from synth.gap.effects import make_effect
+        >>> make_effect("delay").required_samples(3), make_effect("saturation").required_samples(3)
+        (50, 60)
+        """
+        return 10 * (nominal_coefficients + len(self.parameter_names) + 1)
+
+    def required_duration(self, plant: Plant) -> float:
+        """Shortest record [s] the effect can be judged on: one time constant of the model's slowest mode
+        (a record shorter than that holds no settled response to tell a gain from a dynamic effect).
+
+        Examples
+        --------
+        >>> from synth.gap.effects import make_effect
+        >>> make_effect("lag").required_duration(Plant.from_string("1/((s+0.5)*(s+10))"))
+        2.0
+        """
+        return 1.0 / slowest_pole(plant)
 
     @property
     def screenable(self) -> bool:
@@ -360,8 +396,9 @@ class Effect:
             v = self.base_input(plant, u, dt, params)
         else:
             v = self.input_map(u, dt, params)
-        for name, phi in zip(self.basis_names, self.input_basis(u, dt, params)):
-            v = v + params.get(name, 0.0) * phi
+        if any(params.get(name, 0.0) != 0.0 for name in self.basis_names):  # switched off: no basis needed
+            for name, phi in zip(self.basis_names, self.input_basis(u, dt, params)):
+                v = v + params.get(name, 0.0) * phi
         return v
 
     def apply(self, plant: Plant, t: np.ndarray, u: np.ndarray, params: Params, offset: float = 0.0,
