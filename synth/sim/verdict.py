@@ -1,0 +1,328 @@
+"""A step verdict with its evidence: settled, limit cycle, diverging, or undetermined within N s.
+
+:func:`step_verdict` simulates a reference step over a first horizon read from the loop's
+dynamics (:func:`synth.sim.horizon.plan_horizon`), judges the run and, while the run does not
+decide, doubles the horizon up to a cap. The rules (:func:`judge`), on the output after the step:
+
+* **diverging**: the output is not finite, or it grows (RMS of the last third of the last half more
+  than 3 times that of the first third, or its excursion 10 times larger) on two horizons in a row;
+* **limit cycle**: a sustained oscillation (:func:`synth.sim.limitcycle.detect_oscillation`) with
+  at least :data:`MIN_CYCLES` whole cycles in the last half, whose amplitude and period over the last
+  quarter agree within :data:`STEADY` (1 %) with those over the quarter before;
+* **settled**: no sustained oscillation, the last quarter within 1 % of the step of the final
+  value, no drift across it (slope times its length below 0.5 % of the step), and the motion of
+  its last half no larger than that of its first half;
+* otherwise the horizon is doubled; at the cap the verdict is **undetermined** and says what was
+  seen (cycles, the rule that failed).
+
+Every verdict carries its evidence: the horizons tried, the sample time and count, the cycles
+seen and the rule that decided.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from synth.errors import ModelError
+from synth.sim.horizon import HorizonPlan, plan_horizon
+from synth.sim.limitcycle import detect_oscillation
+from synth.sim.loops import NonlinearLoop
+from synth.sim.metrics import NonlinearStepMetrics, nonlinear_step_metrics
+from synth.sim.results import SimResult
+
+__all__ = ["MAX_SAMPLES", "MIN_CYCLES", "STEADY", "VERDICTS", "Evidence", "Judgement", "StepVerdict", "judge",
+           "step_verdict"]
+
+VERDICTS = ("settled", "limit_cycle", "diverging", "undetermined")
+"""The four answers of a step simulation."""
+MIN_CYCLES = 6
+"""Whole cycles a limit cycle needs in the last half of the run."""
+STEADY = 0.01
+"""Largest relative change of amplitude and period between the last two quarters of a limit cycle."""
+MAX_SAMPLES = 1_000_000
+"""Default cap on the samples of one run (the cap is also at most 32 times the first horizon)."""
+
+
+@dataclass(frozen=True)
+class Judgement:
+    """What one run says (see :func:`judge`).
+
+    Attributes
+    ----------
+    verdict : str or None
+        ``settled``, ``limit_cycle`` or ``diverging``; None when this run does not decide.
+    criterion : str
+        The rule that decided, or the one that failed.
+    cycles : int
+        Whole cycles seen in the last half of the run.
+    growing : bool
+        The run grows (a second growing run confirms divergence).
+    """
+
+    verdict: str | None
+    criterion: str
+    cycles: int
+    growing: bool = False
+
+
+@dataclass(frozen=True)
+class Evidence:
+    """Why a verdict is what it is.
+
+    Attributes
+    ----------
+    horizon : float
+        Simulated time of the run the verdict rests on (s).
+    dt : float
+        Sample time (s).
+    samples : int
+        Samples of that run.
+    cycles : int
+        Whole cycles seen in its last half.
+    horizons : tuple of float
+        Every horizon tried, in order (each one a fresh run from rest).
+    cap : float
+        Longest horizon allowed (s).
+    criterion : str
+        The rule that decided, or why nothing did.
+    plan : HorizonPlan
+        How the first horizon was chosen.
+    """
+
+    horizon: float
+    dt: float
+    samples: int
+    cycles: int
+    horizons: tuple[float, ...]
+    cap: float
+    criterion: str
+    plan: HorizonPlan
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready dict (``plan`` as a dict).
+
+        Examples
+        --------
+        >>> plan = HorizonPlan(5.0, 0.5, True, 3.2, None, "linear loop settles")
+        >>> Evidence(5.0, 0.001, 5001, 0, (5.0,), 160.0, "in the band", plan).to_dict()["samples"]
+        5001
+        """
+        out = {k: getattr(self, k) for k in self.__dataclass_fields__}
+        out["horizons"] = list(self.horizons)
+        out["plan"] = self.plan.to_dict()
+        return out
+
+
+@dataclass(frozen=True)
+class StepVerdict:
+    """Result of :func:`step_verdict`.
+
+    Attributes
+    ----------
+    verdict : str
+        One of :data:`VERDICTS`.
+    evidence : Evidence
+    metrics : NonlinearStepMetrics
+        Step metrics of the last run.
+    result : SimResult
+        The last run.
+    """
+
+    verdict: str
+    evidence: Evidence
+    metrics: NonlinearStepMetrics
+    result: SimResult
+
+    @property
+    def determined(self) -> bool:
+        """The runs decided (the verdict is not ``undetermined``)."""
+        return self.verdict != "undetermined"
+
+    def summary(self, unit: str = "") -> str:
+        """One line: the verdict and its evidence.
+
+        Examples
+        --------
+        >>> from synth.plant import Plant; from synth.controllers import Controller
+        >>> v = step_verdict(NonlinearLoop(Plant.from_string("1/(s+1)"), Controller("P", {"kp": 1})), 0, 1)
+        >>> v.summary()
+        'settled: within 1 % of the step over the last 1.2 s (horizon 4.8 s, 4776 samples of 1 ms)'
+        """
+        e = self.evidence
+        unit = f" {unit}" if unit else ""
+        where = f"horizon {e.horizon:.3g} s, {e.samples} samples of {e.dt * 1000:.3g} ms"
+        lc = self.metrics.limit_cycle
+        if self.verdict == "limit_cycle":
+            return (f"limit cycle: amplitude {lc.amplitude:.4g}{unit}, period {lc.period:.4g} s "
+                    f"({e.cycles} cycles in the last half; {e.criterion}; {where})")
+        if self.verdict == "undetermined":
+            return f"undetermined within {e.horizon:.3g} s: {e.criterion} ({e.cycles} cycles seen; {where})"
+        return f"{self.verdict.replace('_', ' ')}: {e.criterion} ({where})"
+
+    def to_dict(self) -> dict[str, Any]:
+        """``{"verdict", "evidence", **metrics}`` (JSON-ready; the time series is left out).
+
+        Examples
+        --------
+        >>> from synth.plant import Plant; from synth.controllers import Controller
+        >>> v = step_verdict(NonlinearLoop(Plant.from_string("1/(s+1)"), Controller("P", {"kp": 1})), 0, 1)
+        >>> d = v.to_dict(); d["verdict"], d["evidence"]["samples"], round(d["final_value"], 3)
+        ('settled', 4776, 0.5)
+        """
+        return {"verdict": self.verdict, "evidence": self.evidence.to_dict(), **self.metrics.to_dict()}
+
+
+def _steady(t: np.ndarray, y: np.ndarray, quarter: float, min_amplitude: float) -> str | None:
+    """None when the last two quarters show the same cycle (amplitude and period within STEADY)."""
+    cut = t <= t[-1] - quarter
+    a = detect_oscillation(t, y, window=quarter, min_amplitude=min_amplitude, min_cycles=2)
+    b = detect_oscillation(t[cut], y[cut], window=quarter, min_amplitude=min_amplitude, min_cycles=2)
+    if not (a.present and b.present and a.amplitude and b.amplitude and a.period and b.period):
+        return "fewer than 2 cycles in each of the last two quarters"
+    da = abs(a.amplitude - b.amplitude) / a.amplitude
+    dp = abs(a.period - b.period) / a.period
+    if da > STEADY or dp > STEADY:
+        return f"amplitude still changes {100 * da:.2g} %, period {100 * dp:.2g} % between the last two quarters"
+    return None
+
+
+def judge(result: SimResult, t_step: float, step_size: float, metrics: NonlinearStepMetrics,
+          min_amplitude: float = 0.0, previous: Judgement | None = None) -> Judgement:
+    """Does this run decide? (The rules are in the module docstring.)
+
+    Parameters
+    ----------
+    result : SimResult
+    t_step : float
+        Time of the step (s).
+    step_size : float
+        Size of the reference step (output units); 1 when it is 0.
+    metrics : NonlinearStepMetrics
+        Its step metrics.
+    min_amplitude : float
+        Smallest oscillation that counts (output units).
+    previous : Judgement, optional
+        The judgement of the previous (half as long) run: a second growing run confirms divergence.
+
+    Examples
+    --------
+    >>> from synth.plant import Plant; from synth.controllers import Controller
+    >>> from synth.sim.simulator import simulate_step
+    >>> r = simulate_step(NonlinearLoop(Plant.from_string("1/(s+1)"), Controller("P", {"kp": 1})), 0, 1, 2.0)
+    >>> judge(r, 0.0, 1.0, nonlinear_step_metrics(r)).verdict is None  # still 4 % off at 2 s
+    True
+    """
+    scale = abs(step_size) or 1.0
+    t, y = result.t, result.output
+    after = t >= t_step - 1e-12
+    ta, ya = t[after], y[after]
+    osc = metrics.limit_cycle
+    if not np.all(np.isfinite(ya)) or np.max(np.abs(ya - ya[0])) > 1e9 * scale:
+        return Judgement("diverging", "the output left every bound (not finite or 1e9 times the step)", 0, True)
+    if osc.diverging:
+        if previous is not None and previous.growing:
+            return Judgement("diverging", f"grows on two horizons in a row ({osc.reason})", osc.cycles, True)
+        return Judgement(None, f"growing ({osc.reason}); confirming on a longer horizon", osc.cycles, True)
+    span = float(ta[-1] - ta[0])
+    if osc.present:
+        if osc.cycles < MIN_CYCLES:
+            return Judgement(None, f"only {osc.cycles} cycles in the last half (need {MIN_CYCLES})", osc.cycles)
+        why = _steady(ta, ya, span / 4, min_amplitude)
+        if why is not None:
+            return Judgement(None, why, osc.cycles)
+        return Judgement("limit_cycle", f"amplitude and period steady within {100 * STEADY:g} % over the last "
+                         f"two quarters ({span / 4:.3g} s each)", osc.cycles)
+    quarter = ta >= ta[-1] - span / 4
+    tq, yq = ta[quarter], ya[quarter] - metrics.final_value
+    off = float(np.max(np.abs(yq)))
+    if off > 0.01 * scale:
+        return Judgement(None, f"the last quarter is {100 * off / scale:.2g} % of the step from its final value",
+                         osc.cycles)
+    slope = float(np.polyfit(tq - tq[0], yq, 1)[0]) if tq.size > 2 else 0.0
+    if abs(slope) * span / 4 > 0.005 * scale:
+        return Judgement(None, "the output still drifts over the last quarter", osc.cycles)
+    half = tq.size // 2
+    early, late = np.ptp(yq[:half]) if half else 0.0, np.ptp(yq[half:])
+    if late > early + 1e-9 * (scale + abs(metrics.final_value)):
+        return Judgement(None, "the motion over the last quarter does not decay", osc.cycles)
+    return Judgement("settled", f"within 1 % of the step over the last {span / 4:.2g} s", osc.cycles)
+
+
+def step_verdict(loop: NonlinearLoop, start: float, end: float, t_step: float = 0.0, horizon: float | None = None,
+                 max_horizon: float | None = None, disturbances: Sequence[Any] = (), seed: int = 0,
+                 min_amplitude: float = 0.0, window: float | None = None) -> StepVerdict:
+    """Simulate a step until the run decides: settled, limit cycle, diverging, or undetermined.
+
+    Parameters
+    ----------
+    loop : NonlinearLoop
+    start, end : float
+        Reference before and after the step (absolute output units).
+    t_step : float
+        Time of the step (s).
+    horizon : float, optional
+        First horizon (s); default from the loop's dynamics (:func:`~synth.sim.horizon.plan_horizon`).
+    max_horizon : float, optional
+        Cap (s); default the smaller of 32 times the first horizon (at least 60 s) and
+        :data:`MAX_SAMPLES` samples.
+    disturbances, seed
+        As in :func:`synth.sim.simulator.simulate`.
+    min_amplitude : float
+        Smallest oscillation that counts as a limit cycle (output units).
+    window : float, optional
+        Seconds at the end examined for the reported oscillation metrics (default the last half).
+
+    Returns
+    -------
+    StepVerdict
+
+    Examples
+    --------
+    The issue's loop: P(20) on ``1/(s(s+1)(s+2))`` with the actuator saturated at +-1; no horizon
+    given, the saturation's cycle is found and measured:
+
+    >>> from synth.plant import Plant; from synth.controllers import Controller
+    >>> from synth.sim.blocks import Saturation
+    >>> loop = NonlinearLoop(Plant.from_string("1/(s*(s+1)*(s+2))"), Controller("P", {"kp": 20}),
+    ...                      actuator=[Saturation(-1, 1)], dt=0.001)
+    >>> v = step_verdict(loop, 0.0, 0.1)
+    >>> v.verdict, round(v.metrics.limit_cycle.amplitude, 3), round(v.metrics.limit_cycle.period, 2)
+    ('limit_cycle', 0.217, 4.53)
+    >>> short = step_verdict(loop, 0.0, 0.1, max_horizon=5.0)
+    >>> short.verdict, short.evidence.horizons, short.summary()[:24]
+    ('undetermined', (5.0,), 'undetermined within 5 s:')
+    """
+    from synth.sim.simulator import simulate_step
+
+    if horizon is not None and not (np.isfinite(horizon) and horizon > t_step):
+        raise ModelError(f"horizon must be a finite number of seconds after the step ({t_step:g} s), got {horizon!r}")
+    if not (np.isfinite(start) and np.isfinite(end) and np.isfinite(t_step)):
+        raise ModelError(f"the step {start!r} -> {end!r} at {t_step!r} s must be finite")
+    plan = plan_horizon(loop, t_step, horizon)
+    first = plan.horizon
+    cap = max_horizon if max_horizon is not None else min(max(32 * first, 60.0), MAX_SAMPLES * loop.dt)
+    if not (np.isfinite(cap) and cap > t_step):
+        raise ModelError(f"max_horizon must be a finite number of seconds after the step, got {max_horizon!r}")
+    if cap / loop.dt > 50 * MAX_SAMPLES:
+        raise ModelError(f"max_horizon {cap:g} s is {cap / loop.dt:.3g} samples of {loop.dt:g} s; "
+                         f"at most {50 * MAX_SAMPLES:.3g}")
+    T = min(first, cap)
+    tried: list[float] = []
+    previous: Judgement | None = None
+    while True:
+        tried.append(T)
+        result = simulate_step(loop, start, end, T, t_step, disturbances, seed)
+        metrics = nonlinear_step_metrics(result, t_step, min_amplitude=min_amplitude, window=window)
+        j = judge(result, t_step, end - start, metrics, min_amplitude, previous)
+        if j.verdict is not None or T >= cap * (1 - 1e-12):
+            break
+        previous = j
+        T = min(2 * T, cap)
+    verdict = j.verdict or "undetermined"
+    evidence = Evidence(float(result.t[-1]), loop.dt, int(result.t.size), j.cycles, tuple(tried), float(cap),
+                        j.criterion, plan)
+    return StepVerdict(verdict, evidence, metrics, result)
