@@ -4,14 +4,18 @@
 dynamics (:func:`synth.sim.horizon.plan_horizon`), judges the run and, while the run does not
 decide, doubles the horizon up to a cap. The rules (:func:`judge`), on the output after the step:
 
-* **diverging**: the output is not finite, or it grows (RMS of the last third of the last half more
-  than 3 times that of the first third, or its excursion 10 times larger) on two horizons in a row;
-* **limit cycle**: a sustained oscillation (:func:`synth.sim.limitcycle.detect_oscillation`) with
-  at least :data:`MIN_CYCLES` whole cycles in the last half, whose amplitude and period over the last
-  quarter agree within :data:`STEADY` (1 %) with those over the quarter before;
-* **settled**: no sustained oscillation, the last quarter within 1 % of the step of the final
-  value, no drift across it (slope times its length below 0.5 % of the step), and the motion of
-  its last half no larger than that of its first half;
+* **diverging**: the output is not finite or beyond 1e9 steps; or it grows on two horizons in a
+  row (over the last half, the RMS of the last third more than 3 times that of the first, or its
+  largest distance from the reference over the last quarter more than 10 steps and 1.3 times that
+  over the second quarter);
+* **limit cycle**: a sustained oscillation (:func:`synth.sim.limitcycle.detect_oscillation`, at
+  least 3 regular cycles) in the last quarter of the run and in the quarter before, at least
+  :data:`MIN_CYCLES` whole cycles in the two, with periods equal within :data:`STEADY` (1 %) and
+  amplitudes equal within 1 %, or varying by less than 20 % without a trend over the last three
+  quarters (a quantized or sampled cycle whose waveform changes from cycle to cycle);
+* **settled**: no sustained oscillation in the last quarter, which stays within :data:`SETTLED`
+  (0.01 %) of the step (or ``min_amplitude``) of the final value and moves (peak to peak) at most
+  half as much as the quarter before (or less than twice ``min_amplitude``);
 * otherwise the horizon is doubled; at the cap the verdict is **undetermined** and says what was
   seen (cycles, the rule that failed).
 
@@ -29,12 +33,12 @@ import numpy as np
 
 from synth.errors import ModelError
 from synth.sim.horizon import HorizonPlan, plan_horizon
-from synth.sim.limitcycle import detect_oscillation
+from synth.sim.limitcycle import Oscillation, detect_oscillation
 from synth.sim.loops import NonlinearLoop
 from synth.sim.metrics import NonlinearStepMetrics, nonlinear_step_metrics
 from synth.sim.results import SimResult
 
-__all__ = ["MAX_SAMPLES", "MIN_CYCLES", "STEADY", "VERDICTS", "Evidence", "Judgement", "StepVerdict", "judge",
+__all__ = ["MAX_SAMPLES", "MIN_CYCLES", "SETTLED", "STEADY", "VERDICTS", "Evidence", "Judgement", "StepVerdict", "default_cap", "judge",
            "step_verdict"]
 
 VERDICTS = ("settled", "limit_cycle", "diverging", "undetermined")
@@ -43,6 +47,8 @@ MIN_CYCLES = 6
 """Whole cycles a limit cycle needs in the last half of the run."""
 STEADY = 0.01
 """Largest relative change of amplitude and period between the last two quarters of a limit cycle."""
+SETTLED = 1e-4
+"""Largest distance from the final value over the last quarter of a settled run (fraction of the step)."""
 MAX_SAMPLES = 1_000_000
 """Default cap on the samples of one run (the cap is also at most 32 times the first horizon)."""
 
@@ -176,21 +182,33 @@ class StepVerdict:
         return {"verdict": self.verdict, "evidence": self.evidence.to_dict(), **self.metrics.to_dict()}
 
 
-def _steady(t: np.ndarray, y: np.ndarray, quarter: float, min_amplitude: float) -> str | None:
-    """None when the last two quarters show the same cycle (amplitude and period within STEADY)."""
-    cut = t <= t[-1] - quarter
-    a = detect_oscillation(t, y, window=quarter, min_amplitude=min_amplitude, min_cycles=2)
-    b = detect_oscillation(t[cut], y[cut], window=quarter, min_amplitude=min_amplitude, min_cycles=2)
-    if not (a.present and b.present and a.amplitude and b.amplitude and a.period and b.period):
-        return "fewer than 2 cycles in each of the last two quarters"
+def _steady(a: Oscillation, b: Oscillation, c: Oscillation) -> tuple[str | None, str]:
+    """(None, how) when the last quarter ``a`` and the one before ``b`` show the same cycle: period within
+    STEADY, and amplitude within STEADY or varying without a trend over the quarters ``c``, ``b``, ``a``."""
+    if not (b.present and a.amplitude and b.amplitude and a.period and b.period):
+        return f"the quarter before the last shows no sustained cycle ({b.reason})", ""
     da = abs(a.amplitude - b.amplitude) / a.amplitude
     dp = abs(a.period - b.period) / a.period
-    if da > STEADY or dp > STEADY:
-        return f"amplitude still changes {100 * da:.2g} %, period {100 * dp:.2g} % between the last two quarters"
-    return None
+    if dp > STEADY:
+        return f"the period still changes {100 * dp:.2g} % between the last two quarters", ""
+    if da <= STEADY:
+        return None, f"amplitude and period steady within {100 * STEADY:g} %"
+    if c.present and c.amplitude and (a.amplitude - b.amplitude) * (b.amplitude - c.amplitude) < 0 and da < 0.2:
+        return None, (f"period steady within {100 * STEADY:g} %; amplitude varies {100 * da:.2g} % between "
+                      "quarters without a trend")
+    return f"the amplitude still changes {100 * da:.2g} % between the last two quarters", ""
 
 
-def judge(result: SimResult, t_step: float, step_size: float, metrics: NonlinearStepMetrics,
+def _excursion_grows(ta: np.ndarray, ya: np.ndarray, end: float, scale: float) -> bool:
+    """The largest distance from the reference over the last quarter is more than 10 steps and 1.3
+    times that over the second quarter: a drift, or an oscillation growing without a bound."""
+    span = ta[-1] - ta[0]
+    last = np.abs(ya[ta >= ta[-1] - span / 4] - end)
+    second = np.abs(ya[(ta >= ta[0] + span / 4) & (ta < ta[0] + span / 2)] - end)
+    return bool(last.size and second.size and last.max() > 10 * scale and last.max() > 1.3 * second.max())
+
+
+def judge(result: SimResult, t_step: float, step: tuple[float, float], metrics: NonlinearStepMetrics,
           min_amplitude: float = 0.0, previous: Judgement | None = None) -> Judgement:
     """Does this run decide? (The rules are in the module docstring.)
 
@@ -199,10 +217,10 @@ def judge(result: SimResult, t_step: float, step_size: float, metrics: Nonlinear
     result : SimResult
     t_step : float
         Time of the step (s).
-    step_size : float
-        Size of the reference step (output units); 1 when it is 0.
+    step : (float, float)
+        Reference before and after the step (output units).
     metrics : NonlinearStepMetrics
-        Its step metrics.
+        Its step metrics, with the limit cycle examined over the last quarter of the run.
     min_amplitude : float
         Smallest oscillation that counts (output units).
     previous : Judgement, optional
@@ -213,43 +231,66 @@ def judge(result: SimResult, t_step: float, step_size: float, metrics: Nonlinear
     >>> from synth.plant import Plant; from synth.controllers import Controller
     >>> from synth.sim.simulator import simulate_step
     >>> r = simulate_step(NonlinearLoop(Plant.from_string("1/(s+1)"), Controller("P", {"kp": 1})), 0, 1, 2.0)
-    >>> judge(r, 0.0, 1.0, nonlinear_step_metrics(r)).verdict is None  # still 4 % off at 2 s
-    True
+    >>> judge(r, 0.0, (0.0, 1.0), nonlinear_step_metrics(r, window=0.5)).criterion  # 4 % off at 2 s
+    'the last quarter is 3.7 % of the step from its final value'
     """
-    scale = abs(step_size) or 1.0
+    scale = abs(step[1] - step[0]) or 1.0
     t, y = result.t, result.output
     after = t >= t_step - 1e-12
     ta, ya = t[after], y[after]
-    osc = metrics.limit_cycle
     if not np.all(np.isfinite(ya)) or np.max(np.abs(ya - ya[0])) > 1e9 * scale:
         return Judgement("diverging", "the output left every bound (not finite or 1e9 times the step)", 0, True)
-    if osc.diverging:
-        if previous is not None and previous.growing:
-            return Judgement("diverging", f"grows on two horizons in a row ({osc.reason})", osc.cycles, True)
-        return Judgement(None, f"growing ({osc.reason}); confirming on a longer horizon", osc.cycles, True)
     span = float(ta[-1] - ta[0])
-    if osc.present:
-        if osc.cycles < MIN_CYCLES:
-            return Judgement(None, f"only {osc.cycles} cycles in the last half (need {MIN_CYCLES})", osc.cycles)
-        why = _steady(ta, ya, span / 4, min_amplitude)
+    half = detect_oscillation(ta, ya, window=span / 2, min_amplitude=min_amplitude)
+    if half.diverging or _excursion_grows(ta, ya, step[1], scale):
+        why = half.reason if half.diverging else "the distance from the reference grows past 10 steps"
+        if previous is not None and previous.growing:
+            return Judgement("diverging", f"grows on two horizons in a row ({why})", half.cycles, True)
+        return Judgement(None, f"growing ({why}); confirming on a longer horizon", half.cycles, True)
+    a = metrics.limit_cycle
+    if a.present:
+        cut = ta < ta[-1] - span / 4
+        b = detect_oscillation(ta[cut], ya[cut], window=span / 4, min_amplitude=min_amplitude)
+        cycles = a.cycles + b.cycles
+        if cycles < MIN_CYCLES:
+            return Judgement(None, f"only {cycles} cycles in the last half (need {MIN_CYCLES})", cycles)
+        cut2 = ta < ta[-1] - span / 2
+        c = detect_oscillation(ta[cut2], ya[cut2], window=span / 4, min_amplitude=min_amplitude)
+        why, how = _steady(a, b, c)
         if why is not None:
-            return Judgement(None, why, osc.cycles)
-        return Judgement("limit_cycle", f"amplitude and period steady within {100 * STEADY:g} % over the last "
-                         f"two quarters ({span / 4:.3g} s each)", osc.cycles)
+            return Judgement(None, why, cycles)
+        return Judgement("limit_cycle", f"{how} over the last two quarters ({span / 4:.3g} s each)", cycles)
     quarter = ta >= ta[-1] - span / 4
-    tq, yq = ta[quarter], ya[quarter] - metrics.final_value
+    previous_quarter = (ta >= ta[-1] - span / 2) & ~quarter
+    yq = ya[quarter] - metrics.final_value
     off = float(np.max(np.abs(yq)))
-    if off > 0.01 * scale:
-        return Judgement(None, f"the last quarter is {100 * off / scale:.2g} % of the step from its final value",
-                         osc.cycles)
-    slope = float(np.polyfit(tq - tq[0], yq, 1)[0]) if tq.size > 2 else 0.0
-    if abs(slope) * span / 4 > 0.005 * scale:
-        return Judgement(None, "the output still drifts over the last quarter", osc.cycles)
-    half = tq.size // 2
-    early, late = np.ptp(yq[:half]) if half else 0.0, np.ptp(yq[half:])
-    if late > early + 1e-9 * (scale + abs(metrics.final_value)):
-        return Judgement(None, "the motion over the last quarter does not decay", osc.cycles)
-    return Judgement("settled", f"within 1 % of the step over the last {span / 4:.2g} s", osc.cycles)
+    if off > max(SETTLED * scale, min_amplitude):
+        return Judgement(None, f"the last quarter is {100 * off / scale:.2g} % of the step from its final value "
+                         f"(settled needs {100 * SETTLED:g} %)", a.cycles)
+    late, early = float(np.ptp(ya[quarter])), float(np.ptp(ya[previous_quarter]))
+    quiet = max(2 * min_amplitude, 1e-9 * (scale + abs(metrics.final_value)))
+    if late > quiet and late > 0.5 * early:
+        return Judgement(None, f"the motion over the last quarter is {late / max(early, 1e-300):.2g} times that "
+                         "over the quarter before (settled needs 0.5)", a.cycles)
+    return Judgement("settled", f"within {100 * SETTLED:g} % of the step over the last {span / 4:.2g} s, "
+                     "its motion at most half that of the quarter before", a.cycles)
+
+
+def default_cap(loop: NonlinearLoop, first: float) -> float:
+    """The longest horizon :func:`step_verdict` tries by default: 64 times the first horizon, 200
+    times the slowest plant time constant (``1/|p|`` of its slowest non-zero pole), at least 60 s,
+    and at most :data:`MAX_SAMPLES` samples.
+
+    Examples
+    --------
+    >>> from synth.plant import Plant; from synth.controllers import Controller
+    >>> default_cap(NonlinearLoop(Plant.from_string("1/(s+0.5)"), Controller("P", {"kp": 1})), 2.0)
+    400.0
+    """
+    poles = np.abs(np.roots(np.asarray(loop.plant.den, float)))
+    poles = poles[poles > 1e-12]
+    slow = 200.0 / float(np.min(poles)) if poles.size else 0.0
+    return float(min(max(64 * first, slow, 60.0), MAX_SAMPLES * loop.dt))
 
 
 def step_verdict(loop: NonlinearLoop, start: float, end: float, t_step: float = 0.0, horizon: float | None = None,
@@ -267,14 +308,14 @@ def step_verdict(loop: NonlinearLoop, start: float, end: float, t_step: float = 
     horizon : float, optional
         First horizon (s); default from the loop's dynamics (:func:`~synth.sim.horizon.plan_horizon`).
     max_horizon : float, optional
-        Cap (s); default the smaller of 32 times the first horizon (at least 60 s) and
-        :data:`MAX_SAMPLES` samples.
+        Cap (s); default :func:`default_cap`.
     disturbances, seed
         As in :func:`synth.sim.simulator.simulate`.
     min_amplitude : float
         Smallest oscillation that counts as a limit cycle (output units).
     window : float, optional
-        Seconds at the end examined for the reported oscillation metrics (default the last half).
+        Seconds at the end examined for the reported oscillation (default the last quarter of the
+        run, the part the verdict compares with the quarter before).
 
     Returns
     -------
@@ -304,7 +345,7 @@ def step_verdict(loop: NonlinearLoop, start: float, end: float, t_step: float = 
         raise ModelError(f"the step {start!r} -> {end!r} at {t_step!r} s must be finite")
     plan = plan_horizon(loop, t_step, horizon)
     first = plan.horizon
-    cap = max_horizon if max_horizon is not None else min(max(32 * first, 60.0), MAX_SAMPLES * loop.dt)
+    cap = max_horizon if max_horizon is not None else default_cap(loop, first)
     if not (np.isfinite(cap) and cap > t_step):
         raise ModelError(f"max_horizon must be a finite number of seconds after the step, got {max_horizon!r}")
     if cap / loop.dt > 50 * MAX_SAMPLES:
@@ -316,8 +357,9 @@ def step_verdict(loop: NonlinearLoop, start: float, end: float, t_step: float = 
     while True:
         tried.append(T)
         result = simulate_step(loop, start, end, T, t_step, disturbances, seed)
-        metrics = nonlinear_step_metrics(result, t_step, min_amplitude=min_amplitude, window=window)
-        j = judge(result, t_step, end - start, metrics, min_amplitude, previous)
+        metrics = nonlinear_step_metrics(result, t_step, min_amplitude=min_amplitude,
+                                         window=window if window is not None else (T - t_step) / 4)
+        j = judge(result, t_step, (start, end), metrics, min_amplitude, previous)
         if j.verdict is not None or T >= cap * (1 - 1e-12):
             break
         previous = j
