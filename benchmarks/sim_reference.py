@@ -127,11 +127,11 @@ def simulate_reference(case: dict[str, Any], horizon: float, method: str = "expm
     if abs(float(np.ravel(D)[0])) > 0:
         raise ValueError("the reference takes strictly proper plants")
     delay = float(case.get("delay", 0.0))
-    m = int(math.floor(delay / dt + 1e-9))
+    m = math.floor(delay / dt + 1e-9)
     f = delay / dt - m
     if f < 1e-9:
         f = 0.0
-    n = int(round(horizon / dt)) + 1
+    n = round(horizon / dt) + 1
     t = np.arange(n) * dt
     step = float(case["step"])
     t_step = float(case.get("t_step", 0.0))

@@ -24,8 +24,8 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
-from benchmarks.sim_cases import random_cases, synth_loop  # noqa: E402
-from benchmarks.sim_reference import reference_run  # noqa: E402
+from benchmarks.sim_cases import random_cases, synth_loop
+from benchmarks.sim_reference import reference_run
 
 __all__ = ["compare", "main", "run_case"]
 

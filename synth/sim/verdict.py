@@ -38,8 +38,8 @@ from synth.sim.loops import NonlinearLoop
 from synth.sim.metrics import NonlinearStepMetrics, nonlinear_step_metrics
 from synth.sim.results import SimResult
 
-__all__ = ["MAX_SAMPLES", "MIN_CYCLES", "SETTLED", "STEADY", "VERDICTS", "Evidence", "Judgement", "StepVerdict", "default_cap", "judge",
-           "step_verdict"]
+__all__ = ["MAX_SAMPLES", "MIN_CYCLES", "SETTLED", "STEADY", "VERDICTS", "Evidence", "Judgement", "StepVerdict",
+           "default_cap", "judge", "step_verdict"]
 
 VERDICTS = ("settled", "limit_cycle", "diverging", "undetermined")
 """The four answers of a step simulation."""
@@ -314,8 +314,8 @@ def step_verdict(loop: NonlinearLoop, start: float, end: float, t_step: float = 
     min_amplitude : float
         Smallest oscillation that counts as a limit cycle (output units).
     window : float, optional
-        Seconds at the end examined for the reported oscillation (default the last quarter of the
-        run, the part the verdict compares with the quarter before).
+        Seconds at the end examined for the reported oscillation (default: the last half of the run
+        for a limit cycle, whose two quarters the verdict found equal; else the last quarter).
 
     Returns
     -------
@@ -364,6 +364,8 @@ def step_verdict(loop: NonlinearLoop, start: float, end: float, t_step: float = 
             break
         previous = j
         T = min(2 * T, cap)
+    if j.verdict == "limit_cycle" and window is None:  # steady over the last half: measure it there
+        metrics = nonlinear_step_metrics(result, t_step, min_amplitude=min_amplitude, window=(T - t_step) / 2)
     verdict = j.verdict or "undetermined"
     evidence = Evidence(float(result.t[-1]), loop.dt, int(result.t.size), j.cycles, tuple(tried), float(cap),
                         j.criterion, plan)
