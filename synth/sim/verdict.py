@@ -12,7 +12,9 @@ decide, doubles the horizon up to a cap. The rules (:func:`judge`), on the outpu
   least 3 regular cycles) in the last quarter of the run and in the quarter before, at least
   :data:`MIN_CYCLES` whole cycles in the two, with periods equal within :data:`STEADY` (1 %) and
   amplitudes equal within 1 %, or varying by less than 20 % without a trend over the last three
-  quarters (a quantized or sampled cycle whose waveform changes from cycle to cycle);
+  quarters (a quantized or sampled cycle whose waveform changes from cycle to cycle); or, when the
+  crossings are irregular (a waveform crossing its mean more than twice per period), both quarters
+  repeat themselves (autocorrelation above 0.98) with the same period and amplitude within 1 %;
 * **settled**: no sustained oscillation in the last quarter, which stays within :data:`SETTLED`
   (0.01 %) of the step (or ``min_amplitude``) of the final value and moves (peak to peak) at most
   half as much as the quarter before (or less than twice ``min_amplitude``);
@@ -25,6 +27,7 @@ seen and the rule that decided.
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -208,6 +211,30 @@ def _excursion_grows(ta: np.ndarray, ya: np.ndarray, end: float, scale: float) -
     return bool(last.size and second.size and last.max() > 10 * scale and last.max() > 1.3 * second.max())
 
 
+def _periodic(t: np.ndarray, y: np.ndarray, min_amplitude: float) -> tuple[float, float] | None:
+    """(period, half peak-to-peak) when ``y`` repeats itself (normalized autocorrelation of at least
+    0.98 at a lag holding 3 or more repeats in the window); None otherwise. Catches cycles whose
+    waveform crosses its mean more than twice per period."""
+    r = y - np.mean(y)
+    half = 0.5 * float(np.ptp(y))
+    if half <= max(min_amplitude, 1e-9 * (1.0 + abs(float(np.mean(y))))) or r.size < 16:
+        return None
+    n = r.size
+    f = np.fft.rfft(r, 2 * n)
+    ac = np.fft.irfft(f * np.conj(f))[: n // 3]
+    ac = ac / (ac[0] * (1 - np.arange(ac.size) / n))
+    below = np.nonzero(ac < 0.5)[0]
+    if below.size == 0:
+        return None
+    k0 = int(below[0])
+    peak = k0 + int(np.argmax(ac[k0:])) if k0 < ac.size else None
+    if peak is None or peak >= ac.size - 1 or ac[peak] < 0.98:
+        return None
+    a, b, c = ac[peak - 1], ac[peak], ac[peak + 1]
+    shift = 0.5 * (a - c) / (a - 2 * b + c) if (a - 2 * b + c) != 0 else 0.0
+    return float((peak + shift) * (t[1] - t[0])), half
+
+
 def judge(result: SimResult, t_step: float, step: tuple[float, float], metrics: NonlinearStepMetrics,
           min_amplitude: float = 0.0, previous: Judgement | None = None) -> Judgement:
     """Does this run decide? (The rules are in the module docstring.)
@@ -248,6 +275,15 @@ def judge(result: SimResult, t_step: float, step: tuple[float, float], metrics: 
             return Judgement("diverging", f"grows on two horizons in a row ({why})", half.cycles, True)
         return Judgement(None, f"growing ({why}); confirming on a longer horizon", half.cycles, True)
     a = metrics.limit_cycle
+    if not a.present and a.reason.startswith("irregular"):
+        cut = ta < ta[-1] - span / 4
+        last = ~cut & (ta >= ta[-1] - span / 4)
+        pa = _periodic(ta[last], ya[last], min_amplitude)
+        pb = _periodic(ta[cut & (ta >= ta[-1] - span / 2)], ya[cut & (ta >= ta[-1] - span / 2)], min_amplitude)
+        if pa and pb and abs(pa[0] - pb[0]) <= STEADY * pa[0] and abs(pa[1] - pb[1]) <= STEADY * pa[1]:
+            return Judgement("limit_cycle", f"the last two quarters repeat with period {pa[0]:.4g} s (autocorrelation "
+                             "above 0.98; the waveform crosses its mean more than twice per period) and equal "
+                             f"amplitudes within {100 * STEADY:g} %", int(span / 2 / pa[0]))
     if a.present:
         cut = ta < ta[-1] - span / 4
         b = detect_oscillation(ta[cut], ya[cut], window=span / 4, min_amplitude=min_amplitude)
@@ -366,6 +402,15 @@ def step_verdict(loop: NonlinearLoop, start: float, end: float, t_step: float = 
         T = min(2 * T, cap)
     if j.verdict == "limit_cycle" and window is None:  # steady over the last half: measure it there
         metrics = nonlinear_step_metrics(result, t_step, min_amplitude=min_amplitude, window=(T - t_step) / 2)
+    if j.verdict == "limit_cycle" and not metrics.limit_cycle.present:  # a cycle with a complex waveform
+        after = result.t >= T - (T - t_step) / 4
+        period, amplitude = _periodic(result.t[after], result.output[after], min_amplitude) or (None, None)
+        if period is not None:
+            osc = metrics.limit_cycle
+            metrics = dataclasses.replace(metrics, settling_time=None, limit_cycle=dataclasses.replace(
+                osc, present=True, amplitude=amplitude, period=period, frequency=2 * np.pi / period,
+                cycles=j.cycles, center=float(np.mean(result.output[after])),
+                reason=f"periodic: period {period:.4g} s by autocorrelation ({osc.reason})"))
     verdict = j.verdict or "undetermined"
     evidence = Evidence(float(result.t[-1]), loop.dt, int(result.t.size), j.cycles, tuple(tried), float(cap),
                         j.criterion, plan)
