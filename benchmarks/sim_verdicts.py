@@ -27,7 +27,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 from benchmarks.sim_cases import random_cases, synth_loop
 from benchmarks.sim_reference import reference_run
 
-__all__ = ["compare", "main", "run_case"]
+__all__ = ["compare", "investigate", "main", "run_case"]
 
 
 def run_case(case: dict[str, Any], method: str = "expm") -> dict[str, Any]:
@@ -63,6 +63,26 @@ def compare(row: dict[str, Any]) -> dict[str, Any]:
         if r.get("settling_time") is not None and s["settling_time"] is not None:
             out["settling"] = abs(s["settling_time"] - r["settling_time"]) / dt
     return out
+
+
+def investigate(row: dict[str, Any], max_samples: int = 1_000_000) -> dict[str, Any]:
+    """The reference again over a longer run (4 times the longer of the two horizons, at most
+    ``max_samples``), for a row where the two disagree: which side was wrong?"""
+    case = row["case"]
+    T = min(4 * max(row["synth"]["horizon"], row["reference"]["horizon"]), max_samples * case["dt"])
+    ref = reference_run(case, horizon=T, longest=T, max_samples=max_samples)
+    return ref
+
+
+def _off(c: dict[str, Any], dt: float) -> str:
+    parts = []
+    if not c["verdict"]:
+        parts.append("verdict")
+    for key, tol, unit in (("amplitude", 0.02, "%"), ("period", 0.02, "%"), ("rise", 1.0, " samples"),
+                           ("settling", 1.0, " samples")):
+        if key in c and c[key] > tol:
+            parts.append(f"{key} {100 * c[key]:.3g}{unit}" if unit == "%" else f"{key} {c[key]:.3g}{unit}")
+    return ", ".join(parts)
 
 
 def _describe(case: dict[str, Any]) -> str:
@@ -123,6 +143,23 @@ def main(argv: list[str] | None = None) -> int:
           f"{ts.sum():.1f} s | |")
     print(f"| time per loop, reference (median / p95 / total) | {np.median(tr):.3f} / {np.percentile(tr, 95):.3f} / "
           f"{tr.sum():.1f} s | |")
+    print("\nDisagreements, each checked by a longer run of the reference:\n")
+    print("| loop | blocks | synth (horizon) | reference (horizon) | reference, longer run | what differs |")
+    print("|---|---|---|---|---|---|")
+    for i, row in enumerate(rows):
+        off = _off(row["compare"], row["dt"])
+        if not off:
+            continue
+        s_, r_ = row["synth"], row["reference"]
+        longer = investigate(row)
+        row["reference_longer"] = longer
+        extra = (f" {longer['amplitude']:.4g} / {longer['period']:.4g} s" if longer["verdict"] == "limit_cycle"
+                 else "")
+        ours = (f" {s_['amplitude']:.4g} / {s_['period']:.4g} s" if s_["verdict"] == "limit_cycle" else "")
+        theirs = (f" {r_['amplitude']:.4g} / {r_['period']:.4g} s" if r_["verdict"] == "limit_cycle" else "")
+        print(f"| {i} | {_describe(row['case'])} | {s_['verdict']}{ours} ({s_['horizon']:.4g} s) | "
+              f"{r_['verdict']}{theirs} ({r_['horizon']:.4g} s) | {longer['verdict']}{extra} ({longer['horizon']:.4g} s) "
+              f"| {off} |", flush=True)
     if args.json:
         Path(args.json).write_text(json.dumps(rows, indent=1, default=str))
     return 0
