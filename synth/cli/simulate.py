@@ -256,12 +256,12 @@ def _print_metrics(say: Any, spec: Any, loop: Any, m: Any, step: tuple[float, fl
 
 
 def _plot(result: Any, loop: Any, metrics: Any, step: tuple[float, float], spec: Any, path: Path) -> None:
-    from synth.sim.figures import step_comparison
-    from synth.sim.simulator import simulate_step
-
     import dataclasses
 
     import numpy as np
+
+    from synth.sim.figures import step_comparison
+    from synth.sim.simulator import simulate_step
 
     linear = simulate_step(loop.linear(), step[0], step[1], float(result.t[-1]))
     masked = {}
