@@ -9,10 +9,10 @@ decide, doubles the horizon up to a cap. The rules (:func:`judge`), on the outpu
   largest distance from the reference over the last quarter more than 10 steps and 1.3 times that
   over the second quarter);
 * **limit cycle**: a sustained oscillation (:func:`synth.sim.limitcycle.detect_oscillation`, at
-  least 3 regular cycles) in the last quarter of the run and in the quarter before, at least
-  :data:`MIN_CYCLES` whole cycles in the two, with periods equal within :data:`STEADY` (1 %) and
-  amplitudes equal within 1 %, or varying by less than 20 % without a trend over the last three
-  quarters (a quantized or sampled cycle whose waveform changes from cycle to cycle); or, when the
+  least 3 regular cycles) in each of the last three quarters of the run, at least
+  :data:`MIN_CYCLES` whole cycles in the last two, with periods equal within :data:`STEADY` (1 %)
+  and amplitudes equal within 1 %, or varying by less than 20 % without a trend (a quantized or
+  sampled cycle whose waveform changes from cycle to cycle); or, when the
   crossings are irregular (a waveform crossing its mean more than twice per period), both quarters
   repeat themselves (autocorrelation above 0.98) with the same period and amplitude within 1 %;
 * **settled**: no sustained oscillation in the last quarter, which stays within :data:`SETTLED`
@@ -186,20 +186,21 @@ class StepVerdict:
 
 
 def _steady(a: Oscillation, b: Oscillation, c: Oscillation) -> tuple[str | None, str]:
-    """(None, how) when the last quarter ``a`` and the one before ``b`` show the same cycle: period within
-    STEADY, and amplitude within STEADY or varying without a trend over the quarters ``c``, ``b``, ``a``."""
-    if not (b.present and a.amplitude and b.amplitude and a.period and b.period):
-        return f"the quarter before the last shows no sustained cycle ({b.reason})", ""
-    da = abs(a.amplitude - b.amplitude) / a.amplitude
-    dp = abs(a.period - b.period) / a.period
+    """(None, how) when the last three quarters ``c``, ``b``, ``a`` show the same cycle: periods within
+    STEADY, and amplitudes within STEADY or varying without a trend (by less than 20 %)."""
+    if not (b.present and c.present and a.amplitude and b.amplitude and c.amplitude and a.period and b.period
+            and c.period):
+        return "the two quarters before the last do not both show a sustained cycle", ""
+    dp = max(abs(a.period - b.period), abs(b.period - c.period)) / a.period
     if dp > STEADY:
-        return f"the period still changes {100 * dp:.2g} % between the last two quarters", ""
+        return f"the period still changes {100 * dp:.2g} % between the last three quarters", ""
+    da = max(abs(a.amplitude - b.amplitude), abs(b.amplitude - c.amplitude)) / a.amplitude
     if da <= STEADY:
-        return None, f"amplitude and period steady within {100 * STEADY:g} %"
-    if c.present and c.amplitude and (a.amplitude - b.amplitude) * (b.amplitude - c.amplitude) < 0 and da < 0.2:
+        return None, f"amplitude and period steady within {100 * STEADY:g} % over the last three quarters"
+    if (a.amplitude - b.amplitude) * (b.amplitude - c.amplitude) < 0 and da < 0.2:
         return None, (f"period steady within {100 * STEADY:g} %; amplitude varies {100 * da:.2g} % between "
-                      "quarters without a trend")
-    return f"the amplitude still changes {100 * da:.2g} % between the last two quarters", ""
+                      "the last three quarters without a trend")
+    return f"the amplitude still changes {100 * da:.2g} % between the last three quarters", ""
 
 
 def _excursion_grows(ta: np.ndarray, ya: np.ndarray, end: float, scale: float) -> bool:
@@ -295,7 +296,7 @@ def judge(result: SimResult, t_step: float, step: tuple[float, float], metrics: 
         why, how = _steady(a, b, c)
         if why is not None:
             return Judgement(None, why, cycles)
-        return Judgement("limit_cycle", f"{how} over the last two quarters ({span / 4:.3g} s each)", cycles)
+        return Judgement("limit_cycle", f"{how} ({span / 4:.3g} s each)", cycles)
     quarter = ta >= ta[-1] - span / 4
     previous_quarter = (ta >= ta[-1] - span / 2) & ~quarter
     yq = ya[quarter] - metrics.final_value
