@@ -117,10 +117,21 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--seed", type=int, default=15)
     ap.add_argument("--quick", action="store_true", help="12 loops")
     ap.add_argument("--ivp", action="store_true", help="reference plant by solve_ivp (slow)")
+    ap.add_argument("--ivp-check", type=int, metavar="K", default=0,
+                    help="only compare the reference's two plant propagators (expm, solve_ivp) on K loops over 20 s")
     ap.add_argument("--json", help="write every row to this file")
     args = ap.parse_args(argv)
     n = 12 if args.quick else args.n
     cases = random_cases(n, args.seed)
+    if args.ivp_check:
+        from benchmarks.sim_reference import simulate_reference
+
+        for i, case in enumerate(cases[:args.ivp_check]):
+            a, b = simulate_reference(case, 20.0, "expm"), simulate_reference(case, 20.0, "ivp")
+            ok = np.isfinite(a.y) & np.isfinite(b.y)
+            print(f"{i:3d} {_describe(case):48s} max |expm - solve_ivp| = "
+                  f"{np.max(np.abs(a.y[ok] - b.y[ok])) / max(abs(case['step']), 1e-12):.2g} steps")
+        return 0
     from synth.sim.verdict import step_verdict  # warm numba's cache outside the timing
     step_verdict(synth_loop(cases[0]), 0.0, 1.0)
     rows, comps = [], []

@@ -12,9 +12,8 @@ decide, doubles the horizon up to a cap. The rules (:func:`judge`), on the outpu
   least 3 regular cycles) in each of the last three quarters of the run, at least
   :data:`MIN_CYCLES` whole cycles in the last two, with periods equal within :data:`STEADY` (1 %)
   and amplitudes equal within 1 %, or varying by less than 20 % without a trend (a quantized or
-  sampled cycle whose waveform changes from cycle to cycle); or, when the
-  crossings are irregular (a waveform crossing its mean more than twice per period), both quarters
-  repeat themselves (autocorrelation above 0.98) with the same period and amplitude within 1 %;
+  sampled cycle whose waveform changes from cycle to cycle); or, when the crossings are irregular
+  (a waveform crossing its mean more than twice per period), the last two quarters repeat themselves (autocorrelation above 0.98) with the same period and amplitude within 1 %;
 * **settled**: no sustained oscillation in the last quarter, which stays within :data:`SETTLED`
   (0.01 %) of the step (or ``min_amplitude``) of the final value and moves (peak to peak) at most
   half as much as the quarter before (or less than twice ``min_amplitude``);
@@ -49,11 +48,11 @@ VERDICTS = ("settled", "limit_cycle", "diverging", "undetermined")
 MIN_CYCLES = 6
 """Whole cycles a limit cycle needs in the last half of the run."""
 STEADY = 0.01
-"""Largest relative change of amplitude and period between the last two quarters of a limit cycle."""
+"""Largest relative change of amplitude and period between the last three quarters of a limit cycle."""
 SETTLED = 1e-4
 """Largest distance from the final value over the last quarter of a settled run (fraction of the step)."""
 MAX_SAMPLES = 1_000_000
-"""Default cap on the samples of one run (the cap is also at most 32 times the first horizon)."""
+"""Most samples of one run under the default cap (:func:`default_cap`)."""
 
 
 @dataclass(frozen=True)
