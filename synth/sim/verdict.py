@@ -13,7 +13,8 @@ decide, doubles the horizon up to a cap. The rules (:func:`judge`), on the outpu
   :data:`MIN_CYCLES` whole cycles in the last two, with periods equal within :data:`STEADY` (1 %)
   and amplitudes equal within 1 %, or varying by less than 20 % without a trend (a quantized or
   sampled cycle whose waveform changes from cycle to cycle); or, when the crossings are irregular
-  (a waveform crossing its mean more than twice per period), the last two quarters repeat themselves (autocorrelation above 0.98) with the same period and amplitude within 1 %;
+  (a waveform crossing its mean more than twice per period), the last two quarters repeat
+  themselves (autocorrelation above 0.98) with the same period and amplitude within 1 %;
 * **settled**: no sustained oscillation in the last quarter, which stays within :data:`SETTLED`
   (0.01 %) of the step (or ``min_amplitude``) of the final value and moves (peak to peak) at most
   half as much as the quarter before (or less than twice ``min_amplitude``);
