@@ -14,7 +14,10 @@ decide, doubles the horizon up to a cap. The rules (:func:`judge`), on the outpu
   and amplitudes equal within 1 %, or varying by less than 20 % without a trend (a quantized or
   sampled cycle whose waveform changes from cycle to cycle); or, when the crossings are irregular
   (a waveform crossing its mean more than twice per period), the last two quarters repeat
-  themselves (autocorrelation above 0.98) with the same period and amplitude within 1 %;
+  themselves (autocorrelation above 0.98) with the same period and amplitude within 1 %, or (a
+  sustained irregular oscillation, e.g. quasi-periodic relay or quantizer chatter) the peak-to-peak
+  ranges of the last three quarters are equal within 10 % (amplitude: half that range; period: the
+  mean of the crossings);
 * **settled**: no sustained oscillation in the last quarter, which stays within :data:`SETTLED`
   (0.01 %) of the step (or ``min_amplitude``) of the final value and moves (peak to peak) at most
   half as much as the quarter before (or less than twice ``min_amplitude``);
@@ -285,6 +288,14 @@ def judge(result: SimResult, t_step: float, step: tuple[float, float], metrics: 
             return Judgement("limit_cycle", f"the last two quarters repeat with period {pa[0]:.4g} s (autocorrelation "
                              "above 0.98; the waveform crosses its mean more than twice per period) and equal "
                              f"amplitudes within {100 * STEADY:g} %", int(span / 2 / pa[0]))
+        spans = [float(np.ptp(ya[(ta >= ta[-1] - k * span / 4) & (ta < ta[-1] - (k - 1) * span / 4 + 1e-12)]))
+                 for k in (1, 2, 3)]
+        floor = 2 * max(SETTLED * scale, min_amplitude)
+        change = max(abs(spans[0] - spans[1]), abs(spans[1] - spans[2])) / max(spans[0], 1e-300)
+        if min(spans) > floor and change <= 0.1 and a.cycles >= 3:
+            return Judgement("limit_cycle", f"a sustained irregular oscillation: its peak-to-peak range is equal within "
+                             f"{100 * change:.2g} % over the last three quarters ({a.cycles} cycles of mean period "
+                             f"{a.period:.4g} s in the last); its waveform does not repeat exactly", a.cycles)
     if a.present:
         cut = ta < ta[-1] - span / 4
         b = detect_oscillation(ta[cut], ya[cut], window=span / 4, min_amplitude=min_amplitude)
@@ -406,12 +417,16 @@ def step_verdict(loop: NonlinearLoop, start: float, end: float, t_step: float = 
     if j.verdict == "limit_cycle" and not metrics.limit_cycle.present:  # a cycle with a complex waveform
         after = result.t >= T - (T - t_step) / 4
         period, amplitude = _periodic(result.t[after], result.output[after], min_amplitude) or (None, None)
+        osc = metrics.limit_cycle
         if period is not None:
-            osc = metrics.limit_cycle
-            metrics = dataclasses.replace(metrics, settling_time=None, limit_cycle=dataclasses.replace(
-                osc, present=True, amplitude=amplitude, period=period, frequency=2 * np.pi / period,
-                cycles=j.cycles, center=float(np.mean(result.output[after])),
-                reason=f"periodic: period {period:.4g} s by autocorrelation ({osc.reason})"))
+            how = f"periodic: period {period:.4g} s by autocorrelation ({osc.reason})"
+        else:  # irregular: half the peak-to-peak range of the last quarter, the mean period of its crossings
+            last = detect_oscillation(result.t, result.output, window=(T - t_step) / 4, min_amplitude=min_amplitude)
+            amplitude, period = 0.5 * float(np.ptp(result.output[after])), last.period or float("nan")
+            how = f"irregular: half the peak-to-peak range of the last quarter, mean period ({last.reason})"
+        metrics = dataclasses.replace(metrics, settling_time=None, limit_cycle=dataclasses.replace(
+            osc, present=True, amplitude=amplitude, period=period, frequency=2 * np.pi / period,
+            cycles=j.cycles, center=float(np.mean(result.output[after])), reason=how))
     verdict = j.verdict or "undetermined"
     evidence = Evidence(float(result.t[-1]), loop.dt, int(result.t.size), j.cycles, tuple(tried), float(cap),
                         j.criterion, plan)
