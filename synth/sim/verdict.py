@@ -4,10 +4,11 @@
 dynamics (:func:`synth.sim.horizon.plan_horizon`), judges the run and, while the run does not
 decide, doubles the horizon up to a cap. The rules (:func:`judge`), on the output after the step:
 
-* **diverging**: the output is not finite or beyond 1e9 steps; or it grows on two horizons in a
-  row (over the last half, the RMS of the last third more than 3 times that of the first, or its
+* **diverging**: the output is not finite or beyond 1e9 steps; or it grows over the run and over
+  its first half (over the last half, the RMS of the last third more than 3 times that of the first, or its
   largest distance from the reference over the last quarter more than 10 steps and 1.3 times that
-  over the second quarter);
+  over the second quarter) and sets a new record (the largest distance over the last quarter is
+  1.1 times the largest before it: bounded bursts do not count);
 * **limit cycle**: a sustained oscillation (:func:`synth.sim.limitcycle.detect_oscillation`, at
   least 3 regular cycles) in each of the last three quarters of the run, at least
   :data:`MIN_CYCLES` whole cycles in the last two, with periods equal within :data:`STEADY` (1 %)
@@ -239,6 +240,22 @@ def _periodic(t: np.ndarray, y: np.ndarray, min_amplitude: float) -> tuple[float
     return float((peak + shift) * (t[1] - t[0])), half
 
 
+def _growing(ta: np.ndarray, ya: np.ndarray, end: float, scale: float, min_amplitude: float) -> tuple[bool, str, int]:
+    """(grows, why, cycles): the growth rule of :func:`judge` on one record."""
+    half = detect_oscillation(ta, ya, window=(ta[-1] - ta[0]) / 2, min_amplitude=min_amplitude)
+    grows = (half.diverging or _excursion_grows(ta, ya, end, scale)) and _new_record(ta, ya, end)
+    why = half.reason if half.diverging else "the distance from the reference grows past 10 steps"
+    return grows, why, half.cycles
+
+
+def _new_record(ta: np.ndarray, ya: np.ndarray, end: float) -> bool:
+    """The largest distance from the reference over the last quarter exceeds 1.1 times the largest
+    before it (a bounded, bursting oscillation sets no new record; a growing one does)."""
+    last = ta >= ta[-1] - (ta[-1] - ta[0]) / 4
+    before = np.abs(ya[~last] - end)
+    return bool(before.size and np.max(np.abs(ya[last] - end)) > 1.1 * np.max(before))
+
+
 def judge(result: SimResult, t_step: float, step: tuple[float, float], metrics: NonlinearStepMetrics,
           min_amplitude: float = 0.0, previous: Judgement | None = None) -> Judgement:
     """Does this run decide? (The rules are in the module docstring.)
@@ -272,12 +289,14 @@ def judge(result: SimResult, t_step: float, step: tuple[float, float], metrics: 
     if not np.all(np.isfinite(ya)) or np.max(np.abs(ya - ya[0])) > 1e9 * scale:
         return Judgement("diverging", "the output left every bound (not finite or 1e9 times the step)", 0, True)
     span = float(ta[-1] - ta[0])
-    half = detect_oscillation(ta, ya, window=span / 2, min_amplitude=min_amplitude)
-    if half.diverging or _excursion_grows(ta, ya, step[1], scale):
-        why = half.reason if half.diverging else "the distance from the reference grows past 10 steps"
-        if previous is not None and previous.growing:
-            return Judgement("diverging", f"grows on two horizons in a row ({why})", half.cycles, True)
-        return Judgement(None, f"growing ({why}); confirming on a longer horizon", half.cycles, True)
+    grows, why, cycles = _growing(ta, ya, step[1], scale, min_amplitude)
+    if grows:
+        early = ta <= ta[0] + span / 2  # the first half of this run, as if it had been the previous horizon
+        before = previous.growing if previous is not None else _growing(ta[early], ya[early], step[1], scale,
+                                                                         min_amplitude)[0]
+        if before:
+            return Judgement("diverging", f"grows over this horizon and over its first half ({why})", cycles, True)
+        return Judgement(None, f"growing ({why}); confirming on a longer horizon", cycles, True)
     a = metrics.limit_cycle
     if not a.present and a.reason.startswith("irregular"):
         cut = ta < ta[-1] - span / 4
