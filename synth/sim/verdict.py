@@ -4,8 +4,9 @@
 dynamics (:func:`synth.sim.horizon.plan_horizon`), judges the run and, while the run does not
 decide, doubles the horizon up to a cap. The rules (:func:`judge`), on the output after the step:
 
-* **diverging**: the output is not finite or beyond 1e9 steps; or it grows over the run and over
-  its first half (over the last half, the RMS of the last third more than 3 times that of the first, or its
+* **diverging**: the output is not finite or beyond 1e9 steps; or it grows on two horizons in a
+  row (when the first horizon is already the cap: over the run and over its first half), growing
+  meaning: over the last half, the RMS of the last third more than 3 times that of the first, or its
   largest distance from the reference over the last quarter more than 10 steps and 1.3 times that
   over the second quarter) and sets a new record (the largest distance over the last quarter is
   1.1 times the largest before it: bounded bursts do not count);
@@ -257,7 +258,7 @@ def _new_record(ta: np.ndarray, ya: np.ndarray, end: float) -> bool:
 
 
 def judge(result: SimResult, t_step: float, step: tuple[float, float], metrics: NonlinearStepMetrics,
-          min_amplitude: float = 0.0, previous: Judgement | None = None) -> Judgement:
+          min_amplitude: float = 0.0, previous: Judgement | None = None, last_run: bool = False) -> Judgement:
     """Does this run decide? (The rules are in the module docstring.)
 
     Parameters
@@ -273,6 +274,9 @@ def judge(result: SimResult, t_step: float, step: tuple[float, float], metrics: 
         Smallest oscillation that counts (output units).
     previous : Judgement, optional
         The judgement of the previous (half as long) run: a second growing run confirms divergence.
+    last_run : bool
+        No longer run will follow (the cap): with no previous run, growth over the run and over its
+        first half confirms divergence.
 
     Examples
     --------
@@ -291,11 +295,12 @@ def judge(result: SimResult, t_step: float, step: tuple[float, float], metrics: 
     span = float(ta[-1] - ta[0])
     grows, why, cycles = _growing(ta, ya, step[1], scale, min_amplitude)
     if grows:
-        early = ta <= ta[0] + span / 2  # the first half of this run, as if it had been the previous horizon
-        before = previous.growing if previous is not None else _growing(ta[early], ya[early], step[1], scale,
-                                                                         min_amplitude)[0]
-        if before:
-            return Judgement("diverging", f"grows over this horizon and over its first half ({why})", cycles, True)
+        if previous is not None and previous.growing:
+            return Judgement("diverging", f"grows on two horizons in a row ({why})", cycles, True)
+        if last_run and previous is None:  # no longer run allowed: its first half stands for the previous one
+            early = ta <= ta[0] + span / 2
+            if _growing(ta[early], ya[early], step[1], scale, min_amplitude)[0]:
+                return Judgement("diverging", f"grows over the run and over its first half ({why})", cycles, True)
         return Judgement(None, f"growing ({why}); confirming on a longer horizon", cycles, True)
     a = metrics.limit_cycle
     if not a.present and a.reason.startswith("irregular"):
@@ -426,7 +431,7 @@ def step_verdict(loop: NonlinearLoop, start: float, end: float, t_step: float = 
         result = simulate_step(loop, start, end, T, t_step, disturbances, seed)
         metrics = nonlinear_step_metrics(result, t_step, min_amplitude=min_amplitude,
                                          window=window if window is not None else (T - t_step) / 4)
-        j = judge(result, t_step, (start, end), metrics, min_amplitude, previous)
+        j = judge(result, t_step, (start, end), metrics, min_amplitude, previous, T >= cap * (1 - 1e-12))
         if j.verdict is not None or T >= cap * (1 - 1e-12):
             break
         previous = j
