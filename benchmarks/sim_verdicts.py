@@ -107,7 +107,7 @@ def _summary(comps: list[dict[str, Any]]) -> list[tuple[str, str, str]]:
 
 
 def _describe(case: dict[str, Any]) -> str:
-    blocks = "+".join(k for k, _ in case["actuator"]) + ("|sensor q" if case["sensor"] else "")
+    blocks = "+".join(k for k, _ in case["actuator"]) + (", sensor quantizer" if case["sensor"] else "")
     return f"{case['controller']['type']} n={len(case['poles'])} delay={case['delay']:.2g} {blocks}"
 
 
