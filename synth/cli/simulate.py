@@ -7,7 +7,7 @@ import sys
 from pathlib import Path
 from typing import Any
 
-__all__ = ["COMMAND", "DESCRIPTION", "HELP", "ORDER", "add_arguments", "run"]
+__all__ = ["COMMAND", "DESCRIPTION", "EXIT_CODES", "HELP", "ORDER", "add_arguments", "run"]
 
 COMMAND = "simulate"
 ORDER = 30
@@ -18,6 +18,14 @@ in-loop delay; see docs/simulation.md) and report the step metrics: rise time,
 overshoot, settling time, peak actuator rate and amplitude, time rate-limited
 and saturated, and whether the run ends in a limit cycle (amplitude, period).
 
+The horizon follows the dynamics: the first one is read from the linear loop's
+slowest visible mode and the period at which the loop's phase is -180 deg (where a
+limit cycle would sit), or is --horizon / simulation.horizon when given; it is
+doubled until the run decides - settled, limit cycle (amplitude and period steady
+over the last two quarters), diverging - or the cap (--max-horizon) is reached:
+then the verdict is "undetermined within N s". Each verdict prints its evidence
+(horizons tried, samples, cycles seen, the rule that decided).
+
 Writes the time series (CSV) and a plot (PNG) into --out (default
 reports/<spec name>/simulate/); --csv and --plot put them elsewhere. Files
 synth did not write are never overwritten (use --force).
@@ -27,7 +35,9 @@ example:
   synth simulate specs/x4_rotor.yaml -c "P(8)" --delay 0.015 --json -
   synth simulate specs/x4_rotor.yaml --sweep kp=1:12:23 --json sweep.json
 
-exit codes: 0 settles, 1 ends in a sustained oscillation or diverges, 2 bad input"""
+exit codes: 0 settles, 1 ends in a sustained oscillation or diverges, 2 bad input,
+3 undetermined within the cap (with --sweep: 1 if any run oscillates or diverges,
+else 3 if any is undetermined)"""
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
@@ -35,7 +45,12 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--controller", "-c",
                    help='controller, e.g. "P(3)" (default: the spec\'s reference controller)')
     p.add_argument("--step", metavar="FROM:TO", help="reference step in output units (default: simulation.step)")
-    p.add_argument("--horizon", type=float, metavar="S", help="simulated seconds (default: simulation.horizon)")
+    p.add_argument("--horizon", type=float, metavar="S",
+                   help="first simulated horizon in seconds, extended until the verdict is determined "
+                   "(default: simulation.horizon if the spec sets it, else from the loop's dynamics)")
+    p.add_argument("--max-horizon", type=float, metavar="S",
+                   help="longest horizon tried before answering 'undetermined' (default: 64 times the first "
+                   "horizon, at least 200 slowest plant time constants and 60 s, at most 1e6 samples)")
     p.add_argument("--step-time", type=float, metavar="S", help="time of the step (default: simulation.step_time)")
     p.add_argument("--delay", type=float, metavar="S",
                    help="in-loop delay in seconds (default: simulation.loop_delay)")
@@ -51,13 +66,18 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 
 def _step(text: str) -> tuple[float, float]:
+    import math
+
     from synth.errors import SynthError
 
     parts = text.split(":")
     try:
         if len(parts) != 2:
             raise ValueError
-        return float(parts[0]), float(parts[1])
+        a, b = float(parts[0]), float(parts[1])
+        if not (math.isfinite(a) and math.isfinite(b)):
+            raise ValueError
+        return a, b
     except ValueError:
         raise SynthError(f"expected FROM:TO in output units, e.g. 820:920, got {text!r}", where="--step") from None
 
@@ -139,30 +159,30 @@ def run(args: argparse.Namespace) -> int:
     except ModelError as exc:
         raise exc.located("--controller") from None
     step = _step(args.step) if args.step else sim.default_step()
-    horizon = sim.horizon if args.horizon is None else args.horizon
+    given = args.horizon if args.horizon is not None else (sim.horizon if "horizon" in sim.model_fields_set else None)
     t_step = sim.step_time if args.step_time is None else args.step_time
-    if not horizon > 0:
-        raise SynthError(f"must be > 0 s, got {horizon:g}", where="--horizon")
-    if not 0 <= t_step < horizon:
-        raise SynthError(f"must be in [0, horizon), got {t_step:g} s", where="--step-time")
-    if args.delay is not None and args.delay < 0:
-        raise SynthError(f"must be >= 0 s, got {args.delay:g}", where="--delay")
+    _check_times(args, given, t_step, sim.dt)
     loop = sim.build_loop(spec.nominal_plant(), controller, str(controller))
     if args.delay is not None:
         loop = loop.replace(loop_delay=args.delay)
     disturbances = sim.build_disturbances()
     say = (lambda *a: None) if args.quiet or args.json == "-" else print
     if args.sweep:
+        from synth.sim.horizon import plan_horizon
+
+        horizon = given if given is not None else plan_horizon(loop, t_step).horizon
         return _run_sweep(args, spec, sim, loop, step, horizon, t_step, disturbances, say)
 
-    from synth.sim.metrics import nonlinear_step_metrics
-    from synth.sim.simulator import simulate_step
+    from synth.sim.verdict import step_verdict
 
-    result = simulate_step(loop, step[0], step[1], horizon, t_step, disturbances, sim.seed)
-    metrics = nonlinear_step_metrics(result, t_step, min_amplitude=sim.limit_cycle.min_amplitude,
-                                     window=sim.limit_cycle.window)
+    try:
+        v = step_verdict(loop, step[0], step[1], t_step, given, args.max_horizon, disturbances, sim.seed,
+                         sim.limit_cycle.min_amplitude, sim.limit_cycle.window)
+    except ModelError as exc:
+        raise exc.located("--max-horizon" if args.max_horizon is not None else "simulation") from None
+    result, metrics = v.result, v.metrics
     payload = {"spec": spec.name, "controller": str(controller), "step": list(step), "step_time": t_step,
-               "horizon": horizon, "loop": loop.to_dict(), **metrics.to_dict()}
+               "horizon": v.evidence.horizon, "loop": loop.to_dict(), **v.to_dict()}
     out_dir = Path(args.out) if args.out else Path("reports") / spec.name / "simulate"
     folder = OutputDir(out_dir, args.force) if not (args.csv and args.plot) else None
     csv_path = _claim(Path(args.csv), args.force) if args.csv else folder.claim("timeseries.csv")  # type: ignore[union-attr]
@@ -178,23 +198,54 @@ def run(args: argparse.Namespace) -> int:
         sys.stdout.write(dump_json(to_jsonable(payload)))
     elif args.json:
         write_json(args.json, payload, force=args.force)
-    _print_metrics(say, spec, loop, metrics, step)
+    _print_metrics(say, spec, loop, metrics, step, v.verdict)
+    say(f"\nverdict: {v.summary(spec.plant.output.unit)}\nfirst horizon: {v.evidence.plan.reason}")
     if folder is not None:
         csv_path, plot_path = folder.final(csv_path), folder.final(plot_path)
     say(f"\ntime series: {csv_path}\nplot: {plot_path}")
-    lc = metrics.limit_cycle
-    return 1 if (lc.present or lc.diverging) else 0
+    return EXIT_CODES[v.verdict]
 
 
-def _print_metrics(say: Any, spec: Any, loop: Any, m: Any, step: tuple[float, float]) -> None:
+EXIT_CODES = {"settled": 0, "limit_cycle": 1, "diverging": 1, "undetermined": 3}
+"""Exit code of each verdict (2 is bad input)."""
+
+
+def _check_times(args: argparse.Namespace, given: float | None, t_step: float, dt: float) -> None:
+    """One-line errors for horizons and delays that cannot be simulated."""
+    import math
+
+    from synth.errors import SynthError
+    from synth.sim.verdict import MAX_SAMPLES
+
+    for name, value in (("--horizon", args.horizon), ("--max-horizon", args.max_horizon),
+                        ("--step-time", args.step_time), ("--delay", args.delay)):
+        if value is not None and not math.isfinite(value):
+            raise SynthError(f"must be a finite number of seconds, got {value:g}", where=name)
+    if given is not None and not given > 0:
+        raise SynthError(f"must be > 0 s, got {given:g}", where="--horizon")
+    if given is not None and not 0 <= t_step < given:
+        raise SynthError(f"must be in [0, horizon), got {t_step:g} s", where="--step-time")
+    if t_step < 0:
+        raise SynthError(f"must be >= 0 s, got {t_step:g}", where="--step-time")
+    if args.max_horizon is not None and not args.max_horizon > t_step:
+        raise SynthError(f"must be after the step ({t_step:g} s), got {args.max_horizon:g}", where="--max-horizon")
+    for name, value in (("--horizon", given), ("--max-horizon", args.max_horizon)):
+        if value is not None and value / dt > 10 * MAX_SAMPLES:
+            raise SynthError(f"{value:g} s is {value / dt:.3g} samples of {dt:g} s; at most {10 * MAX_SAMPLES:.3g}",
+                             where=name)
+    if args.delay is not None and (args.delay < 0 or args.delay / dt > MAX_SAMPLES):
+        raise SynthError(f"must be >= 0 s and at most {MAX_SAMPLES:.3g} samples, got {args.delay:g}", where="--delay")
+
+
+def _print_metrics(say: Any, spec: Any, loop: Any, m: Any, step: tuple[float, float], verdict: str) -> None:
     from synth.cli._table import table
     from synth.requirements.base import fmt
 
     u = spec.plant.input.unit or "input units"
     y = spec.plant.output.unit or "output units"
     lc = m.limit_cycle
-    cycle = (f"{fmt(lc.amplitude)} {y} every {fmt(lc.period)} s" if lc.present else
-             ("diverges" if lc.diverging else "none"))
+    cycle = {"limit_cycle": f"{fmt(lc.amplitude)} {y} every {fmt(lc.period)} s" if lc.present else "yes",
+             "diverging": "diverges", "settled": "none", "undetermined": "undetermined"}[verdict]
     rows = [
         ["rise time 10-90 %", f"{fmt(m.rise_time)} s"],
         ["overshoot", f"{fmt(m.overshoot)} %"],
@@ -212,10 +263,23 @@ def _print_metrics(say: Any, spec: Any, loop: Any, m: Any, step: tuple[float, fl
 
 
 def _plot(result: Any, loop: Any, metrics: Any, step: tuple[float, float], spec: Any, path: Path) -> None:
+    import dataclasses
+
+    import numpy as np
+
     from synth.sim.figures import step_comparison
     from synth.sim.simulator import simulate_step
 
     linear = simulate_step(loop.linear(), step[0], step[1], float(result.t[-1]))
+    masked = {}
+    for name in ("output", "actuator"):  # a diverging linear loop: drawn only while near the nonlinear range
+        ours, theirs = np.asarray(getattr(result, name), float), np.array(getattr(linear, name), float)
+        lo, hi = float(np.min(ours)), float(np.max(ours))
+        span = max(hi - lo, abs(step[1] - step[0]), 1e-12)
+        with np.errstate(invalid="ignore"):
+            theirs[~(np.abs(theirs - 0.5 * (lo + hi)) <= 20 * span)] = np.nan
+        masked[name] = theirs
+    linear = dataclasses.replace(linear, **masked)
     units = {"input": spec.plant.input.unit, "output": spec.plant.output.unit}
     step_comparison({str(loop.controller): {"nonlinear": result, "linear": linear}}, path, units)
 
@@ -230,6 +294,7 @@ def _run_sweep(args: argparse.Namespace, spec: Any, sim: Any, loop: Any, step: t
     from synth.sim.metrics import nonlinear_step_metrics
     from synth.sim.signals import step_reference
     from synth.sim.simulator import simulate_batch
+    from synth.sim.verdict import judge, step_verdict
 
     name, values = _sweep(args.sweep, loop.controller)
     loops = [loop.with_gain(name, v) for v in values]
@@ -242,18 +307,28 @@ def _run_sweep(args: argparse.Namespace, spec: Any, sim: Any, loop: Any, step: t
         batch = simulate_batch(loops[start:start + chunk], step_reference(step[0], step[1], t_step), horizon,
                                disturbances, sim.seed)
         for i, res in enumerate(batch):
-            m = nonlinear_step_metrics(res, t_step, min_amplitude=sim.limit_cycle.min_amplitude,
-                                       window=sim.limit_cycle.window)
+            window = sim.limit_cycle.window or (horizon - t_step) / 4
+            m = nonlinear_step_metrics(res, t_step, min_amplitude=sim.limit_cycle.min_amplitude, window=window)
+            j = judge(res, t_step, step, m, sim.limit_cycle.min_amplitude)
             value = values[start + i]
-            entries.append({name: value, **m.to_dict()})
+            verdict = j.verdict
+            evidence: dict[str, Any] = {"horizon": float(res.t[-1]), "dt": res.dt, "samples": int(res.t.size),
+                                        "cycles": j.cycles, "horizons": [float(res.t[-1])], "criterion": j.criterion}
+            if verdict is None:  # this run does not decide: this variant alone, on longer horizons
+                v = step_verdict(loops[start + i], step[0], step[1], t_step, 2 * horizon, args.max_horizon,
+                                 disturbances, sim.seed, sim.limit_cycle.min_amplitude, sim.limit_cycle.window)
+                verdict, m = v.verdict, v.metrics
+                evidence = v.evidence.to_dict()
+                evidence["horizons"] = [float(res.t[-1]), *evidence["horizons"]]
+            entries.append({name: value, "verdict": verdict, "evidence": evidence, **m.to_dict()})
             series.setdefault("t", res.t)
             series[f"output_{name}={value:.6g}"] = res.output
             lc = m.limit_cycle
             rows.append([f"{value:.4g}", fmt(m.rise_time), fmt(m.overshoot),
                          fmt(m.settling_time) if m.settling_time is not None else "-",
                          fmt(m.rate_limited_time), fmt(m.saturated_time),
-                         f"{fmt(lc.amplitude)} / {fmt(lc.period)} s" if lc.present else
-                         ("diverges" if lc.diverging else "none")])
+                         f"{fmt(lc.amplitude)} / {fmt(lc.period)} s" if verdict == "limit_cycle" else
+                         {"diverging": "diverges", "settled": "none"}.get(verdict, "undetermined")])
         bar.update(len(batch))
     bar.close()
     payload = {"spec": spec.name, "controller": str(loop.controller), "parameter": name, "step": list(step),
@@ -273,5 +348,5 @@ def _run_sweep(args: argparse.Namespace, spec: Any, sim: Any, loop: Any, step: t
     say(table([name, "rise [s]", "overshoot [%]", "settling [s]", "rate-limited [s]", "saturated [s]",
                "limit cycle (amplitude / period)"], rows))
     say(f"\ntime series: {folder.final(csv_path) if folder is not None else csv_path}")
-    oscillating = [e for e in entries if e["limit_cycle"]["present"] or e["limit_cycle"]["diverging"]]
-    return 1 if oscillating else 0
+    codes = {EXIT_CODES[e["verdict"]] for e in entries}
+    return 1 if 1 in codes else (3 if 3 in codes else 0)

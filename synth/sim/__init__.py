@@ -13,6 +13,9 @@ Public API (imported on first use, so ``import synth`` does not load numba):
     Exogenous signals (:mod:`synth.sim.signals`).
 ``nonlinear_step_metrics``, ``detect_oscillation``
     Step metrics and limit-cycle detection.
+``step_verdict``, ``StepVerdict``, ``Evidence``, ``plan_horizon``, ``HorizonPlan``
+    Simulate a step until it is settled, a limit cycle or diverging (else undetermined), with the
+    evidence (:mod:`synth.sim.verdict`, :mod:`synth.sim.horizon`).
 ``saturation_df``, ``rate_limiter_df``, ``dead_zone_df``, ``numeric_df``, ``harmonic_balance``,
 ``sampled_loop_response``, ``predict_loop_cycles``
     Describing functions and harmonic balance (:mod:`synth.sim.describing`).
@@ -45,6 +48,8 @@ _WHERE = {
                           "psd_signal"),
     "synth.sim.metrics": ("NonlinearStepMetrics", "nonlinear_step_metrics"),
     "synth.sim.limitcycle": ("Oscillation", "detect_oscillation"),
+    "synth.sim.verdict": ("step_verdict", "StepVerdict", "Evidence"),
+    "synth.sim.horizon": ("plan_horizon", "HorizonPlan"),
     "synth.sim.describing": ("saturation_df", "rate_limiter_df", "dead_zone_df", "numeric_df", "harmonic_balance",
                              "PredictedCycle", "sampled_loop_response", "predict_loop_cycles",
                              "LoopCyclePrediction"),

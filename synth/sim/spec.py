@@ -28,7 +28,8 @@ if TYPE_CHECKING:
     from synth.sim.blocks import Block
 
 __all__ = [
-    "BLOCK_SPECS", "BLOCK_TAGS", "DISTURBANCE_TAGS", "SIMULATION_TAGS", "BacklashSpec", "BlockEntry", "DeadZoneSpec",
+    "BLOCK_SPECS", "BLOCK_TAGS", "DISTURBANCE_TAGS", "MAX_DELAY_SAMPLES", "MAX_RUN_SAMPLES", "SIMULATION_TAGS",
+    "BacklashSpec", "BlockEntry", "DeadZoneSpec",
     "DelaySpec", "DisturbanceEntry", "DynamicsSpec", "LagSpec", "LimitCycleSpec", "NoiseSpec", "OnsetSpec",
     "OperatingPointSpec", "PsdDisturbanceSpec", "PublishedSimSpec", "QuantizerSpec", "RateLimitSpec",
     "RecordDisturbanceSpec", "SampleHoldSpec", "SaturationSpec", "SimulationSpec", "StaticSpec", "StepDisturbanceSpec",
@@ -44,7 +45,7 @@ def _blocks() -> Any:
 
 
 class _Model(BaseModel):
-    model_config = ConfigDict(extra="forbid", frozen=True)
+    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
 
 
 class _BlockSpec(_Model):
@@ -201,6 +202,11 @@ class DelaySpec(_BlockSpec):
         return _blocks().Delay(self.delay)
 
 
+MAX_RUN_SAMPLES = 10_000_000
+"""Most samples of one simulated run a spec may ask for (``horizon / dt``)."""
+MAX_DELAY_SAMPLES = 1_000_000
+"""Most samples of in-loop delay (``loop_delay`` and delay blocks over ``dt``)."""
+
 BLOCK_SPECS = (RateLimitSpec, SaturationSpec, DeadZoneSpec, QuantizerSpec, BacklashSpec, StaticSpec, LagSpec,
                DynamicsSpec, SupplySagSpec, SampleHoldSpec, NoiseSpec, DelaySpec)
 BlockEntry = Annotated[Union[BLOCK_SPECS], Field(discriminator="type")]  # type: ignore[valid-type]
@@ -340,8 +346,18 @@ class SimulationSpec(_Model):
             if ratio < 1 - 1e-9 or abs(ratio - round(ratio)) > 1e-6 * ratio:
                 raise ValueError(f"controller_rate {self.controller_rate:g} Hz must be 1/dt "
                                  f"({1 / self.dt:g} Hz) divided by a whole number")
-        if self.step_time >= self.horizon:
+        fixed = "horizon" in self.model_fields_set  # else the horizon follows the loop's dynamics
+        if fixed and self.step_time >= self.horizon:
             raise ValueError(f"step_time {self.step_time:g} s must be inside the horizon ({self.horizon:g} s)")
+        if self.horizon / self.dt > MAX_RUN_SAMPLES:
+            raise ValueError(f"horizon {self.horizon:g} s at dt {self.dt:g} s is {self.horizon / self.dt:.3g} samples; "
+                             f"at most {MAX_RUN_SAMPLES:.3g}")
+        if fixed and self.dt > self.horizon / 20:
+            raise ValueError(f"dt {self.dt:g} s must be at most 1/20 of the horizon ({self.horizon:g} s)")
+        delays = self.loop_delay + sum(b.delay for b in (*self.actuator, *self.sensor) if isinstance(b, DelaySpec))
+        if delays / self.dt > MAX_DELAY_SAMPLES:
+            raise ValueError(f"the in-loop delays ({delays:g} s) are {delays / self.dt:.3g} samples of {self.dt:g} s; "
+                             f"at most {MAX_DELAY_SAMPLES:.3g}")
         if len(self.actuator) > 16 or len(self.sensor) > 15:
             raise ValueError("at most 16 actuator and 15 sensor blocks")
         return self

@@ -1,0 +1,457 @@
+"""A step verdict with its evidence: settled, limit cycle, diverging, or undetermined within N s.
+
+:func:`step_verdict` simulates a reference step over a first horizon read from the loop's
+dynamics (:func:`synth.sim.horizon.plan_horizon`), judges the run and, while the run does not
+decide, doubles the horizon up to a cap. The rules (:func:`judge`), on the output after the step:
+
+* **diverging**: the output is not finite or beyond 1e9 steps; or it grows on two horizons in a
+  row (when the first horizon is already the cap: over the run and over its first half), growing
+  meaning: over the last half, the RMS of the last third more than 3 times that of the first, or its
+  largest distance from the reference over the last quarter more than 10 steps and 1.3 times that
+  over the second quarter) and sets a new record (the largest distance over the last quarter is
+  1.1 times the largest before it: bounded bursts do not count);
+* **limit cycle**: a sustained oscillation (:func:`synth.sim.limitcycle.detect_oscillation`, at
+  least 3 regular cycles) in each of the last three quarters of the run, at least
+  :data:`MIN_CYCLES` whole cycles in the last two, with periods equal within :data:`STEADY` (1 %)
+  and amplitudes equal within 1 %, or varying by less than 20 % without a trend (a quantized or
+  sampled cycle whose waveform changes from cycle to cycle); or, when the crossings are irregular
+  (a waveform crossing its mean more than twice per period), the last two quarters repeat
+  themselves (autocorrelation above 0.98) with the same period and amplitude within 1 %, or (a
+  sustained irregular oscillation, e.g. quasi-periodic relay or quantizer chatter) the peak-to-peak
+  ranges of the last three quarters are equal within 10 % (amplitude: half that range; period: the
+  mean of the crossings);
+* **settled**: no sustained oscillation in the last quarter, which stays within :data:`SETTLED`
+  (0.01 %) of the step (or ``min_amplitude``) of the final value and moves (peak to peak) at most
+  half as much as the quarter before (or less than twice ``min_amplitude``);
+* otherwise the horizon is doubled; at the cap the verdict is **undetermined** and says what was
+  seen (cycles, the rule that failed).
+
+Every verdict carries its evidence: the horizons tried, the sample time and count, the cycles
+seen and the rule that decided.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from synth.errors import ModelError
+from synth.sim.horizon import HorizonPlan, plan_horizon
+from synth.sim.limitcycle import Oscillation, detect_oscillation
+from synth.sim.loops import NonlinearLoop
+from synth.sim.metrics import NonlinearStepMetrics, nonlinear_step_metrics
+from synth.sim.results import SimResult
+
+__all__ = ["MAX_SAMPLES", "MIN_CYCLES", "SETTLED", "STEADY", "VERDICTS", "Evidence", "Judgement", "StepVerdict",
+           "default_cap", "judge", "step_verdict"]
+
+VERDICTS = ("settled", "limit_cycle", "diverging", "undetermined")
+"""The four answers of a step simulation."""
+MIN_CYCLES = 6
+"""Whole cycles a limit cycle needs in the last half of the run."""
+STEADY = 0.01
+"""Largest relative change of amplitude and period between the last three quarters of a limit cycle."""
+SETTLED = 1e-4
+"""Largest distance from the final value over the last quarter of a settled run (fraction of the step)."""
+MAX_SAMPLES = 1_000_000
+"""Most samples of one run under the default cap (:func:`default_cap`)."""
+
+
+@dataclass(frozen=True)
+class Judgement:
+    """What one run says (see :func:`judge`).
+
+    Attributes
+    ----------
+    verdict : str or None
+        ``settled``, ``limit_cycle`` or ``diverging``; None when this run does not decide.
+    criterion : str
+        The rule that decided, or the one that failed.
+    cycles : int
+        Whole cycles seen in the last half of the run.
+    growing : bool
+        The run grows (a second growing run confirms divergence).
+    """
+
+    verdict: str | None
+    criterion: str
+    cycles: int
+    growing: bool = False
+
+
+@dataclass(frozen=True)
+class Evidence:
+    """Why a verdict is what it is.
+
+    Attributes
+    ----------
+    horizon : float
+        Simulated time of the run the verdict rests on (s).
+    dt : float
+        Sample time (s).
+    samples : int
+        Samples of that run.
+    cycles : int
+        Whole cycles seen in its last half.
+    horizons : tuple of float
+        Every horizon tried, in order (each one a fresh run from rest).
+    cap : float
+        Longest horizon allowed (s).
+    criterion : str
+        The rule that decided, or why nothing did.
+    plan : HorizonPlan
+        How the first horizon was chosen.
+    """
+
+    horizon: float
+    dt: float
+    samples: int
+    cycles: int
+    horizons: tuple[float, ...]
+    cap: float
+    criterion: str
+    plan: HorizonPlan
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready dict (``plan`` as a dict).
+
+        Examples
+        --------
+        >>> plan = HorizonPlan(5.0, 0.5, True, 3.2, None, "linear loop settles")
+        >>> Evidence(5.0, 0.001, 5001, 0, (5.0,), 160.0, "in the band", plan).to_dict()["samples"]
+        5001
+        """
+        out = {k: getattr(self, k) for k in self.__dataclass_fields__}
+        out["horizons"] = list(self.horizons)
+        out["plan"] = self.plan.to_dict()
+        return out
+
+
+@dataclass(frozen=True)
+class StepVerdict:
+    """Result of :func:`step_verdict`.
+
+    Attributes
+    ----------
+    verdict : str
+        One of :data:`VERDICTS`.
+    evidence : Evidence
+    metrics : NonlinearStepMetrics
+        Step metrics of the last run.
+    result : SimResult
+        The last run.
+    """
+
+    verdict: str
+    evidence: Evidence
+    metrics: NonlinearStepMetrics
+    result: SimResult
+
+    @property
+    def determined(self) -> bool:
+        """The runs decided (the verdict is not ``undetermined``)."""
+        return self.verdict != "undetermined"
+
+    def summary(self, unit: str = "") -> str:
+        """One line: the verdict and its evidence.
+
+        Examples
+        --------
+        >>> from synth.plant import Plant; from synth.controllers import Controller
+        >>> v = step_verdict(NonlinearLoop(Plant.from_string("1/(s+1)"), Controller("P", {"kp": 1})), 0, 1)
+        >>> v.summary()[:56], v.summary()[-38:]
+        ('settled: within 0.01 % of the step over the last 2.4 s, ', '(horizon 9.55 s, 9551 samples of 1 ms)')
+        """
+        e = self.evidence
+        unit = f" {unit}" if unit else ""
+        where = f"horizon {e.horizon:.3g} s, {e.samples} samples of {e.dt * 1000:.3g} ms"
+        lc = self.metrics.limit_cycle
+        if self.verdict == "limit_cycle":
+            return (f"limit cycle: amplitude {lc.amplitude:.4g}{unit}, period {lc.period:.4g} s "
+                    f"({e.cycles} cycles in the last half; {e.criterion}; {where})")
+        if self.verdict == "undetermined":
+            return f"undetermined within {e.horizon:.3g} s: {e.criterion} ({e.cycles} cycles seen; {where})"
+        return f"{self.verdict.replace('_', ' ')}: {e.criterion} ({where})"
+
+    def to_dict(self) -> dict[str, Any]:
+        """``{"verdict", "evidence", **metrics}`` (JSON-ready; the time series is left out).
+
+        Examples
+        --------
+        >>> from synth.plant import Plant; from synth.controllers import Controller
+        >>> v = step_verdict(NonlinearLoop(Plant.from_string("1/(s+1)"), Controller("P", {"kp": 1})), 0, 1)
+        >>> d = v.to_dict(); d["verdict"], d["evidence"]["samples"], round(d["final_value"], 3)
+        ('settled', 9551, 0.5)
+        """
+        return {"verdict": self.verdict, "evidence": self.evidence.to_dict(), **self.metrics.to_dict()}
+
+
+def _steady(a: Oscillation, b: Oscillation, c: Oscillation) -> tuple[str | None, str]:
+    """(None, how) when the last three quarters ``c``, ``b``, ``a`` show the same cycle: periods within
+    STEADY, and amplitudes within STEADY or varying without a trend (by less than 20 %)."""
+    if not (b.present and c.present and a.amplitude and b.amplitude and c.amplitude and a.period and b.period
+            and c.period):
+        return "the two quarters before the last do not both show a sustained cycle", ""
+    dp = max(abs(a.period - b.period), abs(b.period - c.period)) / a.period
+    if dp > STEADY:
+        return f"the period still changes {100 * dp:.2g} % between the last three quarters", ""
+    da = max(abs(a.amplitude - b.amplitude), abs(b.amplitude - c.amplitude)) / a.amplitude
+    if da <= STEADY:
+        return None, f"amplitude and period steady within {100 * STEADY:g} % over the last three quarters"
+    if (a.amplitude - b.amplitude) * (b.amplitude - c.amplitude) < 0 and da < 0.2:
+        return None, (f"period steady within {100 * STEADY:g} %; amplitude varies {100 * da:.2g} % between "
+                      "the last three quarters without a trend")
+    return f"the amplitude still changes {100 * da:.2g} % between the last three quarters", ""
+
+
+def _excursion_grows(ta: np.ndarray, ya: np.ndarray, end: float, scale: float) -> bool:
+    """The largest distance from the reference over the last quarter is more than 10 steps and 1.3
+    times that over the second quarter: a drift, or an oscillation growing without a bound."""
+    span = ta[-1] - ta[0]
+    last = np.abs(ya[ta >= ta[-1] - span / 4] - end)
+    second = np.abs(ya[(ta >= ta[0] + span / 4) & (ta < ta[0] + span / 2)] - end)
+    return bool(last.size and second.size and last.max() > 10 * scale and last.max() > 1.3 * second.max())
+
+
+def _periodic(t: np.ndarray, y: np.ndarray, min_amplitude: float) -> tuple[float, float] | None:
+    """(period, half peak-to-peak) when ``y`` repeats itself (normalized autocorrelation of at least
+    0.98 at a lag holding 3 or more repeats in the window); None otherwise. Catches cycles whose
+    waveform crosses its mean more than twice per period."""
+    r = y - np.mean(y)
+    half = 0.5 * float(np.ptp(y))
+    if half <= max(min_amplitude, 1e-9 * (1.0 + abs(float(np.mean(y))))) or r.size < 16:
+        return None
+    n = r.size
+    f = np.fft.rfft(r, 2 * n)
+    ac = np.fft.irfft(f * np.conj(f))[: n // 3]
+    ac = ac / (ac[0] * (1 - np.arange(ac.size) / n))
+    below = np.nonzero(ac < 0.5)[0]
+    if below.size == 0:
+        return None
+    k0 = int(below[0])
+    peak = k0 + int(np.argmax(ac[k0:])) if k0 < ac.size else None
+    if peak is None or peak >= ac.size - 1 or ac[peak] < 0.98:
+        return None
+    a, b, c = ac[peak - 1], ac[peak], ac[peak + 1]
+    shift = 0.5 * (a - c) / (a - 2 * b + c) if (a - 2 * b + c) != 0 else 0.0
+    return float((peak + shift) * (t[1] - t[0])), half
+
+
+def _growing(ta: np.ndarray, ya: np.ndarray, end: float, scale: float, min_amplitude: float) -> tuple[bool, str, int]:
+    """(grows, why, cycles): the growth rule of :func:`judge` on one record."""
+    half = detect_oscillation(ta, ya, window=(ta[-1] - ta[0]) / 2, min_amplitude=min_amplitude)
+    grows = (half.diverging or _excursion_grows(ta, ya, end, scale)) and _new_record(ta, ya, end)
+    why = half.reason if half.diverging else "the distance from the reference grows past 10 steps"
+    return grows, why, half.cycles
+
+
+def _new_record(ta: np.ndarray, ya: np.ndarray, end: float) -> bool:
+    """The largest distance from the reference over the last quarter exceeds 1.1 times the largest
+    before it (a bounded, bursting oscillation sets no new record; a growing one does)."""
+    last = ta >= ta[-1] - (ta[-1] - ta[0]) / 4
+    before = np.abs(ya[~last] - end)
+    return bool(before.size and np.max(np.abs(ya[last] - end)) > 1.1 * np.max(before))
+
+
+def judge(result: SimResult, t_step: float, step: tuple[float, float], metrics: NonlinearStepMetrics,
+          min_amplitude: float = 0.0, previous: Judgement | None = None, last_run: bool = False) -> Judgement:
+    """Does this run decide? (The rules are in the module docstring.)
+
+    Parameters
+    ----------
+    result : SimResult
+    t_step : float
+        Time of the step (s).
+    step : (float, float)
+        Reference before and after the step (output units).
+    metrics : NonlinearStepMetrics
+        Its step metrics, with the limit cycle examined over the last quarter of the run.
+    min_amplitude : float
+        Smallest oscillation that counts (output units).
+    previous : Judgement, optional
+        The judgement of the previous (half as long) run: a second growing run confirms divergence.
+    last_run : bool
+        No longer run will follow (the cap): with no previous run, growth over the run and over its
+        first half confirms divergence.
+
+    Examples
+    --------
+    >>> from synth.plant import Plant; from synth.controllers import Controller
+    >>> from synth.sim.simulator import simulate_step
+    >>> r = simulate_step(NonlinearLoop(Plant.from_string("1/(s+1)"), Controller("P", {"kp": 1})), 0, 1, 2.0)
+    >>> judge(r, 0.0, (0.0, 1.0), nonlinear_step_metrics(r, window=0.5)).criterion  # still moving at 2 s
+    'the last quarter is 1.5 % of the step from its final value (settled needs 0.01 %)'
+    """
+    scale = abs(step[1] - step[0]) or 1.0
+    t, y = result.t, result.output
+    after = t >= t_step - 1e-12
+    ta, ya = t[after], y[after]
+    if not np.all(np.isfinite(ya)) or np.max(np.abs(ya - ya[0])) > 1e9 * scale:
+        return Judgement("diverging", "the output left every bound (not finite or 1e9 times the step)", 0, True)
+    span = float(ta[-1] - ta[0])
+    grows, why, cycles = _growing(ta, ya, step[1], scale, min_amplitude)
+    if grows:
+        if previous is not None and previous.growing:
+            return Judgement("diverging", f"grows on two horizons in a row ({why})", cycles, True)
+        if last_run and previous is None:  # no longer run allowed: its first half stands for the previous one
+            early = ta <= ta[0] + span / 2
+            if _growing(ta[early], ya[early], step[1], scale, min_amplitude)[0]:
+                return Judgement("diverging", f"grows over the run and over its first half ({why})", cycles, True)
+        return Judgement(None, f"growing ({why}); confirming on a longer horizon", cycles, True)
+    a = metrics.limit_cycle
+    if not a.present and a.reason.startswith("irregular"):
+        cut = ta < ta[-1] - span / 4
+        last = ~cut & (ta >= ta[-1] - span / 4)
+        pa = _periodic(ta[last], ya[last], min_amplitude)
+        pb = _periodic(ta[cut & (ta >= ta[-1] - span / 2)], ya[cut & (ta >= ta[-1] - span / 2)], min_amplitude)
+        if pa and pb and abs(pa[0] - pb[0]) <= STEADY * pa[0] and abs(pa[1] - pb[1]) <= STEADY * pa[1]:
+            return Judgement("limit_cycle", f"the last two quarters repeat with period {pa[0]:.4g} s (autocorrelation "
+                             "above 0.98; the waveform crosses its mean more than twice per period) and equal "
+                             f"amplitudes within {100 * STEADY:g} %", int(span / 2 / pa[0]))
+        spans = [float(np.ptp(ya[(ta >= ta[-1] - k * span / 4) & (ta < ta[-1] - (k - 1) * span / 4 + 1e-12)]))
+                 for k in (1, 2, 3)]
+        floor = 2 * max(SETTLED * scale, min_amplitude)
+        change = max(abs(spans[0] - spans[1]), abs(spans[1] - spans[2])) / max(spans[0], 1e-300)
+        if min(spans) > floor and change <= 0.1 and a.cycles >= 3:
+            return Judgement("limit_cycle", f"a sustained irregular oscillation: its peak-to-peak range is equal within "
+                             f"{100 * change:.2g} % over the last three quarters ({a.cycles} cycles of mean period "
+                             f"{a.period:.4g} s in the last); its waveform does not repeat exactly", a.cycles)
+    if a.present:
+        cut = ta < ta[-1] - span / 4
+        b = detect_oscillation(ta[cut], ya[cut], window=span / 4, min_amplitude=min_amplitude)
+        cycles = a.cycles + b.cycles
+        if cycles < MIN_CYCLES:
+            return Judgement(None, f"only {cycles} cycles in the last half (need {MIN_CYCLES})", cycles)
+        cut2 = ta < ta[-1] - span / 2
+        c = detect_oscillation(ta[cut2], ya[cut2], window=span / 4, min_amplitude=min_amplitude)
+        why, how = _steady(a, b, c)
+        if why is not None:
+            return Judgement(None, why, cycles)
+        return Judgement("limit_cycle", f"{how} ({span / 4:.3g} s each)", cycles)
+    quarter = ta >= ta[-1] - span / 4
+    previous_quarter = (ta >= ta[-1] - span / 2) & ~quarter
+    yq = ya[quarter] - metrics.final_value
+    off = float(np.max(np.abs(yq)))
+    if off > max(SETTLED * scale, min_amplitude):
+        return Judgement(None, f"the last quarter is {100 * off / scale:.2g} % of the step from its final value "
+                         f"(settled needs {100 * SETTLED:g} %)", a.cycles)
+    late, early = float(np.ptp(ya[quarter])), float(np.ptp(ya[previous_quarter]))
+    quiet = max(2 * min_amplitude, 1e-9 * (scale + abs(metrics.final_value)))
+    if late > quiet and late > 0.5 * early:
+        return Judgement(None, f"the motion over the last quarter is {late / max(early, 1e-300):.2g} times that "
+                         "over the quarter before (settled needs 0.5)", a.cycles)
+    return Judgement("settled", f"within {100 * SETTLED:g} % of the step over the last {span / 4:.2g} s, "
+                     "its motion at most half that of the quarter before", a.cycles)
+
+
+def default_cap(loop: NonlinearLoop, first: float) -> float:
+    """The longest horizon :func:`step_verdict` tries by default: 64 times the first horizon, 200
+    times the slowest plant time constant (``1/|p|`` of its slowest non-zero pole), at least 60 s,
+    and at most :data:`MAX_SAMPLES` samples.
+
+    Examples
+    --------
+    >>> from synth.plant import Plant; from synth.controllers import Controller
+    >>> default_cap(NonlinearLoop(Plant.from_string("1/(s+0.5)"), Controller("P", {"kp": 1})), 2.0)
+    400.0
+    """
+    poles = np.abs(np.roots(np.asarray(loop.plant.den, float)))
+    poles = poles[poles > 1e-12]
+    slow = 200.0 / float(np.min(poles)) if poles.size else 0.0
+    return float(min(max(64 * first, slow, 60.0), MAX_SAMPLES * loop.dt))
+
+
+def step_verdict(loop: NonlinearLoop, start: float, end: float, t_step: float = 0.0, horizon: float | None = None,
+                 max_horizon: float | None = None, disturbances: Sequence[Any] = (), seed: int = 0,
+                 min_amplitude: float = 0.0, window: float | None = None) -> StepVerdict:
+    """Simulate a step until the run decides: settled, limit cycle, diverging, or undetermined.
+
+    Parameters
+    ----------
+    loop : NonlinearLoop
+    start, end : float
+        Reference before and after the step (absolute output units).
+    t_step : float
+        Time of the step (s).
+    horizon : float, optional
+        First horizon (s); default from the loop's dynamics (:func:`~synth.sim.horizon.plan_horizon`).
+    max_horizon : float, optional
+        Cap (s); default :func:`default_cap`.
+    disturbances, seed
+        As in :func:`synth.sim.simulator.simulate`.
+    min_amplitude : float
+        Smallest oscillation that counts as a limit cycle (output units).
+    window : float, optional
+        Seconds at the end examined for the reported oscillation (default: the last half of the run
+        for a limit cycle, whose two quarters the verdict found equal; else the last quarter).
+
+    Returns
+    -------
+    StepVerdict
+
+    Examples
+    --------
+    The issue's loop: P(20) on ``1/(s(s+1)(s+2))`` with the actuator saturated at +-1; no horizon
+    given, the saturation's cycle is found and measured:
+
+    >>> from synth.plant import Plant; from synth.controllers import Controller
+    >>> from synth.sim.blocks import Saturation
+    >>> loop = NonlinearLoop(Plant.from_string("1/(s*(s+1)*(s+2))"), Controller("P", {"kp": 20}),
+    ...                      actuator=[Saturation(-1, 1)], dt=0.001)
+    >>> v = step_verdict(loop, 0.0, 0.1)
+    >>> v.verdict, round(v.metrics.limit_cycle.amplitude, 3), round(v.metrics.limit_cycle.period, 2)
+    ('limit_cycle', 0.217, 4.53)
+    >>> short = step_verdict(loop, 0.0, 0.1, max_horizon=5.0)
+    >>> short.verdict, short.evidence.horizons, short.summary()[:24]
+    ('undetermined', (5.0,), 'undetermined within 5 s:')
+    """
+    from synth.sim.simulator import simulate_step
+
+    if horizon is not None and not (np.isfinite(horizon) and horizon > t_step):
+        raise ModelError(f"horizon must be a finite number of seconds after the step ({t_step:g} s), got {horizon!r}")
+    if not (np.isfinite(start) and np.isfinite(end) and np.isfinite(t_step)):
+        raise ModelError(f"the step {start!r} -> {end!r} at {t_step!r} s must be finite")
+    plan = plan_horizon(loop, t_step, horizon)
+    first = plan.horizon
+    cap = max_horizon if max_horizon is not None else default_cap(loop, first)
+    if not (np.isfinite(cap) and cap > t_step):
+        raise ModelError(f"max_horizon must be a finite number of seconds after the step, got {max_horizon!r}")
+    if cap / loop.dt > 50 * MAX_SAMPLES:
+        raise ModelError(f"max_horizon {cap:g} s is {cap / loop.dt:.3g} samples of {loop.dt:g} s; "
+                         f"at most {50 * MAX_SAMPLES:.3g}")
+    T = min(first, cap)
+    tried: list[float] = []
+    previous: Judgement | None = None
+    while True:
+        tried.append(T)
+        result = simulate_step(loop, start, end, T, t_step, disturbances, seed)
+        metrics = nonlinear_step_metrics(result, t_step, min_amplitude=min_amplitude,
+                                         window=window if window is not None else (T - t_step) / 4)
+        j = judge(result, t_step, (start, end), metrics, min_amplitude, previous, T >= cap * (1 - 1e-12))
+        if j.verdict is not None or T >= cap * (1 - 1e-12):
+            break
+        previous = j
+        T = min(2 * T, cap)
+    if j.verdict == "limit_cycle" and window is None:  # steady over the last half: measure it there
+        metrics = nonlinear_step_metrics(result, t_step, min_amplitude=min_amplitude, window=(T - t_step) / 2)
+    if j.verdict == "limit_cycle" and not metrics.limit_cycle.present:  # a cycle with a complex waveform
+        after = result.t >= T - (T - t_step) / 4
+        period, amplitude = _periodic(result.t[after], result.output[after], min_amplitude) or (None, None)
+        osc = metrics.limit_cycle
+        if period is not None:
+            how = f"periodic: period {period:.4g} s by autocorrelation ({osc.reason})"
+        else:  # irregular: half the peak-to-peak range of the last quarter, the mean period of its crossings
+            last = detect_oscillation(result.t, result.output, window=(T - t_step) / 4, min_amplitude=min_amplitude)
+            amplitude, period = 0.5 * float(np.ptp(result.output[after])), last.period or float("nan")
+            how = f"irregular: half the peak-to-peak range of the last quarter, mean period ({last.reason})"
+        metrics = dataclasses.replace(metrics, settling_time=None, limit_cycle=dataclasses.replace(
+            osc, present=True, amplitude=amplitude, period=period, frequency=2 * np.pi / period,
+            cycles=j.cycles, center=float(np.mean(result.output[after])), reason=how))
+    verdict = j.verdict or "undetermined"
+    evidence = Evidence(float(result.t[-1]), loop.dt, int(result.t.size), j.cycles, tuple(tried), float(cap),
+                        j.criterion, plan)
+    return StepVerdict(verdict, evidence, metrics, result)
