@@ -19,7 +19,7 @@ from synth.plant import Plant, as_plant
 from synth.polynomials import format_factored, magnitude_squared_in_w2, trim
 from synth.stability import StabilityResult, closed_loop_stability, gain_margin_factors
 
-__all__ = ["BANDWIDTH_LEVEL", "Loop", "Margins"]
+__all__ = ["BANDWIDTH_LEVEL", "Loop", "LoopBatch", "Margins", "horner"]
 
 BANDWIDTH_LEVEL = 10 ** (-3 / 20)
 """|T| relative to |T(0)| that defines the closed-loop bandwidth (-3 dB)."""
@@ -303,3 +303,121 @@ def _pade(delay: float, order: int) -> tuple[np.ndarray, np.ndarray]:
     den = np.array([c * delay**k for k, c in enumerate(coeffs)])[::-1]
     num = np.array([c * (-delay) ** k for k, c in enumerate(coeffs)])[::-1]
     return num / den[0], den / den[0]
+
+
+def horner(coeffs: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """Evaluate one polynomial per row: ``coeffs`` is ``(n, k)`` (descending powers, zero-padded on the
+    left), ``x`` is ``(n, m)`` or broadcastable to it; the same arithmetic as ``np.polyval`` row by row.
+
+    Examples
+    --------
+    >>> horner(np.array([[1.0, 2.0], [0.0, 3.0]]), np.array([[1.0, 2.0], [1.0, 2.0]]))
+    array([[3., 4.],
+           [3., 3.]])
+    """
+    coeffs = np.asarray(coeffs)
+    x = np.asarray(x)
+    y = np.zeros(np.broadcast_shapes(x.shape, coeffs.shape[:1] + (1,) * (x.ndim - 1)), dtype=np.result_type(x, coeffs))
+    for j in range(coeffs.shape[1]):
+        y = y * x + coeffs[:, j].reshape((-1,) + (1,) * (x.ndim - 1))
+    return y
+
+
+def _rows(polys: list[np.ndarray]) -> np.ndarray:
+    width = max(p.size for p in polys)
+    return np.array([np.pad(np.asarray(p, float), (width - p.size, 0)) for p in polys])
+
+
+class LoopBatch:
+    """One plant with many controllers: the loops' responses evaluated all at once (vectorized).
+
+    Row ``i`` is ``Loop(plant, controllers[i])``; every response takes frequencies of shape ``(m,)``
+    (the same for every row) or ``(n, m)`` (one row of frequencies per loop) and returns ``(n, m)``,
+    with the same arithmetic and the same conventions as :class:`Loop` (``L = inf`` at a loop pole on
+    the axis, ``S = 0`` and ``T = 1`` there).
+
+    Parameters
+    ----------
+    plant : Plant
+    controllers : list of Controller
+
+    Examples
+    --------
+    >>> G = Plant.from_string("23*(s+0.43)/((s+9.6)*(s+0.54))")
+    >>> batch = LoopBatch(G, [Controller("P", {"kp": k}) for k in (1.0, 3.0)])
+    >>> w = np.array([1.0, 100.0])
+    >>> bool(np.allclose(batch.T(w)[1], Loop(G, Controller("P", {"kp": 3.0})).T(w)))
+    True
+    >>> batch.T0().round(4)
+    array([0.6561, 0.8513])
+    """
+
+    def __init__(self, plant: Plant, controllers: list[Controller]) -> None:
+        self.plant = as_plant(plant)
+        self.controllers = [as_controller(c) for c in controllers]
+        tfs = [c.tf() for c in self.controllers]
+        self.cnum = _rows([n for n, _ in tfs])
+        self.cden = _rows([d for _, d in tfs])
+        self.num = _rows([trim(np.polymul(n, self.plant.num)) for n, _ in tfs])
+        self.den = _rows([trim(np.polymul(d, self.plant.den)) for _, d in tfs])
+        self.frequency_ranges = np.array([
+            characteristic_range(n, d, self.plant.num, self.plant.den, delay=self.plant.delay) for n, d in tfs])
+        self._dc = np.array([c.dc_gain() for c in self.controllers])
+
+    def __len__(self) -> int:
+        return len(self.controllers)
+
+    def _w(self, w: Any) -> np.ndarray:
+        w = np.asarray(w, dtype=float)
+        return np.broadcast_to(w, (len(self), w.shape[-1])) if w.ndim == 1 else w
+
+    def L(self, w: Any) -> np.ndarray:
+        """Loop responses ``C_i(jw) G(jw)``, ``(n, m)``."""
+        s = 1j * self._w(w)
+        d = horner(self.den, s)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            L = horner(self.num, s) / d * np.exp(-s * self.plant.delay)
+        return np.where(d == 0, complex(np.inf, 0.0), L)
+
+    def C(self, w: Any) -> np.ndarray:
+        """Controller responses ``C_i(jw)``, ``(n, m)``."""
+        s = 1j * self._w(w)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            return horner(self.cnum, s) / horner(self.cden, s)
+
+    def S(self, w: Any) -> np.ndarray:
+        """Sensitivities ``1/(1 + L)``."""
+        L = self.L(w)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            return np.where(_infinite(L), 0j, 1.0 / (1.0 + L))
+
+    def T(self, w: Any) -> np.ndarray:
+        """Complementary sensitivities ``L/(1 + L)``."""
+        L = self.L(w)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            T = L / (1.0 + L)
+        return np.where(_infinite(L), 1.0 + 0j, T)
+
+    def KS(self, w: Any) -> np.ndarray:
+        """Control sensitivities ``C/(1 + C G)`` (``1/G`` where a controller has a pole on the axis)."""
+        w = self._w(w)
+        C = self.C(w)
+        G = self.plant.freqresp(w)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            KS = C / (1.0 + C * G)
+            return np.where(_infinite(C) | np.isnan(C), 1.0 / G, KS)
+
+    def T0(self) -> np.ndarray:
+        """``|T(0)|`` of every loop (1 with integral action)."""
+        l0 = self._dc * self.plant.dc_gain()
+        with np.errstate(divide="ignore", invalid="ignore"):
+            t0 = np.abs(l0 / (1.0 + l0))
+        return np.where(np.isinf(l0), 1.0, t0)
+
+    def controller_dc_gains(self) -> np.ndarray:
+        """``C_i(0)`` (``inf`` with integral action)."""
+        return self._dc.copy()
+
+
+def _infinite(x: np.ndarray) -> np.ndarray:
+    return np.isinf(x.real) | np.isinf(x.imag)
