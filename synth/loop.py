@@ -353,16 +353,42 @@ class LoopBatch:
     """
 
     def __init__(self, plant: Plant, controllers: list[Controller]) -> None:
-        self.plant = as_plant(plant)
         self.controllers = [as_controller(c) for c in controllers]
         tfs = [c.tf() for c in self.controllers]
         self.cnum = _rows([n for n, _ in tfs])
         self.cden = _rows([d for _, d in tfs])
-        self.num = _rows([trim(np.polymul(n, self.plant.num)) for n, _ in tfs])
-        self.den = _rows([trim(np.polymul(d, self.plant.den)) for _, d in tfs])
-        self.frequency_ranges = np.array([
-            characteristic_range(n, d, self.plant.num, self.plant.den, delay=self.plant.delay) for n, d in tfs])
+        corners = [_corners(n, d) for n, d in tfs]
+        self._corner_lo = np.array([c[0] for c in corners])
+        self._corner_hi = np.array([c[1] for c in corners])
         self._dc = np.array([c.dc_gain() for c in self.controllers])
+        self._set_plant(as_plant(plant))
+
+    def with_plant(self, plant: Plant) -> LoopBatch:
+        """The same controllers around another plant (the controllers' polynomials are reused).
+
+        Examples
+        --------
+        >>> b = LoopBatch(Plant.from_string("1/(s+1)"), [Controller("P", {"kp": 1.0})])
+        >>> b.with_plant(Plant.from_string("2/(s+1)")).T0().round(4)
+        array([0.6667])
+        """
+        new = object.__new__(LoopBatch)
+        new.__dict__.update({k: v for k, v in self.__dict__.items()
+                             if k in ("controllers", "cnum", "cden", "_corner_lo", "_corner_hi", "_dc")})
+        new._set_plant(as_plant(plant))
+        return new
+
+    def _set_plant(self, plant: Plant) -> None:
+        self.plant = plant
+        self.num = _row_product(self.cnum, plant.num)
+        self.den = _row_product(self.cden, plant.den)
+        p_lo, p_hi = _corners(plant.num, plant.den)
+        if plant.delay > 0:
+            p_lo, p_hi = min(p_lo, 1.0 / plant.delay), max(p_hi, 1.0 / plant.delay)
+        lo, hi = np.fmin(self._corner_lo, p_lo), np.fmax(self._corner_hi, p_hi)
+        none = np.isnan(lo)
+        self.frequency_ranges = np.column_stack([np.where(none, 1e-2, lo / 100.0), np.where(none, 1e2, hi * 100.0)])
+        """Each loop's :attr:`Loop.frequency_range`, ``(n, 2)``."""
 
     def __len__(self) -> int:
         return len(self.controllers)
@@ -417,6 +443,27 @@ class LoopBatch:
     def controller_dc_gains(self) -> np.ndarray:
         """``C_i(0)`` (``inf`` with integral action)."""
         return self._dc.copy()
+
+
+def _corners(*polys: np.ndarray) -> tuple[float, float]:
+    """Smallest and largest root magnitude above 1e-12 of the polynomials (nan, nan if none), as
+    :func:`synth.freqgrid.characteristic_range` counts them."""
+    mags: list[float] = []
+    for p in polys:
+        p = np.asarray(p, dtype=float)
+        if p.size > 1:
+            r = np.abs(np.roots(p))
+            mags.extend(r[r > 1e-12].tolist())
+    return (min(mags), max(mags)) if mags else (np.nan, np.nan)
+
+
+def _row_product(rows: np.ndarray, poly: np.ndarray) -> np.ndarray:
+    """Each row's polynomial times ``poly`` (rows zero-padded on the left)."""
+    poly = np.asarray(poly, dtype=float)
+    out = np.zeros((rows.shape[0], rows.shape[1] + poly.size - 1))
+    for j, c in enumerate(poly):
+        out[:, j:j + rows.shape[1]] += rows * c
+    return out
 
 
 def _infinite(x: np.ndarray) -> np.ndarray:

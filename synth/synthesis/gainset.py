@@ -316,8 +316,8 @@ class SlackBatch:
         values = np.asarray(values, dtype=float)
         key = values.tobytes()
         if key not in self._batches:
-            controllers = [self.family.controller(v) for v in values]
-            self._batches[key] = [LoopBatch(p, controllers) for p in self.plants]
+            first = LoopBatch(self.plants[0], [self.family.controller(v) for v in values])
+            self._batches[key] = [first] + [first.with_plant(p) for p in self.plants[1:]]
         return self._batches[key]
 
     def slack(self, requirement: Requirement, values: np.ndarray) -> np.ndarray:
