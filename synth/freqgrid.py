@@ -149,21 +149,21 @@ _GOLDEN = (np.sqrt(5.0) - 1.0) / 2.0
 
 
 def log_grids(w_lo: np.ndarray, w_hi: np.ndarray, per_decade: int = DEFAULT_PER_DECADE) -> np.ndarray:
-    """One log grid per row, ``(n, m)``: row ``i`` from ``w_lo[i]`` to ``w_hi[i]`` with the point count of
-    the widest row's :func:`log_grid` (so no row is coarser than its own :func:`log_grid`).
+    """One :func:`log_grid` per row, ``(n, m)``: row ``i`` is exactly ``log_grid(w_lo[i], w_hi[i])``,
+    its last point repeated up to the longest row's length ``m``.
 
     Examples
     --------
     >>> log_grids(np.array([1.0, 10.0]), np.array([100.0, 100.0]), 1)
-    array([[  1.       ,  10.       , 100.       ],
-           [ 10.       ,  31.6227766, 100.       ]])
+    array([[  1.,  10., 100.],
+           [ 10., 100., 100.]])
     """
     w_lo, w_hi = np.asarray(w_lo, float), np.asarray(w_hi, float)
-    n = max(2, int(np.ceil(per_decade * np.max(np.log10(w_hi / w_lo)))) + 1)
-    t = np.linspace(0.0, 1.0, n)
-    grid = np.exp(np.log(w_lo)[:, None] + np.outer(np.log(w_hi / w_lo), t))
-    grid[:, 0], grid[:, -1] = w_lo, w_hi
-    return grid
+    pairs, inverse = np.unique(np.column_stack([w_lo, w_hi]), axis=0, return_inverse=True)
+    grids = [log_grid(a, b, per_decade) for a, b in pairs]
+    m = max(g.size for g in grids)
+    padded = np.array([np.pad(g, (0, m - g.size), mode="edge") for g in grids])
+    return padded[np.ravel(inverse)]
 
 
 def band_grids(band: tuple[float, float], auto: np.ndarray, per_decade: int = DEFAULT_PER_DECADE) -> np.ndarray:

@@ -11,7 +11,8 @@ from synth.freqgrid import batch_first_crossing, log_grids
 from synth.requirements.base import Bound, Requirement, RequirementResult, fmt, register
 
 if TYPE_CHECKING:
-    from synth.loop import Loop, LoopBatch
+    from synth.loop import Loop
+    from synth.loop_batch import LoopBatch
 
 __all__ = ["Bandwidth"]
 

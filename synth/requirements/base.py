@@ -24,7 +24,8 @@ from pydantic import BaseModel, ConfigDict, field_validator
 from synth.errors import SpecError
 
 if TYPE_CHECKING:
-    from synth.loop import Loop, LoopBatch
+    from synth.loop import Loop
+    from synth.loop_batch import LoopBatch
 
 __all__ = [
     "NEPER_PER_DB",
@@ -240,7 +241,7 @@ class Requirement(BaseModel):
 
         Examples
         --------
-        >>> from synth.loop import LoopBatch; from synth.plant import Plant; from synth.controllers import Controller
+        >>> from synth.loop_batch import LoopBatch; from synth.plant import Plant; from synth.controllers import Controller
         >>> from synth.requirements import Bandwidth
         >>> batch = LoopBatch(Plant.from_string("1/(s+1)"), [Controller("P", {"kp": k}) for k in (9.0, 200.0)])
         >>> bool(np.allclose(Bandwidth(min=100).batch_slack(batch), Requirement.batch_slack(Bandwidth(min=100), batch)))

@@ -11,7 +11,8 @@ from synth.requirements.base import register
 from synth.requirements.sensitivity import PeakRequirement
 
 if TYPE_CHECKING:
-    from synth.loop import Loop, LoopBatch
+    from synth.loop import Loop
+    from synth.loop_batch import LoopBatch
 
 __all__ = ["PeakControlSensitivity"]
 

@@ -23,7 +23,8 @@ from synth.requirements.base import (
 )
 
 if TYPE_CHECKING:
-    from synth.loop import Loop, LoopBatch
+    from synth.loop import Loop
+    from synth.loop_batch import LoopBatch
 
 __all__ = ["MAX_DB", "PeakComplementary", "PeakRequirement", "PeakSensitivity", "Sensitivity", "StaticSensitivity",
            "band_text"]

@@ -11,7 +11,8 @@ from synth.freqgrid import band_grid, band_grids, batch_peak, crossings, log_gri
 from synth.requirements.base import BandMixin, Bound, Requirement, RequirementResult, fmt, register
 
 if TYPE_CHECKING:
-    from synth.loop import Loop, LoopBatch
+    from synth.loop import Loop
+    from synth.loop_batch import LoopBatch
 
 __all__ = ["SlewRate"]
 
@@ -65,7 +66,8 @@ class SlewRate(BandMixin, Requirement):
     def batch_slack(self, batch: LoopBatch, per_decade: int = 80) -> np.ndarray:
         """Vectorized slack: every controller's peak rate demand over the band at once."""
         grid = band_grids(self.band, batch.frequency_ranges, per_decade)
-        value, _ = batch_peak(lambda w: self.max_error * np.abs(batch.C(w)) * w, grid)
+        with np.errstate(invalid="ignore"):  # inf * 0 at w = 0 with integral action: nan, as in evaluate
+            value, _ = batch_peak(lambda w: self.max_error * np.abs(batch.C(w)) * w, grid)
         with np.errstate(divide="ignore"):
             return np.where(value > 0, np.log(self.rate_limit / np.where(value > 0, value, 1.0)), np.inf)
 

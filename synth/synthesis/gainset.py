@@ -23,14 +23,15 @@ import numpy as np
 from scipy.optimize import brentq
 
 from synth.controllers import Controller
-from synth.loop import Loop, LoopBatch
+from synth.loop import Loop
+from synth.loop_batch import LoopBatch
 from synth.plant import Plant
 from synth.requirements.base import Requirement, unique_names
 from synth.stability import affine_stability_intervals
 
 __all__ = [
-    "GainInterval",
     "EXACT_BAND",
+    "GainInterval",
     "GainSet",
     "ScalarFamily",
     "SlackBatch",
@@ -332,6 +333,7 @@ def feasible_gain_set(
     family: ScalarFamily,
     bounds: tuple[float, float],
     n_bracket: int = 121,
+    vectorized: bool = True,
 ) -> GainSet:
     """All values of the family's parameter within ``bounds`` meeting every requirement on every plant.
 
@@ -344,6 +346,9 @@ def feasible_gain_set(
     bounds : (lo, hi)
     n_bracket : int
         Points of the bracketing grid (the ends are then refined by root finding).
+    vectorized : bool
+        Evaluate the bracketing grid vectorized (:class:`SlackBatch`; the default) or one value at a
+        time with the exact scalar slack (same result, slower).
 
     Returns
     -------
@@ -372,7 +377,7 @@ def feasible_gain_set(
     batch_fns = {}
     for name, req in zip(names, requirements):
         slack_fns[name] = slack_fn(req)
-        batch_fns[name] = lambda values, r=req: fast.slack(r, values)
+        batch_fns[name] = (lambda values, r=req: fast.slack(r, values)) if vectorized else None
         sets[name] = requirement_set(slack_fns[name], lo, hi, n_bracket, batch_fns[name])
 
     total: list[tuple[float, float]] = [(lo, hi)]
