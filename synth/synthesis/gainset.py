@@ -385,8 +385,8 @@ def feasible_gain_set(
         total = _intersect(total, ivs)
     intervals = []
     for a, b in total:
-        intervals.append(GainInterval(a, b, _binding(a, sets, lo, hi, slack_fns, family),
-                                      _binding(b, sets, lo, hi, slack_fns, family)))
+        intervals.append(GainInterval(a, b, _binding(a, sets, lo, hi, slack_fns, family, batch_fns),
+                                      _binding(b, sets, lo, hi, slack_fns, family, batch_fns)))
     outside: dict[str, list[tuple[float, float]]] = {}
     for name in names:
         if not sets[name]:
@@ -397,13 +397,17 @@ def feasible_gain_set(
 
 
 def _binding(x: float, sets: dict[str, list[tuple[float, float]]], lo: float, hi: float,
-             slack_fns: dict[str, Callable[[float], float]], family: ScalarFamily) -> list[str]:
+             slack_fns: dict[str, Callable[[float], float]], family: ScalarFamily,
+             batch_fns: dict[str, Callable[[np.ndarray], np.ndarray] | None]) -> list[str]:
     tol = 1e-9 * max(1.0, abs(x))
     out = []
     for name, ivs in sets.items():
         if any((abs(x - a) <= tol and a != lo) or (abs(x - b) <= tol and b != hi) for a, b in ivs):
             out.append(name)
     for name, f in slack_fns.items():
+        fast = batch_fns.get(name)
+        if fast is not None and abs(float(fast(np.array([x]))[0])) > EXACT_BAND:
+            continue  # far from zero: the exact slack cannot be within 1e-9 of it
         if name not in out and abs(f(x)) <= 1e-9:
             out.append(name)  # active exactly at the end (e.g. the bound coincides with it)
     if abs(x - lo) <= tol or abs(x - hi) <= tol:
