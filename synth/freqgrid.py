@@ -15,7 +15,8 @@ from scipy.optimize import minimize_scalar
 
 from synth.stability import bisect_roots
 
-__all__ = ["DEFAULT_PER_DECADE", "Curve", "band_grid", "characteristic_range", "crossings", "log_grid", "peak"]
+__all__ = ["DEFAULT_PER_DECADE", "Curve", "band_grid", "band_grids", "batch_first_crossing", "batch_peak",
+           "characteristic_range", "crossings", "log_grid", "log_grids", "peak"]
 
 Curve = Callable[[np.ndarray], np.ndarray]
 
@@ -140,3 +141,140 @@ def crossings(curve: Curve, level: float, grid: np.ndarray) -> np.ndarray:
             lambda x: np.asarray(curve(x), dtype=float) - level, lo[~positive], hi[~positive]
         )
     return np.sort(np.concatenate([roots, exact]))
+
+
+# ------------------------------------------------------------------ vectorized: one curve per row
+
+_GOLDEN = (np.sqrt(5.0) - 1.0) / 2.0
+
+
+def log_grids(w_lo: np.ndarray, w_hi: np.ndarray, per_decade: int = DEFAULT_PER_DECADE) -> np.ndarray:
+    """One :func:`log_grid` per row, ``(n, m)``: row ``i`` is exactly ``log_grid(w_lo[i], w_hi[i])``,
+    its last point repeated up to the longest row's length ``m``.
+
+    Examples
+    --------
+    >>> log_grids(np.array([1.0, 10.0]), np.array([100.0, 100.0]), 1)
+    array([[  1.,  10., 100.],
+           [ 10., 100., 100.]])
+    """
+    w_lo, w_hi = np.asarray(w_lo, float), np.asarray(w_hi, float)
+    pairs, inverse = np.unique(np.column_stack([w_lo, w_hi]), axis=0, return_inverse=True)
+    grids = [log_grid(a, b, per_decade) for a, b in pairs]
+    m = max(g.size for g in grids)
+    padded = np.array([np.pad(g, (0, m - g.size), mode="edge") for g in grids])
+    return padded[np.ravel(inverse)]
+
+
+def band_grids(band: tuple[float, float], auto: np.ndarray, per_decade: int = DEFAULT_PER_DECADE) -> np.ndarray:
+    """:func:`band_grid` for many rows at once: ``auto`` is ``(n, 2)`` (each row's frequency range).
+
+    Examples
+    --------
+    >>> band_grids((0.0, 30.0), np.array([[0.005, 960.0]]), 10)[0, :2]
+    array([0.   , 0.003])
+    """
+    lo, hi = float(band[0]), float(band[1])
+    auto = np.asarray(auto, float)
+    if lo > 0:
+        return np.broadcast_to(log_grid(lo, hi, per_decade), (auto.shape[0], log_grid(lo, hi, per_decade).size))
+    start = np.minimum(auto[:, 0], hi * 1e-4)
+    grid = log_grids(start, np.full(start.shape, hi), per_decade)
+    return np.concatenate([np.zeros((grid.shape[0], 1)), grid], axis=1)
+
+
+def _golden_max(curve: Callable[[np.ndarray], np.ndarray], a: np.ndarray, b: np.ndarray, log: np.ndarray,
+                iterations: int = 80) -> tuple[np.ndarray, np.ndarray]:
+    """Maximize ``curve`` on ``[a, b]`` (shape ``(n, k)``; in ``log w`` where ``log``), golden section."""
+    with np.errstate(divide="ignore"):
+        a = np.where(log, np.log(np.where(log, a, 1.0)), a)
+        b = np.where(log, np.log(np.where(log, b, 1.0)), b)
+
+    def f(x: np.ndarray) -> np.ndarray:
+        return np.asarray(curve(np.where(log, np.exp(x), x)), dtype=float)
+
+    c, d = b - _GOLDEN * (b - a), a + _GOLDEN * (b - a)
+    fc, fd = f(c), f(d)
+    for _ in range(iterations):
+        left = fc >= fd
+        a, b = np.where(left, a, c), np.where(left, d, b)
+        c_new = np.where(left, b - _GOLDEN * (b - a), d)
+        d_new = np.where(left, c, a + _GOLDEN * (b - a))
+        c, d = c_new, d_new
+        fc_known, fd_known = np.where(left, np.nan, fd), np.where(left, fc, np.nan)
+        fresh = f(np.where(left, c, d))
+        fc, fd = np.where(left, fresh, fc_known), np.where(left, fd_known, fresh)
+        if np.all(np.abs(b - a) <= 1e-12 * np.maximum(1.0, np.abs(b))):
+            break
+    x = 0.5 * (a + b)
+    return f(x), np.where(log, np.exp(x), x)
+
+
+def batch_peak(curve: Curve, grid: np.ndarray, tol_db: float = 3.0, top: int = 3) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`peak` for one curve per row: ``curve`` maps frequencies ``(n, k)`` to values ``(n, k)``,
+    ``grid`` is ``(n, m)``. The ``top`` highest local maxima of each row within ``tol_db`` of its largest
+    grid value are refined at once by golden-section search in ``log w``. Returns ``(values, w)``.
+
+    Examples
+    --------
+    >>> f = lambda w: 1.0 / np.abs(1.0 - w**2 + np.array([[0.2], [0.4]]) * 1j * w)
+    >>> v, w = batch_peak(f, np.tile(log_grid(0.01, 100.0, 5), (2, 1)))
+    >>> v.round(4), w.round(4)
+    (array([5.0252, 2.5516]), array([0.9899, 0.9592]))
+    """
+    grid = np.asarray(grid, dtype=float)
+    values = np.asarray(curve(grid), dtype=float)
+    n, m = values.shape
+    rows = np.arange(n)
+    clean = np.where(np.isnan(values), -np.inf, values)
+    i_best = np.argmax(clean, axis=1)
+    best_v, best_w = values[rows, i_best], grid[rows, i_best]
+    if m < 3:
+        return best_v, best_w
+    inner = (clean[:, 1:-1] >= clean[:, :-2]) & (clean[:, 1:-1] >= clean[:, 2:])
+    with np.errstate(invalid="ignore", over="ignore"):
+        inner &= clean[:, 1:-1] >= (best_v * 10 ** (-tol_db / 20))[:, None]
+    inner &= np.isfinite(best_v)[:, None]
+    score = np.where(inner, clean[:, 1:-1], -np.inf)
+    k = min(top, m - 2)
+    cand = np.argsort(-score, axis=1, kind="stable")[:, :k] + 1
+    ok = np.isfinite(score[rows[:, None], cand - 1])
+    if not np.any(ok):
+        return best_v, best_w
+    a, b = grid[rows[:, None], cand - 1], grid[rows[:, None], cand + 1]
+    v, w = _golden_max(curve, a, b, a > 0)
+    v = np.where(ok & ~np.isnan(v), v, -np.inf)
+    j = np.argmax(v, axis=1)
+    better = v[rows, j] > best_v
+    return np.where(better, v[rows, j], best_v), np.where(better, w[rows, j], best_w)
+
+
+def batch_first_crossing(curve: Curve, level: np.ndarray, grid: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Lowest frequency of each row where ``curve(w) - level`` changes sign (as :func:`crossings`' first
+    element) on a positive ``grid`` ``(n, m)``; ``nan`` where none. Also returns whether each row starts
+    below ``level``.
+
+    Examples
+    --------
+    >>> f = lambda w: 1.0 / np.abs(1j * w / np.array([[1.0], [10.0]]) + 1.0)
+    >>> w, below = batch_first_crossing(f, np.full(2, 1 / np.sqrt(2)), np.tile(log_grid(0.01, 100.0), (2, 1)))
+    >>> w.round(8), below
+    (array([ 1., 10.]), array([False, False]))
+    """
+    grid = np.asarray(grid, dtype=float)
+    level = np.asarray(level, dtype=float)
+    g = np.asarray(curve(grid), dtype=float) - level[:, None]
+    sign = np.sign(g)
+    n, m = g.shape
+    rows = np.arange(n)
+    change = sign[:, :-1] * sign[:, 1:] < 0
+    has = change.any(axis=1)
+    idx = np.argmax(change, axis=1)
+    zero = np.zeros((n, m), bool)
+    zero[:, 1:-1] = sign[:, 1:-1] == 0
+    first_zero = np.where(zero.any(axis=1), grid[rows, np.argmax(zero, axis=1)], np.inf)
+    lo = np.where(has, np.log(grid[rows, idx]), 0.0)
+    hi = np.where(has, np.log(grid[rows, idx + 1]), 1.0)
+    root = np.exp(bisect_roots(lambda x: np.asarray(curve(np.exp(x)[:, None]), float)[:, 0] - level, lo, hi))
+    root = np.minimum(np.where(has, root, np.inf), first_zero)
+    return np.where(np.isfinite(root), root, np.nan), g[:, 0] < 0

@@ -1,6 +1,7 @@
 import json
 import subprocess
 import sys
+from pathlib import Path
 
 import pytest
 
@@ -29,7 +30,12 @@ def test_check_failing_controller_exits_1(run_cli):
 def test_design_x4_contains_k3(run_cli, tmp_path):
     out = tmp_path / "rep"
     js = tmp_path / "design.json"
-    res = run_cli("design", "specs/x4_rotor.yaml", "--out", str(out), "--json", str(js))
+    # the X-4 spec without its nonlinear-simulation block: the design and its figures are what is checked
+    # here (tests/test_report.py regenerates the committed report with the simulation and the gap case)
+    spec = tmp_path / "x4_rotor.yaml"
+    text = Path("specs/x4_rotor.yaml").read_text()
+    spec.write_text(text[:text.index("\nsimulation:")] + "\n")
+    res = run_cli("design", str(spec), "--out", str(out), "--json", str(js))
     assert res.code == 0, res.err
     data = json.loads(js.read_text())
     assert data["feasible"] and data["controller"]["type"] == "P"

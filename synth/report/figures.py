@@ -16,6 +16,7 @@ __all__ = [
     "bode_with_slew_bound",
     "bound_drawn",
     "delay_chart",
+    "feasibility_grid",
     "feasibility_map",
     "gain_set_plot",
     "sensitivity_plot",
@@ -29,6 +30,7 @@ import numpy as np
 from synth.figure_files import save_figure
 from synth.freqgrid import log_grid
 from synth.loop import Loop
+from synth.loop_batch import LoopBatch
 from synth.requirements import Sensitivity, SlewRate, StaticSensitivity
 from synth.requirements.sensitivity import PeakSensitivity
 from synth.timeresp import default_horizon, step_response
@@ -206,15 +208,27 @@ def delay_chart(rows: list[dict[str, Any]], marks: dict[str, float], path: Path)
     return save_figure(fig, path)
 
 
-def feasibility_map(spec: Any, design_controller: Any, path: Path, n: int = 45,
-                    reference: Any | None = None) -> Path | None:
-    """For two free parameters: where in the parameter plane each requirement holds (exact check on a
-    grid), the feasible region shaded, the design marked.
+def feasibility_grid(spec: Any, design_controller: Any, n: int = 45,
+                     ) -> tuple[str, str, np.ndarray, np.ndarray, np.ndarray] | None:
+    """The data of :func:`feasibility_map`: ``(xa, xb, A, B, slack)`` with ``slack[0, j, i]`` +1/-1 for a
+    stable/unstable loop at ``(A[i], B[j])`` on every plant and ``slack[k + 1, j, i]`` requirement ``k``'s
+    worst slack over the plants (None unless the spec has two free parameters).
 
-    Only signs are drawn, so stability is the exact yes/no test (no stability margin is computed) and
-    each requirement is evaluated at 20 points per decade with refined peaks and crossings.
+    Stability is exact: along each column the stabilizing set of the second parameter comes from the
+    D-decomposition (:func:`synth.synthesis.gainset.stability_set`). The requirements are evaluated for
+    the whole grid at once (:meth:`~synth.requirements.base.Requirement.batch_slack`, 20 points per
+    decade, peaks and crossings refined).
+
+    Examples
+    --------
+    >>> from synth.spec import load_spec; from synth.controllers import Controller
+    >>> xa, xb, A, B, slack = feasibility_grid(load_spec("specs/x4_rotor_pi.yaml"),
+    ...                                        Controller("PI", {"kp": 4.0, "ki": 40.0}), n=5)
+    >>> xa, xb, slack.shape, bool(slack[0].min() == 1.0)
+    ('kp', 'ki', (6, 5, 5), True)
     """
     from synth.controllers import Controller
+    from synth.synthesis.gainset import ScalarFamily
 
     free = spec.controller.free_parameters()
     if len(free) != 2 or design_controller is None:
@@ -226,16 +240,64 @@ def feasibility_map(spec: Any, design_controller: Any, path: Path, n: int = 45,
     xb_hi = min(xb_hi, max(2.5 * abs(design_controller.parameters[xb]), xb_lo + 1e-9))
     A = np.linspace(xa_lo, xa_hi, n)
     B = np.linspace(xb_lo, xb_hi, n)
-    names = [r.name() for r in spec.requirements]
-    slack = np.full((len(names) + 1, n, n), np.nan)
+    requirements = list(spec.requirements)
+    slack = np.full((len(requirements) + 1, n, n), np.nan)
     base = dict(design_controller.parameters)
     plants = spec.plants()
     for i, a in enumerate(A):
-        for j, b in enumerate(B):
-            c = Controller(design_controller.type, {**base, xa: float(a), xb: float(b)})
-            loops = [Loop(p, c) for p in plants]
-            slack[0, j, i] = 1.0 if all(loop.stability().stable for loop in loops) else -1.0
-            slack[1:, j, i] = [min(req.evaluate(loop, 20).slack for loop in loops) for req in spec.requirements]
+        slack[0, :, i] = _column_stability(ScalarFamily(design_controller.type, xb, {**base, xa: float(a)}),
+                                           plants, B)
+    aa, bb = np.meshgrid(A, B)  # [j, i]: b = B[j], a = A[i]
+    controllers = [Controller(design_controller.type, {**base, xa: float(a), xb: float(b)})
+                   for a, b in zip(aa.ravel(), bb.ravel())]
+    first = LoopBatch(plants[0], controllers)
+    batches = [first] + [first.with_plant(p) for p in plants[1:]]
+    for k, req in enumerate(requirements):
+        worst = np.min([req.batch_slack(b, 20) for b in batches], axis=0)
+        slack[k + 1] = worst.reshape(n, n)
+    return xa, xb, A, B, slack
+
+
+def _column_stability(family: Any, plants: list[Any], values: np.ndarray) -> np.ndarray:
+    """+1/-1: the loop stable/unstable on every plant at each of ``values`` (sorted) of the family's parameter.
+
+    Exact: the stabilizing intervals come from the D-decomposition of ``C = C0 + rho C1`` (each part with
+    its common factors ``s`` cancelled, so that ``PI`` over ``ki`` is ``kp + ki (1/s)``); a family not affine
+    in its parameter is tested point by point.
+    """
+    from synth.stability import affine_stability_intervals
+
+    lo, hi = float(values[0]), float(values[-1])
+    inner = values[values > 0] if np.any(values > 0) else values
+    parts = family.affine_parts(float(inner[0]), hi) if hi > float(inner[0]) else None
+    if parts is None:
+        return np.array([1.0 if all(Loop(p, family.controller(v)).stability().stable for p in plants) else -1.0
+                         for v in values])
+    c0, c1 = (_cancel_origin(*part) for part in parts)
+    ok = np.ones(values.size, bool)
+    for p in plants:
+        ivs = affine_stability_intervals(c0 if np.any(c0[0]) else None, c1, p.num, p.den, p.delay, lo, hi)
+        ok &= np.array([any(iv.lo <= v <= iv.hi for iv in ivs) for v in values])
+    return np.where(ok, 1.0, -1.0)
+
+
+def _cancel_origin(num: np.ndarray, den: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    num, den = np.trim_zeros(np.asarray(num, float), "f"), np.trim_zeros(np.asarray(den, float), "f")
+    num = num if num.size else np.array([0.0])
+    while num.size > 1 and den.size > 1 and num[-1] == 0.0 and den[-1] == 0.0:
+        num, den = num[:-1], den[:-1]
+    return num, den
+
+
+def feasibility_map(spec: Any, design_controller: Any, path: Path, n: int = 45,
+                    reference: Any | None = None) -> Path | None:
+    """For two free parameters: where in the parameter plane each requirement holds (on a grid), the
+    feasible region shaded, the design marked (data from :func:`feasibility_grid`)."""
+    grid = feasibility_grid(spec, design_controller, n)
+    if grid is None:
+        return None
+    xa, xb, A, B, slack = grid
+    names = [r.name() for r in spec.requirements]
     fig, ax = plt.subplots(figsize=(7.5, 5.2))
     ok = np.all(slack >= 0, axis=0)
     ax.contourf(A, B, ok.astype(float), levels=[0.5, 1.5], colors=["#2e8b57"], alpha=0.18)

@@ -7,10 +7,12 @@ from typing import TYPE_CHECKING, Any, ClassVar, Literal
 import numpy as np
 from pydantic import PositiveFloat, model_validator
 
+from synth.freqgrid import batch_first_crossing, log_grids
 from synth.requirements.base import Bound, Requirement, RequirementResult, fmt, register
 
 if TYPE_CHECKING:
     from synth.loop import Loop
+    from synth.loop_batch import LoopBatch
 
 __all__ = ["Bandwidth"]
 
@@ -62,3 +64,21 @@ class Bandwidth(Requirement):
         return self.result(value=wb, bound=bound, unit="rad/s", slack=slack, margin=margin,
                            binding_frequency=wb if np.isfinite(wb) else None, message=msg,
                            crossover=wc, T0=loop.T0())
+
+    def batch_slack(self, batch: LoopBatch, per_decade: int = 80) -> np.ndarray:
+        """Vectorized slack: every loop's first -3 dB crossing of ``|T|`` at once (as ``Loop.bandwidth``)."""
+        from synth.loop import BANDWIDTH_LEVEL
+
+        t0 = batch.T0()
+        ranges = batch.frequency_ranges
+        grid = log_grids(ranges[:, 0], ranges[:, 1] * 10, per_decade)
+        cross, below = batch_first_crossing(lambda w: np.abs(batch.T(w)), t0 * BANDWIDTH_LEVEL, grid)
+        wb = np.where(np.isnan(cross), np.where(below, grid[:, 0], np.inf), cross)
+        wb = np.where((t0 == 0.0) | ~np.isfinite(t0), np.nan, wb)
+        slack = np.full(wb.shape, np.inf)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            if self.min is not None:
+                slack = np.minimum(slack, np.where(wb > 0, np.log(wb / self.min), -np.inf))
+            if self.max is not None:
+                slack = np.minimum(slack, np.where(wb > 0, np.log(self.max / wb), np.inf))
+        return np.where(np.isnan(wb), -np.inf, slack)

@@ -25,6 +25,7 @@ from synth.errors import SpecError
 
 if TYPE_CHECKING:
     from synth.loop import Loop
+    from synth.loop_batch import LoopBatch
 
 __all__ = [
     "NEPER_PER_DB",
@@ -36,6 +37,7 @@ __all__ = [
     "RequirementResult",
     "check_band",
     "db",
+    "db_values",
     "fmt",
     "magnitude",
     "register",
@@ -215,6 +217,52 @@ class Requirement(BaseModel):
         """Evaluate on ``loop``; ``per_decade`` sets the density of the frequency grid."""
         raise NotImplementedError
 
+    def slack(self, loop: Loop, per_decade: int = 80) -> float:
+        """The slack of :meth:`evaluate` alone (a type may skip work its message needs and its slack
+        does not; the number is the same).
+
+        Examples
+        --------
+        >>> from synth.loop import Loop; from synth.plant import Plant; from synth.controllers import Controller
+        >>> from synth.requirements import Bandwidth
+        >>> loop = Loop(Plant.from_string("1/(s+1)"), Controller("P", {"kp": 9.0}))
+        >>> Bandwidth(min=100).slack(loop) == Bandwidth(min=100).evaluate(loop).slack
+        True
+        """
+        return self.evaluate(loop, per_decade).slack
+
+    def batch_slack(self, batch: LoopBatch, per_decade: int = 80) -> np.ndarray:
+        """Slack on every loop of ``batch`` (one plant, many controllers), as an array.
+
+        A type with a vectorized form overrides this (all loops and frequencies at once, peaks and
+        crossings refined; it agrees with :meth:`slack` to rounding and is used to bracket the edges
+        of feasible sets, which :meth:`slack` then refines). This base form is the scalar fallback:
+        :meth:`slack` on one loop at a time.
+
+        Examples
+        --------
+        >>> from synth.loop_batch import LoopBatch; from synth.plant import Plant; from synth.controllers import Controller
+        >>> from synth.requirements import Bandwidth
+        >>> batch = LoopBatch(Plant.from_string("1/(s+1)"), [Controller("P", {"kp": k}) for k in (9.0, 200.0)])
+        >>> bool(np.allclose(Bandwidth(min=100).batch_slack(batch), Requirement.batch_slack(Bandwidth(min=100), batch)))
+        True
+        """
+        from synth.loop import Loop
+
+        return np.array([self.slack(Loop(batch.plant, c), per_decade) for c in batch.controllers], dtype=float)
+
+    @classmethod
+    def has_batch_form(cls) -> bool:
+        """Whether the type has a vectorized :meth:`batch_slack` (else the scalar fallback runs).
+
+        Examples
+        --------
+        >>> from synth.requirements import Bandwidth
+        >>> Bandwidth.has_batch_form()
+        True
+        """
+        return cls.batch_slack is not Requirement.batch_slack
+
     def name(self) -> str:
         """Label given in the spec, or the type name."""
         return self.label or self.type
@@ -359,6 +407,18 @@ def db(x: float) -> float:
     """
     with np.errstate(divide="ignore"):
         return float(20.0 * np.log10(abs(x)))
+
+
+def db_values(x: Any) -> np.ndarray:
+    """``20 log10 |x|`` elementwise, ``-inf`` for zero.
+
+    Examples
+    --------
+    >>> db_values(np.array([0.1, 10.0])).round(6)
+    array([-20.,  20.])
+    """
+    with np.errstate(divide="ignore"):
+        return 20.0 * np.log10(np.abs(np.asarray(x)))
 
 
 def unique_names(requirements: list[Requirement]) -> list[str]:

@@ -12,6 +12,7 @@ from synth.requirements.sensitivity import PeakRequirement
 
 if TYPE_CHECKING:
     from synth.loop import Loop
+    from synth.loop_batch import LoopBatch
 
 __all__ = ["PeakControlSensitivity"]
 
@@ -37,3 +38,7 @@ class PeakControlSensitivity(PeakRequirement):
     def curve(self, loop: Loop) -> Callable[[np.ndarray], np.ndarray]:
         """``|C S|`` as a function of ``w``."""
         return lambda w: np.abs(loop.KS(w))
+
+    def batch_curve(self, batch: LoopBatch) -> Callable[[np.ndarray], np.ndarray]:
+        """``|C S|`` of every loop."""
+        return lambda w: np.abs(batch.KS(w))

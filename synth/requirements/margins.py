@@ -11,6 +11,7 @@ from synth.requirements.base import NEPER_PER_DB, Bound, Requirement, Requiremen
 
 if TYPE_CHECKING:
     from synth.loop import Loop
+    from synth.loop_batch import LoopBatch
 
 __all__ = ["MarginsRequirement"]
 
@@ -65,3 +66,21 @@ class MarginsRequirement(Requirement):
         msg = f"{'; '.join(texts)}: {'met' if slack >= 0 else 'NOT met'}, tightest: {name}"
         return self.result(value=value, bound=bound, unit=unit, slack=slack, margin=value - bound,
                            binding_frequency=w, message=msg, binding=name, **m.to_dict())
+
+    def batch_slack(self, batch: LoopBatch, per_decade: int = 80) -> np.ndarray:
+        """Vectorized slack: gain crossovers of all loops by batched polynomial roots, phase crossovers
+        (the gain margin) by bisection on a shared grid (:meth:`~synth.loop_batch.LoopBatch.upper_gain_margins`)."""
+        parts = []
+        if self.gain_margin_db is not None:
+            k_hi = batch.upper_gain_margins()
+            with np.errstate(divide="ignore"):
+                gm = np.where(np.isfinite(k_hi), 20 * np.log10(k_hi), np.inf)
+            parts.append((gm - self.gain_margin_db) * NEPER_PER_DB)
+        if self.phase_margin_deg is not None or self.delay_margin is not None:
+            pm, dm = batch.phase_and_delay_margins()
+            if self.phase_margin_deg is not None:
+                parts.append(np.radians(pm - self.phase_margin_deg))
+            if self.delay_margin is not None:
+                with np.errstate(divide="ignore"):
+                    parts.append(np.where(dm > 0, np.log(np.where(dm > 0, dm, 1.0) / self.delay_margin), -np.inf))
+        return np.min(parts, axis=0)

@@ -8,7 +8,7 @@ from typing import TYPE_CHECKING, Any, ClassVar, Literal
 import numpy as np
 from pydantic import Field
 
-from synth.freqgrid import band_grid, crossings, log_grid, peak
+from synth.freqgrid import band_grid, band_grids, batch_peak, crossings, log_grid, log_grids, peak
 from synth.requirements.base import (
     NEPER_PER_DB,
     BandMixin,
@@ -17,12 +17,14 @@ from synth.requirements.base import (
     RequirementResult,
     check_band,
     db,
+    db_values,
     fmt,
     register,
 )
 
 if TYPE_CHECKING:
     from synth.loop import Loop
+    from synth.loop_batch import LoopBatch
 
 __all__ = ["MAX_DB", "PeakComplementary", "PeakRequirement", "PeakSensitivity", "Sensitivity", "StaticSensitivity",
            "band_text"]
@@ -87,6 +89,12 @@ class Sensitivity(BandMixin, Requirement):
                            margin=margin, binding_frequency=w_peak, message=msg,
                            met_up_to=up_to, band=list(self.band))
 
+    def batch_slack(self, batch: LoopBatch, per_decade: int = 80) -> np.ndarray:
+        """Vectorized slack: the peak of every loop's ``|S|`` over the band at once."""
+        grid = band_grids(self.band, batch.frequency_ranges, per_decade)
+        value, _ = batch_peak(lambda w: np.abs(batch.S(w)), grid)
+        return (self.max_db - db_values(value)) * NEPER_PER_DB
+
 
 @register
 class StaticSensitivity(Requirement):
@@ -133,6 +141,14 @@ class StaticSensitivity(Requirement):
                            margin=margin, binding_frequency=0.0, message=msg, plant_gain=g,
                            controller_dc_gain=c0, minimum_dc_gain=(1.0 / self.linear_bound("max_db") - 1) / g)
 
+    def batch_slack(self, batch: LoopBatch, per_decade: int = 80) -> np.ndarray:
+        """Vectorized slack: the same closed form for every controller's DC gain."""
+        g = float(self.plant_gain) if self.plant_gain is not None else batch.plant.dc_gain()
+        l0 = batch.controller_dc_gains() * g
+        with np.errstate(divide="ignore", invalid="ignore"):
+            value_db = np.where(np.isinf(l0), -np.inf, np.where(l0 == -1, np.inf, db_values(1.0 / (1.0 + l0))))
+        return (self.max_db - value_db) * NEPER_PER_DB
+
 
 class PeakRequirement(Requirement):
     """Peak of a closed-loop magnitude over a band (default: all frequencies): the base of the peak types.
@@ -153,6 +169,30 @@ class PeakRequirement(Requirement):
     def curve(self, loop: Loop) -> Callable[[np.ndarray], np.ndarray]:  # pragma: no cover - overridden
         """The magnitude whose peak is bounded, as a function of ``w``."""
         raise NotImplementedError
+
+    def batch_curve(self, batch: LoopBatch) -> Callable[[np.ndarray], np.ndarray] | None:
+        """The vectorized :meth:`curve` (frequencies ``(n, m)`` to magnitudes ``(n, m)``), or None
+        when the type has none (its :meth:`batch_slack` then falls back to one loop at a time)."""
+        return None
+
+    @classmethod
+    def has_batch_form(cls) -> bool:
+        """Whether the type's :meth:`batch_curve` is given."""
+        return cls.batch_curve is not PeakRequirement.batch_curve
+
+    def batch_slack(self, batch: LoopBatch, per_decade: int = 80) -> np.ndarray:
+        """Vectorized slack from :meth:`batch_curve`: every loop's peak at once."""
+        curve = self.batch_curve(batch)
+        if curve is None:
+            return Requirement.batch_slack(self, batch, per_decade)
+        if self.band is not None:
+            check_band(self.band)
+            grid = band_grids(self.band, batch.frequency_ranges, per_decade)
+        else:
+            ranges = batch.frequency_ranges
+            grid = log_grids(ranges[:, 0], ranges[:, 1] * 10, per_decade)
+        value, _ = batch_peak(curve, grid)
+        return (self.max_db - db_values(value)) * NEPER_PER_DB
 
     def evaluate(self, loop: Loop, per_decade: int = 80) -> RequirementResult:
         if self.band is not None:
@@ -193,6 +233,10 @@ class PeakSensitivity(PeakRequirement):
         """``|S|`` as a function of ``w``."""
         return lambda w: np.abs(loop.S(w))
 
+    def batch_curve(self, batch: LoopBatch) -> Callable[[np.ndarray], np.ndarray]:
+        """``|S|`` of every loop."""
+        return lambda w: np.abs(batch.S(w))
+
 
 @register
 class PeakComplementary(PeakRequirement):
@@ -214,3 +258,7 @@ class PeakComplementary(PeakRequirement):
     def curve(self, loop: Loop) -> Callable[[np.ndarray], np.ndarray]:
         """``|T|`` as a function of ``w``."""
         return lambda w: np.abs(loop.T(w))
+
+    def batch_curve(self, batch: LoopBatch) -> Callable[[np.ndarray], np.ndarray]:
+        """``|T|`` of every loop."""
+        return lambda w: np.abs(batch.T(w))

@@ -7,11 +7,12 @@ from typing import TYPE_CHECKING, Any, ClassVar, Literal
 import numpy as np
 from pydantic import PositiveFloat
 
-from synth.freqgrid import band_grid, crossings, log_grid, peak
+from synth.freqgrid import band_grid, band_grids, batch_peak, crossings, log_grid, peak
 from synth.requirements.base import BandMixin, Bound, Requirement, RequirementResult, fmt, register
 
 if TYPE_CHECKING:
     from synth.loop import Loop
+    from synth.loop_batch import LoopBatch
 
 __all__ = ["SlewRate"]
 
@@ -56,6 +57,19 @@ class SlewRate(BandMixin, Requirement):
         if cross.size:
             return float(cross[0])
         return float(grid[0]) if demand(grid[:1])[0] > self.rate_limit else None
+
+    def slack(self, loop: Loop, per_decade: int = 80) -> float:
+        """The slack of :meth:`evaluate` without the crossing frequency its message quotes."""
+        value, _ = peak(self.demand(loop), band_grid(self.band, loop.frequency_range, per_decade))
+        return float(np.log(self.rate_limit / value) if value > 0 else np.inf)
+
+    def batch_slack(self, batch: LoopBatch, per_decade: int = 80) -> np.ndarray:
+        """Vectorized slack: every controller's peak rate demand over the band at once."""
+        grid = band_grids(self.band, batch.frequency_ranges, per_decade)
+        with np.errstate(invalid="ignore"):  # inf * 0 at w = 0 with integral action: nan, as in evaluate
+            value, _ = batch_peak(lambda w: self.max_error * np.abs(batch.C(w)) * w, grid)
+        with np.errstate(divide="ignore"):
+            return np.where(value > 0, np.log(self.rate_limit / np.where(value > 0, value, 1.0)), np.inf)
 
     def evaluate(self, loop: Loop, per_decade: int = 80) -> RequirementResult:
         grid = band_grid(self.band, loop.frequency_range, per_decade)

@@ -3,7 +3,11 @@
 Every requirement's slack is a continuous function of the parameter. Its sign
 changes are bracketed on a grid and each boundary is then found by root
 finding (Brent) to ``1e-10`` relative, so the interval ends do not depend on
-the grid. Closed-loop stability is handled exactly: when the controller is
+the grid. The bracketing grid is evaluated vectorized (every plant x frequency
+x value at once, :meth:`~synth.requirements.base.Requirement.batch_slack`);
+the points next to a sign change, and those whose vectorized slack is within
+:data:`EXACT_BAND` of zero, are re-evaluated one by one with the exact scalar
+slack, which the root finding then uses alone. Closed-loop stability is handled exactly: when the controller is
 affine in the parameter the stability boundaries come from the
 D-decomposition (every value at which a closed-loop root crosses the
 imaginary axis, delay included).
@@ -20,14 +24,17 @@ from scipy.optimize import brentq
 
 from synth.controllers import Controller
 from synth.loop import Loop
+from synth.loop_batch import LoopBatch
 from synth.plant import Plant
 from synth.requirements.base import Requirement, unique_names
 from synth.stability import affine_stability_intervals
 
 __all__ = [
+    "EXACT_BAND",
     "GainInterval",
     "GainSet",
     "ScalarFamily",
+    "SlackBatch",
     "critical_gains",
     "feasible_gain_set",
     "requirement_set",
@@ -35,6 +42,10 @@ __all__ = [
 ]
 
 _MET_TOL = 1e-12
+
+EXACT_BAND = 1e-4
+"""Vectorized slacks within this distance of zero (Np or rad) are re-evaluated by the exact scalar slack
+before the sign is trusted (the vectorized and scalar slacks agree to about 1e-7)."""
 
 
 @dataclass
@@ -225,26 +236,95 @@ def _assemble(grid: np.ndarray, flags: list[bool], root: Callable[[float, float,
 
 
 def requirement_set(slack: Callable[[float], float], lo: float, hi: float,
-                    n: int = 121) -> list[tuple[float, float]]:
+                    n: int = 121, batch: Callable[[np.ndarray], np.ndarray] | None = None,
+                    ) -> list[tuple[float, float]]:
     """Intervals of ``[lo, hi]`` where ``slack(v) >= 0``: bracketed on a grid, refined by Brent.
+
+    ``batch`` (optional) gives approximate slacks at many values at once; the grid is then evaluated
+    by it and only the points next to a sign change or within :data:`EXACT_BAND` of zero by ``slack``
+    (repeated until every sign change lies between exactly evaluated points), so the result is the same
+    as with ``slack`` alone.
 
     Examples
     --------
     >>> slack = lambda k: np.log(2.5 / k) if k > 0 else np.inf  # met for k <= 2.5
     >>> [(float(a), float(b)) for a, b in requirement_set(slack, 0.0, 10.0)]
     [(0.0, 2.5)]
+    >>> fast = lambda ks: np.log(2.5 / np.maximum(ks, 1e-300))
+    >>> [(float(a), float(b)) for a, b in requirement_set(slack, 0.0, 10.0, batch=fast)]
+    [(0.0, 2.5)]
     """
     grid = _grid(lo, hi, n)
-    values = np.array([slack(v) for v in grid])
+    values = _grid_values(slack, grid, batch)
     flags = list(values >= -_MET_TOL)
+    known = {float(v): float(x) for v, x in zip(grid, values)}
+
+    def exact(v: float) -> float:
+        return known[v] if v in known else slack(v)
 
     def root(a: float, b: float, fa: bool) -> float:
-        sa, sb = slack(a), slack(b)
+        sa, sb = exact(a), exact(b)
         if np.isfinite(sa) and np.isfinite(sb):
             return float(brentq(lambda v: slack(v) + _MET_TOL, a, b, xtol=1e-12, rtol=1e-10))
         return _bisect_flag(lambda v: slack(v) >= -_MET_TOL, a, b, fa)
 
     return _assemble(grid, flags, root)
+
+
+def _grid_values(slack: Callable[[float], float], grid: np.ndarray,
+                 batch: Callable[[np.ndarray], np.ndarray] | None) -> np.ndarray:
+    """Slack on the grid: exact everywhere (no ``batch``), or vectorized with exact values where the sign
+    matters (near zero, unknown, or on either side of a sign change)."""
+    if batch is None:
+        return np.array([slack(v) for v in grid], dtype=float)
+    values = np.array(batch(grid), dtype=float)
+    done = np.zeros(grid.size, bool)
+    need = np.isnan(values) | (np.abs(values) <= EXACT_BAND)
+    while True:
+        flags = values >= -_MET_TOL
+        change = np.flatnonzero(flags[1:] != flags[:-1])
+        need[change] = True
+        need[change + 1] = True
+        need &= ~done
+        if not need.any():
+            return values
+        for i in np.flatnonzero(need):
+            values[i] = slack(float(grid[i]))
+        done |= need
+        need[:] = False
+
+
+class SlackBatch:
+    """Vectorized slacks of requirements over many values of a family's parameter, the worst over
+    the plants (one :class:`~synth.loop.LoopBatch` per plant and set of values, shared by the
+    requirements).
+
+    Examples
+    --------
+    >>> from synth.requirements import Bandwidth
+    >>> from synth.plant import Plant
+    >>> sb = SlackBatch(ScalarFamily("P", "kp", {}), [Plant.from_string("1/(s+1)")])
+    >>> sb.slack(Bandwidth(min=100), np.array([9.0, 200.0])).round(3)
+    array([-2.305,  0.696])
+    """
+
+    def __init__(self, family: ScalarFamily, plants: list[Plant], per_decade: int = 80) -> None:
+        self.family, self.plants, self.per_decade = family, plants, per_decade
+        self._batches: dict[bytes, list[LoopBatch]] = {}
+
+    def batches(self, values: np.ndarray) -> list[LoopBatch]:
+        """One :class:`~synth.loop.LoopBatch` per plant for the controllers at ``values`` (cached)."""
+        values = np.asarray(values, dtype=float)
+        key = values.tobytes()
+        if key not in self._batches:
+            first = LoopBatch(self.plants[0], [self.family.controller(v) for v in values])
+            self._batches[key] = [first] + [first.with_plant(p) for p in self.plants[1:]]
+        return self._batches[key]
+
+    def slack(self, requirement: Requirement, values: np.ndarray) -> np.ndarray:
+        """Worst slack over the plants of ``requirement`` at every value."""
+        out = [requirement.batch_slack(b, self.per_decade) for b in self.batches(values)]
+        return np.min(np.array(out), axis=0)
 
 
 def feasible_gain_set(
@@ -253,6 +333,7 @@ def feasible_gain_set(
     family: ScalarFamily,
     bounds: tuple[float, float],
     n_bracket: int = 121,
+    vectorized: bool = True,
 ) -> GainSet:
     """All values of the family's parameter within ``bounds`` meeting every requirement on every plant.
 
@@ -265,6 +346,9 @@ def feasible_gain_set(
     bounds : (lo, hi)
     n_bracket : int
         Points of the bracketing grid (the ends are then refined by root finding).
+    vectorized : bool
+        Evaluate the bracketing grid vectorized (:class:`SlackBatch`; the default) or one value at a
+        time with the exact scalar slack (same result, slower).
 
     Returns
     -------
@@ -285,37 +369,45 @@ def feasible_gain_set(
     def slack_fn(req: Requirement) -> Callable[[float], float]:
         def f(v: float) -> float:
             c = family.controller(v)
-            return min(req.evaluate(Loop(p, c)).slack for p in plants)
+            return min(req.slack(Loop(p, c)) for p in plants)
         return f
 
+    fast = SlackBatch(family, plants)
     slack_fns = {}
+    batch_fns = {}
     for name, req in zip(names, requirements):
         slack_fns[name] = slack_fn(req)
-        sets[name] = requirement_set(slack_fns[name], lo, hi, n_bracket)
+        batch_fns[name] = (lambda values, r=req: fast.slack(r, values)) if vectorized else None
+        sets[name] = requirement_set(slack_fns[name], lo, hi, n_bracket, batch_fns[name])
 
     total: list[tuple[float, float]] = [(lo, hi)]
     for ivs in sets.values():
         total = _intersect(total, ivs)
     intervals = []
     for a, b in total:
-        intervals.append(GainInterval(a, b, _binding(a, sets, lo, hi, slack_fns, family),
-                                      _binding(b, sets, lo, hi, slack_fns, family)))
+        intervals.append(GainInterval(a, b, _binding(a, sets, lo, hi, slack_fns, family, batch_fns),
+                                      _binding(b, sets, lo, hi, slack_fns, family, batch_fns)))
     outside: dict[str, list[tuple[float, float]]] = {}
     for name in names:
         if not sets[name]:
             wide_lo = lo if lo <= 0 else lo / 10.0
-            outside[name] = requirement_set(slack_fns[name], wide_lo, hi * 10 if hi > 0 else hi + 10, n_bracket)
+            outside[name] = requirement_set(slack_fns[name], wide_lo, hi * 10 if hi > 0 else hi + 10, n_bracket,
+                                            batch_fns[name])
     return GainSet(family.parameter, (lo, hi), intervals, sets, outside)
 
 
 def _binding(x: float, sets: dict[str, list[tuple[float, float]]], lo: float, hi: float,
-             slack_fns: dict[str, Callable[[float], float]], family: ScalarFamily) -> list[str]:
+             slack_fns: dict[str, Callable[[float], float]], family: ScalarFamily,
+             batch_fns: dict[str, Callable[[np.ndarray], np.ndarray] | None]) -> list[str]:
     tol = 1e-9 * max(1.0, abs(x))
     out = []
     for name, ivs in sets.items():
         if any((abs(x - a) <= tol and a != lo) or (abs(x - b) <= tol and b != hi) for a, b in ivs):
             out.append(name)
     for name, f in slack_fns.items():
+        fast = batch_fns.get(name)
+        if fast is not None and abs(float(fast(np.array([x]))[0])) > EXACT_BAND:
+            continue  # far from zero: the exact slack cannot be within 1e-9 of it
         if name not in out and abs(f(x)) <= 1e-9:
             out.append(name)  # active exactly at the end (e.g. the bound coincides with it)
     if abs(x - lo) <= tol or abs(x - hi) <= tol:

@@ -1,0 +1,120 @@
+"""Whole CLI commands of the README, timed in fresh processes beside a baseline measured in the same run.
+
+The baseline is another checkout of synth (by default a ``git worktree`` of ``--baseline-ref`` made in a
+temporary folder); each command runs with ``PYTHONPATH`` pointing at one checkout and its working directory
+there, alternately baseline and current, and the best of ``--repeat`` runs is kept (the machine is shared:
+the minimum is the least disturbed run). Every command is run once untimed first on each side, so
+first-use work (the synthetic X-4 record, numba's compile cache) is excluded ("warm").
+
+Run:  python benchmarks/cli_speed.py [--repeat 3] [--baseline-ref main | --baseline DIR] [--quick]
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+
+PI_SPEC = """\
+name: x4_pi_delay
+description: "X-4 rotor, 20 ms in-loop delay, PI: |S| <= -15 dB on [0.01, 5] rad/s, peak |S| <= 6 dB"
+plant:
+  tf: "23*(s+0.43)/((s+9.6)*(s+0.54))"
+  delay: 0.02
+  input: {name: throttle, unit: PWM}
+  output: {name: rotor speed, unit: rad/s}
+controller:
+  type: PI
+  bounds: {kp: [0, 5], ki: [0, 200]}
+requirements:
+  - {type: sensitivity, max_db: -15, band: [0.01, 5]}
+  - {type: peak_sensitivity, max_db: 6}
+objective: {maximize: integral_gain}
+"""
+
+
+def cases(tmp: Path) -> dict[str, list[str]]:
+    """Label -> command arguments after ``python -m synth`` (``{out}`` is replaced by a fresh folder)."""
+    pi = tmp / "x4_pi_delay.yaml"
+    pi.write_text(PI_SPEC, encoding="utf-8")
+    return {
+        "synth design specs/x4_rotor_from_data.yaml (README main job)":
+            ["design", "specs/x4_rotor_from_data.yaml", "--out", "{out}"],
+        "synth design specs/x4_rotor.yaml": ["design", "specs/x4_rotor.yaml", "--out", "{out}"],
+        "synth design x4_pi_delay.yaml (PI, 20 ms delay, with report)": ["design", str(pi), "--out", "{out}"],
+        "synth check specs/x4_rotor.yaml --controller P(3)":
+            ["check", "specs/x4_rotor.yaml", "--controller", "P(3)"],
+    }
+
+
+def run(root: Path, args: list[str], tmp: Path) -> float:
+    """Wall time of ``python -m synth ARGS`` in ``root`` with ``PYTHONPATH=root``; raises on failure."""
+    out = Path(tempfile.mkdtemp(dir=tmp))
+    argv = [sys.executable, "-m", "synth", *[a.replace("{out}", str(out / "r")) for a in args]]
+    env = {**os.environ, "PYTHONPATH": str(root)}
+    t0 = time.perf_counter()
+    proc = subprocess.run(argv, cwd=root, env=env, capture_output=True, text=True)
+    elapsed = time.perf_counter() - t0
+    if proc.returncode not in (0, 1):  # 1: a design that is infeasible or a check that fails is still a run
+        raise RuntimeError(f"{' '.join(argv)} in {root} exited {proc.returncode}:\n{proc.stderr[-2000:]}")
+    return elapsed
+
+
+def baseline_checkout(ref: str, tmp: Path) -> Path:
+    """A detached ``git worktree`` of ``ref`` in ``tmp`` (removed by :func:`remove_checkout`)."""
+    path = tmp / "baseline"
+    subprocess.run(["git", "-C", str(ROOT), "worktree", "add", "--detach", str(path), ref],
+                   check=True, capture_output=True)
+    return path
+
+
+def remove_checkout(path: Path) -> None:
+    """Remove a worktree made by :func:`baseline_checkout`."""
+    subprocess.run(["git", "-C", str(ROOT), "worktree", "remove", "--force", str(path)], capture_output=True)
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--repeat", type=int, default=3, help="timed runs per command and side (best kept)")
+    parser.add_argument("--baseline-ref", default="main", help="git ref of the baseline (default main)")
+    parser.add_argument("--baseline", type=Path, help="an existing checkout to use as the baseline instead")
+    parser.add_argument("--quick", action="store_true", help="one timed run, and only the check command")
+    args = parser.parse_args()
+    repeat = 1 if args.quick else args.repeat
+    with tempfile.TemporaryDirectory(prefix="synth-cli-speed-") as tmp_name:
+        tmp = Path(tmp_name)
+        base = args.baseline.resolve() if args.baseline else baseline_checkout(args.baseline_ref, tmp)
+        try:
+            todo = cases(tmp)
+            if args.quick:
+                todo = {k: v for k, v in todo.items() if v[0] == "check"}
+            sides = {"baseline": base, "current": ROOT}
+            best: dict[tuple[str, str], float] = {}
+            for label, argv in todo.items():
+                for root in sides.values():  # warm-up: first-use data, caches
+                    run(root, argv, tmp)
+                for _ in range(repeat):
+                    for side, root in sides.items():  # interleaved, so both sides see the same load
+                        t = run(root, argv, tmp)
+                        best[label, side] = min(best.get((label, side), float("inf")), t)
+            print(f"baseline: {base} ({args.baseline_ref if not args.baseline else 'given'}); "
+                  f"current: {ROOT}; best of {repeat}, warm; load average {os.getloadavg()[0]:.1f}")
+            print()
+            print("| command | baseline [s] | current [s] | speed-up |")
+            print("|---|---|---|---|")
+            for label in todo:
+                b, c = best[label, "baseline"], best[label, "current"]
+                print(f"| `{label}` | {b:.2f} | {c:.2f} | {b / c:.1f}x |")
+        finally:
+            if not args.baseline:
+                remove_checkout(base)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,357 @@
+"""Many loops of one plant at once: the responses of ``Loop(plant, c)`` for a list of controllers,
+evaluated vectorized (all loops and frequencies in one array), for the one-parameter feasible set,
+the report's slack curves and feasibility maps (see :meth:`synth.requirements.base.Requirement.batch_slack`).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from synth.controllers import Controller, as_controller
+from synth.freqgrid import log_grids
+from synth.plant import Plant, as_plant
+from synth.stability import bisect_roots
+
+__all__ = ["LoopBatch", "horner"]
+
+
+def horner(coeffs: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """Evaluate one polynomial per row: ``coeffs`` is ``(n, k)`` (descending powers, zero-padded on the
+    left), ``x`` is ``(n, m)`` or broadcastable to it; the same arithmetic as ``np.polyval`` row by row.
+
+    Examples
+    --------
+    >>> horner(np.array([[1.0, 2.0], [0.0, 3.0]]), np.array([[1.0, 2.0], [1.0, 2.0]]))
+    array([[3., 4.],
+           [3., 3.]])
+    """
+    coeffs = np.asarray(coeffs)
+    x = np.asarray(x)
+    y = np.zeros(np.broadcast_shapes(x.shape, coeffs.shape[:1] + (1,) * (x.ndim - 1)), dtype=np.result_type(x, coeffs))
+    for j in range(coeffs.shape[1]):
+        y = y * x + coeffs[:, j].reshape((-1,) + (1,) * (x.ndim - 1))
+    return y
+
+
+def _rows(polys: list[np.ndarray]) -> np.ndarray:
+    width = max(p.size for p in polys)
+    return np.array([np.pad(np.asarray(p, float), (width - p.size, 0)) for p in polys])
+
+
+class LoopBatch:
+    """One plant with many controllers: the loops' responses evaluated all at once (vectorized).
+
+    Row ``i`` is ``Loop(plant, controllers[i])``; every response takes frequencies of shape ``(m,)``
+    (the same for every row) or ``(n, m)`` (one row of frequencies per loop) and returns ``(n, m)``,
+    with the same arithmetic and the same conventions as :class:`Loop` (``L = inf`` at a loop pole on
+    the axis, ``S = 0`` and ``T = 1`` there).
+
+    Parameters
+    ----------
+    plant : Plant
+    controllers : list of Controller
+
+    Examples
+    --------
+    >>> G = Plant.from_string("23*(s+0.43)/((s+9.6)*(s+0.54))")
+    >>> batch = LoopBatch(G, [Controller("P", {"kp": k}) for k in (1.0, 3.0)])
+    >>> w = np.array([1.0, 100.0])
+    >>> from synth.loop import Loop
+    >>> bool(np.allclose(batch.T(w)[1], Loop(G, Controller("P", {"kp": 3.0})).T(w)))
+    True
+    >>> batch.T0().round(4)
+    array([0.6561, 0.8513])
+    """
+
+    def __init__(self, plant: Plant, controllers: list[Controller]) -> None:
+        self.controllers = [as_controller(c) for c in controllers]
+        tfs = [c.tf() for c in self.controllers]
+        self.cnum = _rows([n for n, _ in tfs])
+        self.cden = _rows([d for _, d in tfs])
+        corners = [_corners(n, d) for n, d in tfs]
+        self._corner_lo = np.array([c[0] for c in corners])
+        self._corner_hi = np.array([c[1] for c in corners])
+        self._dc = np.array([c.dc_gain() for c in self.controllers])
+        self._set_plant(as_plant(plant))
+
+    def with_plant(self, plant: Plant) -> LoopBatch:
+        """The same controllers around another plant (the controllers' polynomials are reused).
+
+        Examples
+        --------
+        >>> b = LoopBatch(Plant.from_string("1/(s+1)"), [Controller("P", {"kp": 1.0})])
+        >>> b.with_plant(Plant.from_string("2/(s+1)")).T0().round(4)
+        array([0.6667])
+        """
+        new = object.__new__(LoopBatch)
+        new.__dict__.update({k: v for k, v in self.__dict__.items()
+                             if k in ("controllers", "cnum", "cden", "_corner_lo", "_corner_hi", "_dc")})
+        new._set_plant(as_plant(plant))
+        return new
+
+    def _set_plant(self, plant: Plant) -> None:
+        self.plant = plant
+        self.num = _row_product(self.cnum, plant.num)
+        self.den = _row_product(self.cden, plant.den)
+        p_lo, p_hi = _corners(plant.num, plant.den)
+        if plant.delay > 0:
+            p_lo, p_hi = min(p_lo, 1.0 / plant.delay), max(p_hi, 1.0 / plant.delay)
+        lo, hi = np.fmin(self._corner_lo, p_lo), np.fmax(self._corner_hi, p_hi)
+        none = np.isnan(lo)
+        self.frequency_ranges = np.column_stack([np.where(none, 1e-2, lo / 100.0), np.where(none, 1e2, hi * 100.0)])
+        """Each loop's :attr:`Loop.frequency_range`, ``(n, 2)``."""
+
+    def __len__(self) -> int:
+        return len(self.controllers)
+
+    def _w(self, w: Any) -> np.ndarray:
+        w = np.asarray(w, dtype=float)
+        return np.broadcast_to(w, (len(self), w.shape[-1])) if w.ndim == 1 else w
+
+    def L(self, w: Any) -> np.ndarray:
+        """Loop responses ``C_i(jw) G(jw)``, ``(n, m)``."""
+        s = 1j * self._w(w)
+        d = horner(self.den, s)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            L = horner(self.num, s) / d * np.exp(-s * self.plant.delay)
+        return np.where(d == 0, complex(np.inf, 0.0), L)
+
+    def C(self, w: Any) -> np.ndarray:
+        """Controller responses ``C_i(jw)``, ``(n, m)``."""
+        s = 1j * self._w(w)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            return horner(self.cnum, s) / horner(self.cden, s)
+
+    def S(self, w: Any) -> np.ndarray:
+        """Sensitivities ``1/(1 + L)``."""
+        L = self.L(w)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            return np.where(_infinite(L), 0j, 1.0 / (1.0 + L))
+
+    def T(self, w: Any) -> np.ndarray:
+        """Complementary sensitivities ``L/(1 + L)``."""
+        L = self.L(w)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            T = L / (1.0 + L)
+        return np.where(_infinite(L), 1.0 + 0j, T)
+
+    def KS(self, w: Any) -> np.ndarray:
+        """Control sensitivities ``C/(1 + C G)`` (``1/G`` where a controller has a pole on the axis)."""
+        w = self._w(w)
+        C = self.C(w)
+        G = self.plant.freqresp(w)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            KS = C / (1.0 + C * G)
+            return np.where(_infinite(C) | np.isnan(C), 1.0 / G, KS)
+
+    def T0(self) -> np.ndarray:
+        """``|T(0)|`` of every loop (1 with integral action)."""
+        l0 = self._dc * self.plant.dc_gain()
+        with np.errstate(divide="ignore", invalid="ignore"):
+            t0 = np.abs(l0 / (1.0 + l0))
+        return np.where(np.isinf(l0), 1.0, t0)
+
+    def controller_dc_gains(self) -> np.ndarray:
+        """``C_i(0)`` (``inf`` with integral action)."""
+        return self._dc.copy()
+
+    def gain_crossovers(self) -> list[np.ndarray]:
+        """Each loop's :meth:`Loop.gain_crossovers` (exact polynomial roots, one eigenvalue problem per
+        degree for all loops of that degree).
+
+        Examples
+        --------
+        >>> b = LoopBatch(Plant.from_string("10/(s+1)"), [Controller("P", {"kp": k}) for k in (1.0, 0.05)])
+        >>> [w.round(4) for w in b.gain_crossovers()]
+        [array([9.9499]), array([], dtype=float64)]
+        """
+        q = _pad_sub(_row_magnitude_squared(self.num), _row_magnitude_squared(self.den))
+        out = []
+        for r in _row_roots(q):
+            keep = (np.abs(r.imag) <= 1e-9 * (1 + np.abs(r.real))) & (r.real > 0)
+            out.append(np.sort(np.sqrt(r[keep].real)))
+        return out
+
+    def phase_and_delay_margins(self) -> tuple[np.ndarray, np.ndarray]:
+        """Each loop's phase margin (deg) and delay margin (s) as :meth:`Loop.margins` gives them.
+
+        Examples
+        --------
+        >>> G = Plant.from_string("23*(s+0.43)/((s+9.6)*(s+0.54))", delay=0.02)
+        >>> pm, dm = LoopBatch(G, [Controller("P", {"kp": 3.0})]).phase_and_delay_margins()
+        >>> round(float(pm[0]), 1)
+        19.8
+        """
+        crossings = self.gain_crossovers()
+        rows = np.concatenate([np.full(c.size, i) for i, c in enumerate(crossings)]).astype(int)
+        wc = np.concatenate(crossings) if rows.size else np.zeros(0)
+        pm, dm = np.full(len(self), np.inf), np.full(len(self), np.inf)
+        if wc.size:
+            s = 1j * wc
+            with np.errstate(divide="ignore", invalid="ignore"):
+                L = horner(self.num[rows], s[:, None])[:, 0] / horner(self.den[rows], s[:, None])[:, 0] \
+                    * np.exp(-s * self.plant.delay)
+            this = (np.degrees(np.angle(L)) + 360.0) % 360.0 - 180.0
+            np.minimum.at(pm, rows, this)
+            with np.errstate(divide="ignore", invalid="ignore"):
+                np.minimum.at(dm, rows, np.where(this > 0, np.radians(this) / wc, 0.0))
+        return pm, dm
+
+    def upper_gain_margins(self, limit: float = 1e4, per_decade: int = 100) -> np.ndarray:
+        """Each loop's smallest gain factor above 1 that puts a closed-loop root on the imaginary axis
+        (``inf`` if none up to ``limit``): the ``k_hi`` of :func:`synth.stability.gain_margin_factors`,
+        found for all loops at once from the sign changes of ``Im L(jw)`` where ``Re L < 0`` on a log grid
+        four decades beyond :attr:`frequency_ranges` (and ``w = 0``), refined by bisection.
+
+        Examples
+        --------
+        >>> b = LoopBatch(Plant.from_string("1/(s+1)^3"), [Controller("P", {"kp": k}) for k in (1.0, 2.0)])
+        >>> b.upper_gain_margins().round(6)
+        array([8., 4.])
+        """
+        n = len(self)
+        k = np.full(n, np.inf)
+        todo = np.arange(n)
+        for cap in (10.0, limit):  # as gain_margin_factors: most loops have a boundary below 10
+            if todo.size == 0:
+                break
+            r = self._boundary_gains(todo, cap, per_decade) if self.plant.delay > 0 else self._rational_boundary_gains()
+            r = r if self.plant.delay > 0 else np.where(r <= cap, r, np.inf)[todo]
+            r = np.where((r > 1.0 + 1e-12) & (r <= limit), r, np.inf)
+            k[todo] = r
+            todo = todo[~np.isfinite(r)]
+        l0 = self._dc * self.plant.dc_gain()
+        with np.errstate(divide="ignore", invalid="ignore"):
+            r0 = np.where(np.isfinite(l0) & (l0 < 0), -1.0 / l0, np.inf)
+        r0 = np.where((r0 > 1.0 + 1e-12) & (r0 <= limit), r0, np.inf)
+        return np.minimum(k, r0)
+
+    def _rational_boundary_gains(self) -> np.ndarray:
+        """Without a delay: smallest ``-1/L(jw)`` above 1 over the exact phase crossovers (real roots of
+        ``Im num(jw) conj(den(jw))``, batched polynomial roots)."""
+        nr, ni = _row_axis_parts(self.num)
+        dr, di = _row_axis_parts(self.den)
+        h = _pad_sub(_row_poly_product(ni, dr), _row_poly_product(nr, di))
+        out = np.full(len(self), np.inf)
+        roots = _row_roots(h)
+        rows = np.concatenate([np.full(r.size, i) for i, r in enumerate(roots)]).astype(int)
+        if rows.size == 0:
+            return out
+        wr = np.concatenate(roots)
+        keep = (np.abs(wr.imag) <= 1e-9 * (1 + np.abs(wr.real))) & (wr.real > 0)
+        rows, w = rows[keep], wr.real[keep]
+        Lc = self._rows_L(rows, w)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            r = np.where(Lc.real < 0, -1.0 / Lc.real, np.inf)
+        r = np.where(r > 1.0 + 1e-12, r, np.inf)
+        np.minimum.at(out, rows, r)
+        return out
+
+    def _boundary_gains(self, which: np.ndarray, cap: float, per_decade: int) -> np.ndarray:
+        """Smallest factor ``-1/L(jw)`` above 1 over the phase crossovers of the loops ``which`` with
+        ``|L| >= 0.5/cap`` (with a delay the grid resolves its phase up to there)."""
+        ranges = self.frequency_ranges[which]
+        grid = log_grids(ranges[:, 0] * 1e-2, ranges[:, 1] * 1e2, per_decade)
+        if self.plant.delay > 0:  # a few points per half turn of the delay's phase where |L| >= 0.5/cap
+            big = np.abs(self._rows_L(np.repeat(which, grid.shape[1]), grid.ravel())).reshape(grid.shape) >= 0.5 / cap
+            w_top = 1.2 * float(np.max(np.where(big, grid, 0.0)))
+            count = min(int(np.ceil(w_top * self.plant.delay / 0.3)) + 2, 20000)
+            extra = np.linspace(0.0, w_top, count)[1:]
+            grid = np.sort(np.concatenate([grid, np.broadcast_to(extra, (which.size, extra.size))], axis=1), axis=1)
+        rows = np.repeat(which, grid.shape[1])
+        L = self._rows_L(rows, grid.ravel()).reshape(grid.shape)
+        im = np.where(_infinite(L), np.nan, L.imag)
+        local, idx = np.nonzero(np.sign(im[:, :-1]) * np.sign(im[:, 1:]) < 0)
+        out = np.full(which.size, np.inf)
+        if local.size:
+            rows = which[local]
+            wc = bisect_roots(lambda w: self._rows_L(rows, w).imag, grid[local, idx], grid[local, idx + 1])
+            Lc = self._rows_L(rows, wc)
+            with np.errstate(divide="ignore", invalid="ignore"):
+                r = np.where(Lc.real < 0, -1.0 / Lc.real, np.inf)
+            r = np.where((r > 1.0 + 1e-12) & (r <= cap), r, np.inf)
+            np.minimum.at(out, local, r)
+        return out
+
+    def _rows_L(self, rows: np.ndarray, w: np.ndarray) -> np.ndarray:
+        s = 1j * np.asarray(w, float)[:, None]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            return (horner(self.num[rows], s) / horner(self.den[rows], s))[:, 0] * np.exp(-s[:, 0] * self.plant.delay)
+
+
+def _corners(*polys: np.ndarray) -> tuple[float, float]:
+    """Smallest and largest root magnitude above 1e-12 of the polynomials (nan, nan if none), as
+    :func:`synth.freqgrid.characteristic_range` counts them."""
+    mags: list[float] = []
+    for p in polys:
+        p = np.asarray(p, dtype=float)
+        if p.size > 1:
+            r = np.abs(np.roots(p))
+            mags.extend(r[r > 1e-12].tolist())
+    return (min(mags), max(mags)) if mags else (np.nan, np.nan)
+
+
+def _row_magnitude_squared(rows: np.ndarray) -> np.ndarray:
+    """Row-wise :func:`synth.polynomials.magnitude_squared_in_w2` (zero-padded on the left)."""
+    k = rows.shape[1]
+    mirrored = rows * (-1.0) ** np.arange(k - 1, -1, -1)
+    q = np.zeros((rows.shape[0], 2 * k - 1))
+    for j in range(k):
+        q[:, j:j + k] += rows * mirrored[:, j:j + 1]
+    even = q[:, ::-1][:, 0::2] * (-1.0) ** np.arange((2 * k) // 2)
+    return even[:, ::-1]
+
+
+def _row_axis_parts(rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Real and imaginary parts of ``p(jw)`` as real polynomials in ``w`` (row-wise)."""
+    k = rows.shape[1]
+    power = np.arange(k - 1, -1, -1)
+    unit = 1j ** power
+    return rows * np.round(unit.real), rows * np.round(unit.imag)
+
+
+def _row_poly_product(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    out = np.zeros((a.shape[0], a.shape[1] + b.shape[1] - 1))
+    for j in range(b.shape[1]):
+        out[:, j:j + a.shape[1]] += a * b[:, j:j + 1]
+    return out
+
+
+def _pad_sub(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    width = max(a.shape[1], b.shape[1])
+    return np.pad(a, ((0, 0), (width - a.shape[1], 0))) - np.pad(b, ((0, 0), (width - b.shape[1], 0)))
+
+
+def _row_roots(rows: np.ndarray) -> list[np.ndarray]:
+    """Roots of each row's polynomial (leading zeros dropped), one batched eigenvalue problem per degree."""
+    lead = np.argmax(rows != 0, axis=1)
+    zero = ~np.any(rows != 0, axis=1)
+    degree = np.where(zero, 0, rows.shape[1] - 1 - lead)
+    out: list[np.ndarray] = [np.zeros(0, complex)] * rows.shape[0]
+    for d in np.unique(degree):
+        sel = np.flatnonzero(degree == d)
+        if d < 1:
+            continue
+        coeffs = np.array([rows[i, lead[i]:] for i in sel])
+        comp = np.zeros((len(sel), d, d))
+        comp[:, 0, :] = -coeffs[:, 1:] / coeffs[:, :1]
+        comp[:, np.arange(1, d), np.arange(d - 1)] = 1.0
+        roots = np.linalg.eigvals(comp)
+        for j, i in enumerate(sel):
+            out[i] = roots[j]
+    return out
+
+
+def _row_product(rows: np.ndarray, poly: np.ndarray) -> np.ndarray:
+    """Each row's polynomial times ``poly`` (rows zero-padded on the left)."""
+    poly = np.asarray(poly, dtype=float)
+    out = np.zeros((rows.shape[0], rows.shape[1] + poly.size - 1))
+    for j, c in enumerate(poly):
+        out[:, j:j + rows.shape[1]] += rows * c
+    return out
+
+
+def _infinite(x: np.ndarray) -> np.ndarray:
+    return np.isinf(x.real) | np.isinf(x.imag)
