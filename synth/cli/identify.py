@@ -42,7 +42,11 @@ with the input held between samples (a step stays a step) and the output interpo
 --x4-demo uses a SYNTHETIC X-4 step train generated from the seed paper's model
 (not measured data; see synth.ident.x4_record).
 
-exit codes: 0 identified, 2 bad input"""
+A fit that fails (IPOPT diverged or hit its iteration limit, parameters at absurd magnitudes,
+a fitted delay outside the record, a fit no better than the output's mean or than noise) is
+never written as a result: one line says what failed and what to try, exit 1.
+
+exit codes: 0 identified, 1 the fit failed, 2 bad input"""
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
@@ -91,7 +95,7 @@ def _demo_defaults(args: argparse.Namespace) -> None:
 def run(args: argparse.Namespace) -> int:
     from synth.data import load_record
     from synth.data.readers import parse_column_map
-    from synth.errors import ModelError, SynthError
+    from synth.errors import FitError, ModelError, SynthError
     from synth.ident.structure import parse_structure
     from synth.ident.timefit import identify
     from synth.outputs import OutputDir, dump_json, write_json
@@ -110,6 +114,9 @@ def run(args: argparse.Namespace) -> int:
                          output_unit=args.output_unit, columns=parse_column_map(args.columns))
     try:
         result = identify(record, structure, args.delay, args.sensor, args.average)
+    except FitError as exc:  # the options were valid; the structure does not fit this record
+        print(f"synth identify: {exc}", file=sys.stderr)
+        return 1
     except ModelError as exc:
         where = "--delay" if "delay" in exc.message and "structure" not in exc.message else None
         raise (exc.located(where) if where else exc) from None

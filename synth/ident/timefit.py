@@ -37,7 +37,8 @@ from scipy.stats import t as student_t
 
 from synth.data.coerce import RecordLike, as_record
 from synth.data.record import Record
-from synth.errors import DataError, ModelError
+from synth.errors import DataError, FitError, ModelError
+from synth.ident.fit_failure import fit_failure
 from synth.ident.sim_error_problem import SimulationErrorProblem
 from synth.ident.srivc import linear_initial_model, map_to_structure
 from synth.ident.steps import StepAverage, average_steps, find_steps
@@ -229,6 +230,9 @@ def fit_structure(record: Record, structure: Structure | str, delay: str | float
         Bad structure, sensor or delay option.
     DataError
         Fewer samples than parameters, or a periodic fit of a model with an integrator.
+    FitError
+        The fit failed (see :func:`fit_failure`): diverged, stopped at a limit, absurd
+        parameters, a delay outside the record, or no better than the output's mean.
 
     Examples
     --------
@@ -343,13 +347,23 @@ def fit_structure(record: Record, structure: Structure | str, delay: str | float
         par = prob.inputs(w, m, f_hat)
     d_hat = m * dt + f_hat
     yhat = np.asarray(prob.yhat_fn(xs, par)).ravel()
+    y_fit = y if mask is None else y[mask]
+    resid_fit = (y - yhat) if mask is None else (y - yhat)[mask]
+    fit_pct = float(100.0 * (1.0 - np.linalg.norm(resid_fit) / np.linalg.norm(y_fit - np.mean(y_fit))))
+    failure = fit_failure(dict(zip(st.parameters, theta.tolist())), theta0, st_info.get("status"),
+                          bool(st_info.get("success")), fit_pct, d_hat if fit_delay else None, n * dt,
+                          int(y_fit.size), p_total)
+    if failure:
+        raise FitError(f"fit of {st.formula!r} failed: {failure}; try another structure, a fixed delay or a shorter "
+                       f"part of the record", where=record.source, status=st_info.get("status"),
+                       parameters={**dict(zip(st.parameters, theta.tolist())), delay_name: float(d_hat)})
+    d_hat = max(d_hat, 0.0)
     J = np.asarray(prob.jac_fn(xs, par))
     scale_vec = np.r_[prob.scale, 1.0, 1.0] if fit_delay else np.r_[prob.scale, 1.0]
     J = J / scale_vec[None, :]
     resid = y - yhat
-    y_fit = y
     if mask is not None:
-        J, resid, y_fit = J[mask], resid[mask], y[mask]
+        J, resid = J[mask], resid[mask]
     dof = resid.size - J.shape[1]
     s2 = float(np.sum(resid**2) / dof)
     JtJ = J.T @ J
@@ -366,7 +380,6 @@ def fit_structure(record: Record, structure: Structure | str, delay: str | float
     if not fit_delay:
         params[delay_name], std[delay_name] = float(d_hat), 0.0
     ci = {k: (params[k] - tq * std[k], params[k] + tq * std[k]) for k in params}
-    fit_pct = float(100.0 * (1.0 - np.linalg.norm(resid) / np.linalg.norm(y_fit - np.mean(y_fit))))
     plant = st.plant(theta, delay=d_hat, input=record.input, output=record.output, label="identified")
     measured = plant.series(sensor) if sensor is not None else plant
     if sensor is not None:
