@@ -8,8 +8,9 @@ import pytest
 from synth.data import record_from_arrays
 from synth.errors import FitError, SynthError
 from synth.ident.fit_failure import fit_failure
+from synth.ident.identification import identify
 from synth.ident.simulate import simulate_plant
-from synth.ident.timefit import fit_structure, identify
+from synth.ident.timefit import fit_structure
 from synth.plant import Plant
 
 T = np.arange(0, 6, 0.01)

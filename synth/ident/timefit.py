@@ -4,7 +4,8 @@ The model, its exact zero-order-hold discretization with a fractional delay and 
 Gauss-Newton IPOPT problem are in :mod:`synth.ident.sim_error_problem`; the
 deterministic start (SRIVC on a delay grid, mapped onto the structure) in
 :mod:`synth.ident.srivc`. Here: the fit itself (the whole-sample delay search, the
-fallback starts), its uncertainty and :func:`identify` (a step train is averaged first).
+fallback starts) and its uncertainty; :func:`synth.ident.identification.identify` averages a
+step train first.
 
 Delay search
 ------------
@@ -35,17 +36,15 @@ from typing import Any
 import numpy as np
 from scipy.stats import t as student_t
 
-from synth.data.coerce import RecordLike, as_record
 from synth.data.record import Record
 from synth.errors import DataError, FitError, ModelError
 from synth.ident.fit_failure import fit_failure
 from synth.ident.sim_error_problem import SimulationErrorProblem
 from synth.ident.srivc import linear_initial_model, map_to_structure
-from synth.ident.steps import StepAverage, average_steps, find_steps
 from synth.ident.structure import Structure, parse_structure
 from synth.plant import Plant
 
-__all__ = ["IdentifyResult", "TimeFitResult", "fit_structure", "identify"]
+__all__ = ["TimeFitResult", "fit_structure"]
 
 # ------------------------------------------------------------------- results
 
@@ -387,89 +386,3 @@ def fit_structure(record: Record, structure: Structure | str, delay: str | float
     return TimeFitResult(st, params, std, ci, names, cov, float(d_hat), fit_delay, b_hat, float(sd[-1]),
                          fit_pct, float(np.sqrt(s2)), plant, sensor, measured, initial_out, info, t.copy(), y.copy(),
                          yhat, u0, periodic)
-
-
-# ------------------------------------------------------------------ identify
-
-
-@dataclass(frozen=True, eq=False)
-class IdentifyResult:
-    """Identification of a record: the step averaging (if any) and the fit.
-
-    Examples
-    --------
-    >>> from synth.ident.x4_record import x4_step_train, SENSOR
-    >>> clean = x4_step_train(periods=1, noise_std=0.0)  # noise-free, fitted as it is (no averaging)
-    >>> res = identify(clean, "k*(s+z)/((s+p1)*(s+p2))", delay="fit", sensor=SENSOR, average="none")
-    >>> sorted(round(v, 5) for v in res.fit.parameters.values())
-    [0.02, 0.43, 0.54, 9.6, 23.0]
-    """
-
-    record: Record
-    fit: TimeFitResult
-    average: StepAverage | None
-
-    @property
-    def plant(self) -> Plant:
-        """The identified plant ``F`` (with its delay)."""
-        return self.fit.plant
-
-    def to_dict(self) -> dict[str, Any]:
-        """The fit's JSON plus ``record`` and ``averaging``."""
-        return {**self.fit.to_dict(), "record": self.record.to_dict(),
-                "averaging": self.average.to_dict() if self.average is not None else None}
-
-
-def _two_level(u: np.ndarray) -> bool:
-    lo, hi = float(np.min(u)), float(np.max(u))
-    near = (np.abs(u - lo) <= 0.05 * (hi - lo)) | (np.abs(u - hi) <= 0.05 * (hi - lo))
-    return bool(np.mean(near) >= 0.98)
-
-
-def identify(record: RecordLike, structure: Structure | str, delay: str | float | None = None,
-             sensor: Plant | str | None = None, average: str = "auto") -> IdentifyResult:
-    """Identify a structure from a record: average a step train if there is one, then fit.
-
-    Parameters
-    ----------
-    record : Record, tuple of arrays, ndarray, mapping, DataFrame, str or Path
-        What :func:`synth.data.as_record` accepts: ``(t, u, y)`` arrays, an N x 3 array,
-        columns (taken as time, input, output in that order), a CSV/MAT path or a Record.
-    structure : Structure or str
-    delay : {"fit", float, None}
-        See :func:`fit_structure`.
-    sensor : Plant or str, optional
-        Known sensor in series.
-    average : {"auto", "cycle", "edge", "none"}
-        ``"auto"``: a two-level input with at least two steps is averaged
-        (:func:`synth.ident.steps.average_steps`), anything else is fitted as it is.
-
-    Returns
-    -------
-    IdentifyResult
-
-    Raises
-    ------
-    DataError
-        ``record`` is not a record, or its columns fail the record's checks.
-
-    Examples
-    --------
-    >>> from synth.ident.simulate import simulate_plant
-    >>> t = np.arange(0, 3, 0.01); u = np.where(t >= 0.5, 1.0, 0.0)
-    >>> y = simulate_plant(Plant.from_string("2/(s+3)"), t, u)
-    >>> identify((t, u, y), "k/(s+p)", average="none").plant.to_string(4)
-    '2/(s+3)'
-    """
-    record = as_record(record)
-    if average not in ("auto", "cycle", "edge", "none"):
-        raise ModelError(f"average must be 'auto', 'cycle', 'edge' or 'none', got {average!r}")
-    avg = None
-    data, periodic = record, False
-    if average != "none" and _two_level(record.u):
-        steps = find_steps(record)
-        if steps.count >= 2 or average in ("cycle", "edge"):
-            avg = average_steps(record, steps, "auto" if average == "auto" else average)
-            data, periodic = avg.record(), avg.periodic
-    fit = fit_structure(data, structure, delay, sensor, periodic)
-    return IdentifyResult(record, fit, avg)
