@@ -168,6 +168,8 @@ def _print(result: Any, args: argparse.Namespace, json_path: Path, figures: list
         print(f"averaged {avg.count} {avg.mode}s ({avg.up} up, {avg.down} down steps, {avg.dropped} dropped): "
               f"SNR {avg.snr_before_db:.1f} dB -> {avg.snr_after_db:.1f} dB "
               f"(noise std {avg.noise_std_before:.3g} -> {avg.noise_std_after:.3g}, step {avg.step_size:.4g})")
+    if result.whole_record_note:
+        print(result.whole_record_note)
     print(table(["parameter", "value", "std", "95 % interval"], rows))
     print(f"fit {fit.fit_percent:.2f} %, residual std {fit.residual_std:.3g}, "
           f"IPOPT {fit.solver.get('status')} ({fit.solver.get('iterations')} iterations)")

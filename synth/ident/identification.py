@@ -24,7 +24,7 @@ from synth.ident.structure import Structure, parse_structure
 from synth.ident.timefit import TimeFitResult, fit_structure
 from synth.plant import Plant
 
-__all__ = ["IdentifyResult", "identify"]
+__all__ = ["IdentifyResult", "identify", "settling_time"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -46,6 +46,7 @@ class IdentifyResult:
     directions: DirectionComparison | None = None
     direction_note: str = ""
     by_direction: bool = False
+    whole_record_note: str = ""
 
     @property
     def plant(self) -> Plant:
@@ -62,7 +63,8 @@ class IdentifyResult:
         return {**self.fit.to_dict(), "record": self.record.to_dict(),
                 "averaging": self.average.to_dict() if self.average is not None else None,
                 "directions": self.directions.to_dict() if self.directions is not None else None,
-                "direction_note": self.direction_note, "by_direction": self.by_direction}
+                "direction_note": self.direction_note, "by_direction": self.by_direction,
+                "whole_record": self.whole_record_note}
 
 
 def _two_level(u: np.ndarray) -> bool:
@@ -88,6 +90,10 @@ def identify(record: RecordLike, structure: Structure | str, delay: str | float 
     average : {"auto", "cycle", "edge", "none"}
         ``"auto"``: a two-level input with at least two steps is averaged
         (:func:`synth.ident.steps.average_steps`), anything else is fitted as it is.
+        Edge windows assume the plant at rest before each step: when the fitted model's
+        settling time (:func:`settling_time`) is longer than a window, the whole record is
+        fitted instead, started from the edge fit, with its start-up (one settling time, at most
+        a quarter of the record) weighted 0 (``whole_record_note`` says so).
         An averaged train with up and down steps is also fitted per direction and the two
         fits compared (:func:`synth.ident.directions.fit_by_direction`); if that comparison
         cannot be made the reason is in ``direction_note``.
@@ -132,6 +138,9 @@ def identify(record: RecordLike, structure: Structure | str, delay: str | float 
         raise DataError("by direction needs a step train with up and down steps (averaged, not average='none')",
                         where=record.source)
     fit = fit_structure(data, structure, delay, sensor, periodic)
+    whole = ""
+    if avg is not None and avg.mode == "edge" and average == "auto":
+        fit, whole = _refit_unsettled(record, avg, fit, structure, delay, sensor)
     directions, note = None, ""
     if two_ways:
         try:
@@ -140,4 +149,39 @@ def identify(record: RecordLike, structure: Structure | str, delay: str | float 
             if by_direction:
                 raise
             note = f"up and down steps not compared: {exc}"
-    return IdentifyResult(record, fit, avg, directions, note, by_direction)
+    return IdentifyResult(record, fit, avg, directions, note, by_direction, whole)
+
+
+def settling_time(plant: Plant, fraction: float = np.exp(-5.0)) -> float:
+    """Time for the slowest mode of ``plant`` to decay to ``fraction`` of its start, plus the delay (inf if not stable).
+
+    Examples
+    --------
+    >>> round(settling_time(Plant.from_string("1/((s+1)*(s+10))", delay=0.1)), 3)
+    5.1
+    """
+    poles = np.roots(np.atleast_1d(plant.den))
+    if poles.size == 0:
+        return float(plant.delay)
+    slowest = float(np.min(-poles.real))
+    return float(np.log(1.0 / fraction) / slowest + plant.delay) if slowest > 0 else float("inf")
+
+
+def _refit_unsettled(record: Record, avg: StepAverage, fit: TimeFitResult, structure: Structure,
+                     delay: str | float | None, sensor: Plant | str | None) -> tuple[TimeFitResult, str]:
+    """Edge windows assume the plant at rest before each step; if the fitted model does not settle within
+    a window, fit the whole record instead (from the edge fit, the start-up weighted 0), which assumes nothing."""
+    window = float(avg.t[-1] + record.dt)
+    settle = settling_time(fit.measured)
+    if not np.isfinite(settle) or settle <= window:
+        return fit, ""
+    skip = min(settle, 0.25 * record.duration)
+    weights = ((record.t - record.t[0]) >= skip).astype(float)
+    initial = {**fit.parameters}
+    try:
+        whole = fit_structure(record, structure, delay, sensor, False, initial=initial, weights=weights)
+    except (DataError, FitError) as exc:
+        return fit, f"the edge windows ({window:.3g} s) are shorter than the model's settling time ({settle:.3g} s); " \
+                    f"the whole-record fit failed ({exc}), so the edge fit is kept (biased)"
+    return whole, (f"the edge windows ({window:.3g} s) are shorter than the model's settling time ({settle:.3g} s): "
+                   f"fitted the whole record instead, the first {skip:.3g} s (start-up from an unknown state) weighted 0")
