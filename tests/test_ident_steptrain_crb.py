@@ -5,7 +5,6 @@ of the simulated output, F = J^T J / sigma^2)."""
 from __future__ import annotations
 
 import numpy as np
-import pytest
 
 from synth.ident.identification import identify
 from synth.ident.simulate import simulate_plant
