@@ -71,3 +71,19 @@ def test_cli_exit_1_one_line_nothing_written(run_cli, tmp_path):
     assert len(lines) == 1 and "fit of 'k/(s+p)' failed: the fitted delay" in lines[0], res.err
     assert "--delay:" not in lines[0] and "try another structure, a fixed delay" in lines[0]
     assert not (out / "identify.json").exists()
+
+
+def test_real_thrust_stand_staircase_second_order_fit_fails_exit_1(run_cli, tmp_path):
+    """The issue's real BLDC thrust-stand log: `K/((T1*s+1)*(T2*s+1)) --delay fit` diverged (K = 2e24) and was
+    written as a result. README: an up-only ESC staircase logged at 20-50 Hz, "not high-rate transient step
+    responses", so the two time constants are not in the record."""
+    from tests.conftest import shared_path
+
+    path = shared_path("data", "esc_thrust_stand_1s", "StepsTest20230624_2023-06-24_190243.csv")
+    out = tmp_path / "out"
+    res = run_cli("identify", "--data", str(path), "--time", "Time (s)", "--input", "ESC signal", "--output", "Thrust",
+                  "--structure", "K/((T1*s+1)*(T2*s+1))", "--delay", "fit", "--out", str(out))
+    assert res.code == 1 and res.out == ""
+    lines = res.err.strip().splitlines()
+    assert len(lines) == 1 and "fit of 'K/((T1*s+1)*(T2*s+1))' failed: parameters at absurd magnitudes" in lines[0]
+    assert not out.exists() or not (out / "identify.json").exists()
