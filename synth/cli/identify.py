@@ -141,6 +141,7 @@ def run(args: argparse.Namespace) -> int:
         figures.append(train_figure(record, folder.claim("train.png")))
     json_path.write_text(dump_json(payload), encoding="utf-8")
     folder.commit()
+    json_path, figures = folder.final(json_path), [folder.final(f) for f in figures]  # the paths after the move
     if args.json == "-":
         sys.stdout.write(dump_json(payload))
     elif args.json:
