@@ -64,11 +64,13 @@ class OutputExistsError(SynthError):
     """Writing would overwrite a file that synth did not write."""
 
 
-class FitError(SynthError):
+class FitError(SynthError, RuntimeError):
     """A fit ran but failed: it diverged, hit the iteration limit, or its result is not a model of the record.
 
     Not bad input (the command line exits 1, not 2): the record and the options were
     valid, the structure just does not fit them. The message says what failed and what to try.
+    Also a ``RuntimeError``, so code that tries several fits and skips the ones that fail at
+    run time (the gap attribution's re-fits) keeps doing so.
 
     Parameters
     ----------

@@ -36,8 +36,9 @@ def test_a_delay_fitted_below_zero_names_the_fit_not_the_option():
     assert "delay" in info.value.parameters and info.value.parameters["delay"] < 0
 
 
-def test_iteration_limit_is_a_failure_with_the_solver_status():
-    with pytest.raises(FitError, match="IPOPT stopped with Maximum_Iterations_Exceeded") as info:
+def test_iteration_limit_on_noise_fails_with_the_solver_status():
+    """IPOPT crawls on the flat cost of noise: stopped at the limit (the status is kept) and not above noise."""
+    with pytest.raises(FitError, match="no more of the output than noise") as info:
         identify((T, U, _noise_only()), "K/(T*s+1)", delay="fit")
     assert info.value.status == "Maximum_Iterations_Exceeded"
 
@@ -52,6 +53,10 @@ def test_failure_rules():
     assert "outside [0, 10) s" in fit_failure(ok, start, "Solve_Succeeded", True, 95.0, 10.0, 10.0)
     assert "no better than its mean" in fit_failure(ok, start, "Solve_Succeeded", True, -0.5, None, 10.0)
     assert fit_failure(ok, start, "Solve_Succeeded", True, 95.0, -1e-8, 10.0) == ""  # IPOPT's bound relaxation
+    limit = "Maximum_Iterations_Exceeded"
+    assert limit in fit_failure(ok, start, limit, False, 95.0, 0.1, 10.0, remaining_step=3.0)  # far from converged
+    assert fit_failure(ok, start, limit, False, 95.0, 0.1, 10.0, remaining_step=0.01) == ""  # converged as data tell
+    assert "Diverging" in fit_failure(ok, start, "Diverging_Iterates", False, 95.0, 0.1, 10.0, remaining_step=0.0)
 
 
 def test_a_good_fit_is_unchanged():

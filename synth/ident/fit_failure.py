@@ -9,7 +9,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.stats import f as f_dist
 
-__all__ = ["ABSURD_FACTOR", "FAILED_STATUSES", "SIGNIFICANCE", "fit_failure"]
+__all__ = ["ABSURD_FACTOR", "CONVERGED_WITHIN", "FAILED_STATUSES", "LIMIT_STATUSES", "SIGNIFICANCE", "fit_failure"]
 
 #: IPOPT return statuses that end a fit without a usable optimum
 FAILED_STATUSES = ("Diverging_Iterates", "Maximum_Iterations_Exceeded", "Maximum_CpuTime_Exceeded",
@@ -17,6 +17,12 @@ FAILED_STATUSES = ("Diverging_Iterates", "Maximum_Iterations_Exceeded", "Maximum
                    "Error_In_Step_Computation", "Not_Enough_Degrees_Of_Freedom", "Invalid_Problem_Definition",
                    "Internal_Error", "Insufficient_Memory", "Unrecoverable_Exception", "NonIpopt_Exception_Thrown",
                    "User_Requested_Stop", "Invalid_Option")
+
+#: statuses of a solver stopped at a limit: accepted if the remaining step is small (see :func:`fit_failure`)
+LIMIT_STATUSES = ("Maximum_Iterations_Exceeded", "Maximum_CpuTime_Exceeded", "Maximum_WallTime_Exceeded")
+
+#: less than this many standard errors still to go (see :func:`fit_failure`) counts as converged
+CONVERGED_WITHIN = 0.1
 
 #: p-value of the F-test above which a fit explains no more than noise (see :func:`fit_failure`)
 SIGNIFICANCE = 1e-3
@@ -26,7 +32,8 @@ ABSURD_FACTOR = 1e8
 
 
 def fit_failure(parameters: dict[str, float], start: np.ndarray, status: str | None, success: bool,
-                fit_percent: float, delay: float | None, duration: float, samples: int = 0, free: int = 0) -> str:
+                fit_percent: float, delay: float | None, duration: float, samples: int = 0, free: int = 0,
+                remaining_step: float = float("inf")) -> str:
     """Why a finished fit is not a result, or ``""`` if it is one.
 
     A fit fails when the solver diverged or stopped at a limit (:data:`FAILED_STATUSES`), a
@@ -52,6 +59,12 @@ def fit_failure(parameters: dict[str, float], start: np.ndarray, status: str | N
         Length of the fitted record [s].
     samples, free : int
         Fitted samples and free parameters (delay and offset included); 0 skips the F-test.
+    remaining_step : float
+        How far the final point still is from the optimum, in standard errors: the square root of the
+        best decrease of ``SSR / s^2`` along the Gauss-Newton step. A solver stopped at an iteration or
+        time limit (:data:`LIMIT_STATUSES`) with less than ``CONVERGED_WITHIN`` to go has converged as
+        far as the data can tell (e.g. crawling along a fold such as ``T1 = T2``) and is not a failure;
+        diverging is always one.
 
     Returns
     -------
@@ -68,11 +81,15 @@ def fit_failure(parameters: dict[str, float], start: np.ndarray, status: str | N
     'fit 0.20 %: the model explains no more of the output than noise would (F-test p = 0.85)'
     >>> fit_failure({"k": 2.0, "p": 3.0}, np.array([2.1, 2.9]), "Solve_Succeeded", True, 99.1, 0.02, 60.0)
     ''
+    >>> fit_failure({"k": 2.0, "p": 3.0}, np.array([2.1, 2.9]), "Maximum_Iterations_Exceeded", False, 98.6, 0.02,
+    ...             60.0, remaining_step=0.004)  # stopped at the limit, but converged within its uncertainty
+    ''
     """
     bad = {k: v for (k, v), v0 in zip(parameters.items(), np.asarray(start, float))
            if not np.isfinite(v) or abs(v) > ABSURD_FACTOR * max(1.0, abs(float(v0)) if np.isfinite(v0) else 1.0)}
     shown = ", ".join(f"{k} = {v:.3g}" for k, v in bad.items())
-    if not success and status in FAILED_STATUSES:
+    limited = status in LIMIT_STATUSES and remaining_step < CONVERGED_WITHIN
+    if not success and status in FAILED_STATUSES and not limited:
         detail = ", ".join(x for x in (shown, f"fit {fit_percent:.2f} %" if np.isfinite(fit_percent) else "") if x)
         return f"IPOPT stopped with {status}" + (f" ({detail})" if detail else "")
     if bad:

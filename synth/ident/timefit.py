@@ -38,7 +38,7 @@ from scipy.stats import t as student_t
 
 from synth.data.record import Record
 from synth.errors import DataError, FitError, ModelError
-from synth.ident.fit_failure import fit_failure
+from synth.ident.fit_failure import LIMIT_STATUSES, fit_failure
 from synth.ident.sim_error_problem import SimulationErrorProblem
 from synth.ident.srivc import linear_initial_model, map_to_structure
 from synth.ident.structure import Structure, parse_structure
@@ -184,6 +184,30 @@ def _as_sensor(sensor: Plant | str | None) -> Plant | None:
         return Plant.from_string(sensor)
     except ModelError as exc:
         raise exc.located("sensor") from None
+
+
+def _remaining_improvement(prob: SimulationErrorProblem, xs: np.ndarray, par: np.ndarray, J: np.ndarray,
+                           resid: np.ndarray, JtJ: np.ndarray, scale_vec: np.ndarray, s2: float, mask: np.ndarray | None,
+                           y: np.ndarray, lb: np.ndarray | None, fit_delay: bool, dt: float) -> float:
+    """How far a fit stopped at a limit still is from its optimum: ``sqrt`` of the best decrease of
+    ``SSR / s^2`` along the Gauss-Newton step (halved down to 1/32), i.e. in standard errors."""
+    step = np.linalg.lstsq(JtJ, J.T @ resid, rcond=None)[0] / scale_vec
+    ssr0 = float(resid @ resid)
+    best = 0.0
+    for alpha in (1.0, 0.5, 0.25, 0.125, 0.0625, 0.03125):
+        trial = xs + alpha * step
+        p = prob.p
+        if lb is not None:
+            trial[:p] = np.maximum(trial[:p], lb / prob.scale)
+        if fit_delay:
+            trial[p] = min(max(trial[p], 0.0), dt)
+        r = y - np.asarray(prob.yhat_fn(trial, par)).ravel()
+        if mask is not None:
+            r = r[mask]
+        ssr = float(r @ r)
+        if np.isfinite(ssr):
+            best = max(best, (ssr0 - ssr) / s2)
+    return float(np.sqrt(best))
 
 
 def fit_structure(record: Record, structure: Structure | str, delay: str | float | None = None,
@@ -349,14 +373,6 @@ def fit_structure(record: Record, structure: Structure | str, delay: str | float
     y_fit = y if mask is None else y[mask]
     resid_fit = (y - yhat) if mask is None else (y - yhat)[mask]
     fit_pct = float(100.0 * (1.0 - np.linalg.norm(resid_fit) / np.linalg.norm(y_fit - np.mean(y_fit))))
-    failure = fit_failure(dict(zip(st.parameters, theta.tolist())), theta0, st_info.get("status"),
-                          bool(st_info.get("success")), fit_pct, d_hat if fit_delay else None, n * dt,
-                          int(y_fit.size), p_total)
-    if failure:
-        raise FitError(f"fit of {st.formula!r} failed: {failure}; try another structure, a fixed delay or a shorter "
-                       f"part of the record", where=record.source, status=st_info.get("status"),
-                       parameters={**dict(zip(st.parameters, theta.tolist())), delay_name: float(d_hat)})
-    d_hat = max(d_hat, 0.0)
     J = np.asarray(prob.jac_fn(xs, par))
     scale_vec = np.r_[prob.scale, 1.0, 1.0] if fit_delay else np.r_[prob.scale, 1.0]
     J = J / scale_vec[None, :]
@@ -366,11 +382,24 @@ def fit_structure(record: Record, structure: Structure | str, delay: str | float
     dof = resid.size - J.shape[1]
     s2 = float(np.sum(resid**2) / dof)
     JtJ = J.T @ J
-    try:
-        cov = s2 * np.linalg.inv(JtJ)
-    except np.linalg.LinAlgError:
-        cov = s2 * np.linalg.pinv(JtJ)
-    sd = np.sqrt(np.clip(np.diag(cov), 0.0, None))
+    with np.errstate(all="ignore"):
+        try:
+            cov = s2 * np.linalg.inv(JtJ)
+        except (np.linalg.LinAlgError, ValueError):
+            cov = s2 * np.linalg.pinv(JtJ) if np.all(np.isfinite(JtJ)) else np.full(JtJ.shape, np.nan)
+        sd = np.sqrt(np.clip(np.diag(cov), 0.0, None))
+    remaining = float("inf")
+    if st_info.get("status") in LIMIT_STATUSES and s2 > 0 and np.all(np.isfinite(JtJ)):
+        remaining = _remaining_improvement(prob, xs, par, J, resid, JtJ, scale_vec, s2, mask, y, lb, fit_delay, dt)
+        info["remaining_improvement_std"] = remaining
+    failure = fit_failure(dict(zip(st.parameters, theta.tolist())), theta0, st_info.get("status"),
+                          bool(st_info.get("success")), fit_pct, d_hat if fit_delay else None, n * dt,
+                          int(y_fit.size), p_total, remaining)
+    if failure:
+        raise FitError(f"fit of {st.formula!r} failed: {failure}; try another structure, a fixed delay or a shorter "
+                       f"part of the record", where=record.source, status=st_info.get("status"),
+                       parameters={**dict(zip(st.parameters, theta.tolist())), delay_name: float(d_hat)})
+    d_hat = max(d_hat, 0.0)
     tq = float(student_t.ppf(0.975, dof))
     names = [*st.parameters, *([delay_name] if fit_delay else []), "offset"]
     values = [*theta.tolist(), *([d_hat] if fit_delay else []), b_hat]
