@@ -31,6 +31,23 @@ __all__ = ["IdentifyResult", "identify", "settling_time"]
 class IdentifyResult:
     """Identification of a record: the step averaging (if any) and the fit.
 
+    Attributes
+    ----------
+    record : Record
+        The record as given.
+    fit : TimeFitResult
+        The fit (of the average, or of the whole record; see ``whole_record_note``).
+    average : StepAverage or None
+        The step averaging, if the input was a step train.
+    directions : DirectionComparison or None
+        Up-step and down-step fits and their comparison (a train with both directions).
+    direction_note : str
+        Why the directions were not compared, if they could not be.
+    by_direction : bool
+        The up and down fits are the result (a direction-dependent model was asked for).
+    whole_record_note : str
+        Set when the edge windows were too short for the model to settle and the whole record was fitted.
+
     Examples
     --------
     >>> from synth.ident.x4_record import x4_step_train, SENSOR
