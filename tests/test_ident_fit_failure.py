@@ -59,11 +59,20 @@ def test_failure_rules():
     assert "Diverging" in fit_failure(ok, start, "Diverging_Iterates", False, 95.0, 0.1, 10.0, remaining_step=0.0)
 
 
+def test_fit_structure_raises_with_check_and_reports_without():
+    """identify and the CLI check; a caller that tries several fits (the gap's re-fits) reads solver["failure"]."""
+    rec = record_from_arrays(T, U, _noise_only())
+    with pytest.raises(FitError, match="than noise would"):
+        fit_structure(rec, "k/(s+p)", delay="fit", check=True)
+    res = fit_structure(rec, "k/(s+p)", delay="fit")
+    assert "than noise would" in res.solver["failure"]
+
+
 def test_a_good_fit_is_unchanged():
     y = 3.0 + simulate_plant(Plant.from_string("2/(s+3)", delay=0.043), T, U)
     y = y + 0.01 * np.random.default_rng(0).normal(size=T.size)
-    res = fit_structure(record_from_arrays(T, U, y), "k/(s+p)", delay="fit")
-    assert res.parameters["k"] == pytest.approx(2.0, rel=0.02) and res.fit_percent > 95
+    res = fit_structure(record_from_arrays(T, U, y), "k/(s+p)", delay="fit", check=True)
+    assert res.parameters["k"] == pytest.approx(2.0, rel=0.02) and res.fit_percent > 95 and res.solver["failure"] == ""
 
 
 def test_cli_exit_1_one_line_nothing_written(run_cli, tmp_path):

@@ -212,6 +212,6 @@ def fit_by_direction(record: Record, structure: Structure | str, delay: str | fl
     steps = steps or find_steps(record)
     up_avg = average_steps(record, steps, "edge", direction=1)
     down_avg = average_steps(record, steps, "edge", direction=-1)
-    up = fit_structure(up_avg.record(), structure, delay, sensor)
-    down = fit_structure(down_avg.record(), structure, delay, sensor)
+    up = fit_structure(up_avg.record(), structure, delay, sensor, check=True)
+    down = fit_structure(down_avg.record(), structure, delay, sensor, check=True)
     return compare_fits(up, down, alpha, up_avg, down_avg)

@@ -154,7 +154,7 @@ def identify(record: RecordLike, structure: Structure | str, delay: str | float 
     if by_direction and not two_ways:
         raise DataError("by direction needs a step train with up and down steps (averaged, not average='none')",
                         where=record.source)
-    fit = fit_structure(data, structure, delay, sensor, periodic)
+    fit = fit_structure(data, structure, delay, sensor, periodic, check=True)
     whole = ""
     if avg is not None and avg.mode == "edge" and average == "auto":
         fit, whole = _refit_unsettled(record, avg, fit, structure, delay, sensor)
@@ -162,7 +162,7 @@ def identify(record: RecordLike, structure: Structure | str, delay: str | float 
     if two_ways:
         try:
             directions = fit_by_direction(record, structure, delay, sensor, avg.steps)  # type: ignore[union-attr]
-        except (DataError, FitError) as exc:
+        except (DataError, ModelError, RuntimeError, ValueError, np.linalg.LinAlgError) as exc:  # FitError too
             if by_direction:
                 raise
             note = f"up and down steps not compared: {exc}"
@@ -196,7 +196,7 @@ def _refit_unsettled(record: Record, avg: StepAverage, fit: TimeFitResult, struc
     weights = ((record.t - record.t[0]) >= skip).astype(float)
     initial = {**fit.parameters}
     try:
-        whole = fit_structure(record, structure, delay, sensor, False, initial=initial, weights=weights)
+        whole = fit_structure(record, structure, delay, sensor, False, initial=initial, weights=weights, check=True)
     except (DataError, FitError) as exc:
         return fit, f"the edge windows ({window:.3g} s) are shorter than the model's settling time ({settle:.3g} s); " \
                     f"the whole-record fit failed ({exc}), so the edge fit is kept (biased)"

@@ -214,7 +214,7 @@ def fit_structure(record: Record, structure: Structure | str, delay: str | float
                   sensor: Plant | str | None = None, periodic: bool = False,
                   initial: dict[str, float] | None = None,
                   lower: dict[str, float] | None = None,
-                  weights: np.ndarray | None = None) -> TimeFitResult:
+                  weights: np.ndarray | None = None, check: bool = False) -> TimeFitResult:
     """Fit a structure to a record by simulation error (casadi + IPOPT).
 
     Parameters
@@ -242,6 +242,10 @@ def fit_structure(record: Record, structure: Structure | str, delay: str | float
         Per-sample 0/1 weights of the cost (0: simulated but not fitted, e.g. held-out
         segments or a start-up transient from an unknown initial state); the residual
         statistics use the weighted samples only.
+    check : bool
+        Raise :class:`~synth.errors.FitError` when the fit failed (what :func:`synth.ident.identification.identify`,
+        ``synth identify`` and :func:`synth.ident.directions.fit_by_direction` do). Without it the reason is in
+        ``solver["failure"]`` (empty for a good fit), for callers that try several fits and keep the best.
 
     Returns
     -------
@@ -254,8 +258,9 @@ def fit_structure(record: Record, structure: Structure | str, delay: str | float
     DataError
         Fewer samples than parameters, or a periodic fit of a model with an integrator.
     FitError
-        The fit failed (see :func:`fit_failure`): diverged, stopped at a limit, absurd
-        parameters, a delay outside the record, or no better than the output's mean.
+        With ``check``: the fit failed (see :func:`synth.ident.fit_failure.fit_failure`): diverged,
+        stopped at a limit, absurd parameters, a delay outside the record, or no better than the
+        output's mean or than noise.
 
     Examples
     --------
@@ -395,7 +400,8 @@ def fit_structure(record: Record, structure: Structure | str, delay: str | float
     failure = fit_failure(dict(zip(st.parameters, theta.tolist())), theta0, st_info.get("status"),
                           bool(st_info.get("success")), fit_pct, d_hat if fit_delay else None, n * dt,
                           int(y_fit.size), p_total, remaining)
-    if failure:
+    info["failure"] = failure
+    if failure and check:
         raise FitError(f"fit of {st.formula!r} failed: {failure}; try another structure, a fixed delay or a shorter "
                        f"part of the record", where=record.source, status=st_info.get("status"),
                        parameters={**dict(zip(st.parameters, theta.tolist())), delay_name: float(d_hat)})
