@@ -405,7 +405,8 @@ def fit_structure(record: Record, structure: Structure | str, delay: str | float
         raise FitError(f"fit of {st.formula!r} failed: {failure}; try another structure, a fixed delay or a shorter "
                        f"part of the record", where=record.source, status=st_info.get("status"),
                        parameters={**dict(zip(st.parameters, theta.tolist())), delay_name: float(d_hat)})
-    d_hat = max(d_hat, 0.0)
+    if -1e-7 <= d_hat < 0.0:  # IPOPT relaxes the bound f >= 0 by 1e-8
+        d_hat = 0.0
     tq = float(student_t.ppf(0.975, dof))
     names = [*st.parameters, *([delay_name] if fit_delay else []), "offset"]
     values = [*theta.tolist(), *([d_hat] if fit_delay else []), b_hat]
