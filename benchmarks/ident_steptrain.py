@@ -30,11 +30,12 @@ sys.path.insert(0, str(ROOT))
 
 from synth.data import load_record  # noqa: E402
 from synth.ident import x4_record as x4  # noqa: E402
+from synth.ident.identification import identify  # noqa: E402
 from synth.ident.sim_error_problem import SimulationErrorProblem  # noqa: E402
 from synth.ident.simulate import simulate_plant  # noqa: E402
 from synth.ident.steps import average_steps  # noqa: E402
 from synth.ident.structure import parse_structure  # noqa: E402
-from synth.ident.timefit import fit_structure, identify  # noqa: E402
+from synth.ident.timefit import fit_structure  # noqa: E402
 from synth.plant import Plant  # noqa: E402
 
 NAMES = ("k", "z", "p1", "p2", "delay")

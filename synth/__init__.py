@@ -65,7 +65,7 @@ def write_design_report(*args, **kwargs):
 
 
 def identify(*args, **kwargs):
-    """Identify a structure from a record or arrays (see :func:`synth.ident.timefit.identify`).
+    """Identify a structure from a record or arrays (see :func:`synth.ident.identification.identify`).
 
     The record may be ``(t, u, y)`` arrays, an N x 3 array, a DataFrame or mapping of
     columns, a CSV/MAT path or a :class:`Record` (see :func:`as_record`).
@@ -80,7 +80,7 @@ def identify(*args, **kwargs):
     >>> identify((t, u, y), "k/(s+p)", average="none").plant.to_string(4)
     '2/(s+3)'
     """
-    from synth.ident.timefit import identify as _identify
+    from synth.ident.identification import identify as _identify
 
     return _identify(*args, **kwargs)
 

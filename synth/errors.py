@@ -8,7 +8,7 @@ wrong, so the command line can print it as-is and exit with code 2.
 
 from __future__ import annotations
 
-__all__ = ["DataError", "ModelError", "OutputExistsError", "SpecError", "SynthError"]
+__all__ = ["DataError", "FitError", "ModelError", "OutputExistsError", "SpecError", "SynthError"]
 
 
 class SynthError(Exception):
@@ -62,3 +62,43 @@ class DataError(SynthError):
 
 class OutputExistsError(SynthError):
     """Writing would overwrite a file that synth did not write."""
+
+
+class FitError(SynthError, RuntimeError):
+    """A fit ran but failed: it diverged, hit the iteration limit, or its result is not a model of the record.
+
+    Not bad input (the command line exits 1, not 2): the record and the options were
+    valid, the structure just does not fit them. The message says what failed and what to try.
+    Also a ``RuntimeError``, so code that tries several fits and skips the ones that fail at
+    run time (the gap attribution's re-fits) keeps doing so.
+
+    Parameters
+    ----------
+    message : str
+        What failed and what to try.
+    where : str, optional
+        The record (file) the fit was on.
+    status : str, optional
+        The solver's return status (e.g. IPOPT's ``"Diverging_Iterates"``).
+    parameters : dict, optional
+        The parameter values the solver ended at (for diagnosis; never a result).
+
+    Examples
+    --------
+    >>> err = FitError("diverged", where="run.csv", status="Diverging_Iterates", parameters={"K": 2e24})
+    >>> str(err), err.status, err.parameters
+    ('run.csv: diverged', 'Diverging_Iterates', {'K': 2e+24})
+    >>> str(err.located("identify")), err.located("identify").status
+    ('identify: run.csv: diverged', 'Diverging_Iterates')
+    """
+
+    def __init__(self, message: str, where: str | None = None, status: str | None = None,
+                 parameters: dict[str, float] | None = None) -> None:
+        super().__init__(message, where)
+        self.status = status
+        self.parameters = dict(parameters or {})
+
+    def located(self, where: str) -> FitError:
+        """Return a copy with ``where`` prefixed, keeping the status and parameters."""
+        inner = f"{where}: {self.where}" if self.where else where
+        return FitError(self.message, where=inner, status=self.status, parameters=self.parameters)

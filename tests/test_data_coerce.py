@@ -8,8 +8,8 @@ import pytest
 import synth
 from synth.data import Record, as_record, load_record, record_from_arrays
 from synth.errors import DataError
+from synth.ident.identification import identify
 from synth.ident.simulate import simulate_plant
-from synth.ident.timefit import identify
 from synth.plant import Plant
 
 T = np.arange(0, 2, 0.01)

@@ -33,7 +33,8 @@ import pytest
 from synth.gap.attribution.heldout import DiagnoseOptions, diagnose_effects
 from synth.gap.attribution.roundrobin import diagnose_runs
 from synth.gap.diagnose import diagnose
-from synth.ident.timefit import fit_structure, identify
+from synth.ident.identification import identify
+from synth.ident.timefit import fit_structure
 from synth.plant import Plant
 from tests.conftest import shared_path
 from tests.gap_realdata_helpers import EMPS_DRIVE_GAIN, dcmotor_controller_output, dcmotor_record, emps_record, tanks_record

@@ -9,7 +9,7 @@ from __future__ import annotations
 import pytest
 
 from synth.data import load_record
-from synth.ident.timefit import identify
+from synth.ident.identification import identify
 from tests.conftest import shared_path
 
 AUTHORS = {"K": 245.5, "T1": 0.1468, "Td": 0.035}

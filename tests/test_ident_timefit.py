@@ -7,8 +7,9 @@ import pytest
 
 from synth.data import record_from_arrays
 from synth.errors import DataError, ModelError
+from synth.ident.identification import identify
 from synth.ident.simulate import simulate_plant
-from synth.ident.timefit import fit_structure, identify
+from synth.ident.timefit import fit_structure
 from synth.ident.x4_record import SENSOR, STRUCTURE, TRUTH, x4_step_train
 from synth.plant import Plant
 

@@ -35,6 +35,10 @@ example:
   synth identify --data runs.mat --columns "data[0]=t,data[4]=torque,data[3]=speed" \\
       --time t --input torque --output speed --structure "K/(T*s+1)"
 
+Up and down steps of a train are also fitted apart and compared parameter by parameter
+against their standard errors; a difference beyond them is reported (with its size in
+standard errors and its p-value). --by-direction reports both fits as the model.
+
 Records: '#' comment lines anywhere; units in headers ('Time (s)', 'Voltage [V]') become the
 signals' units and columns may be named with or without them; uneven time stamps are resampled
 with the input held between samples (a step stays a step) and the output interpolated.
@@ -42,7 +46,11 @@ with the input held between samples (a step stays a step) and the output interpo
 --x4-demo uses a SYNTHETIC X-4 step train generated from the seed paper's model
 (not measured data; see synth.ident.x4_record).
 
-exit codes: 0 identified, 2 bad input"""
+A fit that fails (IPOPT diverged or hit its iteration limit, parameters at absurd magnitudes,
+a fitted delay outside the record, a fit no better than the output's mean or than noise) is
+never written as a result: one line says what failed and what to try, exit 1.
+
+exit codes: 0 identified, 1 the fit failed, 2 bad input"""
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
@@ -64,6 +72,9 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--sensor", metavar="TF", help='known sensor in series, e.g. "442/((s+45)*(s+9.7))"')
     p.add_argument("--average", choices=["auto", "cycle", "edge", "none"], default="auto",
                    help="step-train averaging (default auto: average a two-level input with several steps)")
+    p.add_argument("--by-direction", action="store_true",
+                   help="direction-dependent model: fit the up steps and the down steps apart and report both "
+                        "(a step train is always checked for a difference between them)")
     p.add_argument("--x4-demo", action="store_true",
                    help="use the SYNTHETIC X-4 step train (generated on first use) with the paper's structure and sensor")
     p.add_argument("--out", metavar="DIR", help="folder for identify.json and figures "
@@ -91,9 +102,9 @@ def _demo_defaults(args: argparse.Namespace) -> None:
 def run(args: argparse.Namespace) -> int:
     from synth.data import load_record
     from synth.data.readers import parse_column_map
-    from synth.errors import ModelError, SynthError
+    from synth.errors import FitError, ModelError, SynthError
+    from synth.ident.identification import identify
     from synth.ident.structure import parse_structure
-    from synth.ident.timefit import identify
     from synth.outputs import OutputDir, dump_json, write_json
 
     if args.x4_demo:
@@ -113,7 +124,10 @@ def run(args: argparse.Namespace) -> int:
     record = load_record(args.data, args.time, args.input, args.output, input_unit=args.input_unit,
                          output_unit=args.output_unit, columns=parse_column_map(args.columns))
     try:
-        result = identify(record, structure, args.delay, args.sensor, args.average)
+        result = identify(record, structure, args.delay, args.sensor, args.average, by_direction=args.by_direction)
+    except FitError as exc:  # the options were valid; the structure does not fit this record
+        print(f"synth identify: {exc}", file=sys.stderr)
+        return 1
     except ModelError as exc:
         where = "--delay" if "delay" in exc.message and "structure" not in exc.message else None
         raise (exc.located(where) if where else exc) from None
@@ -131,6 +145,7 @@ def run(args: argparse.Namespace) -> int:
         figures.append(train_figure(record, folder.claim("train.png")))
     json_path.write_text(dump_json(payload), encoding="utf-8")
     folder.commit()
+    json_path, figures = folder.final(json_path), [folder.final(f) for f in figures]  # the paths after the move
     if args.json == "-":
         sys.stdout.write(dump_json(payload))
     elif args.json:
@@ -158,8 +173,22 @@ def _print(result: Any, args: argparse.Namespace, json_path: Path, figures: list
         print(f"averaged {avg.count} {avg.mode}s ({avg.up} up, {avg.down} down steps, {avg.dropped} dropped): "
               f"SNR {avg.snr_before_db:.1f} dB -> {avg.snr_after_db:.1f} dB "
               f"(noise std {avg.noise_std_before:.3g} -> {avg.noise_std_after:.3g}, step {avg.step_size:.4g})")
+    if result.whole_record_note:
+        print(result.whole_record_note)
     print(table(["parameter", "value", "std", "95 % interval"], rows))
     print(f"fit {fit.fit_percent:.2f} %, residual std {fit.residual_std:.3g}, "
           f"IPOPT {fit.solver.get('status')} ({fit.solver.get('iterations')} iterations)")
     print(f"plant: {fit.plant.to_string()}")
+    if result.directions is not None:
+        comp = result.directions
+        if result.by_direction:
+            for label, side in (("up steps", comp.up), ("down steps", comp.down)):
+                print(f"\n{label}: {side.plant.to_string()} (fit {side.fit_percent:.2f} %)")
+                print(table(["parameter", "value", "std", "up - down", "sigma"],
+                            [[k, f"{v:.6g}", f"{side.std[k]:.3g}", f"{comp.difference[k]:+.3g}" if k in comp.z else "",
+                              f"{comp.z[k]:+.1f}" if k in comp.z else ""] for k, v in side.parameters.items()]))
+        hint = " (--by-direction reports both fits)" if comp.significant and not result.by_direction else ""
+        print(comp.summary() + hint)
+    elif result.direction_note:
+        print(result.direction_note)
     print(f"\nresult: {json_path}" + "".join(f"\nfigure: {p}" for p in figures))

@@ -41,7 +41,7 @@ _EXPORTS = {
     "simulate_plant": "simulate",
     "parse_structure": "structure", "Structure": "structure",
     "find_steps": "steps", "average_steps": "steps", "StepAverage": "steps",
-    "fit_structure": "timefit", "identify": "timefit", "TimeFitResult": "timefit", "IdentifyResult": "timefit",
+    "fit_structure": "timefit", "identify": "identification", "TimeFitResult": "timefit", "IdentifyResult": "identification",
     "x4_step_train": "x4_record", "x4_step_train_path": "x4_record",
     "design_sweep": "sweep_design", "SweepDesign": "sweep_design",
     "frequency_response": "spectra", "FrequencyResponse": "spectra", "rate_to_attitude": "spectra",

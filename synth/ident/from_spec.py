@@ -67,7 +67,7 @@ def resolve_data(data: str, base: Path | None) -> Path:
 def _identify_cached(path: str, stamp: tuple[int, int], settings: IdentifySettings, input_unit: str,
                      output_unit: str, label: str) -> Any:
     from synth.data import load_record
-    from synth.ident.timefit import identify
+    from synth.ident.identification import identify
 
     record = load_record(path, settings.time, settings.input, settings.output,
                          input_unit=input_unit, output_unit=output_unit)
@@ -76,7 +76,7 @@ def _identify_cached(path: str, stamp: tuple[int, int], settings: IdentifySettin
 
 
 def identify_plant(settings: IdentifySettings, base: Path | None, input: Signal, output: Signal) -> Any:
-    """Identify the record of ``settings`` (cached); returns :class:`synth.ident.timefit.IdentifyResult`.
+    """Identify the record of ``settings`` (cached); returns :class:`synth.ident.identification.IdentifyResult`.
 
     Errors in the data or the fit are :class:`~synth.errors.SynthError` naming the file.
     """
@@ -105,7 +105,7 @@ def uncertainty_plants(result: Any, confidence: float, input: Signal, output: Si
 
     Examples
     --------
-    >>> from synth.ident.timefit import identify
+    >>> from synth.ident.identification import identify
     >>> from synth.data import record_from_arrays
     >>> from synth.ident.simulate import simulate_plant
     >>> t = np.arange(0, 4, 0.01); u = np.where(t >= 0.5, 1.0, 0.0)

@@ -248,7 +248,8 @@ def _snr(step: float, sigma: float) -> float:
     return float(20.0 * np.log10(abs(step) / sigma)) if sigma > 0 else float("inf")
 
 
-def average_steps(record: Record, steps: Steps | None = None, mode: str = "auto", pre: float | None = None) -> StepAverage:
+def average_steps(record: Record, steps: Steps | None = None, mode: str = "auto", pre: float | None = None,
+                  direction: int = 0) -> StepAverage:
     """Cut, align and average the step responses of a record.
 
     Parameters
@@ -261,6 +262,10 @@ def average_steps(record: Record, steps: Steps | None = None, mode: str = "auto"
     pre : float, optional
         ``"edge"`` mode: seconds kept before each step (default a tenth of the
         window, at most the time before the first step).
+    direction : {0, 1, -1}
+        ``"edge"`` mode: average every step (0), only the up steps (1) or only the down
+        steps (-1, sign-flipped); the windows are as long as with all steps. A direction
+        other than 0 implies ``"edge"``.
 
     Returns
     -------
@@ -277,10 +282,21 @@ def average_steps(record: Record, steps: Steps | None = None, mode: str = "auto"
     >>> avg = average_steps(x4_step_train())
     >>> avg.mode, avg.count, avg.dropped, round(avg.snr_before_db), round(avg.snr_after_db)
     ('cycle', 69, 1, 39, 57)
+    >>> down = average_steps(x4_step_train(), direction=-1)
+    >>> down.mode, down.count, (down.up, down.down), down.step_size > 0
+    ('edge', 69, (0, 69), True)
     """
     if mode not in ("auto", "cycle", "edge"):
         raise DataError(f"mode must be 'auto', 'cycle' or 'edge', got {mode!r}")
+    if direction not in (0, 1, -1):
+        raise DataError(f"direction must be 0 (all steps), 1 (up) or -1 (down), got {direction!r}")
     steps = steps or find_steps(record)
+    if direction:
+        if mode == "cycle":
+            raise DataError("a periodic average holds both directions; average one direction with mode='edge'")
+        if not np.any(steps.direction == direction):
+            raise DataError(f"no {'up' if direction > 0 else 'down'} step in the input", where=record.source)
+        return _average_edges(record, steps, pre, direction)
     periodic = _is_periodic(steps)
     if mode == "cycle" and periodic is None:
         raise DataError("the input is not a periodic square wave (steps must alternate at a constant period); "
@@ -314,12 +330,13 @@ def _average_cycles(record: Record, steps: Steps, period: int, high: int) -> Ste
                        low_time)
 
 
-def _average_edges(record: Record, steps: Steps, pre: float | None) -> StepAverage:
-    idx = steps.index
-    gaps = np.diff(np.r_[idx, record.n])
+def _average_edges(record: Record, steps: Steps, pre: float | None, direction: int = 0) -> StepAverage:
+    gaps = np.diff(np.r_[steps.index, record.n])
     post = int(np.min(gaps))
+    keep = steps.direction == direction if direction else np.ones(steps.count, bool)
+    idx, dirs = steps.index[keep], steps.direction[keep]
     if pre is None:
-        n_pre = min(max(1, post // 10), int(idx[0]))
+        n_pre = min(max(1, post // 10), int(steps.index[0]))
     else:
         n_pre = round(pre / record.dt)
     if n_pre < 1 or n_pre > idx[0]:
@@ -328,7 +345,7 @@ def _average_edges(record: Record, steps: Steps, pre: float | None) -> StepAvera
     if post < 10:
         raise DataError(f"steps are only {post} samples apart; too short to average", where=record.source)
     win = idx[:, None] + np.arange(-n_pre, post)[None, :]
-    sign = steps.direction[:, None].astype(float)
+    sign = dirs[:, None].astype(float)
     yw = record.y[win]
     uw = record.u[win]
     yw = sign * (yw - yw[:, :n_pre].mean(axis=1, keepdims=True))
@@ -338,7 +355,7 @@ def _average_edges(record: Record, steps: Steps, pre: float | None) -> StepAvera
     step = float(np.mean(y[-tail:]) - np.mean(y[:n_pre]))
     before, after = _noise(yw)
     t = np.arange(-n_pre, post) * record.dt
-    ups = int(np.sum(steps.direction > 0))
+    ups = int(np.sum(dirs > 0))
     return StepAverage("edge", t, u, y, int(idx.size), ups, int(idx.size) - ups, 0, step, before, after,
                        _snr(step, before), _snr(step, after), False, steps, record.input, record.output, record.source,
                        n_pre)

@@ -4,7 +4,8 @@ The model, its exact zero-order-hold discretization with a fractional delay and 
 Gauss-Newton IPOPT problem are in :mod:`synth.ident.sim_error_problem`; the
 deterministic start (SRIVC on a delay grid, mapped onto the structure) in
 :mod:`synth.ident.srivc`. Here: the fit itself (the whole-sample delay search, the
-fallback starts), its uncertainty and :func:`identify` (a step train is averaged first).
+fallback starts) and its uncertainty; :func:`synth.ident.identification.identify` averages a
+step train first.
 
 Delay search
 ------------
@@ -35,16 +36,15 @@ from typing import Any
 import numpy as np
 from scipy.stats import t as student_t
 
-from synth.data.coerce import RecordLike, as_record
 from synth.data.record import Record
-from synth.errors import DataError, ModelError
+from synth.errors import DataError, FitError, ModelError
+from synth.ident.fit_failure import LIMIT_STATUSES, fit_failure
 from synth.ident.sim_error_problem import SimulationErrorProblem
 from synth.ident.srivc import linear_initial_model, map_to_structure
-from synth.ident.steps import StepAverage, average_steps, find_steps
 from synth.ident.structure import Structure, parse_structure
 from synth.plant import Plant
 
-__all__ = ["IdentifyResult", "TimeFitResult", "fit_structure", "identify"]
+__all__ = ["TimeFitResult", "fit_structure"]
 
 # ------------------------------------------------------------------- results
 
@@ -186,11 +186,35 @@ def _as_sensor(sensor: Plant | str | None) -> Plant | None:
         raise exc.located("sensor") from None
 
 
+def _remaining_improvement(prob: SimulationErrorProblem, xs: np.ndarray, par: np.ndarray, J: np.ndarray,
+                           resid: np.ndarray, JtJ: np.ndarray, scale_vec: np.ndarray, s2: float, mask: np.ndarray | None,
+                           y: np.ndarray, lb: np.ndarray | None, fit_delay: bool, dt: float) -> float:
+    """How far a fit stopped at a limit still is from its optimum: ``sqrt`` of the best decrease of
+    ``SSR / s^2`` along the Gauss-Newton step (halved down to 1/32), i.e. in standard errors."""
+    step = np.linalg.lstsq(JtJ, J.T @ resid, rcond=None)[0] / scale_vec
+    ssr0 = float(resid @ resid)
+    best = 0.0
+    for alpha in (1.0, 0.5, 0.25, 0.125, 0.0625, 0.03125):
+        trial = xs + alpha * step
+        p = prob.p
+        if lb is not None:
+            trial[:p] = np.maximum(trial[:p], lb / prob.scale)
+        if fit_delay:
+            trial[p] = min(max(trial[p], 0.0), dt)
+        r = y - np.asarray(prob.yhat_fn(trial, par)).ravel()
+        if mask is not None:
+            r = r[mask]
+        ssr = float(r @ r)
+        if np.isfinite(ssr):
+            best = max(best, (ssr0 - ssr) / s2)
+    return float(np.sqrt(best))
+
+
 def fit_structure(record: Record, structure: Structure | str, delay: str | float | None = None,
                   sensor: Plant | str | None = None, periodic: bool = False,
                   initial: dict[str, float] | None = None,
                   lower: dict[str, float] | None = None,
-                  weights: np.ndarray | None = None) -> TimeFitResult:
+                  weights: np.ndarray | None = None, check: bool = False) -> TimeFitResult:
     """Fit a structure to a record by simulation error (casadi + IPOPT).
 
     Parameters
@@ -218,6 +242,10 @@ def fit_structure(record: Record, structure: Structure | str, delay: str | float
         Per-sample 0/1 weights of the cost (0: simulated but not fitted, e.g. held-out
         segments or a start-up transient from an unknown initial state); the residual
         statistics use the weighted samples only.
+    check : bool
+        Raise :class:`~synth.errors.FitError` when the fit failed (what :func:`synth.ident.identification.identify`,
+        ``synth identify`` and :func:`synth.ident.directions.fit_by_direction` do). Without it the reason is in
+        ``solver["failure"]`` (empty for a good fit), for callers that try several fits and keep the best.
 
     Returns
     -------
@@ -229,6 +257,10 @@ def fit_structure(record: Record, structure: Structure | str, delay: str | float
         Bad structure, sensor or delay option.
     DataError
         Fewer samples than parameters, or a periodic fit of a model with an integrator.
+    FitError
+        With ``check``: the fit failed (see :func:`synth.ident.fit_failure.fit_failure`): diverged,
+        stopped at a limit, absurd parameters, a delay outside the record, or no better than the
+        output's mean or than noise.
 
     Examples
     --------
@@ -343,21 +375,38 @@ def fit_structure(record: Record, structure: Structure | str, delay: str | float
         par = prob.inputs(w, m, f_hat)
     d_hat = m * dt + f_hat
     yhat = np.asarray(prob.yhat_fn(xs, par)).ravel()
+    y_fit = y if mask is None else y[mask]
+    resid_fit = (y - yhat) if mask is None else (y - yhat)[mask]
+    fit_pct = float(100.0 * (1.0 - np.linalg.norm(resid_fit) / np.linalg.norm(y_fit - np.mean(y_fit))))
     J = np.asarray(prob.jac_fn(xs, par))
     scale_vec = np.r_[prob.scale, 1.0, 1.0] if fit_delay else np.r_[prob.scale, 1.0]
     J = J / scale_vec[None, :]
     resid = y - yhat
-    y_fit = y
     if mask is not None:
-        J, resid, y_fit = J[mask], resid[mask], y[mask]
+        J, resid = J[mask], resid[mask]
     dof = resid.size - J.shape[1]
     s2 = float(np.sum(resid**2) / dof)
     JtJ = J.T @ J
-    try:
-        cov = s2 * np.linalg.inv(JtJ)
-    except np.linalg.LinAlgError:
-        cov = s2 * np.linalg.pinv(JtJ)
-    sd = np.sqrt(np.clip(np.diag(cov), 0.0, None))
+    with np.errstate(all="ignore"):
+        try:
+            cov = s2 * np.linalg.inv(JtJ)
+        except (np.linalg.LinAlgError, ValueError):
+            cov = s2 * np.linalg.pinv(JtJ) if np.all(np.isfinite(JtJ)) else np.full(JtJ.shape, np.nan)
+        sd = np.sqrt(np.clip(np.diag(cov), 0.0, None))
+    remaining = float("inf")
+    if st_info.get("status") in LIMIT_STATUSES and s2 > 0 and np.all(np.isfinite(JtJ)):
+        remaining = _remaining_improvement(prob, xs, par, J, resid, JtJ, scale_vec, s2, mask, y, lb, fit_delay, dt)
+        info["remaining_improvement_std"] = remaining
+    failure = fit_failure(dict(zip(st.parameters, theta.tolist())), theta0, st_info.get("status"),
+                          bool(st_info.get("success")), fit_pct, d_hat if fit_delay else None, n * dt,
+                          int(y_fit.size), p_total, remaining)
+    info["failure"] = failure
+    if failure and check:
+        raise FitError(f"fit of {st.formula!r} failed: {failure}; try another structure, a fixed delay or a shorter "
+                       f"part of the record", where=record.source, status=st_info.get("status"),
+                       parameters={**dict(zip(st.parameters, theta.tolist())), delay_name: float(d_hat)})
+    if -1e-7 <= d_hat < 0.0:  # IPOPT relaxes the bound f >= 0 by 1e-8
+        d_hat = 0.0
     tq = float(student_t.ppf(0.975, dof))
     names = [*st.parameters, *([delay_name] if fit_delay else []), "offset"]
     values = [*theta.tolist(), *([d_hat] if fit_delay else []), b_hat]
@@ -366,7 +415,6 @@ def fit_structure(record: Record, structure: Structure | str, delay: str | float
     if not fit_delay:
         params[delay_name], std[delay_name] = float(d_hat), 0.0
     ci = {k: (params[k] - tq * std[k], params[k] + tq * std[k]) for k in params}
-    fit_pct = float(100.0 * (1.0 - np.linalg.norm(resid) / np.linalg.norm(y_fit - np.mean(y_fit))))
     plant = st.plant(theta, delay=d_hat, input=record.input, output=record.output, label="identified")
     measured = plant.series(sensor) if sensor is not None else plant
     if sensor is not None:
@@ -374,89 +422,3 @@ def fit_structure(record: Record, structure: Structure | str, delay: str | float
     return TimeFitResult(st, params, std, ci, names, cov, float(d_hat), fit_delay, b_hat, float(sd[-1]),
                          fit_pct, float(np.sqrt(s2)), plant, sensor, measured, initial_out, info, t.copy(), y.copy(),
                          yhat, u0, periodic)
-
-
-# ------------------------------------------------------------------ identify
-
-
-@dataclass(frozen=True, eq=False)
-class IdentifyResult:
-    """Identification of a record: the step averaging (if any) and the fit.
-
-    Examples
-    --------
-    >>> from synth.ident.x4_record import x4_step_train, SENSOR
-    >>> clean = x4_step_train(periods=1, noise_std=0.0)  # noise-free, fitted as it is (no averaging)
-    >>> res = identify(clean, "k*(s+z)/((s+p1)*(s+p2))", delay="fit", sensor=SENSOR, average="none")
-    >>> sorted(round(v, 5) for v in res.fit.parameters.values())
-    [0.02, 0.43, 0.54, 9.6, 23.0]
-    """
-
-    record: Record
-    fit: TimeFitResult
-    average: StepAverage | None
-
-    @property
-    def plant(self) -> Plant:
-        """The identified plant ``F`` (with its delay)."""
-        return self.fit.plant
-
-    def to_dict(self) -> dict[str, Any]:
-        """The fit's JSON plus ``record`` and ``averaging``."""
-        return {**self.fit.to_dict(), "record": self.record.to_dict(),
-                "averaging": self.average.to_dict() if self.average is not None else None}
-
-
-def _two_level(u: np.ndarray) -> bool:
-    lo, hi = float(np.min(u)), float(np.max(u))
-    near = (np.abs(u - lo) <= 0.05 * (hi - lo)) | (np.abs(u - hi) <= 0.05 * (hi - lo))
-    return bool(np.mean(near) >= 0.98)
-
-
-def identify(record: RecordLike, structure: Structure | str, delay: str | float | None = None,
-             sensor: Plant | str | None = None, average: str = "auto") -> IdentifyResult:
-    """Identify a structure from a record: average a step train if there is one, then fit.
-
-    Parameters
-    ----------
-    record : Record, tuple of arrays, ndarray, mapping, DataFrame, str or Path
-        What :func:`synth.data.as_record` accepts: ``(t, u, y)`` arrays, an N x 3 array,
-        columns (taken as time, input, output in that order), a CSV/MAT path or a Record.
-    structure : Structure or str
-    delay : {"fit", float, None}
-        See :func:`fit_structure`.
-    sensor : Plant or str, optional
-        Known sensor in series.
-    average : {"auto", "cycle", "edge", "none"}
-        ``"auto"``: a two-level input with at least two steps is averaged
-        (:func:`synth.ident.steps.average_steps`), anything else is fitted as it is.
-
-    Returns
-    -------
-    IdentifyResult
-
-    Raises
-    ------
-    DataError
-        ``record`` is not a record, or its columns fail the record's checks.
-
-    Examples
-    --------
-    >>> from synth.ident.simulate import simulate_plant
-    >>> t = np.arange(0, 3, 0.01); u = np.where(t >= 0.5, 1.0, 0.0)
-    >>> y = simulate_plant(Plant.from_string("2/(s+3)"), t, u)
-    >>> identify((t, u, y), "k/(s+p)", average="none").plant.to_string(4)
-    '2/(s+3)'
-    """
-    record = as_record(record)
-    if average not in ("auto", "cycle", "edge", "none"):
-        raise ModelError(f"average must be 'auto', 'cycle', 'edge' or 'none', got {average!r}")
-    avg = None
-    data, periodic = record, False
-    if average != "none" and _two_level(record.u):
-        steps = find_steps(record)
-        if steps.count >= 2 or average in ("cycle", "edge"):
-            avg = average_steps(record, steps, "auto" if average == "auto" else average)
-            data, periodic = avg.record(), avg.periodic
-    fit = fit_structure(data, structure, delay, sensor, periodic)
-    return IdentifyResult(record, fit, avg)

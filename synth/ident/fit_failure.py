@@ -1,0 +1,109 @@
+"""When a finished simulation-error fit is not a result (issue 16: a failed fit is a failure).
+
+:func:`synth.ident.timefit.fit_structure` raises :class:`synth.errors.FitError` with the
+reason :func:`fit_failure` gives; ``synth identify`` prints it as one line and exits 1.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy.stats import f as f_dist
+
+__all__ = ["ABSURD_FACTOR", "CONVERGED_WITHIN", "FAILED_STATUSES", "LIMIT_STATUSES", "SIGNIFICANCE", "fit_failure"]
+
+#: IPOPT return statuses that end a fit without a usable optimum
+FAILED_STATUSES = ("Diverging_Iterates", "Maximum_Iterations_Exceeded", "Maximum_CpuTime_Exceeded",
+                   "Maximum_WallTime_Exceeded", "Infeasible_Problem_Detected", "Invalid_Number_Detected",
+                   "Error_In_Step_Computation", "Not_Enough_Degrees_Of_Freedom", "Invalid_Problem_Definition",
+                   "Internal_Error", "Insufficient_Memory", "Unrecoverable_Exception", "NonIpopt_Exception_Thrown",
+                   "User_Requested_Stop", "Invalid_Option")
+
+#: statuses of a solver stopped at a limit: accepted if the remaining step is small (see :func:`fit_failure`)
+LIMIT_STATUSES = ("Maximum_Iterations_Exceeded", "Maximum_CpuTime_Exceeded", "Maximum_WallTime_Exceeded")
+
+#: less than this many standard errors still to go (see :func:`fit_failure`) counts as converged
+CONVERGED_WITHIN = 0.1
+
+#: p-value of the F-test above which a fit explains no more than noise (see :func:`fit_failure`)
+SIGNIFICANCE = 1e-3
+
+#: a fitted parameter this many times larger than its deterministic start (and than 1) is a diverged fit
+ABSURD_FACTOR = 1e8
+
+
+def fit_failure(parameters: dict[str, float], start: np.ndarray, status: str | None, success: bool,
+                fit_percent: float, delay: float | None, duration: float, samples: int = 0, free: int = 0,
+                remaining_step: float = float("inf")) -> str:
+    """Why a finished fit is not a result, or ``""`` if it is one.
+
+    A fit fails when the solver diverged or stopped at a limit (:data:`FAILED_STATUSES`), a
+    parameter is not finite or ``ABSURD_FACTOR`` times larger than both its start and 1, the fit is
+    no better than the output's mean (``fit_percent <= 0``) or than noise would be (given ``samples``
+    and ``free``: the F-test of the explained variance against the residual one has a p-value above
+    ``SIGNIFICANCE``), or a fitted delay lies outside ``[0, duration)``.
+
+    Parameters
+    ----------
+    parameters : dict
+        Fitted structure parameters.
+    start : numpy.ndarray
+        Their deterministic starting values (same order).
+    status : str or None
+        The solver's return status.
+    success : bool
+        The solver reported success.
+    fit_percent : float
+    delay : float or None
+        The fitted delay [s] (``None`` when it was fixed).
+    duration : float
+        Length of the fitted record [s].
+    samples, free : int
+        Fitted samples and free parameters (delay and offset included); 0 skips the F-test.
+    remaining_step : float
+        How far the final point still is from the optimum, in standard errors: the square root of the
+        best decrease of ``SSR / s^2`` along the Gauss-Newton step. A solver stopped at an iteration or
+        time limit (:data:`LIMIT_STATUSES`) with less than ``CONVERGED_WITHIN`` to go has converged as
+        far as the data can tell (e.g. crawling along a fold such as ``T1 = T2``) and is not a failure;
+        diverging is always one.
+
+    Returns
+    -------
+    str
+        What failed, in a few words (empty if nothing did).
+
+    Examples
+    --------
+    >>> fit_failure({"K": 2e24, "T": 0.1}, np.array([3.0, 0.1]), "Diverging_Iterates", False, -2.19, 0.01, 60.0)
+    'IPOPT stopped with Diverging_Iterates (K = 2e+24, fit -2.19 %)'
+    >>> fit_failure({"k": 2.0, "p": 3.0}, np.array([2.1, 2.9]), "Solve_Succeeded", True, 99.1, -452.67, 60.0)
+    'the fitted delay is -452.67 s, outside [0, 60) s'
+    >>> fit_failure({"k": 2.0, "p": 3.0}, np.array([2.1, 2.9]), "Solve_Succeeded", True, 0.2, 0.02, 2.0, 200, 4)
+    'fit 0.20 %: the model explains no more of the output than noise would (F-test p = 0.85)'
+    >>> fit_failure({"k": 2.0, "p": 3.0}, np.array([2.1, 2.9]), "Solve_Succeeded", True, 99.1, 0.02, 60.0)
+    ''
+    >>> fit_failure({"k": 2.0, "p": 3.0}, np.array([2.1, 2.9]), "Maximum_Iterations_Exceeded", False, 98.6, 0.02,
+    ...             60.0, remaining_step=0.004)  # stopped at the limit, but converged within its uncertainty
+    ''
+    """
+    bad = {k: v for (k, v), v0 in zip(parameters.items(), np.asarray(start, float))
+           if not np.isfinite(v) or abs(v) > ABSURD_FACTOR * max(1.0, abs(float(v0)) if np.isfinite(v0) else 1.0)}
+    shown = ", ".join(f"{k} = {v:.3g}" for k, v in bad.items())
+    limited = status in LIMIT_STATUSES and remaining_step < CONVERGED_WITHIN
+    if not success and status in FAILED_STATUSES and not limited:
+        detail = ", ".join(x for x in (shown, f"fit {fit_percent:.2f} %" if np.isfinite(fit_percent) else "") if x)
+        return f"IPOPT stopped with {status}" + (f" ({detail})" if detail else "")
+    if bad:
+        return f"parameters at absurd magnitudes ({shown})"
+    if delay is not None and not (np.isfinite(delay) and -1e-7 <= delay < duration):  # IPOPT relaxes bounds by 1e-8
+        return f"the fitted delay is {delay:.5g} s, outside [0, {duration:.5g}) s"
+    if not np.isfinite(fit_percent) or fit_percent <= 0.0:
+        return f"fit {fit_percent:.2f} %: the model explains the output no better than its mean"
+    if samples > free > 1:
+        explained = 1.0 - (1.0 - fit_percent / 100.0) ** 2  # share of the variance about the mean
+        dof = samples - free
+        f_stat = (explained / (free - 1)) / (max(1.0 - explained, 1e-300) / dof)
+        p_value = float(f_dist.sf(f_stat, free - 1, dof))
+        if p_value > SIGNIFICANCE:
+            return (f"fit {fit_percent:.2f} %: the model explains no more of the output than noise would "
+                    f"(F-test p = {p_value:.2g})")
+    return ""

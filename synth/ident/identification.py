@@ -1,0 +1,204 @@
+"""Identify a structure from a record: average a step train, fit, and compare up and down steps.
+
+:func:`identify` is the entry point behind ``synth identify`` and :func:`synth.identify`:
+a two-level input with several steps is averaged (:mod:`synth.ident.steps`), the
+structure is fitted to the average (:func:`synth.ident.timefit.fit_structure`), and when
+the train has up and down steps they are also fitted apart and compared
+(:mod:`synth.ident.directions`): a difference beyond their uncertainty is reported, and
+``by_direction=True`` makes the two fits the result.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from synth.data.coerce import RecordLike, as_record
+from synth.data.record import Record
+from synth.errors import DataError, FitError, ModelError
+from synth.ident.directions import DirectionComparison, fit_by_direction
+from synth.ident.steps import StepAverage, average_steps, find_steps
+from synth.ident.structure import Structure, parse_structure
+from synth.ident.timefit import TimeFitResult, fit_structure
+from synth.plant import Plant
+
+__all__ = ["IdentifyResult", "identify", "settling_time"]
+
+
+@dataclass(frozen=True, eq=False)
+class IdentifyResult:
+    """Identification of a record: the step averaging (if any) and the fit.
+
+    Attributes
+    ----------
+    record : Record
+        The record as given.
+    fit : TimeFitResult
+        The fit (of the average, or of the whole record; see ``whole_record_note``).
+    average : StepAverage or None
+        The step averaging, if the input was a step train.
+    directions : DirectionComparison or None
+        Up-step and down-step fits and their comparison (a train with both directions).
+    direction_note : str
+        Why the directions were not compared, if they could not be.
+    by_direction : bool
+        The up and down fits are the result (a direction-dependent model was asked for).
+    whole_record_note : str
+        Set when the edge windows were too short for the model to settle and the whole record was fitted.
+
+    Examples
+    --------
+    >>> from synth.ident.x4_record import x4_step_train, SENSOR
+    >>> clean = x4_step_train(periods=1, noise_std=0.0)  # noise-free, fitted as it is (no averaging)
+    >>> res = identify(clean, "k*(s+z)/((s+p1)*(s+p2))", delay="fit", sensor=SENSOR, average="none")
+    >>> sorted(round(v, 5) for v in res.fit.parameters.values())
+    [0.02, 0.43, 0.54, 9.6, 23.0]
+    """
+
+    record: Record
+    fit: TimeFitResult
+    average: StepAverage | None
+    directions: DirectionComparison | None = None
+    direction_note: str = ""
+    by_direction: bool = False
+    whole_record_note: str = ""
+
+    @property
+    def plant(self) -> Plant:
+        """The identified plant ``F`` (with its delay; with ``by_direction``, the fit of both directions together)."""
+        return self.fit.plant
+
+    @property
+    def direction_dependent(self) -> bool:
+        """Up and down steps differ beyond their uncertainty."""
+        return self.directions is not None and self.directions.significant
+
+    def to_dict(self) -> dict[str, Any]:
+        """The fit's JSON plus ``record``, ``averaging`` and ``directions`` (up/down fits and their comparison)."""
+        return {**self.fit.to_dict(), "record": self.record.to_dict(),
+                "averaging": self.average.to_dict() if self.average is not None else None,
+                "directions": self.directions.to_dict() if self.directions is not None else None,
+                "direction_note": self.direction_note, "by_direction": self.by_direction,
+                "whole_record": self.whole_record_note}
+
+
+def _two_level(u: np.ndarray) -> bool:
+    lo, hi = float(np.min(u)), float(np.max(u))
+    near = (np.abs(u - lo) <= 0.05 * (hi - lo)) | (np.abs(u - hi) <= 0.05 * (hi - lo))
+    return bool(np.mean(near) >= 0.98)
+
+
+def identify(record: RecordLike, structure: Structure | str, delay: str | float | None = None,
+             sensor: Plant | str | None = None, average: str = "auto", by_direction: bool = False) -> IdentifyResult:
+    """Identify a structure from a record: average a step train if there is one, then fit.
+
+    Parameters
+    ----------
+    record : Record, tuple of arrays, ndarray, mapping, DataFrame, str or Path
+        What :func:`synth.data.as_record` accepts: ``(t, u, y)`` arrays, an N x 3 array,
+        columns (taken as time, input, output in that order), a CSV/MAT path or a Record.
+    structure : Structure or str
+    delay : {"fit", float, None}
+        See :func:`synth.ident.timefit.fit_structure`.
+    sensor : Plant or str, optional
+        Known sensor in series.
+    average : {"auto", "cycle", "edge", "none"}
+        ``"auto"``: a two-level input with at least two steps is averaged
+        (:func:`synth.ident.steps.average_steps`), anything else is fitted as it is.
+        Edge windows assume the plant at rest before each step: when the fitted model's
+        settling time (:func:`settling_time`) is longer than a window, the whole record is
+        fitted instead, started from the edge fit, with its start-up (one settling time, at most
+        a quarter of the record) weighted 0 (``whole_record_note`` says so).
+        An averaged train with up and down steps is also fitted per direction and the two
+        fits compared (:func:`synth.ident.directions.fit_by_direction`); if that comparison
+        cannot be made the reason is in ``direction_note``.
+    by_direction : bool
+        Fit a direction-dependent model: the up-step and down-step fits are the result
+        (``directions``); a failure of either is an error. Needs a step train with both.
+
+    Returns
+    -------
+    IdentifyResult
+
+    Raises
+    ------
+    DataError
+        ``record`` is not a record, or its columns fail the record's checks; ``by_direction``
+        on a record without up and down steps.
+    FitError
+        The fit failed (:func:`synth.ident.fit_failure.fit_failure`).
+
+    Examples
+    --------
+    >>> from synth.ident.simulate import simulate_plant
+    >>> t = np.arange(0, 3, 0.01); u = np.where(t >= 0.5, 1.0, 0.0)
+    >>> y = simulate_plant(Plant.from_string("2/(s+3)"), t, u)
+    >>> identify((t, u, y), "k/(s+p)", average="none").plant.to_string(4)
+    '2/(s+3)'
+    """
+    record = as_record(record)
+    if average not in ("auto", "cycle", "edge", "none"):
+        raise ModelError(f"average must be 'auto', 'cycle', 'edge' or 'none', got {average!r}")
+    avg = None
+    data, periodic = record, False
+    if average != "none" and _two_level(record.u):
+        steps = find_steps(record)
+        if steps.count >= 2 or average in ("cycle", "edge"):
+            avg = average_steps(record, steps, "auto" if average == "auto" else average)
+            data, periodic = avg.record(), avg.periodic
+    if isinstance(structure, str):
+        structure = parse_structure(structure)
+    two_ways = avg is not None and bool(np.any(avg.steps.direction > 0) and np.any(avg.steps.direction < 0))
+    if by_direction and not two_ways:
+        raise DataError("by direction needs a step train with up and down steps (averaged, not average='none')",
+                        where=record.source)
+    fit = fit_structure(data, structure, delay, sensor, periodic, check=True)
+    whole = ""
+    if avg is not None and avg.mode == "edge" and average == "auto":
+        fit, whole = _refit_unsettled(record, avg, fit, structure, delay, sensor)
+    directions, note = None, ""
+    if two_ways:
+        try:
+            directions = fit_by_direction(record, structure, delay, sensor, avg.steps)  # type: ignore[union-attr]
+        except (DataError, ModelError, RuntimeError, ValueError, np.linalg.LinAlgError) as exc:  # FitError too
+            if by_direction:
+                raise
+            note = f"up and down steps not compared: {exc}"
+    return IdentifyResult(record, fit, avg, directions, note, by_direction, whole)
+
+
+def settling_time(plant: Plant, fraction: float = np.exp(-5.0)) -> float:
+    """Time for the slowest mode of ``plant`` to decay to ``fraction`` of its start, plus the delay (inf if not stable).
+
+    Examples
+    --------
+    >>> round(settling_time(Plant.from_string("1/((s+1)*(s+10))", delay=0.1)), 3)
+    5.1
+    """
+    poles = np.roots(np.atleast_1d(plant.den))
+    if poles.size == 0:
+        return float(plant.delay)
+    slowest = float(np.min(-poles.real))
+    return float(np.log(1.0 / fraction) / slowest + plant.delay) if slowest > 0 else float("inf")
+
+
+def _refit_unsettled(record: Record, avg: StepAverage, fit: TimeFitResult, structure: Structure,
+                     delay: str | float | None, sensor: Plant | str | None) -> tuple[TimeFitResult, str]:
+    """Edge windows assume the plant at rest before each step; if the fitted model does not settle within
+    a window, fit the whole record instead (from the edge fit, the start-up weighted 0), which assumes nothing."""
+    window = float(avg.t[-1] + record.dt)
+    settle = settling_time(fit.measured)
+    if not np.isfinite(settle) or settle <= window:
+        return fit, ""
+    skip = min(settle, 0.25 * record.duration)
+    weights = ((record.t - record.t[0]) >= skip).astype(float)
+    initial = {**fit.parameters}
+    try:
+        whole = fit_structure(record, structure, delay, sensor, False, initial=initial, weights=weights, check=True)
+    except (DataError, FitError) as exc:
+        return fit, f"the edge windows ({window:.3g} s) are shorter than the model's settling time ({settle:.3g} s); " \
+                    f"the whole-record fit failed ({exc}), so the edge fit is kept (biased)"
+    return whole, (f"the edge windows ({window:.3g} s) are shorter than the model's settling time ({settle:.3g} s): "
+                   f"fitted the whole record instead, the first {skip:.3g} s (start-up from an unknown state) weighted 0")
