@@ -188,7 +188,7 @@ class PlantSpec(StrictModel):
         return Signal(self.input.name, self.input.unit), Signal(self.output.name, self.output.unit)
 
     def identification(self) -> Any | None:
-        """The :class:`synth.ident.timefit.IdentifyResult` of an ``identify:`` plant (None for ``tf:``)."""
+        """The :class:`synth.ident.identification.IdentifyResult` of an ``identify:`` plant (None for ``tf:``)."""
         if self.identify is None:
             return None
         from synth.ident.from_spec import identify_plant
