@@ -8,6 +8,7 @@ import numpy as np
 from pydantic import PositiveFloat, model_validator
 
 from synth.requirements.base import Bound, Requirement, RequirementResult, fmt, register
+from synth.requirements.margins import unstable_result
 
 if TYPE_CHECKING:
     from synth.loop import Loop
@@ -19,7 +20,8 @@ __all__ = ["Bandwidth"]
 class Bandwidth(Requirement):
     """Closed-loop -3 dB bandwidth of T (relative to ``|T(0)|``) at least ``min`` (and at most ``max``).
 
-    The loop's crossover frequency is reported alongside.
+    The loop's crossover frequency is reported alongside. The bandwidth of a closed loop that is not
+    stable is not a bandwidth: the requirement is then not met, with the reason.
 
     Examples
     --------
@@ -28,6 +30,9 @@ class Bandwidth(Requirement):
     >>> r = Bandwidth(type="bandwidth", min=60).evaluate(loop)
     >>> round(r.value, 2), round(r.details["crossover"], 2), r.met
     (83.16, 68.33, True)
+    >>> r = Bandwidth(min=5).evaluate(Loop(Plant.from_string("10/((s-1)*(s+5))"), Controller("P", {"kp": 0.4})))
+    >>> r.met, r.message.split(":")[0]
+    (False, 'closed loop UNSTABLE (1 root(s) in the closed right half-plane)')
     """
 
     type: Literal["bandwidth"] = "bandwidth"
@@ -46,6 +51,8 @@ class Bandwidth(Requirement):
         return self
 
     def evaluate(self, loop: Loop, per_decade: int = 80) -> RequirementResult:
+        if not loop.stability().stable:
+            return unstable_result(self, loop, "bandwidth", crossover=loop.crossover())
         wb = loop.bandwidth(per_decade)
         wc = loop.crossover()
         slacks = []

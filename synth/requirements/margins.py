@@ -12,12 +12,17 @@ from synth.requirements.base import NEPER_PER_DB, Bound, Requirement, Requiremen
 if TYPE_CHECKING:
     from synth.loop import Loop
 
-__all__ = ["MarginsRequirement"]
+__all__ = ["UNSTABLE_SLACK", "MarginsRequirement", "unstable_result"]
 
 
 @register
 class MarginsRequirement(Requirement):
     """Gain margin (dB), phase margin (deg) and optionally delay margin (s), each a lower bound.
+
+    The gain margin is two-sided: the loop must stay stable when its gain rises by ``gain_margin_db``
+    and when it falls by as much (an open-loop unstable plant, or a conditionally stable loop, has a
+    lower gain limit; both limits are in ``details``). Margins of a closed loop that is not stable are
+    not margins: the requirement is then not met, with the reason, and its value is ``nan``.
 
     Examples
     --------
@@ -27,6 +32,10 @@ class MarginsRequirement(Requirement):
     ...     Loop(G, Controller("P", {"kp": 3.0})))
     >>> r.met, round(r.details["gain_margin_db"], 2), round(r.details["phase_margin_deg"], 1)
     (False, 1.79, 19.8)
+    >>> unstable = Loop(Plant.from_string("10/((s-1)*(s+5))"), Controller("P", {"kp": 0.4}))
+    >>> r = MarginsRequirement(phase_margin_deg=45).evaluate(unstable)
+    >>> r.met, r.message
+    (False, 'closed loop UNSTABLE (1 root(s) in the closed right half-plane): phase margin undefined, NOT met')
     """
 
     type: Literal["margins"] = "margins"
@@ -49,10 +58,16 @@ class MarginsRequirement(Requirement):
 
     def evaluate(self, loop: Loop, per_decade: int = 80) -> RequirementResult:
         m = loop.margins()
+        if not m.closed_loop_stable:
+            given = [f.replace("_db", "").replace("_deg", "").replace("_", " ") for f in self.bounds
+                     if getattr(self, f) is not None]
+            return unstable_result(self, loop, " and ".join(given), **m.to_dict())
         parts = []
         if self.gain_margin_db is not None:
-            slack = (m.gain_margin_db - self.gain_margin_db) * NEPER_PER_DB
-            parts.append((slack, "gain margin", m.gain_margin_db, self.gain_margin_db, "dB", m.phase_crossover))
+            two_sided = min(m.gain_margin_db, -m.lower_gain_margin_db)
+            w = m.phase_crossover if m.gain_margin_db <= -m.lower_gain_margin_db else m.lower_phase_crossover
+            slack = (two_sided - self.gain_margin_db) * NEPER_PER_DB
+            parts.append((slack, "gain margin", two_sided, self.gain_margin_db, "dB", w))
         if self.phase_margin_deg is not None:
             slack = np.radians(m.phase_margin_deg - self.phase_margin_deg)
             parts.append((slack, "phase margin", m.phase_margin_deg, self.phase_margin_deg, "deg",
@@ -65,3 +80,34 @@ class MarginsRequirement(Requirement):
         msg = f"{'; '.join(texts)}: {'met' if slack >= 0 else 'NOT met'}, tightest: {name}"
         return self.result(value=value, bound=bound, unit=unit, slack=slack, margin=value - bound,
                            binding_frequency=w, message=msg, binding=name, **m.to_dict())
+
+
+UNSTABLE_SLACK = -1.0
+"""Slack of a margin-type requirement on a closed loop that is not stable (per unstable root): below any
+met value, finite so that root bracketing over a parameter still brackets the stability boundary."""
+
+
+def unstable_result(req: Requirement, loop: Loop, what: str, **details: Any) -> RequirementResult:
+    """The result of a requirement that presumes a stable closed loop, on one that is not: not met,
+    value ``nan``, the reason in the message (``what`` names the undefined quantity).
+
+    Examples
+    --------
+    >>> from synth.loop import Loop; from synth.plant import Plant; from synth.controllers import Controller
+    >>> loop = Loop(Plant.from_string("10/((s-1)*(s+5))"), Controller("P", {"kp": 0.5}))
+    >>> r = unstable_result(MarginsRequirement(phase_margin_deg=45), loop, "phase margin")
+    >>> r.met, r.message
+    (False, 'closed loop marginally stable (a root on the imaginary axis at 0 rad/s): phase margin undefined, NOT met')
+    """
+    st = loop.stability()
+    if st.marginal_frequency is not None:
+        why = f"closed loop marginally stable (a root on the imaginary axis at {fmt(st.marginal_frequency)} rad/s)"
+    else:
+        why = f"closed loop UNSTABLE ({st.unstable_poles} root(s) in the closed right half-plane)"
+    bound_field = next((f for f in req.bounds if getattr(req, f, None) is not None), None)
+    bound = float(getattr(req, bound_field)) if bound_field else float("nan")
+    unit = req.bounds[bound_field].unit if bound_field else ""
+    return req.result(value=float("nan"), bound=bound, unit=unit, slack=UNSTABLE_SLACK * max(st.unstable_poles, 1),
+                      margin=float("nan"), binding_frequency=st.marginal_frequency,
+                      message=f"{why}: {what} undefined, NOT met",
+                      **{**details, "closed_loop_stable": False, "unstable_roots": st.unstable_poles})
