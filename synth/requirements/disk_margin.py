@@ -8,7 +8,7 @@ import numpy as np
 from pydantic import PositiveFloat, field_validator
 
 from synth.freqgrid import log_grid, peak
-from synth.requirements.base import Bound, Requirement, RequirementResult, fmt, register
+from synth.requirements.base import Bound, Requirement, RequirementResult, db, fmt, register
 from synth.requirements.margins import unstable_result
 
 if TYPE_CHECKING:
@@ -30,17 +30,20 @@ def disk_gain_phase(alpha: float, skew: float = 0.0) -> tuple[float, float, floa
     >>> round(float(20 * np.log10(g_hi)), 3), round(pm, 2)
     (6.0, 36.76)
     """
+    if not np.isfinite(alpha):
+        return 0.0, float("inf"), 180.0
     a, b = (1 - skew) / 2 * alpha, (1 + skew) / 2 * alpha
     g_hi = (1 + a) / (1 - b) if b < 1 else np.inf
-    g_lo = (1 - a) / (1 + b)
-    # phase of F(d) on |F| = 1: scan the disk's boundary
-    d = np.exp(1j * np.linspace(0, np.pi, 20001))
-    f = (1 + a * d) / (1 - b * d)
-    on = np.abs(np.abs(f) - 1.0)
-    pm = float(np.degrees(np.abs(np.angle(f[np.argmin(on)])))) if b < 1 else 90.0
+    g_lo = max((1 - a) / (1 + b), 0.0)
     if skew == 0.0:
-        pm = float(np.degrees(2 * np.arctan(alpha / 2)))  # closed form for the balanced disk
-    return float(g_lo), float(g_hi), pm
+        return float(g_lo), float(g_hi), float(np.degrees(2 * np.arctan(alpha / 2)))  # the balanced disk
+    # the largest phase of F on |F| = 1 lies where the unit circle meets the disk's boundary: scan it
+    d = np.exp(1j * np.linspace(0, np.pi, 20001))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        f = (1 + a * d) / (1 - b * d)
+    on = np.abs(np.abs(f) - 1.0)
+    on[~np.isfinite(on)] = np.inf
+    return float(g_lo), float(g_hi), float(np.degrees(np.abs(np.angle(f[np.argmin(on)]))))
 
 
 @register
@@ -86,12 +89,13 @@ class DiskMargin(Requirement):
         value = max(value, abs(1.0 + c) if loop.L(np.array([hi * 10]))[0] == 0 else 0.0)
         alpha = 1.0 / value if value > 0 else np.inf
         g_lo, g_hi, pm = disk_gain_phase(alpha, self.skew)
+        lo_db, hi_db = db(g_lo), db(g_hi)
         slack = float(np.log(alpha / self.min))
         msg = (f"disk margin {fmt(alpha)} >= {fmt(self.min)}: {'met' if slack >= 0 else 'NOT met'} "
-               f"(gain {fmt(20 * np.log10(g_lo))}/+{fmt(20 * np.log10(g_hi))} dB with +-{fmt(pm)} deg; "
+               f"(gain {fmt(lo_db)}/+{fmt(hi_db)} dB with +-{fmt(pm)} deg; "
                f"peak at {fmt(w)} rad/s on {per_decade} points/decade, refined)")
         return self.result(value=alpha, bound=self.min, unit="", slack=slack, margin=alpha - self.min,
                            binding_frequency=w, message=msg, skew=self.skew,
-                           gain_margin_db=float(20 * np.log10(g_hi)), lower_gain_margin_db=float(20 * np.log10(g_lo)),
+                           gain_margin_db=hi_db, lower_gain_margin_db=lo_db,
                            phase_margin_deg=pm, grid_points_per_decade=per_decade,
                            grid=[float(grid[0]), float(grid[-1])])

@@ -169,8 +169,10 @@ def _disk_margin(b: NLPBuilder, req: DiskMargin, plant: Plant, ctx: NLPContext) 
 @nlp_form(DelayMargin, exact=False)
 def _delay_margin(b: NLPBuilder, req: DelayMargin, plant: Plant, ctx: NLPContext) -> None:
     # at each gain crossover of the start design: |1 + L| >= 2 sin(wc tau / 2), i.e. PM >= wc tau
-    # (the crossovers move with the design; the certificate checks the exact margin)
-    NLP_FORMS.entry(MarginsRequirement).build(b, MarginsRequirement(delay_margin=req.min), plant, ctx)
+    # (the crossovers move with the design; the certificate checks the exact margin), tightened so that
+    # a design on the bound passes the exact check
+    tightened = MarginsRequirement(delay_margin=req.min * (1 + 10 * BACKOFF))
+    NLP_FORMS.entry(MarginsRequirement).build(b, tightened, plant, ctx)
 
 
 @nlp_form(StepResponse, exact=False)
