@@ -18,6 +18,7 @@ from synth.requirements.control_sensitivity import PeakControlSensitivity
 from synth.requirements.delay_margin import DelayMargin
 from synth.requirements.disk_margin import DiskMargin
 from synth.requirements.margins import MarginsRequirement
+from synth.requirements.no_limit_cycle import NoLimitCycle
 from synth.requirements.sensitivity import (
     PeakComplementary,
     PeakRequirement,
@@ -35,6 +36,7 @@ __all__ = [
     "DelayMargin",
     "DiskMargin",
     "MarginsRequirement",
+    "NoLimitCycle",
     "PeakComplementary",
     "PeakControlSensitivity",
     "PeakRequirement",
