@@ -2,11 +2,13 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from functools import cache
 from typing import TYPE_CHECKING, Any, ClassVar, Literal
 
 import numpy as np
 from pydantic import Field, NonNegativeFloat, field_validator, model_validator
+from scipy.optimize import brentq, minimize_scalar
 
 from synth.freqgrid import log_grid
 from synth.requirements.base import NEPER_PER_DB, Bound, Requirement, RequirementResult, db, fmt, register
@@ -48,7 +50,25 @@ def rate_limiter_locus(points: int = 400) -> tuple[np.ndarray, np.ndarray]:
     return psi[keep], np.abs(c)[keep]
 
 
-def critical_gain_factor(L: np.ndarray, w: np.ndarray, delays: tuple[float, float],
+def _interior(L: np.ndarray, w: np.ndarray, delays: tuple[float, float], rate_limit: bool) -> np.ndarray:
+    """Gain factor at each frequency at which the swept angle interval meets a critical locus."""
+    lo, hi = delays
+    mag = np.abs(L)
+    psi0 = np.angle(L) + np.pi  # angle from the negative real axis
+    a, b = psi0 - w * hi, psi0 - w * lo  # the delays sweep [a, b] at each frequency
+    a_mod = np.mod(a, TWO_PI)
+    contains_axis = (b - a >= TWO_PI) | (a_mod + (b - a) >= TWO_PI) | (a_mod == 0.0)
+    with np.errstate(divide="ignore"):
+        inv = np.where(mag > 0, 1.0 / mag, np.inf)
+    k = np.where(contains_axis, inv, np.inf)
+    if rate_limit:
+        psi_c, r_c = rate_limiter_locus()
+        inside = ~contains_axis & (a_mod < psi_c[-1])
+        k = np.minimum(k, np.where(inside, np.interp(a_mod, psi_c, r_c) * inv, np.inf))
+    return k
+
+
+def critical_gain_factor(L: Callable[[np.ndarray], np.ndarray], w: np.ndarray, delays: tuple[float, float],
                          kinds: tuple[str, ...]) -> tuple[float, float | None, float | None]:
     """Smallest loop-gain factor ``k`` at which ``k L(jw) exp(-jw tau)`` meets a block's critical locus for
     some ``tau`` in ``delays``: ``(k, w, tau)`` of the worst point (``inf`` when it never does).
@@ -56,49 +76,56 @@ def critical_gain_factor(L: np.ndarray, w: np.ndarray, delays: tuple[float, floa
     Every locus here contains ``-1`` (N = 1 at small amplitude); saturation and dead zone add the
     negative real axis left of ``-1``, the rate limiter its curve :func:`rate_limiter_locus`. A delay
     only turns ``L`` clockwise, so the delays in the range sweep an angle interval at each frequency and
-    the test is exact in the delay; in frequency it is exact on the grid ``w``, plus the crossings of
-    the negative real axis between grid points at both ends of the delay range.
+    the test is exact in the delay. In frequency the grid ``w`` brackets the minima, which are then
+    refined (bounded Brent), and the crossings of the negative real axis at both ends of the delay range
+    are solved for (Brent): the result does not depend on the grid once it resolves the curve.
 
     Examples
     --------
     ``L = 20/(s (s+1) (s+2))`` with a saturation: a cycle is predicted (``|L|`` is 3.33 at 1.414 rad/s
     on the negative real axis), and a loop gain reduced by 3.33 would avoid it:
 
-    >>> w = np.geomspace(0.01, 100, 4001)
-    >>> L = 20 / (1j * w * (1j * w + 1) * (1j * w + 2))
-    >>> k, wk, _ = critical_gain_factor(L, w, (0.0, 0.0), ("saturation",))
-    >>> round(float(k), 4), round(wk, 3)
-    (0.3, 1.414)
+    >>> L = lambda w: 20 / (1j * w * (1j * w + 1) * (1j * w + 2))
+    >>> k, wk, _ = critical_gain_factor(L, np.geomspace(0.01, 100, 201), (0.0, 0.0), ("saturation",))
+    >>> round(k, 8), round(wk, 6)
+    (0.3, 1.414214)
     """
     lo, hi = delays
-    mag = np.abs(L)
-    psi0 = np.unwrap(np.angle(L)) + np.pi  # angle from the negative real axis
-    a, b = psi0 - w * hi, psi0 - w * lo  # the delays sweep [a, b] at each frequency
-    a_mod = np.mod(a, TWO_PI)
-    contains_axis = (b - a >= TWO_PI) | (a_mod + (b - a) >= TWO_PI) | (a_mod == 0.0)
-    with np.errstate(divide="ignore"):
-        inv = np.where(mag > 0, 1.0 / mag, np.inf)
-    k = np.where(contains_axis, inv, np.inf)
-    if "rate_limit" in kinds:
-        psi_c, r_c = rate_limiter_locus()
-        inside = ~contains_axis & (a_mod < psi_c[-1])
-        r = np.interp(a_mod, psi_c, r_c)
-        k = np.minimum(k, np.where(inside, r * inv, np.inf))
-    best = int(np.argmin(k)) if k.size else 0
-    k_star, w_star = (float(k[best]), float(w[best])) if k.size and np.isfinite(k[best]) else (np.inf, None)
-    tau_star = None if w_star is None else float(np.clip((psi0[best] - np.round(psi0[best] / TWO_PI) * TWO_PI) / w_star
-                                                          if w_star > 0 else lo, lo, hi))
-    for edge in (lo, hi):  # negative-real-axis crossings between grid points
-        turns = np.floor((psi0 - w * edge) / TWO_PI)
-        idx = np.flatnonzero(np.diff(turns) != 0)
+    rate = "rate_limit" in kinds
+    w = np.asarray(w, float)
+    Lw = L(w)
+
+    def k_at(x: float) -> float:
+        v = float(_interior(L(np.array([x])), np.array([x]), delays, rate)[0])
+        return v if np.isfinite(v) else 1e300  # Brent needs finite values
+
+    k = _interior(Lw, w, delays, rate)
+    k_star, w_star, tau_star = np.inf, None, None
+    if np.any(np.isfinite(k)):
+        best = float(np.min(k))
+        left = np.concatenate([[np.inf], k[:-1]])
+        right = np.concatenate([k[1:], [np.inf]])
+        minima = np.isfinite(k) & (k <= left) & (k <= right) & (k <= 1.5 * best)
+        for i in np.flatnonzero(minima)[:20]:
+            a, b = w[max(i - 1, 0)], w[min(i + 1, w.size - 1)]
+            x, v = w[i], float(k[i])
+            if b > a:
+                res = minimize_scalar(k_at, bounds=(a, b), method="bounded", options={"xatol": 1e-12 * b})
+                if res.fun < v:
+                    x, v = float(res.x), float(res.fun)
+            if v < k_star:
+                k_star, w_star, tau_star = v, x, hi
+    for edge in (lo, hi):  # negative-real-axis crossings at the ends of the delay range
+        z = Lw * np.exp(-1j * w * edge)
+        im = z.imag
+        idx = np.flatnonzero((np.sign(im[:-1]) != np.sign(im[1:])) & ((z.real[:-1] < 0) | (z.real[1:] < 0)))
         for i in idx:
-            target = max(turns[i], turns[i + 1]) * TWO_PI
-            p0, p1 = psi0[i] - w[i] * edge, psi0[i + 1] - w[i + 1] * edge
-            f = (target - p0) / (p1 - p0) if p1 != p0 else 0.0
-            m = mag[i] + f * (mag[i + 1] - mag[i])
-            if m > 0 and 1.0 / m < k_star:
-                k_star, w_star, tau_star = 1.0 / m, float(w[i] + f * (w[i + 1] - w[i])), float(edge)
-    return k_star, w_star, tau_star
+            f = lambda x, e=edge: float((L(np.array([x]))[0] * np.exp(-1j * x * e)).imag)  # noqa: E731
+            x = brentq(f, w[i], w[i + 1], xtol=1e-14 * w[i + 1], rtol=1e-13) if f(w[i]) * f(w[i + 1]) < 0 else w[i]
+            zx = L(np.array([x]))[0] * np.exp(-1j * x * edge)
+            if zx.real < 0 and 1.0 / abs(zx) < k_star:
+                k_star, w_star, tau_star = 1.0 / abs(zx), float(x), float(edge)
+    return float(k_star), w_star, tau_star
 
 
 @register
@@ -110,8 +137,8 @@ class NoLimitCycle(Requirement):
     dead_zone, rate_limit; the chain is checked block by block, each by its own critical locus, as the
     chain's describing function is not the product of theirs). The measured value is the describing
     function gain margin: the smallest loop-gain factor at which the Nyquist curve, turned by any delay
-    in the range, meets a critical locus (:func:`critical_gain_factor`, exact in the delay, on a log
-    frequency grid of ``per_decade`` points per decade). Harmonic balance is a prediction:
+    in the range, meets a critical locus (:func:`critical_gain_factor`, exact in the delay; in frequency
+    bracketed on a log grid of ``per_decade`` points per decade and refined). Harmonic balance is a prediction:
     ``synth simulate`` confirms it in the time domain. On a closed loop that is not stable (small
     signals already grow) the requirement is not met.
 
@@ -158,14 +185,15 @@ class NoLimitCycle(Requirement):
         lo, hi = loop.frequency_range
         w = log_grid(lo, hi * 10, per_decade)
         kinds = tuple(sorted({b.type for b in self.actuator}))
-        k, wk, tau = critical_gain_factor(loop.L(w), w, self.delay, kinds)
+        k, wk, tau = critical_gain_factor(loop.L, w, self.delay, kinds)
         value = db(k) if np.isfinite(k) else np.inf
         slack = (value - self.min_gain_margin_db) * NEPER_PER_DB
         where = "" if wk is None else f", nearest at {fmt(wk)} rad/s with {fmt(tau * 1e3)} ms added"
         msg = (f"describing-function gain margin {fmt(value)} dB >= {fmt(self.min_gain_margin_db)} dB over "
                f"in-loop delays [{fmt(self.delay[0] * 1e3)}, {fmt(self.delay[1] * 1e3)}] ms: "
                f"{'met (no limit cycle predicted)' if slack >= 0 else 'NOT met (a limit cycle is predicted)'}"
-               f"{where}; {', '.join(kinds)}; exact in the delay, {per_decade} points/decade in frequency")
+               f"{where}; {', '.join(kinds)}; exact in the delay, bracketed on {per_decade} points/decade "
+               "in frequency and refined")
         return self.result(value=value, bound=self.min_gain_margin_db, unit="dB", slack=slack,
                            margin=value - self.min_gain_margin_db, binding_frequency=wk, message=msg,
                            gain_factor=k, delay_at_binding=tau, blocks=list(kinds),
