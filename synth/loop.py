@@ -63,8 +63,21 @@ class Margins:
     lower_phase_crossover: float | None = None
 
     def to_dict(self) -> dict[str, Any]:
-        """JSON-ready dict."""
-        return dict(self.__dict__)
+        """JSON-ready dict: the six classical fields, plus ``closed_loop_stable`` only when False and
+        ``lower_phase_crossover`` only when there is a lower gain limit (reports of stable loops keep
+        their layout).
+
+        Examples
+        --------
+        >>> sorted(Margins(6.0, -np.inf, 1.0, 45.0, 0.5, 1.5).to_dict())[:3]
+        ['delay_margin', 'gain_crossover', 'gain_margin_db']
+        """
+        out = dict(self.__dict__)
+        if out["closed_loop_stable"]:
+            del out["closed_loop_stable"]
+        if out["lower_phase_crossover"] is None:
+            del out["lower_phase_crossover"]
+        return out
 
 
 @dataclass(frozen=True, eq=False)
