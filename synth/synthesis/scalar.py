@@ -49,7 +49,7 @@ def _optimize_scalar(f: Callable[[float], float], intervals: list[tuple[float, f
                                   options={"xatol": 1e-10 * max(1.0, abs(b))})
             if -res.fun > v:
                 x, v = float(res.x), float(-res.fun)
-        if v > best_v:
+        if v > best_v or best_x is None:
             best_x, best_v = x, v
     return float(best_x), float(best_v)
 
