@@ -8,7 +8,7 @@ import numpy as np
 from pydantic import PositiveFloat, model_validator
 
 from synth.requirements.base import Bound, Requirement, RequirementResult, fmt, register
-from synth.requirements.margins import unstable_result
+from synth.requirements.margins import closed_loop_unstable, unstable_result
 
 if TYPE_CHECKING:
     from synth.loop import Loop
@@ -51,7 +51,7 @@ class Bandwidth(Requirement):
         return self
 
     def evaluate(self, loop: Loop, per_decade: int = 80) -> RequirementResult:
-        if not loop.stability().stable:
+        if closed_loop_unstable(loop):
             return unstable_result(self, loop, "bandwidth", crossover=loop.crossover())
         wb = loop.bandwidth(per_decade)
         wc = loop.crossover()

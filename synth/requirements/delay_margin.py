@@ -9,7 +9,7 @@ from pydantic import PositiveFloat
 
 from synth.errors import ModelError
 from synth.requirements.base import Bound, Requirement, RequirementResult, fmt, register
-from synth.requirements.margins import unstable_result
+from synth.requirements.margins import closed_loop_unstable, unstable_result
 from synth.stability import closed_loop_stability
 
 if TYPE_CHECKING:
@@ -69,7 +69,7 @@ class DelayMargin(Requirement):
     example: ClassVar[dict[str, Any]] = {"type": "delay_margin", "min": 0.01}
 
     def evaluate(self, loop: Loop, per_decade: int = 80) -> RequirementResult:
-        if not loop.stability().stable:
+        if closed_loop_unstable(loop):
             return unstable_result(self, loop, "delay margin")
         per_crossover = delay_margins_per_crossover(loop)
         dm, wc = min(((d, w) for w, _, d in per_crossover), default=(np.inf, None))

@@ -9,7 +9,7 @@ from pydantic import PositiveFloat, field_validator
 
 from synth.freqgrid import log_grid, peak
 from synth.requirements.base import Bound, Requirement, RequirementResult, db, fmt, register
-from synth.requirements.margins import unstable_result
+from synth.requirements.margins import closed_loop_unstable, unstable_result
 
 if TYPE_CHECKING:
     from synth.loop import Loop
@@ -80,7 +80,7 @@ class DiskMargin(Requirement):
         return skew
 
     def evaluate(self, loop: Loop, per_decade: int = 80) -> RequirementResult:
-        if not loop.stability().stable:
+        if closed_loop_unstable(loop):
             return unstable_result(self, loop, "disk margin")
         c = (self.skew - 1.0) / 2.0
         lo, hi = loop.frequency_range

@@ -12,7 +12,7 @@ from synth.requirements.base import NEPER_PER_DB, Bound, Requirement, Requiremen
 if TYPE_CHECKING:
     from synth.loop import Loop
 
-__all__ = ["UNSTABLE_SLACK", "MarginsRequirement", "unstable_result"]
+__all__ = ["UNSTABLE_SLACK", "MarginsRequirement", "closed_loop_unstable", "unstable_result"]
 
 
 @register
@@ -58,7 +58,7 @@ class MarginsRequirement(Requirement):
 
     def evaluate(self, loop: Loop, per_decade: int = 80) -> RequirementResult:
         m = loop.margins()
-        if not m.closed_loop_stable:
+        if closed_loop_unstable(loop):
             given = [f.replace("_db", "").replace("_deg", "").replace("_", " ") for f in self.bounds
                      if getattr(self, f) is not None]
             return unstable_result(self, loop, " and ".join(given), **m.to_dict())
@@ -80,6 +80,22 @@ class MarginsRequirement(Requirement):
         msg = f"{'; '.join(texts)}: {'met' if slack >= 0 else 'NOT met'}, tightest: {name}"
         return self.result(value=value, bound=bound, unit=unit, slack=slack, margin=value - bound,
                            binding_frequency=w, message=msg, binding=name, **m.to_dict())
+
+
+def closed_loop_unstable(loop: Loop) -> bool:
+    """Whether ``loop`` has a closed-loop root in the closed right half-plane, by count (polynomial roots
+    within a tolerance of the axis count; with a delay, the Nyquist count). A delayed loop whose return
+    difference only comes within rounding of zero on the axis is flagged "marginal" by its stability row
+    but is not counted here, so a requirement's set ends exactly where the count changes.
+
+    Examples
+    --------
+    >>> from synth.loop import Loop; from synth.plant import Plant; from synth.controllers import Controller
+    >>> G = Plant.from_string("10/((s-1)*(s+5))")
+    >>> [closed_loop_unstable(Loop(G, Controller("P", {"kp": k}))) for k in (0.4, 0.5, 0.6)]
+    [True, True, False]
+    """
+    return loop.stability().unstable_poles > 0
 
 
 UNSTABLE_SLACK = -1.0

@@ -12,7 +12,7 @@ from scipy.optimize import brentq, minimize_scalar
 
 from synth.freqgrid import log_grid
 from synth.requirements.base import NEPER_PER_DB, Bound, Requirement, RequirementResult, db, fmt, register
-from synth.requirements.margins import unstable_result
+from synth.requirements.margins import closed_loop_unstable, unstable_result
 from synth.sim.describing import rate_limiter_df
 from synth.sim.spec import BlockEntry
 
@@ -180,7 +180,7 @@ class NoLimitCycle(Requirement):
         return self
 
     def evaluate(self, loop: Loop, per_decade: int = 80) -> RequirementResult:
-        if not loop.stability().stable:
+        if closed_loop_unstable(loop):
             return unstable_result(self, loop, "limit-cycle check")
         lo, hi = loop.frequency_range
         w = log_grid(lo, hi * 10, per_decade)

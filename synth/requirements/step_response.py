@@ -8,7 +8,7 @@ import numpy as np
 from pydantic import NonNegativeFloat, PositiveFloat, model_validator
 
 from synth.requirements.base import Bound, Requirement, RequirementResult, fmt, register
-from synth.requirements.margins import unstable_result
+from synth.requirements.margins import closed_loop_unstable, unstable_result
 from synth.timeresp import default_horizon, step_metrics, step_response
 
 if TYPE_CHECKING:
@@ -68,7 +68,7 @@ class StepResponse(Requirement):
         return self
 
     def evaluate(self, loop: Loop, per_decade: int = 80) -> RequirementResult:
-        if not loop.stability().stable:
+        if closed_loop_unstable(loop):
             return unstable_result(self, loop, "step response")
         final = loop.T0()
         horizon = default_horizon(loop)
