@@ -43,7 +43,14 @@ class Margins:
     gain_crossover : float or None
         Crossover frequency where the phase margin is smallest (rad/s).
     delay_margin : float
-        Extra loop delay that makes the loop marginal (s): min over crossovers of PM/w.
+        Extra loop delay that makes the loop marginal (s): min over crossovers of PM/w, the phase
+        margin taken in (0, 360] deg (0 when the closed loop is not stable).
+    closed_loop_stable : bool
+        The margins describe a stable closed loop; when False they are not margins of anything (a
+        requirement on them is not met).
+    lower_phase_crossover : float or None
+        Frequency of the lower gain limit's crossing (rad/s): the loop of an open-loop unstable plant
+        turns unstable when its gain falls by ``-lower_gain_margin_db``.
     """
 
     gain_margin_db: float
@@ -52,10 +59,25 @@ class Margins:
     phase_margin_deg: float
     gain_crossover: float | None
     delay_margin: float
+    closed_loop_stable: bool = True
+    lower_phase_crossover: float | None = None
 
     def to_dict(self) -> dict[str, Any]:
-        """JSON-ready dict."""
-        return dict(self.__dict__)
+        """JSON-ready dict: the six classical fields, plus ``closed_loop_stable`` only when False and
+        ``lower_phase_crossover`` only when there is a lower gain limit (reports of stable loops keep
+        their layout).
+
+        Examples
+        --------
+        >>> sorted(Margins(6.0, -np.inf, 1.0, 45.0, 0.5, 1.5).to_dict())[:3]
+        ['delay_margin', 'gain_crossover', 'gain_margin_db']
+        """
+        out = dict(self.__dict__)
+        if out["closed_loop_stable"]:
+            del out["closed_loop_stable"]
+        if out["lower_phase_crossover"] is None:
+            del out["lower_phase_crossover"]
+        return out
 
 
 @dataclass(frozen=True, eq=False, init=False)
@@ -157,6 +179,8 @@ class Loop:
         l0 = self.controller.dc_gain() * self.plant.dc_gain()
         if np.isinf(l0):
             return 1.0
+        if 1.0 + l0 == 0.0:  # a closed-loop pole at s = 0: |T(0)| is unbounded
+            return float("inf")
         return float(abs(l0 / (1.0 + l0)))
 
     # --------------------------------------------------------------- frequencies
@@ -226,14 +250,25 @@ class Loop:
     def margins(self) -> Margins:
         """Gain, phase and delay margins, delay included.
 
+        The gain limits come from the D-decomposition in the loop gain (a Nyquist-exact count): for a
+        conditionally stable loop or an open-loop unstable plant both a lower and an upper limit are
+        reported. On a closed loop that is not stable the margins are flagged (``closed_loop_stable``)
+        and the delay margin is 0.
+
         Examples
         --------
         >>> G = Plant.from_string("23*(s+0.43)/((s+9.6)*(s+0.54))", delay=0.02)
         >>> m = Loop(G, Controller("P", {"kp": 3.0})).margins()
         >>> round(m.gain_margin_db, 2), round(m.phase_crossover, 2)
         (1.79, 84.28)
+
+        An open-loop unstable plant has a lower gain limit (here ``k > 0.5``, i.e. -12.04 dB from 2):
+
+        >>> m = Loop(Plant.from_string("10/((s-1)*(s+5))"), Controller("P", {"kp": 2.0})).margins()
+        >>> round(m.lower_gain_margin_db, 2), m.gain_margin_db, round(m.phase_margin_deg, 2)
+        (-12.04, inf, 39.99)
         """
-        k_lo, k_hi, _, w_hi = self.gain_factors
+        k_lo, k_hi, w_lo, w_hi = self.gain_factors
         gm = 20 * np.log10(k_hi) if np.isfinite(k_hi) else np.inf
         lgm = 20 * np.log10(k_lo) if k_lo > 0 else -np.inf
         pm, wpm, dm = np.inf, None, np.inf
@@ -242,11 +277,11 @@ class Loop:
             this = (phase + 180.0 + 180.0) % 360.0 - 180.0  # wrapped to [-180, 180)
             if this < pm:
                 pm, wpm = float(this), float(wc)
-            if this > 0:
-                dm = min(dm, np.radians(this) / wc)
-            else:
-                dm = 0.0
-        return Margins(float(gm), float(lgm), w_hi, pm, wpm, float(dm))
+            # extra delay turns L(j wc) clockwise: it reaches -1 after the phase margin taken in (0, 360] deg
+            turn = this if this > 0 else this + 360.0
+            dm = min(dm, np.radians(turn) / wc) if this != 0.0 else 0.0
+        stable = self.stability().stable
+        return Margins(float(gm), float(lgm), w_hi, pm, wpm, float(dm) if stable else 0.0, stable, w_lo)
 
     # --------------------------------------------------------- closed-loop poles
     def closed_loop_poles(self, pade_order: int = 10) -> np.ndarray:

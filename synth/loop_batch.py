@@ -103,6 +103,23 @@ class LoopBatch:
         self.frequency_ranges = np.column_stack([np.where(none, 1e-2, lo / 100.0), np.where(none, 1e2, hi * 100.0)])
         """Each loop's :attr:`Loop.frequency_range`, ``(n, 2)``."""
 
+    def closed_loop_unstable(self) -> np.ndarray:
+        """Per loop, whether a closed-loop root lies in the closed right half-plane (exact, by count:
+        :meth:`synth.loop.Loop.stability` on each loop, delay included; cached per plant).
+
+        Examples
+        --------
+        >>> G = Plant.from_string("10/((s-1)*(s+5))")
+        >>> LoopBatch(G, [Controller("P", {"kp": k}) for k in (0.4, 2.0)]).closed_loop_unstable().tolist()
+        [True, False]
+        """
+        from synth.loop import Loop
+
+        if getattr(self, "_unstable", None) is None or self._unstable_plant is not self.plant:
+            self._unstable = np.array([Loop(self.plant, c).stability().unstable_poles > 0 for c in self.controllers])
+            self._unstable_plant = self.plant
+        return self._unstable
+
     def __len__(self) -> int:
         return len(self.controllers)
 

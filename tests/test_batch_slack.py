@@ -129,7 +129,9 @@ def test_batch_magnitudes_against_a_dense_grid(seed: int):
         T = np.abs(L[mine] / (1 + L[mine]))
         t0 = Loop(plant, c).T0()
         below = np.flatnonzero(T < t0 * 10 ** (-3 / 20))
-        if below.size and below[0] > 0:
+        if batch.closed_loop_unstable()[i]:  # no bandwidth: the requirement is unmet by the root count
+            assert Bandwidth(min=1.0).batch_slack(batch)[i] < 0
+        elif below.size and below[0] > 0:
             wb = np.exp(Bandwidth(min=1.0).batch_slack(batch)[i])
             assert wb == pytest.approx(w[mine][below[0]], rel=2e-3)
 

@@ -15,7 +15,10 @@ from synth.requirements.base import (
     unique_names,
 )
 from synth.requirements.control_sensitivity import PeakControlSensitivity
+from synth.requirements.delay_margin import DelayMargin
+from synth.requirements.disk_margin import DiskMargin
 from synth.requirements.margins import MarginsRequirement
+from synth.requirements.no_limit_cycle import NoLimitCycle
 from synth.requirements.sensitivity import (
     PeakComplementary,
     PeakRequirement,
@@ -24,12 +27,16 @@ from synth.requirements.sensitivity import (
     StaticSensitivity,
 )
 from synth.requirements.slew_rate import SlewRate
+from synth.requirements.step_response import StepResponse
 
 __all__ = [
     "REQUIREMENT_TYPES",
     "Bandwidth",
     "Bound",
+    "DelayMargin",
+    "DiskMargin",
     "MarginsRequirement",
+    "NoLimitCycle",
     "PeakComplementary",
     "PeakControlSensitivity",
     "PeakRequirement",
@@ -40,6 +47,7 @@ __all__ = [
     "Sensitivity",
     "SlewRate",
     "StaticSensitivity",
+    "StepResponse",
     "magnitude",
     "register",
     "unique_names",

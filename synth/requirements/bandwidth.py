@@ -9,6 +9,7 @@ from pydantic import PositiveFloat, model_validator
 
 from synth.freqgrid import batch_first_crossing, log_grids
 from synth.requirements.base import Bound, Requirement, RequirementResult, fmt, register
+from synth.requirements.margins import closed_loop_unstable, unstable_result, with_unstable_rows
 
 if TYPE_CHECKING:
     from synth.loop import Loop
@@ -21,7 +22,8 @@ __all__ = ["Bandwidth"]
 class Bandwidth(Requirement):
     """Closed-loop -3 dB bandwidth of T (relative to ``|T(0)|``) at least ``min`` (and at most ``max``).
 
-    The loop's crossover frequency is reported alongside.
+    The loop's crossover frequency is reported alongside. The bandwidth of a closed loop that is not
+    stable is not a bandwidth: the requirement is then not met, with the reason.
 
     Examples
     --------
@@ -30,6 +32,9 @@ class Bandwidth(Requirement):
     >>> r = Bandwidth(type="bandwidth", min=60).evaluate(loop)
     >>> round(r.value, 2), round(r.details["crossover"], 2), r.met
     (83.16, 68.33, True)
+    >>> r = Bandwidth(min=5).evaluate(Loop(Plant.from_string("10/((s-1)*(s+5))"), Controller("P", {"kp": 0.4})))
+    >>> r.met, r.message.split(":")[0]
+    (False, 'closed loop UNSTABLE (1 root(s) in the closed right half-plane)')
     """
 
     type: Literal["bandwidth"] = "bandwidth"
@@ -48,6 +53,8 @@ class Bandwidth(Requirement):
         return self
 
     def evaluate(self, loop: Loop, per_decade: int = 80) -> RequirementResult:
+        if closed_loop_unstable(loop):
+            return unstable_result(self, loop, "bandwidth", crossover=loop.crossover())
         wb = loop.bandwidth(per_decade)
         wc = loop.crossover()
         slacks = []
@@ -81,4 +88,4 @@ class Bandwidth(Requirement):
                 slack = np.minimum(slack, np.where(wb > 0, np.log(wb / self.min), -np.inf))
             if self.max is not None:
                 slack = np.minimum(slack, np.where(wb > 0, np.log(self.max / wb), np.inf))
-        return np.where(np.isnan(wb), -np.inf, slack)
+        return with_unstable_rows(self, batch, np.where(np.isnan(wb), -np.inf, slack))

@@ -13,12 +13,17 @@ if TYPE_CHECKING:
     from synth.loop import Loop
     from synth.loop_batch import LoopBatch
 
-__all__ = ["MarginsRequirement"]
+__all__ = ["UNSTABLE_SLACK", "MarginsRequirement", "closed_loop_unstable", "unstable_result", "with_unstable_rows"]
 
 
 @register
 class MarginsRequirement(Requirement):
     """Gain margin (dB), phase margin (deg) and optionally delay margin (s), each a lower bound.
+
+    The gain margin is two-sided: the loop must stay stable when its gain rises by ``gain_margin_db``
+    and when it falls by as much (an open-loop unstable plant, or a conditionally stable loop, has a
+    lower gain limit; both limits are in ``details``). Margins of a closed loop that is not stable are
+    not margins: the requirement is then not met, with the reason, and its value is ``nan``.
 
     Examples
     --------
@@ -28,6 +33,10 @@ class MarginsRequirement(Requirement):
     ...     Loop(G, Controller("P", {"kp": 3.0})))
     >>> r.met, round(r.details["gain_margin_db"], 2), round(r.details["phase_margin_deg"], 1)
     (False, 1.79, 19.8)
+    >>> unstable = Loop(Plant.from_string("10/((s-1)*(s+5))"), Controller("P", {"kp": 0.4}))
+    >>> r = MarginsRequirement(phase_margin_deg=45).evaluate(unstable)
+    >>> r.met, r.message
+    (False, 'closed loop UNSTABLE (1 root(s) in the closed right half-plane): phase margin undefined, NOT met')
     """
 
     type: Literal["margins"] = "margins"
@@ -50,10 +59,16 @@ class MarginsRequirement(Requirement):
 
     def evaluate(self, loop: Loop, per_decade: int = 80) -> RequirementResult:
         m = loop.margins()
+        if closed_loop_unstable(loop):
+            given = [f.replace("_db", "").replace("_deg", "").replace("_", " ") for f in self.bounds
+                     if getattr(self, f) is not None]
+            return unstable_result(self, loop, " and ".join(given), **m.to_dict())
         parts = []
         if self.gain_margin_db is not None:
-            slack = (m.gain_margin_db - self.gain_margin_db) * NEPER_PER_DB
-            parts.append((slack, "gain margin", m.gain_margin_db, self.gain_margin_db, "dB", m.phase_crossover))
+            two_sided = min(m.gain_margin_db, -m.lower_gain_margin_db)
+            w = m.phase_crossover if m.gain_margin_db <= -m.lower_gain_margin_db else m.lower_phase_crossover
+            slack = (two_sided - self.gain_margin_db) * NEPER_PER_DB
+            parts.append((slack, "gain margin", two_sided, self.gain_margin_db, "dB", w))
         if self.phase_margin_deg is not None:
             slack = np.radians(m.phase_margin_deg - self.phase_margin_deg)
             parts.append((slack, "phase margin", m.phase_margin_deg, self.phase_margin_deg, "deg",
@@ -83,4 +98,77 @@ class MarginsRequirement(Requirement):
             if self.delay_margin is not None:
                 with np.errstate(divide="ignore"):
                     parts.append(np.where(dm > 0, np.log(np.where(dm > 0, dm, 1.0) / self.delay_margin), -np.inf))
-        return np.min(parts, axis=0)
+        values = np.min(parts, axis=0)
+        # a non-positive phase or delay margin at a crossover: the scalar form takes the phase margin in
+        # (0, 360 deg] and judges the loop by its root count; those rows get its exact value
+        return with_unstable_rows(self, batch, values, also=~np.isfinite(values) | (values < 0))
+
+def closed_loop_unstable(loop: Loop) -> bool:
+    """Whether ``loop`` has a closed-loop root in the closed right half-plane, by count (polynomial roots
+    within a tolerance of the axis count; with a delay, the Nyquist count). A delayed loop whose return
+    difference only comes within rounding of zero on the axis is flagged "marginal" by its stability row
+    but is not counted here, so a requirement's set ends exactly where the count changes.
+
+    Examples
+    --------
+    >>> from synth.loop import Loop; from synth.plant import Plant; from synth.controllers import Controller
+    >>> G = Plant.from_string("10/((s-1)*(s+5))")
+    >>> [closed_loop_unstable(Loop(G, Controller("P", {"kp": k}))) for k in (0.4, 0.5, 0.6)]
+    [True, True, False]
+    """
+    return loop.stability().unstable_poles > 0
+
+
+UNSTABLE_SLACK = -1.0
+"""Slack of a margin-type requirement on a closed loop that is not stable (per unstable root): below any
+met value, finite so that root bracketing over a parameter still brackets the stability boundary."""
+
+
+def unstable_result(req: Requirement, loop: Loop, what: str, **details: Any) -> RequirementResult:
+    """The result of a requirement that presumes a stable closed loop, on one that is not: not met,
+    value ``nan``, the reason in the message (``what`` names the undefined quantity).
+
+    Examples
+    --------
+    >>> from synth.loop import Loop; from synth.plant import Plant; from synth.controllers import Controller
+    >>> loop = Loop(Plant.from_string("10/((s-1)*(s+5))"), Controller("P", {"kp": 0.5}))
+    >>> r = unstable_result(MarginsRequirement(phase_margin_deg=45), loop, "phase margin")
+    >>> r.met, r.message
+    (False, 'closed loop marginally stable (a root on the imaginary axis at 0 rad/s): phase margin undefined, NOT met')
+    """
+    st = loop.stability()
+    if st.marginal_frequency is not None:
+        why = f"closed loop marginally stable (a root on the imaginary axis at {fmt(st.marginal_frequency)} rad/s)"
+    else:
+        why = f"closed loop UNSTABLE ({st.unstable_poles} root(s) in the closed right half-plane)"
+    bound_field = next((f for f in req.bounds if getattr(req, f, None) is not None), None)
+    bound = float(getattr(req, bound_field)) if bound_field else float("nan")
+    unit = req.bounds[bound_field].unit if bound_field else ""
+    return req.result(value=float("nan"), bound=bound, unit=unit, slack=UNSTABLE_SLACK * max(st.unstable_poles, 1),
+                      margin=float("nan"), binding_frequency=st.marginal_frequency,
+                      message=f"{why}: {what} undefined, NOT met",
+                      **{**details, "closed_loop_stable": False, "unstable_roots": st.unstable_poles})
+
+
+def with_unstable_rows(req: Requirement, batch: LoopBatch, values: np.ndarray,
+                       also: np.ndarray | None = None) -> np.ndarray:
+    """A batch slack whose closed-loop unstable loops carry the scalar verdict (:func:`unstable_result`):
+    the vectorized margin and bandwidth formulas presume a stable closed loop. Rows marked in ``also``
+    are evaluated exactly too.
+
+    Examples
+    --------
+    >>> from synth.loop_batch import LoopBatch; from synth.plant import Plant; from synth.controllers import Controller
+    >>> batch = LoopBatch(Plant.from_string("10/((s-1)*(s+5))"), [Controller("P", {"kp": k}) for k in (0.4, 2.0)])
+    >>> with_unstable_rows(MarginsRequirement(phase_margin_deg=45), batch, np.array([0.3, 0.3])).tolist()
+    [-1.0, 0.3]
+    """
+    from synth.loop import Loop
+
+    unstable = batch.closed_loop_unstable() | (False if also is None else also)
+    if not unstable.any():
+        return values
+    values = np.array(values, dtype=float)
+    for i in np.flatnonzero(unstable):
+        values[i] = req.slack(Loop(batch.plant, batch.controllers[i]))
+    return values

@@ -153,6 +153,13 @@ class PlantSpec(StrictModel):
 
     _parses = field_validator("tf")(classmethod(lambda cls, text: check_transfer_function(text)))
 
+    @field_validator("tf")
+    @classmethod
+    def _not_zero(cls, text: str | None) -> str | None:
+        if text is not None and not any(Plant.from_string(text).num):
+            raise ValueError(f"transfer function {text!r} is identically zero: no controller can act on this plant")
+        return text
+
     @model_validator(mode="after")
     def _one_source(self) -> PlantSpec:
         if (self.tf is None) == (self.identify is None):

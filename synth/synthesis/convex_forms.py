@@ -52,12 +52,16 @@ from synth.loop import BANDWIDTH_LEVEL
 from synth.plant import Plant
 from synth.requirements import (
     Bandwidth,
+    DelayMargin,
+    DiskMargin,
     MarginsRequirement,
+    NoLimitCycle,
     PeakComplementary,
     PeakSensitivity,
     Sensitivity,
     SlewRate,
     StaticSensitivity,
+    StepResponse,
 )
 from synth.requirements.base import Requirement, magnitude
 from synth.requirements.control_sensitivity import PeakControlSensitivity
@@ -473,3 +477,21 @@ def build_forms(requirements: list[Requirement], names: list[str], plants: list[
     forms.append(sensitivity_form("stability (kept along the iterations)", make_points(plants, par, grid),
                                   par.size, 1.0 / stability_level, elastic=False))
     return forms
+
+
+@convex_form(DiskMargin, exact=True)
+def _disk_margin(ctx: FormContext, name: str, req: DiskMargin) -> list[Form]:
+    # |S + c| <= 1/alpha with S + c = ((1 + c) D + c N)/(D + N): a ratio of affine parts
+    c = (req.skew - 1.0) / 2.0
+    pts = make_points(ctx.plants, ctx.par, ctx.grid)
+    U = pts.D.scaled(np.full(pts.n, 1.0 + c)) + pts.N.scaled(np.full(pts.n, c))
+    return [RatioBound(name, U, pts.P, ctx.tight / req.min, ctx.par.size)]
+
+
+@convex_form(DelayMargin, exact=False)
+@convex_form(StepResponse, exact=False)
+@convex_form(NoLimitCycle, exact=False)
+def _no_convex_form(ctx: FormContext, name: str, req: Requirement) -> list[Form]:
+    # no convex form: the NLP stage (delay margin) and the certificate inside the design loop enforce them
+    # (the certificate re-checks every requirement exactly; a design that fails it is not reported)
+    return []

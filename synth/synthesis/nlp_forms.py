@@ -20,13 +20,17 @@ from synth.loop import BANDWIDTH_LEVEL, Loop
 from synth.plant import Plant
 from synth.requirements import (
     Bandwidth,
+    DelayMargin,
+    DiskMargin,
     MarginsRequirement,
+    NoLimitCycle,
     PeakComplementary,
     PeakControlSensitivity,
     PeakSensitivity,
     Sensitivity,
     SlewRate,
     StaticSensitivity,
+    StepResponse,
 )
 from synth.requirements.base import Requirement, magnitude
 from synth.synthesis.form_registry import FormRegistry
@@ -155,3 +159,26 @@ def _margins(b: NLPBuilder, req: MarginsRequirement, plant: Plant, ctx: NLPConte
             b.geq(L.re + 1.0 / magnitude(req.gain_margin_db * (1 + BACKOFF)))
 
 
+@nlp_form(DiskMargin, exact=True)
+def _disk_margin(b: NLPBuilder, req: DiskMargin, plant: Plant, ctx: NLPContext) -> None:
+    # |1 + c (1 + L)| <= |1 + L| / alpha, squared
+    c = (req.skew - 1.0) / 2.0
+    _, L = loop_response(b.ctrl, plant, ctx.points(req))
+    b.geq(TIGHT * (1.0 + L).abs2() / req.min**2 - (L * c + (1.0 + c)).abs2())
+
+
+@nlp_form(DelayMargin, exact=False)
+def _delay_margin(b: NLPBuilder, req: DelayMargin, plant: Plant, ctx: NLPContext) -> None:
+    # at each gain crossover of the start design: |1 + L| >= 2 sin(wc tau / 2), i.e. PM >= wc tau
+    # (the crossovers move with the design; the certificate checks the exact margin), tightened so that
+    # a design on the bound passes the exact check
+    tightened = MarginsRequirement(delay_margin=req.min * (1 + 10 * BACKOFF))
+    NLP_FORMS.entry(MarginsRequirement).build(b, tightened, plant, ctx)
+
+
+@nlp_form(StepResponse, exact=False)
+@nlp_form(NoLimitCycle, exact=False)
+def _certified_only(b: NLPBuilder, req: StepResponse | NoLimitCycle, plant: Plant, ctx: NLPContext) -> None:
+    # no NLP form: the certificate inside the design loop checks the step response and the describing
+    # function exactly, and a design that fails it is not reported as a solution
+    return None

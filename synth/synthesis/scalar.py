@@ -29,7 +29,7 @@ from synth.results import (
 from synth.spec import Spec
 from synth.synthesis.gainset import GainSet, ScalarFamily, feasible_gain_set
 
-__all__ = ["INWARD", "design_scalar", "feasible_verdict", "infeasible_verdict", "scalar_family"]
+__all__ = ["INWARD", "design_scalar", "feasible_verdict", "infeasible_verdict", "scalar_family", "stabilizing_text"]
 
 
 def _optimize_scalar(f: Callable[[float], float], intervals: list[tuple[float, float]]) -> tuple[float, float]:
@@ -49,7 +49,7 @@ def _optimize_scalar(f: Callable[[float], float], intervals: list[tuple[float, f
                                   options={"xatol": 1e-10 * max(1.0, abs(b))})
             if -res.fun > v:
                 x, v = float(res.x), float(-res.fun)
-        if v > best_v:
+        if v > best_v or best_x is None:
             best_x, best_v = x, v
     return float(best_x), float(best_v)
 
@@ -130,7 +130,7 @@ def design_scalar(spec: Spec) -> DesignResult:
             c = family.controller(x)
             return min(r.slack for r in check(spec, c).requirements)
 
-        x, _ = _optimize_scalar(min_slack, [bounds])
+        x, _ = _optimize_scalar(min_slack, gain_set.per_requirement["stability"] or [bounds])  # stabilizing first
         compromise = check(spec, family.controller(x))
         result = DesignResult(spec.name, False, None, None, None, gain_set, None, compromise, method,
                               reference=reference_check(spec))
@@ -190,7 +190,27 @@ def feasible_verdict(result: DesignResult, family: ScalarFamily) -> str:
     obj = result.objective
     return (f"{result.controller} meets all {len(result.check.requirements) - 1} requirements and keeps the "
             f"loop stable ({obj['sense']} {obj['name']}: {fmt(obj['value'])} {obj['unit']}). "
-            f"Feasible {p}: {sets}.")
+            f"Feasible {p}: {sets}.") + stabilizing_text(gs)
+
+
+def stabilizing_text(gs: GainSet) -> str:
+    """The stabilizing set of the parameter, when it is not the whole search range (exact: D-decomposition).
+
+    Examples
+    --------
+    >>> from synth.synthesis.gainset import GainInterval
+    >>> stabilizing_text(GainSet("kp", (0.0, 20.0), [], {"stability": [(0.5, 20.0)]}))
+    ' The closed loop is stable only for kp in (0.5, 20] (exact, D-decomposition); the search stayed inside it.'
+    """
+    lo, hi = gs.bounds
+    stab = gs.per_requirement.get("stability")
+    if stab is None or stab == [(lo, hi)]:
+        return ""
+    if not stab:
+        return f" No {gs.parameter} in [{fmt(lo)}, {fmt(hi)}] stabilizes the closed loop (exact, D-decomposition)."
+    ivs = ", ".join(f"{'[' if a == lo else '('}{fmt(a)}, {fmt(b)}{']' if b == hi else ')'}" for a, b in stab)
+    return (f" The closed loop is stable only for {gs.parameter} in {ivs} (exact, D-decomposition); "
+            "the search stayed inside it.")
 
 
 def infeasible_verdict(result: DesignResult, family: ScalarFamily) -> str:
@@ -219,6 +239,9 @@ def infeasible_verdict(result: DesignResult, family: ScalarFamily) -> str:
     for a, b in gs.conflicts():
         parts.append(f"{a} and {b} conflict: {a} needs {p} in "
                      f"{_ivs(gs.per_requirement[a])}, {b} needs {_ivs(gs.per_requirement[b])}.")
+    stab = stabilizing_text(gs)
+    if stab:
+        parts.append(stab.strip())
     if result.compromise is not None:
         failed = result.compromise.failed()
         parts.append(f"Best compromise {result.compromise.controller} (not a solution): "
