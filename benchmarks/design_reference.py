@@ -87,7 +87,7 @@ class Evaluation:
 class LoopModel:
     """A problem's plant, controller structure, requirements and objective, evaluated on its own grids."""
 
-    def __init__(self, num: list[float], den: list[float], delay: float, spec: dict[str, Any]):
+    def __init__(self, num: list[float], den: list[float], delay: float, spec: dict[str, Any], eps_scale: float = 1e-6):
         self.num, self.den, self.delay = _strip(np.array(num)), _strip(np.array(den)), float(delay)
         self.spec = spec
         c = spec["controller"]
@@ -111,7 +111,7 @@ class LoopModel:
         if self.delay > 0:
             feats.append(1 / self.delay)
         self.w_lo, self.w_hi = min(feats) * 1e-3, max(feats) * 1e3
-        self.eps = min(feats) * 1e-6
+        self.eps = min(feats) * eps_scale
         self.grids = {d: self._grid(d) for d in (COARSE_PER_DECADE, DENSE_PER_DECADE)}
 
     def _grid(self, per_decade: int) -> dict[str, np.ndarray]:
@@ -458,8 +458,11 @@ def _dense_pen(srch: _Search, x: float) -> float:
 
 
 def check_point(num: list[float], den: list[float], delay: float, spec: dict[str, Any],
-                params: dict[str, float]) -> Evaluation:
+                params: dict[str, float], eps_scale: float = 1e-6) -> Evaluation:
     """Dense check of one controller (e.g. synth's design).
+
+    Closed-loop poles with ``Re > -eps`` count as unstable, ``eps = eps_scale`` times the smallest plant or
+    requirement frequency.
 
     Examples
     --------
@@ -470,4 +473,4 @@ def check_point(num: list[float], den: list[float], delay: float, spec: dict[str
     (False, 1)
     """
     with np.errstate(all="ignore"):
-        return LoopModel(num, den, delay, spec).evaluate(dict(params), dense=True)
+        return LoopModel(num, den, delay, spec, eps_scale).evaluate(dict(params), dense=True)

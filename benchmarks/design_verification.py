@@ -6,9 +6,12 @@ reference's dense check of synth's design. Outcomes:
 
 - ``false infeasible``: synth said infeasible, the reference holds a point that passes its dense check
   (synth's own ``check`` of that point is recorded too, to tell a search miss from a definition clash);
-- ``false feasible``: synth's design fails the reference's dense check (slack below ``-TOL``);
+- ``false feasible``: synth's design fails the reference's dense check (slack below ``-TOL``); when the
+  only failure is a closed-loop pole within the reference's ``eps`` of the imaginary axis that a check with
+  ``eps`` a million times smaller calls stable, it is counted apart ("pole within eps of the axis");
 - ``undetermined``: synth found a design that failed its own dense re-check, or hit the time limit;
-- ``error``: synth raised;
+- ``declined``: synth answered with one of its one-line errors (e.g. no stabilizing start found);
+- ``error``: synth raised anything else (a crash);
 - ``agree``: both feasible (objective compared) or both infeasible (the reference's failure to find a
   point is evidence, not proof);
 - ``ref missed``: synth's design passes the reference check, the reference search found nothing.
@@ -38,7 +41,10 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 from benchmarks.design_problems import Problem, generate
 from benchmarks.design_reference import check_point, reference
 
-__all__ = ["TOL", "classify", "run_problem", "summarize"]
+__all__ = ["SYNTH_ERRORS", "TOL", "classify", "run_problem", "summarize"]
+
+SYNTH_ERRORS = ("SynthError", "SpecError", "ModelError", "DataError")
+"""synth's one-line errors: a refusal with a reason ("declined"), not a crash."""
 
 TOL = 1e-3
 """Slack (nepers, radians) by which synth's design may miss in the reference check: 0.009 dB, 0.06 deg."""
@@ -97,6 +103,8 @@ def run_problem(p: Problem, *, time_limit: float = 120.0, budget: float = 1.0) -
         rec["synth_in_reference"] = e.to_dict()
         rec["synth_passes_reference"] = e.feasible(TOL)
         rec["synth_min_return_difference"] = e.values.get("min|1+L|")
+        if not e.stable:  # is it a pole on the axis, or one just left of it (within the reference's eps)?
+            rec["synth_stable_with_eps_1e-12"] = check_point(p.num, p.den, p.delay, p.spec, params, 1e-12).stable
         if p.spec.get("objective") and r.feasible and e.objective is not None:
             rec["objective_gap"] = _gap(p.spec, r.best.objective, e.objective)  # type: ignore[union-attr]
     if d is not None and not d.feasible and "failed the dense re-check" in (d.verdict or ""):
@@ -118,12 +126,16 @@ def classify(rec: dict[str, Any]) -> str:
     """One word for a record (see the module docstring)."""
     st = rec["synth_status"]
     if st == "error":
-        return "error"
+        declined = rec.get("synth_error", "").split(":")[0] in SYNTH_ERRORS
+        if not declined:
+            return "error"
+        return "declined (ref feasible)" if rec["ref_feasible"] else "declined"
     if st in ("timeout", "undetermined"):
         return "undetermined (ref feasible)" if rec["ref_feasible"] else "undetermined"
     if st == "feasible":
         if not rec["synth_passes_reference"]:
-            return "false feasible"
+            return "false feasible (pole within eps of the axis)" if rec.get("synth_stable_with_eps_1e-12") \
+                else "false feasible"
         return "agree feasible" if rec["ref_feasible"] else "ref missed"
     return "false infeasible" if rec["ref_feasible"] else "agree infeasible"
 
@@ -137,9 +149,12 @@ def summarize(records: list[dict[str, Any]]) -> list[tuple[str, str]]:
     ts = np.array([r["synth_seconds"] for r in records])
     tr = np.array([r["ref_seconds"] for r in records])
     rows = [("problems", str(n))]
-    for k in ("false infeasible", "false feasible", "agree feasible", "agree infeasible", "ref missed",
-              "undetermined", "undetermined (ref feasible)", "error"):
+    for k in ("false infeasible", "false feasible", "false feasible (pole within eps of the axis)", "agree feasible",
+              "agree infeasible", "ref missed",
+              "undetermined", "undetermined (ref feasible)", "declined", "declined (ref feasible)", "error"):
         rows.append((k, str(count.get(k, 0))))
+    nodesign = [r for r in records if r["ref_feasible"] and r["synth_status"] != "feasible"]
+    rows.append(("no design although the reference holds one (any synth status)", str(len(nodesign))))
     if gaps:
         g = np.array(gaps)
         rows.append(("objective within 1 % of the reference's best", f"{np.mean(g <= 0.01) * 100:.1f} % of {len(g)}"))
@@ -162,33 +177,44 @@ def main() -> None:
     ap.add_argument("--time-limit", type=float, default=120.0, help="per synth.design call [s]")
     ap.add_argument("--budget", type=float, default=1.0, help="scales the reference's search")
     ap.add_argument("--quick", action="store_true", help="10 problems")
+    ap.add_argument("--summarize", type=Path, nargs="+", help="only re-read (and re-classify) JSON-lines files")
     args = ap.parse_args()
     from tqdm import tqdm
 
-    n = 10 if args.quick else args.n
-    problems = generate(args.start + n, args.seed)[args.start:]
-    fh = args.json.open("w") if args.json else None
     records = []
-    for p in tqdm(problems, desc="design verification"):
-        rec = run_problem(p, time_limit=args.time_limit, budget=args.budget)
-        records.append(rec)
-        if fh:
-            fh.write(json.dumps(rec, default=float) + "\n")
-            fh.flush()
+    if args.summarize:
+        for path in args.summarize:
+            records += [json.loads(line) for line in path.read_text().splitlines() if line.strip()]
+        for rec in records:
+            rec["outcome"] = classify(rec)
+        records.sort(key=lambda r: r["index"])
+    else:
+        n = 10 if args.quick else args.n
+        problems = generate(args.start + n, args.seed)[args.start:]
+        fh = args.json.open("w") if args.json else None
+        for p in tqdm(problems, desc="design verification"):
+            rec = run_problem(p, time_limit=args.time_limit, budget=args.budget)
+            records.append(rec)
+            if fh:
+                fh.write(json.dumps(rec, default=float) + "\n")
+                fh.flush()
     rows = summarize(records)
     print("\n| measure | value |\n|---|---|")
     for k, v in rows:
         print(f"| {k} | {v} |")
     bad = [r for r in records if r["outcome"] in ("false infeasible", "false feasible", "error",
-                                                   "undetermined (ref feasible)")]
+                                                   "false feasible (pole within eps of the axis)",
+                                                   "undetermined (ref feasible)", "declined (ref feasible)")]
     for r in bad:
         print(f"- #{r['index']} {r['outcome']}: {r['controller']} {r['features']} {r['requirements']}"
               f" synth={r.get('synth_params') or r.get('synth_error') or r['synth_status']}"
               f" ref={None if r['ref_best'] is None else r['ref_best']['params']}"
-              f" synth.check(ref point)={r.get('synth_check_of_ref_point')}")
+              f" synth.check(ref point)={r.get('synth_check_of_ref_point')}"
+              f"{' [' + r['synth_error'] + ']' if r.get('synth_error') else ''}")
     gaps = sorted((r for r in records if r.get("objective_gap", 0) > 0.01), key=lambda r: -r["objective_gap"])
     for r in gaps:
-        print(f"- #{r['index']} objective gap {r['objective_gap'] * 100:.2f} %: {r['controller']} {r['features']}")
+        print(f"- #{r['index']} objective gap {r['objective_gap'] * 100:.2f} %: {r['controller']} {r['features']}"
+              f" {r['requirements']} synth={r.get('synth_params')} ref={r['ref_best']['params']}")
 
 
 if __name__ == "__main__":
