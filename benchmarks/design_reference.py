@@ -110,6 +110,13 @@ class LoopModel:
                 feats.append(1 / r["delay_margin"])
         if self.delay > 0:
             feats.append(1 / self.delay)
+        wide = np.logspace(-6, 6, 2401)
+        mag = np.abs(self.G(wide))
+        for name in ("kp", "k"):  # where the loop crosses over at the largest proportional gain
+            if name in self.bounds and self.bounds[name][1] > 0:
+                x = np.log(mag * self.bounds[name][1])
+                feats += [float(wide[i]) for i in np.nonzero(np.sign(x[:-1]) != np.sign(x[1:]))[0]]
+        feats = feats or [1.0]
         self.w_lo, self.w_hi = min(feats) * 1e-3, max(feats) * 1e3
         self.eps = min(feats) * eps_scale
         self.grids = {d: self._grid(d) for d in (COARSE_PER_DECADE, DENSE_PER_DECADE)}

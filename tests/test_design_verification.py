@@ -4,7 +4,8 @@
 peak |S|, margins and static-sensitivity requirements) against the independent reference of
 ``benchmarks/design_reference.py`` with a cheap search budget: synth must never call a problem infeasible
 when the reference holds a point that passes its dense check, and synth's design must pass that check.
-The full benchmark is ``python benchmarks/design_verification.py`` (benchmarks/README.md).
+The full benchmark is ``python benchmarks/design_verification.py`` (benchmarks/README.md). Problems where
+synth is wrong today are marked ``xfail(strict=True)`` with the reason, so that a fix shows up.
 """
 
 from __future__ import annotations
@@ -16,9 +17,15 @@ from benchmarks.design_verification import run_problem
 
 SEED = 2026
 N = 30
+KNOWN_SYNTH_BUGS = {
+    16: "synth designs P(kp=0) on 15.36/s (a closed-loop pole at s = 0) and calls the loop stable",
+}
 
 
-@pytest.mark.parametrize("index", range(N))
+@pytest.mark.parametrize("index", [
+    pytest.param(i, marks=pytest.mark.xfail(reason=KNOWN_SYNTH_BUGS[i], strict=True)) if i in KNOWN_SYNTH_BUGS else i
+    for i in range(N)
+])
 def test_design_agrees_with_reference(index: int) -> None:
     p = problem(SEED, index, controllers=("PI",) if index % 3 == 2 else ("P",), simple=True)
     rec = run_problem(p, time_limit=120.0, budget=0.3)
