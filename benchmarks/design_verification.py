@@ -123,7 +123,15 @@ def run_problem(p: Problem, *, time_limit: float = 120.0, budget: float = 1.0) -
 
 
 def classify(rec: dict[str, Any]) -> str:
-    """One word for a record (see the module docstring)."""
+    """The outcome of a record (see the module docstring).
+
+    Examples
+    --------
+    >>> classify({"synth_status": "infeasible", "ref_feasible": True})
+    'false infeasible'
+    >>> classify({"synth_status": "error", "synth_error": "SynthError: no start", "ref_feasible": False})
+    'declined'
+    """
     st = rec["synth_status"]
     if st == "error":
         declined = rec.get("synth_error", "").split(":")[0] in SYNTH_ERRORS
