@@ -1,0 +1,252 @@
+"""Randomized-truth verification of ``synth.design`` against an independent reference (issue 15, item 1).
+
+For each seeded problem of ``benchmarks/design_problems.py``: ``synth.design`` (timed, with a time
+limit), the reference search of ``benchmarks/design_reference.py`` (timed, same process and run), and the
+reference's dense check of synth's design. Outcomes:
+
+- ``false infeasible``: synth said infeasible, the reference holds a point that passes its dense check
+  (synth's own ``check`` of that point is recorded too, to tell a search miss from a definition clash);
+- ``false feasible``: synth's design fails the reference's dense check (slack below ``-TOL``); when the
+  only failure is a closed-loop pole within the reference's ``eps`` of the imaginary axis that a check with
+  ``eps`` a million times smaller calls stable, it is counted apart ("pole within eps of the axis");
+- ``undetermined``: synth found a design that failed its own dense re-check, or hit the time limit;
+- ``declined``: synth answered with one of its one-line errors (e.g. no stabilizing start found);
+- ``error``: synth raised anything else (a crash);
+- ``agree``: both feasible (objective compared) or both infeasible (the reference's failure to find a
+  point is evidence, not proof);
+- ``ref missed``: synth's design passes the reference check, the reference search found nothing.
+
+The objective gap is measured with the reference's own evaluation of synth's controller:
+``(best_ref - synth)/best_ref`` for bandwidth, in linear magnitude for peak |S| (positive: synth worse).
+
+Run: ``python benchmarks/design_verification.py --n 300 --seed 0 --json out.jsonl`` (records stream
+into the JSON-lines file as they finish, so a partial run is usable); ``--quick`` for 10 problems.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import signal
+import sys
+import time
+import warnings
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+from benchmarks.design_problems import Problem, generate
+from benchmarks.design_reference import check_point, controller_polys, reference
+
+__all__ = ["SYNTH_ERRORS", "TOL", "classify", "degenerate_reference", "run_problem", "summarize"]
+
+SYNTH_ERRORS = ("SynthError", "SpecError", "ModelError", "DataError")
+"""synth's one-line errors: a refusal with a reason ("declined"), not a crash."""
+
+TOL = 1e-3
+"""Slack (nepers, radians) by which synth's design may miss in the reference check: 0.009 dB, 0.06 deg."""
+
+
+class _TimeoutError(Exception):
+    pass
+
+
+def _alarm(signum: int, frame: Any) -> None:
+    raise _TimeoutError()
+
+
+def _gap(spec: dict[str, Any], ref_obj: float, synth_obj: float) -> float:
+    name = next(iter(spec["objective"].values()))
+    if name == "bandwidth":
+        return float((ref_obj - synth_obj) / ref_obj) if ref_obj > 0 else 0.0
+    return float(10 ** ((synth_obj - ref_obj) / 20) - 1.0)
+
+
+def run_problem(p: Problem, *, time_limit: float = 120.0, budget: float = 1.0) -> dict[str, Any]:
+    """Design, reference and cross-checks for one problem; a JSON-ready record."""
+    import synth
+
+    rec: dict[str, Any] = {"index": p.index, "spec": p.spec, "features": p.features,
+                           "controller": p.spec["controller"]["type"],
+                           "requirements": [r["type"] for r in p.spec["requirements"]]}
+    t0 = time.perf_counter()
+    old = signal.signal(signal.SIGALRM, _alarm)
+    signal.alarm(int(time_limit))
+    d = None
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            d = synth.design(synth.parse_spec(p.spec))
+        rec["synth_status"] = "feasible" if d.feasible else "infeasible"
+        rec["synth_verdict"] = d.verdict
+    except _TimeoutError:
+        rec["synth_status"] = "timeout"
+    except Exception as e:
+        rec["synth_status"] = "error"
+        rec["synth_error"] = f"{type(e).__name__}: {e}"
+    finally:
+        signal.alarm(0)
+        signal.signal(signal.SIGALRM, old)
+    rec["synth_seconds"] = time.perf_counter() - t0
+    r = reference(p.num, p.den, p.delay, p.spec, budget=budget, seed=p.index)
+    rec["ref_seconds"] = r.seconds
+    rec["ref_feasible"] = r.feasible
+    rec["ref_method"] = r.method
+    rec["ref_best"] = None if r.best is None else r.best.to_dict()
+    if d is not None and d.feasible:
+        params = dict(d.controller.parameters)
+        rec["synth_params"] = params
+        e = check_point(p.num, p.den, p.delay, p.spec, params)
+        rec["synth_in_reference"] = e.to_dict()
+        rec["synth_passes_reference"] = e.feasible(TOL)
+        rec["synth_min_return_difference"] = e.values.get("min|1+L|")
+        if not e.stable:  # is it a pole on the axis, or one just left of it (within the reference's eps)?
+            rec["synth_stable_with_eps_1e-12"] = check_point(p.num, p.den, p.delay, p.spec, params, 1e-12).stable
+        if p.spec.get("objective") and r.feasible and e.objective is not None:
+            rec["objective_gap"] = _gap(p.spec, r.best.objective, e.objective)  # type: ignore[union-attr]
+    if d is not None and not d.feasible and "failed the dense re-check" in (d.verdict or ""):
+        rec["synth_status"] = "undetermined"
+    if r.feasible and rec["synth_status"] != "feasible":
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                c = synth.check(synth.parse_spec(p.spec), synth.Controller(
+                    p.spec["controller"]["type"], r.best.params))  # type: ignore[union-attr]
+            rec["synth_check_of_ref_point"] = bool(c.feasible)
+        except Exception as e:
+            rec["synth_check_of_ref_point"] = f"{type(e).__name__}: {e}"
+    rec["outcome"] = classify(rec)
+    return rec
+
+
+def classify(rec: dict[str, Any]) -> str:
+    """The outcome of a record (see the module docstring).
+
+    Examples
+    --------
+    >>> classify({"synth_status": "infeasible", "ref_feasible": True})
+    'false infeasible'
+    >>> classify({"synth_status": "error", "synth_error": "SynthError: no start", "ref_feasible": False})
+    'declined'
+    """
+    st = rec["synth_status"]
+    if st == "error":
+        declined = rec.get("synth_error", "").split(":")[0] in SYNTH_ERRORS
+        if not declined:
+            return "error"
+        return "declined (ref feasible)" if rec["ref_feasible"] else "declined"
+    if st in ("timeout", "undetermined"):
+        return "undetermined (ref feasible)" if rec["ref_feasible"] else "undetermined"
+    if st == "feasible":
+        if not rec["synth_passes_reference"]:
+            return "false feasible (pole within eps of the axis)" if rec.get("synth_stable_with_eps_1e-12") \
+                else "false feasible"
+        return "agree feasible" if rec["ref_feasible"] else "ref missed"
+    return "false infeasible" if rec["ref_feasible"] else "agree infeasible"
+
+
+def degenerate_reference(rec: dict[str, Any]) -> bool:
+    """The reference's best point has ``|T(0)| < 0.01`` in a problem with a bandwidth objective or requirement
+    (the -3 dB bandwidth, measured from ``|T(0)|``, is then ill-posed: a controller with a zero near the
+    origin, or a vanishing gain, gets a huge "bandwidth")."""
+    uses = "bandwidth" in rec["spec"].get("objective", {}).values() or any(
+        r["type"] == "bandwidth" for r in rec["spec"]["requirements"])
+    if rec.get("ref_best") is None or not uses:
+        return False
+    p = rec["spec"]
+    prob = generate(rec["index"] + 1, int(p["name"].split("_")[1]))[rec["index"]]
+    cn, cd = controller_polys(p["controller"]["type"], p["controller"].get("order"), rec["ref_best"]["params"])
+    s = 1j * 1e-9
+    L = np.polyval(prob.num, s) / np.polyval(prob.den, s) * np.polyval(cn, s) / np.polyval(cd, s)
+    return bool(abs(L / (1 + L)) < 0.01)
+
+
+def summarize(records: list[dict[str, Any]]) -> list[tuple[str, str]]:
+    """Rows ``(measure, value)`` of the summary table."""
+    n = len(records)
+    out = [o for r in records for o in [r["outcome"]]]
+    count = {k: out.count(k) for k in sorted(set(out))}
+    for r in records:
+        if r.get("objective_gap", 0) > 0.01 and "degenerate" not in r:
+            r["degenerate"] = degenerate_reference(r)
+    gaps = [r["objective_gap"] for r in records if "objective_gap" in r and r["outcome"] == "agree feasible"
+            and not r.get("degenerate")]
+    n_deg = sum(1 for r in records if r.get("degenerate"))
+    ts = np.array([r["synth_seconds"] for r in records])
+    tr = np.array([r["ref_seconds"] for r in records])
+    rows = [("problems", str(n))]
+    for k in ("false infeasible", "false feasible", "false feasible (pole within eps of the axis)", "agree feasible",
+              "agree infeasible", "ref missed",
+              "undetermined", "undetermined (ref feasible)", "declined", "declined (ref feasible)", "error"):
+        rows.append((k, str(count.get(k, 0))))
+    nodesign = [r for r in records if r["ref_feasible"] and r["synth_status"] != "feasible"]
+    rows.append(("no design although the reference holds one (any synth status)", str(len(nodesign))))
+    if gaps:
+        g = np.array(gaps)
+        rows.append(("objective within 1 % of the reference's best", f"{np.mean(g <= 0.01) * 100:.1f} % of {len(g)}"))
+        rows.append(("worst objective gap (synth worse)", f"{g.max() * 100:.2f} %"))
+        rows.append(("synth better than the reference by > 1 %", str(int(np.sum(g < -0.01)))))
+    rows.append(("gaps left out: the reference's best has |T(0)| < 0.01 (bandwidth ill-posed)", str(n_deg)))
+    rows.append(("synth design time, median / p95 [s]", f"{np.median(ts):.2f} / {np.percentile(ts, 95):.2f}"))
+    rows.append(("reference time, median / p95 [s]", f"{np.median(tr):.2f} / {np.percentile(tr, 95):.2f}"))
+    marginal = [r["index"] for r in records if r.get("synth_min_return_difference") is not None
+                and r["synth_min_return_difference"] < 1e-2]
+    rows.append(("synth designs with min |1 + L| < 0.01 (at the stability edge)", str(len(marginal))))
+    return rows
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description="randomized-truth verification of synth.design")
+    ap.add_argument("--n", type=int, default=300)
+    ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--start", type=int, default=0, help="first problem index")
+    ap.add_argument("--json", type=Path, help="write the records as JSON lines (streamed)")
+    ap.add_argument("--time-limit", type=float, default=120.0, help="per synth.design call [s]")
+    ap.add_argument("--budget", type=float, default=1.0, help="scales the reference's search")
+    ap.add_argument("--quick", action="store_true", help="10 problems")
+    ap.add_argument("--summarize", type=Path, nargs="+", help="only re-read (and re-classify) JSON-lines files")
+    args = ap.parse_args()
+    from tqdm import tqdm
+
+    records = []
+    if args.summarize:
+        for path in args.summarize:
+            records += [json.loads(line) for line in path.read_text().splitlines() if line.strip()]
+        for rec in records:
+            rec["outcome"] = classify(rec)
+        records.sort(key=lambda r: r["index"])
+    else:
+        n = 10 if args.quick else args.n
+        problems = generate(args.start + n, args.seed)[args.start:]
+        fh = args.json.open("w") if args.json else None
+        for p in tqdm(problems, desc="design verification"):
+            rec = run_problem(p, time_limit=args.time_limit, budget=args.budget)
+            records.append(rec)
+            if fh:
+                fh.write(json.dumps(rec, default=float) + "\n")
+                fh.flush()
+    rows = summarize(records)
+    print("\n| measure | value |\n|---|---|")
+    for k, v in rows:
+        print(f"| {k} | {v} |")
+    bad = [r for r in records if r["outcome"] in ("false infeasible", "false feasible", "error",
+                                                   "false feasible (pole within eps of the axis)",
+                                                   "undetermined (ref feasible)", "declined (ref feasible)")]
+    for r in bad:
+        print(f"- #{r['index']} {r['outcome']}: {r['controller']} {r['features']} {r['requirements']}"
+              f" synth={r.get('synth_params') or r.get('synth_error') or r['synth_status']}"
+              f" ref={None if r['ref_best'] is None else r['ref_best']['params']}"
+              f" synth.check(ref point)={r.get('synth_check_of_ref_point')}"
+              f"{' [' + r['synth_error'] + ']' if r.get('synth_error') else ''}")
+    gaps = sorted((r for r in records if r.get("objective_gap", 0) > 0.01), key=lambda r: -r["objective_gap"])
+    for r in gaps:
+        print(f"- #{r['index']} objective gap {r['objective_gap'] * 100:.2f} %"
+              f"{' (degenerate reference point)' if r.get('degenerate') else ''}: {r['controller']} {r['features']}"
+              f" {r['requirements']} synth={r.get('synth_params')} ref={r['ref_best']['params']}")
+
+
+if __name__ == "__main__":
+    main()
