@@ -87,7 +87,8 @@ def test_dask_local_cluster_gives_the_same_points():
     assert [p.controller for p in on_dask.points] == [p.controller for p in local.points]
 
 
-def test_bad_scheduler_address_is_a_clean_error(run_cli, tmp_path):
+def test_bad_scheduler_address_is_a_clean_error(run_cli, tmp_path, monkeypatch):
+    monkeypatch.setenv("SYNTH_DASK_CONNECT_TIMEOUT", "1s")  # the refusal, not the default 10 s wait, is tested
     res = run_cli("tradeoff", "specs/x4_rotor.yaml", "--sweep", "requirements.bandwidth.min=60:70:2",
                   "--scheduler", "tcp://127.0.0.1:1", "--out", str(tmp_path / "r"), "--quiet")
     assert res.code == 2 and "cannot reach the Dask scheduler" in res.err

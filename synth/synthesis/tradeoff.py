@@ -438,7 +438,7 @@ def _dask_client(scheduler: Any) -> tuple[Any, str, int]:
         raise SynthError("--scheduler needs dask.distributed: pip install 'synth[dask]'", where="--scheduler") from None
     if isinstance(scheduler, str):
         try:
-            client = Client(scheduler, timeout="10s")
+            client = Client(scheduler, timeout=os.environ.get("SYNTH_DASK_CONNECT_TIMEOUT", "10s"))
         except OSError as exc:
             raise SynthError(f"cannot reach the Dask scheduler: {exc}", where=f"--scheduler {scheduler}") from None
     else:
