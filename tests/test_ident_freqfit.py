@@ -7,9 +7,10 @@ import pytest
 
 from synth.data import record_from_arrays
 from synth.errors import ModelError
-from synth.ident.freqfit import coherence_weight, fit_cost, fit_frequency_response, verify_step
+from synth.ident.freqfit import coherence_weight, fit_cost, fit_frequency_response
 from synth.ident.simulate import simulate_plant
 from synth.ident.spectra import frequency_response, rate_to_attitude
+from synth.ident.step_verification import verify_step
 from synth.ident.sweep_design import design_sweep
 from synth.plant import Plant
 

@@ -105,8 +105,9 @@ def run(args: argparse.Namespace) -> int:
 
     from synth.cli._outputs import check_outputs
     from synth.errors import ModelError, SynthError
-    from synth.ident.freqfit import FrequencyFitError, fit_frequency_response, verify_step
+    from synth.ident.freqfit import FrequencyFitError, fit_frequency_response
     from synth.ident.spectra import correct_response, frequency_response, rate_to_attitude
+    from synth.ident.step_verification import verify_step
     from synth.outputs import OutputDir, dump_json, write_json
     from synth.plant import Plant
 

@@ -48,7 +48,7 @@ _EXPORTS = {
     "correct_response": "spectra", "run_quality": "sweep_quality", "rank_runs": "sweep_quality",
     "RunQuality": "sweep_quality", "FrequencyFitError": "freqfit",
     "coherent_band": "coherence",
-    "fit_frequency_response": "freqfit", "FreqFit": "freqfit", "fit_cost": "freqfit", "verify_step": "freqfit",
+    "fit_frequency_response": "freqfit", "FreqFit": "freqfit", "fit_cost": "freqfit", "verify_step": "step_verification",
     "hq_from_plant": "hq", "hq_from_frd": "hq", "HQMetrics": "hq_metrics",
     "analyze_psd": "psd", "analyze_records": "psd", "PsdAnalysis": "psd", "suggest_bandwidth": "bandwidth_suggestion",
 }

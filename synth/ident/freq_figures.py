@@ -15,8 +15,9 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 from synth.figure_files import save_figure
-from synth.ident.freqfit import FreqFit, StepVerification
+from synth.ident.freqfit import FreqFit
 from synth.ident.spectra import FrequencyResponse
+from synth.ident.step_verification import StepVerification
 
 __all__ = ["bode_figure", "verification_figure"]
 
