@@ -12,7 +12,6 @@ from __future__ import annotations
 
 from synth.results import DesignResult
 from synth.spec import Spec
-from synth.synthesis.multi import design_convex
 from synth.synthesis.scalar import design_scalar
 
 __all__ = ["design"]
@@ -42,4 +41,6 @@ def design(spec: Spec) -> DesignResult:
     """
     if len(spec.controller.free_parameters()) == 1:
         return design_scalar(spec)
+    from synth.synthesis.multi import design_convex  # cvxpy and casadi load only for several parameters
+
     return design_convex(spec)

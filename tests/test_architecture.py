@@ -236,3 +236,14 @@ def test_tests_and_benchmarks_use_only_public_names():
                     crossing += [f"{path.relative_to(ROOT)}:{node.lineno} imports {a.name} from {node.module}"
                                  for a in node.names if a.name.startswith("_") and not a.name.startswith("__")]
     assert crossing == []
+
+
+def test_import_synth_loads_no_solver_or_plotting_library():
+    """``import synth`` stays light: cvxpy, casadi, numba, matplotlib and scipy.stats load on first use."""
+    import subprocess
+    import sys
+
+    heavy = ("cvxpy", "casadi", "numba", "matplotlib", "scipy.stats", "scipy.signal", "jinja2")
+    code = f"import sys, synth; print([m for m in {heavy!r} if m in sys.modules])"
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT, check=True)
+    assert out.stdout.strip() == "[]"

@@ -9,7 +9,6 @@ from pydantic import NonNegativeFloat, PositiveFloat, model_validator
 
 from synth.requirements.base import Bound, Requirement, RequirementResult, fmt, register
 from synth.requirements.margins import closed_loop_unstable, unstable_result
-from synth.timeresp import default_horizon, step_metrics, step_response
 
 if TYPE_CHECKING:
     from synth.loop import Loop
@@ -68,6 +67,8 @@ class StepResponse(Requirement):
         return self
 
     def evaluate(self, loop: Loop, per_decade: int = 80) -> RequirementResult:
+        from synth.timeresp import default_horizon, step_metrics, step_response  # scipy.signal on first use
+
         if closed_loop_unstable(loop):
             return unstable_result(self, loop, "step response")
         final = loop.T0()
