@@ -270,6 +270,21 @@ class Plant:
         """
         return np.roots(self.den)
 
+    def settling_time(self, time_constants: float) -> float:
+        """``time_constants`` time constants of the slowest pole, plus the delay [s]; inf if a pole is on or
+        right of the imaginary axis (the model never forgets its state), the delay for a static gain.
+
+        Examples
+        --------
+        >>> Plant.from_string("1/(0.5*s+1)", delay=0.1).settling_time(20), Plant.from_string("1/s").settling_time(5)
+        (10.1, inf)
+        """
+        poles = self.poles()
+        if poles.size == 0:
+            return float(self.delay)
+        slowest = float(np.min(-poles.real))
+        return round(time_constants / slowest + float(self.delay), 12) if slowest > 0 else float("inf")
+
     def zeros(self) -> np.ndarray:
         """Zeros of the rational part.
 

@@ -177,11 +177,7 @@ def settling_time(plant: Plant, fraction: float = np.exp(-5.0)) -> float:
     >>> round(settling_time(Plant.from_string("1/((s+1)*(s+10))", delay=0.1)), 3)
     5.1
     """
-    poles = np.roots(np.atleast_1d(plant.den))
-    if poles.size == 0:
-        return float(plant.delay)
-    slowest = float(np.min(-poles.real))
-    return float(np.log(1.0 / fraction) / slowest + plant.delay) if slowest > 0 else float("inf")
+    return plant.settling_time(float(np.log(1.0 / fraction)))
 
 
 def _refit_unsettled(record: Record, avg: StepAverage, fit: TimeFitResult, structure: Structure,

@@ -66,14 +66,12 @@ def settle_time(plant: Plant) -> float:
     >>> settle_time(Plant.from_string("1/(0.5*s+1)", delay=0.1))
     10.1
     """
-    poles = plant.poles()
-    if poles.size == 0:
-        return float(plant.delay)
-    slowest = float(np.min(-poles.real))
-    if slowest <= 0.0:
+    settle = plant.settling_time(SETTLE_TIME_CONSTANTS)
+    if not np.isfinite(settle):
+        poles = plant.poles()
         raise ModelError("several validation records need a stable model (each run starts at rest); this one "
                          f"has a pole at {poles[np.argmax(poles.real)]:.4g}", where="plant")
-    return round(SETTLE_TIME_CONSTANTS / slowest + float(plant.delay), 12)
+    return settle
 
 
 def stitch_runs(records: Sequence[Record], settle: float) -> Stitched:
