@@ -174,6 +174,40 @@ class LoopBatch:
         """``C_i(0)`` (``inf`` with integral action)."""
         return self._dc.copy()
 
+    def gain_multiples(self) -> tuple[int, np.ndarray] | None:
+        """``(r, c)`` when every controller is ``c[i] >= 0`` times controller ``r`` (a P gain swept, or a
+        lead-lag's gain): the loops then differ by a gain only, ``L_i = c[i] L_r``, and a requirement
+        whose measure scales with the loop gain needs one exact evaluation; ``None`` otherwise.
+
+        Examples
+        --------
+        >>> G = Plant.from_string("1/(s+1)")
+        >>> r, c = LoopBatch(G, [Controller("P", {"kp": k}) for k in (0.0, 2.0, 5.0)]).gain_multiples()
+        >>> r, c.tolist()
+        (1, [0.0, 1.0, 2.5])
+        >>> LoopBatch(G, [Controller("PI", {"kp": 1.0, "ki": k}) for k in (1.0, 2.0)]).gain_multiples() is None
+        True
+        """
+        lead = np.argmax(self.cden != 0, axis=1)
+        scale = self.cden[np.arange(len(self)), lead]
+        if np.any(scale == 0) or np.any(lead != lead[0]):
+            return None
+        den = self.cden / scale[:, None]
+        num = self.cnum / scale[:, None]
+        nonzero = np.flatnonzero(np.any(num != 0, axis=1))
+        if nonzero.size == 0:
+            return None
+        r = int(nonzero[0])
+        ref = num[r]
+        c = num @ ref / (ref @ ref)
+        tol = 1e-12 * np.max(np.abs(num), axis=1, initial=0.0)[:, None] + 1e-300
+        same_num = np.all(np.abs(num - c[:, None] * ref) <= tol, axis=1)
+        same_den = np.all(np.abs(den - den[r]) <= 1e-12 * np.max(np.abs(den[r])), axis=1)
+        if not (np.all(same_num) and np.all(same_den) and np.all(c >= 0)):
+            return None
+        c[r] = 1.0
+        return r, c
+
     def gain_crossovers(self) -> list[np.ndarray]:
         """Each loop's :meth:`Loop.gain_crossovers` (exact polynomial roots, one eigenvalue problem per
         degree for all loops of that degree).
@@ -259,7 +293,7 @@ class LoopBatch:
         wr = np.concatenate(roots)
         keep = (np.abs(wr.imag) <= 1e-9 * (1 + np.abs(wr.real))) & (wr.real > 0)
         rows, w = rows[keep], wr.real[keep]
-        Lc = self._rows_L(rows, w)
+        Lc = self.rows_L(rows, w)
         with np.errstate(divide="ignore", invalid="ignore"):
             r = np.where(Lc.real < 0, -1.0 / Lc.real, np.inf)
         r = np.where(r > 1.0 + 1e-12, r, np.inf)
@@ -272,27 +306,35 @@ class LoopBatch:
         ranges = self.frequency_ranges[which]
         grid = log_grids(ranges[:, 0] * 1e-2, ranges[:, 1] * 1e2, per_decade)
         if self.plant.delay > 0:  # a few points per half turn of the delay's phase where |L| >= 0.5/cap
-            big = np.abs(self._rows_L(np.repeat(which, grid.shape[1]), grid.ravel())).reshape(grid.shape) >= 0.5 / cap
+            big = np.abs(self.rows_L(np.repeat(which, grid.shape[1]), grid.ravel())).reshape(grid.shape) >= 0.5 / cap
             w_top = 1.2 * float(np.max(np.where(big, grid, 0.0)))
             count = min(int(np.ceil(w_top * self.plant.delay / 0.3)) + 2, 20000)
             extra = np.linspace(0.0, w_top, count)[1:]
             grid = np.sort(np.concatenate([grid, np.broadcast_to(extra, (which.size, extra.size))], axis=1), axis=1)
         rows = np.repeat(which, grid.shape[1])
-        L = self._rows_L(rows, grid.ravel()).reshape(grid.shape)
+        L = self.rows_L(rows, grid.ravel()).reshape(grid.shape)
         im = np.where(_infinite(L), np.nan, L.imag)
         local, idx = np.nonzero(np.sign(im[:, :-1]) * np.sign(im[:, 1:]) < 0)
         out = np.full(which.size, np.inf)
         if local.size:
             rows = which[local]
-            wc = bisect_roots(lambda w: self._rows_L(rows, w).imag, grid[local, idx], grid[local, idx + 1])
-            Lc = self._rows_L(rows, wc)
+            wc = bisect_roots(lambda w: self.rows_L(rows, w).imag, grid[local, idx], grid[local, idx + 1])
+            Lc = self.rows_L(rows, wc)
             with np.errstate(divide="ignore", invalid="ignore"):
                 r = np.where(Lc.real < 0, -1.0 / Lc.real, np.inf)
             r = np.where((r > 1.0 + 1e-12) & (r <= cap), r, np.inf)
             np.minimum.at(out, local, r)
         return out
 
-    def _rows_L(self, rows: np.ndarray, w: np.ndarray) -> np.ndarray:
+    def rows_L(self, rows: np.ndarray, w: np.ndarray) -> np.ndarray:
+        """``L`` of loop ``rows[j]`` at ``w[j]`` for every ``j`` (one frequency per entry), ``(len(w),)``.
+
+        Examples
+        --------
+        >>> b = LoopBatch(Plant.from_string("1/(s+1)"), [Controller("P", {"kp": k}) for k in (1.0, 2.0)])
+        >>> b.rows_L(np.array([1, 0]), np.array([0.0, 1.0])).round(3).tolist()
+        [(2+0j), (0.5-0.5j)]
+        """
         s = 1j * np.asarray(w, float)[:, None]
         with np.errstate(divide="ignore", invalid="ignore"):
             return (horner(self.num[rows], s) / horner(self.den[rows], s))[:, 0] * np.exp(-s[:, 0] * self.plant.delay)

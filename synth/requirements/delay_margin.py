@@ -9,11 +9,12 @@ from pydantic import PositiveFloat
 
 from synth.errors import ModelError
 from synth.requirements.base import Bound, Requirement, RequirementResult, fmt, register
-from synth.requirements.margins import closed_loop_unstable, unstable_result
+from synth.requirements.margins import closed_loop_unstable, unstable_result, with_unstable_rows
 from synth.stability import closed_loop_stability
 
 if TYPE_CHECKING:
     from synth.loop import Loop
+    from synth.loop_batch import LoopBatch
 
 __all__ = ["DelayMargin", "delay_margins_per_crossover"]
 
@@ -92,3 +93,32 @@ class DelayMargin(Requirement):
                            crossovers=[{"frequency": w, "phase_margin_deg": pm, "delay_margin": d}
                                        for w, pm, d in per_crossover],
                            nyquist_stable_at_bound=nyquist, determined=agree)
+
+    def batch_slack(self, batch: LoopBatch, per_decade: int = 80) -> np.ndarray:
+        """Vectorized slack: every loop's gain crossovers at once (batched polynomial roots), ``PM/wc``
+        with the phase margin in ``(0, 360]`` deg as :func:`delay_margins_per_crossover` takes it; unstable
+        rows carry the scalar verdict (the Nyquist cross-check runs where the exact slack is evaluated).
+
+        Examples
+        --------
+        >>> from synth.loop import Loop; from synth.loop_batch import LoopBatch
+        >>> from synth.plant import Plant; from synth.controllers import Controller
+        >>> G = Plant.from_string("23*(s+0.43)/((s+9.6)*(s+0.54))")
+        >>> batch = LoopBatch(G, [Controller("P", {"kp": k}) for k in (1.0, 3.0, 5.0)])
+        >>> req = DelayMargin(min=0.02)
+        >>> bool(np.allclose(req.batch_slack(batch), [req.slack(Loop(G, c)) for c in batch.controllers]))
+        True
+        """
+        crossings = batch.gain_crossovers()
+        dm = np.full(len(batch), np.inf)
+        rows = np.concatenate([np.full(c.size, i) for i, c in enumerate(crossings)]).astype(int)
+        if rows.size:
+            wc = np.concatenate(crossings)
+            L = batch.rows_L(rows, wc)
+            phase = np.degrees(np.angle(L))
+            pm = (phase + 180.0) % 360.0
+            pm = np.where((pm == 0.0) & (phase != -180.0), 360.0, pm)
+            np.minimum.at(dm, rows, np.radians(pm) / wc)
+        with np.errstate(divide="ignore"):
+            values = np.where(dm > 0, np.log(np.where(dm > 0, dm, 1.0) / self.min), -np.inf)
+        return with_unstable_rows(self, batch, values)

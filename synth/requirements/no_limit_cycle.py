@@ -12,12 +12,13 @@ from scipy.optimize import brentq, minimize_scalar
 
 from synth.freqgrid import log_grid
 from synth.requirements.base import NEPER_PER_DB, Bound, Requirement, RequirementResult, db, fmt, register
-from synth.requirements.margins import closed_loop_unstable, unstable_result
+from synth.requirements.margins import closed_loop_unstable, unstable_result, with_unstable_rows
 from synth.sim.describing import rate_limiter_df
 from synth.sim.spec import BlockEntry
 
 if TYPE_CHECKING:
     from synth.loop import Loop
+    from synth.loop_batch import LoopBatch
 
 __all__ = ["SUPPORTED_BLOCKS", "NoLimitCycle", "critical_gain_factor", "rate_limiter_locus"]
 
@@ -179,13 +180,26 @@ class NoLimitCycle(Requirement):
             raise ValueError(f"delay must be [low, high], got [{self.delay[0]:g}, {self.delay[1]:g}]")
         return self
 
+    def kinds(self) -> tuple[str, ...]:
+        """The actuator's block types, sorted (each is checked by its own critical locus).
+
+        Examples
+        --------
+        >>> NoLimitCycle(actuator=[{"type": "saturation", "min": -1, "max": 1}, {"type": "rate_limit", "rate": 5}]).kinds()
+        ('rate_limit', 'saturation')
+        """
+        return tuple(sorted({b.type for b in self.actuator}))
+
+    def _gain_factor(self, loop: Loop, per_decade: int) -> tuple[np.ndarray, tuple[float, float | None, float | None]]:
+        lo, hi = loop.frequency_range
+        w = log_grid(lo, hi * 10, per_decade)
+        return w, critical_gain_factor(loop.L, w, self.delay, self.kinds())
+
     def evaluate(self, loop: Loop, per_decade: int = 80) -> RequirementResult:
         if closed_loop_unstable(loop):
             return unstable_result(self, loop, "limit-cycle check")
-        lo, hi = loop.frequency_range
-        w = log_grid(lo, hi * 10, per_decade)
-        kinds = tuple(sorted({b.type for b in self.actuator}))
-        k, wk, tau = critical_gain_factor(loop.L, w, self.delay, kinds)
+        kinds = self.kinds()
+        w, (k, wk, tau) = self._gain_factor(loop, per_decade)
         value = db(k) if np.isfinite(k) else np.inf
         slack = (value - self.min_gain_margin_db) * NEPER_PER_DB
         where = "" if wk is None else f", nearest at {fmt(wk)} rad/s with {fmt(tau * 1e3)} ms added"
@@ -199,3 +213,32 @@ class NoLimitCycle(Requirement):
                            gain_factor=k, delay_at_binding=tau, blocks=list(kinds),
                            grid_points_per_decade=per_decade, grid=[float(w[0]), float(w[-1])],
                            method="describing function: critical loci -1/N against the delayed Nyquist curve")
+
+    def batch_slack(self, batch: LoopBatch, per_decade: int = 80) -> np.ndarray:
+        """Vectorized slack. The describing-function margin scales with the loop gain (``k L`` meets a
+        locus at ``k`` times the factor of ``L``), so where the controllers differ by a gain only
+        (:meth:`~synth.loop_batch.LoopBatch.gain_multiples`, e.g. a P gain swept) one exact evaluation
+        gives every row; otherwise the rows are evaluated one by one. Unstable rows carry the scalar
+        verdict.
+
+        Examples
+        --------
+        >>> from synth.loop_batch import LoopBatch; from synth.plant import Plant; from synth.controllers import Controller
+        >>> from synth.loop import Loop
+        >>> req = NoLimitCycle(actuator=[{"type": "saturation", "min": -1, "max": 1}])
+        >>> batch = LoopBatch(Plant.from_string("1/(s*(s+1)*(s+2))"), [Controller("P", {"kp": k}) for k in (2.0, 5.0)])
+        >>> [round(float(v), 6) for v in req.batch_slack(batch)] == [round(req.slack(Loop(batch.plant, c)), 6)
+        ...                                                          for c in batch.controllers]
+        True
+        """
+        from synth.loop import Loop
+
+        multiples = batch.gain_multiples()
+        if multiples is None:
+            return super().batch_slack(batch, per_decade)
+        r, c = multiples
+        _, (k_ref, _, _) = self._gain_factor(Loop(batch.plant, batch.controllers[r]), per_decade)
+        with np.errstate(divide="ignore"):
+            k = np.where(c > 0, k_ref / np.where(c > 0, c, 1.0), np.inf)
+            value = np.where(np.isfinite(k), 20.0 * np.log10(k), np.inf)
+        return with_unstable_rows(self, batch, (value - self.min_gain_margin_db) * NEPER_PER_DB)
