@@ -20,7 +20,9 @@ from __future__ import annotations
 
 import csv
 import difflib
+import io
 import re
+import warnings
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -271,6 +273,11 @@ def _read_csv(path: Path) -> Table:
         header = [lines[0][1].strip('"')]  # one column: its header may hold spaces ("speed (rad/s)")
     keep = [i for i, h in enumerate(header) if h]
     names = [header[i] for i in keep]
+    notes = (f"skipped {comments} comment line(s) starting with #",) if comments else ()
+    fast = _numeric_body(lines[1:], delimiter, len(header))
+    if fast is not None:
+        return Table({h: fast[:, i].copy() for i, h in zip(keep, names)}, {h: split_unit(h)[1] for h in names},
+                     str(path), {}, notes)
     values: dict[str, list[float]] = {h: [] for h in names}
     problems: dict[str, str] = {}
     decimal_comma = 0
@@ -290,10 +297,25 @@ def _read_csv(path: Path) -> Table:
                 else:
                     decimal_comma += 1
                     values[h].append(x)
-    notes = ((f"skipped {comments} comment line(s) starting with #",) if comments else ()) + (
-        (f"read {decimal_comma} decimal comma(s)",) if decimal_comma else ())
+    notes += (f"read {decimal_comma} decimal comma(s)",) if decimal_comma else ()
     columns = {h: np.asarray(v, float) for h, v in values.items() if h not in problems}
     return Table(columns, {h: split_unit(h)[1] for h in names}, str(path), problems, notes)
+
+
+def _numeric_body(rows: list[tuple[int, str]], delimiter: str | None, width: int) -> np.ndarray | None:
+    """The data rows as an ``(n, width)`` array by numpy's C parser when every cell is a plain number
+    (the common case, about 20x faster than cell by cell); ``None`` otherwise (empty cells, text, decimal
+    commas, quotes, short rows), which the cell-by-cell reader then handles and explains."""
+    if not rows or any('"' in line for _, line in rows[:1]):
+        return None
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            body = np.loadtxt(io.StringIO("\n".join(line for _, line in rows)), delimiter=delimiter, dtype=float,
+                              ndmin=2, comments=None, quotechar=None)
+    except ValueError:
+        return None
+    return body if body.shape == (len(rows), width) else None
 
 
 def _decimal_comma(cell: str, delimiter: str | None) -> float | None:
