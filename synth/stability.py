@@ -402,6 +402,7 @@ def affine_stability_intervals(
     delay: float,
     lo: float,
     hi: float,
+    first_only: bool = False,
 ) -> list[StabilityInterval]:
     """Exact stabilizing set of ``rho`` in ``[lo, hi]`` for the controller ``C0 + rho C1``.
 
@@ -415,6 +416,10 @@ def affine_stability_intervals(
         Plant rational part and delay.
     lo, hi : float
         Range searched.
+    first_only : bool
+        Stop at the end of the first stabilizing interval that starts at ``lo`` (the pieces between
+        boundaries are tested in order, so only those up to the first destabilizing boundary are
+        counted; e.g. a critical gain). Empty when ``lo`` itself is not stabilizing.
 
     Returns
     -------
@@ -448,6 +453,8 @@ def affine_stability_intervals(
 
     for a, b in pairwise(cuts) if len(cuts) > 1 else [(lo, hi)]:
         if not stable_at(0.5 * (a + b)):
+            if first_only:
+                break
             continue
         if pieces and pieces[-1].hi == a:
             # stable on both sides of a boundary the loop only touches: one interval

@@ -428,7 +428,7 @@ def critical_gains(plant: Plant, delays: list[float], k_max: float = 1e3) -> lis
     one = (np.array([1.0]), np.array([1.0]))
     for d in delays:
         p = plant.with_delay(plant.delay + d) if d else plant
-        ivs = affine_stability_intervals(None, one, p.num, p.den, p.delay, 0.0, k_max)
+        ivs = affine_stability_intervals(None, one, p.num, p.den, p.delay, 0.0, k_max, first_only=True)
         first = next((iv for iv in ivs if iv.lo <= 1e-12), None)
         if first is None:
             crit, w = 0.0, None
