@@ -88,13 +88,41 @@ def _rise_time(loop: Loop) -> float:
 
 
 def _tf_rise_time(tf: str, horizon: float = 20.0) -> float:
-    """10-90 % rise time of a rational transfer function's step response (horizon long enough for slow poles)."""
-    from scipy.signal import lti
+    """10-90 % rise time of a rational transfer function's step response: the first crossings of the
+    two levels bracketed on a 4001-point grid over ``horizon`` (long enough for slow poles) and solved
+    on the exact response ``y(t) = C e^(M t) [0; 1] + D`` (``M = [[A, B], [0, 0]]``) by Brent."""
+    from scipy.linalg import expm
+    from scipy.optimize import brentq
+    from scipy.signal import tf2ss
 
     p = Plant.from_string(tf)
-    t = np.linspace(0.0, horizon, 200001)
-    _, y = lti(p.num, p.den).step(T=t)
-    return step_metrics(t, y, y_final=p.dc_gain()).rise_time
+    A, B, C, D = tf2ss(p.num, p.den)
+    n = A.shape[0]
+    M = np.zeros((n + 1, n + 1))
+    M[:n, :n], M[:n, n] = A, B[:, 0]
+
+    def y(t: float) -> float:
+        return float(C[0] @ expm(M * t)[:n, n] + D[0, 0])
+
+    t = np.linspace(0.0, horizon, 4001)
+    step = expm(M * (t[1] - t[0]))  # exact for the constant input: x(t + dt) = e^(M dt) x(t)
+    states = np.empty((t.size, n + 1))
+    states[0] = np.eye(n + 1)[n]
+    for k in range(1, t.size):
+        states[k] = step @ states[k - 1]
+    values = states[:, :n] @ C[0] + D[0, 0]
+    final = p.dc_gain()
+
+    def first_cross(level: float) -> float:
+        idx = np.flatnonzero(values / final >= level)
+        if idx.size == 0:
+            return float("nan")
+        i = int(idx[0])
+        if i == 0:
+            return 0.0
+        return float(brentq(lambda x: y(x) / final - level, t[i - 1], t[i], xtol=1e-12))
+
+    return first_cross(0.9) - first_cross(0.1)
 
 
 def onset_delay(plant: Plant, gain: float, hi: float = 0.1) -> float | None:
