@@ -116,9 +116,39 @@ class LoopBatch:
         from synth.loop import Loop
 
         if getattr(self, "_unstable", None) is None or self._unstable_plant is not self.plant:
-            self._unstable = np.array([Loop(self.plant, c).stability().unstable_poles > 0 for c in self.controllers])
+            unstable = self._unstable_by_gain()
+            if unstable is None:
+                unstable = np.array([Loop(self.plant, c).stability().unstable_poles > 0 for c in self.controllers])
+            self._unstable = unstable
             self._unstable_plant = self.plant
         return self._unstable
+
+    def _unstable_by_gain(self) -> np.ndarray | None:
+        """Where the loops differ by a gain only (:meth:`gain_multiples`, at least 8 of them): the exact
+        stabilizing set of that gain by D-decomposition (:func:`synth.stability.affine_stability_intervals`,
+        the count at one gain per piece between boundaries), read at every row; the rows within 1e-9 of a
+        boundary are counted one by one."""
+        from synth.loop import Loop
+        from synth.stability import affine_stability_intervals, stability_boundaries
+
+        multiples = self.gain_multiples() if len(self) >= 8 else None
+        if multiples is None:
+            return None
+        r, c = multiples
+        ref = (self.cnum[r], self.cden[r])
+        top = float(np.max(c))
+        p = self.plant
+        pieces = affine_stability_intervals(None, ref, p.num, p.den, p.delay, 0.0, top)
+        edges = np.array([b for b, _ in stability_boundaries(None, ref, p.num, p.den, p.delay, top * 1.0001 + 1e-12)])
+        stable = np.zeros(len(self), bool)
+        for iv in pieces:
+            stable |= (c >= iv.lo) & (c <= iv.hi)
+        near = np.zeros(len(self), bool) if edges.size == 0 else \
+            np.min(np.abs(c[:, None] - edges[None, :]), axis=1) <= 1e-9 * np.maximum(1.0, np.abs(c))
+        unstable = ~stable
+        for i in np.flatnonzero(near):
+            unstable[i] = Loop(self.plant, self.controllers[i]).stability().unstable_poles > 0
+        return unstable
 
     def __len__(self) -> int:
         return len(self.controllers)

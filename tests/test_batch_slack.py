@@ -185,3 +185,74 @@ def test_x4_gain_set_is_unchanged():
     spec = load_spec("specs/x4_rotor.yaml")
     gs = feasible_gain_set(list(spec.requirements), spec.plants(), ScalarFamily("P", "kp", {}), (0, 20))
     assert gs.as_list() == [[2.568562917725855, 20.0]]
+
+
+def _any_plant(rng: np.random.Generator) -> Plant:
+    """Stable or unstable poles, minimum- or non-minimum-phase zeros, either sign, with or without a delay."""
+    poles = rng.uniform(-8.0, 2.0, size=rng.integers(1, 4))
+    zeros = rng.uniform(-6.0, 3.0, size=rng.integers(0, poles.size))
+    num = np.poly(zeros) * rng.choice([-1.0, 1.0]) * rng.uniform(0.5, 20.0)
+    return Plant(num, np.poly(poles), delay=float(rng.choice([0.0, 0.0, 0.01, 0.1])))
+
+
+def _gain_sweep(rng: np.random.Generator) -> list[Controller]:
+    gains = np.concatenate([[0.0], np.sort(rng.uniform(0.0, 30.0, 30))])
+    if rng.random() < 0.5:
+        return [Controller("P", {"kp": float(k)}) for k in gains]
+    z = float(rng.uniform(0.5, 10.0))
+    p = z * float(rng.uniform(1.5, 10.0))
+    return [Controller("leadlag", {"k": float(k), "z": z, "p": p}) for k in gains]
+
+
+def test_gain_swept_batches_count_stability_like_each_loop():
+    """A batch whose controllers differ by a gain reads stability off the D-decomposition set: on random
+    plants (unstable, non-minimum-phase, delayed) it must match each loop's own root or Nyquist count."""
+    rng = np.random.default_rng(2026)
+    for _ in range(25):
+        plant, controllers = _any_plant(rng), _gain_sweep(rng)
+        batch = LoopBatch(plant, controllers)
+        assert batch.gain_multiples() is not None
+        expected = [Loop(plant, c).stability().unstable_poles > 0 for c in controllers]
+        assert batch.closed_loop_unstable().tolist() == expected, plant
+
+
+def test_gain_swept_limit_cycle_and_delay_margin_batches_match_the_scalar_slack():
+    """The describing-function margin scales with the loop gain and the delay margin is read from every
+    loop's crossovers: both vectorized forms agree with the scalar evaluation loop by loop."""
+    from synth.requirements import DelayMargin, NoLimitCycle
+
+    rng = np.random.default_rng(7)
+    reqs = [DelayMargin(min=0.01),
+            NoLimitCycle(actuator=[{"type": "saturation", "min": -1, "max": 1}], delay=(0.0, 0.02)),
+            NoLimitCycle(actuator=[{"type": "rate_limit", "rate": 50.0}], min_gain_margin_db=3.0)]
+    for _ in range(6):
+        plant, controllers = _any_plant(rng), _gain_sweep(rng)
+        batch = LoopBatch(plant, controllers)
+        for req in reqs:
+            scalar = np.array([req.slack(Loop(plant, c)) for c in controllers])
+            fast = req.batch_slack(batch)
+            finite = np.isfinite(scalar)
+            assert np.array_equal(finite, np.isfinite(fast)), (req.type, plant)
+            assert np.allclose(fast[finite], scalar[finite], rtol=0, atol=TOL), (req.type, plant)
+
+
+def test_limit_cycle_margin_of_a_scaled_loop_is_the_direct_one():
+    """The requirement keeps the critical factor of the unit-gain loop and scales it; computed directly on
+    each loop (no scaling, no cache) the factor must be the same."""
+    from synth.freqgrid import log_grid
+    from synth.requirements import NoLimitCycle
+    from synth.requirements.no_limit_cycle import critical_gain_factor
+
+    rng = np.random.default_rng(11)
+    req = NoLimitCycle(actuator=[{"type": "rate_limit", "rate": 50.0}, {"type": "saturation", "min": -1, "max": 1}],
+                       delay=(0.0, 0.01))
+    for _ in range(5):
+        plant = _plant(rng, delay=bool(rng.random() < 0.5))
+        for c in _gain_sweep(rng)[1::6]:
+            loop = Loop(plant, c)
+            if loop.stability().unstable_poles:
+                continue
+            lo, hi = loop.frequency_range
+            k, _, _ = critical_gain_factor(loop.L, log_grid(lo, hi * 10, 80), req.delay, req.kinds())
+            got = req.evaluate(loop).details["gain_factor"]
+            assert got == pytest.approx(k, rel=1e-9), (plant, c)

@@ -2,7 +2,9 @@
 
 A spec may give ``plant: {identify: {...}}`` instead of a transfer function.
 The record is identified once per process (cached on the file's path, size
-and modification time and the settings) and the parameter covariance of the
+and modification time and the settings), and its result kept on disk between
+runs (:mod:`synth.ident.result_cache`: keyed by the file's bytes, the settings
+and the code), and the parameter covariance of the
 fit is carried into the design: the requirements must hold on the identified
 plant and on the plants at both ends of each principal axis of the
 confidence ellipsoid (``2 n`` plants for ``n`` fitted parameters, the delay
@@ -68,11 +70,15 @@ def _identify_cached(path: str, stamp: tuple[int, int], settings: IdentifySettin
                      output_unit: str, label: str) -> Any:
     from synth.data import load_record
     from synth.ident.identification import identify
+    from synth.ident.result_cache import cached_result
 
-    record = load_record(path, settings.time, settings.input, settings.output,
-                         input_unit=input_unit, output_unit=output_unit)
-    return identify(replace(record, source=label), settings.structure, settings.delay, settings.sensor,
-                    settings.average)
+    def compute() -> Any:
+        record = load_record(path, settings.time, settings.input, settings.output,
+                             input_unit=input_unit, output_unit=output_unit)
+        return identify(replace(record, source=label), settings.structure, settings.delay, settings.sensor,
+                        settings.average)
+
+    return cached_result(Path(path), (settings, input_unit, output_unit, label), compute)
 
 
 def identify_plant(settings: IdentifySettings, base: Path | None, input: Signal, output: Signal) -> Any:

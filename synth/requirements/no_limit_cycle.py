@@ -27,6 +27,9 @@ SUPPORTED_BLOCKS = ("saturation", "dead_zone", "rate_limit")
 
 TWO_PI = 2.0 * np.pi
 
+_UNIT_GAIN_FACTORS: dict[tuple[Any, ...], tuple[float, float | None, float | None]] = {}
+"""Critical factors of loops with their controller's gain divided out (see ``NoLimitCycle._gain_factor``)."""
+
 
 @cache
 def rate_limiter_locus(points: int = 400) -> tuple[np.ndarray, np.ndarray]:
@@ -191,9 +194,23 @@ class NoLimitCycle(Requirement):
         return tuple(sorted({b.type for b in self.actuator}))
 
     def _gain_factor(self, loop: Loop, per_decade: int) -> tuple[np.ndarray, tuple[float, float | None, float | None]]:
+        """The critical factor of ``loop``. ``k L`` meets a locus at ``1/k`` times the factor of ``L``, so
+        the factor of the loop with its controller's gain divided out is kept (:data:`_UNIT_GAIN_FACTORS`)
+        and scaled: a gain swept over one plant costs one evaluation."""
         lo, hi = loop.frequency_range
         w = log_grid(lo, hi * 10, per_decade)
-        return w, critical_gain_factor(loop.L, w, self.delay, self.kinds())
+        cnum, cden = loop.controller.tf()
+        gain = float(cnum[np.flatnonzero(cnum)[0]] / cden[np.flatnonzero(cden)[0]]) if np.any(cnum) else 0.0
+        if not gain > 0:
+            return w, critical_gain_factor(loop.L, w, self.delay, self.kinds())
+        key = (self.kinds(), self.delay, per_decade, loop.plant.num.tobytes(), loop.plant.den.tobytes(),
+               loop.plant.delay, (cnum / gain).tobytes(), cden.tobytes())
+        if key not in _UNIT_GAIN_FACTORS:
+            if len(_UNIT_GAIN_FACTORS) >= 4096:
+                _UNIT_GAIN_FACTORS.clear()
+            _UNIT_GAIN_FACTORS[key] = critical_gain_factor(lambda x: loop.L(x) / gain, w, self.delay, self.kinds())
+        k, wk, tau = _UNIT_GAIN_FACTORS[key]
+        return w, (k / gain, wk, tau)
 
     def evaluate(self, loop: Loop, per_decade: int = 80) -> RequirementResult:
         if closed_loop_unstable(loop):
