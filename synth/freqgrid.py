@@ -11,7 +11,6 @@ from __future__ import annotations
 from collections.abc import Callable
 
 import numpy as np
-from scipy.optimize import minimize_scalar
 
 from synth.stability import bisect_roots
 
@@ -77,7 +76,8 @@ def peak(curve: Curve, grid: np.ndarray, tol_db: float = 3.0) -> tuple[float, fl
     """Maximum of a real ``curve(w)`` over ``[grid[0], grid[-1]]``: ``(value, w)``.
 
     Every local maximum on the grid within ``tol_db`` (as 20 log10 ratio) of
-    the largest is refined by bounded Brent search on ``log w``.
+    the largest (at most 20) is refined by golden-section search on ``log w`` between its
+    neighbours, all at once.
 
     Examples
     --------
@@ -95,21 +95,15 @@ def peak(curve: Curve, grid: np.ndarray, tol_db: float = 3.0) -> tuple[float, fl
     interior = np.flatnonzero(
         (values[1:-1] >= values[:-2]) & (values[1:-1] >= values[2:])
     ) + 1
-    candidates = [int(i) for i in interior if values[i] >= best_v * 10 ** (-tol_db / 20)]
-    for i in candidates[:20]:
-        a, b = grid[i - 1], grid[i + 1]
-        if a <= 0:
-            res = minimize_scalar(lambda x: -float(curve(np.array([x]))[0]), bounds=(a, b),
-                                  method="bounded", options={"xatol": 1e-10 * b})
-            w_opt = float(res.x)
-        else:
-            res = minimize_scalar(lambda x: -float(curve(np.array([np.exp(x)]))[0]),
-                                  bounds=(np.log(a), np.log(b)), method="bounded",
-                                  options={"xatol": 1e-10})
-            w_opt = float(np.exp(res.x))
-        v = float(curve(np.array([w_opt]))[0])
-        if v > best_v:
-            best_v, best_w = v, w_opt
+    candidates = np.array([int(i) for i in interior if values[i] >= best_v * 10 ** (-tol_db / 20)][:20], dtype=int)
+    if candidates.size == 0:
+        return best_v, best_w
+    a, b = grid[candidates - 1][None, :], grid[candidates + 1][None, :]
+    v, w = _golden_max(lambda x: np.asarray(curve(x.ravel()), dtype=float).reshape(x.shape), a, b, a > 0)
+    v = np.where(np.isnan(v), -np.inf, v)
+    j = int(np.argmax(v[0]))
+    if v[0, j] > best_v:
+        best_v, best_w = float(v[0, j]), float(w[0, j])
     return best_v, best_w
 
 

@@ -8,7 +8,6 @@ from typing import TYPE_CHECKING, Any, ClassVar, Literal
 
 import numpy as np
 from pydantic import Field, NonNegativeFloat, field_validator, model_validator
-from scipy.optimize import brentq, minimize_scalar
 
 from synth.freqgrid import log_grid
 from synth.requirements.base import NEPER_PER_DB, Bound, Requirement, RequirementResult, db, fmt, register
@@ -94,6 +93,8 @@ def critical_gain_factor(L: Callable[[np.ndarray], np.ndarray], w: np.ndarray, d
     >>> round(k, 8), round(wk, 6)
     (0.3, 1.414214)
     """
+    from scipy.optimize import brentq, minimize_scalar
+
     lo, hi = delays
     rate = "rate_limit" in kinds
     w = np.asarray(w, float)

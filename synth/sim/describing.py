@@ -29,7 +29,6 @@ from dataclasses import asdict, dataclass
 from typing import Any
 
 import numpy as np
-from scipy.optimize import brentq
 
 from synth.errors import ModelError
 
@@ -106,6 +105,8 @@ def rate_limiter_df(A: float, w: float, rate: float, exact: bool = True) -> comp
 
 def _rate_limiter_partial(rho: float, n: int = 4096) -> complex:
     """Exact N for 0.537 < rho = R/(A w) < 1 (unit amplitude): one period of the piecewise output."""
+    from scipy.optimize import brentq
+
     theta_s = np.pi - np.arccos(rho)  # the falling input's slope first exceeds the limit here
 
     def gap(th: float) -> float:
@@ -201,6 +202,8 @@ def harmonic_balance(L: Callable[[np.ndarray], np.ndarray], N: Callable[[float, 
     >>> round(c.frequency, 4), round(c.amplitude, 3), c.stable  # w = sqrt(2); N(A) = 6/20
     (1.4142, 4.204, True)
     """
+    from scipy.optimize import brentq
+
     a_lo, a_hi = a_range
 
     def amplitude(w: float) -> float | None:

@@ -20,7 +20,6 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
-from scipy.optimize import brentq
 
 from synth.controllers import Controller
 from synth.loop import Loop
@@ -254,6 +253,8 @@ def requirement_set(slack: Callable[[float], float], lo: float, hi: float,
     >>> [(float(a), float(b)) for a, b in requirement_set(slack, 0.0, 10.0, batch=fast)]
     [(0.0, 2.5)]
     """
+    from scipy.optimize import brentq
+
     grid = _grid(lo, hi, n)
     values = _grid_values(slack, grid, batch)
     flags = list(values >= -_MET_TOL)

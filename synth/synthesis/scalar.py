@@ -10,7 +10,6 @@ from __future__ import annotations
 from collections.abc import Callable
 
 import numpy as np
-from scipy.optimize import minimize_scalar
 
 from synth.check import check
 from synth.errors import SynthError
@@ -34,6 +33,8 @@ __all__ = ["INWARD", "design_scalar", "feasible_verdict", "infeasible_verdict", 
 
 def _optimize_scalar(f: Callable[[float], float], intervals: list[tuple[float, float]]) -> tuple[float, float]:
     """Maximize ``f`` over a union of intervals: grid, then bounded Brent around the best point."""
+    from scipy.optimize import minimize_scalar
+
     best_x, best_v = None, -np.inf
     for lo, hi in intervals:
         if hi <= lo:
