@@ -25,6 +25,7 @@ def save_figure(fig: plt.Figure, path: str | Path, dpi: int = 110) -> Path:
     'line.png'
     """
     path = Path(path)
+    fig.set_dpi(dpi)  # lay out at the dpi written: the text extents measured here are reused by savefig
     fig.tight_layout()
     path.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(path, dpi=dpi, metadata=METADATA)
