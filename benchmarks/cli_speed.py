@@ -4,7 +4,10 @@ The baseline is another checkout of synth (by default a ``git worktree`` of ``--
 temporary folder); each command runs with ``PYTHONPATH`` pointing at one checkout and its working directory
 there, alternately baseline and current, and the best of ``--repeat`` runs is kept (the machine is shared:
 the minimum is the least disturbed run). Every command is run once untimed first on each side, so
-first-use work (the synthetic X-4 record, numba's compile cache) is excluded ("warm").
+first-use work (the synthetic X-4 record, numba's compile cache, the identification kept on disk by
+:mod:`synth.ident.result_cache`) is excluded ("warm"); one row runs the main job with that cache off, so the
+identification is timed too. CPU time (user + system of the command) is printed beside the wall time: on a
+loaded machine it moves far less than the wall time.
 
 Run:  python benchmarks/cli_speed.py [--repeat 3] [--baseline-ref main | --baseline DIR] [--quick]
 """
@@ -13,6 +16,7 @@ from __future__ import annotations
 
 import argparse
 import os
+import resource
 import subprocess
 import sys
 import tempfile
@@ -40,12 +44,15 @@ objective: {maximize: integral_gain}
 
 
 def cases(tmp: Path) -> dict[str, list[str]]:
-    """Label -> command arguments after ``python -m synth`` (``{out}`` is replaced by a fresh folder)."""
+    """Label -> command arguments after ``python -m synth`` (``{out}`` is replaced by a fresh folder; a leading
+    ``ENV=value`` item is set in the command's environment)."""
     pi = tmp / "x4_pi_delay.yaml"
     pi.write_text(PI_SPEC, encoding="utf-8")
     return {
         "synth design specs/x4_rotor_from_data.yaml (README main job)":
             ["design", "specs/x4_rotor_from_data.yaml", "--out", "{out}"],
+        "main job, identification not reused (SYNTH_IDENTIFY_CACHE=off)":
+            ["SYNTH_IDENTIFY_CACHE=off", "design", "specs/x4_rotor_from_data.yaml", "--out", "{out}"],
         "synth design specs/x4_rotor.yaml": ["design", "specs/x4_rotor.yaml", "--out", "{out}"],
         "synth design x4_pi_delay.yaml (PI, 20 ms delay, with report)": ["design", str(pi), "--out", "{out}"],
         "synth check specs/x4_rotor.yaml --controller P(3)":
@@ -53,17 +60,23 @@ def cases(tmp: Path) -> dict[str, list[str]]:
     }
 
 
-def run(root: Path, args: list[str], tmp: Path) -> float:
-    """Wall time of ``python -m synth ARGS`` in ``root`` with ``PYTHONPATH=root``; raises on failure."""
+def run(root: Path, args: list[str], tmp: Path) -> tuple[float, float]:
+    """Wall and CPU (user + system) time of ``python -m synth ARGS`` in ``root`` with ``PYTHONPATH=root``;
+    raises on failure."""
     out = Path(tempfile.mkdtemp(dir=tmp))
+    extra = dict(a.split("=", 1) for a in args if "=" in a and a.split("=", 1)[0].isupper())
+    args = [a for a in args if not ("=" in a and a.split("=", 1)[0].isupper())]
     argv = [sys.executable, "-m", "synth", *[a.replace("{out}", str(out / "r")) for a in args]]
-    env = {**os.environ, "PYTHONPATH": str(root)}
+    env = {**os.environ, "PYTHONPATH": str(root), **extra}
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
     t0 = time.perf_counter()
     proc = subprocess.run(argv, cwd=root, env=env, capture_output=True, text=True)
     elapsed = time.perf_counter() - t0
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
     if proc.returncode not in (0, 1):  # 1: a design that is infeasible or a check that fails is still a run
         raise RuntimeError(f"{' '.join(argv)} in {root} exited {proc.returncode}:\n{proc.stderr[-2000:]}")
-    return elapsed
+    return elapsed, cpu
 
 
 def baseline_checkout(ref: str, tmp: Path) -> Path:
@@ -96,21 +109,24 @@ def main() -> None:
                 todo = {k: v for k, v in todo.items() if v[0] == "check"}
             sides = {"baseline": base, "current": ROOT}
             best: dict[tuple[str, str], float] = {}
+            cpu: dict[tuple[str, str], float] = {}
             for label, argv in todo.items():
                 for root in sides.values():  # warm-up: first-use data, caches
                     run(root, argv, tmp)
                 for _ in range(repeat):
                     for side, root in sides.items():  # interleaved, so both sides see the same load
-                        t = run(root, argv, tmp)
+                        t, c = run(root, argv, tmp)
                         best[label, side] = min(best.get((label, side), float("inf")), t)
+                        cpu[label, side] = min(cpu.get((label, side), float("inf")), c)
             print(f"baseline: {base} ({args.baseline_ref if not args.baseline else 'given'}); "
                   f"current: {ROOT}; best of {repeat}, warm; load average {os.getloadavg()[0]:.1f}")
             print()
-            print("| command | baseline [s] | current [s] | speed-up |")
-            print("|---|---|---|---|")
+            print("| command | baseline wall [s] | current wall [s] | speed-up | baseline CPU [s] | current CPU [s] |")
+            print("|---|---|---|---|---|---|")
             for label in todo:
                 b, c = best[label, "baseline"], best[label, "current"]
-                print(f"| `{label}` | {b:.2f} | {c:.2f} | {b / c:.1f}x |")
+                print(f"| `{label}` | {b:.2f} | {c:.2f} | {b / c:.1f}x | {cpu[label, 'baseline']:.2f} | "
+                      f"{cpu[label, 'current']:.2f} |")
         finally:
             if not args.baseline:
                 remove_checkout(base)
