@@ -37,7 +37,10 @@ def horner(coeffs: np.ndarray, x: np.ndarray) -> np.ndarray:
 
 def _rows(polys: list[np.ndarray]) -> np.ndarray:
     width = max(p.size for p in polys)
-    return np.array([np.pad(np.asarray(p, float), (width - p.size, 0)) for p in polys])
+    out = np.zeros((len(polys), width))
+    for i, p in enumerate(polys):
+        out[i, width - p.size:] = p
+    return out
 
 
 class LoopBatch:
@@ -70,9 +73,7 @@ class LoopBatch:
         tfs = [c.tf() for c in self.controllers]
         self.cnum = _rows([n for n, _ in tfs])
         self.cden = _rows([d for _, d in tfs])
-        corners = [_corners(n, d) for n, d in tfs]
-        self._corner_lo = np.array([c[0] for c in corners])
-        self._corner_hi = np.array([c[1] for c in corners])
+        self._corner_lo, self._corner_hi = _row_corners(self.cnum, self.cden)
         self._dc = np.array([c.dc_gain() for c in self.controllers])
         self._set_plant(as_plant(plant))
 
@@ -380,6 +381,20 @@ def _corners(*polys: np.ndarray) -> tuple[float, float]:
             r = np.abs(np.roots(p))
             mags.extend(r[r > 1e-12].tolist())
     return (min(mags), max(mags)) if mags else (np.nan, np.nan)
+
+
+def _row_corners(*rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`_corners` of every row at once (the rows of each array are one polynomial each)."""
+    n = rows[0].shape[0]
+    lo, hi = np.full(n, np.inf), np.full(n, -np.inf)
+    for r in rows:
+        for i, roots in enumerate(_row_roots(r)):
+            mags = np.abs(roots)
+            mags = mags[mags > 1e-12]
+            if mags.size:
+                lo[i], hi[i] = min(lo[i], mags.min()), max(hi[i], mags.max())
+    none = ~np.isfinite(lo)
+    return np.where(none, np.nan, lo), np.where(none, np.nan, hi)
 
 
 def _row_magnitude_squared(rows: np.ndarray) -> np.ndarray:
