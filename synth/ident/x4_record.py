@@ -136,8 +136,16 @@ def cache_dir() -> Path:
         return Path(tempfile.gettempdir()) / "synth-cache"
 
 
+_HASHED: dict[tuple[str, int, int], str] = {}
+"""SHA-256 of files already hashed in this process, by (path, size, modification time in ns)."""
+
+
 def _sha256(path: Path) -> str:
-    return hashlib.sha256(path.read_bytes()).hexdigest()
+    st = path.stat()
+    key = (str(path.resolve()), st.st_size, st.st_mtime_ns)
+    if key not in _HASHED:
+        _HASHED[key] = hashlib.sha256(path.read_bytes()).hexdigest()
+    return _HASHED[key]
 
 
 def x4_step_train_path(folder: str | Path | None = None) -> Path:
