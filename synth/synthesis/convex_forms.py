@@ -251,18 +251,27 @@ class RatioBound(Form):
 
 
 class HalfPlane(Form):
-    """Gain and phase margins: ``L(jw)`` stays in a half-plane that excludes ``-1`` (near crossover).
+    """Gain and phase margins: ``L(jw)`` stays in a half-plane that excludes ``-1`` (near crossover), and,
+    when the loop has a lower gain limit, outside the circle of radius ``g`` where it passes left of ``-1``.
 
     The boundary passes through ``-1/g`` and ``exp(j(-180 + phi))``; if that
     line would not protect the phase margin, the vertical line through the
     phase-margin point is used. Applied where ``0.1 <= |L_c| <= 10``. Linear
     parametrizations only (``D = 1``).
+
+    The lower gain limit (an open-loop unstable plant, or a conditionally stable loop): when the current
+    design's Nyquist curve crosses the negative real axis outside the unit circle, the rows with
+    ``|L_c| > 1`` within 45 degrees of the negative real axis get ``|L| >= g``, linearized as
+    ``Re{L conj(L_c)}/|L_c| >= g`` (an inner approximation, tight at ``L_c``), and the half-plane then
+    applies only where ``0.1 <= |L_c| <= 1`` (the curve must be free to encircle ``-1``). Neither part is
+    exact: which rows carry which bound follows the current design, and the certificate decides.
     """
 
     def __init__(self, name: str, points: Points, n_rho: int, gm_db: float | None, pm_deg: float | None) -> None:
         self.name, self.points = name, points
         p2 = np.exp(1j * np.radians(-180.0 + pm_deg)) if pm_deg is not None else None
         p1 = -1.0 / magnitude(gm_db) if gm_db is not None else None
+        self.g_low = magnitude(gm_db) if gm_db is not None else None
         if p2 is not None and (p1 is None or -p1 >= -p2.real):
             anchor, normal = p2, 1.0 + 0j  # vertical line Re L >= Re p2
         elif p2 is None:
@@ -276,26 +285,49 @@ class HalfPlane(Form):
         self.anchor, self.normal = anchor, normal
         self.H = cp.Parameter((points.n, n_rho))
         self.h = cp.Parameter(points.n)
+        self.H2 = cp.Parameter((points.n, n_rho))
+        self.h2 = cp.Parameter(points.n)
 
     def constraints(self, rho, slack):
-        self._cons = [self.H @ rho - self.h >= -slack]
+        self._cons = [self.H @ rho - self.h >= -slack, self.H2 @ rho - self.h2 >= -slack]
         return self._cons
 
-    def _mask(self, L: np.ndarray) -> np.ndarray:
-        return (np.abs(L) >= 0.1) & (np.abs(L) <= 10.0)
+    def _masks(self, L: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(half-plane rows, lower-limit rows) at the design whose loop is ``L``."""
+        mag = np.abs(L)
+        sector = (mag > 1.0) & (np.real(L) < 0) & (np.abs(np.imag(L)) <= -np.real(L))
+        lower = np.zeros(L.size, bool)
+        if self.g_low is not None and np.any(sector):
+            same = self.points.plant_index[1:] == self.points.plant_index[:-1]
+            flips = same & (np.sign(np.imag(L[1:])) != np.sign(np.imag(L[:-1]))) & sector[1:] & sector[:-1]
+            on_axis = sector & (np.abs(np.imag(L)) <= 1e-9 * mag)
+            if np.any(flips) or np.any(on_axis):
+                lower = sector
+        upper = (mag >= 0.1) & (mag <= (1.0 if np.any(lower) else 10.0)) & ~lower
+        return upper, lower
 
     def violation(self, rho):
         L = self.points.N(rho)
-        mask = self._mask(L)
-        if not np.any(mask):
-            return -np.inf
-        return float(np.max(-np.real(np.conj(self.normal) * (L[mask] - self.anchor))))
+        upper, lower = self._masks(L)
+        parts = [-np.inf]
+        if np.any(upper):
+            parts.append(float(np.max(-np.real(np.conj(self.normal) * (L[upper] - self.anchor)))))
+        if np.any(lower):
+            parts.append(float(np.max(1.0 - np.abs(L[lower]) / self.g_low)))
+        return max(parts)
 
     def update(self, rho_c):
-        mask = self._mask(self.points.N(rho_c)).astype(float)
+        Lc = self.points.N(rho_c)
+        upper, lower = self._masks(Lc)
         nbar = np.conj(self.normal)
-        self.H.value = mask[:, None] * np.real(nbar * self.points.N.Q)
-        self.h.value = mask * np.real(nbar * (self.anchor - self.points.N.q0))
+        up = upper.astype(float)
+        self.H.value = up[:, None] * np.real(nbar * self.points.N.Q)
+        self.h.value = up * np.real(nbar * (self.anchor - self.points.N.q0))
+        # Re{L conj(L_c)}/|L_c| >= g on the lower rows (L = N, affine in rho)
+        u = np.where(lower, np.conj(Lc) / np.maximum(np.abs(Lc), 1e-300), 0.0)
+        g = self.g_low if self.g_low is not None else 0.0
+        self.H2.value = np.real(u[:, None] * self.points.N.Q)
+        self.h2.value = np.where(lower, g - np.real(u * self.points.N.q0), 0.0)
 
 
 class T0:
