@@ -174,3 +174,38 @@ def test_pi_design_with_max_overshoot_against_a_brute_force_grid(seed):
     feasible = os_[:-1] <= bound - 0.3
     best = kis[:-1][feasible].max()
     assert ki >= 0.7 * best, (ki, best)  # a good design: near the best of the grid
+
+
+# ------------------------------------------------------------------ margins: the lower gain limit
+UNSTABLE = "10/((s-1)*(s+5))"  # P control is stable for kp > 0.5 only: a lower gain limit
+
+
+def test_margins_convex_form_holds_the_lower_gain_limit():
+    from synth.synthesis.convex_forms import HalfPlane, make_points
+    from synth.synthesis.parametrization import parametrize
+
+    par = parametrize("PI", {"kp": (0.1, 20.0), "ki": (0.0, 0.0)})
+    pts = make_points([Plant.from_string(UNSTABLE)], par, np.geomspace(1e-3, 1e3, 400))
+    form = HalfPlane("margins", pts, par.size, 6.0, 30.0)
+    for kp in (0.8, 1.5, 3.0):
+        rho = par.rho(Controller("PI", {"kp": kp, "ki": 0.0}))
+        _, lower = form.masks(pts.N(rho))  # the rows this design puts under the lower limit
+        assert lower.any()  # L(0) = -2 kp: the curve starts on the negative real axis outside the unit circle
+        # the lower limit holds when |L| >= 2 (6 dB) where the curve passes left of -1: kp >= 1
+        assert (form.violation(rho) > 0) == (2 * kp < 10 ** (6 / 20)), kp
+
+
+def test_pid_on_an_open_loop_unstable_plant_keeps_both_gain_limits():
+    spec = parse_spec({"name": "u", "plant": {"tf": UNSTABLE},
+                       "controller": {"type": "PID", "bounds": {"kp": [0.1, 20], "ki": [0, 20]}},
+                       "requirements": [{"type": "margins", "gain_margin_db": 6, "phase_margin_deg": 40}],
+                       "objective": {"maximize": "integral_gain"}})
+    r = design(spec)
+    assert r.feasible and r.certificate.passed
+    loop = Loop(Plant.from_string(UNSTABLE), r.controller)
+    g = 10 ** (6 / 20)
+    k_lo = 10 ** (r.check.requirements[1].details["lower_gain_margin_db"] / 20)
+    assert 0 < k_lo < 1 / g
+    for k in np.concatenate([np.geomspace(1 / g, g, 25), [k_lo / 1.05]]):
+        roots = np.roots(np.polyadd(loop.den, k * loop.num))  # independent: closed-loop roots at gain factor k
+        assert (np.max(roots.real) < 0) == (k > k_lo), k  # stable across +-6 dB; unstable below the lower limit

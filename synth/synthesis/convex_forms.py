@@ -71,6 +71,7 @@ from synth.synthesis.parametrization import Affine, Parametrization
 __all__ = [
     "BACKOFF",
     "CONVEX_FORMS",
+    "LOWER_SECTOR",
     "T0",
     "Form",
     "FormContext",
@@ -250,6 +251,11 @@ class RatioBound(Form):
         self.level = level
 
 
+LOWER_SECTOR = float(np.tan(np.radians(10.0)))
+"""Half-width (as ``|Im L| / |Re L|``) of the sector about the negative real axis where :class:`HalfPlane` holds
+``|L| >= g`` (the lower gain limit)."""
+
+
 class HalfPlane(Form):
     """Gain and phase margins: ``L(jw)`` stays in a half-plane that excludes ``-1`` (near crossover), and,
     when the loop has a lower gain limit, outside the circle of radius ``g`` where it passes left of ``-1``.
@@ -261,7 +267,7 @@ class HalfPlane(Form):
 
     The lower gain limit (an open-loop unstable plant, or a conditionally stable loop): when the current
     design's Nyquist curve crosses the negative real axis outside the unit circle, the rows with
-    ``|L_c| > 1`` within 45 degrees of the negative real axis get ``|L| >= g``, linearized as
+    ``|L_c| > 1`` within 10 degrees of the negative real axis get ``|L| >= g``, linearized as
     ``Re{L conj(L_c)}/|L_c| >= g`` (an inner approximation, tight at ``L_c``), and the half-plane then
     applies only where ``0.1 <= |L_c| <= 1`` (the curve must be free to encircle ``-1``). Neither part is
     exact: which rows carry which bound follows the current design, and the certificate decides.
@@ -292,15 +298,16 @@ class HalfPlane(Form):
         self._cons = [self.H @ rho - self.h >= -slack, self.H2 @ rho - self.h2 >= -slack]
         return self._cons
 
-    def _masks(self, L: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    def masks(self, L: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(half-plane rows, lower-limit rows) at the design whose loop is ``L``."""
         mag = np.abs(L)
-        sector = (mag > 1.0) & (np.real(L) < 0) & (np.abs(np.imag(L)) <= -np.real(L))
+        sector = (mag > 1.0) & (np.real(L) < 0) & (np.abs(np.imag(L)) <= -LOWER_SECTOR * np.real(L))
         lower = np.zeros(L.size, bool)
         if self.g_low is not None and np.any(sector):
             same = self.points.plant_index[1:] == self.points.plant_index[:-1]
             flips = same & (np.sign(np.imag(L[1:])) != np.sign(np.imag(L[:-1]))) & sector[1:] & sector[:-1]
-            on_axis = sector & (np.abs(np.imag(L)) <= 1e-9 * mag)
+            first = np.concatenate([[True], ~same])  # each plant's lowest frequency: a crossing at w = 0
+            on_axis = sector & first & (np.abs(np.imag(L)) <= 0.02 * mag)
             if np.any(flips) or np.any(on_axis):
                 lower = sector
         upper = (mag >= 0.1) & (mag <= (1.0 if np.any(lower) else 10.0)) & ~lower
@@ -308,7 +315,7 @@ class HalfPlane(Form):
 
     def violation(self, rho):
         L = self.points.N(rho)
-        upper, lower = self._masks(L)
+        upper, lower = self.masks(L)
         parts = [-np.inf]
         if np.any(upper):
             parts.append(float(np.max(-np.real(np.conj(self.normal) * (L[upper] - self.anchor)))))
@@ -318,7 +325,7 @@ class HalfPlane(Form):
 
     def update(self, rho_c):
         Lc = self.points.N(rho_c)
-        upper, lower = self._masks(Lc)
+        upper, lower = self.masks(Lc)
         nbar = np.conj(self.normal)
         up = upper.astype(float)
         self.H.value = up[:, None] * np.real(nbar * self.points.N.Q)
