@@ -265,7 +265,8 @@ class HalfPlane(Form):
     phase-margin point is used. Applied where ``0.1 <= |L_c| <= 10``. Linear
     parametrizations only (``D = 1``).
 
-    The lower gain limit (an open-loop unstable plant, or a conditionally stable loop): when the current
+    The lower gain limit (``lower=True``, set when a plant is open-loop unstable and a gain margin is
+    asked for; a conditionally stable loop of a stable plant is kept out by the half-plane): when the current
     design's Nyquist curve crosses the negative real axis outside the unit circle, the rows with
     ``|L_c| > 1`` within 10 degrees of the negative real axis get ``|L| >= g``, linearized as
     ``Re{L conj(L_c)}/|L_c| >= g`` (an inner approximation, tight at ``L_c``), and the half-plane then
@@ -273,11 +274,12 @@ class HalfPlane(Form):
     exact: which rows carry which bound follows the current design, and the certificate decides.
     """
 
-    def __init__(self, name: str, points: Points, n_rho: int, gm_db: float | None, pm_deg: float | None) -> None:
+    def __init__(self, name: str, points: Points, n_rho: int, gm_db: float | None, pm_deg: float | None,
+                 lower: bool = True) -> None:
         self.name, self.points = name, points
         p2 = np.exp(1j * np.radians(-180.0 + pm_deg)) if pm_deg is not None else None
         p1 = -1.0 / magnitude(gm_db) if gm_db is not None else None
-        self.g_low = magnitude(gm_db) if gm_db is not None else None
+        self.g_low = magnitude(gm_db) if gm_db is not None and lower else None
         if p2 is not None and (p1 is None or -p1 >= -p2.real):
             anchor, normal = p2, 1.0 + 0j  # vertical line Re L >= Re p2
         elif p2 is None:
@@ -295,7 +297,9 @@ class HalfPlane(Form):
         self.h2 = cp.Parameter(points.n)
 
     def constraints(self, rho, slack):
-        self._cons = [self.H @ rho - self.h >= -slack, self.H2 @ rho - self.h2 >= -slack]
+        self._cons = [self.H @ rho - self.h >= -slack]
+        if self.g_low is not None:  # without a lower limit the problem is the half-plane's alone
+            self._cons.append(self.H2 @ rho - self.h2 >= -slack)
         return self._cons
 
     def masks(self, L: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -499,9 +503,10 @@ def _margins(ctx: FormContext, name: str, req: MarginsRequirement) -> list[Form]
     # certificate enforce them
     if ctx.par.ctype == "rational" or (req.gain_margin_db is None and req.phase_margin_deg is None):
         return []
+    unstable = any(np.any(np.roots(p.den).real > 0) for p in ctx.plants if len(p.den) > 1)
     return [HalfPlane(name, make_points(ctx.plants, ctx.par, ctx.grid), ctx.par.size,
                       None if req.gain_margin_db is None else req.gain_margin_db / ctx.tight,
-                      None if req.phase_margin_deg is None else req.phase_margin_deg / ctx.tight)]
+                      None if req.phase_margin_deg is None else req.phase_margin_deg / ctx.tight, lower=unstable)]
 
 
 def build_forms(requirements: list[Requirement], names: list[str], plants: list[Plant],
