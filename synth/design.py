@@ -3,9 +3,11 @@
 With one free parameter (a P gain, or any one parameter with the others fixed) the exact feasible
 set is computed and the objective optimized over it (:func:`synth.synthesis.scalar.design_scalar`).
 With several, the convex-concave procedure and the NLP polish design the controller
-(:func:`synth.synthesis.multi.design_convex`). Every returned design is re-checked on a grid 20
-times denser than the one used while searching, plus exact stability; a design that fails that
-certificate is not reported as a solution. The result types live in :mod:`synth.results`.
+(:func:`synth.synthesis.multi.design_convex`); requirements with no solver form (step response, no limit
+cycle) are met by a certified outer loop on a convex surrogate (:mod:`synth.synthesis.surrogate`).
+Every returned design is re-checked on a grid 20 times denser than the one used while searching, plus
+exact stability; a design that fails that certificate is not reported as a solution. The result types
+live in :mod:`synth.results`.
 """
 
 from __future__ import annotations
@@ -42,5 +44,6 @@ def design(spec: Spec) -> DesignResult:
     if len(spec.controller.free_parameters()) == 1:
         return design_scalar(spec)
     from synth.synthesis.multi import design_convex  # cvxpy and casadi load only for several parameters
+    from synth.synthesis.surrogate import design_certified
 
-    return design_convex(spec)
+    return design_certified(spec, design_convex)

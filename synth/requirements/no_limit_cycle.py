@@ -12,8 +12,9 @@ from pydantic import Field, NonNegativeFloat, field_validator, model_validator
 from synth.freqgrid import log_grid
 from synth.requirements.base import NEPER_PER_DB, Bound, Requirement, RequirementResult, db, fmt, register
 from synth.requirements.margins import closed_loop_unstable, unstable_result, with_unstable_rows
+from synth.requirements.simulated import confirm_prediction
 from synth.sim.describing import rate_limiter_df
-from synth.sim.spec import BlockEntry
+from synth.sim.spec import BlockEntry, SimulationSpec
 
 if TYPE_CHECKING:
     from synth.loop import Loop
@@ -126,7 +127,9 @@ def critical_gain_factor(L: Callable[[np.ndarray], np.ndarray], w: np.ndarray, d
         idx = np.flatnonzero((np.sign(im[:-1]) != np.sign(im[1:])) & ((z.real[:-1] < 0) | (z.real[1:] < 0)))
         for i in idx:
             f = lambda x, e=edge: float((L(np.array([x]))[0] * np.exp(-1j * x * e)).imag)  # noqa: E731
-            x = brentq(f, w[i], w[i + 1], xtol=1e-14 * w[i + 1], rtol=1e-13) if f(w[i]) * f(w[i + 1]) < 0 else w[i]
+            fa, fb = f(w[i]), f(w[i + 1])  # no strict sign change: one end is on the axis itself
+            x = brentq(f, w[i], w[i + 1], xtol=1e-14 * w[i + 1], rtol=1e-13) if fa * fb < 0 else \
+                (w[i] if fa == 0 else w[i + 1])
             zx = L(np.array([x]))[0] * np.exp(-1j * x * edge)
             if zx.real < 0 and 1.0 / abs(zx) < k_star:
                 k_star, w_star, tau_star = 1.0 / abs(zx), float(x), float(edge)
@@ -144,8 +147,12 @@ class NoLimitCycle(Requirement):
     function gain margin: the smallest loop-gain factor at which the Nyquist curve, turned by any delay
     in the range, meets a critical locus (:func:`critical_gain_factor`, exact in the delay; in frequency
     bracketed on a log grid of ``per_decade`` points per decade and refined). Harmonic balance is a prediction:
-    ``synth simulate`` confirms it in the time domain. On a closed loop that is not stable (small
-    signals already grow) the requirement is not met.
+    :meth:`evaluate` (the check, the design's certificate) confirms it by simulating a step with these blocks
+    at both ends of the delay range and at the worst delay (:func:`~synth.requirements.simulated.confirm_prediction`:
+    the spec's ``simulation:`` block sets the sample time, operating point and step; ``confirm: false``
+    skips it); a simulated cycle where none is predicted makes it NOT met, and any disagreement is stated.
+    :meth:`slack`, which the design searches with, is the prediction's alone. On a closed loop that is not
+    stable (small signals already grow) the requirement is not met.
 
     Examples
     --------
@@ -155,16 +162,22 @@ class NoLimitCycle(Requirement):
     >>> r = req.evaluate(Loop(G, Controller("P", {"kp": 5.0})))
     >>> r.met, round(r.value, 2), round(r.binding_frequency, 3)  # |L| = 5/6 on the negative real axis
     (True, 1.58, 1.414)
+    >>> r.details["confirmation"], [s["verdict"] for s in r.details["simulations"]]
+    ('confirmed', ['settled'])
     >>> late = req.model_copy(update={"delay": (0.0, 0.3)})
     >>> r = late.evaluate(Loop(G, Controller("P", {"kp": 5.0})))
-    >>> r.met, round(r.details["delay_at_binding"], 2)
-    (False, 0.3)
+    >>> r.met, round(r.details["delay_at_binding"], 2), r.details["confirmation"]
+    (False, 0.3, 'confirmed')
+    >>> [(s["delay"], s["verdict"]) for s in r.details["simulations"]]
+    [(0.0, 'settled'), (0.3, 'limit_cycle')]
     """
 
     type: Literal["no_limit_cycle"] = "no_limit_cycle"
     actuator: list[BlockEntry] = Field(min_length=1)  # type: ignore[valid-type]
     delay: tuple[NonNegativeFloat, NonNegativeFloat] = (0.0, 0.0)
     min_gain_margin_db: NonNegativeFloat = 0.0
+    confirm: bool = True
+    simulation: SimulationSpec | None = None
     title: ClassVar[str] = "no limit cycle"
     bounds: ClassVar[dict[str, Bound]] = {"min_gain_margin_db": Bound("lower", "dB")}
     example: ClassVar[dict[str, Any]] = {"type": "no_limit_cycle", "delay": [0.0, 0.01],
@@ -213,7 +226,30 @@ class NoLimitCycle(Requirement):
         k, wk, tau = _UNIT_GAIN_FACTORS[key]
         return w, (k / gain, wk, tau)
 
+    @classmethod
+    def wants_simulation(cls, entry: dict[str, Any]) -> bool:
+        """Whether a spec entry takes the spec's ``simulation:`` block (for its confirming runs).
+
+        Examples
+        --------
+        >>> NoLimitCycle.wants_simulation({"type": "no_limit_cycle"}), NoLimitCycle.wants_simulation({"confirm": False})
+        (True, False)
+        """
+        return bool(entry.get("confirm", True))
+
+    def slack(self, loop: Loop, per_decade: int = 80) -> float:
+        """The describing function's slack alone (the confirming simulations are :meth:`evaluate`'s)."""
+        return self.predict(loop, per_decade).slack
+
     def evaluate(self, loop: Loop, per_decade: int = 80) -> RequirementResult:
+        """:meth:`predict`, confirmed by simulation unless ``confirm`` is false or the loop is unstable."""
+        r = self.predict(loop, per_decade)
+        if not self.confirm or r.details.get("closed_loop_stable") is False:
+            return r
+        return confirm_prediction(self, r, loop)
+
+    def predict(self, loop: Loop, per_decade: int = 80) -> RequirementResult:
+        """The describing-function verdict (no simulation)."""
         if closed_loop_unstable(loop):
             return unstable_result(self, loop, "limit-cycle check")
         kinds = self.kinds()

@@ -140,6 +140,10 @@ def _json_value(value: Any) -> Any:
 
 
 def _parse_mapping(data: Mapping[str, Any], source: str, root: yaml.Node | None = None) -> Spec:
+    if data.get("simulation") is not None:  # requirements judged under the simulation: blocks get a copy of them
+        from synth.requirements.simulated import bind_simulation
+
+        data = {**data, "requirements": bind_simulation(data.get("requirements"), data["simulation"])}
     try:
         text = json.dumps(data, default=_json_value)
     except (TypeError, ValueError) as exc:

@@ -71,6 +71,7 @@ from synth.synthesis.parametrization import Affine, Parametrization
 __all__ = [
     "BACKOFF",
     "CONVEX_FORMS",
+    "LOWER_SECTOR",
     "T0",
     "Form",
     "FormContext",
@@ -250,19 +251,35 @@ class RatioBound(Form):
         self.level = level
 
 
+LOWER_SECTOR = float(np.tan(np.radians(10.0)))
+"""Half-width (as ``|Im L| / |Re L|``) of the sector about the negative real axis where :class:`HalfPlane` holds
+``|L| >= g`` (the lower gain limit)."""
+
+
 class HalfPlane(Form):
-    """Gain and phase margins: ``L(jw)`` stays in a half-plane that excludes ``-1`` (near crossover).
+    """Gain and phase margins: ``L(jw)`` stays in a half-plane that excludes ``-1`` (near crossover), and,
+    when the loop has a lower gain limit, outside the circle of radius ``g`` where it passes left of ``-1``.
 
     The boundary passes through ``-1/g`` and ``exp(j(-180 + phi))``; if that
     line would not protect the phase margin, the vertical line through the
     phase-margin point is used. Applied where ``0.1 <= |L_c| <= 10``. Linear
     parametrizations only (``D = 1``).
+
+    The lower gain limit (``lower=True``, set when a plant is open-loop unstable and a gain margin is
+    asked for; a conditionally stable loop of a stable plant is kept out by the half-plane): when the current
+    design's Nyquist curve crosses the negative real axis outside the unit circle, the rows with
+    ``|L_c| > 1`` within 10 degrees of the negative real axis get ``|L| >= g``, linearized as
+    ``Re{L conj(L_c)}/|L_c| >= g`` (an inner approximation, tight at ``L_c``), and the half-plane then
+    applies only where ``0.1 <= |L_c| <= 1`` (the curve must be free to encircle ``-1``). Neither part is
+    exact: which rows carry which bound follows the current design, and the certificate decides.
     """
 
-    def __init__(self, name: str, points: Points, n_rho: int, gm_db: float | None, pm_deg: float | None) -> None:
+    def __init__(self, name: str, points: Points, n_rho: int, gm_db: float | None, pm_deg: float | None,
+                 lower: bool = True) -> None:
         self.name, self.points = name, points
         p2 = np.exp(1j * np.radians(-180.0 + pm_deg)) if pm_deg is not None else None
         p1 = -1.0 / magnitude(gm_db) if gm_db is not None else None
+        self.g_low = magnitude(gm_db) if gm_db is not None and lower else None
         if p2 is not None and (p1 is None or -p1 >= -p2.real):
             anchor, normal = p2, 1.0 + 0j  # vertical line Re L >= Re p2
         elif p2 is None:
@@ -276,26 +293,52 @@ class HalfPlane(Form):
         self.anchor, self.normal = anchor, normal
         self.H = cp.Parameter((points.n, n_rho))
         self.h = cp.Parameter(points.n)
+        self.H2 = cp.Parameter((points.n, n_rho))
+        self.h2 = cp.Parameter(points.n)
 
     def constraints(self, rho, slack):
         self._cons = [self.H @ rho - self.h >= -slack]
+        if self.g_low is not None:  # without a lower limit the problem is the half-plane's alone
+            self._cons.append(self.H2 @ rho - self.h2 >= -slack)
         return self._cons
 
-    def _mask(self, L: np.ndarray) -> np.ndarray:
-        return (np.abs(L) >= 0.1) & (np.abs(L) <= 10.0)
+    def masks(self, L: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(half-plane rows, lower-limit rows) at the design whose loop is ``L``."""
+        mag = np.abs(L)
+        sector = (mag > 1.0) & (np.real(L) < 0) & (np.abs(np.imag(L)) <= -LOWER_SECTOR * np.real(L))
+        lower = np.zeros(L.size, bool)
+        if self.g_low is not None and np.any(sector):
+            same = self.points.plant_index[1:] == self.points.plant_index[:-1]
+            flips = same & (np.sign(np.imag(L[1:])) != np.sign(np.imag(L[:-1]))) & sector[1:] & sector[:-1]
+            first = np.concatenate([[True], ~same])  # each plant's lowest frequency: a crossing at w = 0
+            on_axis = sector & first & (np.abs(np.imag(L)) <= 0.02 * mag)
+            if np.any(flips) or np.any(on_axis):
+                lower = sector
+        upper = (mag >= 0.1) & (mag <= (1.0 if np.any(lower) else 10.0)) & ~lower
+        return upper, lower
 
     def violation(self, rho):
         L = self.points.N(rho)
-        mask = self._mask(L)
-        if not np.any(mask):
-            return -np.inf
-        return float(np.max(-np.real(np.conj(self.normal) * (L[mask] - self.anchor))))
+        upper, lower = self.masks(L)
+        parts = [-np.inf]
+        if np.any(upper):
+            parts.append(float(np.max(-np.real(np.conj(self.normal) * (L[upper] - self.anchor)))))
+        if np.any(lower):
+            parts.append(float(np.max(1.0 - np.abs(L[lower]) / self.g_low)))
+        return max(parts)
 
     def update(self, rho_c):
-        mask = self._mask(self.points.N(rho_c)).astype(float)
+        Lc = self.points.N(rho_c)
+        upper, lower = self.masks(Lc)
         nbar = np.conj(self.normal)
-        self.H.value = mask[:, None] * np.real(nbar * self.points.N.Q)
-        self.h.value = mask * np.real(nbar * (self.anchor - self.points.N.q0))
+        up = upper.astype(float)
+        self.H.value = up[:, None] * np.real(nbar * self.points.N.Q)
+        self.h.value = up * np.real(nbar * (self.anchor - self.points.N.q0))
+        # Re{L conj(L_c)}/|L_c| >= g on the lower rows (L = N, affine in rho)
+        u = np.where(lower, np.conj(Lc) / np.maximum(np.abs(Lc), 1e-300), 0.0)
+        g = self.g_low if self.g_low is not None else 0.0
+        self.H2.value = np.real(u[:, None] * self.points.N.Q)
+        self.h2.value = np.where(lower, g - np.real(u * self.points.N.q0), 0.0)
 
 
 class T0:
@@ -460,9 +503,10 @@ def _margins(ctx: FormContext, name: str, req: MarginsRequirement) -> list[Form]
     # certificate enforce them
     if ctx.par.ctype == "rational" or (req.gain_margin_db is None and req.phase_margin_deg is None):
         return []
+    unstable = any(np.any(np.roots(p.den).real > 0) for p in ctx.plants if len(p.den) > 1)
     return [HalfPlane(name, make_points(ctx.plants, ctx.par, ctx.grid), ctx.par.size,
                       None if req.gain_margin_db is None else req.gain_margin_db / ctx.tight,
-                      None if req.phase_margin_deg is None else req.phase_margin_deg / ctx.tight)]
+                      None if req.phase_margin_deg is None else req.phase_margin_deg / ctx.tight, lower=unstable)]
 
 
 def build_forms(requirements: list[Requirement], names: list[str], plants: list[Plant],

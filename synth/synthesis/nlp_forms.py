@@ -69,9 +69,9 @@ def nlp_form(requirement: type[Requirement], *, exact: bool) -> Callable[[Callab
 
     Examples
     --------
-    >>> from synth.requirements import MarginsRequirement
-    >>> NLP_FORMS.entry(MarginsRequirement).exact
-    True
+    >>> from synth.requirements import DiskMargin, MarginsRequirement
+    >>> NLP_FORMS.entry(DiskMargin).exact, NLP_FORMS.entry(MarginsRequirement).exact
+    (True, False)
     """
     return NLP_FORMS.register(requirement, exact=exact)
 
@@ -139,8 +139,12 @@ def _bandwidth(b: NLPBuilder, req: Bandwidth, plant: Plant, ctx: NLPContext) -> 
         b.geq(TIGHT * BANDWIDTH_LEVEL**2 * t02 * (1.0 + L).abs2() - L.abs2())
 
 
-@nlp_form(MarginsRequirement, exact=True)
+@nlp_form(MarginsRequirement, exact=False)
 def _margins(b: NLPBuilder, req: MarginsRequirement, plant: Plant, ctx: NLPContext) -> None:
+    # phase and delay margins at each gain crossover, the upper gain limit at each phase crossover inside the
+    # unit circle, the lower gain limit at the crossing outside it: exact at those crossings, which are
+    # variables and move with the design; a crossing that appears away from the start design's is left to
+    # the certificate (hence exact=False)
     loop = Loop(plant, ctx.start)
     ctrl = b.ctrl
     for wc in loop.gain_crossovers():
@@ -152,11 +156,24 @@ def _margins(b: NLPBuilder, req: MarginsRequirement, plant: Plant, ctx: NLPConte
         if req.delay_margin is not None:
             b.geq((1.0 + L).abs2() - 4 * ca.sin(ca.fmin(v * req.delay_margin, np.pi) / 2) ** 2)
     if req.gain_margin_db is not None:
-        for wp in phase_crossovers(loop):
+        g = magnitude(req.gain_margin_db * (1 + BACKOFF))
+        for wp in phase_crossovers(loop):  # the upper gain limit: crossings inside the unit circle, right of -1/g
             v = b.var("wp", float(wp), wp / 3.0, 3.0 * wp)
             _, L = loop_response(ctrl, plant, v)
             b.eq(L.im)
-            b.geq(L.re + 1.0 / magnitude(req.gain_margin_db * (1 + BACKOFF)))
+            b.geq(L.re + 1.0 / g)
+        k_lo, _, w_lo, _ = loop.gain_factors
+        if k_lo > 0 and w_lo is not None:  # the lower gain limit (open-loop unstable or conditionally stable
+            # loop): the crossing of the negative real axis outside the unit circle stays left of -g
+            if w_lo > 0:
+                v = b.var("wl", float(w_lo), w_lo / 3.0, 3.0 * w_lo)
+                _, L = loop_response(ctrl, plant, v)
+                b.eq(L.im)
+                b.geq(-L.re - g)
+            elif ctrl.dc() is not None:  # at w = 0: the static loop gain (e.g. an unstable pole under P control)
+                b.geq(-ctrl.dc() * plant.dc_gain() - g)
+            # else: a start without integral action whose lower crossing sits at w = 0, in a structure with an
+            # integrator (its crossing leaves w = 0 as soon as ki > 0): left to the certificate
 
 
 @nlp_form(DiskMargin, exact=True)

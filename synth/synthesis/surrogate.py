@@ -1,0 +1,215 @@
+"""Requirements without a solver form inside the design loop: a certified outer loop on a convex surrogate.
+
+Step-response limits and "no limit cycle" have no convex or NLP form (:data:`CERTIFIED_ONLY`): with several
+free parameters the convex and NLP stages cannot see them, and before this loop the certificate rejected
+every design they made (a PI design with ``max_overshoot`` fell back to a ``ki = 0`` design).
+:func:`design_certified` designs without them, and when the design fails them, designs again under a
+surrogate with exact solver forms, peak ``|S|`` and peak ``|T|`` both at most ``level`` dB (the overshoot
+follows the resonance peak of ``T``, a limit cycle the distance of ``L`` to ``-1`` and its critical loci),
+bisecting on ``level`` for the loosest one whose design passes the exact check of every requirement
+(certificate density). The surrogate is only a search direction: every returned design passed the full
+certificate, and the method says which level was used and how many designs the bisection took. A last
+bisection on the segment from the chosen design towards the first design that failed the exact check
+(:data:`LINE_STEPS` checks) moves it closer to the limits when that scores better and still passes.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+
+from synth.check import check
+from synth.controllers import Controller
+from synth.loop import Loop
+from synth.objectives import score
+from synth.requirements import NoLimitCycle, PeakComplementary, PeakSensitivity, StepResponse
+from synth.requirements.base import Requirement, db, fmt
+from synth.results import CERTIFICATE_PER_DECADE, Certificate, DesignResult, objective_label
+from synth.spec import Spec
+from synth.synthesis.multi import objective_terms
+
+__all__ = ["BISECTIONS", "CERTIFIED_ONLY", "LINE_STEPS", "RESOLUTION_DB", "certified_only", "design_certified",
+           "surrogate_spec"]
+
+CERTIFIED_ONLY = (StepResponse, NoLimitCycle)
+"""Requirement types with no convex or NLP form: the certificate (and this loop) enforce them."""
+BISECTIONS = 6
+"""Designs of the bisection on the surrogate level after the first (it stops earlier at :data:`RESOLUTION_DB`)."""
+LINE_STEPS = 4
+"""Exact checks of the last step, from the chosen design towards the first one that failed."""
+RESOLUTION_DB = 0.1
+"""The bisection stops when the passing and the failing levels are this close (dB)."""
+_FLOOR_DB = 0.05  # peak |S| is at least 1 for every loop of relative degree >= 2, peak |T| with integral action
+
+
+def certified_only(spec: Spec) -> list[Requirement]:
+    """The spec's requirements with no solver form (:data:`CERTIFIED_ONLY`).
+
+    Examples
+    --------
+    >>> from synth.spec import parse_spec
+    >>> spec = parse_spec({"name": "s", "plant": {"tf": "1/(s+1)"}, "controller": {"type": "PI"},
+    ...                    "requirements": [{"type": "step_response", "max_overshoot": 5},
+    ...                                     {"type": "bandwidth", "min": 1}]})
+    >>> [r.type for r in certified_only(spec)]
+    ['step_response']
+    """
+    return [r for r in spec.requirements if isinstance(r, CERTIFIED_ONLY)]
+
+
+def surrogate_spec(spec: Spec, level_db: float | None) -> Spec:
+    """``spec`` without its :func:`certified_only` requirements, with peak ``|S|`` and ``|T|`` at most
+    ``level_db`` instead (none when ``level_db`` is None).
+
+    Examples
+    --------
+    >>> from synth.spec import parse_spec
+    >>> spec = parse_spec({"name": "s", "plant": {"tf": "1/(s+1)"}, "controller": {"type": "PI"},
+    ...                    "requirements": [{"type": "step_response", "max_overshoot": 5}]})
+    >>> [(r.type, r.max_db) for r in surrogate_spec(spec, 2.0).requirements]
+    [('peak_sensitivity', 2.0), ('peak_complementary', 2.0)]
+    """
+    kept = [r for r in spec.requirements if not isinstance(r, CERTIFIED_ONLY)]
+    if level_db is not None:
+        kept += [PeakSensitivity(max_db=level_db, label="surrogate: peak |S|"),
+                 PeakComplementary(max_db=level_db, label="surrogate: peak |T|")]
+    return spec.model_copy(update={"requirements": kept})
+
+
+def _start_level(hard: list[Requirement]) -> float:
+    """The peak |T| of a second-order loop with the tightest overshoot limit (its damping), in dB; else 3 dB."""
+    bounds = [r.max_overshoot for r in hard if isinstance(r, StepResponse) and r.max_overshoot is not None]
+    if not bounds:
+        return 3.0
+    lo = np.log(max(min(bounds), 1e-3) / 100.0)
+    zeta = -lo / np.sqrt(np.pi**2 + lo**2)
+    return float(db(1.0 / (2 * zeta * np.sqrt(1 - zeta**2)))) if zeta < np.sqrt(0.5) else 0.5
+
+
+def _peaks_db(spec: Spec, result: DesignResult) -> float:
+    loops = [Loop(p, result.controller) for p in spec.plants()]
+    return max(max(PeakSensitivity(max_db=0).evaluate(lp).value, PeakComplementary(max_db=0).evaluate(lp).value)
+               for lp in loops)
+
+
+def _better(a: DesignResult, b: DesignResult) -> bool:
+    va, vb = a.objective["value"], b.objective["value"]
+    return va > vb if a.objective["sense"] == "maximize" else va < vb
+
+
+def design_certified(spec: Spec, design_fn: Callable[[Spec], DesignResult]) -> DesignResult:
+    """``design_fn(spec)``, and when the spec has requirements with no solver form that its design could not
+    meet (or met only by dropping the integral action), the certified outer loop of this module.
+
+    The better of the two certified designs is returned (the plain one when the loop finds nothing).
+
+    Examples
+    --------
+    >>> from synth.spec import parse_spec
+    >>> from synth.synthesis.multi import design_convex
+    >>> spec = parse_spec({"name": "os", "plant": {"tf": "2/((s+1)*(s+2))"},
+    ...     "controller": {"type": "PI", "bounds": {"kp": [0.01, 5], "ki": [0, 10]}},
+    ...     "requirements": [{"type": "step_response", "max_overshoot": 10}],
+    ...     "objective": {"maximize": "integral_gain"}})
+    >>> r = design_certified(spec, design_convex)
+    >>> r.feasible, r.certificate.passed, r.certificate.check.requirements[1].value <= 10
+    (True, True, True)
+    >>> round(r.controller.parameters["ki"], 2), r.extras["surrogate"]["designs"] <= 3 + BISECTIONS
+    (1.6, True)
+    """
+    hard = certified_only(spec)
+    if not hard:
+        return design_fn(spec)
+    free = design_fn(surrogate_spec(spec, None))
+    if not free.feasible:  # the other requirements already fail: nothing for the surrogate to add
+        return design_fn(spec)
+    if check(spec, free.controller).feasible:
+        return _certified(spec, free, None, 1)
+    loose = _peaks_db(spec, free)  # the free design's level: too loose (it fails the exact check)
+    tight = _FLOOR_DB  # no design below this level
+    best, tried, over = None, 1, free.controller
+    level = float(np.clip(_start_level(hard), tight + 0.2, max(loose - 0.2, tight + 0.2)))
+    for _ in range(BISECTIONS + 2):
+        trial = design_fn(surrogate_spec(spec, level))
+        tried += 1
+        designed = trial.feasible and "alternatives" not in trial.extras  # not the structure's fallback
+        if designed and check(spec, trial.controller).feasible:  # the certificate re-checks the chosen one
+            if best is None or _better(trial, best[0]):
+                best = (trial, level)
+            tight = level  # passes: a looser level may do better
+        elif designed or best is not None:
+            loose = level  # fails the exact check (or, above a level that passed, no design: stay below)
+            over = trial.controller if designed else over
+        else:
+            tight = level  # no design and nothing passed yet: the surrogate is too strict
+        if loose - tight < RESOLUTION_DB:
+            break
+        level = float(np.sqrt(tight * loose))  # geometric: the free level can be tens of dB
+    integral_only = all(n in ("integral_gain", "low_frequency_gain") and sense == "maximize"
+                        for n, sense, _ in objective_terms(spec))
+    found = None
+    if best is not None:
+        refined, checks = _toward(spec, best[0].controller, over)
+        found = _certified(spec, best[0], best[1], tried, refined, checks) if refined is not None else None
+        if found is None or not found.feasible:
+            found = _certified(spec, best[0], best[1], tried)
+    if found is not None and integral_only:  # the plain design can only do better by dropping integral action
+        return found
+    plain = design_fn(spec)
+    if best is None:
+        plain.method += (f"; certified-only requirements ({', '.join(r.type for r in hard)}): no design under "
+                         f"peak |S|, |T| <= {fmt(_FLOOR_DB)} dB passes them either")
+        return plain
+    assert found is not None
+    if plain.feasible and _better(plain, found):
+        return plain
+    return found
+
+
+def _toward(spec: Spec, inside: Controller, outside: Controller) -> tuple[Controller | None, int]:
+    """The best-scoring controller on the segment from ``inside`` (passes the exact check) towards ``outside``
+    (fails it) that passes the exact check (bisection, :data:`LINE_STEPS` checks), or None when none beats
+    ``inside``; and the number of checks."""
+    if inside.type != outside.type:
+        return None, 0
+    terms = objective_terms(spec)
+    nominal = spec.nominal_plant()
+    base = score(Loop(nominal, inside), terms)
+    lo, hi, found = 0.0, 1.0, None
+    for _ in range(LINE_STEPS):
+        t = 0.5 * (lo + hi)
+        c = inside.with_parameters(**{p: (1 - t) * inside.parameters[p] + t * outside.parameters[p]
+                                      for p in inside.parameters})
+        if check(spec, c).feasible and score(Loop(nominal, c), terms) > base:
+            lo, found = t, c
+        else:
+            hi = t
+    return found, LINE_STEPS
+
+
+def _certified(spec: Spec, result: DesignResult, level: float | None, tried: int,
+               controller: Controller | None = None, checks: int = 0) -> DesignResult:
+    """``result`` (designed on a surrogate spec), or ``controller`` found from it, re-checked and certified
+    against ``spec`` itself."""
+    chosen = controller or result.controller
+    cert = check(spec, chosen, CERTIFICATE_PER_DECADE)  # dense; the step response is grid-free
+    hard = ", ".join(r.type for r in certified_only(spec))
+    how = ("designed without them and met as designed" if level is None else
+           f"designed with peak |S| and |T| <= {fmt(level)} dB instead, the loosest level at which the exact "
+           f"check passed (bisection, {tried} designs)")
+    if controller is not None:
+        how += (f", then moved towards the first design that failed it while the exact check passes "
+                f"(bisection on the segment, {checks} checks)")
+    extras: dict[str, Any] = {**result.extras, "surrogate": {"requirements": hard, "level_db": level,
+                                                             "designs": tried, "segment_checks": checks}}
+    objective = result.objective if controller is None or spec.objective is None else \
+        objective_label(spec, Loop(spec.nominal_plant(), chosen))
+    out = DesignResult(spec.name, cert.feasible, chosen, cert, objective, None,
+                       Certificate(cert.feasible, CERTIFICATE_PER_DECADE, cert), None,
+                       result.method + f"; requirements with no solver form ({hard}): {how}; certificate: every "
+                       "requirement re-checked exactly", reference=result.reference, extras=extras)
+    out.verdict = (f"{chosen} meets all {len(spec.requirements)} requirements and keeps the loop "
+                   f"stable on {len(spec.plants())} plant(s); {hard}: {how}.")
+    return out
