@@ -180,7 +180,7 @@ def test_a_cycle_of_three_samples_is_counted_whole():
     cycles whose samples fell near the mean (period 0.052 s for 0.0325 s, seed 15 loop 78)."""
     t = np.arange(0, 20, 0.01)
     saw = ((t / 0.0325) % 1.0) - 0.5
-    osc = detect_oscillation(t, saw, hysteresis=SAMPLED_HYSTERESIS)
+    osc = detect_oscillation(t, saw, hysteresis=SAMPLED_HYSTERESIS, whole_cycles=True)
     assert osc.present and osc.period == pytest.approx(0.0325, rel=1e-3)
     case = _case(15, 78)
     v = step_verdict(synth_loop(case), 0.0, case["step"], case["t_step"])
@@ -197,7 +197,7 @@ def test_the_detrending_line_does_not_bias_the_period():
     """A line fitted over a fraction of a cycle tilts the crossings: 5 cycles of a sine gave 0.988."""
     t = np.arange(0, 10, 0.001)
     for y in (np.sin(2 * np.pi * t), np.sin(2 * np.pi * t) + 3 * np.exp(-t / 4)):
-        osc = detect_oscillation(t, y, hysteresis=SAMPLED_HYSTERESIS)
+        osc = detect_oscillation(t, y, hysteresis=SAMPLED_HYSTERESIS, whole_cycles=True)
         assert osc.period == pytest.approx(1.0, rel=2e-3)
 
 

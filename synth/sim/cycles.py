@@ -1,15 +1,16 @@
 """Measure a limit cycle found by :func:`synth.sim.verdict.judge`: periodic or not, and its ranges.
 
 A sustained oscillation is *periodic* when the record repeats itself: shifted by one period, the
-waveform differs by at most :data:`~synth.sim.limitcycle.REPEAT` (1 %) RMS of its own RMS
-(:func:`~synth.sim.limitcycle.repetition_error`), its whole cycles have the same length, maximum and
-minimum (:func:`~synth.sim.limitcycle.detect_oscillation`). The period is found, in order, from the
-crossings of the mean (a simple waveform, two crossings per period) or from the autocorrelation
-(:func:`autocorrelation_period`: a waveform crossing its mean more than twice per period, or a
-sampled cycle locked to a whole number of samples whose sub-cycles differ). A cycle that repeats by
-neither is *oscillating but not periodic* (quasi-periodic or chaotic relay and quantizer cycles): its
-amplitude is half the peak-to-peak range of the window, reported with the smallest cycle's, and its
-period is the mean length of its cycles, reported with the shortest and longest.
+waveform differs by at most :data:`~synth.sim.limitcycle.REPEAT` (1 %) RMS of its own RMS and no
+sample moves by more than 10 % of its range (:func:`~synth.sim.limitcycle.repeats`), and its whole
+cycles have the same length, maximum and minimum (:func:`~synth.sim.limitcycle.detect_oscillation`).
+The period is found, in order, from the crossings of the mean (a simple waveform, two crossings
+per period) or from the autocorrelation (:func:`autocorrelation_period`: a waveform crossing its
+mean more than twice per period; a sampled cycle locked onto a pattern of several differing cycles
+is reported as not periodic cycle by cycle). A cycle that repeats by neither is *oscillating but
+not periodic* (quasi-periodic or chaotic relay and quantizer cycles): its amplitude is half the
+peak-to-peak range of the window, reported with the smallest cycle's, and its period is the mean
+length of its cycles, reported with the shortest and longest.
 """
 
 from __future__ import annotations
@@ -18,7 +19,7 @@ import dataclasses
 
 import numpy as np
 
-from synth.sim.limitcycle import REPEAT, Oscillation, repetition_error
+from synth.sim.limitcycle import REPEAT, Oscillation, repeats
 
 __all__ = ["autocorrelation_period", "measure_cycle"]
 
@@ -64,9 +65,9 @@ def autocorrelation_period(t: np.ndarray, y: np.ndarray, min_amplitude: float = 
 
 def _repeating_lag(t: np.ndarray, y: np.ndarray, first: float) -> float | None:
     """The shortest multiple of ``first`` (at most 50 of them and half the record) after which
-    ``y`` repeats within REPEAT RMS; None when none does."""
+    ``y`` repeats (:func:`~synth.sim.limitcycle.repeats`); None when none does."""
     for k in range(1, min(50, int((t[-1] - t[0]) / 2 / first)) + 1):
-        if repetition_error(t, y, k * first) <= REPEAT:
+        if repeats(t, y, k * first):
             return k * first
     return None
 
@@ -75,10 +76,10 @@ def measure_cycle(t: np.ndarray, y: np.ndarray, osc: Oscillation, cycles: int,
                   min_amplitude: float = 0.0) -> Oscillation:
     """The limit cycle of the window ``t, y`` (already judged sustained), measured: ``osc`` is
     :func:`~synth.sim.limitcycle.detect_oscillation` on that window. Returns ``osc`` when it is
-    periodic; otherwise a copy marked periodic when the record repeats after a multiple of the
-    period found by :func:`autocorrelation_period` (a sampled cycle locked onto a pattern of k cycles
-    of slightly different lengths: the period is still their mean length; a complex waveform: the
-    period is the pattern's), or marked not periodic with the ranges of its cycles.
+    periodic; otherwise a copy marked periodic when the record repeats after the period found by
+    :func:`autocorrelation_period` (a complex waveform: the period is the pattern's), or marked not
+    periodic with the ranges of its cycles (a sampled cycle that repeats only every k > 1 cycles of
+    different lengths or amplitudes says so, with their mean length as its period).
 
     Examples
     --------
@@ -95,11 +96,12 @@ def measure_cycle(t: np.ndarray, y: np.ndarray, osc: Oscillation, cycles: int,
     pattern = _repeating_lag(t, y, found[0]) if found is not None else None
     if pattern is not None and osc.present and osc.period:  # regular cycles, repeating every k of them
         k = max(1, round(pattern / osc.period))
-        locked = abs(pattern / k - osc.period) <= REPEAT * osc.period
-        period, half = (osc.period, 0.5 * float(np.ptp(y))) if locked else (pattern, 0.5 * float(np.ptp(y)))
-        how = (f"periodic: the record repeats every {pattern:.4g} s ({k if locked else 1} cycles) within "
-               f"{100 * REPEAT:g} % RMS; period the mean length of the cycles ({osc.reason})")
-        shape = {"periodic": True, "amplitude_range": osc.amplitude_range or (half, half),
+        half = 0.5 * float(np.ptp(y))
+        period = osc.period if abs(pattern / k - osc.period) <= REPEAT * osc.period else pattern
+        how = (f"{'periodic' if k == 1 else 'not periodic cycle by cycle'}: the record repeats every {pattern:.4g} s "
+               f"({k} cycles) within {100 * REPEAT:g} % RMS, no sample off by 10 %"
+               f"{'' if k == 1 else ', its cycles differ'}; period the mean length of the cycles ({osc.reason})")
+        shape = {"periodic": k == 1, "amplitude_range": osc.amplitude_range or (half, half),
                  "period_range": osc.period_range or (period, period)}
     elif pattern is not None:  # a complex waveform (more than two mean crossings a period)
         period, half = pattern, 0.5 * float(np.ptp(y))
@@ -113,7 +115,8 @@ def measure_cycle(t: np.ndarray, y: np.ndarray, osc: Oscillation, cycles: int,
         lengths = osc.period_range or (period, period)
         if found is not None:
             lengths = (min(lengths[0], found[0]), max(lengths[1], found[0]))
-        how = (f"not periodic: shifted by any period the record differs by more than {100 * REPEAT:g} % RMS; "
+        how = (f"not periodic: shifted by any period the record differs by more than {100 * REPEAT:g} % RMS "
+               "or 10 % at a sample; "
                f"amplitude half the peak-to-peak range of the window, period the mean length of its cycles "
                f"({osc.reason})")
         shape = {"periodic": False, "amplitude_range": (min(low, half), half), "period_range": lengths}

@@ -12,8 +12,9 @@ last third of the window is at least ``sustain`` times that of the first
 third (a growing oscillation counts; a decaying one does not).
 
 The crossing instants are interpolated between samples. The period is the mean
-over every whole cycle in the window, the amplitude half the peak-to-peak range
-over them; each cycle is also measured alone (its length, half its peak-to-peak
+over every whole cycle in the window; with ``whole_cycles`` the trend is refitted
+to the cycles' means and the amplitude is half the peak-to-peak range over all
+of them (default: over the last two); each cycle is also measured alone (its length, half its peak-to-peak
 range, its largest and smallest value), and the oscillation is *periodic* when
 their lengths agree within :data:`REPEAT` (1 %) and their maxima and minima
 within 1 % of the amplitude, and the waveform shifted by one period matches
@@ -31,7 +32,8 @@ import numpy as np
 
 from synth.sim._jit import jit
 
-__all__ = ["REPEAT", "SAMPLED_HYSTERESIS", "Oscillation", "cycle_table", "detect_oscillation", "repetition_error"]
+__all__ = ["REPEAT", "SAMPLED_HYSTERESIS", "Oscillation", "cycle_table", "detect_oscillation", "repeats",
+           "repetition_error"]
 
 REPEAT = 0.01
 """Largest spread (max - min over the mean) of the per-cycle lengths and amplitudes of a periodic oscillation."""
@@ -92,18 +94,24 @@ class Oscillation:
     period_range: tuple[float, float] | None = None
 
     def to_dict(self) -> dict[str, Any]:
-        """JSON-ready dict.
+        """JSON-ready dict (``periodic`` and the ranges only when measured).
 
         Examples
         --------
-        >>> Oscillation(False, None, None, None, None, None, 0, None, "flat").to_dict()["present"]
-        False
+        >>> d = Oscillation(False, None, None, None, None, None, 0, None, "flat").to_dict()
+        >>> d["present"], "periodic" in d
+        (False, False)
         """
-        return asdict(self)
+        out = asdict(self)
+        for key in ("periodic", "amplitude_range", "period_range"):
+            if out[key] is None:
+                del out[key]
+        return out
 
 
 def detect_oscillation(t: Any, x: Any, window: float | None = None, min_amplitude: float = 0.0,
-                       min_cycles: int = 3, sustain: float = 0.8, hysteresis: float = 0.5) -> Oscillation:
+                       min_cycles: int = 3, sustain: float = 0.8, hysteresis: float = 0.5,
+                       whole_cycles: bool = False) -> Oscillation:
     """Is there a sustained oscillation at the end of ``x(t)``?
 
     Parameters
@@ -123,14 +131,21 @@ def detect_oscillation(t: Any, x: Any, window: float | None = None, min_amplitud
     hysteresis : float
         Crossing hysteresis as a fraction of the half-amplitude (0.5: robust to noise;
         :data:`SAMPLED_HYSTERESIS` for a noise-free simulated output).
+    whole_cycles : bool
+        Measure over every whole cycle of the window: the trend line refitted to the cycles' means
+        (a line fitted over a fraction of a cycle tilts the crossings: a 1 % period error with 5
+        cycles), the amplitude half the peak-to-peak range over all of them. Default: the line fitted
+        to all samples, the amplitude over the last two cycles.
 
     Examples
     --------
     >>> t = np.arange(0, 10, 0.001)
-    >>> osc = detect_oscillation(t, 3 * np.sin(2 * np.pi * t))
+    >>> osc = detect_oscillation(t, 3 * np.sin(2 * np.pi * t), whole_cycles=True)
     >>> osc.present, round(osc.amplitude, 3), round(osc.period, 4), osc.periodic
     (True, 3.0, 1.0, True)
-    >>> beat = detect_oscillation(t, (1 + 0.2 * np.sin(0.7 * t)) * np.sin(2 * np.pi * t))
+    >>> round(detect_oscillation(t, 3 * np.sin(2 * np.pi * t)).period, 4)  # the line over 5 cycles tilts it
+    0.988
+    >>> beat = detect_oscillation(t, (1 + 0.2 * np.sin(0.7 * t)) * np.sin(2 * np.pi * t), whole_cycles=True)
     >>> beat.present, beat.periodic, [round(a, 2) for a in beat.amplitude_range]
     (True, False, [0.81, 0.94])
     >>> detect_oscillation(t, np.exp(-0.3 * t) * np.sin(2 * np.pi * t)).reason
@@ -168,7 +183,10 @@ def detect_oscillation(t: Any, x: Any, window: float | None = None, min_amplitud
     if growth < sustain:
         return Oscillation(False, float(half), None, None, None, growth, 0, float(np.mean(xw)),
                            f"decaying: the last third of the window has {growth:.2g} times the RMS of the first")
-    ups = _crossings(tw, xw, r, hysteresis * half) if not diverging else _up_crossings(tw, r, 0.0)
+    if diverging:
+        ups = _up_crossings(tw, r, 0.0)
+    else:
+        ups = _crossings(tw, xw, r, hysteresis * half) if whole_cycles else _up_crossings(tw, r, hysteresis * half)
     cycles = max(ups.size - 1, 0)
     if cycles < min_cycles:
         why = "growing without oscillating" if diverging else f"only {cycles} full cycles"
@@ -185,11 +203,14 @@ def detect_oscillation(t: Any, x: Any, window: float | None = None, min_amplitud
                                                                                    float(periods.max()))}
     scale = REPEAT * float(np.mean(each))
     periodic = bool(np.ptp(periods) <= REPEAT * period and np.ptp(tops) <= scale and np.ptp(bottoms) <= scale
-                    and repetition_error(tw[whole], xw[whole], period) <= REPEAT)
+                    and repeats(tw[whole], xw[whole], period))
     if np.std(periods) > 0.35 * period and not diverging:
         return Oscillation(False, float(half), period, w0, None, growth, cycles, float(np.mean(xw)),
                            "irregular: cycle lengths vary by more than 35 %", periodic=False, **ranges)
-    last = tw >= tw[-1] - min(2 * period, window) if diverging else whole
+    if diverging:
+        last = tw >= tw[-1] - min(2 * period, window)
+    else:
+        last = whole if whole_cycles else (tw >= ups[max(0, ups.size - 3)]) & (tw < ups[-1])
     amplitude = 0.5 * float(xw[last].max() - xw[last].min())
     center = float(np.mean(xw[last]))
     coef = 2.0 * np.mean(r[whole] * np.exp(-1j * w0 * tw[whole]))
@@ -279,10 +300,11 @@ def _up_crossings_jit(t, r, h):
     return out[:count]
 
 
-def repetition_error(t: Any, x: Any, period: float) -> float:
+def repetition_error(t: Any, x: Any, period: float, worst: bool = False) -> float:
     """How far ``x(t)`` is from repeating with ``period``: the RMS of ``x(t) - x(t - period)``
     (``x`` interpolated linearly between samples) over the record less its first period, divided by
-    the RMS of ``x`` about its mean; ``inf`` when the record is shorter than two periods.
+    the RMS of ``x`` about its mean (``worst``: the largest ``|x(t) - x(t - period)|`` divided by the
+    peak-to-peak range of ``x``); ``inf`` when the record is shorter than two periods.
 
     Examples
     --------
@@ -298,5 +320,21 @@ def repetition_error(t: Any, x: Any, period: float) -> float:
         return float("inf")
     later = t >= t[0] + period
     d = x[later] - np.interp(t[later] - period, t, x)
+    if worst:
+        return float(np.max(np.abs(d)) / np.ptp(x)) if np.ptp(x) > 0 else 0.0
     spread = float(np.sqrt(np.mean((x - np.mean(x)) ** 2)))
     return float(np.sqrt(np.mean(d**2)) / spread) if spread > 0 else 0.0
+
+
+def repeats(t: Any, x: Any, period: float) -> bool:
+    """``x(t)`` repeats with ``period``: :func:`repetition_error` at most :data:`REPEAT` (1 % RMS), and
+    no sample farther than 10 REPEAT (10 %) of the peak-to-peak range from its value one period before
+    (the RMS alone lets through a record whose sparse switching instants move from cycle to cycle).
+
+    Examples
+    --------
+    >>> t = np.arange(0, 20, 0.01)
+    >>> repeats(t, np.sin(2 * np.pi * t), 1.0), repeats(t, np.sign(np.sin(2 * np.pi * t * 1.0003)), 1.0)
+    (True, False)
+    """
+    return repetition_error(t, x, period) <= REPEAT and repetition_error(t, x, period, worst=True) <= 10 * REPEAT

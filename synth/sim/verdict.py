@@ -207,7 +207,8 @@ class StepVerdict:
 
 def _oscillation(t: np.ndarray, y: np.ndarray, window: float, min_amplitude: float) -> Oscillation:
     """:func:`~synth.sim.limitcycle.detect_oscillation` with the hysteresis of a noise-free simulated output."""
-    return detect_oscillation(t, y, window=window, min_amplitude=min_amplitude, hysteresis=SAMPLED_HYSTERESIS)
+    return detect_oscillation(t, y, window=window, min_amplitude=min_amplitude, hysteresis=SAMPLED_HYSTERESIS,
+                              whole_cycles=True)
 
 
 def _drift(ta: np.ndarray, ya: np.ndarray) -> float:
@@ -446,7 +447,8 @@ def step_verdict(loop: NonlinearLoop, start: float, end: float, t_step: float = 
     while True:
         tried.append(T)
         result = simulate_step(loop, start, end, T, t_step, disturbances, seed)
-        metrics = nonlinear_step_metrics(result, t_step, min_amplitude=min_amplitude,
+        metrics = nonlinear_step_metrics(result, t_step, min_amplitude=min_amplitude, hysteresis=SAMPLED_HYSTERESIS,
+                                         whole_cycles=True,
                                          window=window if window is not None else (T - t_step) / 4)
         j = judge(result, t_step, (start, end), metrics, min_amplitude, previous, T >= cap * (1 - 1e-12))
         if j.verdict is not None or T >= cap * (1 - 1e-12):
@@ -454,7 +456,8 @@ def step_verdict(loop: NonlinearLoop, start: float, end: float, t_step: float = 
         previous = j
         T = min(2 * T, cap)
     if j.verdict == "limit_cycle" and window is None:  # steady over the last half: measure it there
-        metrics = nonlinear_step_metrics(result, t_step, min_amplitude=min_amplitude, window=(T - t_step) / 2)
+        metrics = nonlinear_step_metrics(result, t_step, min_amplitude=min_amplitude, hysteresis=SAMPLED_HYSTERESIS,
+                                         whole_cycles=True, window=(T - t_step) / 2)
     if j.verdict == "limit_cycle":  # periodic, or not (with its ranges); a complex waveform by autocorrelation
         span = (T - t_step) / 2 if window is None else window
         keep = result.t >= T - span
