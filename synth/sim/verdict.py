@@ -13,9 +13,10 @@ decide, doubles the horizon up to a cap. The rules (:func:`judge`), on the outpu
 * **limit cycle**: a sustained oscillation (:func:`synth.sim.limitcycle.detect_oscillation`, at
   least 3 regular cycles) in each of the last three quarters of the run, at least
   :data:`MIN_CYCLES` whole cycles in the last two, with periods equal within :data:`STEADY` (1 %)
-  and amplitudes equal within 1 %, or varying by less than 20 % without a trend (not monotone over
-  the quarters, and a least-squares drift of the whole cycles' amplitudes of at most 1 % over them:
-  a quantized or sampled cycle whose waveform changes from cycle to cycle); or, when the crossings are irregular
+  and amplitudes (each quarter's mean cycle: a slowly drifting centre does not count) within 1 %,
+  or varying by less than 20 % without a trend (not monotone over the quarters, and a
+  least-squares drift of the whole cycles' amplitudes of at most 1 % over them: a quantized or
+  sampled cycle whose waveform changes from cycle to cycle); or, when the crossings are irregular
   (a waveform crossing its mean more than twice per period), the last two quarters repeat
   themselves (autocorrelation above 0.98) with the same period and amplitude within 1 %, or (a
   sustained irregular oscillation, e.g. quasi-periodic relay or quantizer chatter) the peak-to-peak
@@ -223,13 +224,24 @@ def _drift(ta: np.ndarray, ya: np.ndarray) -> float:
     return float(abs(slope) * (ta[-1] - ta[keep][0]) / float(np.mean(halves)))
 
 
-def _steady(a: Oscillation, b: Oscillation, c: Oscillation, drift: float) -> tuple[str | None, str]:
+def _mean_cycle(t: np.ndarray, y: np.ndarray) -> float:
+    """Mean half peak-to-peak range of the whole cycles of ``y`` (0 without any)."""
+    halves = cycle_table(t, y)[1]
+    return float(np.mean(halves)) if halves.size else 0.0
+
+
+def _steady(a: Oscillation, b: Oscillation, c: Oscillation, drift: float,
+            sizes: tuple[float, float, float]) -> tuple[str | None, str]:
     """(None, how) when the last three quarters ``c``, ``b``, ``a`` show the same cycle: periods within
-    STEADY, and amplitudes within STEADY, or varying (by less than 20 %) without a trend: not monotone
-    over the quarters, and ``drift`` (:func:`_drift`) within STEADY."""
+    STEADY, and amplitudes (``sizes``: each quarter's mean half peak-to-peak of a whole cycle) within
+    STEADY, or varying (by less than 20 %) without a trend: not monotone over the quarters, and
+    ``drift`` (:func:`_drift`) within STEADY."""
     if not (b.present and c.present and a.amplitude and b.amplitude and c.amplitude and a.period and b.period
             and c.period):
         return "the two quarters before the last do not both show a sustained cycle", ""
+    # the size of the cycle itself: the mean of its whole cycles' half peak-to-peak ranges, not the
+    # quarter's range, which a slowly drifting centre (a hunting integrator) keeps changing
+    a, b, c = (dataclasses.replace(o, amplitude=size or o.amplitude) for o, size in zip((a, b, c), sizes, strict=True))
     dp = max(abs(a.period - b.period), abs(b.period - c.period)) / a.period
     if dp > STEADY:
         return f"the period still changes {100 * dp:.2g} % between the last three quarters", ""
@@ -340,7 +352,10 @@ def judge(result: SimResult, t_step: float, step: tuple[float, float], metrics: 
             return Judgement(None, f"only {cycles} cycles in the last half (need {MIN_CYCLES})", cycles)
         cut2 = ta < ta[-1] - span / 2
         c = _oscillation(ta[cut2], ya[cut2], window=span / 4, min_amplitude=min_amplitude)
-        why, how = _steady(a, b, c, _drift(ta, ya))
+        sizes = tuple(_mean_cycle(ta[(ta >= ta[-1] - k * span / 4) & (ta <= ta[-1] - (k - 1) * span / 4)],
+                                  ya[(ta >= ta[-1] - k * span / 4) & (ta <= ta[-1] - (k - 1) * span / 4)])
+                      for k in (1, 2, 3))
+        why, how = _steady(a, b, c, _drift(ta, ya), sizes)  # type: ignore[arg-type]
         if why is not None:
             return Judgement(None, why, cycles)
         return Judgement("limit_cycle", f"{how} ({span / 4:.3g} s each)", cycles)
