@@ -1,6 +1,6 @@
 """Benchmark: synth's step verdicts against an independent reference on random nonlinear loops.
 
-    python benchmarks/sim_verdicts.py --n 100 --seed 15     # the README table
+    python benchmarks/sim_verdicts.py --n 100 --seed 104    # the README table (also 105, 106)
     python benchmarks/sim_verdicts.py --quick               # 12 loops
     python benchmarks/sim_verdicts.py --n 5 --ivp           # the reference's plant by solve_ivp
 
