@@ -25,6 +25,7 @@ not decide (reported separately, never counted as agreement).
 
 from __future__ import annotations
 
+import itertools
 import math
 from dataclasses import dataclass
 from typing import Any
@@ -205,7 +206,11 @@ def classify(t: np.ndarray, y: np.ndarray, step: float, t_step: float = 0.0, fin
     ``h_end/h_before`` within 0.5 % of 1 with at least 3 cycles is a limit cycle; below 0.5 with
     the motion below 1e-4 of the step (or below 1e-7 of the step over the whole window) settled;
     farther than 10 steps from the reference and growing is diverging (on the longest run, or
-    when the ratio is above 1.5); anything else is ambiguous.
+    when the ratio is above 1.5); anything else is ambiguous. When the crossings give no verdict
+    or cycles that do not repeat (lengths within 1 %, maxima and minima within 1 % of the
+    amplitude), a record whose last 30 % repeats exactly (to 1e-6 of its amplitude) after a whole
+    number of samples is a limit cycle (a sampled loop locked onto a pattern of k cycles); its
+    period is the pattern's length over k, k the pattern's length over the mean crossing period.
     """
     scale = max(abs(step), 1e-12)
     if not np.all(np.isfinite(y)) or np.max(np.abs(y)) > 1e6 * scale:
@@ -221,6 +226,27 @@ def classify(t: np.ndarray, y: np.ndarray, step: float, t_step: float = 0.0, fin
     settled = {"verdict": "settled", **_step_times(t, y, t_step, float(np.mean(y[end])))}
     if half <= 1e-7 * scale or h_end <= 1e-9 * scale:
         return settled
+    out = _by_crossings(t, y, yy, tt, half, h_end, h_before, settled, scale, step, final)
+    if out["verdict"] == "limit_cycle" and out["repeats"]:
+        return out
+    lag = _exact_period(yy, half)  # crossings that do not repeat, or no verdict: does the record repeat exactly?
+    if lag is not None:  # the sampled loop locked onto a pattern of a whole number of samples
+        pattern = lag * float(t[1] - t[0])
+        k = max(1, round(pattern / out["period"])) if out.get("period") else 1
+        period = pattern / k if abs(pattern / k - out.get("period", pattern)) <= 0.01 * pattern / k else pattern
+        k = round(pattern / period)
+        return {"verdict": "limit_cycle", "amplitude": half, "period": period, "cycles": int(yy.size * k // lag),
+                "period_range": out.get("period_range", [period, period]), "amplitude_range": [half, half],
+                "repeats": True, "how": f"the last 30 % repeats exactly every {lag} samples ({k} cycles)"}
+    return out
+
+
+def _by_crossings(t: np.ndarray, y: np.ndarray, yy: np.ndarray, tt: np.ndarray, half: float, h_end: float,
+                  h_before: float, settled: dict[str, Any], scale: float, step: float, final: bool) -> dict[str, Any]:
+    """The verdict of :func:`classify` from the ratio of the ranges and the mean crossings."""
+    n = y.size
+    end = slice(int(0.9 * n), n)
+    before = slice(int(0.7 * n), int(0.8 * n))
     r = yy - 0.5 * (yy.max() + yy.min())
     ups = _up_crossings(tt, r, 0.3 * half)
     ratio = h_end / h_before if h_before > 0 else np.inf
@@ -244,7 +270,46 @@ def classify(t: np.ndarray, y: np.ndarray, step: float, t_step: float = 0.0, fin
     period = float(np.mean(np.diff(ups[-k - 1:])))
     if ratio < 0.995:
         return {"verdict": "ambiguous", "why": f"decaying slowly (x{ratio:.4f})", "amplitude": amp, "period": period}
-    return {"verdict": "limit_cycle", "amplitude": amp, "period": period, "cycles": int(ups.size - 1)}
+    return {"verdict": "limit_cycle", "amplitude": amp, "period": period, "cycles": int(ups.size - 1),
+            **_cycle_ranges(tt, yy, ups)}
+
+
+def _cycle_ranges(t: np.ndarray, y: np.ndarray, ups: np.ndarray) -> dict[str, Any]:
+    """Each whole cycle of the window alone: the range of their lengths and of their half
+    peak-to-peak; ``repeats`` when the lengths spread by at most 1 % of their mean and the
+    cycles' maxima, and their minima, by at most 1 % of the mean half peak-to-peak."""
+    lengths = np.diff(ups)
+    hi, lo = [], []
+    for a, b in itertools.pairwise(ups):
+        seg = y[(t >= a) & (t < b)]
+        hi.append(float(seg.max()) if seg.size else np.nan)
+        lo.append(float(seg.min()) if seg.size else np.nan)
+    top, bottom = np.asarray(hi), np.asarray(lo)
+    h = 0.5 * (top - bottom)
+    tol = 0.01 * np.mean(h)
+    repeats = bool(np.ptp(lengths) <= 0.01 * np.mean(lengths) and np.ptp(top) <= tol and np.ptp(bottom) <= tol)
+    return {"period_range": [float(lengths.min()), float(lengths.max())],
+            "amplitude_range": [float(h.min()), float(h.max())], "repeats": repeats}
+
+
+def _exact_period(y: np.ndarray, half: float) -> int | None:
+    """The smallest whole number of samples L (at most a third of the record) with
+    |y[k] - y[k - L]| <= 1e-6 half for every k: candidates from the sum of squared differences
+    (by FFT), the first one checked sample by sample. None when the record never repeats."""
+    r = y - np.mean(y)
+    n = r.size
+    if n < 16:
+        return None
+    f = np.fft.rfft(r, 2 * n)
+    ac = np.fft.irfft(f * np.conj(f))[: n // 3 + 1]
+    sq = np.concatenate([[0.0], np.cumsum(r**2)])
+    lags = np.arange(1, ac.size)
+    ssd = (sq[n] - sq[lags]) + sq[n - lags] - 2 * ac[1:]  # sum over k >= L of (r[k] - r[k-L])^2
+    tol = (1e-6 * half) ** 2
+    for lag in lags[ssd <= max(1e-9 * sq[n], tol * n)][:20]:
+        if np.max(np.abs(r[lag:] - r[:-lag])) <= 1e-6 * half:
+            return int(lag)
+    return None
 
 
 def _step_times(t: np.ndarray, y: np.ndarray, t_step: float, yf: float) -> dict[str, Any]:

@@ -1,6 +1,6 @@
 """Benchmark: synth's step verdicts against an independent reference on random nonlinear loops.
 
-    python benchmarks/sim_verdicts.py --n 100 --seed 15     # the README table
+    python benchmarks/sim_verdicts.py --n 100 --seed 104    # the README table (also 105, 106)
     python benchmarks/sim_verdicts.py --quick               # 12 loops
     python benchmarks/sim_verdicts.py --n 5 --ivp           # the reference's plant by solve_ivp
 
@@ -41,7 +41,9 @@ def run_case(case: dict[str, Any], method: str = "expm") -> dict[str, Any]:
     ref = reference_run(case, method)
     t_ref = time.perf_counter() - t0
     m = v.metrics
-    ours = {"verdict": v.verdict, "amplitude": m.limit_cycle.amplitude, "period": m.limit_cycle.period,
+    lc = m.limit_cycle
+    ours = {"verdict": v.verdict, "amplitude": lc.amplitude, "period": lc.period, "periodic": lc.periodic,
+            "amplitude_range": lc.amplitude_range, "period_range": lc.period_range,
             "rise_time": m.rise_time, "settling_time": m.settling_time, "horizon": v.evidence.horizon,
             "criterion": v.evidence.criterion, "cycles": v.evidence.cycles}
     return {"synth": ours, "reference": ref, "t_synth": t_synth, "t_reference": t_ref, "dt": case["dt"]}
@@ -54,9 +56,14 @@ def compare(row: dict[str, Any]) -> dict[str, Any]:
     out["presence"] = (s["verdict"] == "limit_cycle") == (r["verdict"] == "limit_cycle") and \
         s["verdict"] != "undetermined"
     out["verdict"] = s["verdict"] == r["verdict"]
-    if s["verdict"] == r["verdict"] == "limit_cycle":
+    if s["verdict"] == r["verdict"] == "limit_cycle" and s["periodic"] is not False:
         out["amplitude"] = abs(s["amplitude"] - r["amplitude"]) / r["amplitude"]
         out["period"] = abs(s["period"] - r["period"]) / r["period"]
+    elif s["verdict"] == r["verdict"] == "limit_cycle":  # not periodic: is the reference inside synth's ranges?
+        (a0, a1), (p0, p1) = s["amplitude_range"], s["period_range"]
+        out["in_range"] = bool(0.98 * a0 <= r["amplitude"] <= 1.02 * a1 and 0.98 * p0 <= r["period"] <= 1.02 * p1)
+    if s["verdict"] == r["verdict"] == "limit_cycle" and "repeats" in r:
+        out["periodic_agrees"] = bool(s["periodic"] is not False) == r["repeats"]
     if s["verdict"] == r["verdict"] == "settled":
         if r.get("rise_time") is not None and np.isfinite(s["rise_time"]):
             out["rise"] = abs(s["rise_time"] - r["rise_time"]) / dt
@@ -82,6 +89,8 @@ def _off(c: dict[str, Any], dt: float) -> str:
                            ("settling", 1.0, " samples")):
         if key in c and c[key] > tol:
             parts.append(f"{key} {100 * c[key]:.3g}{unit}" if unit == "%" else f"{key} {c[key]:.3g}{unit}")
+    if c.get("in_range") is False:
+        parts.append("reference outside synth's ranges")
     return ", ".join(parts)
 
 
@@ -93,14 +102,21 @@ def _summary(comps: list[dict[str, Any]]) -> list[tuple[str, str, str]]:
         xs = [c[key] for c in comps if key in c]
         return f"{sum(x <= tol for x in xs)}/{len(xs)}" + (f" (worst {max(xs):.3g})" if xs else "")
 
+    def count(key: str) -> str:
+        xs = [c[key] for c in comps if key in c]
+        return f"{sum(xs)}/{len(xs)}"
+
     presence = [c["presence"] for c in decided]
     return [
         ("limit-cycle presence agrees (reference decided)",
          f"{sum(presence)}/{len(presence)} = {100 * np.mean(presence):.1f} %", ">= 98 %"),
         ("same verdict (settled / limit cycle / diverging)", f"{sum(c['verdict'] for c in decided)}/{len(decided)}",
          ""),
-        ("amplitude within 2 %", frac("amplitude", 0.02), "all"),
-        ("period within 2 %", frac("period", 0.02), "all"),
+        ("periodic cycles (synth): amplitude within 2 %", frac("amplitude", 0.02), "all"),
+        ("periodic cycles (synth): period within 2 %", frac("period", 0.02), "all"),
+        ("cycles not periodic (synth): reference's amplitude and period inside synth's ranges (+-2 %)",
+         count("in_range"), "all"),
+        ("periodic or not: synth agrees with the reference's own per-cycle test", count("periodic_agrees"), ""),
         ("rise time within one sample", frac("rise", 1.0), "all"),
         ("settling time within one sample", frac("settling", 1.0), "all"),
     ]
@@ -120,9 +136,12 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--ivp-check", type=int, metavar="K", default=0,
                     help="only compare the reference's two plant propagators (expm, solve_ivp) on K loops over 20 s")
     ap.add_argument("--json", help="write every row to this file")
+    ap.add_argument("--cases", help="only these loop indices (comma-separated), to look at disagreements")
     args = ap.parse_args(argv)
     n = 12 if args.quick else args.n
     cases = random_cases(n, args.seed)
+    index = list(range(n)) if not args.cases else [int(i) for i in args.cases.split(",")]
+    cases = [cases[i] for i in index]
     if args.ivp_check:
         from benchmarks.sim_reference import simulate_reference
 
@@ -142,7 +161,7 @@ def main(argv: list[str] | None = None) -> int:
         comps.append(c)
         s, r = row["synth"], row["reference"]
         flag = "" if c["verdict"] else "  <-- differs"
-        print(f"{i:3d} {_describe(case):48s} synth {s['verdict']:12s} ref {r['verdict']:12s}"
+        print(f"{index[i]:3d} {_describe(case):48s} synth {s['verdict']:12s} ref {r['verdict']:12s}"
               f" {row['t_synth']:6.2f}s {row['t_reference']:6.2f}s{flag}", flush=True)
     print("\nDisagreements, each checked by a longer run of the reference:\n")
     print("| loop | blocks | synth (horizon) | reference (horizon) | reference, longer run | what differs |")
@@ -161,9 +180,12 @@ def main(argv: list[str] | None = None) -> int:
         extra = (f" {longer['amplitude']:.4g} / {longer['period']:.4g} s" if longer["verdict"] == "limit_cycle"
                  else "")
         ours = (f" {s_['amplitude']:.4g} / {s_['period']:.4g} s" if s_["verdict"] == "limit_cycle" else "")
+        if s_["verdict"] == "limit_cycle" and s_["periodic"] is False:
+            ours += (f" not periodic: {s_['amplitude_range'][0]:.4g}-{s_['amplitude_range'][1]:.4g} / "
+                     f"{s_['period_range'][0]:.4g}-{s_['period_range'][1]:.4g} s")
         theirs = (f" {r_['amplitude']:.4g} / {r_['period']:.4g} s" if r_["verdict"] == "limit_cycle" else "")
         still = _off(again, row["dt"]) or "agree"
-        print(f"| {i} | {_describe(row['case'])} | {s_['verdict']}{ours} ({s_['horizon']:.4g} s) | "
+        print(f"| {index[i]} | {_describe(row['case'])} | {s_['verdict']}{ours} ({s_['horizon']:.4g} s) | "
               f"{r_['verdict']}{theirs} ({r_['horizon']:.4g} s) | {longer['verdict']}{extra} ({longer['horizon']:.4g} s) "
               f"| {off}; after the longer run: {still} |", flush=True)
     ts = np.array([r["t_synth"] for r in rows])

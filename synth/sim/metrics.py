@@ -81,7 +81,8 @@ class NonlinearStepMetrics:
 
 def nonlinear_step_metrics(result: SimResult, t_step: float = 0.0, final_value: float | None = None,
                            settle_band: float = 0.02, min_amplitude: float = 0.0,
-                           window: float | None = None) -> NonlinearStepMetrics:
+                           window: float | None = None, hysteresis: float = 0.5,
+                           whole_cycles: bool = False) -> NonlinearStepMetrics:
     """Step metrics of a simulated run whose reference steps at ``t_step``.
 
     Parameters
@@ -97,6 +98,9 @@ def nonlinear_step_metrics(result: SimResult, t_step: float = 0.0, final_value: 
         Smallest oscillation amplitude that counts as a limit cycle (output units).
     window : float, optional
         Seconds at the end examined for a limit cycle (default: the last half after the step).
+    hysteresis, whole_cycles
+        As in :func:`~synth.sim.limitcycle.detect_oscillation` (:func:`~synth.sim.verdict.step_verdict`
+        passes :data:`~synth.sim.limitcycle.SAMPLED_HYSTERESIS` and True).
 
     Examples
     --------
@@ -122,7 +126,8 @@ def nonlinear_step_metrics(result: SimResult, t_step: float = 0.0, final_value: 
     base: StepMetrics = step_metrics(ta - ta[0], ya, y0=y0, y_final=yf, settle_band=settle_band)
     span = ta[-1] - ta[0]
     osc = detect_oscillation(ta, ya, window=window if window is not None else span / 2,
-                             min_amplitude=min_amplitude)
+                             min_amplitude=min_amplitude, hysteresis=hysteresis,
+                             whole_cycles=whole_cycles)
     settling = None if (osc.present or osc.diverging or not np.isfinite(base.settling_time)) \
         else float(base.settling_time)
     before = float(a[i0 - 1]) if i0 > 0 else result.actuator_rest

@@ -13,16 +13,22 @@ decide, doubles the horizon up to a cap. The rules (:func:`judge`), on the outpu
 * **limit cycle**: a sustained oscillation (:func:`synth.sim.limitcycle.detect_oscillation`, at
   least 3 regular cycles) in each of the last three quarters of the run, at least
   :data:`MIN_CYCLES` whole cycles in the last two, with periods equal within :data:`STEADY` (1 %)
-  and amplitudes equal within 1 %, or varying by less than 20 % without a trend (a quantized or
+  and amplitudes (each quarter's mean cycle: a slowly drifting centre does not count) within 1 %,
+  or varying by less than 20 % without a trend (not monotone over the quarters, and a
+  least-squares drift of the whole cycles' amplitudes of at most 1 % over them: a quantized or
   sampled cycle whose waveform changes from cycle to cycle); or, when the crossings are irregular
   (a waveform crossing its mean more than twice per period), the last two quarters repeat
   themselves (autocorrelation above 0.98) with the same period and amplitude within 1 %, or (a
   sustained irregular oscillation, e.g. quasi-periodic relay or quantizer chatter) the peak-to-peak
-  ranges of the last three quarters are equal within 10 % (amplitude: half that range; period: the
-  mean of the crossings);
+  ranges of the last three quarters are equal within 10 % and above twice ``min_amplitude`` and
+  the numerical floor (amplitude: half that range; period: the mean of the crossings). A limit
+  cycle whose whole cycles do not repeat (lengths within 1 %, maxima and minima within 1 % of the
+  amplitude: :attr:`Oscillation.periodic <synth.sim.limitcycle.Oscillation>`) is reported as
+  oscillating but not periodic, with the range of its cycles' amplitudes and lengths;
 * **settled**: no sustained oscillation in the last quarter, which stays within :data:`SETTLED`
   (0.01 %) of the step (or ``min_amplitude``) of the final value and moves (peak to peak) at most
-  half as much as the quarter before (or less than twice ``min_amplitude``);
+  half as much as the quarter before, its last eighth at most :data:`SHRINK` times the eighth
+  before (or less than twice ``min_amplitude``, or 1e-9 of the step: the numerical floor);
 * otherwise the horizon is doubled; at the cap the verdict is **undetermined** and says what was
   seen (cycles, the rule that failed).
 
@@ -40,13 +46,14 @@ from typing import Any
 import numpy as np
 
 from synth.errors import ModelError
+from synth.sim.cycles import autocorrelation_period, measure_cycle
 from synth.sim.horizon import HorizonPlan, plan_horizon
-from synth.sim.limitcycle import Oscillation, detect_oscillation
+from synth.sim.limitcycle import REPEAT, SAMPLED_HYSTERESIS, Oscillation, cycle_table, detect_oscillation
 from synth.sim.loops import NonlinearLoop
 from synth.sim.metrics import NonlinearStepMetrics, nonlinear_step_metrics
 from synth.sim.results import SimResult
 
-__all__ = ["MAX_SAMPLES", "MIN_CYCLES", "SETTLED", "STEADY", "VERDICTS", "Evidence", "Judgement", "StepVerdict",
+__all__ = ["MAX_SAMPLES", "MIN_CYCLES", "SETTLED", "SHRINK", "STEADY", "VERDICTS", "Evidence", "Judgement", "StepVerdict",
            "default_cap", "judge", "step_verdict"]
 
 VERDICTS = ("settled", "limit_cycle", "diverging", "undetermined")
@@ -57,6 +64,10 @@ STEADY = 0.01
 """Largest relative change of amplitude and period between the last three quarters of a limit cycle."""
 SETTLED = 1e-4
 """Largest distance from the final value over the last quarter of a settled run (fraction of the step)."""
+SHRINK = 0.75
+"""Largest ratio of the motion (peak to peak) over the last eighth of a settled run to that over the eighth
+before: an exponential decay that halves the motion per quarter shrinks it by 0.71 per eighth; a small
+sustained oscillation reached within the last quarter keeps a ratio near 1."""
 MAX_SAMPLES = 1_000_000
 """Most samples of one run under the default cap (:func:`default_cap`)."""
 
@@ -170,6 +181,11 @@ class StepVerdict:
         unit = f" {unit}" if unit else ""
         where = f"horizon {e.horizon:.3g} s, {e.samples} samples of {e.dt * 1000:.3g} ms"
         lc = self.metrics.limit_cycle
+        if self.verdict == "limit_cycle" and lc.periodic is False and lc.amplitude_range and lc.period_range:
+            (a0, a1), (p0, p1) = lc.amplitude_range, lc.period_range
+            return (f"limit cycle, oscillating but not periodic: amplitude {a0:.4g} to {a1:.4g}{unit}, cycles of "
+                    f"{p0:.4g} to {p1:.4g} s (mean {lc.period:.4g} s); the cycles do not repeat within "
+                    f"{100 * REPEAT:g} % ({e.cycles} cycles in the last half; {e.criterion}; {where})")
         if self.verdict == "limit_cycle":
             return (f"limit cycle: amplitude {lc.amplitude:.4g}{unit}, period {lc.period:.4g} s "
                     f"({e.cycles} cycles in the last half; {e.criterion}; {where})")
@@ -190,21 +206,53 @@ class StepVerdict:
         return {"verdict": self.verdict, "evidence": self.evidence.to_dict(), **self.metrics.to_dict()}
 
 
-def _steady(a: Oscillation, b: Oscillation, c: Oscillation) -> tuple[str | None, str]:
+def _oscillation(t: np.ndarray, y: np.ndarray, window: float, min_amplitude: float) -> Oscillation:
+    """:func:`~synth.sim.limitcycle.detect_oscillation` with the hysteresis of a noise-free simulated output."""
+    return detect_oscillation(t, y, window=window, min_amplitude=min_amplitude, hysteresis=SAMPLED_HYSTERESIS,
+                              whole_cycles=True)
+
+
+def _drift(ta: np.ndarray, ya: np.ndarray) -> float:
+    """Relative drift of the cycles' size over the last three quarters of the run: the least-squares
+    line through each whole cycle's half peak-to-peak range against its start time, its change over
+    those quarters divided by the mean (inf with fewer than 3 cycles)."""
+    keep = ta >= ta[-1] - 0.75 * (ta[-1] - ta[0])
+    starts, halves = cycle_table(ta[keep], ya[keep])
+    if halves.size < 3 or float(np.mean(halves)) <= 0:
+        return float("inf")
+    slope = np.polyfit(starts - starts[0], halves, 1)[0]
+    return float(abs(slope) * (ta[-1] - ta[keep][0]) / float(np.mean(halves)))
+
+
+def _mean_cycle(t: np.ndarray, y: np.ndarray) -> float:
+    """Mean half peak-to-peak range of the whole cycles of ``y`` (0 without any)."""
+    halves = cycle_table(t, y)[1]
+    return float(np.mean(halves)) if halves.size else 0.0
+
+
+def _steady(a: Oscillation, b: Oscillation, c: Oscillation, drift: float,
+            sizes: tuple[float, float, float]) -> tuple[str | None, str]:
     """(None, how) when the last three quarters ``c``, ``b``, ``a`` show the same cycle: periods within
-    STEADY, and amplitudes within STEADY or varying without a trend (by less than 20 %)."""
+    STEADY, and amplitudes (``sizes``: each quarter's mean half peak-to-peak of a whole cycle) within
+    STEADY, or varying (by less than 20 %) without a trend: not monotone over the quarters, and
+    ``drift`` (:func:`_drift`) within STEADY."""
     if not (b.present and c.present and a.amplitude and b.amplitude and c.amplitude and a.period and b.period
             and c.period):
         return "the two quarters before the last do not both show a sustained cycle", ""
+    # the size of the cycle itself: the mean of its whole cycles' half peak-to-peak ranges, not the
+    # quarter's range, which a slowly drifting centre (a hunting integrator) keeps changing
+    a, b, c = (dataclasses.replace(o, amplitude=size or o.amplitude) for o, size in zip((a, b, c), sizes, strict=True))
     dp = max(abs(a.period - b.period), abs(b.period - c.period)) / a.period
     if dp > STEADY:
         return f"the period still changes {100 * dp:.2g} % between the last three quarters", ""
     da = max(abs(a.amplitude - b.amplitude), abs(b.amplitude - c.amplitude)) / a.amplitude
     if da <= STEADY:
         return None, f"amplitude and period steady within {100 * STEADY:g} % over the last three quarters"
-    if (a.amplitude - b.amplitude) * (b.amplitude - c.amplitude) < 0 and da < 0.2:
+    if (a.amplitude - b.amplitude) * (b.amplitude - c.amplitude) < 0 and da < 0.2 and drift <= STEADY:
         return None, (f"period steady within {100 * STEADY:g} %; amplitude varies {100 * da:.2g} % between "
-                      "the last three quarters without a trend")
+                      f"the last three quarters without a trend (least-squares drift of the cycles {100 * drift:.2g} %)")
+    if da < 0.2 and drift > STEADY:
+        return f"the amplitude varies {100 * da:.2g} % and drifts {100 * drift:.2g} % over the last three quarters", ""
     return f"the amplitude still changes {100 * da:.2g} % between the last three quarters", ""
 
 
@@ -217,33 +265,9 @@ def _excursion_grows(ta: np.ndarray, ya: np.ndarray, end: float, scale: float) -
     return bool(last.size and second.size and last.max() > 10 * scale and last.max() > 1.3 * second.max())
 
 
-def _periodic(t: np.ndarray, y: np.ndarray, min_amplitude: float) -> tuple[float, float] | None:
-    """(period, half peak-to-peak) when ``y`` repeats itself (normalized autocorrelation of at least
-    0.98 at a lag holding 3 or more repeats in the window); None otherwise. Catches cycles whose
-    waveform crosses its mean more than twice per period."""
-    r = y - np.mean(y)
-    half = 0.5 * float(np.ptp(y))
-    if half <= max(min_amplitude, 1e-9 * (1.0 + abs(float(np.mean(y))))) or r.size < 16:
-        return None
-    n = r.size
-    f = np.fft.rfft(r, 2 * n)
-    ac = np.fft.irfft(f * np.conj(f))[: n // 3]
-    ac = ac / (ac[0] * (1 - np.arange(ac.size) / n))
-    below = np.nonzero(ac < 0.5)[0]
-    if below.size == 0:
-        return None
-    k0 = int(below[0])
-    peak = k0 + int(np.argmax(ac[k0:])) if k0 < ac.size else None
-    if peak is None or peak >= ac.size - 1 or ac[peak] < 0.98:
-        return None
-    a, b, c = ac[peak - 1], ac[peak], ac[peak + 1]
-    shift = 0.5 * (a - c) / (a - 2 * b + c) if (a - 2 * b + c) != 0 else 0.0
-    return float((peak + shift) * (t[1] - t[0])), half
-
-
 def _growing(ta: np.ndarray, ya: np.ndarray, end: float, scale: float, min_amplitude: float) -> tuple[bool, str, int]:
     """(grows, why, cycles): the growth rule of :func:`judge` on one record."""
-    half = detect_oscillation(ta, ya, window=(ta[-1] - ta[0]) / 2, min_amplitude=min_amplitude)
+    half = _oscillation(ta, ya, window=(ta[-1] - ta[0]) / 2, min_amplitude=min_amplitude)
     grows = (half.diverging or _excursion_grows(ta, ya, end, scale)) and _new_record(ta, ya, end)
     why = half.reason if half.diverging else "the distance from the reference grows past 10 steps"
     return grows, why, half.cycles
@@ -306,15 +330,15 @@ def judge(result: SimResult, t_step: float, step: tuple[float, float], metrics: 
     if not a.present and a.reason.startswith("irregular"):
         cut = ta < ta[-1] - span / 4
         last = ~cut & (ta >= ta[-1] - span / 4)
-        pa = _periodic(ta[last], ya[last], min_amplitude)
-        pb = _periodic(ta[cut & (ta >= ta[-1] - span / 2)], ya[cut & (ta >= ta[-1] - span / 2)], min_amplitude)
+        pa = autocorrelation_period(ta[last], ya[last], min_amplitude)
+        pb = autocorrelation_period(ta[cut & (ta >= ta[-1] - span / 2)], ya[cut & (ta >= ta[-1] - span / 2)], min_amplitude)
         if pa and pb and abs(pa[0] - pb[0]) <= STEADY * pa[0] and abs(pa[1] - pb[1]) <= STEADY * pa[1]:
             return Judgement("limit_cycle", f"the last two quarters repeat with period {pa[0]:.4g} s (autocorrelation "
                              "above 0.98; the waveform crosses its mean more than twice per period) and equal "
                              f"amplitudes within {100 * STEADY:g} %", int(span / 2 / pa[0]))
         spans = [float(np.ptp(ya[(ta >= ta[-1] - k * span / 4) & (ta < ta[-1] - (k - 1) * span / 4 + 1e-12)]))
                  for k in (1, 2, 3)]
-        floor = 2 * max(SETTLED * scale, min_amplitude)
+        floor = 2 * max(min_amplitude, 1e-9 * (scale + abs(metrics.final_value)))  # the settled rule's floor
         change = max(abs(spans[0] - spans[1]), abs(spans[1] - spans[2])) / max(spans[0], 1e-300)
         if min(spans) > floor and change <= 0.1 and a.cycles >= 3:
             return Judgement("limit_cycle", f"a sustained irregular oscillation: its peak-to-peak range is equal within "
@@ -322,13 +346,16 @@ def judge(result: SimResult, t_step: float, step: tuple[float, float], metrics: 
                              f"{a.period:.4g} s in the last); its waveform does not repeat exactly", a.cycles)
     if a.present:
         cut = ta < ta[-1] - span / 4
-        b = detect_oscillation(ta[cut], ya[cut], window=span / 4, min_amplitude=min_amplitude)
+        b = _oscillation(ta[cut], ya[cut], window=span / 4, min_amplitude=min_amplitude)
         cycles = a.cycles + b.cycles
         if cycles < MIN_CYCLES:
             return Judgement(None, f"only {cycles} cycles in the last half (need {MIN_CYCLES})", cycles)
         cut2 = ta < ta[-1] - span / 2
-        c = detect_oscillation(ta[cut2], ya[cut2], window=span / 4, min_amplitude=min_amplitude)
-        why, how = _steady(a, b, c)
+        c = _oscillation(ta[cut2], ya[cut2], window=span / 4, min_amplitude=min_amplitude)
+        sizes = tuple(_mean_cycle(ta[(ta >= ta[-1] - k * span / 4) & (ta <= ta[-1] - (k - 1) * span / 4)],
+                                  ya[(ta >= ta[-1] - k * span / 4) & (ta <= ta[-1] - (k - 1) * span / 4)])
+                      for k in (1, 2, 3))
+        why, how = _steady(a, b, c, _drift(ta, ya), sizes)  # type: ignore[arg-type]
         if why is not None:
             return Judgement(None, why, cycles)
         return Judgement("limit_cycle", f"{how} ({span / 4:.3g} s each)", cycles)
@@ -344,8 +371,14 @@ def judge(result: SimResult, t_step: float, step: tuple[float, float], metrics: 
     if late > quiet and late > 0.5 * early:
         return Judgement(None, f"the motion over the last quarter is {late / max(early, 1e-300):.2g} times that "
                          "over the quarter before (settled needs 0.5)", a.cycles)
+    eighth = ta >= ta[-1] - span / 8
+    last8, before8 = float(np.ptp(ya[eighth])), float(np.ptp(ya[quarter & ~eighth]))
+    if last8 > quiet and last8 > SHRINK * before8:
+        return Judgement(None, f"the motion over the last eighth is {last8 / max(before8, 1e-300):.2g} times that "
+                         f"over the eighth before (settled needs {SHRINK:g}: still shrinking, not a sustained "
+                         "small oscillation)", a.cycles)
     return Judgement("settled", f"within {100 * SETTLED:g} % of the step over the last {span / 4:.2g} s, "
-                     "its motion at most half that of the quarter before", a.cycles)
+                     f"its motion at most half that of the quarter before and still shrinking", a.cycles)
 
 
 def default_cap(loop: NonlinearLoop, first: float) -> float:
@@ -429,7 +462,8 @@ def step_verdict(loop: NonlinearLoop, start: float, end: float, t_step: float = 
     while True:
         tried.append(T)
         result = simulate_step(loop, start, end, T, t_step, disturbances, seed)
-        metrics = nonlinear_step_metrics(result, t_step, min_amplitude=min_amplitude,
+        metrics = nonlinear_step_metrics(result, t_step, min_amplitude=min_amplitude, hysteresis=SAMPLED_HYSTERESIS,
+                                         whole_cycles=True,
                                          window=window if window is not None else (T - t_step) / 4)
         j = judge(result, t_step, (start, end), metrics, min_amplitude, previous, T >= cap * (1 - 1e-12))
         if j.verdict is not None or T >= cap * (1 - 1e-12):
@@ -437,20 +471,13 @@ def step_verdict(loop: NonlinearLoop, start: float, end: float, t_step: float = 
         previous = j
         T = min(2 * T, cap)
     if j.verdict == "limit_cycle" and window is None:  # steady over the last half: measure it there
-        metrics = nonlinear_step_metrics(result, t_step, min_amplitude=min_amplitude, window=(T - t_step) / 2)
-    if j.verdict == "limit_cycle" and not metrics.limit_cycle.present:  # a cycle with a complex waveform
-        after = result.t >= T - (T - t_step) / 4
-        period, amplitude = _periodic(result.t[after], result.output[after], min_amplitude) or (None, None)
-        osc = metrics.limit_cycle
-        if period is not None:
-            how = f"periodic: period {period:.4g} s by autocorrelation ({osc.reason})"
-        else:  # irregular: half the peak-to-peak range of the last quarter, the mean period of its crossings
-            last = detect_oscillation(result.t, result.output, window=(T - t_step) / 4, min_amplitude=min_amplitude)
-            amplitude, period = 0.5 * float(np.ptp(result.output[after])), last.period or float("nan")
-            how = f"irregular: half the peak-to-peak range of the last quarter, mean period ({last.reason})"
-        metrics = dataclasses.replace(metrics, settling_time=None, limit_cycle=dataclasses.replace(
-            osc, present=True, amplitude=amplitude, period=period, frequency=2 * np.pi / period,
-            cycles=j.cycles, center=float(np.mean(result.output[after])), reason=how))
+        metrics = nonlinear_step_metrics(result, t_step, min_amplitude=min_amplitude, hysteresis=SAMPLED_HYSTERESIS,
+                                         whole_cycles=True, window=(T - t_step) / 2)
+    if j.verdict == "limit_cycle":  # periodic, or not (with its ranges); a complex waveform by autocorrelation
+        span = (T - t_step) / 2 if window is None else window
+        keep = result.t >= T - span
+        metrics = dataclasses.replace(metrics, settling_time=None, limit_cycle=measure_cycle(
+            result.t[keep], result.output[keep], metrics.limit_cycle, j.cycles, min_amplitude))
     verdict = j.verdict or "undetermined"
     evidence = Evidence(float(result.t[-1]), loop.dt, int(result.t.size), j.cycles, tuple(tried), float(cap),
                         j.criterion, plan)
