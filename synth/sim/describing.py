@@ -288,25 +288,32 @@ def _loop_parts(loop: Any, w: Any) -> np.ndarray:
     num, den = loop.controller.tf()
     tc = loop.controller_period
     Ac, Bc, Cc, Dc = discretize_controller(num, den, tc, loop.discretization)
+    z = np.exp(1j * w * dt)
+    zc = np.exp(1j * w * tc)
+
+    def resolvent(zs: np.ndarray, A: np.ndarray, B: np.ndarray) -> np.ndarray:
+        """``(z I - A)^-1 B`` at every ``z`` (``B`` one column, or one column per ``z``), batched."""
+        M = zs[:, None, None] * np.eye(A.shape[0]) - A
+        rhs = np.broadcast_to(B, (zs.size, A.shape[0])) if B.ndim == 1 else B
+        return np.linalg.solve(M, rhs[..., None])[..., 0]
+
+    shift = z ** (-dz.steps - 1)
+    if n:
+        X = resolvent(z, dz.Ad, dz.B_early[None, :] + dz.B_late[None, :] * z[:, None])
+        P = (X @ core.C[1]) * shift + core.D[1, 0] * shift
+    else:
+        P = core.D[1, 0] * shift
+    C = Dc + (resolvent(zc, Ac, Bc) @ Cc if Ac.size else 0.0)
+    S = np.ones(w.size, complex)
+    for b in sen[ns:]:
+        if isinstance(b, SampleHold):
+            S = S * np.exp(-1j * w * max(0.0, 1.0 / b.rate - dt) / 2)
+        elif isinstance(b, Dynamics):
+            A_, B_, C_, D_ = b.state_space()
+            Ad, Bd = zoh(A_, B_[:, None], dt)
+            S = S * (D_ + (resolvent(z, Ad, Bd[:, 0]) @ C_ if Ad.size else 0.0))
     out = np.empty((3, w.size), complex)
-    for i, om in enumerate(w):
-        z = np.exp(1j * om * dt)
-        zc = np.exp(1j * om * tc)
-        if n:
-            X = np.linalg.solve(z * np.eye(n) - dz.Ad, dz.B_early + dz.B_late * z)
-            P = (core.C[1] @ X) * z ** (-dz.steps - 1) + core.D[1, 0] * z ** (-dz.steps - 1)
-        else:
-            P = core.D[1, 0] * z ** (-dz.steps - 1)
-        C = Dc + (Cc @ np.linalg.solve(zc * np.eye(Ac.shape[0]) - Ac, Bc) if Ac.size else 0.0)
-        S = 1.0 + 0j
-        for b in sen[ns:]:
-            if isinstance(b, SampleHold):
-                S *= np.exp(-1j * om * max(0.0, 1.0 / b.rate - dt) / 2)
-            elif isinstance(b, Dynamics):
-                A_, B_, C_, D_ = b.state_space()
-                Ad, Bd = zoh(A_, B_[:, None], dt)
-                S *= D_ + (C_ @ np.linalg.solve(z * np.eye(Ad.shape[0]) - Ad, Bd[:, 0]) if Ad.size else 0.0)
-        out[:, i] = (C, P, S)
+    out[0], out[1], out[2] = C, P, S
     return out
 
 
