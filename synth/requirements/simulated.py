@@ -13,6 +13,7 @@ entry does not give its own (:func:`bind_simulation`).
 
 from __future__ import annotations
 
+import copy
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
@@ -25,6 +26,9 @@ if TYPE_CHECKING:
     from synth.requirements.base import RequirementResult
 
 __all__ = ["SimulatedStep", "bind_simulation", "confirm_prediction", "confirming_runs", "simulated_step"]
+
+_RUNS: dict[tuple[Any, ...], SimulatedStep] = {}
+"""Confirming runs already simulated in this process, by loop, blocks and added delay (deterministic)."""
 
 
 @dataclass
@@ -172,12 +176,21 @@ def confirming_runs(sim: SimulationSpec | None, loop: Loop, actuator: list[Any],
         dt = float(10.0 ** np.floor(np.log10(0.3 / top)))  # at least 20 samples per period at `frequency`
         sim = SimulationSpec.model_validate({"dt": min(dt, 0.01), "step": [0.0, 1.0]})
     hold = 1.0 / sim.controller_rate if sim.controller_rate else sim.dt
+    cnum, cden = loop.controller.tf()
+    loop_key = (sim.model_dump_json(), loop.plant.num.tobytes(), loop.plant.den.tobytes(), loop.plant.delay,
+                cnum.tobytes(), cden.tobytes(),
+                repr([b.model_dump() if hasattr(b, "model_dump") else b for b in actuator]))
     out = []
     for tau in sorted({float(d) for d in delays}):
-        # the sampled controller's zero-order hold lags by half a period: the run adds that much less delay
-        run = simulated_step(sim, loop, extra_delay=max(tau - hold / 2, 0.0), actuator=actuator, sensor=False)
-        run.evidence["zero_order_hold_compensation"] = min(hold / 2, tau)
-        out.append((tau, run))
+        key = (*loop_key, tau)
+        if key not in _RUNS:  # the same loop is confirmed by the design's check and its certificate
+            # the sampled controller's zero-order hold lags by half a period: the run adds that much less delay
+            run = simulated_step(sim, loop, extra_delay=max(tau - hold / 2, 0.0), actuator=actuator, sensor=False)
+            run.evidence["zero_order_hold_compensation"] = min(hold / 2, tau)
+            if len(_RUNS) >= 256:
+                _RUNS.clear()
+            _RUNS[key] = run
+        out.append((tau, copy.deepcopy(_RUNS[key])))
     return out
 
 
