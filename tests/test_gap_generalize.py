@@ -34,7 +34,6 @@ def seeded_record():
     draw = random_plant(rng, "third_order", 1000)
     t, u = experiment(rng, "steps", draw, 1000)
     u = (u - u.min()) / np.ptp(u) * 1.8  # the effects' parameters above are in these units
-    u = u - u[0]  # at rest at zero: synth's cubic spring starts from the linear steady state
     G = Plant(np.array(draw.plant.num), np.array(draw.plant.den), draw.plant.delay)
     return draw, G, t, u
 
