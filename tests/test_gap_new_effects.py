@@ -13,7 +13,7 @@ G = Plant.from_string("2/(0.2*s+1)")
 
 
 def test_new_effects_are_not_default_candidates_and_say_why():
-    for name in ("direction", "duffing", "measured_sag(V)", "aux_input(V)"):
+    for name in ("direction", "duffing", "amplitude_damping", "measured_sag(V)", "aux_input(V)"):
         eff = make_effect(name)
         assert eff.label not in DEFAULT_CANDIDATES and eff.excluded_because
     assert make_effect("measured_sag(Battery V)").aux_channel == "Battery V"

@@ -89,8 +89,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--candidates", metavar="A,B,...",
                    help="effects to try (default: delay, lag, lag(sensor), resonance, rate_limit, saturation, "
                         "deadzone, backlash, quantization, supply_sag, static_nonlinearity, drift, and with --aux COL "
-                        "measured_sag(COL), aux_input(COL); by name only: direction, duffing, friction, "
-                        "saturation(output))")
+                        "measured_sag(COL), aux_input(COL); by name only: direction, duffing, amplitude_damping, "
+                        "friction, saturation(output))")
     p.add_argument("--seed", type=int, default=0, help="seed of the bootstrap (default 0)")
     p.add_argument("--split", choices=("tail", "interleaved"), default="tail",
                    help="without --validate: hold out the second half (tail, default) or every second of "

@@ -26,6 +26,7 @@ effect                 side      augmented model                                
                                                                                               tau_down, delay_up,
                                                                                               delay_down``
 ``duffing``            input     cubic spring ``-cubic y^3 / G(0)`` in feedback              ``cubic``
+``amplitude_damping``  input     quadratic damping ``-drag y' |y'| / G(0)`` in feedback       ``drag``
 ``measured_sag(V)``    input     ``u + sag (u - u_rest) (V / V_nom - 1)``, ``V`` measured     ``sag``
 ``aux_input(d)``       input     ``u + gain (d - d_0)``, ``d`` measured                       ``gain``
 =====================  ========  ===========================================================  ==============
@@ -37,7 +38,8 @@ Modules: :mod:`~synth.gap.effects.base` (the base class and shared helpers),
 :mod:`~synth.gap.effects.quantization`, :mod:`~synth.gap.effects.friction`,
 :mod:`~synth.gap.effects.supply` (supply sag), :mod:`~synth.gap.effects.static_map` (static
 nonlinearity), :mod:`~synth.gap.effects.drift`, :mod:`~synth.gap.effects.direction` (direction-dependent dynamics),
-:mod:`~synth.gap.effects.amplitude` (cubic spring), :mod:`~synth.gap.effects.auxiliary` (driven by a measured
+:mod:`~synth.gap.effects.amplitude` (cubic spring),
+:mod:`~synth.gap.effects.damping` (amplitude-dependent damping), :mod:`~synth.gap.effects.auxiliary` (driven by a measured
 channel); :mod:`~synth.gap.effects.registry` lists them
 (``EFFECTS``, ``DEFAULT_CANDIDATES``, ``make_effect``). This package re-exports those names.
 """
@@ -46,6 +48,7 @@ from synth.gap.effects.actuator import BacklashEffect, DeadzoneEffect, RateLimit
 from synth.gap.effects.amplitude import DuffingEffect
 from synth.gap.effects.auxiliary import AuxEffect, AuxInputEffect, MeasuredSagEffect
 from synth.gap.effects.base import Effect, Params
+from synth.gap.effects.damping import AmplitudeDampingEffect, drag_feedback
 from synth.gap.effects.direction import DirectionEffect
 from synth.gap.effects.drift import DriftEffect
 from synth.gap.effects.dynamics import ResonanceEffect
@@ -60,6 +63,7 @@ __all__ = [
     "DEFAULT_CANDIDATES",
     "EFFECTS",
     "EFFECT_CLASSES",
+    "AmplitudeDampingEffect",
     "AuxEffect",
     "AuxInputEffect",
     "BacklashEffect",
@@ -81,6 +85,7 @@ __all__ = [
     "SupplySagEffect",
     "aux_candidates",
     "coulomb_force",
+    "drag_feedback",
     "make_effect",
     "quantizer_grid",
 ]

@@ -44,7 +44,7 @@ def cubic_feedback(plant: Plant, u: np.ndarray, dt: float, cubic: float) -> np.n
     plant : Plant
         The linear model (a static gain ``G(0)`` that is finite and nonzero).
     u : numpy.ndarray
-        Command samples (held), the model at rest at the first one's linear steady state.
+        Command samples (held), the model at rest at the first one with the spring (``y + cubic y^3 = G(0) u``).
     dt : float
         Sample time [s].
     cubic : float
@@ -85,8 +85,14 @@ def cubic_feedback(plant: Plant, u: np.ndarray, dt: float, cubic: float) -> np.n
     Ad, Bd = M[:n, :n], M[:n, n]
     k = round(plant.delay / dt)
     ud = np.r_[np.full(k, u[0]), u[:u.size - k]] if k > 0 else u
+    # at rest at the first command with the spring: y0 + cubic y0^3 = k0 u0 (the real root nearest the linear
+    # one), driven by w0 = u0 - cubic y0^3 / k0
+    roots = np.roots([cubic, 0.0, 1.0, -k0 * float(ud[0])])
+    real = roots[np.abs(roots.imag) <= 1e-9 * (1.0 + np.abs(roots.real))].real
+    y_rest = float(min(real, key=lambda r: abs(r - k0 * float(ud[0])))) if real.size else k0 * float(ud[0])
+    w_rest = float(ud[0]) - cubic * y_rest**3 / k0
     try:
-        x = np.linalg.solve(np.eye(n) - Ad, Bd * ud[0])
+        x = np.linalg.solve(np.eye(n) - Ad, Bd * w_rest)
     except np.linalg.LinAlgError:
         x = np.zeros(n)
     c = cubic / k0

@@ -13,6 +13,7 @@ from synth.gap.effects.actuator import BacklashEffect, DeadzoneEffect, RateLimit
 from synth.gap.effects.amplitude import DuffingEffect
 from synth.gap.effects.auxiliary import AuxInputEffect, MeasuredSagEffect
 from synth.gap.effects.base import Effect
+from synth.gap.effects.damping import AmplitudeDampingEffect
 from synth.gap.effects.direction import DirectionEffect
 from synth.gap.effects.drift import DriftEffect
 from synth.gap.effects.dynamics import ResonanceEffect
@@ -27,7 +28,7 @@ __all__ = ["DEFAULT_CANDIDATES", "EFFECTS", "EFFECT_CLASSES", "aux_candidates", 
 EFFECT_CLASSES: tuple[type[Effect], ...] = (
     DelayEffect, LagEffect, ResonanceEffect, RateLimitEffect, SaturationEffect, FrictionEffect, DeadzoneEffect,
     BacklashEffect, QuantizationEffect, SupplySagEffect, StaticNonlinearityEffect, DriftEffect, DirectionEffect,
-    DuffingEffect, MeasuredSagEffect, AuxInputEffect)
+    DuffingEffect, AmplitudeDampingEffect, MeasuredSagEffect, AuxInputEffect)
 """The registered effect classes, in the order of the default candidate list."""
 
 EFFECTS: dict[str, type[Effect]] = {cls.name: cls for cls in EFFECT_CLASSES}
