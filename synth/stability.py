@@ -209,7 +209,7 @@ def closed_loop_stability(num: np.ndarray, den: np.ndarray, delay: float = 0.0) 
     if delay > 0.0 and shared_origin and np.any(num):
         # a pole at s = 0 cancelled by a zero: den(0) + num(0) exp(0) = 0, a closed-loop root at the origin
         return StabilityResult(False, shared_origin, n_rhp, "Nyquist argument principle, exact delay", 0.0)
-    if delay <= 0.0:
+    if delay <= 0.0 or not np.any(num):  # no loop (L = 0): the closed loop keeps the open-loop poles
         char = np.polyadd(den, num)
         if char.size < den.size or char[0] == 0.0:
             raise ModelError("closed loop is improper (1 + L has lost its leading term)")

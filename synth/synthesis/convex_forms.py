@@ -50,6 +50,7 @@ import numpy as np
 from synth.freqgrid import band_grid
 from synth.loop import BANDWIDTH_LEVEL
 from synth.plant import Plant
+from synth.polynomials import dc_value
 from synth.requirements import (
     Bandwidth,
     DelayMargin,
@@ -299,18 +300,19 @@ class HalfPlane(Form):
 
 
 class T0:
-    """``|T(0)|`` per plant at a design (1 with integral action)."""
+    """``|T(0)|`` per plant at a design (1 with integral action; the exact limit where a controller zero at
+    the origin meets a plant integrator)."""
 
     def __init__(self, plants: list[Plant], par: Parametrization) -> None:
-        self.gains = np.array([p.dc_gain() for p in plants])
+        self.plants = plants
         self.par = par
 
     def value(self, rho: np.ndarray, plant_index: np.ndarray) -> np.ndarray:
-        c0 = self.par.dc_ratio(rho)
-        if np.isinf(c0):
-            return np.ones(plant_index.size)
-        l0 = self.gains[plant_index] * c0
-        return np.abs(l0 / (1.0 + l0))
+        cn, cd = self.par.controller(rho).tf()
+        l0 = np.array([dc_value(np.polymul(cn, p.num), np.polymul(cd, p.den)) for p in self.plants])
+        with np.errstate(divide="ignore", invalid="ignore"):
+            t0 = np.where(np.isinf(l0), 1.0, np.abs(l0 / (1.0 + l0)))
+        return t0[plant_index]
 
 
 def sensitivity_form(name: str, pts: Points, n_rho: int, m: float, elastic: bool = True) -> RatioBound:

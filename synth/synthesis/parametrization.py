@@ -308,8 +308,14 @@ class RationalParametrization:
         return np.clip(x, lo, hi)
 
     def random(self, rng: np.random.Generator) -> np.ndarray:
+        """A random controller in the bounds: stable real poles spread over three decades around ``w0``
+        (one at the origin with an integrator), numerator coefficients of random sign over six decades."""
         x = self.start()
-        x[: self.m + 1] = rng.normal(size=self.m + 1) * 10 ** rng.uniform(-3, 1)
+        poles = 10 ** rng.uniform(-1.0, 2.0, self.n)
+        if self.has_integrator():
+            poles[0] = 0.0
+        x[self.m + 1:] = np.poly(-poles)[::-1][: self.n]
+        x[: self.m + 1] = rng.normal(size=self.m + 1) * 10 ** rng.uniform(-3, 3)
         lo, hi = self.box()
         return np.clip(x, lo, hi)
 
