@@ -48,8 +48,8 @@ from synth.synthesis.nlp_forms import NLP_FORMS
 from synth.synthesis.parametrization import parametrize
 from synth.synthesis.scalar import design_scalar
 
-__all__ = ["STRUCTURAL", "STRUCTURAL_REFINEMENTS", "certificate_density", "conflict_set", "convex_runs", "design_convex", "exact_forms",
-           "infeasible_verdict", "objective_terms", "polish_redundant"]
+__all__ = ["STRUCTURAL", "STRUCTURAL_REFINEMENTS", "certificate_density", "conflict_set", "convex_runs",
+           "design_convex", "exact_forms", "infeasible_verdict", "objective_terms", "polish_redundant"]
 
 STRUCTURAL = {"PID": "tf", "leadlag": "p"}
 """The structural parameter of each controller type that the convex stage holds at a few fixed values."""
