@@ -81,3 +81,31 @@ def test_leadlag_feasible_between_the_structural_grid_values() -> None:
     num = list(np.polymul([410.028], [-1 / 242.207, 1.0]))
     e = check_point(num, [1.0, 0.357707, 60.734], 0.0209254, spec, d.controller.parameters)
     assert e.feasible(1e-3), e.to_dict()
+
+
+def test_convex_row_with_an_infinite_bound_is_switched_off() -> None:
+    """Was ``ValueError: Parameter value must be real`` (cvxpy) on PID designs with a bandwidth objective from a
+    start with ``kp = ki = 0`` (seed 1, problem 3): ``T(0) = 0`` makes the floor ``|T| >= l T0`` read
+    ``kappa = inf``; such a row bounds nothing and is now off."""
+    import cvxpy as cp
+
+    from synth.synthesis.convex_forms import RatioBound
+    from synth.synthesis.parametrization import Affine
+
+    aff = Affine(np.array([1.0 + 0j, 1.0 + 0j]), np.array([[1.0 + 0j], [1j]]))
+    form = RatioBound("floor", aff, aff, lambda rho: np.array([np.inf, 2.0]), 1)
+    live = RatioBound("live", aff.rows(np.array([False, True])), aff.rows(np.array([False, True])), 2.0, 1)
+    answers = []
+    for f in (form, live):
+        rho = cp.Variable(1)
+        cons = f.constraints(rho, 0)
+        f.update(np.array([0.5]))
+        prob = cp.Problem(cp.Minimize(cp.sum_squares(rho - 3.0)), cons)
+        prob.solve()
+        assert prob.status == "optimal"
+        answers.append(float(rho.value[0]))
+    assert form.on.value.tolist() == [0.0, 1.0]
+    assert answers[0] == pytest.approx(answers[1], abs=1e-6)  # the row with kappa = inf bounds nothing
+    # the live row: |1 + jx| <= 2 Re{(1 + jx)(1 - 0.5j)}/|1 + 0.5j| = 2 (1 + 0.5 x)/sqrt(1.25)
+    x = answers[1]
+    assert abs(1 + 1j * x) <= 2 * (1 + 0.5 * x) / np.sqrt(1.25) + 1e-6

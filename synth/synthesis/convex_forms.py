@@ -180,6 +180,7 @@ class RatioBound(Form):
         self.name, self.U, self.V, self.elastic = name, U, V, elastic
         self.kappa = kappa
         self.active = active
+        self.switchable = active is not None or callable(kappa)  # rows can be off (inactive, or infinite kappa)
         n = U.q0.size
         # |U| is built from constants; only the right-hand side changes with the design (small DPP tensor):
         #   |U(rho)| <= on * kappa |V_c| (Re{V conj V_c}/|V_c|^2 + s)  =  R rho + c + w s
@@ -205,11 +206,11 @@ class RatioBound(Form):
         if self.elastic and not (isinstance(slack, (int, float)) and slack == 0):
             rhs = rhs + cp.diag(self.w) @ (np.ones(n) * slack)
         if self.constant:
-            lhs = np.abs(self.U.q0) if self.active is None else cp.diag(self.on) @ np.abs(self.U.q0)
+            lhs = np.abs(self.U.q0) if not self.switchable else cp.diag(self.on) @ np.abs(self.U.q0)
             self._cons = [lhs <= rhs]
         else:
             parts = cp.vstack([self.Ure @ rho + self.u0re, self.Uim @ rho + self.u0im])
-            if self.active is not None:
+            if self.switchable:
                 parts = parts @ cp.diag(self.on)
             self._cons = [cp.SOC(rhs, parts, axis=0)]
         return self._cons
@@ -218,11 +219,13 @@ class RatioBound(Form):
         Vc = self.V(rho_c)
         mag = np.maximum(np.abs(Vc), 1e-300)
         on = np.ones(mag.size, bool) if self.active is None else self.active(rho_c)
-        scale = np.where(on, self._kappa(rho_c) / mag, 0.0)  # kappa |V_c| / |V_c|^2
+        kappa = self._kappa(rho_c)
+        on = on & np.isfinite(kappa)  # an infinite kappa bounds nothing (e.g. |T| >= l T0 / 0 where T(0) = 0)
+        scale = np.where(on, kappa / mag, 0.0)  # kappa |V_c| / |V_c|^2
         self.on.value = on.astype(float)
         self.R.value = np.real(np.conj(Vc)[:, None] * self.V.Q) * scale[:, None]
         self.c.value = np.where(on, np.real(np.conj(Vc) * self.V.q0) * scale, 1.0)
-        self.w.value = np.where(on, self._kappa(rho_c) * mag, 1.0)
+        self.w.value = np.where(on, kappa * mag, 1.0)
 
     def price(self) -> float:
         """Dual price in relative units: duals times the slack's weight in each row."""
