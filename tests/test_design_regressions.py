@@ -109,3 +109,28 @@ def test_convex_row_with_an_infinite_bound_is_switched_off() -> None:
     # the live row: |1 + jx| <= 2 Re{(1 + jx)(1 - 0.5j)}/|1 + 0.5j| = 2 (1 + 0.5 x)/sqrt(1.25)
     x = answers[1]
     assert abs(1 + 1j * x) <= 2 * (1 + 0.5 * x) / np.sqrt(1.25) + 1e-6
+
+
+def test_gain_margin_form_keeps_a_crossing_left_of_minus_one_outside_the_circle() -> None:
+    """Seed 0, problem 75 (lead-lag on an unstable plant with a gain margin): the convex margin form asked every
+    point near crossover to stay right of ``-1/g``; a stabilizing loop of an unstable plant crosses the negative
+    real axis left of -1, so the form excluded every stabilizing design. There the lower gain margin
+    ``|L| >= g`` applies."""
+    from synth.synthesis.convex_forms import HalfPlane, Points
+    from synth.synthesis.parametrization import Affine
+
+    def form_at(crossings: list[complex]) -> tuple[HalfPlane, np.ndarray]:
+        n = len(crossings)
+        L = Affine(np.array(crossings, complex), np.ones((n, 1), complex))
+        zero = Affine(np.zeros(n, complex), np.zeros((n, 1), complex))
+        one = Affine(np.ones(n, complex), np.zeros((n, 1), complex))
+        pts = Points(np.arange(1.0, n + 1.0), np.zeros(n, int), L, one, zero)
+        form = HalfPlane("margins", pts, 1, 6.0, None)  # g = 10^(6/20) = 1.995
+        form.update(np.zeros(1))
+        return form, form.H.value @ np.zeros(1) - form.h.value
+
+    form, rows = form_at([-3.0 + 0j, -0.3 + 0j])  # lower crossing at |L| = 3 >= g, upper at 0.3 <= 1/g
+    assert form.violation(np.zeros(1)) <= 0 and np.all(rows >= -1e-12)
+    form, rows = form_at([-1.5 + 0j, -0.3 + 0j])  # |L| = 1.5 < g at the lower crossing: violated by g - 1.5
+    assert form.violation(np.zeros(1)) == pytest.approx(10 ** (6 / 20) - 1.5)
+    assert rows[0] == pytest.approx(1.5 - 10 ** (6 / 20)) and rows[1] >= 0

@@ -261,12 +261,19 @@ class HalfPlane(Form):
     line would not protect the phase margin, the vertical line through the
     phase-margin point is used. Applied where ``0.1 <= |L_c| <= 10``. Linear
     parametrizations only (``D = 1``).
+
+    Where the current loop passes *left* of ``-1`` near the negative real axis (``Re L_c < -1``, phase within
+    45 deg of -180: an open-loop unstable plant, or a conditionally stable loop, whose stability needs that
+    crossing), the lower gain margin applies instead: ``|L| >= g`` there, linearized as
+    ``Re{L conj(L_c)}/|L_c| >= g`` (an inner approximation, exact at ``L_c``); without a gain margin those points
+    are left free. (The half-plane there would exclude every stabilizing design.)
     """
 
     def __init__(self, name: str, points: Points, n_rho: int, gm_db: float | None, pm_deg: float | None) -> None:
         self.name, self.points = name, points
         p2 = np.exp(1j * np.radians(-180.0 + pm_deg)) if pm_deg is not None else None
         p1 = -1.0 / magnitude(gm_db) if gm_db is not None else None
+        self.g_lo = None if gm_db is None else float(magnitude(gm_db))
         if p2 is not None and (p1 is None or -p1 >= -p2.real):
             anchor, normal = p2, 1.0 + 0j  # vertical line Re L >= Re p2
         elif p2 is None:
@@ -286,20 +293,34 @@ class HalfPlane(Form):
         return self._cons
 
     def _mask(self, L: np.ndarray) -> np.ndarray:
-        return (np.abs(L) >= 0.1) & (np.abs(L) <= 10.0)
+        return (np.abs(L) >= 0.1) & (np.abs(L) <= 10.0) & ~self._outer(L)
+
+    @staticmethod
+    def _outer(L: np.ndarray) -> np.ndarray:
+        return (np.real(L) < -1.0) & (np.abs(np.angle(-L)) <= np.pi / 4)
 
     def violation(self, rho):
         L = self.points.N(rho)
-        mask = self._mask(L)
-        if not np.any(mask):
-            return -np.inf
-        return float(np.max(-np.real(np.conj(self.normal) * (L[mask] - self.anchor))))
+        mask, outer = self._mask(L), self._outer(L)
+        worst = -np.inf
+        if np.any(mask):
+            worst = float(np.max(-np.real(np.conj(self.normal) * (L[mask] - self.anchor))))
+        if self.g_lo is not None and np.any(outer):
+            worst = max(worst, float(np.max(self.g_lo - np.abs(L[outer]))))
+        return worst
 
     def update(self, rho_c):
-        mask = self._mask(self.points.N(rho_c)).astype(float)
+        Lc = self.points.N(rho_c)
+        mask = self._mask(Lc).astype(float)
         nbar = np.conj(self.normal)
-        self.H.value = mask[:, None] * np.real(nbar * self.points.N.Q)
-        self.h.value = mask * np.real(nbar * (self.anchor - self.points.N.q0))
+        H = mask[:, None] * np.real(nbar * self.points.N.Q)
+        h = mask * np.real(nbar * (self.anchor - self.points.N.q0))
+        if self.g_lo is not None:
+            outer = self._outer(Lc)
+            u = np.conj(Lc[outer] / np.abs(Lc[outer]))
+            H[outer] = np.real(u[:, None] * self.points.N.Q[outer])
+            h[outer] = self.g_lo - np.real(u * self.points.N.q0[outer])
+        self.H.value, self.h.value = H, h
 
 
 class T0:

@@ -152,11 +152,15 @@ def _margins(b: NLPBuilder, req: MarginsRequirement, plant: Plant, ctx: NLPConte
         if req.delay_margin is not None:
             b.geq((1.0 + L).abs2() - 4 * ca.sin(ca.fmin(v * req.delay_margin, np.pi) / 2) ** 2)
     if req.gain_margin_db is not None:
+        g = magnitude(req.gain_margin_db * (1 + BACKOFF))
         for wp in phase_crossovers(loop):
             v = b.var("wp", float(wp), wp / 3.0, 3.0 * wp)
             _, L = loop_response(ctrl, plant, v)
             b.eq(L.im)
-            b.geq(L.re + 1.0 / magnitude(req.gain_margin_db * (1 + BACKOFF)))
+            if np.real(loop.L(np.array([wp]))[0]) < -1.0:  # a crossing left of -1 (unstable plant): |L| >= g
+                b.geq(-L.re - g)
+            else:
+                b.geq(L.re + 1.0 / g)
 
 
 @nlp_form(DiskMargin, exact=True)
