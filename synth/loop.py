@@ -17,7 +17,7 @@ from synth.controllers import Controller, as_controller
 from synth.freqgrid import characteristic_range, crossings, log_grid
 from synth.plant import Plant, as_plant
 from synth.polynomials import dc_value, format_factored, magnitude_squared_in_w2, trim
-from synth.stability import StabilityResult, closed_loop_stability, gain_margin_factors
+from synth.stability import StabilityResult, closed_loop_stability, gain_margin_factors, stability_floor
 
 __all__ = ["BANDWIDTH_LEVEL", "Loop", "Margins"]
 
@@ -237,7 +237,8 @@ class Loop:
     # ------------------------------------------------------------------ stability
     @cached_property
     def _stability(self) -> StabilityResult:
-        return closed_loop_stability(self.num, self.den, self.delay)
+        return closed_loop_stability(self.num, self.den, self.delay,
+                                     stability_floor(self.plant.num, self.plant.den, self.plant.delay))
 
     def stability(self) -> StabilityResult:
         """Exact closed-loop stability (Nyquist count with the delay)."""

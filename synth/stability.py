@@ -30,6 +30,7 @@ from synth.polynomials import largest_crossing, trim
 
 __all__ = [
     "GAIN_SEARCH_LIMIT",
+    "STABILITY_FLOOR",
     "Rational",
     "StabilityInterval",
     "StabilityResult",
@@ -38,6 +39,7 @@ __all__ = [
     "closed_loop_stability",
     "gain_margin_factors",
     "stability_boundaries",
+    "stability_floor",
 ]
 
 _PHASE_STEP = np.pi / 8.0
@@ -59,6 +61,9 @@ class StabilityResult:
         ``"polynomial roots"`` (no delay) or ``"Nyquist argument principle, exact delay"``.
     marginal_frequency : float or None
         Frequency (rad/s) of a closed-loop root on the imaginary axis, if any.
+    near_axis : float or None
+        Set when the only roots that make the loop not stable lie left of the axis but within this
+        distance of it (``Re s > -near_axis``; see :data:`STABILITY_FLOOR`).
     """
 
     stable: bool
@@ -66,6 +71,7 @@ class StabilityResult:
     open_loop_unstable_poles: int
     method: str
     marginal_frequency: float | None = None
+    near_axis: float | None = None
 
     def to_dict(self) -> dict:
         """JSON-ready dict."""
@@ -81,10 +87,36 @@ class StabilityResult:
         """
         if self.stable:
             return f"closed loop stable ({self.method})"
+        if self.near_axis is not None:
+            return (f"closed loop not stable in practice: {self.unstable_poles} root(s) within {self.near_axis:.3g} "
+                    f"of the imaginary axis (Re s > -{self.near_axis:.3g}; {self.method})")
         if self.marginal_frequency is not None:
             return (f"closed loop marginally stable: a root on the imaginary axis near "
                     f"{self.marginal_frequency:.4g} rad/s ({self.method})")
         return f"closed loop UNSTABLE: {self.unstable_poles} root(s) in the right half-plane ({self.method})"
+
+
+STABILITY_FLOOR = 1e-6
+"""Closed-loop roots with ``Re s > -STABILITY_FLOOR * w_lo`` (``w_lo``: the plant's smallest characteristic
+frequency) count as not stable: a root at ``-1e-12`` (a vanishing gain, a controller zero cancelling an
+integrator) is stable in exact arithmetic but leaves a mode that never settles."""
+
+
+def stability_floor(num: np.ndarray, den: np.ndarray, delay: float = 0.0) -> float:
+    """:data:`STABILITY_FLOOR` times the smallest characteristic frequency of a plant (pole and zero
+    magnitudes, ``1/delay``; 1 rad/s when it has none).
+
+    Examples
+    --------
+    >>> stability_floor(np.array([1.0]), np.array([1.0, 0.5, 0.0]))
+    5e-07
+    """
+    return STABILITY_FLOOR * _characteristic_scale(num, den, delay=delay)[0]
+
+
+def _shifted(p: np.ndarray, f: float) -> np.ndarray:
+    """Coefficients of ``p(s - f)``."""
+    return np.poly1d(np.asarray(p, float))(np.poly1d([1.0, -f])).coeffs
 
 
 def _characteristic_scale(*polys: np.ndarray, delay: float = 0.0) -> tuple[float, float]:
@@ -169,8 +201,11 @@ def _indentation_phase(F: _ReturnDifference, center: float, radius: float) -> fl
     return float(np.sum(np.angle(f[1:] / f[:-1])))
 
 
-def closed_loop_stability(num: np.ndarray, den: np.ndarray, delay: float = 0.0) -> StabilityResult:
+def closed_loop_stability(num: np.ndarray, den: np.ndarray, delay: float = 0.0, floor: float = 0.0) -> StabilityResult:
     """Decide closed-loop stability of unity negative feedback around ``L = num/den * exp(-delay s)``.
+
+    With ``floor > 0`` a loop is stable only if every closed-loop root has ``Re s < -floor`` (the same count
+    on the loop shifted by ``floor``: ``num(s - f) e^{f delay} / den(s - f)``); see :func:`stability_floor`.
 
     Parameters
     ----------
@@ -197,7 +232,23 @@ def closed_loop_stability(num: np.ndarray, den: np.ndarray, delay: float = 0.0) 
     True
     >>> closed_loop_stability(np.array([1.6]), np.array([1.0, 0.0]), delay=1.0).stable
     False
+
+    ``L = 1e-8/s`` has its closed-loop root at ``s = -1e-8``: not stable with a floor of 1e-6:
+
+    >>> closed_loop_stability(np.array([1e-8]), np.array([1.0, 0.0]), floor=1e-6).describe()[:52]
+    'closed loop not stable in practice: 1 root(s) within'
     """
+    exact = _count(num, den, delay)
+    if floor <= 0.0 or not exact.stable:
+        return exact
+    shifted = _count(_shifted(num, floor) * np.exp(floor * delay), _shifted(den, floor), delay)
+    if shifted.stable:
+        return exact
+    return StabilityResult(False, shifted.unstable_poles, exact.open_loop_unstable_poles, exact.method,
+                           None, float(floor))
+
+
+def _count(num: np.ndarray, den: np.ndarray, delay: float) -> StabilityResult:
     num, den = trim(np.asarray(num, float)), trim(np.asarray(den, float))
     if num.size > den.size:
         raise ModelError("loop transfer function is improper")

@@ -52,7 +52,9 @@ def test_no_loop_around_an_integrator_is_not_stable() -> None:
     d = _design(spec)
     kp = d.controller.parameters["kp"]
     assert d.feasible and 0 < kp and kp * 0.02 < np.pi / 2  # k e^{-tau s}/s is stable iff 0 < k tau < pi/2
-    assert check_point([1.0], [1.0, 0.0], 0.02, spec, {"kp": kp}, eps_scale=1e-12).feasible(1e-3)
+    # and its closed-loop root is not a hair from the axis (synth.stability.STABILITY_FLOOR; the reference counts
+    # roots with Re s > -1e-6 x its smallest frequency as unstable)
+    assert check_point([1.0], [1.0, 0.0], 0.02, spec, {"kp": kp}).feasible(1e-3)
 
 
 def test_rational_controller_on_an_easy_unstable_plant_finds_a_stabilizing_start() -> None:
@@ -134,3 +136,30 @@ def test_gain_margin_form_keeps_a_crossing_left_of_minus_one_outside_the_circle(
     form, rows = form_at([-1.5 + 0j, -0.3 + 0j])  # |L| = 1.5 < g at the lower crossing: violated by g - 1.5
     assert form.violation(np.zeros(1)) == pytest.approx(10 ** (6 / 20) - 1.5)
     assert rows[0] == pytest.approx(1.5 - 10 ** (6 / 20)) and rows[1] >= 0
+
+
+def test_peak_control_sensitivity_includes_the_limit_at_infinite_frequency() -> None:
+    """Seed 2026, problem 12: ``|C S| = kp |jw + a| / |jw + a + kp g|`` of P control on ``g/(s + a)`` grows to ``kp``
+    as ``w -> inf``; the grid stopped where ``|L|`` was small but not 0, and the design overshot the bound
+    (kp = 8.641 for ``max_db`` 18.7196, i.e. kp <= 10^(18.7196/20) = 8.6294)."""
+    spec = {"name": "f12", "plant": {"tf": "2.27993/(s+0.385444)"}, "controller": {"type": "P", "bounds": {"kp": [0, 9.68]}},
+            "requirements": [{"type": "peak_control_sensitivity", "max_db": 18.7196}],
+            "objective": {"maximize": "bandwidth"}}
+    d = _design(spec)
+    assert d.controller.parameters["kp"] == pytest.approx(10 ** (18.7196 / 20), rel=1e-5)
+    assert d.controller.parameters["kp"] <= 10 ** (18.7196 / 20)
+
+
+def test_a_vanishing_integral_gain_is_not_a_stable_design() -> None:
+    """Seed 1, problem 6: PI(kp = 0.567, ki = 4.8e-9) left a closed-loop root at about -1e-9 (stable in exact
+    arithmetic, a mode that never settles) and was reported; roots within ``STABILITY_FLOOR`` of the axis now
+    count as not stable."""
+    from synth.stability import STABILITY_FLOOR
+
+    c = synth.Controller("PI", {"kp": 0.567, "ki": 4.8e-9})
+    plant = synth.Plant.from_string("0.0829297*(s+0.127637)*(s+0.783373)/((s+0.0154708)*(s+0.051911)*(s+0.0506101))")
+    char = np.polyadd(np.polymul([1.0, 0.0], plant.den), np.polymul([0.567, 4.8e-9], plant.num))
+    slowest = max(np.roots(char).real)
+    assert -STABILITY_FLOOR * 0.0154708 < slowest < 0  # stable, but within the floor of the axis
+    st = Loop(plant, c).stability()
+    assert not st.stable and st.near_axis == pytest.approx(STABILITY_FLOOR * 0.0154708)

@@ -70,10 +70,13 @@ def _inside(x: float, gain_set: GainSet, unstable: Callable[[float], bool]) -> f
         hi_req = (any(not b.startswith("bounds") for b in iv.hi_binding)
                   and not any(b.startswith("bounds") for b in iv.hi_binding)) or (
                       abs(x - iv.hi) <= step and unstable(iv.hi))
-        if lo_req and abs(x - iv.lo) <= step and iv.hi - iv.lo > 2 * step:
-            return iv.lo + step
-        if hi_req and abs(x - iv.hi) <= step and iv.hi - iv.lo > 2 * step:
-            return iv.hi - step
+        for end, sign, req in ((iv.lo, 1.0, lo_req), (iv.hi, -1.0, hi_req)):
+            if req and abs(x - end) <= step:
+                inner = step
+                while iv.hi - iv.lo > 2 * inner and unstable(end + sign * inner) and inner < 1e-2 * (iv.hi - iv.lo):
+                    inner *= 10.0  # a root within the stability floor of the axis: further in
+                if iv.hi - iv.lo > 2 * inner:
+                    return end + sign * inner
     return x
 
 
