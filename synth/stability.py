@@ -474,8 +474,12 @@ def affine_stability_intervals(
     lo: float,
     hi: float,
     first_only: bool = False,
+    floor: float = 0.0,
 ) -> list[StabilityInterval]:
     """Exact stabilizing set of ``rho`` in ``[lo, hi]`` for the controller ``C0 + rho C1``.
+
+    With ``floor > 0`` every closed-loop root must have ``Re s < -floor`` (the same D-decomposition on the loop
+    shifted by ``floor``, as :func:`closed_loop_stability` does).
 
     Parameters
     ----------
@@ -509,6 +513,10 @@ def affine_stability_intervals(
     """
     if hi < lo:
         raise ModelError(f"range [{lo}, {hi}] is reversed")
+    if floor > 0.0:
+        num, den = _shifted(num, floor) * np.exp(floor * delay), _shifted(den, floor)
+        c0 = None if c0 is None else (_shifted(c0[0], floor), _shifted(c0[1], floor))
+        c1 = (_shifted(c1[0], floor), _shifted(c1[1], floor))
     rho_max = max(abs(lo), abs(hi)) * 1.0001 + 1e-12
     bounds = stability_boundaries(c0, c1, num, den, delay, rho_max)
     cuts = sorted({lo, hi, *[r for r, _ in bounds if lo < r < hi]})
