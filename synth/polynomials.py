@@ -6,7 +6,7 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["dc_value", "format_factored", "largest_crossing", "magnitude_squared_in_w2", "mirror", "trim"]
+__all__ = ["dc_value", "format_factored", "largest_crossing", "magnitude_squared_in_w2", "mirror", "shifted", "trim"]
 
 
 def trim(p: np.ndarray) -> np.ndarray:
@@ -50,6 +50,17 @@ def dc_value(num: np.ndarray, den: np.ndarray) -> Any:
         out = np.where(zd > zn, np.inf, np.where(zn > zd, 0.0, vn / vd))
     out = np.where(np.any(num != 0.0, axis=1), out, 0.0)
     return float(out[0]) if one else out
+
+
+def shifted(p: np.ndarray, f: float) -> np.ndarray:
+    """Coefficients of ``p(s - f)`` (roots moved right by ``f``).
+
+    Examples
+    --------
+    >>> shifted(np.array([1.0, 2.0]), 0.5)  # s + 2 -> s + 1.5
+    array([1. , 1.5])
+    """
+    return np.poly1d(np.asarray(p, float))(np.poly1d([1.0, -f])).coeffs
 
 
 def mirror(p: np.ndarray) -> np.ndarray:

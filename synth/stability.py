@@ -26,7 +26,7 @@ from itertools import pairwise
 import numpy as np
 
 from synth.errors import ModelError
-from synth.polynomials import largest_crossing, trim
+from synth.polynomials import largest_crossing, shifted, trim
 
 __all__ = [
     "GAIN_SEARCH_LIMIT",
@@ -112,11 +112,6 @@ def stability_floor(num: np.ndarray, den: np.ndarray, delay: float = 0.0) -> flo
     5e-07
     """
     return STABILITY_FLOOR * _characteristic_scale(num, den, delay=delay)[0]
-
-
-def _shifted(p: np.ndarray, f: float) -> np.ndarray:
-    """Coefficients of ``p(s - f)``."""
-    return np.poly1d(np.asarray(p, float))(np.poly1d([1.0, -f])).coeffs
 
 
 def _characteristic_scale(*polys: np.ndarray, delay: float = 0.0) -> tuple[float, float]:
@@ -241,10 +236,10 @@ def closed_loop_stability(num: np.ndarray, den: np.ndarray, delay: float = 0.0, 
     exact = _count(num, den, delay)
     if floor <= 0.0 or not exact.stable:
         return exact
-    shifted = _count(_shifted(num, floor) * np.exp(floor * delay), _shifted(den, floor), delay)
-    if shifted.stable:
+    moved = _count(shifted(num, floor) * np.exp(floor * delay), shifted(den, floor), delay)
+    if moved.stable:
         return exact
-    return StabilityResult(False, shifted.unstable_poles, exact.open_loop_unstable_poles, exact.method,
+    return StabilityResult(False, moved.unstable_poles, exact.open_loop_unstable_poles, exact.method,
                            None, float(floor))
 
 
@@ -514,9 +509,9 @@ def affine_stability_intervals(
     if hi < lo:
         raise ModelError(f"range [{lo}, {hi}] is reversed")
     if floor > 0.0:
-        num, den = _shifted(num, floor) * np.exp(floor * delay), _shifted(den, floor)
-        c0 = None if c0 is None else (_shifted(c0[0], floor), _shifted(c0[1], floor))
-        c1 = (_shifted(c1[0], floor), _shifted(c1[1], floor))
+        num, den = shifted(num, floor) * np.exp(floor * delay), shifted(den, floor)
+        c0 = None if c0 is None else (shifted(c0[0], floor), shifted(c0[1], floor))
+        c1 = (shifted(c1[0], floor), shifted(c1[1], floor))
     rho_max = max(abs(lo), abs(hi)) * 1.0001 + 1e-12
     bounds = stability_boundaries(c0, c1, num, den, delay, rho_max)
     cuts = sorted({lo, hi, *[r for r, _ in bounds if lo < r < hi]})
