@@ -163,3 +163,21 @@ def test_a_vanishing_integral_gain_is_not_a_stable_design() -> None:
     assert -STABILITY_FLOOR * 0.0154708 < slowest < 0  # stable, but within the floor of the axis
     st = Loop(plant, c).stability()
     assert not st.stable and st.near_axis == pytest.approx(STABILITY_FLOOR * 0.0154708)
+
+
+def test_leadlag_on_an_unstable_plant_skips_a_pole_value_without_a_stabilizing_start() -> None:
+    """Seed 0, problem 8: with the pole p held at its lowest value no lead-lag in the bounds stabilizes the plant,
+    and that run's "no stabilizing controller" ended the whole design; it now skips that value (the reference's
+    point k = 6.80, z = 2.81, p = 926 meets both requirements)."""
+    num = list(np.polymul([561.472], np.polymul([1, 194.075], [1, 165.039])))
+    den = list(np.polymul(np.polymul([1, -2.19306], [1, 30.6091]),
+                          np.polymul(np.polymul([1, 22.8563], [1, 41.801]), [1, 3.41545])))
+    spec = {"name": "f8", "plant": {"tf": "561.472*(s+194.075)*(s+165.039)/((s-2.19306)*(s+30.6091)*(s+22.8563)*"
+                                          "(s+41.801)*(s+3.41545))"},
+            "controller": {"type": "leadlag", "bounds": {"k": [0.0, 6.80029], "z": [0.95067, 380.268],
+                                                         "p": [0.95067, 950.67]}},
+            "requirements": [{"type": "peak_sensitivity", "max_db": 4.54495},
+                             {"type": "margins", "gain_margin_db": 2.18543, "phase_margin_deg": 28.2321}]}
+    d = _design(spec)
+    assert d.feasible
+    assert check_point(num, den, 0.0, spec, d.controller.parameters).feasible(1e-3)

@@ -157,12 +157,21 @@ def convex_runs(spec: Spec, settings: ConvexSettings) -> list[tuple[ConvexDesign
         if start is not None:
             fixed = start if key is None else start.with_parameters(**{key: v})
             initial = par.rho(fixed)
-        runs.append((designer, designer.run(initial)))
+        try:
+            runs.append((designer, designer.run(initial)))
+        except SynthError as e:  # no stabilizing start at this value of the structural parameter
+            if key is None:
+                raise
+            no_start.append(e)
+            return
         if v is not None:
             tried[float(v)] = runs[-1]
 
+    no_start: list[SynthError] = []
     for v in values:
         run(v)
+    if not runs:
+        raise no_start[0]
     if key is not None and len(values) > 1:
         terms, nominal = objective_terms(spec), spec.nominal_plant()
 
@@ -176,6 +185,8 @@ def convex_runs(spec: Spec, settings: ConvexSettings) -> list[tuple[ConvexDesign
 
         for _ in range(STRUCTURAL_REFINEMENTS):  # bisect the structural parameter around the best run
             grid = sorted(tried)
+            if not grid:
+                break
             i = max(range(len(grid)), key=lambda j: rank(grid[j]))
             for j in (i - 1, i + 1):
                 if 0 <= j < len(grid):
