@@ -13,7 +13,7 @@ from synth.controllers import Controller, as_controller
 from synth.freqgrid import log_grids
 from synth.plant import Plant, as_plant
 from synth.polynomials import dc_value
-from synth.stability import bisect_roots
+from synth.rootfind import bisect_roots
 
 __all__ = ["LoopBatch", "horner"]
 
