@@ -11,8 +11,9 @@ nothing from synth. For a problem of ``benchmarks/design_problems.py``:
 - every requirement from its definition on a log grid of ``DENSE_PER_DECADE`` points per decade (20x the
   80 per decade synth designs on), peaks refined by bounded Brent search, crossings by ``brentq``;
 - the search: for one free parameter a grid of 400 values (linear and logarithmic) then bisection to the
-  boundary and golden refinement around the best; for two, a 32 x 32 grid then Nelder-Mead from the best
-  points; for more, 300 random points then Nelder-Mead from the best eight. Screening uses a coarse grid
+  boundary and golden refinement around the best; for two, a grid of 32 linear and 16 logarithmic positions
+  (six decades) per axis then Nelder-Mead from the best points; for more, 300 random points (a third
+  small-biased, a third log-uniform over six decades) then Nelder-Mead from the best eight. Screening uses a coarse grid
   (``COARSE_PER_DECADE``); every point the reference calls feasible has passed the dense check.
 
 A feasible point found is a proof of feasibility (the point itself); not finding one is only evidence.
@@ -423,12 +424,17 @@ def _reference(num: list[float], den: list[float], delay: float, spec: dict[str,
     else:
         if nfree == 2:
             k = max(12, int(32 * np.sqrt(budget)))
-            g1, g2 = np.meshgrid(np.linspace(0, 1, k), np.linspace(0, 1, k))
+            # linear and logarithmic positions on each axis: a feasible set of tiny gains (a high-gain plant, a
+            # vanishing integral gain) lies below the first linear step
+            axis = np.unique(np.concatenate([np.linspace(0, 1, k), np.logspace(-6, 0, k // 2)]))
+            g1, g2 = np.meshgrid(axis, axis)
             U = np.column_stack([g1.ravel(), g2.ravel()])
-            method = f"grid {k}x{k} + Nelder-Mead"
+            method = f"grid {axis.size}x{axis.size} (linear and log) + Nelder-Mead"
         else:
             U = rng.random((max(60, int(300 * budget)), nfree))
-            U[: len(U) // 3] = U[: len(U) // 3] ** 3  # many points near the lower bound (small gains)
+            third = len(U) // 3
+            U[:third] = U[:third] ** 3  # many points near the lower bound (small gains)
+            U[third: 2 * third] = 10.0 ** (-6.0 * U[third: 2 * third])  # log-uniform over six decades
             method = f"{len(U)} random starts + Nelder-Mead"
         X = lo + (hi - lo) * U
         pen = np.array([srch.penalty(x) for x in X])

@@ -9,7 +9,8 @@ reference's dense check of synth's design. Outcomes:
 - ``false feasible``: synth's design fails the reference's dense check (slack below ``-TOL``); when the
   only failure is a closed-loop pole within the reference's ``eps`` of the imaginary axis that a check with
   ``eps`` a million times smaller calls stable, it is counted apart ("pole within eps of the axis");
-- ``undetermined``: synth found a design that failed its own dense re-check, or hit the time limit;
+- ``undetermined``: synth found a design that failed its own dense re-check, or hit the time limit (CPU
+  time of the process, so that the outcome does not depend on the machine's load);
 - ``declined``: synth answered with one of its one-line errors (e.g. no stabilizing start found);
 - ``error``: synth raised anything else (a crash);
 - ``agree``: both feasible (objective compared) or both infeasible (the reference's failure to find a
@@ -72,9 +73,9 @@ def run_problem(p: Problem, *, time_limit: float = 120.0, budget: float = 1.0) -
     rec: dict[str, Any] = {"index": p.index, "spec": p.spec, "features": p.features,
                            "controller": p.spec["controller"]["type"],
                            "requirements": [r["type"] for r in p.spec["requirements"]]}
-    t0 = time.perf_counter()
-    old = signal.signal(signal.SIGALRM, _alarm)
-    signal.alarm(int(time_limit))
+    t0, c0 = time.perf_counter(), time.process_time()
+    old = signal.signal(signal.SIGPROF, _alarm)
+    signal.setitimer(signal.ITIMER_PROF, time_limit)  # CPU time of this process: the limit does not move with load
     d = None
     try:
         with warnings.catch_warnings():
@@ -88,11 +89,14 @@ def run_problem(p: Problem, *, time_limit: float = 120.0, budget: float = 1.0) -
         rec["synth_status"] = "error"
         rec["synth_error"] = f"{type(e).__name__}: {e}"
     finally:
-        signal.alarm(0)
-        signal.signal(signal.SIGALRM, old)
+        signal.setitimer(signal.ITIMER_PROF, 0)
+        signal.signal(signal.SIGPROF, old)
     rec["synth_seconds"] = time.perf_counter() - t0
+    rec["synth_cpu_seconds"] = time.process_time() - c0
+    c0 = time.process_time()
     r = reference(p.num, p.den, p.delay, p.spec, budget=budget, seed=p.index)
     rec["ref_seconds"] = r.seconds
+    rec["ref_cpu_seconds"] = time.process_time() - c0
     rec["ref_feasible"] = r.feasible
     rec["ref_method"] = r.method
     rec["ref_best"] = None if r.best is None else r.best.to_dict()
@@ -192,6 +196,11 @@ def summarize(records: list[dict[str, Any]]) -> list[tuple[str, str]]:
     rows.append(("gaps left out: the reference's best has |T(0)| < 0.01 (bandwidth ill-posed)", str(n_deg)))
     rows.append(("synth design time, median / p95 [s]", f"{np.median(ts):.2f} / {np.percentile(ts, 95):.2f}"))
     rows.append(("reference time, median / p95 [s]", f"{np.median(tr):.2f} / {np.percentile(tr, 95):.2f}"))
+    cs = np.array([r.get("synth_cpu_seconds", np.nan) for r in records])
+    cr = np.array([r.get("ref_cpu_seconds", np.nan) for r in records])
+    if np.all(np.isfinite(cs)) and np.all(np.isfinite(cr)):
+        rows.append(("synth design CPU time, median / p95 [s]", f"{np.median(cs):.2f} / {np.percentile(cs, 95):.2f}"))
+        rows.append(("reference CPU time, median / p95 [s]", f"{np.median(cr):.2f} / {np.percentile(cr, 95):.2f}"))
     marginal = [r["index"] for r in records if r.get("synth_min_return_difference") is not None
                 and r["synth_min_return_difference"] < 1e-2]
     rows.append(("synth designs with min |1 + L| < 0.01 (at the stability edge)", str(len(marginal))))
@@ -204,7 +213,7 @@ def main() -> None:
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--start", type=int, default=0, help="first problem index")
     ap.add_argument("--json", type=Path, help="write the records as JSON lines (streamed)")
-    ap.add_argument("--time-limit", type=float, default=120.0, help="per synth.design call [s]")
+    ap.add_argument("--time-limit", type=float, default=120.0, help="per synth.design call [CPU s]")
     ap.add_argument("--budget", type=float, default=1.0, help="scales the reference's search")
     ap.add_argument("--quick", action="store_true", help="10 problems")
     ap.add_argument("--summarize", type=Path, nargs="+", help="only re-read (and re-classify) JSON-lines files")

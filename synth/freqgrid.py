@@ -12,7 +12,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-from synth.stability import bisect_roots
+from synth.rootfind import bisect_roots
 
 __all__ = ["DEFAULT_PER_DECADE", "Curve", "band_grid", "band_grids", "batch_first_crossing", "batch_peak",
            "characteristic_range", "crossings", "log_grid", "log_grids", "peak"]

@@ -16,8 +16,8 @@ import numpy as np
 from synth.controllers import Controller, as_controller
 from synth.freqgrid import characteristic_range, crossings, log_grid
 from synth.plant import Plant, as_plant
-from synth.polynomials import format_factored, magnitude_squared_in_w2, trim
-from synth.stability import StabilityResult, closed_loop_stability, gain_margin_factors
+from synth.polynomials import dc_value, format_factored, magnitude_squared_in_w2, trim
+from synth.stability import StabilityResult, closed_loop_stability, gain_margin_factors, stability_floor
 
 __all__ = ["BANDWIDTH_LEVEL", "Loop", "Margins"]
 
@@ -176,7 +176,8 @@ class Loop:
 
     def T0(self) -> float:
         """``|T(0)|``: 1 with integral action, ``L(0)/(1 + L(0))`` otherwise."""
-        l0 = self.controller.dc_gain() * self.plant.dc_gain()
+        cn, cd = self.controller.tf()
+        l0 = dc_value(np.polymul(cn, self.plant.num), np.polymul(cd, self.plant.den))  # exact: s cancels first
         if np.isinf(l0):
             return 1.0
         if 1.0 + l0 == 0.0:  # a closed-loop pole at s = 0: |T(0)| is unbounded
@@ -236,7 +237,8 @@ class Loop:
     # ------------------------------------------------------------------ stability
     @cached_property
     def _stability(self) -> StabilityResult:
-        return closed_loop_stability(self.num, self.den, self.delay)
+        return closed_loop_stability(self.num, self.den, self.delay,
+                                     stability_floor(self.plant.num, self.plant.den, self.plant.delay))
 
     def stability(self) -> StabilityResult:
         """Exact closed-loop stability (Nyquist count with the delay)."""

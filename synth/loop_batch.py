@@ -12,7 +12,8 @@ import numpy as np
 from synth.controllers import Controller, as_controller
 from synth.freqgrid import log_grids
 from synth.plant import Plant, as_plant
-from synth.stability import bisect_roots
+from synth.polynomials import dc_value
+from synth.rootfind import bisect_roots
 
 __all__ = ["LoopBatch", "horner"]
 
@@ -96,6 +97,7 @@ class LoopBatch:
         self.plant = plant
         self.num = _row_product(self.cnum, plant.num)
         self.den = _row_product(self.cden, plant.den)
+        self._l0 = dc_value(self.num, self.den)  # L(0), the exact limit (s cancels first)
         p_lo, p_hi = _corners(plant.num, plant.den)
         if plant.delay > 0:
             p_lo, p_hi = min(p_lo, 1.0 / plant.delay), max(p_hi, 1.0 / plant.delay)
@@ -196,7 +198,7 @@ class LoopBatch:
 
     def T0(self) -> np.ndarray:
         """``|T(0)|`` of every loop (1 with integral action)."""
-        l0 = self._dc * self.plant.dc_gain()
+        l0 = self._l0
         with np.errstate(divide="ignore", invalid="ignore"):
             t0 = np.abs(l0 / (1.0 + l0))
         return np.where(np.isinf(l0), 1.0, t0)
@@ -304,7 +306,7 @@ class LoopBatch:
             r = np.where((r > 1.0 + 1e-12) & (r <= limit), r, np.inf)
             k[todo] = r
             todo = todo[~np.isfinite(r)]
-        l0 = self._dc * self.plant.dc_gain()
+        l0 = self._l0
         with np.errstate(divide="ignore", invalid="ignore"):
             r0 = np.where(np.isfinite(l0) & (l0 < 0), -1.0 / l0, np.inf)
         r0 = np.where((r0 > 1.0 + 1e-12) & (r0 <= limit), r0, np.inf)

@@ -2,9 +2,11 @@
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 
-__all__ = ["format_factored", "largest_crossing", "magnitude_squared_in_w2", "mirror", "trim"]
+__all__ = ["dc_value", "format_factored", "largest_crossing", "magnitude_squared_in_w2", "mirror", "shifted", "trim"]
 
 
 def trim(p: np.ndarray) -> np.ndarray:
@@ -18,6 +20,47 @@ def trim(p: np.ndarray) -> np.ndarray:
     p = np.atleast_1d(np.asarray(p, dtype=float))
     nonzero = np.flatnonzero(p != 0.0)
     return p[nonzero[0]:] if nonzero.size else np.array([0.0])
+
+
+def dc_value(num: np.ndarray, den: np.ndarray) -> Any:
+    """``lim_{s -> 0} num(s)/den(s)``, exactly: common factors ``s`` cancel first, so a zero of one factor
+    of a loop at the origin meets the pole of another (``0 * inf``) as a finite limit, never ``nan``.
+
+    ``inf`` when the denominator keeps more factors ``s`` (a pole at the origin), 0 when the numerator
+    does or is the zero polynomial. 2-D inputs are rows of polynomials (one limit per row).
+
+    Examples
+    --------
+    >>> dc_value(np.polymul([2.0, 0.0], [1.0]), np.polymul([1.0, 0.0], [1.0, 4.0]))  # 2s / (s (s+4))
+    0.5
+    >>> dc_value(np.array([1.0]), np.array([1.0, 0.0])), dc_value(np.array([0.0]), np.array([1.0, 0.0]))
+    (inf, 0.0)
+    >>> dc_value(np.array([[0.0, 3.0], [1.0, 0.0]]), np.array([[1.0, 0.0], [2.0, 0.0]])).tolist()
+    [inf, 0.5]
+    """
+    num, den = np.asarray(num, dtype=float), np.asarray(den, dtype=float)
+    one = num.ndim == 1
+    num, den = np.atleast_2d(num), np.atleast_2d(den)
+    rows = np.arange(num.shape[0])
+    zn = np.argmax(num[:, ::-1] != 0.0, axis=1)  # number of factors s (0 for the zero polynomial)
+    zd = np.argmax(den[:, ::-1] != 0.0, axis=1)
+    vn = num[rows, num.shape[1] - 1 - zn]
+    vd = den[rows, den.shape[1] - 1 - zd]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        out = np.where(zd > zn, np.inf, np.where(zn > zd, 0.0, vn / vd))
+    out = np.where(np.any(num != 0.0, axis=1), out, 0.0)
+    return float(out[0]) if one else out
+
+
+def shifted(p: np.ndarray, f: float) -> np.ndarray:
+    """Coefficients of ``p(s - f)`` (roots moved right by ``f``).
+
+    Examples
+    --------
+    >>> shifted(np.array([1.0, 2.0]), 0.5)  # s + 2 -> s + 1.5
+    array([1. , 1.5])
+    """
+    return np.poly1d(np.asarray(p, float))(np.poly1d([1.0, -f])).coeffs
 
 
 def mirror(p: np.ndarray) -> np.ndarray:

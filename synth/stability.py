@@ -26,18 +26,20 @@ from itertools import pairwise
 import numpy as np
 
 from synth.errors import ModelError
-from synth.polynomials import largest_crossing, trim
+from synth.polynomials import largest_crossing, shifted, trim
+from synth.rootfind import bisect_roots
 
 __all__ = [
     "GAIN_SEARCH_LIMIT",
+    "STABILITY_FLOOR",
     "Rational",
     "StabilityInterval",
     "StabilityResult",
     "affine_stability_intervals",
-    "bisect_roots",
     "closed_loop_stability",
     "gain_margin_factors",
     "stability_boundaries",
+    "stability_floor",
 ]
 
 _PHASE_STEP = np.pi / 8.0
@@ -59,6 +61,9 @@ class StabilityResult:
         ``"polynomial roots"`` (no delay) or ``"Nyquist argument principle, exact delay"``.
     marginal_frequency : float or None
         Frequency (rad/s) of a closed-loop root on the imaginary axis, if any.
+    near_axis : float or None
+        Set when the only roots that make the loop not stable lie left of the axis but within this
+        distance of it (``Re s > -near_axis``; see :data:`STABILITY_FLOOR`).
     """
 
     stable: bool
@@ -66,6 +71,7 @@ class StabilityResult:
     open_loop_unstable_poles: int
     method: str
     marginal_frequency: float | None = None
+    near_axis: float | None = None
 
     def to_dict(self) -> dict:
         """JSON-ready dict."""
@@ -81,10 +87,31 @@ class StabilityResult:
         """
         if self.stable:
             return f"closed loop stable ({self.method})"
+        if self.near_axis is not None:
+            return (f"closed loop not stable in practice: {self.unstable_poles} root(s) within {self.near_axis:.3g} "
+                    f"of the imaginary axis (Re s > -{self.near_axis:.3g}; {self.method})")
         if self.marginal_frequency is not None:
             return (f"closed loop marginally stable: a root on the imaginary axis near "
                     f"{self.marginal_frequency:.4g} rad/s ({self.method})")
         return f"closed loop UNSTABLE: {self.unstable_poles} root(s) in the right half-plane ({self.method})"
+
+
+STABILITY_FLOOR = 1e-6
+"""Closed-loop roots with ``Re s > -STABILITY_FLOOR * w_lo`` (``w_lo``: the plant's smallest characteristic
+frequency) count as not stable: a root at ``-1e-12`` (a vanishing gain, a controller zero cancelling an
+integrator) is stable in exact arithmetic but leaves a mode that never settles."""
+
+
+def stability_floor(num: np.ndarray, den: np.ndarray, delay: float = 0.0) -> float:
+    """:data:`STABILITY_FLOOR` times the smallest characteristic frequency of a plant (pole and zero
+    magnitudes, ``1/delay``; 1 rad/s when it has none).
+
+    Examples
+    --------
+    >>> stability_floor(np.array([1.0]), np.array([1.0, 0.5, 0.0]))
+    5e-07
+    """
+    return STABILITY_FLOOR * _characteristic_scale(num, den, delay=delay)[0]
 
 
 def _characteristic_scale(*polys: np.ndarray, delay: float = 0.0) -> tuple[float, float]:
@@ -169,8 +196,11 @@ def _indentation_phase(F: _ReturnDifference, center: float, radius: float) -> fl
     return float(np.sum(np.angle(f[1:] / f[:-1])))
 
 
-def closed_loop_stability(num: np.ndarray, den: np.ndarray, delay: float = 0.0) -> StabilityResult:
+def closed_loop_stability(num: np.ndarray, den: np.ndarray, delay: float = 0.0, floor: float = 0.0) -> StabilityResult:
     """Decide closed-loop stability of unity negative feedback around ``L = num/den * exp(-delay s)``.
+
+    With ``floor > 0`` a loop is stable only if every closed-loop root has ``Re s < -floor`` (the same count
+    on the loop shifted by ``floor``: ``num(s - f) e^{f delay} / den(s - f)``); see :func:`stability_floor`.
 
     Parameters
     ----------
@@ -197,7 +227,23 @@ def closed_loop_stability(num: np.ndarray, den: np.ndarray, delay: float = 0.0) 
     True
     >>> closed_loop_stability(np.array([1.6]), np.array([1.0, 0.0]), delay=1.0).stable
     False
+
+    ``L = 1e-8/s`` has its closed-loop root at ``s = -1e-8``: not stable with a floor of 1e-6:
+
+    >>> closed_loop_stability(np.array([1e-8]), np.array([1.0, 0.0]), floor=1e-6).describe()[:52]
+    'closed loop not stable in practice: 1 root(s) within'
     """
+    exact = _count(num, den, delay)
+    if floor <= 0.0 or not exact.stable:
+        return exact
+    moved = _count(shifted(num, floor) * np.exp(floor * delay), shifted(den, floor), delay)
+    if moved.stable:
+        return exact
+    return StabilityResult(False, moved.unstable_poles, exact.open_loop_unstable_poles, exact.method,
+                           None, float(floor))
+
+
+def _count(num: np.ndarray, den: np.ndarray, delay: float) -> StabilityResult:
     num, den = trim(np.asarray(num, float)), trim(np.asarray(den, float))
     if num.size > den.size:
         raise ModelError("loop transfer function is improper")
@@ -209,7 +255,7 @@ def closed_loop_stability(num: np.ndarray, den: np.ndarray, delay: float = 0.0) 
     if delay > 0.0 and shared_origin and np.any(num):
         # a pole at s = 0 cancelled by a zero: den(0) + num(0) exp(0) = 0, a closed-loop root at the origin
         return StabilityResult(False, shared_origin, n_rhp, "Nyquist argument principle, exact delay", 0.0)
-    if delay <= 0.0:
+    if delay <= 0.0 or not np.any(num):  # no loop (L = 0): the closed loop keeps the open-loop poles
         char = np.polyadd(den, num)
         if char.size < den.size or char[0] == 0.0:
             raise ModelError("closed loop is improper (1 + L has lost its leading term)")
@@ -361,51 +407,6 @@ def stability_boundaries(
     return sorted(zip(r_cross[keep].tolist(), w_cross[keep].tolist()))
 
 
-def bisect_roots(f, lo: np.ndarray, hi: np.ndarray, iterations: int = 200) -> np.ndarray:
-    """Refine many sign-change brackets ``[lo, hi]`` of a vectorized ``f`` at once, each to a width of
-    ``1e-14 max(1, |hi|)`` (its midpoint is returned).
-
-    Every bracket stays a bracket: each step takes the Illinois (modified regula falsi) point, and every
-    third step the midpoint, so a bracket shrinks at least as fast as one bisection in three and usually
-    superlinearly (about 10 evaluations instead of 50).
-
-    Examples
-    --------
-    >>> float(bisect_roots(lambda x: x**2 - 2.0, np.array([1.0]), np.array([2.0]))[0])
-    1.414213562373095
-    """
-    lo = np.array(lo, dtype=float)
-    hi = np.array(hi, dtype=float)
-    if lo.size == 0:
-        return lo
-    f_lo = np.asarray(f(lo), dtype=float)
-    f_hi = np.asarray(f(hi), dtype=float)
-    side = np.zeros(lo.shape, int)  # which end was kept last time (-1 lo, +1 hi): Illinois halves its value
-    done = (hi - lo <= 1e-14 * np.maximum(1.0, np.abs(hi))) | (f_lo == 0) | (f_hi == 0)
-    for k in range(iterations):
-        if np.all(done):
-            break
-        with np.errstate(divide="ignore", invalid="ignore"):
-            x = (lo * f_hi - hi * f_lo) / (f_hi - f_lo)
-        mid = 0.5 * (lo + hi)
-        bad = ~np.isfinite(x) | (x <= lo) | (x >= hi) | (k % 3 == 2)
-        x = np.where(bad, mid, x)
-        x = np.where(done, lo, x)
-        fx = np.asarray(f(x), dtype=float)
-        left = (np.sign(fx) == np.sign(f_lo)) & ~done  # root in [x, hi]: x replaces lo
-        right = ~left & ~done
-        hit = (fx == 0) & ~done
-        f_hi = np.where(left & (side == 1), 0.5 * f_hi, f_hi)
-        f_lo = np.where(right & (side == -1), 0.5 * f_lo, f_lo)
-        lo, f_lo = np.where(left, x, lo), np.where(left, fx, f_lo)
-        hi, f_hi = np.where(right, x, hi), np.where(right, fx, f_hi)
-        side = np.where(left, 1, np.where(right, -1, side))
-        lo = np.where(hit, x, lo)
-        hi = np.where(hit, x, hi)
-        done |= hit | (hi - lo <= 1e-14 * np.maximum(1.0, np.abs(hi)))
-    return 0.5 * (lo + hi)
-
-
 def _combine(c0: Rational | None, c1: Rational, rho: float) -> Rational:
     a1, b1 = c1
     if c0 is None:
@@ -423,8 +424,12 @@ def affine_stability_intervals(
     lo: float,
     hi: float,
     first_only: bool = False,
+    floor: float = 0.0,
 ) -> list[StabilityInterval]:
     """Exact stabilizing set of ``rho`` in ``[lo, hi]`` for the controller ``C0 + rho C1``.
+
+    With ``floor > 0`` every closed-loop root must have ``Re s < -floor`` (the same D-decomposition on the loop
+    shifted by ``floor``, as :func:`closed_loop_stability` does).
 
     Parameters
     ----------
@@ -458,6 +463,10 @@ def affine_stability_intervals(
     """
     if hi < lo:
         raise ModelError(f"range [{lo}, {hi}] is reversed")
+    if floor > 0.0:
+        num, den = shifted(num, floor) * np.exp(floor * delay), shifted(den, floor)
+        c0 = None if c0 is None else (shifted(c0[0], floor), shifted(c0[1], floor))
+        c1 = (shifted(c1[0], floor), shifted(c1[1], floor))
     rho_max = max(abs(lo), abs(hi)) * 1.0001 + 1e-12
     bounds = stability_boundaries(c0, c1, num, den, delay, rho_max)
     cuts = sorted({lo, hi, *[r for r, _ in bounds if lo < r < hi]})

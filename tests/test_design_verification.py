@@ -1,36 +1,67 @@
 """A seeded sample of the randomized-truth verification of ``synth.design`` (issue 15, item 1).
 
-A sample of small problems (order 1-2 stable plants with delays and integrators, P and PI controllers, bandwidth,
-peak |S|, margins and static-sensitivity requirements) against the independent reference of
-``benchmarks/design_reference.py`` with a cheap search budget: synth must never call a problem infeasible
-when the reference holds a point that passes its dense check, and synth's design must pass that check.
-The full benchmark is ``python benchmarks/design_verification.py`` (benchmarks/README.md). Problems where
-synth is wrong today are marked ``xfail(strict=True)`` with the reason, so that a fix shows up.
+Thirty problems of ``benchmarks/design_problems.py`` (seed 2026; the controller structure of each is fixed
+below) against the independent reference of ``benchmarks/design_reference.py`` with a cheap search budget.
+The sample covers every controller structure (P, PI, PID, lead-lag, rational) and plant kind (unstable
+poles, integrators, right-half-plane zeros, lightly damped pairs, delays). It was chosen by cost only: the
+problems of indices 0-92 whose synth design and reference search took the least CPU time in one run, per
+structure, before the outcome was looked at. Asserted: synth never says "infeasible" where the reference
+holds a point that passes its dense check, synth's design always passes that check, synth never crashes (a
+one-line ``SynthError`` is a refusal, not a crash), and its objective is never more than 5 % worse than the
+reference's best and within 1 % of it in at least 95 % of the feasible problems. The full benchmark is
+``python benchmarks/design_verification.py`` (benchmarks/README.md).
 """
 
 from __future__ import annotations
 
+from functools import cache
+from typing import Any
+
 import pytest
 
 from benchmarks.design_problems import problem
-from benchmarks.design_verification import run_problem
+from benchmarks.design_verification import degenerate_reference, run_problem
 
 SEED = 2026
-N = 10  # the suite's budget (issue 18: 8 min on 2 cores); `python benchmarks/design_verification.py` runs hundreds
-KNOWN_SYNTH_BUGS = {
-    16: "synth designs P(kp=0) on 15.36/s (a closed-loop pole at s = 0) and calls the loop stable",
-}
+SAMPLE = [
+    (6, "P"), (10, "P"), (12, "P"), (16, "P"), (18, "P"), (22, "P"), (24, "P"), (28, "P"), (30, "P"), (34, "P"),
+    (36, "P"), (40, "P"), (42, "P"), (46, "P"), (48, "P"),
+    (17, "PI"), (19, "PI"), (31, "PI"), (43, "PI"), (47, "PI"),
+    (14, "PID"), (90, "PID"),
+    (3, "leadlag"), (82, "leadlag"), (85, "leadlag"), (91, "leadlag"),
+    (80, "rational"), (86, "rational"), (89, "rational"), (92, "rational"),
+]
+WRONG = ("false infeasible", "false feasible", "false feasible (pole within eps of the axis)", "error")
 
 
-@pytest.mark.parametrize("index", [
-    pytest.param(i, marks=pytest.mark.xfail(reason=KNOWN_SYNTH_BUGS[i], strict=True)) if i in KNOWN_SYNTH_BUGS else i
-    for i in range(N)
-])
-def test_design_agrees_with_reference(index: int) -> None:
-    p = problem(SEED, index, controllers=("PI",) if index % 3 == 2 else ("P",), simple=True)
-    rec = run_problem(p, time_limit=120.0, budget=0.3)
-    detail = (f"problem {index}: {p.spec} -> synth {rec['synth_status']} {rec.get('synth_params')}, "
-              f"reference {rec['ref_best']}")
-    assert rec["outcome"] != "false feasible", detail
-    assert rec["outcome"] != "false infeasible", detail
-    assert rec["outcome"] != "error", detail
+@cache
+def _record(index: int, kind: str) -> dict[str, Any]:
+    return run_problem(problem(SEED, index, controllers=(kind,)), time_limit=120.0, budget=0.3)
+
+
+@pytest.mark.parametrize(("index", "kind"), SAMPLE, ids=[f"{i}-{k}" for i, k in SAMPLE])
+def test_design_agrees_with_reference(index: int, kind: str) -> None:
+    rec = _record(index, kind)
+    detail = (f"problem {index}: {rec['spec']} -> synth {rec['synth_status']} {rec.get('synth_params')} "
+              f"{rec.get('synth_error', '')}, reference {rec['ref_best']}")
+    assert rec["outcome"] not in WRONG, detail
+    if "objective_gap" in rec and not degenerate_reference(rec):
+        assert rec["objective_gap"] <= 0.05, detail
+
+
+@pytest.mark.xfail(strict=True, reason="problem 14 (PID, maximize bandwidth): synth's design, a local optimum of the "
+                   "convex-concave stage, is 3.2 % below the reference's best (kp=0.0993, ki=1.025, kd=0.695); with "
+                   "10 feasible problems one miss is below 95 %")
+def test_objective_within_one_percent_in_95_percent_of_the_sample() -> None:
+    gaps = [rec["objective_gap"] for rec in (_record(i, k) for i, k in SAMPLE)
+            if "objective_gap" in rec and rec["outcome"] == "agree feasible" and not degenerate_reference(rec)]
+    assert len(gaps) >= 5
+    assert sum(g <= 0.01 for g in gaps) >= 0.95 * len(gaps), [(i, k, round(r.get("objective_gap", 0), 4)) for i, k in SAMPLE
+                                                             for r in [_record(i, k)]]
+
+
+def test_sample_covers_every_structure_and_plant_kind() -> None:
+    kinds = {k for _, k in SAMPLE}
+    features = {f.split("(")[0] for i, k in SAMPLE for f in problem(SEED, i, controllers=(k,)).features}
+    assert kinds == {"P", "PI", "PID", "leadlag", "rational"} and len(SAMPLE) >= 30
+    assert features == {"unstable", "integrator", "rhp_zero", "light", "delay"}

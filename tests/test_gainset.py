@@ -63,8 +63,10 @@ requirements:
   - {{type: bandwidth, min: 10}}
 """)
     gs = feasible_gain_set(list(spec.requirements), spec.plants(), ScalarFamily("P", "kp", {}), (0, 20))
-    assert gs.intervals[-1].hi == pytest.approx(critical_gains(Plant.from_string(X4_PLANT), [0.02])[0]
-                                                ["critical_gain"], rel=1e-9)
+    # the end is where the closed-loop root crossing at 84 rad/s is STABILITY_FLOOR x 0.43 rad/s (4.3e-7) left
+    # of the axis: just inside the exact D-decomposition gain
+    crit = critical_gains(Plant.from_string(X4_PLANT), [0.02])[0]["critical_gain"]
+    assert crit * (1 - 1e-7) <= gs.intervals[-1].hi <= crit
     assert "stability" in gs.intervals[-1].hi_binding
 
 

@@ -17,6 +17,7 @@ from synth.loop import Loop
 from synth.plant import Plant
 from synth.requirements import Bandwidth, MarginsRequirement
 from synth.spec import parse_spec
+from synth.stability import STABILITY_FLOOR
 
 PLANT = "10/((s-1)*(s+5))"  # one open-loop pole at +1; P control stabilizes for K > 0.5 (char. s^2 + 4s + 10K - 5)
 
@@ -91,7 +92,10 @@ def test_design_over_an_unstable_plant_states_the_stabilizing_set():
     assert "margins needs" not in result.verdict
     assert "stable only for kp in (0.5, 17]" in result.verdict
     stab = result.gain_set.per_requirement["stability"]
-    assert stab[0][0] == pytest.approx(0.5, rel=1e-9)  # independent: 10K - 5 > 0
+    # independent: s^2 + 4s + 10K - 5 has its slow root -2 + sqrt(9 - 10K) left of -f (the stability floor,
+    # STABILITY_FLOOR x the plant's smallest corner, 1 rad/s) iff 10K - 5 > 4 - (2 - f)^2
+    f = STABILITY_FLOOR * 1.0
+    assert stab[0][0] == pytest.approx((9 - (2 - f) ** 2) / 10, rel=1e-9)
     assert result.compromise is not None and result.compromise.controller.parameters["kp"] > 0.5
     # the compromise is stable (independent roots)
     assert np.all(_poles(result.compromise.controller.parameters["kp"]).real < 0)

@@ -26,7 +26,7 @@ if TYPE_CHECKING:
     from synth.loop import Loop
     from synth.loop_batch import LoopBatch
 
-__all__ = ["MAX_DB", "PeakComplementary", "PeakRequirement", "PeakSensitivity", "Sensitivity", "StaticSensitivity",
+__all__ = ["FAR", "MAX_DB", "PeakComplementary", "PeakRequirement", "PeakSensitivity", "Sensitivity", "StaticSensitivity",
            "band_text"]
 
 MAX_DB = {"max_db": Bound("upper", "dB")}
@@ -150,6 +150,12 @@ class StaticSensitivity(Requirement):
         return (self.max_db - value_db) * NEPER_PER_DB
 
 
+FAR = 1e6
+"""An unbanded peak also looks at ``FAR`` times the top of the loop's frequency range: the supremum over all
+frequencies can be the limit ``w -> inf`` (``|C S| -> |C(inf)|`` for a biproper controller), which a grid that
+ends where ``|L|`` is small but not 0 misses by ``|1 + L|``."""
+
+
 class PeakRequirement(Requirement):
     """Peak of a closed-loop magnitude over a band (default: all frequencies): the base of the peak types.
 
@@ -191,6 +197,7 @@ class PeakRequirement(Requirement):
         else:
             ranges = batch.frequency_ranges
             grid = log_grids(ranges[:, 0], ranges[:, 1] * 10, per_decade)
+            grid = np.column_stack([grid, ranges[:, 1] * FAR])  # the limit w -> inf (|KS| -> |C(inf)|)
         value, _ = batch_peak(curve, grid)
         return (self.max_db - db_values(value)) * NEPER_PER_DB
 
@@ -201,7 +208,7 @@ class PeakRequirement(Requirement):
             where = band_text(self.band)
         else:
             lo, hi = loop.frequency_range
-            grid = log_grid(lo, hi * 10, per_decade)
+            grid = np.append(log_grid(lo, hi * 10, per_decade), hi * FAR)  # the limit w -> inf (|KS| -> |C(inf)|)
             where = "over all frequencies"
         value, w_peak = peak(self.curve(loop), grid)
         value_db = db(value)

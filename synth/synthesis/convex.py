@@ -34,7 +34,7 @@ from synth.check import evaluate_all
 from synth.errors import SynthError
 from synth.plant import Plant
 from synth.requirements.base import Requirement, magnitude
-from synth.stability import closed_loop_stability
+from synth.stability import closed_loop_stability, stability_floor
 from synth.synthesis.convex_forms import (
     T0,
     Form,
@@ -219,7 +219,8 @@ class ConvexDesigner:
         c = self.par.controller(rho)
         cn, cd = c.tf()
         for p in self.plants:
-            if not closed_loop_stability(np.polymul(cn, p.num), np.polymul(cd, p.den), p.delay).stable:
+            if not closed_loop_stability(np.polymul(cn, p.num), np.polymul(cd, p.den), p.delay,
+                                         stability_floor(p.num, p.den, p.delay)).stable:
                 return False
         return True
 

@@ -50,6 +50,7 @@ import numpy as np
 from synth.freqgrid import band_grid
 from synth.loop import BANDWIDTH_LEVEL
 from synth.plant import Plant
+from synth.polynomials import dc_value
 from synth.requirements import (
     Bandwidth,
     DelayMargin,
@@ -180,6 +181,7 @@ class RatioBound(Form):
         self.name, self.U, self.V, self.elastic = name, U, V, elastic
         self.kappa = kappa
         self.active = active
+        self.switchable = active is not None or callable(kappa)  # rows can be off (inactive, or infinite kappa)
         n = U.q0.size
         # |U| is built from constants; only the right-hand side changes with the design (small DPP tensor):
         #   |U(rho)| <= on * kappa |V_c| (Re{V conj V_c}/|V_c|^2 + s)  =  R rho + c + w s
@@ -205,11 +207,11 @@ class RatioBound(Form):
         if self.elastic and not (isinstance(slack, (int, float)) and slack == 0):
             rhs = rhs + cp.diag(self.w) @ (np.ones(n) * slack)
         if self.constant:
-            lhs = np.abs(self.U.q0) if self.active is None else cp.diag(self.on) @ np.abs(self.U.q0)
+            lhs = np.abs(self.U.q0) if not self.switchable else cp.diag(self.on) @ np.abs(self.U.q0)
             self._cons = [lhs <= rhs]
         else:
             parts = cp.vstack([self.Ure @ rho + self.u0re, self.Uim @ rho + self.u0im])
-            if self.active is not None:
+            if self.switchable:
                 parts = parts @ cp.diag(self.on)
             self._cons = [cp.SOC(rhs, parts, axis=0)]
         return self._cons
@@ -218,11 +220,13 @@ class RatioBound(Form):
         Vc = self.V(rho_c)
         mag = np.maximum(np.abs(Vc), 1e-300)
         on = np.ones(mag.size, bool) if self.active is None else self.active(rho_c)
-        scale = np.where(on, self._kappa(rho_c) / mag, 0.0)  # kappa |V_c| / |V_c|^2
+        kappa = self._kappa(rho_c)
+        on = on & np.isfinite(kappa)  # an infinite kappa bounds nothing (e.g. |T| >= l T0 / 0 where T(0) = 0)
+        scale = np.where(on, kappa / mag, 0.0)  # kappa |V_c| / |V_c|^2
         self.on.value = on.astype(float)
         self.R.value = np.real(np.conj(Vc)[:, None] * self.V.Q) * scale[:, None]
         self.c.value = np.where(on, np.real(np.conj(Vc) * self.V.q0) * scale, 1.0)
-        self.w.value = np.where(on, self._kappa(rho_c) * mag, 1.0)
+        self.w.value = np.where(on, kappa * mag, 1.0)
 
     def price(self) -> float:
         """Dual price in relative units: duals times the slack's weight in each row."""
@@ -342,18 +346,19 @@ class HalfPlane(Form):
 
 
 class T0:
-    """``|T(0)|`` per plant at a design (1 with integral action)."""
+    """``|T(0)|`` per plant at a design (1 with integral action; the exact limit where a controller zero at
+    the origin meets a plant integrator)."""
 
     def __init__(self, plants: list[Plant], par: Parametrization) -> None:
-        self.gains = np.array([p.dc_gain() for p in plants])
+        self.plants = plants
         self.par = par
 
     def value(self, rho: np.ndarray, plant_index: np.ndarray) -> np.ndarray:
-        c0 = self.par.dc_ratio(rho)
-        if np.isinf(c0):
-            return np.ones(plant_index.size)
-        l0 = self.gains[plant_index] * c0
-        return np.abs(l0 / (1.0 + l0))
+        cn, cd = self.par.controller(rho).tf()
+        l0 = np.array([dc_value(np.polymul(cn, p.num), np.polymul(cd, p.den)) for p in self.plants])
+        with np.errstate(divide="ignore", invalid="ignore"):
+            t0 = np.where(np.isinf(l0), 1.0, np.abs(l0 / (1.0 + l0)))
+        return t0[plant_index]
 
 
 def sensitivity_form(name: str, pts: Points, n_rho: int, m: float, elastic: bool = True) -> RatioBound:

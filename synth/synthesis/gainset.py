@@ -26,7 +26,7 @@ from synth.loop import Loop
 from synth.loop_batch import LoopBatch
 from synth.plant import Plant
 from synth.requirements.base import Requirement, unique_names
-from synth.stability import affine_stability_intervals
+from synth.stability import affine_stability_intervals, stability_floor
 
 __all__ = [
     "EXACT_BAND",
@@ -186,7 +186,7 @@ def stability_set(family: ScalarFamily, plants: list[Plant], lo: float, hi: floa
             c0, c1 = parts
             c0 = None if not np.any(c0[0]) else c0
             ivs = [(iv.lo, iv.hi) for iv in affine_stability_intervals(
-                c0, c1, plant.num, plant.den, plant.delay, lo, hi)]
+                c0, c1, plant.num, plant.den, plant.delay, lo, hi, floor=stability_floor(plant.num, plant.den, plant.delay))]
         else:
             ivs = _boolean_set(lambda v, p=plant: Loop(p, family.controller(v)).stability().stable, lo, hi)
         total = ivs if total is None else _intersect(total, ivs)

@@ -48,11 +48,15 @@ from synth.synthesis.nlp_forms import NLP_FORMS
 from synth.synthesis.parametrization import parametrize
 from synth.synthesis.scalar import design_scalar
 
-__all__ = ["STRUCTURAL", "certificate_density", "conflict_set", "convex_runs", "design_convex", "exact_forms",
-           "infeasible_verdict", "objective_terms", "polish_redundant"]
+__all__ = ["STRUCTURAL", "STRUCTURAL_REFINEMENTS", "certificate_density", "conflict_set", "convex_runs",
+           "design_convex", "exact_forms", "infeasible_verdict", "objective_terms", "polish_redundant"]
 
 STRUCTURAL = {"PID": "tf", "leadlag": "p"}
 """The structural parameter of each controller type that the convex stage holds at a few fixed values."""
+
+STRUCTURAL_REFINEMENTS = 2
+"""Times the structural grid (three values over the bounds) is bisected around its best run: a feasible set
+or an optimum between two of the three values (a lead-lag pole over three decades) is not missed."""
 
 
 def design_convex(spec: Spec, settings: ConvexSettings | None = None, nlp: bool | str = True) -> DesignResult:
@@ -143,7 +147,9 @@ def convex_runs(spec: Spec, settings: ConvexSettings) -> list[tuple[ConvexDesign
     runs = []
     w0 = _reference_frequency(spec)
     start = spec.controller.initial_controller()
-    for v in values:
+    tried: dict[float, tuple[ConvexDesigner, ConvexResult]] = {}
+
+    def run(v: float | None) -> None:
         b = dict(bounds) if key is None else {**bounds, key: (v, v)}
         par = parametrize(ctype, b, spec.controller.order, w0)
         designer = ConvexDesigner(requirements, names, spec.plants(), par, (name, sense), settings)
@@ -151,7 +157,41 @@ def convex_runs(spec: Spec, settings: ConvexSettings) -> list[tuple[ConvexDesign
         if start is not None:
             fixed = start if key is None else start.with_parameters(**{key: v})
             initial = par.rho(fixed)
-        runs.append((designer, designer.run(initial)))
+        try:
+            runs.append((designer, designer.run(initial)))
+        except SynthError as e:  # no stabilizing start at this value of the structural parameter
+            if key is None:
+                raise
+            no_start.append(e)
+            return
+        if v is not None:
+            tried[float(v)] = runs[-1]
+
+    no_start: list[SynthError] = []
+    for v in values:
+        run(v)
+    if not runs:
+        raise no_start[0]
+    if key is not None and len(values) > 1:
+        terms, nominal = objective_terms(spec), spec.nominal_plant()
+
+        def rank(v: float) -> tuple[float, float]:
+            """Feasible runs by objective, the others by their exact total violation (the elastic total of a
+            run that stalled, every step towards the linearized answer destabilizing, is not a measure)."""
+            res = tried[v][1]
+            if res.status == "optimal":
+                return (1.0, float(score(Loop(nominal, res.controller), terms)))
+            return (0.0, sum(min(r.slack, 0.0) for r in check(spec, res.controller).requirements))
+
+        for _ in range(STRUCTURAL_REFINEMENTS):  # bisect the structural parameter around the best run
+            grid = sorted(tried)
+            if not grid:
+                break
+            i = max(range(len(grid)), key=lambda j: rank(grid[j]))
+            for j in (i - 1, i + 1):
+                if 0 <= j < len(grid):
+                    a, b = sorted((grid[i], grid[j]))
+                    run(float(np.sqrt(a * b)) if a > 0 else 0.5 * (a + b))
     return runs
 
 

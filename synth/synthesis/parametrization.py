@@ -209,11 +209,15 @@ class LinearParametrization:
         return x
 
     def random(self, rng: np.random.Generator) -> np.ndarray:
-        """A random point in the bounds, spread towards small values."""
+        """A random point in the bounds: by turns spread towards small values, uniform, and log-uniform over
+        six decades above the lower bound (an open-loop unstable plant may need a large gain, a high-gain
+        plant a tiny one)."""
         lo, hi = self.box()
         lo = np.where(np.isfinite(lo), lo, -10.0)
         hi = np.where(np.isfinite(hi), hi, 10.0)
-        x = lo + (hi - lo) * rng.random(self.size) ** 3
+        u = rng.random(self.size)
+        frac = (u**3, u, 10.0 ** (-6.0 * u))[int(rng.integers(3))]
+        x = lo + (hi - lo) * frac
         if self.ctype == "leadlag":
             z_lo, z_hi = self.bounds["z"]
             x[1] = x[0] * (z_lo + (z_hi - z_lo) * rng.random())
@@ -308,8 +312,14 @@ class RationalParametrization:
         return np.clip(x, lo, hi)
 
     def random(self, rng: np.random.Generator) -> np.ndarray:
+        """A random controller in the bounds: stable real poles spread over three decades around ``w0``
+        (one at the origin with an integrator), numerator coefficients of random sign over six decades."""
         x = self.start()
-        x[: self.m + 1] = rng.normal(size=self.m + 1) * 10 ** rng.uniform(-3, 1)
+        poles = 10 ** rng.uniform(-1.0, 2.0, self.n)
+        if self.has_integrator():
+            poles[0] = 0.0
+        x[self.m + 1:] = np.poly(-poles)[::-1][: self.n]
+        x[: self.m + 1] = rng.normal(size=self.m + 1) * 10 ** rng.uniform(-3, 3)
         lo, hi = self.box()
         return np.clip(x, lo, hi)
 

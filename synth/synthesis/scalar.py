@@ -60,16 +60,23 @@ INWARD = 1e-6
 (the end itself has zero slack up to rounding)."""
 
 
-def _inside(x: float, gain_set: GainSet) -> float:
+def _inside(x: float, gain_set: GainSet, unstable: Callable[[float], bool]) -> float:
+    """``x``, or a point ``INWARD`` inside the feasible set when ``x`` is at an end set by a requirement, or at an
+    end where the loop is not stable (a closed-loop root on the axis, e.g. kp = 0 on a plant with an integrator:
+    the stabilizing set is open there)."""
     for iv in gain_set.intervals:
         step = INWARD * max(1.0, abs(x), iv.hi - iv.lo)
-        lo_req = any(not b.startswith("bounds") for b in iv.lo_binding)
-        hi_req = any(not b.startswith("bounds") for b in iv.hi_binding)
-        if lo_req and abs(x - iv.lo) <= step and iv.hi - iv.lo > 2 * step:
-            return iv.lo + step
-        if hi_req and abs(x - iv.hi) <= step and iv.hi - iv.lo > 2 * step and not any(
-                b.startswith("bounds") for b in iv.hi_binding):
-            return iv.hi - step
+        lo_req = any(not b.startswith("bounds") for b in iv.lo_binding) or (abs(x - iv.lo) <= step and unstable(iv.lo))
+        hi_req = (any(not b.startswith("bounds") for b in iv.hi_binding)
+                  and not any(b.startswith("bounds") for b in iv.hi_binding)) or (
+                      abs(x - iv.hi) <= step and unstable(iv.hi))
+        for end, sign, req in ((iv.lo, 1.0, lo_req), (iv.hi, -1.0, hi_req)):
+            if req and abs(x - end) <= step:
+                inner = step
+                while iv.hi - iv.lo > 2 * inner and unstable(end + sign * inner) and inner < 1e-2 * (iv.hi - iv.lo):
+                    inner *= 10.0  # a root within the stability floor of the axis: further in
+                if iv.hi - iv.lo > 2 * inner:
+                    return end + sign * inner
     return x
 
 
@@ -147,7 +154,7 @@ def design_scalar(spec: Spec) -> DesignResult:
         def score(x: float) -> float:
             return objective_score(Loop(nominal, family.controller(x)), terms)
     x, _ = _optimize_scalar(score, [(iv.lo, iv.hi) for iv in gain_set.intervals])
-    x = _inside(x, gain_set)
+    x = _inside(x, gain_set, lambda v: not all(Loop(p, family.controller(v)).stability().stable for p in plants))
     controller = family.controller(x)
     if objective is None:
         label = {"name": "smallest slack", "sense": "maximize", "unit": "Np", "value": float(score(x)),
