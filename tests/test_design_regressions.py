@@ -118,24 +118,31 @@ def test_gain_margin_form_keeps_a_crossing_left_of_minus_one_outside_the_circle(
     point near crossover to stay right of ``-1/g``; a stabilizing loop of an unstable plant crosses the negative
     real axis left of -1, so the form excluded every stabilizing design. There the lower gain margin
     ``|L| >= g`` applies."""
+    import cvxpy as cp
+
     from synth.synthesis.convex_forms import HalfPlane, Points
     from synth.synthesis.parametrization import Affine
 
-    def form_at(crossings: list[complex]) -> tuple[HalfPlane, np.ndarray]:
+    def form_at(crossings: list[complex]) -> tuple[HalfPlane, np.ndarray, np.ndarray]:
         n = len(crossings)
         L = Affine(np.array(crossings, complex), np.ones((n, 1), complex))
         zero = Affine(np.zeros(n, complex), np.zeros((n, 1), complex))
         one = Affine(np.ones(n, complex), np.zeros((n, 1), complex))
         pts = Points(np.arange(1.0, n + 1.0), np.zeros(n, int), L, one, zero)
         form = HalfPlane("margins", pts, 1, 6.0, None)  # g = 10^(6/20) = 1.995
+        form.constraints(cp.Variable(1), 0)
         form.update(np.zeros(1))
-        return form, form.H.value @ np.zeros(1) - form.h.value
+        upper = form.H.value @ np.zeros(1) - form.h.value
+        lower = form.H2.value @ np.zeros(1) - form.h2.value
+        return form, upper, lower
 
-    form, rows = form_at([-3.0 + 0j, -0.3 + 0j])  # lower crossing at |L| = 3 >= g, upper at 0.3 <= 1/g
-    assert form.violation(np.zeros(1)) <= 0 and np.all(rows >= -1e-12)
-    form, rows = form_at([-1.5 + 0j, -0.3 + 0j])  # |L| = 1.5 < g at the lower crossing: violated by g - 1.5
-    assert form.violation(np.zeros(1)) == pytest.approx(10 ** (6 / 20) - 1.5)
-    assert rows[0] == pytest.approx(1.5 - 10 ** (6 / 20)) and rows[1] >= 0
+    g = 10 ** (6 / 20)
+    form, upper, lower = form_at([-3.0 + 0j, -0.3 + 0j])  # lower crossing at |L| = 3 >= g, upper at 0.3 <= 1/g
+    assert form.violation(np.zeros(1)) <= 0 and np.all(upper >= -1e-12) and np.all(lower >= -1e-12)
+    form, upper, lower = form_at([-1.5 + 0j, -0.3 + 0j])  # |L| = 1.5 < g at the lower crossing: violated
+    assert form.violation(np.zeros(1)) == pytest.approx(1.0 - 1.5 / g)  # relative: 1 - |L|/g
+    assert lower[0] == pytest.approx(1.5 - g) and upper[0] == 0.0 and upper[1] >= 0  # the point left of -1
+    # carries |L| >= g, not the half-plane right of -1/g (which it could never meet)
 
 
 def test_peak_control_sensitivity_includes_the_limit_at_infinite_frequency() -> None:
