@@ -1,0 +1,169 @@
+"""Speed of ``synth diagnose`` against record length, with the previous version's time in the same run.
+
+Cases: the X-4 rotor drive (eq. 5, ``23 (s+0.43)/((s+9.6)(s+0.54))``, PWM -> rad/s, sampled at 0.02 s,
+noise 1 rad/s). The nominal handed to the diagnosis has every coefficient off by 5 % (fixed random
+signs). The input is a step train: levels drawn in 150-250 PWM (the first 200), each held 1.5-4 s. One effect is
+withheld (a dead zone, a delay, a drift, a backlash or a rate limit, each several times the noise). The
+estimation record has ``n`` samples, the validation record (another step train, same plant and effect)
+``0.8 n`` samples, as in issue 17 (20,000 + 16,000). One diagnosis (:func:`synth.gap.diagnose.diagnose`:
+localization and attribution with every default candidate, 2 worker processes) per record.
+
+The baseline is the same script run in a ``git worktree`` of ``--baseline-ref`` (default: ``HEAD``), in a
+temporary folder, by a subprocess in the same run, so both columns see the same load.
+
+Run:  python benchmarks/gap/diagnose_speed.py [--sizes 2000 20000 100000 1000000] [--effects ...]
+      [--baseline-ref REF | --no-baseline] [--baseline-timeout 600]
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")  # as `import synth` sets it (numpy is imported first here)
+os.environ.setdefault("OMP_NUM_THREADS", "1")
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[2]
+if str(ROOT) not in sys.path:
+    sys.path.insert(0, str(ROOT))
+
+from synth.data import record_from_arrays  # noqa: E402
+from synth.data.record import Record  # noqa: E402
+from synth.gap.effects import make_effect  # noqa: E402
+from synth.plant import Plant  # noqa: E402
+
+TRUE = Plant.from_string("23*(s+0.43)/((s+9.6)*(s+0.54))")
+DT = 0.02
+NOISE = 1.0
+EFFECTS: dict[str, dict[str, float]] = {
+    "deadzone": {"width": 25.0, "center": 200.0},
+    "delay": {"delay": 0.12},
+    "drift": {"slope": 0.0},  # set to 3 rad/s over the record
+    "backlash": {"width": 12.0},
+    "rate_limit": {"rate": 60.0},
+}
+
+
+def nominal(seed: int = 0) -> Plant:
+    """The true plant with every coefficient off by 5 % (random signs)."""
+    rng = np.random.default_rng(seed)
+    num = TRUE.num * (1.0 + 0.05 * rng.choice([-1.0, 1.0], TRUE.num.size))
+    den = TRUE.den.copy()
+    den[1:] *= 1.0 + 0.05 * rng.choice([-1.0, 1.0], den.size - 1)
+    return Plant(num, den)
+
+
+def step_train(n: int, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
+    """``n`` samples of a step train: levels in 150-250 PWM held 1.5-4 s each."""
+    t = np.arange(n) * DT
+    holds = rng.uniform(1.5, 4.0, size=int(n * DT / 1.5) + 2)
+    edges = np.concatenate([[0.0], np.cumsum(holds)])
+    levels = rng.uniform(150.0, 250.0, size=edges.size)
+    levels[0] = 200.0  # the dead zone's center: the command at rest
+    return t, levels[np.searchsorted(edges, t, side="right") - 1]
+
+
+def case(effect: str, n: int, seed: int = 0) -> tuple[Record, Record]:
+    """The estimation record (``n`` samples) and the validation record (``0.8 n``) with ``effect`` withheld."""
+    rng = np.random.default_rng([seed, n, list(EFFECTS).index(effect)])
+    out = []
+    for m in (n, int(0.8 * n)):
+        t, u = step_train(m, rng)
+        params = dict(EFFECTS[effect])
+        if effect == "drift":
+            params["slope"] = 3.0 / float(t[-1])
+        y = make_effect(effect).apply(TRUE, t, u, params) + NOISE * rng.normal(size=m)
+        out.append(record_from_arrays(t, u, y))
+    return out[0], out[1]
+
+
+def run_one(effect: str, n: int, workers: int = 2) -> dict[str, object]:
+    """Time one diagnosis of the ``effect`` case of ``n`` samples (this checkout's code)."""
+    from synth.gap.diagnose import diagnose
+
+    rec, val = case(effect, n)
+    t0 = time.perf_counter()
+    fd = os.dup(2)
+    try:  # casadi writes its warnings to file descriptor 2
+        with open(os.devnull, "w") as null:
+            os.dup2(null.fileno(), 2)
+            dg = diagnose(nominal(), rec, val, workers=workers)
+    finally:
+        os.dup2(fd, 2)
+        os.close(fd)
+    return {"seconds": time.perf_counter() - t0, "verdict": list(dg.verdict["effects"])}
+
+
+def _baseline(ref: str, effect: str, n: int, timeout: float, tree: Path) -> dict[str, object]:
+    cmd = [sys.executable, str(tree / "benchmarks/gap/diagnose_speed.py"), "--one", effect, str(n)]
+    env = dict(os.environ, PYTHONPATH=str(tree))
+    t0 = time.perf_counter()
+    try:
+        out = subprocess.run(cmd, cwd=tree, env=env, capture_output=True, text=True, timeout=timeout, check=False)
+    except subprocess.TimeoutExpired:
+        return {"seconds": None, "verdict": [f"> {timeout:.0f} s"]}
+    if out.returncode != 0:
+        return {"seconds": None, "verdict": [f"failed: {out.stderr.strip().splitlines()[-1:]}"]}
+    res = json.loads(out.stdout.strip().splitlines()[-1])
+    res["wall"] = time.perf_counter() - t0
+    return res
+
+
+def main(argv: list[str] | None = None) -> None:
+    """CLI."""
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--sizes", type=int, nargs="+", default=[2000, 20000, 100000, 1000000])
+    ap.add_argument("--effects", nargs="+", default=list(EFFECTS), choices=list(EFFECTS))
+    ap.add_argument("--baseline-ref", default="HEAD")
+    ap.add_argument("--no-baseline", action="store_true")
+    ap.add_argument("--baseline-timeout", type=float, default=600.0)
+    ap.add_argument("--baseline-max", type=int, default=100000, help="largest size the baseline is run at")
+    ap.add_argument("--one", nargs=2, metavar=("EFFECT", "N"), help=argparse.SUPPRESS)
+    args = ap.parse_args(argv)
+    if args.one:
+        print(json.dumps(run_one(args.one[0], int(args.one[1]))))
+        return
+    tmp = None
+    if not args.no_baseline:
+        tmp = tempfile.TemporaryDirectory(prefix="synth-baseline-")
+        tree = Path(tmp.name) / "tree"
+        subprocess.run(["git", "worktree", "add", "--detach", str(tree), args.baseline_ref], cwd=ROOT, check=True,
+                       capture_output=True)
+        if not (tree / "benchmarks/gap/diagnose_speed.py").exists():  # the script itself is new: run this one there
+            (tree / "benchmarks/gap/diagnose_speed.py").write_text(Path(__file__).read_text())
+    rows = []
+    try:
+        for n in args.sizes:
+            for effect in args.effects:
+                new = run_one(effect, n)
+                old = (_baseline(args.baseline_ref, effect, n, args.baseline_timeout, tree)
+                       if tmp is not None and n <= args.baseline_max else None)
+                rows.append((effect, n, new, old))
+                print(f"{effect} {n}: {new} | baseline {old}", file=sys.stderr, flush=True)
+    finally:
+        if tmp is not None:
+            subprocess.run(["git", "worktree", "remove", "--force", str(tree)], cwd=ROOT, check=False,
+                           capture_output=True)
+            tmp.cleanup()
+    print("| samples (+0.8 n validation) | effect | time [s] | verdict | baseline time [s] | baseline verdict |")
+    print("|---|---|---|---|---|---|")
+    for effect, n, new, old in rows:
+        o_t = "-" if old is None else ("n/a" if old["seconds"] is None else f"{old['seconds']:.1f}")
+        o_v = "-" if old is None else ", ".join(old["verdict"])
+        print(f"| {n} | {effect} | {new['seconds']:.1f} | {', '.join(new['verdict'])} | {o_t} | {o_v} |")
+    for n in args.sizes:
+        ts = [r[2]["seconds"] for r in rows if r[1] == n]
+        print(f"\n{n} samples: median {np.median(ts):.1f} s, worst {max(ts):.1f} s", end="")
+    print()
+
+
+if __name__ == "__main__":
+    main()
