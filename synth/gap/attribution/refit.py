@@ -478,9 +478,12 @@ def fit_augmented(plant: Plant, t: np.ndarray, u: np.ndarray, y: np.ndarray, eff
 
 def _golden(plant: Plant, eff: Effect, best: _Point, same: list[_Point], key: str, t: np.ndarray, u: np.ndarray,
             y: np.ndarray, formula: str, start: dict[str, float], weights: np.ndarray | None = None) -> list[_Point]:
-    """Search in log(key) between the best grid point's neighbours: parabolic interpolation when both were
-    fitted (the best point inside the grid, :func:`synth.gap.attribution.golden.parabolic_section`, a few fits
-    instead of ten), else golden section."""
+    """Search in log(key) between the best grid point's neighbours (one grid step beyond an end).
+
+    Parabolic interpolation through the best point and its neighbours
+    (:func:`synth.gap.attribution.golden.parabolic_section`, a few fits instead of ten); at an end of the
+    grid the step beyond is fitted first (if it is better still, the search stops there, the end of
+    the range); golden section when a neighbour's fit failed."""
     vals = sorted({p.params[key] for p in same if np.isfinite(p.params.get(key, np.nan)) and p.params[key] > 0})
     bracket = log_bracket(vals, best.params.get(key, np.nan))
     if bracket is None:
@@ -500,8 +503,13 @@ def _golden(plant: Plant, eff: Effect, best: _Point, same: list[_Point], key: st
     ssr = {float(np.log(p.params[key])): p.ssr for p in same if np.isfinite(p.params.get(key, np.nan))
            and p.params[key] > 0}
     a, b = bracket
-    if a in ssr and b in ssr and np.isfinite(ssr[a]) and np.isfinite(ssr[b]):  # bracketed by evaluated points
-        parabolic_section(f, a, x0, b, ssr[a], best.ssr, ssr[b], _GOLDEN - 2, _GOLDEN_TOL)
+    missing = [x for x in (a, b) if x not in ssr]
+    if len(missing) == 1 and a < x0 < b:  # the best is at an end of the grid: fit the step beyond it first
+        ssr[missing[0]] = f(missing[0])
+        if ssr[missing[0]] < best.ssr:  # still going down at the end of the searched range
+            return out
+    if a in ssr and b in ssr and np.isfinite(ssr[a]) and np.isfinite(ssr[b]) and a < x0 < b:
+        parabolic_section(f, a, x0, b, ssr[a], best.ssr, ssr[b], _GOLDEN - 2 - len(missing), _GOLDEN_TOL)
     else:
-        golden_section(f, *bracket, _GOLDEN - 2, tol=_GOLDEN_TOL)
+        golden_section(f, *bracket, _GOLDEN - 2 - len(out), tol=_GOLDEN_TOL)
     return out
