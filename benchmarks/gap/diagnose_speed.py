@@ -8,11 +8,12 @@ estimation record has ``n`` samples, the validation record (another step train, 
 ``0.8 n`` samples, as in issue 17 (20,000 + 16,000). One diagnosis (:func:`synth.gap.diagnose.diagnose`:
 localization and attribution with every default candidate, 2 worker processes) per record.
 
-The baseline is the same script run in a ``git worktree`` of ``--baseline-ref`` (default: ``HEAD``), in a
-temporary folder, by a subprocess in the same run, so both columns see the same load.
+Each diagnosis runs in a fresh process (``--one``; the time is the diagnosis alone, without imports). The
+baseline is the same script run in a ``git worktree`` of ``--baseline-ref`` (default: ``HEAD``), in a
+temporary folder, right after this version's run of the same case, so both columns see the same load.
 
 Run:  python benchmarks/gap/diagnose_speed.py [--sizes 2000 20000 100000 1000000] [--effects ...]
-      [--baseline-ref REF | --no-baseline] [--baseline-timeout 600]
+      [--baseline-ref REF | --no-baseline] [--timeout 600] [--baseline-max 100000]
 """
 
 from __future__ import annotations
@@ -102,19 +103,21 @@ def run_one(effect: str, n: int, workers: int = 2) -> dict[str, object]:
     return {"seconds": time.perf_counter() - t0, "verdict": list(dg.verdict["effects"])}
 
 
-def _baseline(ref: str, effect: str, n: int, timeout: float, tree: Path) -> dict[str, object]:
+def timed(tree: Path, effect: str, n: int, timeout: float) -> dict[str, object]:
+    """One diagnosis by the code in ``tree`` (this checkout or the baseline worktree), in a fresh process.
+
+    ``seconds`` is the diagnosis alone (no imports, no record generation); ``None`` when it did not finish
+    within ``timeout`` seconds or failed (``verdict`` then says which).
+    """
     cmd = [sys.executable, str(tree / "benchmarks/gap/diagnose_speed.py"), "--one", effect, str(n)]
     env = dict(os.environ, PYTHONPATH=str(tree))
-    t0 = time.perf_counter()
     try:
         out = subprocess.run(cmd, cwd=tree, env=env, capture_output=True, text=True, timeout=timeout, check=False)
     except subprocess.TimeoutExpired:
-        return {"seconds": None, "verdict": [f"> {timeout:.0f} s"]}
+        return {"seconds": None, "verdict": [f"not done in {timeout:.0f} s"]}
     if out.returncode != 0:
-        return {"seconds": None, "verdict": [f"failed: {out.stderr.strip().splitlines()[-1:]}"]}
-    res = json.loads(out.stdout.strip().splitlines()[-1])
-    res["wall"] = time.perf_counter() - t0
-    return res
+        return {"seconds": None, "verdict": [f"failed: {' '.join(out.stderr.strip().splitlines()[-1:])}"]}
+    return json.loads(out.stdout.strip().splitlines()[-1])
 
 
 def main(argv: list[str] | None = None) -> None:
@@ -124,7 +127,7 @@ def main(argv: list[str] | None = None) -> None:
     ap.add_argument("--effects", nargs="+", default=list(EFFECTS), choices=list(EFFECTS))
     ap.add_argument("--baseline-ref", default="HEAD")
     ap.add_argument("--no-baseline", action="store_true")
-    ap.add_argument("--baseline-timeout", type=float, default=600.0)
+    ap.add_argument("--timeout", type=float, default=600.0, help="seconds one diagnosis may take (each version)")
     ap.add_argument("--baseline-max", type=int, default=100000, help="largest size the baseline is run at")
     ap.add_argument("--one", nargs=2, metavar=("EFFECT", "N"), help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
@@ -143,8 +146,8 @@ def main(argv: list[str] | None = None) -> None:
     try:
         for n in args.sizes:
             for effect in args.effects:
-                new = run_one(effect, n)
-                old = (_baseline(args.baseline_ref, effect, n, args.baseline_timeout, tree)
+                new = timed(ROOT, effect, n, args.timeout)
+                old = (timed(tree, effect, n, args.timeout)
                        if tmp is not None and n <= args.baseline_max else None)
                 rows.append((effect, n, new, old))
                 print(f"{effect} {n}: {new} | baseline {old}", file=sys.stderr, flush=True)
@@ -153,16 +156,24 @@ def main(argv: list[str] | None = None) -> None:
             subprocess.run(["git", "worktree", "remove", "--force", str(tree)], cwd=ROOT, check=False,
                            capture_output=True)
             tmp.cleanup()
-    print("| samples (+0.8 n validation) | effect | time [s] | verdict | baseline time [s] | baseline verdict |")
+    def cell(res: dict[str, object] | None) -> tuple[str, str]:
+        if res is None:
+            return "-", "-"
+        secs = res["seconds"]
+        return ("n/a" if secs is None else f"{secs:.1f}"), ", ".join(res["verdict"]) or "(none)"
+
+    ref = "" if args.no_baseline else f" ({args.baseline_ref})"
+    print(f"| samples (+0.8 n validation) | effect | time [s] | verdict | baseline{ref} time [s] | baseline verdict |")
     print("|---|---|---|---|---|---|")
     for effect, n, new, old in rows:
-        o_t = "-" if old is None else ("n/a" if old["seconds"] is None else f"{old['seconds']:.1f}")
-        o_v = "-" if old is None else ", ".join(old["verdict"])
-        print(f"| {n} | {effect} | {new['seconds']:.1f} | {', '.join(new['verdict'])} | {o_t} | {o_v} |")
+        print(f"| {n} | {effect} | {' | '.join(cell(new))} | {' | '.join(cell(old))} |")
     for n in args.sizes:
-        ts = [r[2]["seconds"] for r in rows if r[1] == n]
-        print(f"\n{n} samples: median {np.median(ts):.1f} s, worst {max(ts):.1f} s", end="")
-    print()
+        for label, k in (("this version", 2), ("baseline", 3)):
+            ts = [np.inf if r[k]["seconds"] is None else r[k]["seconds"] for r in rows if r[1] == n and r[k] is not None]
+            if ts:  # a run that did not finish counts as longer than the timeout
+                med, worst = (f"{x:.1f} s" if np.isfinite(x) else f"> {args.timeout:.0f} s"
+                              for x in (np.median(ts), max(ts)))
+                print(f"{n} samples, {label}: median {med}, worst {worst} ({len(ts)} records)")
 
 
 if __name__ == "__main__":
