@@ -263,10 +263,13 @@ def diagnose_effects(plant: Plant, record: Record, validate: Record | Sequence[R
     >>> t = np.arange(0, 12, 0.01); u = np.where((t % 2) >= 1, 1.0, 0.0)
     >>> y = simulate_plant(Plant.from_string("2/(0.2*s+1)", delay=0.05), t, u)
     >>> y = y + 0.005 * np.random.default_rng(0).normal(size=t.size)
+    >>> progress = {}
     >>> dg = diagnose_effects(Plant.from_string("2.1/(0.2*s+1)"), record_from_arrays(t, u, y),
-    ...                       options=DiagnoseOptions(candidates=("delay",), n_null=5))
+    ...                       options=DiagnoseOptions(candidates=("delay",), n_null=5), progress=progress)
     >>> dg.verdict["effects"], round(dg.effects[0].parameters["delay"], 3), dg.effects[0].shrinkage > 0.9
     (['delay'], 0.05, True)
+    >>> progress["done"] == progress["total"], progress["step"]
+    (True, 'verdict')
     """
     options = DiagnoseOptions() if options is None else options
     (train_fraction, blocks, n_null, n_boot, alpha, relevance, min_share, seed, calibration, confirm, split, burn_in,

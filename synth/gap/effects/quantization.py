@@ -30,7 +30,8 @@ from synth.sim.blocks import Quantizer
 __all__ = ["QuantizationEffect", "quantizer_grid"]
 
 _GRAM_VALUES = 600  # distinct command values up to which the dense search uses their Gram matrix
-_GRAM_ENTRIES = 4e7  # ... and entries of the response table it is formed from (samples x columns)
+_GRAM_ENTRIES = 2.5e7  # ... and entries of the response table it is formed from (samples x columns)
+_DENSE_SAMPLES = 20000  # a longer record that fits neither is searched on a prefix (see quantizer_grid)
 
 
 @dataclass(frozen=True)
@@ -270,6 +271,10 @@ def quantizer_grid(plant: Plant, t: np.ndarray, u: np.ndarray, y: np.ndarray, ke
     if span <= 0:
         raise ModelError("the input is constant; no quantizer can be fitted", where="record.u")
     center = 0.5 * float(np.max(u) + np.min(u))
+    levels_all = np.unique(u)
+    n_use = _dense_samples(u, len(unit_numerators(plant)))
+    if n_use < t.size:  # a long record: the search on its start (from rest, as the whole); points kept per the whole
+        t, u, y, mask = t[:n_use], u[:n_use], y[:n_use], None if mask is None else np.asarray(mask)[:n_use]
     steps_r, consts = _step_responses(plant, t)
     q_lo, q_hi = 0.005 * span, 0.5 * span
     steps = [q_lo]
@@ -317,7 +322,7 @@ def quantizer_grid(plant: Plant, t: np.ndarray, u: np.ndarray, y: np.ndarray, ke
     pts = np.vstack(fine)
     cost = ssr(pts)
     order = np.argsort(cost, kind="stable")
-    levels = np.unique(u)
+    levels = levels_all
     out: list[Params] = []
     for i in order:
         q, ph = pts[i]
@@ -327,6 +332,32 @@ def quantizer_grid(plant: Plant, t: np.ndarray, u: np.ndarray, y: np.ndarray, ke
         if len(out) == keep:
             break
     return out
+
+
+def _dense_samples(u: np.ndarray, units: int) -> int:
+    """How many samples from the start the dense quantizer search uses: all of them, unless that is too much work.
+
+    The whole record when its distinct values fit the Gram search (:class:`_LevelGram`: at most
+    ``_GRAM_VALUES`` values and ``_GRAM_ENTRIES`` table entries) or it has at most ``_DENSE_SAMPLES``
+    samples (an FFT per point, as always). A longer record: the longest prefix that fits the Gram search,
+    or else the first ``_DENSE_SAMPLES``: the search's cost is then bounded whatever the length (the
+    points it returns are screened on the whole record).
+
+    Examples
+    --------
+    >>> steps = np.repeat(np.arange(1000.0), 100)  # 100,000 samples of 1,000 levels
+    >>> _dense_samples(steps[:5000], 1), _dense_samples(steps, 1), _dense_samples(np.arange(30000.0), 1)
+    (5000, 49900, 20000)
+    """
+    n = u.size
+    first = np.sort(np.unique(u, return_index=True)[1])  # where each distinct value first appears
+    counts = np.arange(1, first.size + 1)  # distinct values in the prefixes from each first appearance
+    if (counts[-1] <= _GRAM_VALUES and n * (units * counts[-1] + 1.0) <= _GRAM_ENTRIES) or n <= _DENSE_SAMPLES:
+        return n
+    cap = np.minimum(np.r_[first[1:], n], _GRAM_ENTRIES // (units * counts + 1.0))  # longest prefix per count
+    ok = (counts <= _GRAM_VALUES) & (cap > first)
+    best = int(np.max(cap[ok])) if np.any(ok) else 0
+    return best if best >= _DENSE_SAMPLES else _DENSE_SAMPLES
 
 
 def _max_margin(levels: np.ndarray, step: float, lattice: float) -> Params:
