@@ -8,12 +8,14 @@ estimation record has ``n`` samples, the validation record (another step train, 
 ``0.8 n`` samples, as in issue 17 (20,000 + 16,000). One diagnosis (:func:`synth.gap.diagnose.diagnose`:
 localization and attribution with every default candidate, 2 worker processes) per record.
 
-Each diagnosis runs in a fresh process (``--one``; the time is the diagnosis alone, without imports). The
+Each diagnosis runs in a fresh process (``--one``; the time is the diagnosis alone, without imports): wall
+time, and CPU time of the process and its worker processes (on a loaded machine the CPU time is the
+comparable number; on an idle 2-core machine the wall time lies between half of it and all of it). The
 baseline is the same script run in a ``git worktree`` of ``--baseline-ref`` (default: ``HEAD``), in a
 temporary folder, right after this version's run of the same case, so both columns see the same load.
 
 Run:  python benchmarks/gap/diagnose_speed.py [--sizes 2000 20000 100000 1000000] [--effects ...]
-      [--baseline-ref REF | --no-baseline] [--timeout 600] [--baseline-max 100000]
+      [--baseline-ref REF | --no-baseline] [--timeout 600] [--baseline-max 100000] [--jobs 1]
 """
 
 from __future__ import annotations
@@ -88,10 +90,16 @@ def case(effect: str, n: int, seed: int = 0) -> tuple[Record, Record]:
 
 def run_one(effect: str, n: int, workers: int = 2) -> dict[str, object]:
     """Time one diagnosis of the ``effect`` case of ``n`` samples (this checkout's code)."""
+    import resource
+
     from synth.gap.diagnose import diagnose
 
+    def cpu() -> float:  # this process and its reaped children (the pool's workers)
+        return sum(r.ru_utime + r.ru_stime for r in (resource.getrusage(resource.RUSAGE_SELF),
+                                                      resource.getrusage(resource.RUSAGE_CHILDREN)))
+
     rec, val = case(effect, n)
-    t0 = time.perf_counter()
+    t0, c0 = time.perf_counter(), cpu()
     fd = os.dup(2)
     try:  # casadi writes its warnings to file descriptor 2
         with open(os.devnull, "w") as null:
@@ -100,7 +108,7 @@ def run_one(effect: str, n: int, workers: int = 2) -> dict[str, object]:
     finally:
         os.dup2(fd, 2)
         os.close(fd)
-    return {"seconds": time.perf_counter() - t0, "verdict": list(dg.verdict["effects"])}
+    return {"seconds": time.perf_counter() - t0, "cpu": cpu() - c0, "verdict": list(dg.verdict["effects"])}
 
 
 def timed(tree: Path, effect: str, n: int, timeout: float) -> dict[str, object]:
@@ -129,6 +137,7 @@ def main(argv: list[str] | None = None) -> None:
     ap.add_argument("--no-baseline", action="store_true")
     ap.add_argument("--timeout", type=float, default=600.0, help="seconds one diagnosis may take (each version)")
     ap.add_argument("--baseline-max", type=int, default=100000, help="largest size the baseline is run at")
+    ap.add_argument("--jobs", type=int, default=1, help="diagnoses run at once (compare CPU times then)")
     ap.add_argument("--one", nargs=2, metavar=("EFFECT", "N"), help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
     if args.one:
@@ -142,38 +151,49 @@ def main(argv: list[str] | None = None) -> None:
                        capture_output=True)
         if not (tree / "benchmarks/gap/diagnose_speed.py").exists():  # the script itself is new: run this one there
             (tree / "benchmarks/gap/diagnose_speed.py").write_text(Path(__file__).read_text())
-    rows = []
+    tasks = [(where, effect, n) for n in args.sizes for effect in args.effects
+             for where in ("new", *(("old",) if tmp is not None and n <= args.baseline_max else ()))]
+    results: dict[tuple[str, str, int], dict[str, object]] = {}
+
+    def work(task: tuple[str, str, int]) -> None:
+        where, effect, n = task
+        results[task] = timed(ROOT if where == "new" else tree, effect, n, args.timeout)
+        print(f"{where} {effect} {n}: {results[task]}", file=sys.stderr, flush=True)
+
     try:
-        for n in args.sizes:
-            for effect in args.effects:
-                new = timed(ROOT, effect, n, args.timeout)
-                old = (timed(tree, effect, n, args.timeout)
-                       if tmp is not None and n <= args.baseline_max else None)
-                rows.append((effect, n, new, old))
-                print(f"{effect} {n}: {new} | baseline {old}", file=sys.stderr, flush=True)
+        from concurrent.futures import ThreadPoolExecutor
+
+        with ThreadPoolExecutor(args.jobs) as pool:
+            list(pool.map(work, tasks))
+        rows = [(effect, n, results[("new", effect, n)], results.get(("old", effect, n)))
+                for n in args.sizes for effect in args.effects]
     finally:
         if tmp is not None:
             subprocess.run(["git", "worktree", "remove", "--force", str(tree)], cwd=ROOT, check=False,
                            capture_output=True)
             tmp.cleanup()
-    def cell(res: dict[str, object] | None) -> tuple[str, str]:
+
+    def cell(res: dict[str, object] | None) -> tuple[str, str, str]:
         if res is None:
-            return "-", "-"
-        secs = res["seconds"]
-        return ("n/a" if secs is None else f"{secs:.1f}"), ", ".join(res["verdict"]) or "(none)"
+            return "-", "-", "-"
+        secs, cpu = res["seconds"], res.get("cpu")
+        return (("n/a" if secs is None else f"{secs:.1f}"), ("n/a" if cpu is None else f"{cpu:.1f}"),
+                ", ".join(res["verdict"]) or "(none)")
 
     ref = "" if args.no_baseline else f" ({args.baseline_ref})"
-    print(f"| samples (+0.8 n validation) | effect | time [s] | verdict | baseline{ref} time [s] | baseline verdict |")
-    print("|---|---|---|---|---|---|")
+    print(f"| samples (+0.8 n validation) | effect | wall [s] | CPU [s] | verdict | baseline{ref} wall [s] | "
+          "baseline CPU [s] | baseline verdict |")
+    print("|---|---|---|---|---|---|---|---|")
     for effect, n, new, old in rows:
         print(f"| {n} | {effect} | {' | '.join(cell(new))} | {' | '.join(cell(old))} |")
     for n in args.sizes:
         for label, k in (("this version", 2), ("baseline", 3)):
-            ts = [np.inf if r[k]["seconds"] is None else r[k]["seconds"] for r in rows if r[1] == n and r[k] is not None]
-            if ts:  # a run that did not finish counts as longer than the timeout
-                med, worst = (f"{x:.1f} s" if np.isfinite(x) else f"> {args.timeout:.0f} s"
-                              for x in (np.median(ts), max(ts)))
-                print(f"{n} samples, {label}: median {med}, worst {worst} ({len(ts)} records)")
+            for what in ("seconds", "cpu"):
+                ts = [np.inf if r[k].get(what) is None else r[k][what] for r in rows if r[1] == n and r[k] is not None]
+                if ts:  # a run that did not finish counts as longer than the timeout
+                    med, worst = (f"{x:.1f} s" if np.isfinite(x) else "not done" for x in (np.median(ts), max(ts)))
+                    print(f"{n} samples, {label}, {'wall' if what == 'seconds' else 'CPU'}: median {med}, "
+                          f"worst {worst} ({len(ts)} records)")
 
 
 if __name__ == "__main__":
