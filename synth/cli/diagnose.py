@@ -145,7 +145,7 @@ def run(args: argparse.Namespace) -> int:
     validate = validates if len(validates) > 1 else (validates[0] if validates else None)
     progress: dict[str, Any] = {}
     try:
-        with _SignalsRaise():
+        with _SignalsRaise(), _ProgressBar(progress, not args.quiet and sys.stderr.isatty()):
             diag = diagnose(plant, record, validate, candidates, seed=args.seed, split=args.split,
                             burn_in=args.burn_in, max_effects=args.max_effects, workers=args.workers,
                             heldout_offset=args.heldout_offset, progress=progress)
@@ -171,6 +171,52 @@ def run(args: argparse.Namespace) -> int:
     if not args.quiet and args.json != "-":
         _print(data, report)
     return 0
+
+
+class _ProgressBar:
+    """A progress bar on standard error while the diagnosis runs (shown after 2 s; the steps of ``progress``).
+
+    A thread reads ``progress`` (``"stage"``, and during the attribution ``"done"`` of ``"total"`` steps and
+    the last ``"step"``) four times a second; nothing is drawn when ``enabled`` is false.
+    """
+
+    def __init__(self, progress: dict[str, Any], enabled: bool) -> None:
+        self.progress, self.enabled = progress, enabled
+
+    def __enter__(self) -> None:
+        if not self.enabled:
+            return
+        import threading
+
+        from tqdm import tqdm
+
+        self.stop = threading.Event()
+        self.bar = tqdm(total=1, desc="diagnose", unit="step", delay=1e9, file=sys.stderr, leave=False,
+                        bar_format="{desc}: {percentage:3.0f}%|{bar}| {n_fmt}/{total_fmt} [{elapsed}]")
+
+        def poll() -> None:
+            if self.stop.wait(2.0):  # a short run draws no bar
+                return
+            while not self.stop.wait(0.25):
+                p = self.progress
+                total, done = int(p.get("total", 0) or 0), int(p.get("done", 0) or 0)
+                stage = str(p.get("stage", "start"))
+                desc = f"diagnose: {stage}" + (f" ({p['step']} done)" if stage == "attribution" and "step" in p else "")
+                if total and (total != self.bar.total or done != self.bar.n):
+                    self.bar.total = total
+                    self.bar.n = min(done, total)
+                self.bar.set_description_str(desc, refresh=False)
+                self.bar.refresh()
+
+        self.thread = threading.Thread(target=poll, daemon=True)
+        self.thread.start()
+
+    def __exit__(self, *exc: Any) -> None:
+        if not self.enabled:
+            return
+        self.stop.set()
+        self.thread.join()
+        self.bar.close()
 
 
 class _SignalsRaise:

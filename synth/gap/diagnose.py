@@ -364,7 +364,8 @@ def diagnose(plant: Plant, record: RecordLike, validate: RecordLike | Sequence[R
     progress : dict, optional
         Filled as the diagnosis goes: ``"localization"`` (a :class:`GapLocalization`) once the gap is
         localized, ``"stage"`` the stage running (``"localization"``, ``"attribution"``, ``"done"``):
-        what an interrupted run can still write.
+        what an interrupted run can still write; during the attribution ``"done"`` of ``"total"`` steps
+        and ``"step"`` (see :func:`synth.gap.attribution.heldout.diagnose_effects`), for a progress bar.
 
     Returns
     -------
@@ -414,7 +415,8 @@ def diagnose(plant: Plant, record: RecordLike, validate: RecordLike | Sequence[R
     att = diagnose_effects(plant, record, list(validate) if isinstance(validate, tuple) else validate,
                            options=DiagnoseOptions(candidates=effects, train_fraction=train_fraction, n_null=n_null,
                                                    n_boot=n_boot, seed=seed, split=split, burn_in=burn_in,
-                                                   max_effects=max_effects, workers=workers, heldout_offset=heldout_offset))
+                                                   max_effects=max_effects, workers=workers, heldout_offset=heldout_offset),
+                           progress=progress)
     att.verdict["not_carried"] = not_carried(att, DiagnoseOptions().confirm)
     channels = {e.label: e.aux_channel for e in effects if e.aux_channel}
     if channels:

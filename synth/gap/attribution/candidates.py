@@ -19,8 +19,24 @@ from synth.gap.attribution.screen import ScreenedFit, screen_effect
 from synth.gap.effects.base import Effect, Params
 from synth.plant import Plant
 
-__all__ = ["candidate_fits", "confirmed_candidates", "joint_fit", "map_jobs", "screened_coefficients", "seeded_grid",
-           "watch_parent"]
+__all__ = ["advance", "candidate_fits", "confirmed_candidates", "joint_fit", "map_jobs", "screened_coefficients",
+           "seeded_grid", "watch_parent"]
+
+
+def advance(progress: dict[str, Any] | None, step: str) -> None:
+    """Count one finished step of a diagnosis in ``progress`` (``"done"``, and ``"step"`` its name), if given.
+
+    A progress bar reads ``progress["done"]`` against ``progress["total"]`` (see ``synth diagnose``).
+
+    Examples
+    --------
+    >>> p = {"total": 3}
+    >>> advance(p, "re-fit"); advance(p, "screen delay"); p["done"], p["step"]
+    (2, 'screen delay')
+    """
+    if progress is not None:
+        progress["done"] = int(progress.get("done", 0)) + 1
+        progress["step"] = step
 
 
 def seeded_grid(effect: Effect, screened: ScreenedFit, u_train: np.ndarray | None = None) -> list[Params]:
@@ -40,10 +56,12 @@ def seeded_grid(effect: Effect, screened: ScreenedFit, u_train: np.ndarray | Non
 
 def candidate_fits(plant: Plant, effects: list[Effect], refit: AugmentedFit, train: Record, evaluated: Record,
                    confirm: int | None, train_mask: np.ndarray | None = None, workers: int = 1,
+                   progress: dict[str, Any] | None = None,
                    ) -> list[tuple[Effect, AugmentedFit | ScreenedFit, np.ndarray, np.ndarray]]:
     """Every candidate's fit on ``train``: joint for all (``confirm=None``) or screened, the best ``confirm`` then joint.
 
-    Each fit is also simulated on ``evaluated`` (the held-out side).
+    Each fit is also simulated on ``evaluated`` (the held-out side). Each screen and each joint fit
+    counts one step in ``progress`` (:func:`advance`).
 
     Effects the screen cannot represent (``Effect.screenable`` false: friction, output-side clipping) are
     always fitted jointly.
@@ -75,6 +93,8 @@ def candidate_fits(plant: Plant, effects: list[Effect], refit: AugmentedFit, tra
                 fit = fit_augmented(plant, t_tr, u_tr, y_tr, eff, start=refit.plant, weights=weights)
             except ModelError:
                 continue
+            finally:
+                advance(progress, f"joint fit {eff.label}")
             out.append((eff, fit, fit.predict(t_tr, u_tr), fit.predict(t_ev, u_ev)))
         return out
     bases = [("nominal", plant), ("refit", refit.plant)]
@@ -85,12 +105,16 @@ def candidate_fits(plant: Plant, effects: list[Effect], refit: AugmentedFit, tra
                 fit = fit_augmented(plant, t_tr, u_tr, y_tr, eff, start=refit.plant, weights=weights)
             except ModelError:
                 continue
+            finally:
+                advance(progress, f"joint fit {eff.label}")
             out.append((eff, fit, fit.predict(t_tr, u_tr), fit.predict(t_ev, u_ev)))
             continue
         try:
             screened.append((eff, screen_effect(eff, bases, t_tr, u_tr, y_tr, t_ev, u_ev, train_mask)))
         except ModelError:
             continue
+        finally:
+            advance(progress, f"screen {eff.label}")
     screened.sort(key=lambda es: es[1].ssr)
     chosen = confirmed_candidates(screened, confirm)
     jobs = []
@@ -99,7 +123,10 @@ def candidate_fits(plant: Plant, effects: list[Effect], refit: AugmentedFit, tra
         if i >= (confirm or 0) and sc.params_held:  # confirmed for its held-denominator fit: start there
             sc = replace(sc, params=sc.params_held)
         jobs.append((plant, t_tr, u_tr, y_tr, eff, refit.plant, weights, seeded_grid(eff, sc, u_tr)))
-    joints = dict(zip(chosen, map_jobs(joint_fit, jobs, workers)))
+    if progress is not None:  # the joint fits were counted as `confirm` steps; there may be one more
+        progress["total"] = int(progress.get("total", 0)) + len(chosen) - (confirm or 0)
+    joints = dict(zip(chosen, map_jobs(joint_fit, jobs, workers,
+                                       lambda i: advance(progress, f"joint fit {screened[chosen[i]][0].label}"))))
     for rank, (eff, sc) in enumerate(screened):
         fit: AugmentedFit | ScreenedFit = sc
         joint = joints.get(rank)
@@ -205,8 +232,10 @@ def watch_parent(parent: int) -> None:
     threading.Thread(target=check, daemon=True).start()
 
 
-def map_jobs(fn: Any, jobs: list[Any], workers: int) -> list[Any]:
+def map_jobs(fn: Any, jobs: list[Any], workers: int, done: Any = None) -> list[Any]:
     """``[fn(j) for j in jobs]``, on ``workers`` processes when there are several jobs.
+
+    ``done(i)``, if given, is called in this process as job ``i`` finishes (in order).
 
     The workers die with this process (:func:`watch_parent`: a SIGKILL of the parent leaves none
     behind), and any exception here, a KeyboardInterrupt or the exception a signal handler raises
@@ -218,14 +247,23 @@ def map_jobs(fn: Any, jobs: list[Any], workers: int) -> list[Any]:
     [1, 2, 3]
     """
     if workers <= 1 or len(jobs) <= 1:
-        return [fn(j) for j in jobs]
+        out = []
+        for i, j in enumerate(jobs):
+            out.append(fn(j))
+            if done is not None:
+                done(i)
+        return out
     import multiprocessing
     import os
 
     pool = multiprocessing.get_context().Pool(min(workers, len(jobs)), initializer=watch_parent,
                                               initargs=(os.getpid(),))
     try:
-        out = pool.map(fn, jobs, chunksize=1)
+        out = []
+        for i, res in enumerate(pool.imap(fn, jobs, chunksize=1)):
+            out.append(res)
+            if done is not None:
+                done(i)
         pool.close()
         return out
     except BaseException:

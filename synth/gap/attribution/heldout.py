@@ -84,7 +84,7 @@ import numpy as np
 from synth.data.record import Record
 from synth.errors import ModelError
 from synth.gap.attribution.calibration import demean, linearized_null, noise_sigma, refit_null
-from synth.gap.attribution.candidates import candidate_fits, screened_coefficients
+from synth.gap.attribution.candidates import advance, candidate_fits, screened_coefficients
 from synth.gap.attribution.forward import ForwardSelection
 from synth.gap.attribution.parsimony import free_parameters, parsimonious_lead, share_of_excess
 from synth.gap.attribution.refit import AugmentedFit, fit_augmented
@@ -224,7 +224,7 @@ class DiagnoseOptions:
 
 
 def diagnose_effects(plant: Plant, record: Record, validate: Record | Sequence[Record] | None = None,
-                     options: DiagnoseOptions | None = None) -> EffectDiagnosis:
+                     options: DiagnoseOptions | None = None, progress: dict[str, Any] | None = None) -> EffectDiagnosis:
     """Attribute the gap between ``plant`` and ``record`` to one effect, and measure its shrinkage.
 
     Parameters
@@ -242,6 +242,10 @@ def diagnose_effects(plant: Plant, record: Record, validate: Record | Sequence[R
         fitted, and is cut into its own ``blocks`` segments, resampled within the run (stratified).
     options : DiagnoseOptions, optional
         Candidates, split, bootstrap and acceptance settings (default: :class:`DiagnoseOptions`).
+    progress : dict, optional
+        Filled as the fits go: ``"total"`` steps (the re-fit, the calibration, each candidate's screen or
+        fit, each joint fit, the further effects), ``"done"`` and ``"step"`` (the last one finished), for
+        a progress bar.
 
     Returns
     -------
@@ -259,10 +263,13 @@ def diagnose_effects(plant: Plant, record: Record, validate: Record | Sequence[R
     >>> t = np.arange(0, 12, 0.01); u = np.where((t % 2) >= 1, 1.0, 0.0)
     >>> y = simulate_plant(Plant.from_string("2/(0.2*s+1)", delay=0.05), t, u)
     >>> y = y + 0.005 * np.random.default_rng(0).normal(size=t.size)
+    >>> progress = {}
     >>> dg = diagnose_effects(Plant.from_string("2.1/(0.2*s+1)"), record_from_arrays(t, u, y),
-    ...                       options=DiagnoseOptions(candidates=("delay",), n_null=5))
+    ...                       options=DiagnoseOptions(candidates=("delay",), n_null=5), progress=progress)
     >>> dg.verdict["effects"], round(dg.effects[0].parameters["delay"], 3), dg.effects[0].shrinkage > 0.9
     (['delay'], 0.05, True)
+    >>> progress["done"] == progress["total"], progress["step"]
+    (True, 'verdict')
     """
     options = DiagnoseOptions() if options is None else options
     (train_fraction, blocks, n_null, n_boot, alpha, relevance, min_share, seed, calibration, confirm, split, burn_in,
@@ -274,6 +281,9 @@ def diagnose_effects(plant: Plant, record: Record, validate: Record | Sequence[R
     labels = [e.label for e in effects]
     if len(set(labels)) != len(labels):
         raise ModelError(f"repeated candidates in {labels}", where="candidates")
+    if progress is not None:
+        progress.update(done=0, step="start",
+                        total=3 + len(effects) + (0 if confirm is None else min(confirm, len(effects))))
     rng = np.random.default_rng(seed)
     sp = split_heldout(plant, record, validate, split, train_fraction, blocks, burn_in)
     fit_offset = heldout_offset == "fit" or (heldout_offset == "auto" and sp.validation)
@@ -324,6 +334,7 @@ def diagnose_effects(plant: Plant, record: Record, validate: Record | Sequence[R
     y_nom = simulate_plant(plant, t_ev, u_ev) + c_nom
     weights = None if train_mask is None else train_mask.astype(float)
     refit = fit_augmented(plant, t_tr, u_tr, y_tr, weights=weights)
+    advance(progress, "re-fit")
     y_ref = refit.predict(t_ev, u_ev)
     s_nom, s_ref = sums(y_nom), sums(y_ref)
     j_nom, j_ref = float(s_nom.sum() / n_held), float(s_ref.sum() / n_held)
@@ -344,8 +355,9 @@ def diagnose_effects(plant: Plant, record: Record, validate: Record | Sequence[R
         null = refit_null(refit, t_tr, u_tr, t_ev, u_ev, held, not sp.validation, sigma, n_null, rng, train_mask,
                            fit_offset, groups)
     threshold = float(np.quantile(null, 1.0 - alpha, method="higher"))
+    advance(progress, "calibration")
 
-    fits = candidate_fits(plant, effects, refit, sp.train, sp.evaluated, confirm, train_mask, workers)
+    fits = candidate_fits(plant, effects, refit, sp.train, sp.evaluated, confirm, train_mask, workers, progress)
 
     by_label = {eff.label: (eff, fit) for eff, fit, _, _ in fits}
     results: list[tuple[EffectResult, np.ndarray, np.ndarray]] = []
@@ -424,6 +436,8 @@ def diagnose_effects(plant: Plant, record: Record, validate: Record | Sequence[R
     else:
         verdict_effects = []
         status = "unexplained"
+    if progress is not None:
+        progress.update(done=progress.get("total", 0), step="verdict")
     verdict = {"effects": verdict_effects, "indistinguishable": indist, "experiments": experiments,
                "status": status, "headline": headline(status, verdict_effects, indist, results, pm_shrink, j_nom, floor),
                "parsimony": parsimony}

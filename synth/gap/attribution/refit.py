@@ -16,8 +16,9 @@ the simulation error ``sum_k (y_k - yhat_k)^2`` with
   nominal coefficients;
 - the input block ``N`` (rate limit, saturation, dead zone, backlash,
   quantizer: not smooth in their parameter) by the effect's deterministic grid
-  and then a golden-section search in the log of the parameter between the
-  best grid point's neighbours, every point a full casadi fit of the rest;
+  and then a search in the log of the parameter between the best grid point's
+  neighbours (parabolic interpolation through the three when the best is inside
+  the grid, golden section otherwise), every point a full casadi fit of the rest;
 - the *basis* parameters ``a_j, d_j`` and the output constant ``c`` (linear in
   the output for a given ``G_aug``) by linear least squares, alternating with
   the casadi fit (until the SSR settles, at most twelve rounds);
@@ -45,7 +46,7 @@ import numpy as np
 
 from synth.data.record import record_from_arrays
 from synth.errors import DataError, ModelError
-from synth.gap.attribution.golden import golden_section, log_bracket
+from synth.gap.attribution.golden import golden_section, log_bracket, parabolic_section
 from synth.gap.effects.base import Effect, Params
 from synth.ident.simulate import simulate_plant
 from synth.ident.timefit import fit_structure
@@ -477,7 +478,12 @@ def fit_augmented(plant: Plant, t: np.ndarray, u: np.ndarray, y: np.ndarray, eff
 
 def _golden(plant: Plant, eff: Effect, best: _Point, same: list[_Point], key: str, t: np.ndarray, u: np.ndarray,
             y: np.ndarray, formula: str, start: dict[str, float], weights: np.ndarray | None = None) -> list[_Point]:
-    """Golden-section search in log(key) between the best grid point's neighbours."""
+    """Search in log(key) between the best grid point's neighbours (one grid step beyond an end).
+
+    Parabolic interpolation through the best point and its neighbours
+    (:func:`synth.gap.attribution.golden.parabolic_section`, a few fits instead of ten); at an end of the
+    grid the step beyond is fitted first (if it is better still, the search stops there, the end of
+    the range); golden section when a neighbour's fit failed."""
     vals = sorted({p.params[key] for p in same if np.isfinite(p.params.get(key, np.nan)) and p.params[key] > 0})
     bracket = log_bracket(vals, best.params.get(key, np.nan))
     if bracket is None:
@@ -493,5 +499,17 @@ def _golden(plant: Plant, eff: Effect, best: _Point, same: list[_Point], key: st
         out.append(pt)
         return pt.ssr
 
-    golden_section(f, *bracket, _GOLDEN - 2, tol=_GOLDEN_TOL)
+    x0 = float(np.log(best.params[key]))
+    ssr = {float(np.log(p.params[key])): p.ssr for p in same if np.isfinite(p.params.get(key, np.nan))
+           and p.params[key] > 0}
+    a, b = bracket
+    missing = [x for x in (a, b) if x not in ssr]
+    if len(missing) == 1 and a < x0 < b:  # the best is at an end of the grid: fit the step beyond it first
+        ssr[missing[0]] = f(missing[0])
+        if ssr[missing[0]] < best.ssr:  # still going down at the end of the searched range
+            return out
+    if a in ssr and b in ssr and np.isfinite(ssr[a]) and np.isfinite(ssr[b]) and a < x0 < b:
+        parabolic_section(f, a, x0, b, ssr[a], best.ssr, ssr[b], _GOLDEN - 2 - len(missing), _GOLDEN_TOL)
+    else:
+        golden_section(f, *bracket, _GOLDEN - 2 - len(out), tol=_GOLDEN_TOL)
     return out

@@ -29,6 +29,10 @@ from synth.sim.blocks import Quantizer
 
 __all__ = ["QuantizationEffect", "quantizer_grid"]
 
+_GRAM_VALUES = 600  # distinct command values up to which the dense search uses their Gram matrix
+_GRAM_ENTRIES = 2.5e7  # ... and entries of the response table it is formed from (samples x columns)
+_DENSE_SAMPLES = 20000  # a longer record that fits neither is searched on a prefix (see quantizer_grid)
+
 
 @dataclass(frozen=True)
 class QuantizationEffect(Effect):
@@ -175,6 +179,55 @@ def _batch_ssr(v: np.ndarray, y: np.ndarray, steps: list[np.ndarray], consts: li
     return np.maximum(float(y @ y) - np.einsum("mi,mi->m", coef, xty), 0.0)
 
 
+class _LevelGram:
+    """Least-squares SSR of ``y`` on the unit numerators' responses to ``v = L[u_index]`` plus a constant.
+
+    The command takes few distinct values on a step train: the response to any ``v`` that maps each of
+    them to a level is ``sum_j L_j r_j`` with ``r_j`` the response to the indicator of value ``j``. The Gram
+    matrix of those responses (and the constant, and their products with ``y``) is formed once; every
+    point then costs ``O(J^2)`` for ``J`` distinct values instead of an FFT convolution of the record
+    (:func:`_batch_ssr`, the same least squares).
+
+    Examples
+    --------
+    >>> t = np.arange(0, 5, 0.1); G = Plant.from_string("1/(s+1)"); u = np.where(t > 1, 1.0, 0.0)
+    >>> steps, consts = _step_responses(G, t)
+    >>> values, index = np.unique(u, return_inverse=True)
+    >>> L = np.array([[0.0, 0.0], [1.0, 2.0]]); y = simulate_plant(G, t, 2.0 * u) + 0.3 * np.sin(t)
+    >>> gram = _LevelGram(G, t, index, values.size, y)
+    >>> np.allclose(gram.ssr(L), _batch_ssr(L[index], y, steps, consts))
+    True
+    """
+
+    def __init__(self, plant: Plant, t: np.ndarray, u_index: np.ndarray, n_values: int, y: np.ndarray,
+                 mask: np.ndarray | None = None) -> None:
+        units = unit_numerators(plant)
+        cols = [simulate_plant(g, t, (u_index == j).astype(float)) for g in units for j in range(n_values)]
+        R = np.column_stack([*cols, np.ones_like(t)])
+        if mask is not None:
+            R, y = R[mask], y[mask]
+        self.k, self.n_values = len(units), n_values
+        self.gram, self.xty, self.yy = R.T @ R, R.T @ y, float(y @ y)
+
+    def ssr(self, levels: np.ndarray) -> np.ndarray:
+        """SSR of every column of ``levels`` (``(J, M)``: each distinct value's level, per point)."""
+        k, J, Q = self.k, self.n_values, self.gram
+        m = levels.shape[1]
+        q_l = [Q[:, i * J:(i + 1) * J] @ levels for i in range(k)] + [np.repeat(Q[:, -1:], m, axis=1)]
+        gram = np.empty((m, k + 1, k + 1))
+        xty = np.empty((m, k + 1))
+        for a in range(k + 1):
+            for c in range(k + 1):
+                block = q_l[c]
+                gram[:, a, c] = block[-1] if a == k else np.einsum("jm,jm->m", levels, block[a * J:(a + 1) * J])
+            xty[:, a] = self.xty[-1] if a == k else self.xty[a * J:(a + 1) * J] @ levels
+        scale = np.maximum(np.sqrt(np.maximum(np.einsum("mii->mi", gram), 0.0)), 1e-300)
+        gram = gram / (scale[:, :, None] * scale[:, None, :])
+        xty = xty / scale
+        coef = np.einsum("mij,mj->mi", np.linalg.pinv(gram, rcond=1e-10, hermitian=True), xty)
+        return np.maximum(self.yy - np.einsum("mi,mi->m", coef, xty), 0.0)
+
+
 def quantizer_grid(plant: Plant, t: np.ndarray, u: np.ndarray, y: np.ndarray, keep: int = 5,
                    mask: np.ndarray | None = None) -> list[Params]:
     """Dense joint search of a command quantizer's ``step`` and ``offset`` with ``plant``'s denominator fixed.
@@ -218,6 +271,10 @@ def quantizer_grid(plant: Plant, t: np.ndarray, u: np.ndarray, y: np.ndarray, ke
     if span <= 0:
         raise ModelError("the input is constant; no quantizer can be fitted", where="record.u")
     center = 0.5 * float(np.max(u) + np.min(u))
+    levels_all = np.unique(u)
+    n_use = _dense_samples(u, len(unit_numerators(plant)))
+    if n_use < t.size:  # a long record: the search on its start (from rest, as the whole); points kept per the whole
+        t, u, y, mask = t[:n_use], u[:n_use], y[:n_use], None if mask is None else np.asarray(mask)[:n_use]
     steps_r, consts = _step_responses(plant, t)
     q_lo, q_hi = 0.005 * span, 0.5 * span
     steps = [q_lo]
@@ -228,6 +285,10 @@ def quantizer_grid(plant: Plant, t: np.ndarray, u: np.ndarray, y: np.ndarray, ke
     # the quantized command depends only on the levels the command's distinct values round to: on a step
     # train (few distinct values) many (step, phase) points give the same input, whose SSR is computed once
     u_values, u_index = np.unique(u, return_inverse=True)
+    # few distinct values (a step train): Gram matrices of the responses to each value's indicator, once
+    gram = (_LevelGram(plant, t, u_index, u_values.size, y, mask)
+            if u_values.size <= _GRAM_VALUES and t.size * (len(steps_r) * u_values.size + 1) <= _GRAM_ENTRIES
+            else None)
 
     chunk = max(512, int(2e7 // u_values.size))  # points per pass: bounds the (values x points) level table
     # the SSR is unchanged by v -> a v + b when the steady responses are constant (gain in the numerator fit, the
@@ -244,7 +305,8 @@ def quantizer_grid(plant: Plant, t: np.ndarray, u: np.ndarray, y: np.ndarray, ke
             distinct, which = np.unique(levels, axis=1, return_inverse=True)
             cost = np.empty(distinct.shape[1])
             for i in range(0, distinct.shape[1], 512):
-                cost[i:i + 512] = _batch_ssr(distinct[:, i:i + 512][u_index], y, steps_r, consts, mask)
+                cost[i:i + 512] = (gram.ssr(distinct[:, i:i + 512]) if gram is not None else
+                                   _batch_ssr(distinct[:, i:i + 512][u_index], y, steps_r, consts, mask))
             out[start:start + chunk] = cost[np.ravel(which)]
         return out
 
@@ -260,7 +322,7 @@ def quantizer_grid(plant: Plant, t: np.ndarray, u: np.ndarray, y: np.ndarray, ke
     pts = np.vstack(fine)
     cost = ssr(pts)
     order = np.argsort(cost, kind="stable")
-    levels = np.unique(u)
+    levels = levels_all
     out: list[Params] = []
     for i in order:
         q, ph = pts[i]
@@ -270,6 +332,32 @@ def quantizer_grid(plant: Plant, t: np.ndarray, u: np.ndarray, y: np.ndarray, ke
         if len(out) == keep:
             break
     return out
+
+
+def _dense_samples(u: np.ndarray, units: int) -> int:
+    """How many samples from the start the dense quantizer search uses: all of them, unless that is too much work.
+
+    The whole record when its distinct values fit the Gram search (:class:`_LevelGram`: at most
+    ``_GRAM_VALUES`` values and ``_GRAM_ENTRIES`` table entries) or it has at most ``_DENSE_SAMPLES``
+    samples (an FFT per point, as always). A longer record: the longest prefix that fits the Gram search,
+    or else the first ``_DENSE_SAMPLES``: the search's cost is then bounded whatever the length (the
+    points it returns are screened on the whole record).
+
+    Examples
+    --------
+    >>> steps = np.repeat(np.arange(1000.0), 100)  # 100,000 samples of 1,000 levels
+    >>> _dense_samples(steps[:5000], 1), _dense_samples(steps, 1), _dense_samples(np.arange(30000.0), 1)
+    (5000, 49900, 20000)
+    """
+    n = u.size
+    first = np.sort(np.unique(u, return_index=True)[1])  # where each distinct value first appears
+    counts = np.arange(1, first.size + 1)  # distinct values in the prefixes from each first appearance
+    if (counts[-1] <= _GRAM_VALUES and n * (units * counts[-1] + 1.0) <= _GRAM_ENTRIES) or n <= _DENSE_SAMPLES:
+        return n
+    cap = np.minimum(np.r_[first[1:], n], _GRAM_ENTRIES // (units * counts + 1.0))  # longest prefix per count
+    ok = (counts <= _GRAM_VALUES) & (cap > first)
+    best = int(np.max(cap[ok])) if np.any(ok) else 0
+    return best if best >= _DENSE_SAMPLES else _DENSE_SAMPLES
 
 
 def _max_margin(levels: np.ndarray, step: float, lattice: float) -> Params:
