@@ -175,7 +175,13 @@ def _print(result: Any, args: argparse.Namespace, json_path: Path, figures: list
               f"(noise std {avg.noise_std_before:.3g} -> {avg.noise_std_after:.3g}, step {avg.step_size:.4g})")
     if result.whole_record_note:
         print(result.whole_record_note)
+    weak = fit.weak
+    for row in rows:
+        if any(w.name == row[0] for w in weak):
+            row[0] += " (weak)"
     print(table(["parameter", "value", "std", "95 % interval"], rows))
+    for w in weak:
+        print(w.text() + ": the record cannot pin it down; do not use it as a confident number")
     print(f"fit {fit.fit_percent:.2f} %, residual std {fit.residual_std:.3g}, "
           f"IPOPT {fit.solver.get('status')} ({fit.solver.get('iterations')} iterations)")
     print(f"plant: {fit.plant.to_string()}")
