@@ -301,7 +301,8 @@ class ConvolutionProblem:
                 step = np.linalg.solve(H + lam * np.diag(d), g)
                 trial = np.maximum(x + step, lb)
                 r_new = self._residual(trial, par, False)[0]
-                ssr_new = float(r_new @ r_new)
+                with np.errstate(all="ignore"):
+                    ssr_new = float(r_new @ r_new)
                 if np.isfinite(ssr_new) and ssr_new < ssr:
                     r, J = self._residual(trial, par, True)
                     x, ssr, accepted = trial, float(r @ r), True

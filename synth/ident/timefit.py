@@ -49,7 +49,7 @@ from synth.plant import Plant
 __all__ = ["LONG_RECORD", "TimeFitResult", "fit_structure"]
 
 #: records longer than this (samples) are fitted by :class:`~synth.ident.convolution_problem.ConvolutionProblem`
-LONG_RECORD = 20_000
+LONG_RECORD = 10_000
 
 # ------------------------------------------------------------------- results
 
