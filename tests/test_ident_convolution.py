@@ -30,7 +30,7 @@ def _case(seed: int):
 @pytest.mark.parametrize("seed, periodic, weighted", [(1, False, True), (2, True, False)])
 def test_convolution_and_ipopt_reach_the_same_fit(seed, periodic, weighted):
     plant, sensor, rng, truth = _case(seed)
-    n = 1000 if periodic else 3000
+    n = 1000 if periodic else 2000
     t = np.arange(n) * DT
     if periodic:  # one period of a square wave, its periodic response (from many periods)
         u = np.where(t < n * DT / 2, 1.0, 0.0)

@@ -12,7 +12,7 @@ from benchmarks.ident_crb import DT, make_case, matched, sensor_text
 from synth.ident.identification import identify
 
 
-@pytest.mark.parametrize("index", [1, 2])  # a periodic train entered from rest, an aperiodic one
+@pytest.mark.parametrize("index", [1])  # a periodic train entered from rest (test_ident_steptrain_crb: an aperiodic one)
 def test_benchmark_sample_fits_near_the_independent_cramer_rao_bound(index):
     case = make_case(index, 16000)
     bound = case.bound

@@ -16,10 +16,14 @@ DESCRIPTION = """Identify a parametric plant from a measured record (CSV or MAT)
 
 A two-level input with several steps is a step train: the steps are found,
 aligned and averaged (SNR before and after is printed), then the structure is
-fitted to the average by simulation error (casadi + IPOPT) with an optional
-delay and an optional known sensor in series (the fit is F*H; F is reported).
-Any other record is fitted as it is. Prints each parameter with its standard
-error and 95 % interval and the fit percent; writes identify.json, fit.png
+fitted to the average by simulation error (casadi + IPOPT; records over 10,000
+samples by FFT convolution and Levenberg-Marquardt) with an optional delay and
+an optional known sensor in series (the fit is F*H; F is reported). A train
+whose model does not settle between steps, or that starts from rest, is fitted
+on the whole record. Any other record is fitted as it is. Prints each parameter
+with its standard error and 95 % interval and the fit percent, and marks a
+parameter the record cannot pin down as weak (its correlation partner and
+interval; also in the JSON, "weakly_identifiable"); writes identify.json, fit.png
 (data, model, residuals) and train.png into --out (default
 reports/identify/<data file stem>/). Files synth did not write are never
 overwritten (use --force).
