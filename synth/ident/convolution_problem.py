@@ -217,6 +217,9 @@ class ConvolutionProblem:
         """Rows: the model output without the offset, then its derivatives in the scaled parameters (and ``f``)."""
         from scipy.fft import irfft, next_fast_len, rfft
 
+        cached = getattr(self, "_last", None)  # the solver's last point: the fit asks for it again
+        if cached is not None and cached[1] is par and np.array_equal(cached[0], dec):
+            return cached[2] if derivatives else cached[2][:1]
         A, B, C, D = self._system(dec, par, derivatives)
         n = self.n
         with np.errstate(all="ignore"):
@@ -240,7 +243,10 @@ class ConvolutionProblem:
             if not np.all(np.isfinite(h)):
                 return np.full((C.shape[0], n), np.nan)
             nfft = n if self.periodic else next_fast_len(n + h.shape[1] - 1, real=True)
-            return irfft(rfft(h, nfft, axis=1) * self._spectrum(par, nfft)[None, :], nfft, axis=1)[:, :n]
+            Y = irfft(rfft(h, nfft, axis=1) * self._spectrum(par, nfft)[None, :], nfft, axis=1)[:, :n]
+        if derivatives:
+            self._last = (np.array(dec, float), par, Y)
+        return Y
 
     def yhat_fn(self, dec: np.ndarray, par: _Inputs) -> np.ndarray:
         """Model output at the decision variables ``(xi, [f,] b)``."""
