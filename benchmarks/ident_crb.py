@@ -91,21 +91,29 @@ def _poles(rng: np.random.Generator, count: int) -> list[float]:
             return p
 
 
-def _zero(rng: np.random.Generator, poles: list[float]) -> float:
-    while True:
+def _zero(rng: np.random.Generator, poles: list[float]) -> float | None:
+    """A zero log-uniform in [0.3, 20] rad/s at least a factor 2 from every pole (None if 200 draws find none)."""
+    for _ in range(200):
         z = float(np.exp(rng.uniform(np.log(0.3), np.log(20.0))))
         if all(max(z / p, p / z) >= 2.0 for p in poles):
             return z
+    return None
 
 
 def _truth(rng: np.random.Generator, kind: str) -> tuple[str, dict[str, float]]:
     cancel = kind.endswith("-cancel")
     base = kind.removesuffix("-cancel")
     order, zeros = int(base[1]), base.count("z")
-    poles = _poles(rng, order)
-    zs: list[float] = []
-    for _ in range(zeros):
-        zs.append(_zero(rng, poles + zs))
+    while True:  # two zeros and three poles may leave no room: draw again
+        poles = _poles(rng, order)
+        zs: list[float] = []
+        for _ in range(zeros):
+            z = _zero(rng, poles + zs)
+            if z is None:
+                break
+            zs.append(z)
+        if len(zs) == zeros:
+            break
     if cancel:  # a zero within 5-15 % of a pole
         zs[0] = poles[int(rng.integers(order))] * float(rng.uniform(1.05, 1.15)) ** float(rng.choice([-1, 1]))
     k = float(np.prod(poles) / np.prod(zs) * rng.uniform(0.5, 2.0)) if zs else float(np.prod(poles) * rng.uniform(0.5, 2))
