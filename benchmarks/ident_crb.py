@@ -318,6 +318,8 @@ def summary(results: list[dict[str, Any]]) -> str:
     lines = [f"{'case':<5}{'plant, design, sensor, delay, noise':<58}{'param':<7}{'std/CRB':>8}{'bias/std':>9}"
              f"{'rep/emp':>8}{'ideal':>14}{'weak':>6}{'s/fit':>7}"]
     pairs, passed, ideal, case_ok = 0, {"efficient": 0, "unbiased": 0, "reported": 0, "all": 0}, [], 0
+    ideal_reported: list[bool] = []
+    ideal_ratio: list[float] = []
     for r in results:
         failed = bool(r["failed"]) or not r["params"]
         ok_case = True
@@ -331,6 +333,9 @@ def summary(results: list[dict[str, Any]]) -> str:
             ok_case &= v["efficient"] and v["unbiased"]
             if p:
                 ideal.append(p["ideal_std_over_crb"] <= 1.5 and abs(p["ideal_bias_over_std"]) <= 0.5)
+                ratio = p["reported_std"] / (p["ideal_std_over_crb"] * r["crb"][name])
+                ideal_reported.append(0.7 <= ratio <= 1.4)
+                ideal_ratio.append(p["reported_std"] / r["crb"][name])
             weak, secs = f"{100 * r['weak_share']:.0f}%", f"{r['seconds_per_fit']:.1f}"
             mark = "" if all(v.values()) else "  <- " + ", ".join(k for k, x in v.items() if not x)
             if p:
@@ -347,6 +352,9 @@ def summary(results: list[dict[str, Any]]) -> str:
                  f"empirical: {100 * passed['reported'] / pairs:.1f} %, all three: {100 * passed['all'] / pairs:.1f} %")
     lines.append(f"the efficient estimator on the same noise (ideal: std/CRB, bias/std) passes std and bias in "
                  f"{100 * np.mean(ideal):.1f} % of the pairs (the rest fail by chance: 20 seeds' statistics are noisy)")
+    lines.append(f"the reported std is within 0.7-1.4 of that estimator's empirical std in "
+                 f"{100 * np.mean(ideal_reported):.1f} % of the pairs; reported std / CRB: median {np.median(ideal_ratio):.2f}, "
+                 f"5-95 % {np.percentile(ideal_ratio, 5):.2f}-{np.percentile(ideal_ratio, 95):.2f}")
     lines.append(f"cases with every parameter efficient and unbiased: {case_ok} of {len(results)}")
     return "\n".join(lines)
 
