@@ -353,7 +353,8 @@ def summary(results: list[dict[str, Any]]) -> str:
     lines.append(f"the efficient estimator on the same noise (ideal: std/CRB, bias/std) passes std and bias in "
                  f"{100 * np.mean(ideal):.1f} % of the pairs (the rest fail by chance: 20 seeds' statistics are noisy)")
     lines.append(f"the reported std is within 0.7-1.4 of that estimator's empirical std in "
-                 f"{100 * np.mean(ideal_reported):.1f} % of the pairs; reported std / CRB: median {np.median(ideal_ratio):.2f}, "
+                 f"{100 * np.mean(ideal_reported):.1f} % of the pairs; reported std / CRB: median "
+                 f"{np.median(ideal_ratio):.2f}, "
                  f"5-95 % {np.percentile(ideal_ratio, 5):.2f}-{np.percentile(ideal_ratio, 95):.2f}")
     lines.append(f"cases with every parameter efficient and unbiased: {case_ok} of {len(results)}")
     return "\n".join(lines)
