@@ -340,7 +340,7 @@ def summary(results: list[dict[str, Any]]) -> str:
             mark = "" if all(v.values()) else "  <- " + ", ".join(k for k, x in v.items() if not x)
             if p:
                 lines.append(f"{r['case'] if i == 0 else '':<5}{r['label'] if i == 0 else '':<58}{name:<7}"
-                             f"{p['std_over_crb']:>8.2f}{p['bias_over_std']:>9.2f}{p['reported_over_emp']:>8.2f}"
+                             f"{p['std_over_crb']:>8.2f}{p['bias_over_std']:>9.2f}{p['reported_over_emp']:>8.3g}"
                              f"{p['ideal_std_over_crb']:>8.2f}{p['ideal_bias_over_std']:>6.2f}"
                              f"{weak if i == 0 else '':>6}{secs if i == 0 else '':>7}{mark}")
             else:
