@@ -16,10 +16,14 @@ DESCRIPTION = """Identify a parametric plant from a measured record (CSV or MAT)
 
 A two-level input with several steps is a step train: the steps are found,
 aligned and averaged (SNR before and after is printed), then the structure is
-fitted to the average by simulation error (casadi + IPOPT) with an optional
-delay and an optional known sensor in series (the fit is F*H; F is reported).
-Any other record is fitted as it is. Prints each parameter with its standard
-error and 95 % interval and the fit percent; writes identify.json, fit.png
+fitted to the average by simulation error (casadi + IPOPT; records over 10,000
+samples by FFT convolution and Levenberg-Marquardt) with an optional delay and
+an optional known sensor in series (the fit is F*H; F is reported). A train
+whose model does not settle between steps, or that starts from rest, is fitted
+on the whole record. Any other record is fitted as it is. Prints each parameter
+with its standard error and 95 % interval and the fit percent, and marks a
+parameter the record cannot pin down as weak (its correlation partner and
+interval; also in the JSON, "weakly_identifiable"); writes identify.json, fit.png
 (data, model, residuals) and train.png into --out (default
 reports/identify/<data file stem>/). Files synth did not write are never
 overwritten (use --force).
@@ -175,7 +179,13 @@ def _print(result: Any, args: argparse.Namespace, json_path: Path, figures: list
               f"(noise std {avg.noise_std_before:.3g} -> {avg.noise_std_after:.3g}, step {avg.step_size:.4g})")
     if result.whole_record_note:
         print(result.whole_record_note)
+    weak = fit.weak
+    for row in rows:
+        if any(w.name == row[0] for w in weak):
+            row[0] += " (weak)"
     print(table(["parameter", "value", "std", "95 % interval"], rows))
+    for w in weak:
+        print(w.text() + ": the record cannot pin it down; do not use it as a confident number")
     print(f"fit {fit.fit_percent:.2f} %, residual std {fit.residual_std:.3g}, "
           f"IPOPT {fit.solver.get('status')} ({fit.solver.get('iterations')} iterations)")
     print(f"plant: {fit.plant.to_string()}")

@@ -91,7 +91,8 @@ def _two_level(u: np.ndarray) -> bool:
 
 
 def identify(record: RecordLike, structure: Structure | str, delay: str | float | None = None,
-             sensor: Plant | str | None = None, average: str = "auto", by_direction: bool = False) -> IdentifyResult:
+             sensor: Plant | str | None = None, average: str = "auto", by_direction: bool = False,
+             compare_directions: bool = True) -> IdentifyResult:
     """Identify a structure from a record: average a step train if there is one, then fit.
 
     Parameters
@@ -107,6 +108,10 @@ def identify(record: RecordLike, structure: Structure | str, delay: str | float 
     average : {"auto", "cycle", "edge", "none"}
         ``"auto"``: a two-level input with at least two steps is averaged
         (:func:`synth.ident.steps.average_steps`), anything else is fitted as it is.
+        A periodic train that starts after the input has been constant for longer than the fitted
+        model's settling time is refitted on the whole record from the periodic fit (the start-up
+        transient from rest carries information that the periodic average drops; the constant
+        start, up to one settling time, is weighted 0; ``whole_record_note`` says so).
         Edge windows assume the plant at rest before each step: when the fitted model's
         settling time (:func:`settling_time`) is longer than a window, the whole record is
         fitted instead, started from the edge fit, with its start-up (one settling time, at most
@@ -114,6 +119,8 @@ def identify(record: RecordLike, structure: Structure | str, delay: str | float 
         An averaged train with up and down steps is also fitted per direction and the two
         fits compared (:func:`synth.ident.directions.fit_by_direction`); if that comparison
         cannot be made the reason is in ``direction_note``.
+    compare_directions : bool
+        ``False`` skips that comparison (two more fits; e.g. in a Monte Carlo study of the fit itself).
     by_direction : bool
         Fit a direction-dependent model: the up-step and down-step fits are the result
         (``directions``); a failure of either is an error. Needs a step train with both.
@@ -158,8 +165,10 @@ def identify(record: RecordLike, structure: Structure | str, delay: str | float 
     whole = ""
     if avg is not None and avg.mode == "edge" and average == "auto":
         fit, whole = _refit_unsettled(record, avg, fit, structure, delay, sensor)
+    elif avg is not None and avg.mode == "cycle" and average == "auto":
+        fit, whole = _refit_from_rest(record, avg, fit, structure, delay, sensor)
     directions, note = None, ""
-    if two_ways:
+    if two_ways and (compare_directions or by_direction):
         try:
             directions = fit_by_direction(record, structure, delay, sensor, avg.steps)  # type: ignore[union-attr]
         except (DataError, ModelError, RuntimeError, ValueError, np.linalg.LinAlgError) as exc:  # FitError too
@@ -198,3 +207,22 @@ def _refit_unsettled(record: Record, avg: StepAverage, fit: TimeFitResult, struc
                     f"the whole-record fit failed ({exc}), so the edge fit is kept (biased)"
     return whole, (f"the edge windows ({window:.3g} s) are shorter than the model's settling time ({settle:.3g} s): "
                    f"fitted the whole record instead, the first {skip:.3g} s (start-up from an unknown state) weighted 0")
+
+
+def _refit_from_rest(record: Record, avg: StepAverage, fit: TimeFitResult, structure: Structure,
+                     delay: str | float | None, sensor: Plant | str | None) -> tuple[TimeFitResult, str]:
+    """A periodic train entered from rest (constant input for longer than the model's settling time): fit the whole
+    record from the periodic fit, its start-up transient included, the constant start weighted 0."""
+    settle = settling_time(fit.measured)
+    first = float(record.t[avg.steps.index[0]] - record.t[0])
+    if not np.isfinite(settle) or first < settle:
+        return fit, ""
+    weights = ((record.t - record.t[0]) >= settle).astype(float)
+    try:
+        whole = fit_structure(record, structure, delay, sensor, False, initial={**fit.parameters}, weights=weights,
+                              check=True)
+    except (DataError, FitError) as exc:
+        return fit, f"the whole-record fit from rest failed ({exc}), so the periodic fit is kept"
+    return whole, (f"the input is constant for {first:.3g} s before the train, longer than the model's settling time "
+                   f"({settle:.3g} s): fitted the whole record, the start-up transient from rest included, the first "
+                   f"{settle:.3g} s weighted 0")

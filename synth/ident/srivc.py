@@ -148,30 +148,48 @@ def _srivc(t: np.ndarray, v: np.ndarray, y: np.ndarray, na: int, nb: int, delay:
     den = np.poly(-lam * np.ones(na)) if na else np.array([1.0])
     num = None
     for it in range(iterations + 1):
-        reps = _reps(den, duration) if periodic else 1
-        yf = _bank(den, t, y, na + 1, 0.0, periodic, reps)
-        vf = _bank(den, t, v, nb + 1, delay, periodic, reps)
-        phi = np.column_stack([-yf[k] for k in range(na)] + vf)
-        if num is None:
-            zeta = phi
-        else:
-            xhat = _tile_filter(Plant(num, den, delay), t, v, periodic, reps)
-            xf = _bank(den, t, xhat, na, 0.0, periodic, reps)
-            zeta = np.column_stack([-xf[k] for k in range(na)] + vf)
-        try:
-            est = np.linalg.solve(zeta.T @ phi, zeta.T @ yf[na])
-        except np.linalg.LinAlgError:
-            est = np.linalg.lstsq(phi, yf[na], rcond=None)[0]
-        a = est[:na][::-1]
-        new_den = _stable(np.r_[1.0, a]) if na else np.array([1.0])
-        new_num = est[na:][::-1]
+        try:  # an iterate far off (e.g. poles far beyond the sampling rate) may overflow the filters
+            with np.errstate(over="ignore", invalid="ignore"):
+                new_num, new_den = _srivc_step(t, v, y, na, nb, delay, periodic, duration, num, den)
+        except (np.linalg.LinAlgError, ValueError, FloatingPointError):
+            break
+        if not (np.all(np.isfinite(new_num)) and np.all(np.isfinite(new_den))):
+            break
         converged = num is not None and np.allclose(new_den, den, rtol=1e-7) and np.allclose(new_num, num, rtol=1e-7)
         den, num = new_den, new_num
         if converged and it > 0:
             break
+    if num is None:
+        return np.array([0.0]), den, float("inf")
     reps = _reps(den, duration) if periodic else 1
-    sim = _tile_filter(Plant(num, den, delay), t, v, periodic, reps)
-    return num, den, float(np.sum((y - sim) ** 2))
+    try:
+        with np.errstate(over="ignore", invalid="ignore"):
+            sim = _tile_filter(Plant(num, den, delay), t, v, periodic, reps)
+    except (np.linalg.LinAlgError, ValueError, FloatingPointError):
+        return num, den, float("inf")
+    ssr = float(np.sum((y - sim) ** 2))
+    return num, den, ssr if np.isfinite(ssr) else float("inf")
+
+
+def _srivc_step(t: np.ndarray, v: np.ndarray, y: np.ndarray, na: int, nb: int, delay: float, periodic: bool,
+                duration: float, num: np.ndarray | None, den: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """One SRIVC iteration: the instrumental-variable estimate with the prefilter ``1/den``."""
+    reps = _reps(den, duration) if periodic else 1
+    yf = _bank(den, t, y, na + 1, 0.0, periodic, reps)
+    vf = _bank(den, t, v, nb + 1, delay, periodic, reps)
+    phi = np.column_stack([-yf[k] for k in range(na)] + vf)
+    if num is None:
+        zeta = phi
+    else:
+        xhat = _tile_filter(Plant(num, den, delay), t, v, periodic, reps)
+        xf = _bank(den, t, xhat, na, 0.0, periodic, reps)
+        zeta = np.column_stack([-xf[k] for k in range(na)] + vf)
+    try:
+        est = np.linalg.solve(zeta.T @ phi, zeta.T @ yf[na])
+    except np.linalg.LinAlgError:
+        est = np.linalg.lstsq(phi, yf[na], rcond=None)[0]
+    a = est[:na][::-1]
+    return est[na:][::-1], (_stable(np.r_[1.0, a]) if na else np.array([1.0]))
 
 
 def _first_response(t: np.ndarray, w: np.ndarray, y: np.ndarray) -> float:

@@ -38,13 +38,18 @@ from scipy.stats import t as student_t
 
 from synth.data.record import Record
 from synth.errors import DataError, FitError, ModelError
+from synth.ident.convolution_problem import ConvolutionProblem
 from synth.ident.fit_failure import LIMIT_STATUSES, fit_failure
+from synth.ident.identifiability import WeakParameter, weak_parameters
 from synth.ident.sim_error_problem import SimulationErrorProblem
 from synth.ident.srivc import linear_initial_model, map_to_structure
 from synth.ident.structure import Structure, parse_structure
 from synth.plant import Plant
 
-__all__ = ["TimeFitResult", "fit_structure"]
+__all__ = ["LONG_RECORD", "TimeFitResult", "fit_structure"]
+
+#: records longer than this (samples) are fitted by :class:`~synth.ident.convolution_problem.ConvolutionProblem`
+LONG_RECORD = 10_000
 
 # ------------------------------------------------------------------- results
 
@@ -116,6 +121,24 @@ class TimeFitResult:
         """``y - yhat``."""
         return self.y - self.yhat
 
+    @property
+    def weak(self) -> list[WeakParameter]:
+        """Parameters the record cannot pin down (:func:`synth.ident.identifiability.weak_parameters`).
+
+        Examples
+        --------
+        >>> from synth.data import record_from_arrays
+        >>> from synth.ident.simulate import simulate_plant
+        >>> t = np.arange(0, 4, 0.01); u = np.where(t >= 0.5, 1.0, 0.0)
+        >>> y = simulate_plant(Plant.from_string("2/(s+3)"), t, u) + 0.01 * np.random.default_rng(0).normal(size=t.size)
+        >>> fit_structure(record_from_arrays(t, u, y), "k/(s+p)").weak
+        []
+        """
+        delay_name = self.names[len(self.structure.parameters)] if self.delay_fitted else None
+        dt = float(self.t[1] - self.t[0]) if self.t.size > 1 else 0.0
+        return weak_parameters(self.names, {**self.parameters, "offset": self.offset}, self.covariance, self.ci95,
+                               delay_name, dt)
+
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready result: ``parameters``, ``std``, ``ci95``, ``fit_percent``, ``tf`` and more.
 
@@ -150,6 +173,7 @@ class TimeFitResult:
             "measured_model": self.measured.to_dict(),
             "initial": dict(self.initial),
             "solver": dict(self.solver),
+            "weakly_identifiable": [w.to_dict() for w in self.weak],
         }
 
 
@@ -214,7 +238,7 @@ def fit_structure(record: Record, structure: Structure | str, delay: str | float
                   sensor: Plant | str | None = None, periodic: bool = False,
                   initial: dict[str, float] | None = None,
                   lower: dict[str, float] | None = None,
-                  weights: np.ndarray | None = None, check: bool = False) -> TimeFitResult:
+                  weights: np.ndarray | None = None, check: bool = False, solver: str = "auto") -> TimeFitResult:
     """Fit a structure to a record by simulation error (casadi + IPOPT).
 
     Parameters
@@ -246,6 +270,12 @@ def fit_structure(record: Record, structure: Structure | str, delay: str | float
         Raise :class:`~synth.errors.FitError` when the fit failed (what :func:`synth.ident.identification.identify`,
         ``synth identify`` and :func:`synth.ident.directions.fit_by_direction` do). Without it the reason is in
         ``solver["failure"]`` (empty for a good fit), for callers that try several fits and keep the best.
+    solver : {"auto", "ipopt", "convolution"}
+        ``"ipopt"``: casadi's symbolic recursion over the record and IPOPT
+        (:class:`~synth.ident.sim_error_problem.SimulationErrorProblem`); ``"convolution"``: the same
+        cost evaluated by FFT convolution and solved by Levenberg-Marquardt
+        (:class:`~synth.ident.convolution_problem.ConvolutionProblem`), whose cost does not grow with
+        a symbolic graph; ``"auto"``: the convolution above ``LONG_RECORD`` samples.
 
     Returns
     -------
@@ -318,7 +348,13 @@ def fit_structure(record: Record, structure: Structure | str, delay: str | float
         if int(mask.sum()) <= p_total + 1:
             raise DataError(f"{int(mask.sum())} weighted samples cannot determine {p_total} parameters",
                             where=record.source)
-    prob = SimulationErrorProblem(st, sensor, n, dt, periodic, theta0, fit_delay, y, has_d, weights)
+    if solver not in ("auto", "ipopt", "convolution"):
+        raise ModelError(f"solver must be 'auto', 'ipopt' or 'convolution', got {solver!r}", where="solver")
+    if solver == "convolution" or (solver == "auto" and n > LONG_RECORD):
+        prob: Any = ConvolutionProblem(st, sensor, n, dt, periodic, theta0, fit_delay, y, has_d, weights)
+        info["method"] = "Levenberg-Marquardt, exact Jacobian by FFT convolution of the sensitivities"
+    else:
+        prob = SimulationErrorProblem(st, sensor, n, dt, periodic, theta0, fit_delay, y, has_d, weights)
     b0 = y_ref if not periodic else y_ref - float(Plant(num_chk, den_chk).dc_gain()) * w_mean * (
         sensor.dc_gain() if sensor is not None else 1.0)
     initial_out = {**dict(zip(st.parameters, theta0.tolist())), delay_name: d0}

@@ -1,0 +1,149 @@
+"""Which fitted parameters the record cannot pin down (weak identifiability), from the fit's covariance.
+
+A parameter is *weakly identifiable* when its standard error is a large share of its value
+(``std > WEAK_RELATIVE_STD |value|``: the 95 % interval spans about +-50 % or more), or when
+it is tied to another parameter (``|correlation| >= TIED_CORRELATION``) and still known only to
+``TIED_RELATIVE_STD`` or worse. The typical case is a near pole-zero cancellation: the zero
+and the pole it nearly cancels move together along a ridge of the cost, each with a large
+standard error and a correlation near 1. Such a number is reported with its interval and its
+correlation partner, not as a confident value. The delay is measured against
+``max(|delay|, dt)`` (a delay of a fraction of a sample known to a fraction of a sample is
+pinned down); the output offset is a nuisance parameter and not judged.
+
+This rests on the linearized (Gauss-Newton) covariance: where it says a parameter is weak,
+its interval is also only a rough guide (the cost is far from quadratic along the ridge).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+__all__ = ["TIED_CORRELATION", "TIED_RELATIVE_STD", "WEAK_RELATIVE_STD", "WeakParameter", "weak_parameters"]
+
+#: a parameter whose standard error exceeds this share of its value is weakly identifiable
+WEAK_RELATIVE_STD = 0.25
+#: a correlation this close to +-1 with another parameter ties the two together ...
+TIED_CORRELATION = 0.995
+#: ... and makes the parameter weakly identifiable when its standard error is above this share of its value
+TIED_RELATIVE_STD = 0.05
+
+
+@dataclass(frozen=True)
+class WeakParameter:
+    """A parameter the record cannot pin down.
+
+    Attributes
+    ----------
+    name : str
+    value, std : float
+    relative_std : float
+        ``std / |value|`` (for the delay ``std / max(|delay|, dt)``).
+    interval : tuple of float
+        The fit's 95 % interval.
+    partner : str or None
+        The parameter it is most correlated with.
+    correlation : float
+        That correlation.
+    reason : str
+        Why it is flagged, in words.
+    """
+
+    name: str
+    value: float
+    std: float
+    relative_std: float
+    interval: tuple[float, float]
+    partner: str | None
+    correlation: float
+    reason: str
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready fields.
+
+        Examples
+        --------
+        >>> w = WeakParameter("z", 1.0, 0.6, 0.6, (-0.2, 2.2), "p", 0.999, "std 60 % of the value")
+        >>> w.to_dict()["partner"], w.to_dict()["interval"]
+        ('p', [-0.2, 2.2])
+        """
+        return {"name": self.name, "value": self.value, "std": self.std, "relative_std": self.relative_std,
+                "interval": list(self.interval), "partner": self.partner, "correlation": self.correlation,
+                "reason": self.reason}
+
+    def text(self) -> str:
+        """One line for a report.
+
+        Examples
+        --------
+        >>> WeakParameter("z", 1.0, 0.6, 0.6, (-0.2, 2.2), "p", 0.999, "std 60 % of the value").text()
+        'z = 1 is weakly identifiable (std 60 % of the value; correlation +0.999 with p; 95 % interval [-0.2, 2.2])'
+        """
+        partner = f"; correlation {self.correlation:+.3f} with {self.partner}" if self.partner else ""
+        return (f"{self.name} = {self.value:.6g} is weakly identifiable ({self.reason}{partner}; "
+                f"95 % interval [{self.interval[0]:.6g}, {self.interval[1]:.6g}])")
+
+
+def weak_parameters(names: list[str], values: dict[str, float], covariance: np.ndarray,
+                    intervals: dict[str, tuple[float, float]], delay_name: str | None = None,
+                    dt: float = 0.0) -> list[WeakParameter]:
+    """The weakly identifiable parameters of a fit (see the module text for the rule).
+
+    Parameters
+    ----------
+    names : list of str
+        Rows and columns of ``covariance`` (``"offset"`` is skipped).
+    values : dict
+        Fitted values by name.
+    covariance : numpy.ndarray
+    intervals : dict
+        95 % intervals by name.
+    delay_name : str, optional
+        The delay's name (judged against ``max(|delay|, dt)``).
+    dt : float
+        Sample time [s].
+
+    Returns
+    -------
+    list of WeakParameter
+        Empty when every parameter is pinned down.
+
+    Examples
+    --------
+    >>> cov = np.array([[0.04, 0.03992], [0.03992, 0.04]])  # std 0.2 each, correlation 0.998
+    >>> weak = weak_parameters(["z", "p"], {"z": 1.0, "p": 1.1}, cov, {"z": (0.6, 1.4), "p": (0.7, 1.5)})
+    >>> [(w.name, w.partner, round(w.correlation, 3)) for w in weak]
+    [('z', 'p', 0.998), ('p', 'z', 0.998)]
+    >>> weak_parameters(["k", "p"], {"k": 2.0, "p": 3.0}, np.diag([1e-4, 1e-4]), {"k": (1.98, 2.02), "p": (2.98, 3.02)})
+    []
+    """
+    cov = np.asarray(covariance, float)
+    idx = [i for i, n in enumerate(names) if n != "offset"]
+    if not idx or cov.shape != (len(names), len(names)):
+        return []
+    sd = np.sqrt(np.clip(np.diag(cov), 0.0, None))
+    with np.errstate(all="ignore"):
+        corr = cov / np.outer(sd, sd)
+    out = []
+    for i in idx:
+        name = names[i]
+        value = float(values[name])
+        ref = max(abs(value), dt) if name == delay_name else abs(value)
+        rel = float(sd[i] / ref) if ref > 0 else (float("inf") if sd[i] > 0 else 0.0)
+        others = [j for j in idx if j != i and np.isfinite(corr[i, j])]
+        j = max(others, key=lambda k: abs(corr[i, k])) if others else None
+        rho = float(corr[i, j]) if j is not None else 0.0
+        if not np.isfinite(sd[i]):
+            reason = "its standard error is not finite"
+        elif rel > WEAK_RELATIVE_STD:
+            reason = f"std {100 * rel:.3g} % of the value"
+        elif abs(rho) >= TIED_CORRELATION and rel > TIED_RELATIVE_STD:
+            reason = f"std {100 * rel:.3g} % of the value, tied to another parameter"
+        else:
+            continue
+        lo, hi = intervals.get(name, (float("nan"), float("nan")))
+        out.append(WeakParameter(name, value, float(sd[i]), rel, (float(lo), float(hi)),
+                                 names[j] if j is not None else None, rho, reason))
+    return out
