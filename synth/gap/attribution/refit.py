@@ -58,7 +58,7 @@ _CHI2_1_95 = 3.841458820694124
 _ROUNDS = 12  # most alternations of the casadi fit and the least-squares basis step
 _ROUNDS_TOL = 1e-6  # ... stopped when the training SSR changes less than this (relative)
 _GOLDEN = 12  # most golden-section evaluations after the grid
-_GOLDEN_TOL = 0.01  # ... or until the bracket is this narrow in log
+_GOLDEN_TOL = 0.002  # ... or until the bracket is this narrow in log (0.2 %: finer than a long record's profile interval)
 
 
 def monomial(power: int) -> str:
