@@ -30,53 +30,13 @@ from scipy.linalg import matrix_balance
 
 from synth.errors import ModelError
 from synth.ident.structure import Structure
+from synth.ident.symbolic_model import companion_form, taylor_expm, with_sensor
 from synth.plant import Plant
 
 __all__ = ["ConvolutionProblem"]
 
 _BLOCK = 256  # samples per block of the impulse response
 _MAX_ITER = 100
-
-
-def _companion(num: list[Any], den: list[Any]) -> tuple[list[list[Any]], list[Any], Any]:
-    n = len(den) - 1
-    a = [d / den[0] for d in den[1:]]
-    b = [0.0] * (n + 1 - len(num)) + [c / den[0] for c in num]
-    D = b[0]
-    r = [b[i + 1] - D * a[i] for i in range(n)]
-    A = [[0.0] * n for _ in range(n)]
-    for i in range(n - 1):
-        A[i][i + 1] = 1.0
-    for j in range(n):
-        A[n - 1][j] = -a[n - 1 - j]
-    return A, [r[n - 1 - j] for j in range(n)], D
-
-
-def _series(num: list[Any], den: list[Any], sensor: Plant | None) -> tuple[list[Any], list[Any]]:
-    if sensor is None:
-        return list(num), list(den)
-
-    def mul(p: list[Any], q: np.ndarray) -> list[Any]:
-        out: list[Any] = [0.0] * (len(p) + q.size - 1)
-        for i, x in enumerate(p):
-            for j, y in enumerate(q):
-                out[i + j] = out[i + j] + x * float(y)
-        return out
-
-    return mul(list(num), sensor.num), mul(list(den), sensor.den)
-
-
-def _expm(M: Any, squarings: int, order: int = 12) -> Any:
-    import casadi as ca
-
-    n = M.shape[0]
-    X = M / float(2**squarings)
-    E = ca.SX.eye(n)
-    for k in range(order, 0, -1):
-        E = ca.SX.eye(n) + (X @ E) / k
-    for _ in range(squarings):
-        E = E @ E
-    return E
 
 
 @dataclass(frozen=True)
@@ -118,15 +78,15 @@ class ConvolutionProblem:
         self.mask = None if weights is None else np.asarray(weights, float) > 0
         self.col = 1 if (fit_delay or has_d) else 0
         xi, f = ca.SX.sym("xi", p), ca.SX.sym("f")
-        num, den = _series(*st.casadi_coefficients(xi * ca.DM(self.scale)), sensor)
-        num0, den0 = _series(*[list(c) for c in st.coefficients(theta0)], sensor)
+        num, den = with_sensor(*st.casadi_coefficients(xi * ca.DM(self.scale)), sensor)
+        num0, den0 = with_sensor(*[list(c) for c in st.coefficients(theta0)], sensor)
         order = len(den) - 1
         if order == 0:
             raise ModelError(f"structure {st.formula!r}: a static gain needs no dynamic fit")
-        A0 = np.asarray(_companion(num0, den0)[0], float)
+        A0 = np.asarray(companion_form(num0, den0)[0], float)
         _, (scl, _) = matrix_balance(A0, permute=False, separate=True)
         Tm, Ti = np.diag(scl), np.diag(1.0 / scl)
-        A_l, C_l, D = _companion(num, den)
+        A_l, C_l, D = companion_form(num, den)
         A = ca.DM(Ti) @ ca.vertcat(*[ca.horzcat(*row) for row in A_l]) @ ca.DM(Tm)
         C = ca.horzcat(*C_l) @ ca.DM(Tm)
         Mnum = np.zeros((order + 1, order + 1))
@@ -134,7 +94,7 @@ class ConvolutionProblem:
         Mnum[:order, order] = Ti[:, -1]
         squarings = int(max(0, np.ceil(np.log2(max(float(np.linalg.norm(Mnum * dt, 1)), 1e-12)))) + 4)
         M = ca.vertcat(ca.horzcat(A, ca.DM(Ti[:, -1])), ca.SX.zeros(1, order + 1))
-        E_dt, E_rest, E_f = _expm(M * dt, squarings), _expm(M * (dt - f), squarings), _expm(M * f, squarings)
+        E_dt, E_rest, E_f = (taylor_expm(M * step, squarings, symbolic="SX") for step in (dt, dt - f, f))
         B_late = E_rest[:order, order]
         B_early = E_rest[:order, :order] @ E_f[:order, order]
         mats = ca.vertcat(ca.vec(E_dt[:order, :order]), B_late, B_early, ca.vec(C), D)

@@ -39,41 +39,12 @@ from scipy.linalg import matrix_balance
 
 from synth.errors import ModelError
 from synth.ident.structure import Structure
+from synth.ident.symbolic_model import companion_form, taylor_expm, with_sensor
 from synth.plant import Plant
 
 __all__ = ["SimulationErrorProblem"]
 
 # ---------------------------------------------------------------- realization
-
-
-def _companion(num: list[Any], den: list[Any]) -> tuple[list[list[Any]], list[Any], Any]:
-    """Controllable canonical ``A`` (nested lists), ``C`` and ``D`` of ``num/den`` (any numeric type)."""
-    n = len(den) - 1
-    lead = den[0]
-    a = [d / lead for d in den[1:]]
-    b = [0.0] * (n + 1 - len(num)) + [c / lead for c in num]
-    D = b[0]
-    r = [b[i + 1] - D * a[i] for i in range(n)]
-    A = [[0.0] * n for _ in range(n)]
-    for i in range(n - 1):
-        A[i][i + 1] = 1.0
-    for j in range(n):
-        A[n - 1][j] = -a[n - 1 - j]
-    C = [r[n - 1 - j] for j in range(n)]
-    return A, C, D
-
-
-def _expm(M: Any, squarings: int, order: int = 12) -> Any:
-    import casadi as ca
-
-    n = M.shape[0]
-    X = M / float(2**squarings)
-    E = ca.MX.eye(n)
-    for k in range(order, 0, -1):
-        E = ca.MX.eye(n) + (X @ E) / k
-    for _ in range(squarings):
-        E = E @ E
-    return E
 
 
 def _matpow(M: Any, k: int) -> Any:
@@ -88,20 +59,6 @@ def _matpow(M: Any, k: int) -> Any:
         if k:
             base = base @ base
     return result
-
-
-def _series(num: list[Any], den: list[Any], sensor: Plant | None) -> tuple[list[Any], list[Any]]:
-    if sensor is None:
-        return list(num), list(den)
-
-    def mul(p: list[Any], q: np.ndarray) -> list[Any]:
-        out: list[Any] = [0.0] * (len(p) + q.size - 1)
-        for i, x in enumerate(p):
-            for j, y in enumerate(q):
-                out[i + j] = out[i + j] + x * float(y)
-        return out
-
-    return mul(list(num), sensor.num), mul(list(den), sensor.den)
 
 
 # ------------------------------------------------------------------ the NLP
@@ -165,16 +122,16 @@ class SimulationErrorProblem:
         b = ca.MX.sym("b")
         W = ca.MX.sym("W", 2, n)
         theta = xi * ca.DM(self.scale)
-        num, den = _series(*st.casadi_coefficients(theta), sensor)
-        num0, den0 = _series(*[list(c) for c in st.coefficients(theta0)], sensor)
-        A0, _, _ = _companion(num0, den0)
+        num, den = with_sensor(*st.casadi_coefficients(theta), sensor)
+        num0, den0 = with_sensor(*[list(c) for c in st.coefficients(theta0)], sensor)
+        A0, _, _ = companion_form(num0, den0)
         order = len(den) - 1
         if order == 0:
             raise ModelError(f"structure {st.formula!r}: a static gain needs no dynamic fit")
         A0 = np.asarray(A0, float)
         _, (scl, _) = matrix_balance(A0, permute=False, separate=True)
         Tm, Ti = np.diag(scl), np.diag(1.0 / scl)
-        A_l, C_l, D = _companion(num, den)
+        A_l, C_l, D = companion_form(num, den)
         A = ca.vertcat(*[ca.horzcat(*row) for row in A_l])
         C = ca.horzcat(*C_l)
         A = ca.DM(Ti) @ A @ ca.DM(Tm)
@@ -186,9 +143,9 @@ class SimulationErrorProblem:
         norm = float(np.linalg.norm(Mnum * dt, 1))
         squarings = int(max(0, np.ceil(np.log2(max(norm, 1e-12)))) + 4)
         M = ca.vertcat(ca.horzcat(A, Bv), ca.DM.zeros(1, order + 1))
-        E_dt = _expm(M * dt, squarings)
-        E_rest = _expm(M * (dt - f), squarings)
-        E_f = _expm(M * f, squarings)
+        E_dt = taylor_expm(M * dt, squarings, symbolic="MX")
+        E_rest = taylor_expm(M * (dt - f), squarings, symbolic="MX")
+        E_f = taylor_expm(M * f, squarings, symbolic="MX")
         Ad = E_dt[:order, :order]
         B_late = E_rest[:order, order]
         B_early = E_rest[:order, :order] @ E_f[:order, order]
