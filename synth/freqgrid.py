@@ -15,7 +15,7 @@ import numpy as np
 from synth.rootfind import bisect_roots
 
 __all__ = ["DEFAULT_PER_DECADE", "Curve", "band_grid", "band_grids", "batch_first_crossing", "batch_peak",
-           "characteristic_range", "crossings", "log_grid", "log_grids", "peak"]
+           "characteristic_range", "corner_frequencies", "crossings", "log_grid", "log_grids", "peak"]
 
 Curve = Callable[[np.ndarray], np.ndarray]
 
@@ -30,17 +30,29 @@ def characteristic_range(*polys: np.ndarray, delay: float = 0.0) -> tuple[float,
     >>> characteristic_range(np.array([1.0, 10.0]), np.array([1.0, 1.0]))
     (0.01, 1000.0)
     """
+    lo, hi = corner_frequencies(*polys)
+    if delay > 0:
+        lo, hi = (1.0 / delay, 1.0 / delay) if np.isnan(lo) else (min(lo, 1.0 / delay), max(hi, 1.0 / delay))
+    if np.isnan(lo):
+        return 1e-2, 1e2
+    return float(lo) / 100.0, float(hi) * 100.0
+
+
+def corner_frequencies(*polys: np.ndarray) -> tuple[float, float]:
+    """Smallest and largest root magnitude above 1e-12 of the polynomials (``nan, nan`` if none).
+
+    Examples
+    --------
+    >>> corner_frequencies(np.array([1.0, 10.0]), np.array([1.0, 1.0]))
+    (1.0, 10.0)
+    """
     mags: list[float] = []
     for p in polys:
         p = np.asarray(p, dtype=float)
         if p.size > 1:
             r = np.abs(np.roots(p))
             mags.extend(r[r > 1e-12].tolist())
-    if delay > 0:
-        mags.append(1.0 / delay)
-    if not mags:
-        return 1e-2, 1e2
-    return float(min(mags)) / 100.0, float(max(mags)) * 100.0
+    return (float(min(mags)), float(max(mags))) if mags else (np.nan, np.nan)
 
 
 def log_grid(w_lo: float, w_hi: float, per_decade: int = DEFAULT_PER_DECADE) -> np.ndarray:

@@ -17,7 +17,8 @@ from synth.controllers import Controller, as_controller
 from synth.freqgrid import characteristic_range, crossings, log_grid
 from synth.plant import Plant, as_plant
 from synth.polynomials import dc_value, format_factored, magnitude_squared_in_w2, trim
-from synth.stability import StabilityResult, closed_loop_stability, gain_margin_factors, stability_floor
+from synth.stability import StabilityResult, closed_loop_stability, stability_floor
+from synth.stability_sets import gain_margin_factors
 
 __all__ = ["BANDWIDTH_LEVEL", "Loop", "Margins"]
 
@@ -246,7 +247,7 @@ class Loop:
 
     @cached_property
     def gain_factors(self) -> tuple[float, float, float | None, float | None]:
-        """``(k_lo, k_hi, w_lo, w_hi)`` of :func:`synth.stability.gain_margin_factors` (cached)."""
+        """``(k_lo, k_hi, w_lo, w_hi)`` of :func:`synth.stability_sets.gain_margin_factors` (cached)."""
         return gain_margin_factors(self.num, self.den, self.delay)
 
     def margins(self) -> Margins:

@@ -10,7 +10,7 @@ from typing import Any
 import numpy as np
 
 from synth.controllers import Controller, as_controller
-from synth.freqgrid import log_grids
+from synth.freqgrid import corner_frequencies, log_grids
 from synth.plant import Plant, as_plant
 from synth.polynomials import dc_value
 from synth.rootfind import bisect_roots
@@ -98,7 +98,7 @@ class LoopBatch:
         self.num = _row_product(self.cnum, plant.num)
         self.den = _row_product(self.cden, plant.den)
         self._l0 = dc_value(self.num, self.den)  # L(0), the exact limit (s cancels first)
-        p_lo, p_hi = _corners(plant.num, plant.den)
+        p_lo, p_hi = corner_frequencies(plant.num, plant.den)
         if plant.delay > 0:
             p_lo, p_hi = min(p_lo, 1.0 / plant.delay), max(p_hi, 1.0 / plant.delay)
         lo, hi = np.fmin(self._corner_lo, p_lo), np.fmax(self._corner_hi, p_hi)
@@ -128,11 +128,11 @@ class LoopBatch:
 
     def _unstable_by_gain(self) -> np.ndarray | None:
         """Where the loops differ by a gain only (:meth:`gain_multiples`, at least 8 of them): the exact
-        stabilizing set of that gain by D-decomposition (:func:`synth.stability.affine_stability_intervals`,
+        stabilizing set of that gain by D-decomposition (:func:`synth.stability_sets.affine_stability_intervals`,
         the count at one gain per piece between boundaries), read at every row; the rows within 1e-9 of a
         boundary are counted one by one."""
         from synth.loop import Loop
-        from synth.stability import affine_stability_intervals, stability_boundaries
+        from synth.stability_sets import affine_stability_intervals, stability_boundaries
 
         multiples = self.gain_multiples() if len(self) >= 8 else None
         if multiples is None:
@@ -285,7 +285,7 @@ class LoopBatch:
 
     def upper_gain_margins(self, limit: float = 1e4, per_decade: int = 100) -> np.ndarray:
         """Each loop's smallest gain factor above 1 that puts a closed-loop root on the imaginary axis
-        (``inf`` if none up to ``limit``): the ``k_hi`` of :func:`synth.stability.gain_margin_factors`,
+        (``inf`` if none up to ``limit``): the ``k_hi`` of :func:`synth.stability_sets.gain_margin_factors`,
         found for all loops at once from the sign changes of ``Im L(jw)`` where ``Re L < 0`` on a log grid
         four decades beyond :attr:`frequency_ranges` (and ``w = 0``), refined by bisection.
 
@@ -373,20 +373,8 @@ class LoopBatch:
             return (horner(self.num[rows], s) / horner(self.den[rows], s))[:, 0] * np.exp(-s[:, 0] * self.plant.delay)
 
 
-def _corners(*polys: np.ndarray) -> tuple[float, float]:
-    """Smallest and largest root magnitude above 1e-12 of the polynomials (nan, nan if none), as
-    :func:`synth.freqgrid.characteristic_range` counts them."""
-    mags: list[float] = []
-    for p in polys:
-        p = np.asarray(p, dtype=float)
-        if p.size > 1:
-            r = np.abs(np.roots(p))
-            mags.extend(r[r > 1e-12].tolist())
-    return (min(mags), max(mags)) if mags else (np.nan, np.nan)
-
-
 def _row_corners(*rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """:func:`_corners` of every row at once (the rows of each array are one polynomial each)."""
+    """:func:`synth.freqgrid.corner_frequencies` of every row at once (the rows of each array are one polynomial each)."""
     n = rows[0].shape[0]
     lo, hi = np.full(n, np.inf), np.full(n, -np.inf)
     for r in rows:

@@ -11,38 +11,30 @@ imaginary axis, up to the frequency where ``|L(jw)|`` has fallen below a level
 ``r < 1`` for good (found exactly from a polynomial in ``w**2``); beyond it
 ``1 + L`` stays in the right half-plane and adds no winding.
 
-:func:`affine_stability_intervals` finds every value of a real parameter
-``rho`` (the controller is ``C0 + rho*C1``) at which a closed-loop root
-crosses the imaginary axis (the D-decomposition), then tests one point
-between neighbouring boundaries: the result is the exact set of stabilizing
-values.
+The stabilizing set of a parameter (the D-decomposition) and the gain
+margins built on this count are in :mod:`synth.stability_sets`.
 """
 
 from __future__ import annotations
 
 from dataclasses import asdict, dataclass
-from itertools import pairwise
 
 import numpy as np
 
 from synth.errors import ModelError
 from synth.polynomials import largest_crossing, shifted, trim
-from synth.rootfind import bisect_roots
 
 __all__ = [
-    "GAIN_SEARCH_LIMIT",
+    "PHASE_STEP",
     "STABILITY_FLOOR",
     "Rational",
-    "StabilityInterval",
     "StabilityResult",
-    "affine_stability_intervals",
+    "characteristic_scale",
     "closed_loop_stability",
-    "gain_margin_factors",
-    "stability_boundaries",
     "stability_floor",
 ]
 
-_PHASE_STEP = np.pi / 8.0
+PHASE_STEP = np.pi / 8.0
 
 
 @dataclass(frozen=True)
@@ -111,10 +103,10 @@ def stability_floor(num: np.ndarray, den: np.ndarray, delay: float = 0.0) -> flo
     >>> stability_floor(np.array([1.0]), np.array([1.0, 0.5, 0.0]))
     5e-07
     """
-    return STABILITY_FLOOR * _characteristic_scale(num, den, delay=delay)[0]
+    return STABILITY_FLOOR * characteristic_scale(num, den, delay=delay)[0]
 
 
-def _characteristic_scale(*polys: np.ndarray, delay: float = 0.0) -> tuple[float, float]:
+def characteristic_scale(*polys: np.ndarray, delay: float = 0.0) -> tuple[float, float]:
     """Smallest and largest characteristic frequencies (rad/s): root magnitudes and 1/delay."""
     mags = []
     for p in polys:
@@ -168,7 +160,7 @@ class _ReturnDifference:
 
 def _segment_phase(F: _ReturnDifference, a: float, b: float, delay: float) -> tuple[float, float]:
     """Continuous phase change of F(jw) for w from a to b, and min |F| seen."""
-    pts = [np.linspace(a, b, max(3, int(np.ceil((b - a) * delay / _PHASE_STEP)) + 2))]
+    pts = [np.linspace(a, b, max(3, int(np.ceil((b - a) * delay / PHASE_STEP)) + 2))]
     if a > 0:
         pts.append(np.geomspace(a, b, max(3, int(40 * np.log10(b / a)) + 2)))
     w = np.unique(np.concatenate(pts))
@@ -177,7 +169,7 @@ def _segment_phase(F: _ReturnDifference, a: float, b: float, delay: float) -> tu
         ratio = f[1:] / f[:-1]
         step = np.abs(np.angle(ratio))
         chord = np.abs(f[1:] - f[:-1])
-        bad = (step > _PHASE_STEP) | (chord > 0.5 * np.minimum(np.abs(f[1:]), np.abs(f[:-1])))
+        bad = (step > PHASE_STEP) | (chord > 0.5 * np.minimum(np.abs(f[1:]), np.abs(f[:-1])))
         if not np.any(bad) or w.size > 2_000_000:
             break
         idx = np.flatnonzero(bad)
@@ -275,7 +267,7 @@ def _count(num: np.ndarray, den: np.ndarray, delay: float) -> StabilityResult:
             "closed-loop stability is not robust to any delay; make the loop strictly proper"
         )
     level = max(0.5, 0.5 * (1.0 + abs(c_inf)))
-    w_lo_scale, _ = _characteristic_scale(num, den, delay=delay)
+    w_lo_scale, _ = characteristic_scale(num, den, delay=delay)
     w_top = largest_crossing(num, den, level)
     axis_max = max((w for w, _ in axis), default=0.0)
     w_top = max(w_top * 1.05, 2.0 * axis_max, 1e-3 * w_lo_scale)
@@ -316,216 +308,3 @@ def _marginal_frequency(F: _ReturnDifference, w_top: float) -> float:
 
 # --------------------------------------------------------------------------- D-decomposition
 Rational = tuple[np.ndarray, np.ndarray]
-
-
-@dataclass(frozen=True)
-class StabilityInterval:
-    """A closed interval of a parameter over which the closed loop is stable.
-
-    ``lo_is_boundary`` / ``hi_is_boundary`` tell whether the end is a
-    stability boundary (a closed-loop root on the imaginary axis, excluded)
-    rather than the end of the searched range.
-    """
-
-    lo: float
-    hi: float
-    lo_is_boundary: bool
-    hi_is_boundary: bool
-    lo_frequency: float | None = None
-    hi_frequency: float | None = None
-
-
-def _boundary_function(c0: Rational | None, c1: Rational, num: np.ndarray, den: np.ndarray, delay: float):
-    a1, b1 = c1
-    a0, b0 = c0 if c0 is not None else (np.array([0.0]), np.array([1.0]))
-
-    def parts(w: np.ndarray):
-        s = 1j * np.asarray(w, dtype=float)
-        e = np.exp(-delay * s)
-        n, d = np.polyval(num, s), np.polyval(den, s)
-        X = np.polyval(b0, s) * d + np.polyval(a0, s) * n * e
-        Y = np.polyval(b0, s) * d
-        U = np.polyval(a1, s) * n * e
-        V = np.polyval(b1, s) * d
-        return X * V, Y * U
-
-    def h(w: np.ndarray) -> np.ndarray:
-        top, bottom = parts(w)
-        return np.imag(top * np.conj(bottom))
-
-    def rho(w: np.ndarray) -> np.ndarray:
-        top, bottom = parts(np.atleast_1d(np.asarray(w, dtype=float)))
-        with np.errstate(divide="ignore", invalid="ignore"):
-            return np.where(np.abs(bottom) < 1e-300, np.inf, np.real(-top / bottom))
-
-    return h, rho
-
-
-def stability_boundaries(
-    c0: Rational | None,
-    c1: Rational,
-    num: np.ndarray,
-    den: np.ndarray,
-    delay: float,
-    rho_max: float,
-) -> list[tuple[float, float]]:
-    """Values ``rho`` (with their frequencies) where ``1 + (C0 + rho C1) G`` has a root on the axis.
-
-    ``G = num/den * exp(-delay s)``; only ``|rho| <= rho_max`` is searched.
-
-    Examples
-    --------
-    For ``G = 1/(s+1)^3`` the gain ``rho = 8`` puts roots at ``+-j sqrt(3)``:
-
-    >>> [(round(r, 6), round(w, 6)) for r, w in stability_boundaries(
-    ...     None, (np.array([1.0]), np.array([1.0])), np.array([1.0]),
-    ...     np.array([1.0, 3.0, 3.0, 1.0]), 0.0, 100.0)]
-    [(-1.0, 0.0), (8.0, 1.732051)]
-    """
-    a1, b1 = c1
-    a0, b0 = c0 if c0 is not None else (np.array([0.0]), np.array([1.0]))
-    h, rho = _boundary_function(c0, c1, num, den, delay)
-    loop0_num, loop0_den = np.polymul(a0, num), np.polymul(b0, den)
-    loop1_num, loop1_den = np.polymul(a1, num), np.polymul(b1, den)
-    w_a = largest_crossing(loop0_num, loop0_den, 0.5) if np.any(a0 != 0) else 0.0
-    w_b = largest_crossing(loop1_num, loop1_den, 0.5 / max(rho_max, 1e-300))
-    lo_scale, hi_scale = _characteristic_scale(a0, b0, a1, b1, num, den, delay=delay)
-    w_max = max(w_a, w_b, hi_scale) * 1.2
-    w_min = 1e-4 * lo_scale
-    grid = [np.geomspace(w_min, w_max, int(100 * np.log10(w_max / w_min)) + 2)]
-    if delay > 0:
-        grid.append(np.linspace(0.0, w_max, int(np.ceil(w_max * delay / _PHASE_STEP)) + 2)[1:])
-    w = np.unique(np.concatenate(grid))
-    hv = h(w)
-    scale = np.max(np.abs(hv)) if hv.size else 1.0
-    sign = np.sign(hv)
-    idx = np.flatnonzero(sign[:-1] * sign[1:] < 0)
-    exact = np.flatnonzero((sign == 0) & (np.arange(sign.size) > 0) & (np.abs(hv) <= 1e-14 * scale))
-    w_cross = np.concatenate([[0.0], bisect_roots(h, w[idx], w[idx + 1]), w[exact]])
-    r_cross = rho(w_cross)
-    keep = np.isfinite(r_cross) & (np.abs(r_cross) <= rho_max)
-    return sorted(zip(r_cross[keep].tolist(), w_cross[keep].tolist()))
-
-
-def _combine(c0: Rational | None, c1: Rational, rho: float) -> Rational:
-    a1, b1 = c1
-    if c0 is None:
-        return rho * np.asarray(a1, float), np.asarray(b1, float)
-    a0, b0 = c0
-    return np.polyadd(np.polymul(a0, b1), rho * np.polymul(a1, b0)), np.polymul(b0, b1)
-
-
-def affine_stability_intervals(
-    c0: Rational | None,
-    c1: Rational,
-    num: np.ndarray,
-    den: np.ndarray,
-    delay: float,
-    lo: float,
-    hi: float,
-    first_only: bool = False,
-    floor: float = 0.0,
-) -> list[StabilityInterval]:
-    """Exact stabilizing set of ``rho`` in ``[lo, hi]`` for the controller ``C0 + rho C1``.
-
-    With ``floor > 0`` every closed-loop root must have ``Re s < -floor`` (the same D-decomposition on the loop
-    shifted by ``floor``, as :func:`closed_loop_stability` does).
-
-    Parameters
-    ----------
-    c0 : (num, den) or None
-        Fixed part of the controller (None for zero).
-    c1 : (num, den)
-        Part multiplied by ``rho``.
-    num, den, delay
-        Plant rational part and delay.
-    lo, hi : float
-        Range searched.
-    first_only : bool
-        Stop at the end of the first stabilizing interval that starts at ``lo`` (the pieces between
-        boundaries are tested in order, so only those up to the first destabilizing boundary are
-        counted; e.g. a critical gain). Empty when ``lo`` itself is not stabilizing.
-
-    Returns
-    -------
-    list of StabilityInterval
-
-    Examples
-    --------
-    The X-4 rotor plant with a 20 ms in-loop delay under P control:
-
-    >>> from synth.plant import Plant
-    >>> G = Plant.from_string("23*(s+0.43)/((s+9.6)*(s+0.54))", delay=0.02)
-    >>> iv = affine_stability_intervals(None, (np.array([1.0]), np.array([1.0])),
-    ...                                 G.num, G.den, G.delay, 0.0, 20.0)
-    >>> [(round(i.lo, 3), round(i.hi, 3)) for i in iv]
-    [(0.0, 3.688)]
-    """
-    if hi < lo:
-        raise ModelError(f"range [{lo}, {hi}] is reversed")
-    if floor > 0.0:
-        num, den = shifted(num, floor) * np.exp(floor * delay), shifted(den, floor)
-        c0 = None if c0 is None else (shifted(c0[0], floor), shifted(c0[1], floor))
-        c1 = (shifted(c1[0], floor), shifted(c1[1], floor))
-    rho_max = max(abs(lo), abs(hi)) * 1.0001 + 1e-12
-    bounds = stability_boundaries(c0, c1, num, den, delay, rho_max)
-    cuts = sorted({lo, hi, *[r for r, _ in bounds if lo < r < hi]})
-    freq = {r: w for r, w in bounds}
-    pieces: list[StabilityInterval] = []
-
-    def stable_at(r: float) -> bool:
-        cn, cd = _combine(c0, c1, r)
-        ln, ld = np.polymul(cn, num), np.polymul(cd, den)
-        if np.all(ln == 0):
-            return bool(np.all(np.roots(trim(den)).real < 0)) if trim(den).size > 1 else True
-        return closed_loop_stability(ln, ld, delay).stable
-
-    for a, b in pairwise(cuts) if len(cuts) > 1 else [(lo, hi)]:
-        if not stable_at(0.5 * (a + b)):
-            if first_only:
-                break
-            continue
-        if pieces and pieces[-1].hi == a:
-            # stable on both sides of a boundary the loop only touches: one interval
-            prev = pieces.pop()
-            pieces.append(StabilityInterval(prev.lo, b, prev.lo_is_boundary, b in freq,
-                                            prev.lo_frequency, freq.get(b)))
-        else:
-            pieces.append(StabilityInterval(a, b, a in freq, b in freq, freq.get(a), freq.get(b)))
-    return pieces
-
-
-GAIN_SEARCH_LIMIT = 1e4
-"""Loop-gain factors beyond this (80 dB) are reported as infinite gain margin."""
-
-
-def gain_margin_factors(
-    num: np.ndarray, den: np.ndarray, delay: float
-) -> tuple[float, float, float | None, float | None]:
-    """Scalar loop-gain factors ``(k_lo, k_hi)`` bracketing ``k = 1`` at which ``k L`` turns marginal.
-
-    Returns ``(k_lo, k_hi, w_lo, w_hi)`` with the frequencies of the axis roots;
-    ``k_lo = 0`` and ``k_hi = inf`` when no such gain exists within a factor
-    :data:`GAIN_SEARCH_LIMIT` (80 dB). Only meaningful for a stable loop:
-    ``20 log10(k_hi)`` is the classical gain margin.
-
-    Examples
-    --------
-    >>> k_lo, k_hi, _, w = gain_margin_factors(np.array([1.0]), np.array([1.0, 3.0, 3.0, 1.0]), 0.0)
-    >>> round(k_hi, 6), round(w, 4)
-    (8.0, 1.7321)
-    """
-    # At a boundary |rho| = 1/|L(jw)|: a search up to |rho| = cap finds every boundary below cap,
-    # so widen the cap tenfold until a gain above 1 turns up (most loops stop at the first step).
-    cap = 10.0
-    while True:
-        bounds = stability_boundaries(None, (num, den), np.array([1.0]), np.array([1.0]), delay, cap)
-        pos = [(r, w) for r, w in bounds if r > 0]
-        above = [(r, w) for r, w in pos if r > 1.0 + 1e-12]
-        if above or cap >= GAIN_SEARCH_LIMIT:
-            break
-        cap = min(cap * 10.0, GAIN_SEARCH_LIMIT)
-    below = [(r, w) for r, w in pos if r < 1.0 - 1e-12 and r > 1.0 / GAIN_SEARCH_LIMIT]
-    k_hi, w_hi = min(above) if above else (np.inf, None)
-    k_lo, w_lo = max(below) if below else (0.0, None)
-    return float(k_lo), float(k_hi), w_lo, w_hi

@@ -7,7 +7,8 @@ import pytest
 from scipy.optimize import brentq
 
 from synth.plant import Plant
-from synth.stability import affine_stability_intervals, closed_loop_stability, gain_margin_factors
+from synth.stability import closed_loop_stability
+from synth.stability_sets import affine_stability_intervals, gain_margin_factors
 
 from .conftest import X4_PLANT
 

@@ -265,7 +265,7 @@ def _column_stability(family: Any, plants: list[Any], values: np.ndarray) -> np.
     its common factors ``s`` cancelled, so that ``PI`` over ``ki`` is ``kp + ki (1/s)``); a family not affine
     in its parameter is tested point by point.
     """
-    from synth.stability import affine_stability_intervals
+    from synth.stability_sets import affine_stability_intervals
 
     lo, hi = float(values[0]), float(values[-1])
     inner = values[values > 0] if np.any(values > 0) else values

@@ -26,7 +26,8 @@ from synth.loop import Loop
 from synth.loop_batch import LoopBatch
 from synth.plant import Plant
 from synth.requirements.base import Requirement, unique_names
-from synth.stability import affine_stability_intervals, stability_floor
+from synth.stability import stability_floor
+from synth.stability_sets import affine_stability_intervals
 
 __all__ = [
     "EXACT_BAND",
