@@ -108,7 +108,7 @@ class LoopBatch:
 
     def closed_loop_unstable(self) -> np.ndarray:
         """Per loop, whether a closed-loop root lies in the closed right half-plane (exact, by count:
-        :meth:`synth.loop.Loop.stability` on each loop, delay included; cached per plant).
+        :meth:`unstable_root_counts`).
 
         Examples
         --------
@@ -116,42 +116,56 @@ class LoopBatch:
         >>> LoopBatch(G, [Controller("P", {"kp": k}) for k in (0.4, 2.0)]).closed_loop_unstable().tolist()
         [True, False]
         """
+        return self.unstable_root_counts() > 0
+
+    def unstable_root_counts(self) -> np.ndarray:
+        """Per loop, the closed-loop roots in the closed right half-plane as :meth:`synth.loop.Loop.stability`
+        counts them (delay and stability floor included; cached per plant). Loops that differ by a gain only
+        (:meth:`gain_multiples`, at least 8 of them) are counted by D-decomposition in that gain
+        (:func:`synth.stability_sets.affine_root_counts`), others one by one, unless the counts were
+        given (:meth:`with_root_counts`).
+
+        Examples
+        --------
+        >>> G = Plant.from_string("1/(s+1)^3")
+        >>> LoopBatch(G, [Controller("P", {"kp": k}) for k in (1.0, 9.0)]).unstable_root_counts().tolist()
+        [0, 2]
+        """
         from synth.loop import Loop
 
-        if getattr(self, "_unstable", None) is None or self._unstable_plant is not self.plant:
-            unstable = self._unstable_by_gain()
-            if unstable is None:
-                unstable = np.array([Loop(self.plant, c).stability().unstable_poles > 0 for c in self.controllers])
-            self._unstable = unstable
-            self._unstable_plant = self.plant
-        return self._unstable
+        if getattr(self, "_counts", None) is None or self._counts_plant is not self.plant:
+            counts = self._counts_by_gain()
+            if counts is None:
+                counts = np.array([Loop(self.plant, c).stability().unstable_poles for c in self.controllers], int)
+            self._counts, self._counts_plant = counts, self.plant
+        return self._counts
 
-    def _unstable_by_gain(self) -> np.ndarray | None:
-        """Where the loops differ by a gain only (:meth:`gain_multiples`, at least 8 of them): the exact
-        stabilizing set of that gain by D-decomposition (:func:`synth.stability_sets.affine_stability_intervals`,
-        the count at one gain per piece between boundaries), read at every row; the rows within 1e-9 of a
-        boundary are counted one by one."""
-        from synth.loop import Loop
-        from synth.stability_sets import affine_stability_intervals, stability_boundaries
+    def with_root_counts(self, counts: np.ndarray) -> LoopBatch:
+        """The same loops with their :meth:`unstable_root_counts` given (e.g. read off a D-decomposition over
+        a grid of one parameter, as the report's feasibility map does).
+
+        Examples
+        --------
+        >>> b = LoopBatch(Plant.from_string("1/(s+1)"), [Controller("P", {"kp": 1.0})])
+        >>> b.with_root_counts(np.array([0])).closed_loop_unstable().tolist()
+        [False]
+        """
+        new = object.__new__(LoopBatch)
+        new.__dict__.update(self.__dict__)
+        new._counts, new._counts_plant = np.asarray(counts, int).copy(), self.plant
+        return new
+
+    def _counts_by_gain(self) -> np.ndarray | None:
+        from synth.stability import stability_floor
+        from synth.stability_sets import affine_root_counts
 
         multiples = self.gain_multiples() if len(self) >= 8 else None
         if multiples is None:
             return None
         r, c = multiples
-        ref = (self.cnum[r], self.cden[r])
-        top = float(np.max(c))
         p = self.plant
-        pieces = affine_stability_intervals(None, ref, p.num, p.den, p.delay, 0.0, top)
-        edges = np.array([b for b, _ in stability_boundaries(None, ref, p.num, p.den, p.delay, top * 1.0001 + 1e-12)])
-        stable = np.zeros(len(self), bool)
-        for iv in pieces:
-            stable |= (c >= iv.lo) & (c <= iv.hi)
-        near = np.zeros(len(self), bool) if edges.size == 0 else \
-            np.min(np.abs(c[:, None] - edges[None, :]), axis=1) <= 1e-9 * np.maximum(1.0, np.abs(c))
-        unstable = ~stable
-        for i in np.flatnonzero(near):
-            unstable[i] = Loop(self.plant, self.controllers[i]).stability().unstable_poles > 0
-        return unstable
+        return affine_root_counts(None, (self.cnum[r], self.cden[r]), p.num, p.den, p.delay, c,
+                                  stability_floor(p.num, p.den, p.delay))
 
     def __len__(self) -> int:
         return len(self.controllers)
@@ -280,14 +294,15 @@ class LoopBatch:
             this = (np.degrees(np.angle(L)) + 360.0) % 360.0 - 180.0
             np.minimum.at(pm, rows, this)
             with np.errstate(divide="ignore", invalid="ignore"):
-                np.minimum.at(dm, rows, np.where(this > 0, np.radians(this) / wc, 0.0))
+                # extra delay turns L(j wc) clockwise: the phase margin taken in (0, 360] deg, as Loop.margins
+                turn = np.where(this > 0, this, this + 360.0)
+                np.minimum.at(dm, rows, np.where(this != 0, np.radians(turn) / wc, 0.0))
         return pm, dm
 
     def upper_gain_margins(self, limit: float = 1e4, per_decade: int = 100) -> np.ndarray:
         """Each loop's smallest gain factor above 1 that puts a closed-loop root on the imaginary axis
-        (``inf`` if none up to ``limit``): the ``k_hi`` of :func:`synth.stability_sets.gain_margin_factors`,
-        found for all loops at once from the sign changes of ``Im L(jw)`` where ``Re L < 0`` on a log grid
-        four decades beyond :attr:`frequency_ranges` (and ``w = 0``), refined by bisection.
+        (``inf`` if none up to ``limit``): the ``k_hi`` of :func:`synth.stability_sets.gain_margin_factors`
+        (see :meth:`gain_margin_factors`).
 
         Examples
         --------
@@ -295,47 +310,68 @@ class LoopBatch:
         >>> b.upper_gain_margins().round(6)
         array([8., 4.])
         """
+        return self.gain_margin_factors(limit, per_decade)[1]
+
+    def gain_margin_factors(self, limit: float = 1e4, per_decade: int = 100) -> tuple[np.ndarray, np.ndarray]:
+        """Each loop's ``(k_lo, k_hi)`` of :func:`synth.stability_sets.gain_margin_factors`: the largest gain
+        factor below 1 (above ``1/limit``, else 0) and the smallest above 1 (up to ``limit``, else ``inf``) that
+        put a closed-loop root on the imaginary axis. Found for all loops at once from the real axis
+        crossings of ``L(jw)`` (``w = 0`` included): exact polynomial roots without a delay; with one, the
+        sign changes of ``Im L(jw)`` on a log grid four decades beyond :attr:`frequency_ranges` plus a few
+        points per half turn of the delay's phase, refined by bisection.
+
+        Examples
+        --------
+        An open-loop unstable plant needs ``k > 0.5`` (here ``kp = 2``: a factor 0.25 below):
+
+        >>> b = LoopBatch(Plant.from_string("10/((s-1)*(s+5))"), [Controller("P", {"kp": 2.0})])
+        >>> [x.round(6).tolist() for x in b.gain_margin_factors()]
+        [[0.25], [inf]]
+        """
         n = len(self)
-        k = np.full(n, np.inf)
+        k_lo, k_hi = np.zeros(n), np.full(n, np.inf)
         todo = np.arange(n)
         for cap in (10.0, limit):  # as gain_margin_factors: most loops have a boundary below 10
             if todo.size == 0:
                 break
-            r = self._boundary_gains(todo, cap, per_decade) if self.plant.delay > 0 else self._rational_boundary_gains()
-            r = r if self.plant.delay > 0 else np.where(r <= cap, r, np.inf)[todo]
-            r = np.where((r > 1.0 + 1e-12) & (r <= limit), r, np.inf)
-            k[todo] = r
-            todo = todo[~np.isfinite(r)]
+            if self.plant.delay > 0:
+                r = self._boundary_gains(todo, cap, per_decade)
+            else:
+                r = self._rational_boundary_gains()[todo]
+            r = np.where(r <= cap, r, np.nan)
+            above = np.where(r > 1.0 + 1e-12, r, np.inf)
+            below = np.where((r < 1.0 - 1e-12) & (r > 1.0 / limit), r, 0.0)
+            k_hi[todo] = np.nanmin(above, axis=1, initial=np.inf)
+            k_lo[todo] = np.maximum(k_lo[todo], np.nanmax(below, axis=1, initial=0.0))
+            todo = todo[~np.isfinite(k_hi[todo])]
         l0 = self._l0
         with np.errstate(divide="ignore", invalid="ignore"):
-            r0 = np.where(np.isfinite(l0) & (l0 < 0), -1.0 / l0, np.inf)
-        r0 = np.where((r0 > 1.0 + 1e-12) & (r0 <= limit), r0, np.inf)
-        return np.minimum(k, r0)
+            r0 = np.where(np.isfinite(l0) & (l0 < 0), -1.0 / l0, np.nan)
+        k_hi = np.minimum(k_hi, np.where((r0 > 1.0 + 1e-12) & (r0 <= limit), r0, np.inf))
+        k_lo = np.maximum(k_lo, np.where((r0 < 1.0 - 1e-12) & (r0 > 1.0 / limit), r0, 0.0))
+        return k_lo, k_hi
 
     def _rational_boundary_gains(self) -> np.ndarray:
-        """Without a delay: smallest ``-1/L(jw)`` above 1 over the exact phase crossovers (real roots of
-        ``Im num(jw) conj(den(jw))``, batched polynomial roots)."""
+        """Without a delay: ``-1/L(jw)`` at every exact phase crossover with ``Re L < 0`` (real roots of
+        ``Im num(jw) conj(den(jw))``, batched polynomial roots), one row per loop, NaN-padded."""
         nr, ni = _row_axis_parts(self.num)
         dr, di = _row_axis_parts(self.den)
         h = _pad_sub(_row_poly_product(ni, dr), _row_poly_product(nr, di))
-        out = np.full(len(self), np.inf)
         roots = _row_roots(h)
         rows = np.concatenate([np.full(r.size, i) for i, r in enumerate(roots)]).astype(int)
         if rows.size == 0:
-            return out
+            return np.full((len(self), 1), np.nan)
         wr = np.concatenate(roots)
         keep = (np.abs(wr.imag) <= 1e-9 * (1 + np.abs(wr.real))) & (wr.real > 0)
         rows, w = rows[keep], wr.real[keep]
         Lc = self.rows_L(rows, w)
         with np.errstate(divide="ignore", invalid="ignore"):
-            r = np.where(Lc.real < 0, -1.0 / Lc.real, np.inf)
-        r = np.where(r > 1.0 + 1e-12, r, np.inf)
-        np.minimum.at(out, rows, r)
-        return out
+            r = np.where(Lc.real < 0, -1.0 / Lc.real, np.nan)
+        return _ragged(rows, r, len(self))
 
     def _boundary_gains(self, which: np.ndarray, cap: float, per_decade: int) -> np.ndarray:
-        """Smallest factor ``-1/L(jw)`` above 1 over the phase crossovers of the loops ``which`` with
-        ``|L| >= 0.5/cap`` (with a delay the grid resolves its phase up to there)."""
+        """``-1/L(jw)`` at the phase crossovers with ``Re L < 0`` of the loops ``which`` where
+        ``|L| >= 0.5/cap`` (with a delay the grid resolves its phase up to there), one row per loop, NaN-padded."""
         ranges = self.frequency_ranges[which]
         grid = log_grids(ranges[:, 0] * 1e-2, ranges[:, 1] * 1e2, per_decade)
         if self.plant.delay > 0:  # a few points per half turn of the delay's phase where |L| >= 0.5/cap
@@ -348,16 +384,14 @@ class LoopBatch:
         L = self.rows_L(rows, grid.ravel()).reshape(grid.shape)
         im = np.where(_infinite(L), np.nan, L.imag)
         local, idx = np.nonzero(np.sign(im[:, :-1]) * np.sign(im[:, 1:]) < 0)
-        out = np.full(which.size, np.inf)
-        if local.size:
-            rows = which[local]
-            wc = bisect_roots(lambda w: self.rows_L(rows, w).imag, grid[local, idx], grid[local, idx + 1])
-            Lc = self.rows_L(rows, wc)
-            with np.errstate(divide="ignore", invalid="ignore"):
-                r = np.where(Lc.real < 0, -1.0 / Lc.real, np.inf)
-            r = np.where((r > 1.0 + 1e-12) & (r <= cap), r, np.inf)
-            np.minimum.at(out, local, r)
-        return out
+        if local.size == 0:
+            return np.full((which.size, 1), np.nan)
+        rows = which[local]
+        wc = bisect_roots(lambda w: self.rows_L(rows, w).imag, grid[local, idx], grid[local, idx + 1])
+        Lc = self.rows_L(rows, wc)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            r = np.where(Lc.real < 0, -1.0 / Lc.real, np.nan)
+        return _ragged(local, r, which.size)
 
     def rows_L(self, rows: np.ndarray, w: np.ndarray) -> np.ndarray:
         """``L`` of loop ``rows[j]`` at ``w[j]`` for every ``j`` (one frequency per entry), ``(len(w),)``.
@@ -385,6 +419,16 @@ def _row_corners(*rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
                 lo[i], hi[i] = min(lo[i], mags.min()), max(hi[i], mags.max())
     none = ~np.isfinite(lo)
     return np.where(none, np.nan, lo), np.where(none, np.nan, hi)
+
+
+def _ragged(rows: np.ndarray, values: np.ndarray, n: int) -> np.ndarray:
+    """``values`` grouped by their row (``rows`` sorted or not) into an ``(n, k)`` array padded with NaN."""
+    out = np.full((n, max(1, int(np.bincount(rows, minlength=n).max()) if rows.size else 1)), np.nan)
+    order = np.argsort(rows, kind="stable")
+    rows, values = rows[order], values[order]
+    start = np.searchsorted(rows, np.arange(n))
+    out[rows, np.arange(rows.size) - start[rows]] = values
+    return out
 
 
 def _row_magnitude_squared(rows: np.ndarray) -> np.ndarray:

@@ -19,8 +19,8 @@ from synth.polynomials import largest_crossing, shifted, trim
 from synth.rootfind import bisect_roots
 from synth.stability import PHASE_STEP, Rational, characteristic_scale, closed_loop_stability
 
-__all__ = ["GAIN_SEARCH_LIMIT", "StabilityInterval", "affine_stability_intervals", "gain_margin_factors",
-           "stability_boundaries"]
+__all__ = ["GAIN_SEARCH_LIMIT", "StabilityInterval", "affine_root_counts", "affine_stability_intervals",
+           "gain_margin_factors", "stability_boundaries"]
 
 
 @dataclass(frozen=True)
@@ -198,6 +198,60 @@ def affine_stability_intervals(
         else:
             pieces.append(StabilityInterval(a, b, a in freq, b in freq, freq.get(a), freq.get(b)))
     return pieces
+
+
+def affine_root_counts(
+    c0: Rational | None,
+    c1: Rational,
+    num: np.ndarray,
+    den: np.ndarray,
+    delay: float,
+    values: np.ndarray,
+    floor: float = 0.0,
+) -> np.ndarray:
+    """Closed-loop roots in the closed right half-plane at each of ``values`` of ``rho`` (controller
+    ``C0 + rho C1``), as :func:`synth.stability.closed_loop_stability` with ``floor`` counts them at each value.
+
+    The count is constant between neighbouring stability boundaries (:func:`stability_boundaries`, on the
+    loop shifted by ``floor`` when it is positive): one count per piece that holds a value, and every value
+    within ``1e-9`` (relative) of a boundary counted by itself.
+
+    Examples
+    --------
+    ``G = 1/(s+1)^3`` under P control: stable for ``-1 < k < 8``, a complex pair beyond 8:
+
+    >>> affine_root_counts(None, (np.array([1.0]), np.array([1.0])), np.array([1.0]),
+    ...                    np.array([1.0, 3.0, 3.0, 1.0]), 0.0, np.array([-2.0, 0.0, 7.9, 8.1, 20.0])).tolist()
+    [1, 0, 0, 2, 2]
+    """
+    values = np.asarray(values, dtype=float)
+    counts = np.zeros(values.size, dtype=int)
+    if values.size == 0:
+        return counts
+    b_num, b_den = num, den
+    b_c0, b_c1 = c0, c1
+    if floor > 0.0:
+        b_num, b_den = shifted(num, floor) * np.exp(floor * delay), shifted(den, floor)
+        b_c0 = None if c0 is None else (shifted(c0[0], floor), shifted(c0[1], floor))
+        b_c1 = (shifted(c1[0], floor), shifted(c1[1], floor))
+    rho_max = float(np.max(np.abs(values))) * 1.0001 + 1e-12
+    edges = np.array(sorted(r for r, _ in stability_boundaries(b_c0, b_c1, b_num, b_den, delay, rho_max)))
+
+    def count_at(r: float) -> int:
+        cn, cd = _combine(c0, c1, r)
+        while cn.size > 1 and cd.size > 1 and cn[-1] == 0.0 and cd[-1] == 0.0:  # C0 + 0 C1 = C0: s cancels
+            cn, cd = cn[:-1], cd[:-1]
+        return closed_loop_stability(np.polymul(cn, num), np.polymul(cd, den), delay, floor).unstable_poles
+
+    piece = np.searchsorted(edges, values) if edges.size else np.zeros(values.size, dtype=int)
+    near = np.zeros(values.size, bool) if edges.size == 0 else \
+        np.min(np.abs(values[:, None] - edges[None, :]), axis=1) <= 1e-9 * np.maximum(1.0, np.abs(values))
+    for k in np.unique(piece[~near]):
+        inside = values[(piece == k) & ~near]
+        counts[(piece == k) & ~near] = count_at(0.5 * (float(inside.min()) + float(inside.max())))
+    for i in np.flatnonzero(near):
+        counts[i] = count_at(float(values[i]))
+    return counts
 
 
 GAIN_SEARCH_LIMIT = 1e4

@@ -256,3 +256,38 @@ def test_limit_cycle_margin_of_a_scaled_loop_is_the_direct_one():
             k, _, _ = critical_gain_factor(loop.L, log_grid(lo, hi * 10, 80), req.delay, req.kinds())
             got = req.evaluate(loop).details["gain_factor"]
             assert got == pytest.approx(k, rel=1e-9), (plant, c)
+
+
+def test_margins_batch_matches_the_scalar_slack_on_unstable_and_conditionally_stable_loops():
+    """Two-sided gain margins (a lower limit on open-loop unstable plants), negative phase margins and delay
+    margins past a negative phase margin: the vectorized margins equal the scalar ones loop by loop, and the
+    unstable loops carry the scalar verdict (one unit of slack below zero per counted root)."""
+    rng = np.random.default_rng(31)
+    reqs = [MarginsRequirement(gain_margin_db=3.0), MarginsRequirement(phase_margin_deg=30.0),
+            MarginsRequirement(gain_margin_db=6.0, phase_margin_deg=40.0, delay_margin=0.005)]
+    for _ in range(8):
+        plant = _any_plant(rng)
+        controllers = _controllers(rng) + _gain_sweep(rng)[::4]
+        batch = LoopBatch(plant, controllers)
+        for req in reqs:
+            scalar = np.array([req.slack(Loop(plant, c)) for c in controllers])
+            assert _same(req.batch_slack(batch), scalar), (req, plant)
+
+
+def test_root_counts_of_a_parameter_grid_match_each_loop():
+    """The feasibility map reads the stability of a PI/PID/lead-lag plane column by column off a
+    D-decomposition (affine_root_counts); every count must be each loop's own."""
+    from synth.report.figures import _column_root_counts
+
+    rng = np.random.default_rng(5)
+    for _ in range(6):
+        plant = _any_plant(rng)
+        for kind, name, base in [("PI", "ki", {"kp": float(rng.uniform(0.0, 5.0))}),
+                                 ("PID", "kd", {"kp": float(rng.uniform(0.1, 3.0)), "ki": float(rng.uniform(0, 2)),
+                                                "tf": 0.01}),
+                                 ("leadlag", "k", {"z": 1.0, "p": 8.0})]:
+            family = ScalarFamily(kind, name, {**base, name: 1.0})
+            values = np.linspace(0.0, float(rng.uniform(1.0, 20.0)), 15)
+            counts = _column_root_counts(family, [plant], values)[0]
+            expected = [Loop(plant, family.controller(float(v))).stability().unstable_poles for v in values]
+            assert counts.tolist() == expected, (plant, kind)

@@ -244,41 +244,43 @@ def feasibility_grid(spec: Any, design_controller: Any, n: int = 45,
     slack = np.full((len(requirements) + 1, n, n), np.nan)
     base = dict(design_controller.parameters)
     plants = spec.plants()
+    counts = np.zeros((len(plants), n, n), dtype=int)  # [plant, j, i]
     for i, a in enumerate(A):
-        slack[0, :, i] = _column_stability(ScalarFamily(design_controller.type, xb, {**base, xa: float(a)}),
-                                           plants, B)
+        counts[:, :, i] = _column_root_counts(ScalarFamily(design_controller.type, xb, {**base, xa: float(a)}),
+                                              plants, B)
+    slack[0] = np.where(np.all(counts == 0, axis=0), 1.0, -1.0)
     aa, bb = np.meshgrid(A, B)  # [j, i]: b = B[j], a = A[i]
     controllers = [Controller(design_controller.type, {**base, xa: float(a), xb: float(b)})
                    for a, b in zip(aa.ravel(), bb.ravel())]
     first = LoopBatch(plants[0], controllers)
-    batches = [first] + [first.with_plant(p) for p in plants[1:]]
+    batches = [(first if k == 0 else first.with_plant(p)).with_root_counts(counts[k].ravel())
+               for k, p in enumerate(plants)]
     for k, req in enumerate(requirements):
         worst = np.min([req.batch_slack(b, 20) for b in batches], axis=0)
         slack[k + 1] = worst.reshape(n, n)
     return xa, xb, A, B, slack
 
 
-def _column_stability(family: Any, plants: list[Any], values: np.ndarray) -> np.ndarray:
-    """+1/-1: the loop stable/unstable on every plant at each of ``values`` (sorted) of the family's parameter.
+def _column_root_counts(family: Any, plants: list[Any], values: np.ndarray) -> np.ndarray:
+    """Closed-loop right-half-plane roots, ``(len(plants), len(values))``, at each of ``values`` (sorted) of
+    the family's parameter, as :meth:`synth.loop.Loop.stability` counts them (stability floor included).
 
-    Exact: the stabilizing intervals come from the D-decomposition of ``C = C0 + rho C1`` (each part with
-    its common factors ``s`` cancelled, so that ``PI`` over ``ki`` is ``kp + ki (1/s)``); a family not affine
-    in its parameter is tested point by point.
+    Exact: the counts come from the D-decomposition of ``C = C0 + rho C1``
+    (:func:`synth.stability_sets.affine_root_counts`, each part with its common factors ``s`` cancelled, so
+    that ``PI`` over ``ki`` is ``kp + ki (1/s)``); a family not affine in its parameter is counted point by point.
     """
-    from synth.stability_sets import affine_stability_intervals
+    from synth.stability import stability_floor
+    from synth.stability_sets import affine_root_counts
 
-    lo, hi = float(values[0]), float(values[-1])
+    hi = float(values[-1])
     inner = values[values > 0] if np.any(values > 0) else values
     parts = family.affine_parts(float(inner[0]), hi) if hi > float(inner[0]) else None
     if parts is None:
-        return np.array([1.0 if all(Loop(p, family.controller(v)).stability().stable for p in plants) else -1.0
-                         for v in values])
+        return np.array([[Loop(p, family.controller(float(v))).stability().unstable_poles for v in values]
+                         for p in plants], dtype=int)
     c0, c1 = (_cancel_origin(*part) for part in parts)
-    ok = np.ones(values.size, bool)
-    for p in plants:
-        ivs = affine_stability_intervals(c0 if np.any(c0[0]) else None, c1, p.num, p.den, p.delay, lo, hi)
-        ok &= np.array([any(iv.lo <= v <= iv.hi for iv in ivs) for v in values])
-    return np.where(ok, 1.0, -1.0)
+    return np.array([affine_root_counts(c0 if np.any(c0[0]) else None, c1, p.num, p.den, p.delay, values,
+                                        stability_floor(p.num, p.den, p.delay)) for p in plants], dtype=int)
 
 
 def _cancel_origin(num: np.ndarray, den: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

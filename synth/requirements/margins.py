@@ -83,14 +83,17 @@ class MarginsRequirement(Requirement):
                            binding_frequency=w, message=msg, binding=name, **m.to_dict())
 
     def batch_slack(self, batch: LoopBatch, per_decade: int = 80) -> np.ndarray:
-        """Vectorized slack: gain crossovers of all loops by batched polynomial roots, phase crossovers
-        (the gain margin) by bisection on a shared grid (:meth:`~synth.loop_batch.LoopBatch.upper_gain_margins`)."""
+        """Vectorized slack, the scalar form's numbers: gain crossovers of all loops by batched polynomial
+        roots, the two-sided gain margin from the factors of
+        :meth:`~synth.loop_batch.LoopBatch.gain_margin_factors`; loops that are not closed-loop stable carry
+        the scalar verdict (:func:`with_unstable_rows`)."""
         parts = []
         if self.gain_margin_db is not None:
-            k_hi = batch.upper_gain_margins()
+            k_lo, k_hi = batch.gain_margin_factors()
             with np.errstate(divide="ignore"):
                 gm = np.where(np.isfinite(k_hi), 20 * np.log10(k_hi), np.inf)
-            parts.append((gm - self.gain_margin_db) * NEPER_PER_DB)
+                lower = np.where(k_lo > 0, -20 * np.log10(np.where(k_lo > 0, k_lo, 1.0)), np.inf)
+            parts.append((np.minimum(gm, lower) - self.gain_margin_db) * NEPER_PER_DB)
         if self.phase_margin_deg is not None or self.delay_margin is not None:
             pm, dm = batch.phase_and_delay_margins()
             if self.phase_margin_deg is not None:
@@ -99,9 +102,7 @@ class MarginsRequirement(Requirement):
                 with np.errstate(divide="ignore"):
                     parts.append(np.where(dm > 0, np.log(np.where(dm > 0, dm, 1.0) / self.delay_margin), -np.inf))
         values = np.min(parts, axis=0)
-        # a non-positive phase or delay margin at a crossover: the scalar form takes the phase margin in
-        # (0, 360 deg] and judges the loop by its root count; those rows get its exact value
-        return with_unstable_rows(self, batch, values, also=~np.isfinite(values) | (values < 0))
+        return with_unstable_rows(self, batch, values, also=np.isnan(values))
 
 def closed_loop_unstable(loop: Loop) -> bool:
     """Whether ``loop`` has a closed-loop root in the closed right half-plane, by count (polynomial roots
@@ -152,9 +153,10 @@ def unstable_result(req: Requirement, loop: Loop, what: str, **details: Any) -> 
 
 def with_unstable_rows(req: Requirement, batch: LoopBatch, values: np.ndarray,
                        also: np.ndarray | None = None) -> np.ndarray:
-    """A batch slack whose closed-loop unstable loops carry the scalar verdict (:func:`unstable_result`):
-    the vectorized margin and bandwidth formulas presume a stable closed loop. Rows marked in ``also``
-    are evaluated exactly too.
+    """A batch slack whose closed-loop unstable loops carry the scalar verdict (:func:`unstable_result`:
+    :data:`UNSTABLE_SLACK` per root counted by :meth:`~synth.loop_batch.LoopBatch.unstable_root_counts`): the
+    vectorized margin and bandwidth formulas presume a stable closed loop. Stable rows marked in ``also``
+    are evaluated one by one.
 
     Examples
     --------
@@ -165,10 +167,10 @@ def with_unstable_rows(req: Requirement, batch: LoopBatch, values: np.ndarray,
     """
     from synth.loop import Loop
 
-    unstable = batch.closed_loop_unstable() | (False if also is None else also)
-    if not unstable.any():
-        return values
+    counts = batch.unstable_root_counts()
     values = np.array(values, dtype=float)
-    for i in np.flatnonzero(unstable):
-        values[i] = req.slack(Loop(batch.plant, batch.controllers[i]))
+    values[counts > 0] = UNSTABLE_SLACK * counts[counts > 0]
+    if also is not None:
+        for i in np.flatnonzero(also & (counts == 0)):
+            values[i] = req.slack(Loop(batch.plant, batch.controllers[i]))
     return values
