@@ -30,9 +30,9 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-from scipy.stats import norm
 
 from synth.data.record import Record
+from synth.distributions import norm_sf
 from synth.ident.steps import StepAverage, Steps, average_steps, find_steps
 from synth.ident.structure import Structure
 from synth.ident.timefit import TimeFitResult, fit_structure
@@ -161,7 +161,7 @@ def compare_fits(up: TimeFitResult, down: TimeFitResult, alpha: float = ALPHA,
     sd = {k: float(np.hypot(up.std[k], down.std[k])) for k in names}
     z = {k: diff[k] / sd[k] if sd[k] > 0 else (0.0 if diff[k] == 0 else float(np.copysign(np.inf, diff[k])))
          for k in names}
-    p = {k: float(2.0 * norm.sf(abs(z[k]))) for k in names}
+    p = {k: float(2.0 * norm_sf(abs(z[k]))) for k in names}
     p_family = float(min(1.0, min(p.values()) * len(p))) if p else 1.0
     return DirectionComparison(up, down, diff, sd, z, p, p_family, alpha, p_family < alpha, up_average, down_average)
 

@@ -7,7 +7,8 @@ reason :func:`fit_failure` gives; ``synth identify`` prints it as one line and e
 from __future__ import annotations
 
 import numpy as np
-from scipy.stats import f as f_dist
+
+from synth.distributions import f_sf
 
 __all__ = ["ABSURD_FACTOR", "CONVERGED_WITHIN", "FAILED_STATUSES", "LIMIT_STATUSES", "SIGNIFICANCE", "fit_failure"]
 
@@ -102,7 +103,7 @@ def fit_failure(parameters: dict[str, float], start: np.ndarray, status: str | N
         explained = 1.0 - (1.0 - fit_percent / 100.0) ** 2  # share of the variance about the mean
         dof = samples - free
         f_stat = (explained / (free - 1)) / (max(1.0 - explained, 1e-300) / dof)
-        p_value = float(f_dist.sf(f_stat, free - 1, dof))
+        p_value = float(f_sf(f_stat, free - 1, dof))
         if p_value > SIGNIFICANCE:
             return (f"fit {fit_percent:.2f} %: the model explains no more of the output than noise would "
                     f"(F-test p = {p_value:.2g})")

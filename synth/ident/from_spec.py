@@ -19,8 +19,8 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from scipy.stats import chi2
 
+from synth.distributions import chi2_ppf
 from synth.errors import ModelError, SynthError
 from synth.plant import Plant, Signal
 
@@ -130,7 +130,7 @@ def uncertainty_plants(result: Any, confidence: float, input: Signal, output: Si
     if not np.all(np.isfinite(P)) or P.size == 0:
         return []
     values, vectors = np.linalg.eigh(0.5 * (P + P.T))
-    radius = float(np.sqrt(chi2.ppf(confidence, len(names))))
+    radius = float(np.sqrt(chi2_ppf(confidence, len(names))))
     delay_name = st.delay_parameter or "delay"
     centre = np.array([fit.parameters[n] for n in names])
     plants: list[Plant] = []

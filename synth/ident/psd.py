@@ -21,9 +21,9 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
-from scipy.stats import chi2
 
 from synth.data.disturbance import DisturbanceRecord
+from synth.distributions import chi2_median
 from synth.errors import DataError
 from synth.ident.spectrum_features import (
     Spike,
@@ -215,7 +215,7 @@ def analyze_psd(signals: Sequence[np.ndarray], dt: float, share: float = 0.9, ba
     except DataError as exc:
         trend = None
         notes.append(f"no trend: {exc.message}")
-    smooth = np.where(mask, 10 ** (median / 10) / (chi2.median(effective_dof(k)) / effective_dof(k)), S)
+    smooth = np.where(mask, 10 ** (median / 10) / (chi2_median(effective_dof(k)) / effective_dof(k)), S)
     total = float(np.sum(S) * dw)
     disturbance = float(np.sum(smooth - floor) * dw)
     try:

@@ -19,8 +19,8 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-from scipy.stats import chi2
 
+from synth.distributions import chi2_median
 from synth.errors import DataError
 from synth.ident.welch import effective_dof
 
@@ -232,7 +232,7 @@ def noise_floor(w: np.ndarray, S: np.ndarray, segments: int, band: tuple[float, 
         raise DataError(f"fewer than 3 bins between {band[0]:.4g} and {band[1]:.4g} rad/s for the noise floor",
                         where="psd: floor band")
     nu = effective_dof(segments)
-    return float(np.median(S[sel]) / (chi2.median(nu) / nu)), (float(band[0]), float(band[1]))
+    return float(np.median(S[sel]) / (chi2_median(nu) / nu)), (float(band[0]), float(band[1]))
 
 
 def share_frequency(w: np.ndarray, D: np.ndarray, share: float) -> float:

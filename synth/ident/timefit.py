@@ -34,9 +34,9 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
-from scipy.stats import t as student_t
 
 from synth.data.record import Record
+from synth.distributions import t_ppf
 from synth.errors import DataError, FitError, ModelError
 from synth.ident.convolution_problem import ConvolutionProblem
 from synth.ident.fit_failure import LIMIT_STATUSES, fit_failure
@@ -443,7 +443,7 @@ def fit_structure(record: Record, structure: Structure | str, delay: str | float
                        parameters={**dict(zip(st.parameters, theta.tolist())), delay_name: float(d_hat)})
     if -1e-7 <= d_hat < 0.0:  # IPOPT relaxes the bound f >= 0 by 1e-8
         d_hat = 0.0
-    tq = float(student_t.ppf(0.975, dof))
+    tq = float(t_ppf(0.975, dof))
     names = [*st.parameters, *([delay_name] if fit_delay else []), "offset"]
     values = [*theta.tolist(), *([d_hat] if fit_delay else []), b_hat]
     params = {k: float(v) for k, v in zip(names[:-1], values[:-1])}

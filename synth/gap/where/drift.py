@@ -34,8 +34,8 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
-from scipy.stats import kstwobign
 
+from synth.distributions import kolmogorov_ppf
 from synth.errors import DataError
 
 __all__ = ["DriftResult", "cusum_drift"]
@@ -145,7 +145,7 @@ def cusum_drift(t: np.ndarray, e: np.ndarray, n_blocks: int = 64,
             last_sample.append(min((i + 1) * L, t.size) - 1)
     b, tb = np.asarray(b_list), np.asarray(t_list)
     floor = 0.1 * float(np.sqrt(np.mean(e**2)))
-    threshold = float(kstwobign.ppf(1.0 - false_alarm))
+    threshold = float(kolmogorov_ppf(1.0 - false_alarm))
     if b.size < 8:
         return DriftResult(False, None, None, None, None, 0.0, threshold, floor, L, tb, 0 * tb)
     d = np.diff(b)

@@ -29,8 +29,8 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
-from scipy.stats import chi2
 
+from synth.distributions import chi2_isf, chi2_ppf, chi2_sf
 from synth.errors import DataError
 
 __all__ = ["ErrorModel", "fit_error_model"]
@@ -93,7 +93,7 @@ class ErrorModel:
         """Frequencies where the confidence region excludes 0 (all False unless significant overall)."""
         if not self.significant_overall:
             return np.zeros(self.w.size, bool)
-        return self.stat > chi2.ppf(self.level, 2)
+        return self.stat > chi2_ppf(self.level, 2)
 
     def to_dict(self) -> dict[str, Any]:
         """Plain dict for JSON."""
@@ -186,7 +186,7 @@ def fit_error_model(u: np.ndarray, e: np.ndarray, dt: float, na: int = 4, nb: in
     P = cov[: na + nb, : na + nb]
     Pbb = P[na:, na:]
     wald = float(b @ np.linalg.solve(Pbb, b))
-    wald_p = float(chi2.sf(wald, nb))
+    wald_p = float(chi2_sf(wald, nb))
     if w is None:
         w_lo = 2.0 * np.pi / (u.size * dt)
         w = np.logspace(np.log10(w_lo), np.log10(0.99 * np.pi / dt), 200)
@@ -200,8 +200,8 @@ def fit_error_model(u: np.ndarray, e: np.ndarray, dt: float, na: int = 4, nb: in
     keep = lam > 1e-6 * lam[:, -1:]  # near 0 and Nyquist E is real: Im has no variance, test one dimension
     stat = np.sum(np.where(keep, proj**2 / np.where(keep, lam, 1.0), 0.0), axis=1)
     dof = keep.sum(axis=1)
-    stat = chi2.isf(np.maximum(chi2.sf(stat, dof), 1e-300), 2)  # on the chi2(2) scale: one threshold for all w
-    radius = np.sqrt(chi2.ppf(level, 2) * lam[:, -1])
+    stat = chi2_isf(np.maximum(chi2_sf(stat, dof), 1e-300), 2)  # on the chi2(2) scale: one threshold for all w
+    radius = np.sqrt(chi2_ppf(level, 2) * lam[:, -1])
     mag = np.abs(E)
     return ErrorModel(a, b, P, float(dt), w, E, stat, np.maximum(mag - radius, 0.0), mag + radius,
                       wald, wald_p, float(level))

@@ -34,8 +34,8 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-from scipy.stats import f as f_dist
 
+from synth.distributions import f_cdf, f_sf
 from synth.errors import DataError
 from synth.gap.where.residual import ModelResidual
 from synth.ident.simulate import simulate_plant
@@ -167,7 +167,7 @@ def _test_bins(e2: np.ndarray, idx: np.ndarray, labels: list[str], bounds: list[
         if n_in >= MIN_BIN and n_out >= MIN_BIN and ms_out > 0:
             d1, d2 = max(n_in / factor, 1.0), max(n_out / factor, 1.0)
             F = ms_in / ms_out
-            p = float(min(1.0, 2.0 * min(f_dist.sf(F, d1, d2), f_dist.cdf(F, d1, d2))))
+            p = float(min(1.0, 2.0 * min(f_sf(F, d1, d2), f_cdf(F, d1, d2))))
             flagged = p < (1.0 - level) / nb
         out.append(RegimeBin(labels[j], bounds[j][0], bounds[j][1], n_in, float(np.sqrt(ms_in)), ratio, p, flagged))
     return out

@@ -23,8 +23,8 @@ from typing import Any
 
 import numpy as np
 from scipy.signal import lfilter
-from scipy.stats import norm
 
+from synth.distributions import norm_ppf
 from synth.errors import DataError
 
 __all__ = ["CrossCorrelation", "fit_ar", "prewhitened_xcorr"]
@@ -176,5 +176,5 @@ def prewhitened_xcorr(u: np.ndarray, e: np.ndarray, dt: float, max_lag: int = 50
     r = np.empty(lags.size)
     for i, tau in enumerate(lags):
         r[i] = np.dot(fu[: n - tau], fe[tau:]) if tau >= 0 else np.dot(fu[-tau:], fe[: n + tau])
-    bound = float(norm.ppf(1.0 - alpha / 2.0) / np.sqrt(n))
+    bound = float(norm_ppf(1.0 - alpha / 2.0) / np.sqrt(n))
     return CrossCorrelation(lags, r / scale, bound, float(dt), a, alpha)
