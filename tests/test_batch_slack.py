@@ -277,7 +277,7 @@ def test_margins_batch_matches_the_scalar_slack_on_unstable_and_conditionally_st
 def test_root_counts_of_a_parameter_grid_match_each_loop():
     """The feasibility map reads the stability of a PI/PID/lead-lag plane column by column off a
     D-decomposition (affine_root_counts); every count must be each loop's own."""
-    from synth.report.figures import _column_root_counts
+    from synth.report.figures import column_root_counts
 
     rng = np.random.default_rng(5)
     for _ in range(6):
@@ -288,6 +288,6 @@ def test_root_counts_of_a_parameter_grid_match_each_loop():
                                  ("leadlag", "k", {"z": 1.0, "p": 8.0})]:
             family = ScalarFamily(kind, name, {**base, name: 1.0})
             values = np.linspace(0.0, float(rng.uniform(1.0, 20.0)), 15)
-            counts = _column_root_counts(family, [plant], values)[0]
+            counts = column_root_counts(family, [plant], values)[0]
             expected = [Loop(plant, family.controller(float(v))).stability().unstable_poles for v in values]
             assert counts.tolist() == expected, (plant, kind)

@@ -16,6 +16,7 @@ __all__ = [
     "bode_with_slew_bound",
     "bound_drawn",
     "delay_chart",
+    "column_root_counts",
     "feasibility_grid",
     "feasibility_map",
     "gain_set_plot",
@@ -224,8 +225,8 @@ def feasibility_grid(spec: Any, design_controller: Any, n: int = 45,
     >>> from synth.spec import load_spec; from synth.controllers import Controller
     >>> xa, xb, A, B, slack = feasibility_grid(load_spec("specs/x4_rotor_pi.yaml"),
     ...                                        Controller("PI", {"kp": 4.0, "ki": 40.0}), n=5)
-    >>> xa, xb, slack.shape, bool(slack[0].min() == 1.0)
-    ('kp', 'ki', (6, 5, 5), True)
+    >>> xa, xb, slack.shape, int((slack[0] < 0).sum()), slack[0, 0, 0]  # kp = ki = 0 keeps the pole at s = 0
+    ('kp', 'ki', (6, 5, 5), 1, -1.0)
     """
     from synth.controllers import Controller
     from synth.synthesis.gainset import ScalarFamily
@@ -246,7 +247,7 @@ def feasibility_grid(spec: Any, design_controller: Any, n: int = 45,
     plants = spec.plants()
     counts = np.zeros((len(plants), n, n), dtype=int)  # [plant, j, i]
     for i, a in enumerate(A):
-        counts[:, :, i] = _column_root_counts(ScalarFamily(design_controller.type, xb, {**base, xa: float(a)}),
+        counts[:, :, i] = column_root_counts(ScalarFamily(design_controller.type, xb, {**base, xa: float(a)}),
                                               plants, B)
     slack[0] = np.where(np.all(counts == 0, axis=0), 1.0, -1.0)
     aa, bb = np.meshgrid(A, B)  # [j, i]: b = B[j], a = A[i]
@@ -261,13 +262,20 @@ def feasibility_grid(spec: Any, design_controller: Any, n: int = 45,
     return xa, xb, A, B, slack
 
 
-def _column_root_counts(family: Any, plants: list[Any], values: np.ndarray) -> np.ndarray:
+def column_root_counts(family: Any, plants: list[Any], values: np.ndarray) -> np.ndarray:
     """Closed-loop right-half-plane roots, ``(len(plants), len(values))``, at each of ``values`` (sorted) of
     the family's parameter, as :meth:`synth.loop.Loop.stability` counts them (stability floor included).
 
     Exact: the counts come from the D-decomposition of ``C = C0 + rho C1``
     (:func:`synth.stability_sets.affine_root_counts`, each part with its common factors ``s`` cancelled, so
     that ``PI`` over ``ki`` is ``kp + ki (1/s)``); a family not affine in its parameter is counted point by point.
+
+    Examples
+    --------
+    >>> from synth.plant import Plant; from synth.synthesis.gainset import ScalarFamily
+    >>> G = Plant.from_string("10/((s-1)*(s+5))")
+    >>> column_root_counts(ScalarFamily("PI", "kp", {"kp": 1.0, "ki": 0.0}), [G], np.array([0.2, 0.4, 2.0])).tolist()
+    [[1, 1, 0]]
     """
     from synth.stability import stability_floor
     from synth.stability_sets import affine_root_counts
