@@ -15,8 +15,8 @@ __all__ = [
     "COLORS",
     "bode_with_slew_bound",
     "bound_drawn",
-    "delay_chart",
     "column_root_counts",
+    "delay_chart",
     "feasibility_grid",
     "feasibility_map",
     "gain_set_plot",
@@ -225,7 +225,7 @@ def feasibility_grid(spec: Any, design_controller: Any, n: int = 45,
     >>> from synth.spec import load_spec; from synth.controllers import Controller
     >>> xa, xb, A, B, slack = feasibility_grid(load_spec("specs/x4_rotor_pi.yaml"),
     ...                                        Controller("PI", {"kp": 4.0, "ki": 40.0}), n=5)
-    >>> xa, xb, slack.shape, int((slack[0] < 0).sum()), slack[0, 0, 0]  # kp = ki = 0 keeps the pole at s = 0
+    >>> xa, xb, slack.shape, int((slack[0] < 0).sum()), float(slack[0, 0, 0])  # kp = ki = 0: the pole at s = 0 stays
     ('kp', 'ki', (6, 5, 5), 1, -1.0)
     """
     from synth.controllers import Controller
