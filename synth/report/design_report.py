@@ -9,6 +9,7 @@ from typing import Any
 import numpy as np
 
 from synth.controllers import Controller
+from synth.forked import run_beside
 from synth.loop import Loop
 from synth.outputs import GENERATOR, OutputDir, dump_json, to_jsonable
 from synth.reference import compare
@@ -71,6 +72,68 @@ def report_data(spec: Spec, result: DesignResult, keep: dict[str, Any] | None = 
             data["sim_to_real_gap"] = x4_gap_case(spec, objects=keep)
     data |= paper_section_data(spec)  # the seed paper's own section (issue 19): synth.report.paper_section
     return reproducible(to_jsonable(data))
+
+
+_FIGURE_ORDER = ("bode", "sensitivity", "step", "gain_set", "region", "delay")
+
+
+def _design_figure_jobs(spec: Spec, result: DesignResult, loops: list[tuple[str, Loop]], marks: dict[str, float],
+                        ref: Controller | None, result_data: dict[str, Any], out: OutputDir,
+                        ) -> list[tuple[str, Any]]:
+    """``(figure key, job)`` for the figures that need only the design; each job returns ``(path or None,
+    the requirement bounds it drew or None, the file names it claimed)``."""
+
+    def job(draw: Any, with_bounds: bool = False) -> Any:
+        def run() -> tuple[Path | None, list[dict[str, Any]] | None, list[str]]:
+            before = len(out.written)
+            drawn: list[dict[str, Any]] = []
+            path = draw(drawn) if with_bounds else draw()
+            return path, drawn if with_bounds else None, list(out.written[before:])
+        return run
+
+    jobs: list[tuple[str, Any]] = []
+    if result.gain_set is None and result.controller is not None:
+        jobs.append(("region", job(lambda: figures.feasibility_map(spec, result.controller,
+                                                                   out.claim("feasible_region.png"), reference=ref))))
+    slew = [r for r in spec.requirements if isinstance(r, SlewRate)]
+    if slew and loops:
+        jobs.append(("bode", job(lambda drawn: figures.bode_with_slew_bound(
+            loops, slew, out.claim("bode_slew_bound.png"), drawn=drawn), True)))
+    if loops:
+        jobs.append(("sensitivity", job(lambda drawn: figures.sensitivity_plot(
+            loops, list(spec.requirements), out.claim("sensitivity.png"), drawn=drawn), True)))
+    gain = result_data.get("gain_set_detail")
+    if gain is not None:
+        jobs.append(("gain_set", job(lambda: figures.gain_set_plot(
+            gain["parameter"], tuple(gain["bounds"]), _slack_curves(spec), result_data["gain_set"], marks,
+            out.claim("gain_set.png")))))
+    if loops:
+        jobs.append(("step", job(lambda: figures.step_plot(loops, out.claim("step_response.png")))))
+    return jobs
+
+
+def _analysis_figures(spec: Spec, data: dict[str, Any], objects: dict[str, Any], shown: Controller | None,
+                      ref: Controller | None, marks: dict[str, float], out: OutputDir) -> dict[str, Path]:
+    """The figures drawn from ``report_data``'s results (delay table, simulations, gap case, paper section)."""
+    figs: dict[str, Path] = {}
+    delay_table = data["analysis"].get("delay_table")
+    if delay_table:
+        rows = [{**r, "critical_gain": float(r["critical_gain"])} for r in delay_table]
+        figs["delay"] = figures.delay_chart(rows, marks, out.claim("critical_gain_vs_delay.png"))
+    if spec.simulation is not None:
+        from synth.report.simulation_report import simulation_figures
+
+        figs.update(simulation_figures(spec, shown, ref, out, marks))
+    if "diagnosis" in objects:  # the seed-1 gap case: gap map and before/after overlay of the simulated rig
+        from synth.figure_files import save_figure
+        from synth.gap.overlay import overlay_figure
+        from synth.gap.where.gapmap import write_gap_map
+
+        diag = objects["diagnosis"]
+        figs["gap_map"] = write_gap_map(diag.localization, out.claim("gap_map.png"), diag.plant)
+        figs["gap_overlay"] = save_figure(overlay_figure(diag.attribution), out.claim("gap_overlay.png"))
+    figs.update(paper_section_figures(spec, out))  # the seed paper's own section (issue 19), if the spec asks
+    return figs
 
 
 def _slack_curves(spec: Spec) -> dict[str, tuple[np.ndarray, np.ndarray]]:
@@ -140,8 +203,7 @@ def write_design_report(spec: Spec, result: DesignResult, out_dir: str | Path, *
      'sim_step', 'step']
     """
     out = OutputDir(out_dir, force)
-    objects: dict[str, Any] = {}
-    data = report_data(spec, result, keep=objects)
+    _ = out.staging  # made before the figure worker forks: both processes write into this one folder
     plant = spec.nominal_plant()
     loops: list[tuple[str, Loop]] = []
     shown = result.controller or (result.compromise.controller if result.compromise else None)
@@ -151,49 +213,30 @@ def write_design_report(spec: Spec, result: DesignResult, out_dir: str | Path, *
     ref = reference_controller(spec)
     if ref is not None:
         loops.append(("reference " + str(ref), Loop(plant, ref)))
-    figs: dict[str, Path] = {}
-    bounds: dict[str, list[dict[str, Any]]] = {}  # figure -> the requirement bounds it draws
-    slew = [r for r in spec.requirements if isinstance(r, SlewRate)]
-    if slew and loops:
-        figs["bode"] = figures.bode_with_slew_bound(loops, slew, out.claim("bode_slew_bound.png"),
-                                                    drawn=bounds.setdefault("bode", []))
-    if loops:
-        figs["sensitivity"] = figures.sensitivity_plot(loops, list(spec.requirements), out.claim("sensitivity.png"),
-                                                       drawn=bounds.setdefault("sensitivity", []))
-        figs["step"] = figures.step_plot(loops, out.claim("step_response.png"))
     marks: dict[str, float] = {}
     for name, loop in loops:
         if isinstance(loop.controller, Controller) and loop.controller.type == "P":
             marks[name] = loop.controller.parameters["kp"]
+    result_data = reproducible(to_jsonable(result.to_dict()))
+    # figures that need only the design: drawn by a forked worker while this process computes report_data
+    jobs = _design_figure_jobs(spec, result, loops, marks, ref, result_data, out)
+    objects: dict[str, Any] = {}
+
+    def own_work() -> tuple[dict[str, Any], dict[str, Path]]:
+        data = report_data(spec, result, keep=objects)
+        return data, _analysis_figures(spec, data, objects, shown, ref, marks, out)
+
+    drawn_by_worker, (data, figs) = run_beside([job for _, job in jobs], own_work)
+    bounds: dict[str, list[dict[str, Any]]] = {}  # figure -> the requirement bounds it draws
+    for (key, _), (path, drawn, claimed) in zip(jobs, drawn_by_worker):
+        for name in claimed:  # names the worker claimed in its copy of ``out``
+            out.claim(name)
+        if path is not None:
+            figs[key] = path
+        if drawn is not None:
+            bounds[key] = drawn
+    figs = {key: figs[key] for key in _FIGURE_ORDER if key in figs} | figs
     gain = data.get("gain_set_detail")
-    if gain is not None:
-        figs["gain_set"] = figures.gain_set_plot(
-            gain["parameter"], tuple(gain["bounds"]), _slack_curves(spec), data["gain_set"], marks,
-            out.claim("gain_set.png"))
-    if result.gain_set is None and result.controller is not None:
-        fmap = figures.feasibility_map(spec, result.controller, out.claim("feasible_region.png"), reference=ref)
-        if fmap is not None:
-            figs["region"] = fmap
-    delay_table = data["analysis"].get("delay_table")
-    if delay_table:
-        rows = [{**r, "critical_gain": float(r["critical_gain"])} for r in delay_table]
-        figs["delay"] = figures.delay_chart(rows, marks, out.claim("critical_gain_vs_delay.png"))
-
-    if spec.simulation is not None:
-        from synth.report.simulation_report import simulation_figures
-
-        figs.update(simulation_figures(spec, shown, ref, out, marks))
-
-    if "diagnosis" in objects:  # the seed-1 gap case: gap map and before/after overlay of the simulated rig
-        from synth.figure_files import save_figure
-        from synth.gap.overlay import overlay_figure
-        from synth.gap.where.gapmap import write_gap_map
-
-        diag = objects["diagnosis"]
-        figs["gap_map"] = write_gap_map(diag.localization, out.claim("gap_map.png"), diag.plant)
-        figs["gap_overlay"] = save_figure(overlay_figure(diag.attribution), out.claim("gap_overlay.png"))
-
-    figs.update(paper_section_figures(spec, out))  # the seed paper's own section (issue 19), if the spec asks
 
     columns, rows = _columns(data, list(spec.requirements))
     ref_line = ""
@@ -211,7 +254,8 @@ def write_design_report(spec: Spec, result: DesignResult, out_dir: str | Path, *
         published=(data["analysis"].get("reference") or {}).get("published_closed_loops", []),
         reference=data["analysis"].get("reference"),
         slew=data["analysis"].get("slew_rate", []),
-        delay_table=[{**r, "critical_gain": float(r["critical_gain"])} for r in delay_table or []],
+        delay_table=[{**r, "critical_gain": float(r["critical_gain"])}
+                     for r in data["analysis"].get("delay_table") or []],
         marks=marks, certificate=data.get("certificate"), ref_line=ref_line, sim=data.get("simulation"),
         synthesis=data.get("synthesis"), diagnosis=data.get("diagnosis"), ident=data.get("identification"),
         f=lambda x, d=4: fmt(None if x is None else float(x), d), gap=data.get("sim_to_real_gap"),

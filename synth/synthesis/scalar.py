@@ -13,6 +13,7 @@ import numpy as np
 
 from synth.check import check
 from synth.errors import SynthError
+from synth.forked import run_beside
 from synth.loop import Loop
 from synth.objectives import score as objective_score
 from synth.requirements.base import fmt
@@ -125,6 +126,16 @@ def design_scalar(spec: Spec) -> DesignResult:
     >>> result.feasible, result.controller.parameters["kp"], result.gain_set.contains(3.0)
     (True, 20.0, True)
     """
+    (reference,), (result, verdict_gain_set) = run_beside([lambda: reference_check(spec)],
+                                                          lambda: _design_without_reference(spec))
+    result.reference = reference
+    result.verdict += reference_verdict(spec, reference, verdict_gain_set)
+    return result
+
+
+def _design_without_reference(spec: Spec) -> tuple[DesignResult, GainSet | None]:
+    """:func:`design_scalar` but for the reference controller's check (run beside it, on the other core where
+    the command line allows: :mod:`synth.forked`) and the verdict's sentence on it."""
     family, bounds = scalar_family(spec)
     requirements = list(spec.requirements)
     plants = spec.plants()
@@ -140,10 +151,9 @@ def design_scalar(spec: Spec) -> DesignResult:
 
         x, _ = _optimize_scalar(min_slack, gain_set.per_requirement["stability"] or [bounds])  # stabilizing first
         compromise = check(spec, family.controller(x))
-        result = DesignResult(spec.name, False, None, None, None, gain_set, None, compromise, method,
-                              reference=reference_check(spec))
-        result.verdict = infeasible_verdict(result, family) + reference_verdict(spec, result.reference)
-        return result
+        result = DesignResult(spec.name, False, None, None, None, gain_set, None, compromise, method)
+        result.verdict = infeasible_verdict(result, family)
+        return result, None
 
     if objective is None:
         def score(x: float) -> float:
@@ -166,12 +176,11 @@ def design_scalar(spec: Spec) -> DesignResult:
     certificate = Certificate(cert_check.feasible, CERTIFICATE_PER_DECADE, cert_check)
     feasible = certificate.passed
     result = DesignResult(spec.name, feasible, controller if feasible else None, final, label,
-                          gain_set, certificate, None, method, reference=reference_check(spec))
-    result.verdict = (feasible_verdict(result, family) if feasible else (
+                          gain_set, certificate, None, method)
+    result.verdict = feasible_verdict(result, family) if feasible else (
         f"The optimum {controller} failed the dense re-check ("
         + "; ".join(r.message for r in cert_check.failed()) + "): not reported as a solution.")
-    ) + reference_verdict(spec, result.reference, gain_set)
-    return result
+    return result, gain_set
 
 
 def _ends(names: list[str]) -> str:

@@ -1,0 +1,119 @@
+"""Two cores for a report: independent jobs (figures) run in one forked child process while this process
+goes on with its own work; the jobs' results come back pickled through a pipe.
+
+Forking is off unless :func:`allow_fork` turned it on (the command line does; a library caller's threads or
+event loop are its own business), and ``SYNTH_JOBS=1`` turns it off again.
+
+Correctness never depends on the child: where ``fork`` is unavailable, when it is off, or when the
+child fails or one of its jobs raises, the jobs run here, in order (so an exception is raised here, as
+without the child). The child dies with its parent (``PR_SET_PDEATHSIG`` on Linux) and never returns into
+the caller: it leaves through ``os._exit``.
+"""
+
+from __future__ import annotations
+
+import os
+import pickle
+import signal
+from collections.abc import Callable, Sequence
+from typing import Any, TypeVar
+
+__all__ = ["allow_fork", "run_beside"]
+
+T = TypeVar("T")
+
+_ALLOWED = [False]
+
+
+def allow_fork(allowed: bool = True) -> None:
+    """Let :func:`run_beside` use a forked child (off by default; ``SYNTH_JOBS=1`` keeps it off).
+
+    Examples
+    --------
+    >>> allow_fork(False); run_beside([lambda: 1], lambda: 2)
+    ([1], 2)
+    """
+    _ALLOWED[0] = allowed
+
+
+def run_beside(jobs: Sequence[Callable[[], Any]], own_work: Callable[[], T]) -> tuple[list[Any], T]:
+    """Run ``jobs`` (in order) in a forked child while ``own_work()`` runs here; return both results.
+
+    Parameters
+    ----------
+    jobs : sequence of callables without arguments
+        Independent of ``own_work`` and of each other's side effects here (a child's changes to this
+        process's objects are lost: only return values come back, so they must pickle).
+    own_work : callable without arguments
+        What this process does meanwhile.
+
+    Returns
+    -------
+    (list, object)
+        The jobs' return values in order, and ``own_work()``'s.
+
+    Examples
+    --------
+    >>> allow_fork(); run_beside([lambda: 2 + 2, lambda: "x" * 3], lambda: 10)
+    ([4, 'xxx'], 10)
+    """
+    if len(jobs) == 0 or not _ALLOWED[0] or not hasattr(os, "fork") or os.environ.get("SYNTH_JOBS", "") == "1":
+        mine = own_work()
+        return [job() for job in jobs], mine
+    read_end, write_end = os.pipe()
+    pid = os.fork()
+    if pid == 0:  # the child: run the jobs, send the results, leave without running the caller's code
+        status = 1
+        try:
+            os.close(read_end)
+            _die_with_parent()
+            payload = pickle.dumps(_run_all(jobs), protocol=pickle.HIGHEST_PROTOCOL)
+            with os.fdopen(write_end, "wb") as pipe:
+                pipe.write(payload)
+            status = 0
+        finally:
+            os._exit(status)
+    os.close(write_end)
+    try:
+        mine = own_work()
+        with os.fdopen(read_end, "rb") as pipe:
+            payload = pipe.read()
+    except BaseException:
+        os.kill(pid, signal.SIGKILL)
+        os.waitpid(pid, 0)
+        raise
+    _, status = os.waitpid(pid, 0)
+    outcomes = _unpickle(payload) if status == 0 else None
+    if outcomes is None or len(outcomes) != len(jobs):
+        outcomes = [(False, None)] * len(jobs)
+    return [value if ok else job() for job, (ok, value) in zip(jobs, outcomes)], mine
+
+
+def _run_all(jobs: Sequence[Callable[[], Any]]) -> list[tuple[bool, Any]]:
+    out: list[tuple[bool, Any]] = []
+    for job in jobs:
+        try:
+            value = job()
+            pickle.dumps(value)
+            out.append((True, value))
+        except Exception:  # the parent runs this job again and raises there
+            out.append((False, None))
+    return out
+
+
+def _unpickle(payload: bytes) -> list[tuple[bool, Any]] | None:
+    try:
+        return pickle.loads(payload)
+    except Exception:
+        return None
+
+
+def _die_with_parent() -> None:
+    """Ask Linux to kill this process when its parent dies (no effect elsewhere)."""
+    try:
+        import ctypes
+
+        libc = ctypes.CDLL("libc.so.6", use_errno=True)
+        libc.prctl(1, int(signal.SIGKILL), 0, 0, 0)  # PR_SET_PDEATHSIG = 1
+    except (OSError, AttributeError):
+        pass
