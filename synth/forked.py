@@ -1,13 +1,13 @@
-"""Two cores for a report: independent jobs (figures) run in one forked child process while this process
-goes on with its own work; the jobs' results come back pickled through a pipe.
+"""Two cores for one command: independent jobs (a design, figures) run in one forked child process while
+this process goes on with its own work; the jobs' results come back pickled through a pipe.
 
 Forking is off unless :func:`allow_fork` turned it on (the command line does; a library caller's threads or
 event loop are its own business), and ``SYNTH_JOBS=1`` turns it off again.
 
-Correctness never depends on the child: where ``fork`` is unavailable, when it is off, or when the
-child fails or one of its jobs raises, the jobs run here, in order (so an exception is raised here, as
-without the child). The child dies with its parent (``PR_SET_PDEATHSIG`` on Linux) and never returns into
-the caller: it leaves through ``os._exit``.
+Correctness never depends on the child: where ``fork`` is unavailable or it is off, the jobs run here, in
+order; an exception a job raised in the child is raised here; a job whose result or exception does not
+survive pickling, or every job of a child that died, runs here again. The child dies with its parent
+(``PR_SET_PDEATHSIG`` on Linux) and never returns into the caller: it leaves through ``os._exit``.
 """
 
 from __future__ import annotations
@@ -85,23 +85,37 @@ def run_beside(jobs: Sequence[Callable[[], Any]], own_work: Callable[[], T]) -> 
     _, status = os.waitpid(pid, 0)
     outcomes = _unpickle(payload) if status == 0 else None
     if outcomes is None or len(outcomes) != len(jobs):
-        outcomes = [(False, None)] * len(jobs)
-    return [value if ok else job() for job, (ok, value) in zip(jobs, outcomes)], mine
+        outcomes = [("rerun", None)] * len(jobs)
+    return [_result(job, outcome) for job, outcome in zip(jobs, outcomes)], mine
 
 
-def _run_all(jobs: Sequence[Callable[[], Any]]) -> list[tuple[bool, Any]]:
-    out: list[tuple[bool, Any]] = []
+def _run_all(jobs: Sequence[Callable[[], Any]]) -> list[tuple[str, Any]]:
+    """Each job's ``("value", result)``, ``("raised", exception)`` or ``("rerun", None)`` (its result or
+    exception does not survive pickling: the parent runs it again)."""
+    out: list[tuple[str, Any]] = []
     for job in jobs:
         try:
-            value = job()
-            pickle.dumps(value)
-            out.append((True, value))
-        except Exception:  # the parent runs this job again and raises there
-            out.append((False, None))
+            outcome: tuple[str, Any] = ("value", job())
+        except Exception as exc:
+            outcome = ("raised", exc)
+        try:
+            pickle.loads(pickle.dumps(outcome))
+        except Exception:
+            outcome = ("rerun", None)
+        out.append(outcome)
     return out
 
 
-def _unpickle(payload: bytes) -> list[tuple[bool, Any]] | None:
+def _result(job: Callable[[], Any], outcome: tuple[str, Any]) -> Any:
+    kind, value = outcome
+    if kind == "value":
+        return value
+    if kind == "raised":
+        raise value
+    return job()
+
+
+def _unpickle(payload: bytes) -> list[tuple[str, Any]] | None:
     try:
         return pickle.loads(payload)
     except Exception:

@@ -60,7 +60,13 @@ def shifted(p: np.ndarray, f: float) -> np.ndarray:
     >>> shifted(np.array([1.0, 2.0]), 0.5)  # s + 2 -> s + 1.5
     array([1. , 1.5])
     """
-    return np.poly1d(np.asarray(p, float))(np.poly1d([1.0, -f])).coeffs
+    p = trim(p)
+    step = np.array([1.0, -float(f)])
+    out = p[:1]
+    for c in p[1:]:  # Horner's scheme on polynomials: out * (s - f) + c
+        out = np.convolve(out, step)
+        out[-1] += c
+    return out
 
 
 def mirror(p: np.ndarray) -> np.ndarray:

@@ -12,12 +12,12 @@ from __future__ import annotations
 from dataclasses import asdict, dataclass
 
 import numpy as np
-from scipy.signal import cont2discrete, lti, tf2ss
 
 from synth.loop import Loop
 from synth.polynomials import trim
+from synth.statespace import tf_to_ss, zoh
 
-__all__ = ["StepMetrics", "default_horizon", "step_metrics", "step_response"]
+__all__ = ["StepMetrics", "default_horizon", "exact_step", "step_metrics", "step_response"]
 
 
 @dataclass(frozen=True)
@@ -134,10 +134,7 @@ def step_response(loop: Loop, t_end: float | None = None, n: int = 2001) -> tupl
     t_end = default_horizon(loop) if t_end is None else float(t_end)
     t = np.linspace(0.0, t_end, n)
     if loop.delay == 0.0:
-        num = loop.num
-        den = trim(np.polyadd(loop.den, loop.num))
-        _, y = lti(num, den).step(T=t)
-        return t, np.asarray(y, float), 0.0
+        return t, exact_step(loop.num, trim(np.polyadd(loop.den, loop.num)), t), 0.0
     return _delayed_step(loop, t_end, n)
 
 
@@ -176,6 +173,29 @@ def _zoh(num: np.ndarray, den: np.ndarray, dt: float):
     num, den = trim(num), trim(den)
     if den.size == 1:
         return np.zeros((0, 0)), np.zeros(0), np.zeros(0), float(num[-1] / den[0])
-    A, B, C, D = tf2ss(num, den)
-    Ad, Bd, Cd, Dd, _ = cont2discrete((A, B, C, D), dt, method="zoh")
-    return Ad, Bd[:, 0], Cd[0], float(Dd[0, 0])
+    A, B, C, D = tf_to_ss(num, den)
+    Ad, Bd = zoh(A, B, dt)
+    return Ad, Bd[:, 0], C, D
+
+
+def exact_step(num: np.ndarray, den: np.ndarray, t: np.ndarray) -> np.ndarray:
+    """Unit step response of ``num/den`` (proper, no delay) at the evenly spaced times ``t`` (from 0), exact:
+    a step is held constant, so its zero-order-hold discretization at the spacing of ``t`` has no error.
+
+    Examples
+    --------
+    >>> exact_step(np.array([1.0]), np.array([1.0, 1.0]), np.array([0.0, np.log(2.0)])).round(12).tolist()
+    [0.0, 0.5]
+    """
+    t = np.asarray(t, float)
+    A, B, C, D = tf_to_ss(num, den)
+    if A.size == 0 or t.size < 2:  # a static gain, or only t = 0 (the state starts at rest)
+        return np.full(t.size, D)
+    Ad, Bd = zoh(A, B, float(t[1] - t[0]))
+    x = np.zeros(A.shape[0])
+    y = np.empty(t.size)
+    bd = Bd[:, 0]
+    for k in range(t.size):
+        y[k] = C @ x + D
+        x = Ad @ x + bd
+    return y

@@ -35,10 +35,17 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--quiet", "-q", action="store_true", help="print nothing; use the exit code")
 
 
+def _prepare_report() -> None:
+    from synth.report.figures import warm_up
+
+    warm_up()
+
+
 def run(args: argparse.Namespace) -> int:
     from synth.cli._outputs import check_outputs, spec_name
     from synth.cli._table import print_requirements
     from synth.design import design
+    from synth.forked import run_beside
     from synth.outputs import dump_json, write_json
     from synth.requirements.base import fmt
     from synth.spec import load_spec
@@ -47,7 +54,10 @@ def run(args: argparse.Namespace) -> int:
     folder = None if args.no_report or not name else (Path(args.out) if args.out else Path("reports") / name)
     check_outputs(folder, ["result.json", "report.html"], [args.json], args.force)
     spec = load_spec(args.spec)
-    result = design(spec)
+    if args.no_report:
+        result = design(spec)
+    else:  # the design on the other core while this one loads the report's modules (synth.forked)
+        (result,), _ = run_beside([lambda: design(spec)], _prepare_report)
     say = (lambda *a: None) if args.quiet or args.json == "-" else print
     out_dir = Path(args.out) if args.out else Path("reports") / spec.name
     data = None

@@ -10,7 +10,6 @@ record of half a million samples takes milliseconds.
 from __future__ import annotations
 
 import numpy as np
-from scipy.signal import lfilter, ss2tf
 
 from synth.errors import DataError, ModelError
 from synth.plant import Plant
@@ -32,6 +31,8 @@ def _shift(x: np.ndarray, k: int) -> np.ndarray:
 def _filter(Ad: np.ndarray, B: np.ndarray, C: np.ndarray, x: np.ndarray) -> np.ndarray:
     if not np.any(B):
         return np.zeros_like(x)
+    from scipy.signal import lfilter, ss2tf  # here: importing scipy.signal costs 0.4 s
+
     num, den = ss2tf(Ad, B[:, None], C[None, :], np.zeros((1, 1)))
     return lfilter(num[0], den, x)
 

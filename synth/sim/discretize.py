@@ -16,59 +16,20 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.linalg import expm
-from scipy.signal import cont2discrete, tf2ss
 
 from synth.errors import ModelError
+from synth.statespace import generalized_bilinear, tf_to_ss, zoh
 
 __all__ = ["DISCRETIZATIONS", "DelayedZOH", "delayed_zoh", "discretize_controller", "tf_to_ss", "zoh"]
 
 DISCRETIZATIONS = {
-    "tustin": "bilinear",
-    "zoh": "zoh",
-    "backward_euler": "backward_diff",
-    "forward_euler": "euler",
+    "tustin": 0.5,
+    "zoh": None,
+    "backward_euler": 1.0,
+    "forward_euler": 0.0,
 }
-"""Controller discretization methods (spec name -> scipy ``cont2discrete`` method)."""
-
-
-def tf_to_ss(num: np.ndarray, den: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
-    """State space ``(A, B, C, D)`` of a proper SISO transfer function; ``B`` is a vector.
-
-    Examples
-    --------
-    >>> A, B, C, D = tf_to_ss(np.array([2.0]), np.array([1.0, 3.0]))
-    >>> A.tolist(), B.tolist(), C.tolist(), D
-    ([[-3.0]], [1.0], [2.0], 0.0)
-    """
-    num = np.atleast_1d(np.asarray(num, float))
-    den = np.atleast_1d(np.asarray(den, float))
-    if den.size == 1:
-        return np.zeros((0, 0)), np.zeros(0), np.zeros(0), float(num[-1] / den[0])
-    A, B, C, D = tf2ss(num, den)
-    return A, B[:, 0], C[0], float(D[0, 0])
-
-
-def zoh(A: np.ndarray, B: np.ndarray, h: float) -> tuple[np.ndarray, np.ndarray]:
-    """``(e^{A h}, int_0^h e^{A s} ds B)`` for ``B`` with one column per input.
-
-    Examples
-    --------
-    >>> Ad, Gd = zoh(np.array([[-1.0]]), np.array([[1.0]]), np.log(2.0))
-    >>> float(Ad[0, 0]), round(float(Gd[0, 0]), 12)
-    (0.5, 0.5)
-    """
-    n = A.shape[0]
-    B = np.asarray(B, float).reshape(n, -1)
-    if n == 0:
-        return np.zeros((0, 0)), np.zeros((0, B.shape[1]))
-    if h == 0.0:
-        return np.eye(n), np.zeros_like(B)
-    M = np.zeros((n + B.shape[1], n + B.shape[1]))
-    M[:n, :n] = A * h
-    M[:n, n:] = B * h
-    E = expm(M)
-    return E[:n, :n], E[:n, n:]
+"""Controller discretization methods: spec name -> the ``alpha`` of the generalized bilinear transform
+(:func:`synth.statespace.generalized_bilinear`; ``None``: zero-order hold, exact for a held input)."""
 
 
 @dataclass(frozen=True)
@@ -138,6 +99,8 @@ def discretize_controller(num: np.ndarray, den: np.ndarray, period: float,
     A, B, C, D = tf_to_ss(num, den)
     if A.size == 0:
         return A, B, C, D
-    Ad, Bd, Cd, Dd, _ = cont2discrete((A, B[:, None], C[None, :], np.array([[D]])), period,
-                                      method=DISCRETIZATIONS[method])
-    return np.asarray(Ad), np.asarray(Bd)[:, 0], np.asarray(Cd)[0], float(np.asarray(Dd)[0, 0])
+    alpha = DISCRETIZATIONS[method]
+    if alpha is None:
+        Ad, Bd = zoh(A, B, period)
+        return Ad, Bd[:, 0], C, D
+    return generalized_bilinear(A, B, C, D, period, alpha)
