@@ -37,11 +37,15 @@ def allow_fork(allowed: bool = True) -> None:
 
 
 def run_beside(jobs: Sequence[Callable[[], Any]], own_work: Callable[[], T]) -> tuple[list[Any], T]:
-    """Run ``jobs`` (in order) in a forked child while ``own_work()`` runs here; return both results.
+    """Run ``jobs`` in a forked child while ``own_work()`` runs here; return both results.
+
+    The child takes the jobs in order; when ``own_work`` is done this process takes the ones the child has
+    not started (one ticket per job in a pipe, read one byte at a time by either process), so the two
+    cores stay busy whichever side has more to do.
 
     Parameters
     ----------
-    jobs : sequence of callables without arguments
+    jobs : sequence of callables without arguments (at most 255)
         Independent of ``own_work`` and of each other's side effects here (a child's changes to this
         process's objects are lost: only return values come back, so they must pickle).
     own_work : callable without arguments
@@ -57,43 +61,57 @@ def run_beside(jobs: Sequence[Callable[[], Any]], own_work: Callable[[], T]) -> 
     >>> allow_fork(); run_beside([lambda: 2 + 2, lambda: "x" * 3], lambda: 10)
     ([4, 'xxx'], 10)
     """
-    if len(jobs) == 0 or not _ALLOWED[0] or not hasattr(os, "fork") or os.environ.get("SYNTH_JOBS", "") == "1":
+    if len(jobs) == 0 or len(jobs) > 255 or not _ALLOWED[0] or not hasattr(os, "fork") \
+            or os.environ.get("SYNTH_JOBS", "") == "1":
         mine = own_work()
         return [job() for job in jobs], mine
+    tickets_read, tickets_write = os.pipe()
+    os.write(tickets_write, bytes(range(len(jobs))))  # < PIPE_BUF: one atomic write, never blocks
+    os.close(tickets_write)
     read_end, write_end = os.pipe()
     pid = os.fork()
-    if pid == 0:  # the child: run the jobs, send the results, leave without running the caller's code
+    if pid == 0:  # the child: run jobs while tickets last, send the results, leave without returning
         status = 1
         try:
             os.close(read_end)
             _die_with_parent()
-            payload = pickle.dumps(_run_all(jobs), protocol=pickle.HIGHEST_PROTOCOL)
+            payload = pickle.dumps(_run_tickets(jobs, tickets_read), protocol=pickle.HIGHEST_PROTOCOL)
             with os.fdopen(write_end, "wb") as pipe:
                 pipe.write(payload)
             status = 0
         finally:
             os._exit(status)
     os.close(write_end)
+    here: dict[int, Any] = {}
     try:
         mine = own_work()
+        while ticket := os.read(tickets_read, 1):  # the jobs the child has not started yet
+            here[ticket[0]] = jobs[ticket[0]]()
         with os.fdopen(read_end, "rb") as pipe:
             payload = pipe.read()
     except BaseException:
         os.kill(pid, signal.SIGKILL)
         os.waitpid(pid, 0)
         raise
+    finally:
+        os.close(tickets_read)
     _, status = os.waitpid(pid, 0)
-    outcomes = _unpickle(payload) if status == 0 else None
-    if outcomes is None or len(outcomes) != len(jobs):
-        outcomes = [("rerun", None)] * len(jobs)
-    return [_result(job, outcome) for job, outcome in zip(jobs, outcomes)], mine
+    there = (_unpickle(payload) if status == 0 else None) or {}
+    out = []
+    for i, job in enumerate(jobs):
+        if i in here:
+            out.append(here[i])
+        else:  # the child's result; a job of a child that died runs here
+            out.append(_result(job, there.get(i, ("rerun", None))))
+    return out, mine
 
 
-def _run_all(jobs: Sequence[Callable[[], Any]]) -> list[tuple[str, Any]]:
-    """Each job's ``("value", result)``, ``("raised", exception)`` or ``("rerun", None)`` (its result or
-    exception does not survive pickling: the parent runs it again)."""
-    out: list[tuple[str, Any]] = []
-    for job in jobs:
+def _run_tickets(jobs: Sequence[Callable[[], Any]], tickets: int) -> dict[int, tuple[str, Any]]:
+    """Each job the child took: ``("value", result)``, ``("raised", exception)`` or ``("rerun", None)`` (its
+    result or exception does not survive pickling: the parent runs it again)."""
+    out: dict[int, tuple[str, Any]] = {}
+    while ticket := os.read(tickets, 1):
+        job = jobs[ticket[0]]
         try:
             outcome: tuple[str, Any] = ("value", job())
         except Exception as exc:
@@ -102,7 +120,7 @@ def _run_all(jobs: Sequence[Callable[[], Any]]) -> list[tuple[str, Any]]:
             pickle.loads(pickle.dumps(outcome))
         except Exception:
             outcome = ("rerun", None)
-        out.append(outcome)
+        out[ticket[0]] = outcome
     return out
 
 
@@ -115,7 +133,7 @@ def _result(job: Callable[[], Any], outcome: tuple[str, Any]) -> Any:
     return job()
 
 
-def _unpickle(payload: bytes) -> list[tuple[str, Any]] | None:
+def _unpickle(payload: bytes) -> dict[int, tuple[str, Any]] | None:
     try:
         return pickle.loads(payload)
     except Exception:

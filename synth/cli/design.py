@@ -6,6 +6,7 @@ import argparse
 import shlex
 import sys
 from pathlib import Path
+from typing import Any
 
 __all__ = ["COMMAND", "DESCRIPTION", "HELP", "ORDER", "add_arguments", "run"]
 
@@ -35,10 +36,17 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--quiet", "-q", action="store_true", help="print nothing; use the exit code")
 
 
-def _prepare_report() -> None:
+def _prepare_report(spec: Any) -> None:
+    """What the report will need, made ready on this core while the design runs on the other: its modules,
+    matplotlib's text machinery and, when the spec simulates, the compiled simulation kernels."""
+    from synth.report.design_report import write_design_report  # noqa: F401 (the import is the work)
     from synth.report.figures import warm_up
 
     warm_up()
+    if spec.simulation is not None or any(getattr(r, "simulation", None) is not None for r in spec.requirements):
+        from synth.sim.verdict import warm_up as warm_simulation
+
+        warm_simulation()
 
 
 def run(args: argparse.Namespace) -> int:
@@ -57,7 +65,7 @@ def run(args: argparse.Namespace) -> int:
     if args.no_report:
         result = design(spec)
     else:  # the design on the other core while this one loads the report's modules (synth.forked)
-        (result,), _ = run_beside([lambda: design(spec)], _prepare_report)
+        (result,), _ = run_beside([lambda: design(spec)], lambda: _prepare_report(spec))
     say = (lambda *a: None) if args.quiet or args.json == "-" else print
     out_dir = Path(args.out) if args.out else Path("reports") / spec.name
     data = None

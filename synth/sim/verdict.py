@@ -54,7 +54,7 @@ from synth.sim.metrics import NonlinearStepMetrics, nonlinear_step_metrics
 from synth.sim.results import SimResult
 
 __all__ = ["MAX_SAMPLES", "MIN_CYCLES", "SETTLED", "SHRINK", "STEADY", "VERDICTS", "Evidence", "Judgement", "StepVerdict",
-           "default_cap", "judge", "step_verdict"]
+           "default_cap", "judge", "step_verdict", "warm_up"]
 
 VERDICTS = ("settled", "limit_cycle", "diverging", "undetermined")
 """The four answers of a step simulation."""
@@ -482,3 +482,21 @@ def step_verdict(loop: NonlinearLoop, start: float, end: float, t_step: float = 
     evidence = Evidence(float(result.t[-1]), loop.dt, int(result.t.size), j.cycles, tuple(tried), float(cap),
                         j.criterion, plan)
     return StepVerdict(verdict, evidence, metrics, result)
+
+
+def warm_up() -> None:
+    """Run one short saturated step to its verdict: numba loads the compiled simulation and cycle-detection
+    kernels from its disk cache (about 0.3 s on first use in a process). The design command does this on
+    one core while the design runs on the other, so that its report's simulations start warm.
+
+    Examples
+    --------
+    >>> warm_up()
+    """
+    from synth.controllers import Controller
+    from synth.plant import Plant
+    from synth.sim.blocks import Saturation
+
+    loop = NonlinearLoop(Plant.from_string("1/(s+1)"), Controller("P", {"kp": 2.0}), actuator=[Saturation(-1, 1)],
+                         dt=0.01)
+    step_verdict(loop, 0.0, 1.0, max_horizon=2.0)

@@ -1,0 +1,96 @@
+"""synth.forked.run_beside: results in order whichever process ran a job, exceptions raised here, a dead
+child's jobs rerun here, serial when forking is off; and the design command's outputs are the same bytes
+whether its figures and design ran beside each other or one after the other."""
+
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from synth.forked import allow_fork, run_beside
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+@pytest.fixture(autouse=True)
+def _fork_allowed():
+    allow_fork(True)
+    yield
+    allow_fork(False)
+
+
+def test_results_come_back_in_order_and_both_processes_take_jobs():
+    import time
+
+    def job(i: int):
+        def run():
+            time.sleep(0.05)
+            return i * i, os.getpid()
+        return run
+
+    results, mine = run_beside([job(i) for i in range(8)], lambda: time.sleep(0.12) or "own")
+    assert mine == "own"
+    assert [r[0] for r in results] == [i * i for i in range(8)]
+    pids = {r[1] for r in results}
+    assert os.getpid() in pids and len(pids) == 2  # the child and, once its own work was done, this process
+
+
+def test_an_exception_in_the_child_is_raised_here():
+    def bad():
+        raise ValueError("no such plant")
+
+    with pytest.raises(ValueError, match="no such plant"):
+        run_beside([lambda: 1, bad], lambda: None)
+
+
+def test_a_result_that_does_not_pickle_is_computed_here_again():
+    calls = []
+
+    def unpicklable():
+        calls.append(os.getpid())
+        return lambda: 0  # a lambda does not pickle
+
+    (value,), _ = run_beside([unpicklable], lambda: None)
+    assert callable(value) and calls == [os.getpid()]  # this process's own call (the child's is lost)
+
+
+def test_a_child_that_dies_leaves_its_jobs_to_this_process():
+    def die_in_child():
+        if os.getpid() != parent:
+            os.kill(os.getpid(), signal.SIGKILL)
+        return "done here"
+
+    parent = os.getpid()
+    (value,), _ = run_beside([die_in_child], lambda: None)
+    assert value == "done here"
+
+
+def test_off_means_serial_in_this_process():
+    allow_fork(False)
+    (pid,), _ = run_beside([os.getpid], lambda: None)
+    assert pid == os.getpid()
+
+
+def test_design_outputs_are_the_same_bytes_forked_or_serial(tmp_path: Path):
+    """The design command with its worker and with SYNTH_JOBS=1: every file identical (but the command line
+    quoted in the HTML, which names the output folder)."""
+    outs = {}
+    for jobs in ("2", "1"):
+        out = tmp_path / f"jobs{jobs}"
+        env = {**os.environ, "SYNTH_JOBS": jobs}
+        done = subprocess.run([sys.executable, "-m", "synth", "design", "specs/x4_rotor_pi.yaml", "--out", str(out)],
+                              cwd=ROOT, env=env, capture_output=True, text=True, timeout=300)
+        assert done.returncode == 0, done.stderr
+        outs[jobs] = out
+    names = sorted(p.name for p in outs["2"].iterdir())
+    assert names == sorted(p.name for p in outs["1"].iterdir()) and "feasible_region.png" in names
+    for name in names:
+        forked, serial = (outs["2"] / name).read_bytes(), (outs["1"] / name).read_bytes()
+        if name == "report.html":
+            forked, serial = forked.replace(b"jobs2", b"jobsN"), serial.replace(b"jobs1", b"jobsN")
+        assert forked == serial, name
