@@ -75,6 +75,7 @@ def run_beside(jobs: Sequence[Callable[[], Any]], own_work: Callable[[], T]) -> 
         try:
             os.close(read_end)
             _die_with_parent()
+            _ALLOWED[0] = False  # two cores: a job's own run_beside calls run serially in the child
             payload = pickle.dumps(_run_tickets(jobs, tickets_read), protocol=pickle.HIGHEST_PROTOCOL)
             with os.fdopen(write_end, "wb") as pipe:
                 pipe.write(payload)

@@ -36,17 +36,25 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--quiet", "-q", action="store_true", help="print nothing; use the exit code")
 
 
-def _prepare_report(spec: Any) -> None:
+def _prepare_report(spec: Any) -> dict[str, Any] | None:
     """What the report will need, made ready on this core while the design runs on the other: its modules,
-    matplotlib's text machinery and, when the spec simulates, the compiled simulation kernels."""
-    from synth.report.design_report import write_design_report  # noqa: F401 (the import is the work)
+    matplotlib's text machinery, the seed paper's section when the spec asks for it (it depends on the spec
+    alone and is cached), the gain-set figure's slack curves (the spec alone) and, when the spec simulates,
+    the compiled simulation kernels. Returns the curves (None without one free parameter)."""
+    from synth.report.design_report import slack_curves
     from synth.report.figures import warm_up
 
     warm_up()
+    if spec.analysis.paper is not None:
+        from synth.report.paper_section import paper_section_data
+
+        paper_section_data(spec)
+    curves = slack_curves(spec) if len(spec.controller.free_parameters()) == 1 else None
     if spec.simulation is not None or any(getattr(r, "simulation", None) is not None for r in spec.requirements):
         from synth.sim.verdict import warm_up as warm_simulation
 
         warm_simulation()
+    return curves
 
 
 def run(args: argparse.Namespace) -> int:
@@ -62,10 +70,11 @@ def run(args: argparse.Namespace) -> int:
     folder = None if args.no_report or not name else (Path(args.out) if args.out else Path("reports") / name)
     check_outputs(folder, ["result.json", "report.html"], [args.json], args.force)
     spec = load_spec(args.spec)
+    curves = None
     if args.no_report:
         result = design(spec)
     else:  # the design on the other core while this one loads the report's modules (synth.forked)
-        (result,), _ = run_beside([lambda: design(spec)], lambda: _prepare_report(spec))
+        (result,), curves = run_beside([lambda: design(spec)], lambda: _prepare_report(spec))
     say = (lambda *a: None) if args.quiet or args.json == "-" else print
     out_dir = Path(args.out) if args.out else Path("reports") / spec.name
     data = None
@@ -75,7 +84,7 @@ def run(args: argparse.Namespace) -> int:
         command = "synth design " + shlex.quote(args.spec)
         if args.out:
             command += f" --out {shlex.quote(args.out)}"
-        files = write_design_report(spec, result, out_dir, command=command, force=args.force)
+        files = write_design_report(spec, result, out_dir, command=command, force=args.force, curves=curves)
         import json
 
         data = json.loads(files.result_json.read_text(encoding="utf-8"))

@@ -14,7 +14,6 @@ from synth.loop import Loop
 from synth.outputs import GENERATOR, OutputDir, dump_json, to_jsonable
 from synth.reference import compare
 from synth.report import figures
-from synth.report.paper_section import paper_section_data, paper_section_figures
 from synth.report.templating import render, reproducible, unit_text
 from synth.requirements import SlewRate
 from synth.requirements.base import Requirement, fmt
@@ -23,7 +22,7 @@ from synth.spec import Spec
 from synth.synthesis.gainset import SlackBatch
 from synth.synthesis.scalar import scalar_family
 
-__all__ = ["ReportFiles", "report_data", "write_design_report"]
+__all__ = ["ReportFiles", "report_data", "slack_curves", "write_design_report"]
 
 
 @dataclass
@@ -70,7 +69,10 @@ def report_data(spec: Spec, result: DesignResult, keep: dict[str, Any] | None = 
 
         if gap_case_applies(spec):  # seed 1's gap diagnosed on the simulated rig (issue 6): synth.gap.x4_case
             data["sim_to_real_gap"] = x4_gap_case(spec, objects=keep)
-    data |= paper_section_data(spec)  # the seed paper's own section (issue 19): synth.report.paper_section
+    if spec.analysis.paper is not None:  # the seed paper's own section (issue 19): synth.report.paper_section
+        from synth.report.paper_section import paper_section_data
+
+        data |= paper_section_data(spec)
     return reproducible(to_jsonable(data))
 
 
@@ -79,7 +81,7 @@ _FIGURE_ORDER = ("bode", "sensitivity", "step", "gain_set", "region", "delay")
 
 def _design_figure_jobs(spec: Spec, result: DesignResult, loops: list[tuple[str, Loop]], marks: dict[str, float],
                         ref: Controller | None, result_data: dict[str, Any], out: OutputDir,
-                        ) -> list[tuple[str, Any]]:
+                        curves: dict[str, tuple[np.ndarray, np.ndarray]] | None = None) -> list[tuple[str, Any]]:
     """``(figure key, job)`` for the figures that need only the design; each job returns ``(path or None,
     the requirement bounds it drew or None, the file names it claimed)``."""
 
@@ -95,6 +97,11 @@ def _design_figure_jobs(spec: Spec, result: DesignResult, loops: list[tuple[str,
     if result.gain_set is None and result.controller is not None:
         jobs.append(("region", job(lambda: figures.feasibility_map(spec, result.controller,
                                                                    out.claim("feasible_region.png"), reference=ref))))
+    gain = result_data.get("gain_set_detail")
+    if gain is not None:  # the heavier jobs first: the worker starts on them
+        jobs.append(("gain_set", job(lambda: figures.gain_set_plot(
+            gain["parameter"], tuple(gain["bounds"]), curves if curves is not None else slack_curves(spec),
+            result_data["gain_set"], marks, out.claim("gain_set.png")))))
     slew = [r for r in spec.requirements if isinstance(r, SlewRate)]
     if slew and loops:
         jobs.append(("bode", job(lambda drawn: figures.bode_with_slew_bound(
@@ -102,11 +109,6 @@ def _design_figure_jobs(spec: Spec, result: DesignResult, loops: list[tuple[str,
     if loops:
         jobs.append(("sensitivity", job(lambda drawn: figures.sensitivity_plot(
             loops, list(spec.requirements), out.claim("sensitivity.png"), drawn=drawn), True)))
-    gain = result_data.get("gain_set_detail")
-    if gain is not None:
-        jobs.append(("gain_set", job(lambda: figures.gain_set_plot(
-            gain["parameter"], tuple(gain["bounds"]), _slack_curves(spec), result_data["gain_set"], marks,
-            out.claim("gain_set.png")))))
     if loops:
         jobs.append(("step", job(lambda: figures.step_plot(loops, out.claim("step_response.png")))))
     return jobs
@@ -132,12 +134,24 @@ def _analysis_figures(spec: Spec, data: dict[str, Any], objects: dict[str, Any],
         diag = objects["diagnosis"]
         figs["gap_map"] = write_gap_map(diag.localization, out.claim("gap_map.png"), diag.plant)
         figs["gap_overlay"] = save_figure(overlay_figure(diag.attribution), out.claim("gap_overlay.png"))
-    figs.update(paper_section_figures(spec, out))  # the seed paper's own section (issue 19), if the spec asks
+    if spec.analysis.paper is not None:  # the seed paper's own section (issue 19), if the spec asks
+        from synth.report.paper_section import paper_section_figures
+
+        figs.update(paper_section_figures(spec, out))
     return figs
 
 
-def _slack_curves(spec: Spec) -> dict[str, tuple[np.ndarray, np.ndarray]]:
-    """Each requirement's worst slack over the plants against the free parameter (vectorized)."""
+def slack_curves(spec: Spec) -> dict[str, tuple[np.ndarray, np.ndarray]]:
+    """Each requirement's worst slack over the plants against the spec's one free parameter (vectorized,
+    121 values over its bounds): the curves of the report's gain-set figure.
+
+    Examples
+    --------
+    >>> from synth.spec import load_spec
+    >>> curves = slack_curves(load_spec("specs/x4_rotor.yaml"))
+    >>> sorted(curves)[0], curves["bandwidth"][0].size
+    ('bandwidth', 121)
+    """
     family, (lo, hi) = scalar_family(spec)
     xs = np.linspace(lo, hi, 121)
     fast = SlackBatch(family, spec.plants(), per_decade=40)
@@ -185,12 +199,14 @@ def _num(x: Any) -> float | None:
 
 
 def write_design_report(spec: Spec, result: DesignResult, out_dir: str | Path, *, command: str = "",
-                        force: bool = False) -> ReportFiles:
+                        force: bool = False,
+                        curves: dict[str, tuple[np.ndarray, np.ndarray]] | None = None) -> ReportFiles:
     """Write ``result.json``, ``report.html`` and figures for a design into ``out_dir``.
 
     Files synth wrote earlier are replaced; any other existing file of the
     same name is left alone (:class:`~synth.errors.OutputExistsError`) unless
-    ``force`` is given.
+    ``force`` is given. ``curves`` are the gain-set figure's :func:`slack_curves` when the caller has them
+    already (the design command computes them beside the design).
 
     Examples
     --------
@@ -219,7 +235,7 @@ def write_design_report(spec: Spec, result: DesignResult, out_dir: str | Path, *
             marks[name] = loop.controller.parameters["kp"]
     result_data = reproducible(to_jsonable(result.to_dict()))
     # figures that need only the design: drawn by a forked worker while this process computes report_data
-    jobs = _design_figure_jobs(spec, result, loops, marks, ref, result_data, out)
+    jobs = _design_figure_jobs(spec, result, loops, marks, ref, result_data, out, curves)
     objects: dict[str, Any] = {}
 
     def own_work() -> tuple[dict[str, Any], dict[str, Path]]:
