@@ -43,11 +43,47 @@ objective: {maximize: integral_gain}
 """
 
 
+P_SPEC = """\
+name: dc_motor_p
+description: "A DC motor speed loop nobody here tuned, P control: |S| <= -6 dB below 2 rad/s, margins"
+plant:
+  tf: "120/((s+4)*(s+60))"
+  delay: 0.005
+controller:
+  type: P
+  bounds: {kp: [0, 30]}
+requirements:
+  - {type: sensitivity, max_db: -6, band: [0, 2]}
+  - {type: margins, gain_margin_db: 6, phase_margin_deg: 45}
+  - {type: bandwidth, min: 5}
+objective: {maximize: bandwidth}
+"""
+
+PID_SPEC = """\
+name: servo_pid
+description: "A position servo (integrator, lightly damped mode), PID with a fixed derivative filter"
+plant:
+  tf: "400/(s*(s^2+4*s+400))"
+  delay: 0.002
+controller:
+  type: PID
+  bounds: {kp: [0, 5], ki: [0, 5], kd: [0, 0.5], tf: [0.005, 0.005]}
+requirements:
+  - {type: peak_sensitivity, max_db: 6}
+  - {type: margins, gain_margin_db: 6, phase_margin_deg: 40}
+  - {type: bandwidth, min: 2}
+objective: {maximize: bandwidth}
+"""
+
+
 def cases(tmp: Path) -> dict[str, list[str]]:
     """Label -> command arguments after ``python -m synth`` (``{out}`` is replaced by a fresh folder; a leading
     ``ENV=value`` item is set in the command's environment)."""
     pi = tmp / "x4_pi_delay.yaml"
     pi.write_text(PI_SPEC, encoding="utf-8")
+    p_spec, pid_spec = tmp / "dc_motor_p.yaml", tmp / "servo_pid.yaml"
+    p_spec.write_text(P_SPEC, encoding="utf-8")
+    pid_spec.write_text(PID_SPEC, encoding="utf-8")
     return {
         "synth design specs/x4_rotor_from_data.yaml (README main job)":
             ["design", "specs/x4_rotor_from_data.yaml", "--out", "{out}"],
@@ -55,6 +91,12 @@ def cases(tmp: Path) -> dict[str, list[str]]:
             ["SYNTH_IDENTIFY_CACHE=off", "design", "specs/x4_rotor_from_data.yaml", "--out", "{out}"],
         "synth design specs/x4_rotor.yaml": ["design", "specs/x4_rotor.yaml", "--out", "{out}"],
         "synth design x4_pi_delay.yaml (PI, 20 ms delay, with report)": ["design", str(pi), "--out", "{out}"],
+        "synth design specs/x4_rotor_pi.yaml (PI, nonlinear step, with report)":
+            ["design", "specs/x4_rotor_pi.yaml", "--out", "{out}"],
+        "synth design specs/x4_rotor_robust.yaml (PI over 3 plants, with report)":
+            ["design", "specs/x4_rotor_robust.yaml", "--out", "{out}"],
+        "synth design dc_motor_p.yaml (P, with report)": ["design", str(p_spec), "--out", "{out}"],
+        "synth design servo_pid.yaml (PID, with report)": ["design", str(pid_spec), "--out", "{out}"],
         "synth check specs/x4_rotor.yaml --controller P(3)":
             ["check", "specs/x4_rotor.yaml", "--controller", "P(3)"],
     }
