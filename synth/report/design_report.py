@@ -94,9 +94,15 @@ def _design_figure_jobs(spec: Spec, result: DesignResult, loops: list[tuple[str,
         return run
 
     jobs: list[tuple[str, Any]] = []
-    if result.gain_set is None and result.controller is not None:
-        jobs.append(("region", job(lambda: figures.feasibility_map(spec, result.controller,
-                                                                   out.claim("feasible_region.png"), reference=ref))))
+    if result.gain_set is None and result.controller is not None \
+            and len(spec.controller.free_parameters()) == 2:
+        if len(spec.plants()) == 1:
+            jobs.append(("region", job(lambda: figures.feasibility_map(
+                spec, result.controller, out.claim("feasible_region.png"), reference=ref))))
+        else:  # the plane's grid one plant per job (both cores share them), drawn when all are in
+            for k in range(len(spec.plants())):
+                jobs.append((f"region:{k}", lambda k=k: (
+                    figures.feasibility_grid(spec, result.controller, plants=[k]), None, [])))
     gain = result_data.get("gain_set_detail")
     if gain is not None:  # the heavier jobs first: the worker starts on them
         jobs.append(("gain_set", job(lambda: figures.gain_set_plot(
@@ -244,13 +250,19 @@ def write_design_report(spec: Spec, result: DesignResult, out_dir: str | Path, *
 
     drawn_by_worker, (data, figs) = run_beside([job for _, job in jobs], own_work)
     bounds: dict[str, list[dict[str, Any]]] = {}  # figure -> the requirement bounds it draws
+    plane = []
     for (key, _), (path, drawn, claimed) in zip(jobs, drawn_by_worker):
         for name in claimed:  # names the worker claimed in its copy of ``out``
             out.claim(name)
-        if path is not None:
+        if key.startswith("region:"):
+            plane.append(path)
+        elif path is not None:
             figs[key] = path
         if drawn is not None:
             bounds[key] = drawn
+    if plane:
+        figs["region"] = figures.feasibility_map(spec, result.controller, out.claim("feasible_region.png"),
+                                                 reference=ref, grid=figures.combine_grids(plane))
     figs = {key: figs[key] for key in _FIGURE_ORDER if key in figs} | figs
     gain = data.get("gain_set_detail")
 

@@ -16,6 +16,7 @@ __all__ = [
     "bode_with_slew_bound",
     "bound_drawn",
     "column_root_counts",
+    "combine_grids",
     "delay_chart",
     "feasibility_grid",
     "feasibility_map",
@@ -210,11 +211,13 @@ def delay_chart(rows: list[dict[str, Any]], marks: dict[str, float], path: Path)
     return save_figure(fig, path)
 
 
-def feasibility_grid(spec: Any, design_controller: Any, n: int = 45,
+def feasibility_grid(spec: Any, design_controller: Any, n: int = 45, plants: list[int] | None = None,
                      ) -> tuple[str, str, np.ndarray, np.ndarray, np.ndarray] | None:
     """The data of :func:`feasibility_map`: ``(xa, xb, A, B, slack)`` with ``slack[0, j, i]`` +1/-1 for a
     stable/unstable loop at ``(A[i], B[j])`` on every plant and ``slack[k + 1, j, i]`` requirement ``k``'s
-    worst slack over the plants (None unless the spec has two free parameters).
+    worst slack over the plants (None unless the spec has two free parameters). ``plants`` (indices into
+    ``spec.plants()``) restricts it to some plants; the grids of a partition of the plants combine into
+    the whole one by :func:`combine_grids` (the report computes one plant per job).
 
     Stability is exact: along each column the stabilizing set of the second parameter comes from the
     D-decomposition (:func:`synth.synthesis.gainset.stability_set`). The requirements are evaluated for
@@ -245,7 +248,8 @@ def feasibility_grid(spec: Any, design_controller: Any, n: int = 45,
     requirements = list(spec.requirements)
     slack = np.full((len(requirements) + 1, n, n), np.nan)
     base = dict(design_controller.parameters)
-    plants = spec.plants()
+    every = spec.plants()
+    plants = every if plants is None else [every[k] for k in plants]
     counts = np.zeros((len(plants), n, n), dtype=int)  # [plant, j, i]
     for i, a in enumerate(A):
         counts[:, :, i] = column_root_counts(ScalarFamily(design_controller.type, xb, {**base, xa: float(a)}),
@@ -300,11 +304,29 @@ def _cancel_origin(num: np.ndarray, den: np.ndarray) -> tuple[np.ndarray, np.nda
     return num, den
 
 
+def combine_grids(parts: list[tuple[str, str, np.ndarray, np.ndarray, np.ndarray]],
+                  ) -> tuple[str, str, np.ndarray, np.ndarray, np.ndarray]:
+    """One :func:`feasibility_grid` from the grids of disjoint sets of plants (the worst slack of each).
+
+    Examples
+    --------
+    >>> from synth.spec import load_spec; from synth.controllers import Controller
+    >>> spec, c = load_spec("specs/x4_rotor_robust.yaml"), Controller("PI", {"kp": 4.0, "ki": 40.0})
+    >>> whole = feasibility_grid(spec, c, n=5)
+    >>> parts = [feasibility_grid(spec, c, n=5, plants=[k]) for k in range(len(spec.plants()))]
+    >>> bool(np.array_equal(combine_grids(parts)[4], whole[4]))
+    True
+    """
+    xa, xb, A, B, _ = parts[0]
+    return xa, xb, A, B, np.min([p[4] for p in parts], axis=0)
+
+
 def feasibility_map(spec: Any, design_controller: Any, path: Path, n: int = 45,
-                    reference: Any | None = None) -> Path | None:
+                    reference: Any | None = None,
+                    grid: tuple[str, str, np.ndarray, np.ndarray, np.ndarray] | None = None) -> Path | None:
     """For two free parameters: where in the parameter plane each requirement holds (on a grid), the
-    feasible region shaded, the design marked (data from :func:`feasibility_grid`)."""
-    grid = feasibility_grid(spec, design_controller, n)
+    feasible region shaded, the design marked (data from :func:`feasibility_grid`, unless ``grid`` gives it)."""
+    grid = feasibility_grid(spec, design_controller, n) if grid is None else grid
     if grid is None:
         return None
     xa, xb, A, B, slack = grid
