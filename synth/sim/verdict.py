@@ -47,14 +47,28 @@ import numpy as np
 
 from synth.errors import ModelError
 from synth.sim.cycles import autocorrelation_period, measure_cycle
+from synth.sim.holding import winding_behind
 from synth.sim.horizon import HorizonPlan, plan_horizon
 from synth.sim.limitcycle import REPEAT, SAMPLED_HYSTERESIS, Oscillation, cycle_table, detect_oscillation
 from synth.sim.loops import NonlinearLoop
 from synth.sim.metrics import NonlinearStepMetrics, nonlinear_step_metrics
 from synth.sim.results import SimResult
 
-__all__ = ["MAX_SAMPLES", "MIN_CYCLES", "SETTLED", "SHRINK", "STEADY", "VERDICTS", "Evidence", "Judgement", "StepVerdict",
-           "default_cap", "judge", "step_verdict", "warm_up"]
+__all__ = [
+    "MAX_SAMPLES",
+    "MIN_CYCLES",
+    "SETTLED",
+    "SHRINK",
+    "STEADY",
+    "VERDICTS",
+    "Evidence",
+    "Judgement",
+    "StepVerdict",
+    "default_cap",
+    "judge",
+    "step_verdict",
+    "warm_up",
+]
 
 VERDICTS = ("settled", "limit_cycle", "diverging", "undetermined")
 """The four answers of a step simulation."""
@@ -282,7 +296,8 @@ def _new_record(ta: np.ndarray, ya: np.ndarray, end: float) -> bool:
 
 
 def judge(result: SimResult, t_step: float, step: tuple[float, float], metrics: NonlinearStepMetrics,
-          min_amplitude: float = 0.0, previous: Judgement | None = None, last_run: bool = False) -> Judgement:
+          min_amplitude: float = 0.0, previous: Judgement | None = None, last_run: bool = False,
+          actuator: Sequence[Any] = ()) -> Judgement:
     """Does this run decide? (The rules are in the module docstring.)
 
     Parameters
@@ -301,6 +316,9 @@ def judge(result: SimResult, t_step: float, step: tuple[float, float], metrics: 
     last_run : bool
         No longer run will follow (the cap): with no previous run, growth over the run and over its
         first half confirms divergence.
+    actuator : sequence of Block
+        The loop's actuator chain: a still output is not settled while the command winds behind a block
+        that holds it only for a while (a dead zone, backlash, quantizer, relay).
 
     Examples
     --------
@@ -377,6 +395,9 @@ def judge(result: SimResult, t_step: float, step: tuple[float, float], metrics: 
         return Judgement(None, f"the motion over the last eighth is {last8 / max(before8, 1e-300):.2g} times that "
                          f"over the eighth before (settled needs {SHRINK:g}: still shrinking, not a sustained "
                          "small oscillation)", a.cycles)
+    held = winding_behind(result, after, span, actuator, SHRINK)
+    if held is not None:
+        return Judgement(None, held, a.cycles)
     return Judgement("settled", f"within {100 * SETTLED:g} % of the step over the last {span / 4:.2g} s, "
                      f"its motion at most half that of the quarter before and still shrinking", a.cycles)
 
@@ -465,7 +486,8 @@ def step_verdict(loop: NonlinearLoop, start: float, end: float, t_step: float = 
         metrics = nonlinear_step_metrics(result, t_step, min_amplitude=min_amplitude, hysteresis=SAMPLED_HYSTERESIS,
                                          whole_cycles=True,
                                          window=window if window is not None else (T - t_step) / 4)
-        j = judge(result, t_step, (start, end), metrics, min_amplitude, previous, T >= cap * (1 - 1e-12))
+        j = judge(result, t_step, (start, end), metrics, min_amplitude, previous, T >= cap * (1 - 1e-12),
+                  loop.actuator)
         if j.verdict is not None or T >= cap * (1 - 1e-12):
             break
         previous = j
