@@ -249,7 +249,8 @@ def _steady(a: Oscillation, b: Oscillation, c: Oscillation, drift: float,
     """(None, how) when the last three quarters ``c``, ``b``, ``a`` show the same cycle: periods within
     STEADY, and amplitudes (``sizes``: each quarter's mean half peak-to-peak of a whole cycle) within
     STEADY, or varying (by less than 20 %) without a trend: not monotone over the quarters, and
-    ``drift`` (:func:`_drift`) within STEADY."""
+    ``drift`` (:func:`_drift`) within STEADY, or converging geometrically (the quarters' changes shrinking
+    by a ratio below 0.8) to a limit within STEADY of the last quarter's."""
     if not (b.present and c.present and a.amplitude and b.amplitude and c.amplitude and a.period and b.period
             and c.period):
         return "the two quarters before the last do not both show a sustained cycle", ""
@@ -265,6 +266,13 @@ def _steady(a: Oscillation, b: Oscillation, c: Oscillation, drift: float,
     if (a.amplitude - b.amplitude) * (b.amplitude - c.amplitude) < 0 and da < 0.2 and drift <= STEADY:
         return None, (f"period steady within {100 * STEADY:g} %; amplitude varies {100 * da:.2g} % between "
                       f"the last three quarters without a trend (least-squares drift of the cycles {100 * drift:.2g} %)")
+    d1, d2 = b.amplitude - c.amplitude, a.amplitude - b.amplitude
+    if d1 * d2 > 0 and abs(d2) < 0.8 * abs(d1):  # converging geometrically: the rest of the way is d2 r/(1-r)
+        r = d2 / d1
+        rest = abs(d2) * r / (1.0 - r) / a.amplitude
+        if rest <= STEADY:
+            return None, (f"period steady within {100 * STEADY:g} %; amplitude converging (the quarters' changes "
+                          f"shrink by {r:.2g}; the limit lies within {100 * rest:.2g} % of the last quarter's)")
     if da < 0.2 and drift > STEADY:
         return f"the amplitude varies {100 * da:.2g} % and drifts {100 * drift:.2g} % over the last three quarters", ""
     return f"the amplitude still changes {100 * da:.2g} % between the last three quarters", ""
