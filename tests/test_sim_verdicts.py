@@ -225,3 +225,39 @@ def test_a_quasi_periodic_quantizer_cycle_is_not_periodic_and_reports_its_ranges
     assert v.summary().startswith("limit cycle, oscillating but not periodic: amplitude")
     d = json.loads(json.dumps(v.to_dict()))
     assert d["limit_cycle"]["periodic"] is False and len(d["limit_cycle"]["amplitude_range"]) == 2
+
+
+def test_an_integrator_winding_behind_a_relay_and_backlash_is_not_settled():
+    """Seed 105 loop 15: the output stands still from about 40 s while the PID's integrator winds behind the
+    backlash until the relay flips; the independent reference finds the cycle. synth used to call it settled."""
+    case = random_cases(100, 105)[15]
+    v = step_verdict(synth_loop(case), 0.0, case["step"], case["t_step"])
+    ref = reference_run(case, horizon=120.0)
+    assert (v.verdict, ref["verdict"]) == ("limit_cycle", "limit_cycle")
+    assert v.metrics.limit_cycle.amplitude == pytest.approx(ref["amplitude"], rel=0.02)
+    assert v.metrics.limit_cycle.period == pytest.approx(ref["period"], rel=0.02)
+
+
+def test_winding_up_behind_a_saturation_for_ever_is_settled_and_behind_a_dead_zone_it_waits():
+    """PI on 1/(s+1) stepping to 1: saturated at 0.5 the output settles at 0.5 while the integrator winds for
+    ever (settled); behind a dead zone of half-width 0.3 the command winds through the zone and the output
+    then reaches the reference (settled there, not at the value it stood still at)."""
+    from synth.sim.blocks import DeadZone
+
+    G, pi = Plant.from_string("1/(s+1)"), Controller("PI", {"kp": 1.0, "ki": 1.0})
+    sat = step_verdict(NonlinearLoop(G, pi, actuator=[Saturation(-0.5, 0.5)], dt=0.01), 0.0, 1.0)
+    assert sat.verdict == "settled" and sat.metrics.final_value == pytest.approx(0.5, abs=1e-6)
+    dz = step_verdict(NonlinearLoop(G, pi, actuator=[DeadZone(width=0.3)], dt=0.01), 0.0, 1.0)
+    assert dz.verdict == "settled" and dz.metrics.final_value == pytest.approx(1.0, abs=1e-3)
+
+
+def test_a_cycle_still_converging_at_the_cap_is_a_limit_cycle():
+    """Seed 107 loop 95 (PID, quantizer and rate limit, linearly unstable): a 289-amplitude, 9.47 s cycle whose
+    amplitude still converges at synth's 1,000 s cap; the independent reference on 480 s agrees within 2 %."""
+    case = random_cases(100, 107)[95]
+    v = step_verdict(synth_loop(case), 0.0, case["step"], case["t_step"])
+    ref = reference_run(case, horizon=480.0)
+    assert (v.verdict, ref["verdict"]) == ("limit_cycle", "limit_cycle")
+    assert "converging" in v.evidence.criterion
+    assert v.metrics.limit_cycle.amplitude == pytest.approx(ref["amplitude"], rel=0.02)
+    assert v.metrics.limit_cycle.period == pytest.approx(ref["period"], rel=0.02)
