@@ -4,9 +4,10 @@ this process goes on with its own work; the jobs' results come back pickled thro
 Forking is off unless :func:`allow_fork` turned it on (the command line does; a library caller's threads or
 event loop are its own business), and ``SYNTH_JOBS=1`` turns it off again.
 
-Correctness never depends on the child: where ``fork`` is unavailable or it is off, the jobs run here, in
-order; an exception a job raised in the child is raised here; a job whose result or exception does not
-survive pickling, or every job of a child that died, runs here again. The child dies with its parent
+Correctness never depends on the child: off Linux (macOS's system libraries are not safe to use in a forked
+child) or when it is off, the jobs run here, in order; an exception a job raised in the child is raised
+here; a job whose result or exception does not survive pickling, or every job of a child that died, runs
+here again. The child dies with its parent
 (``PR_SET_PDEATHSIG`` on Linux) and never returns into the caller: it leaves through ``os._exit``.
 """
 
@@ -15,6 +16,7 @@ from __future__ import annotations
 import os
 import pickle
 import signal
+import sys
 from collections.abc import Callable, Sequence
 from typing import Any, TypeVar
 
@@ -61,8 +63,8 @@ def run_beside(jobs: Sequence[Callable[[], Any]], own_work: Callable[[], T]) -> 
     >>> allow_fork(); run_beside([lambda: 2 + 2, lambda: "x" * 3], lambda: 10)
     ([4, 'xxx'], 10)
     """
-    if len(jobs) == 0 or len(jobs) > 255 or not _ALLOWED[0] or not hasattr(os, "fork") \
-            or os.environ.get("SYNTH_JOBS", "") == "1":
+    if len(jobs) == 0 or len(jobs) > 255 or not _ALLOWED[0] or not sys.platform.startswith("linux") \
+            or os.environ.get("SYNTH_JOBS", "") == "1":  # fork is safe with these libraries on Linux only
         mine = own_work()
         return [job() for job in jobs], mine
     tickets_read, tickets_write = os.pipe()
