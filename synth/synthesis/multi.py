@@ -323,8 +323,7 @@ def _design(spec: Spec, settings: ConvexSettings, nlp: bool | str) -> DesignResu
                      terms, start_designer.grid, settings.per_decade, settings.stability_level)
         extras["synthesis"]["nlp"] = res.to_dict()
         stages.append(f"NLP polish (casadi + IPOPT, {res.iterations} iterations, {res.status})")
-        if res.success:
-            found.append(("nlp", res.controller))
+        found.extend(("nlp", c) for c in reversed(res.candidates))
     candidates, passed = _certify_best(spec, found, terms, per_decade, cache)
     method = "; ".join(stages) + f"; certificate: dense re-check, {per_decade} points per decade"
     if passed is not None:

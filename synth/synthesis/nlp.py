@@ -59,6 +59,8 @@ class NLPResult:
     iterations: int
     solve_time: float
     history: list[dict[str, Any]] = field(default_factory=list)
+    candidates: list[Controller] = field(default_factory=list)
+    """The design of every round IPOPT solved, last first (a later round that fails keeps the earlier ones)."""
 
     def to_dict(self) -> dict[str, Any]:
         return {"success": self.success, "status": self.status, "controller": self.controller.to_dict(),
@@ -80,12 +82,11 @@ def _term(b: NLPBuilder, name: str, plants: list[Plant], grid: np.ndarray, start
         w0 = loop0.bandwidth() if name == "bandwidth" else (loop0.crossover() or grid[0])
         v = b.var(name, float(w0), float(grid[0]), float(grid[-1]))
         t02 = t0_squared(ctrl, plant)
-        for r in np.geomspace(1e-3, 1.0, 80):
-            _, L = loop_response(ctrl, plant, v * r)
-            if name == "bandwidth":
-                b.geq(L.abs2() - BANDWIDTH_LEVEL**2 * t02 * (1.0 + L).abs2())
-            else:
-                b.geq(L.abs2() - 1.0)
+        _, L = loop_response(ctrl, plant, v * ca.DM(np.geomspace(1e-3, 1.0, 80)))  # one column: 80 ratios
+        if name == "bandwidth":
+            b.geq(L.abs2() - BANDWIDTH_LEVEL**2 * t02 * (1.0 + L).abs2())
+        else:
+            b.geq(L.abs2() - 1.0)
         return v
     if name == "peak_sensitivity":
         ms0 = float(np.max(np.abs(loop0.S(grid))))
@@ -139,7 +140,8 @@ def polish(requirements: list[Requirement], plants: list[Plant], start: Controll
     Returns
     -------
     NLPResult
-        ``success`` means IPOPT converged; the caller still certifies the design.
+        ``success`` means IPOPT converged in at least one round (``candidates`` holds each such round's
+        design, ``controller`` the last); the caller still certifies the design.
 
     Examples
     --------
@@ -159,6 +161,7 @@ def polish(requirements: list[Requirement], plants: list[Plant], start: Controll
     grid = np.asarray(grid, float)
     extra = np.array([])
     success = False
+    solved: list[Controller] = []
     for rnd in range(rounds):
         ctrl = SymbolicController(current.type, current, bounds)
         b = NLPBuilder(ctrl)
@@ -179,6 +182,7 @@ def polish(requirements: list[Requirement], plants: list[Plant], start: Controll
         history.append({"round": rnd, "status": status, "controller": str(candidate)})
         if not success:
             break
+        solved.insert(0, candidate)
         moved = _crossovers_changed(current, candidate, plants)
         between = _violated_frequencies(requirements, plants, candidate)
         from synth.objectives import score as _score
@@ -193,12 +197,13 @@ def polish(requirements: list[Requirement], plants: list[Plant], start: Controll
         if not moved and not between.size and not improved:
             break
     value = None
-    if success:
+    if solved:
         from synth.objectives import score
 
+        current = solved[0]
         value = score(Loop(plants[0], current), objective)
-    return NLPResult(success, status, current, value, len(history), iterations,
-                     time.perf_counter() - t_start, history)
+    return NLPResult(bool(solved), status, current, value, len(history), iterations,
+                     time.perf_counter() - t_start, history, solved)
 
 
 def _violated_frequencies(requirements: list[Requirement], plants: list[Plant], c: Controller) -> np.ndarray:
