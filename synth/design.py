@@ -12,11 +12,13 @@ live in :mod:`synth.results`.
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 from synth.results import DesignResult
 from synth.spec import Spec
 from synth.synthesis.scalar import design_scalar
 
-__all__ = ["design"]
+__all__ = ["design", "design_jobs"]
 
 
 def design(spec: Spec) -> DesignResult:
@@ -47,3 +49,38 @@ def design(spec: Spec) -> DesignResult:
     from synth.synthesis.surrogate import design_certified
 
     return design_certified(spec, design_convex)
+
+
+def design_jobs(spec: Spec) -> tuple[list[Callable[[], DesignResult]], Callable[[list[DesignResult]], DesignResult]]:
+    """:func:`design` as independent jobs and the step that combines their results into its answer.
+
+    A PI or PID whose integral gain may be zero is designed with and without integral action; the two
+    designs are independent, so the command line runs them on two cores (:func:`synth.forked.run_beside`).
+    Everything else is one job. ``combine(results)`` is what :func:`design` returns.
+
+    Examples
+    --------
+    >>> from synth.spec import load_spec
+    >>> jobs, combine = design_jobs(load_spec("specs/x4_rotor.yaml"))
+    >>> len(jobs), combine([job() for job in jobs]).controller.parameters["kp"]
+    (1, 20.0)
+    """
+    from synth.synthesis.integral_action import integral_only, without_integral_action
+    from synth.synthesis.surrogate import certified_only
+
+    without = without_integral_action(spec)
+    if len(spec.controller.free_parameters()) == 1 or certified_only(spec) or without is None \
+            or integral_only(spec):  # maximize ki: the design without it only runs when this one fails
+        return [lambda: design(spec)], lambda results: results[0]
+
+    def with_integral_action() -> DesignResult:  # cvxpy and casadi are imported in the job, on its core
+        from synth.synthesis.multi import design_convex_jobs
+
+        return design_convex_jobs(spec)[0][0]()
+
+    def combine(results: list[DesignResult]) -> DesignResult:
+        from synth.synthesis.multi import design_convex_jobs
+
+        return design_convex_jobs(spec)[1](results)
+
+    return [with_integral_action, lambda: design(without)], combine

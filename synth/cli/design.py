@@ -60,7 +60,7 @@ def _prepare_report(spec: Any) -> dict[str, Any] | None:
 def run(args: argparse.Namespace) -> int:
     from synth.cli._outputs import check_outputs, spec_name
     from synth.cli._table import print_requirements
-    from synth.design import design
+    from synth.design import design, design_jobs
     from synth.forked import run_beside
     from synth.outputs import dump_json, write_json
     from synth.requirements.base import fmt
@@ -74,7 +74,9 @@ def run(args: argparse.Namespace) -> int:
     if args.no_report:
         result = design(spec)
     else:  # the design on the other core while this one loads the report's modules (synth.forked)
-        (result,), curves = run_beside([lambda: design(spec)], lambda: _prepare_report(spec))
+        jobs, combine = design_jobs(spec)  # a PI/PID with and without integral action: two jobs
+        results, curves = run_beside(jobs, lambda: _prepare_report(spec))
+        result = combine(results)
     say = (lambda *a: None) if args.quiet or args.json == "-" else print
     out_dir = Path(args.out) if args.out else Path("reports") / spec.name
     data = None

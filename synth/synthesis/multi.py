@@ -20,6 +20,7 @@ readings) and the better certified design wins.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
@@ -43,13 +44,14 @@ from synth.synthesis.convex import ConvexDesigner
 from synth.synthesis.convex_forms import CONVEX_FORMS
 from synth.synthesis.convex_results import ConvexResult
 from synth.synthesis.convex_settings import ConvexSettings
+from synth.synthesis.integral_action import integral_only, objective_terms, without_integral_action
 from synth.synthesis.nlp import polish
 from synth.synthesis.nlp_forms import NLP_FORMS
 from synth.synthesis.parametrization import parametrize
 from synth.synthesis.scalar import design_scalar
 
 __all__ = ["STRUCTURAL", "STRUCTURAL_REFINEMENTS", "certificate_density", "conflict_set", "convex_runs",
-           "design_convex", "exact_forms", "infeasible_verdict", "objective_terms", "polish_redundant"]
+           "design_convex", "design_convex_jobs", "exact_forms", "infeasible_verdict", "objective_terms", "polish_redundant"]
 
 STRUCTURAL = {"PID": "tf", "leadlag": "p"}
 """The structural parameter of each controller type that the convex stage holds at a few fixed values."""
@@ -78,18 +80,62 @@ def design_convex(spec: Spec, settings: ConvexSettings | None = None, nlp: bool 
     >>> r.feasible, round(r.controller.parameters["ki"], 2)
     (True, 24.93)
     """
+    jobs, combine = _jobs(spec, settings or ConvexSettings(), nlp)
+    results = [jobs[0]()]
+    if len(jobs) == 2 and _may_need_alternative(spec, results[0]):  # else the alternative cannot win
+        results.append(jobs[1]())
+    return combine(results)
+
+
+def design_convex_jobs(spec: Spec, settings: ConvexSettings | None = None, nlp: bool | str = True
+                       ) -> tuple[list[Callable[[], DesignResult]], Callable[[list[DesignResult]], DesignResult]]:
+    """:func:`design_convex` as independent jobs and the step that combines their results.
+
+    When the integral gain may be zero, the structure without it is a second design, independent of the
+    first: the two can run on two cores (:func:`synth.forked.run_beside`). ``combine`` makes the same
+    choice :func:`design_convex` makes (given the first job's result alone, it returns it).
+
+    Examples
+    --------
+    >>> from synth.spec import parse_spec
+    >>> spec = parse_spec({"name": "pi", "plant": {"tf": "23*(s+0.43)/((s+9.6)*(s+0.54))", "delay": 0.02},
+    ...                    "controller": {"type": "PI", "bounds": {"kp": [0, 10], "ki": [0, 200]}},
+    ...                    "requirements": [{"type": "peak_sensitivity", "max_db": 6}],
+    ...                    "objective": {"maximize": "integral_gain"}})
+    >>> jobs, combine = design_convex_jobs(spec)  # maximize ki: without it only if this fails, so one job
+    >>> len(jobs), round(combine([job() for job in jobs]).controller.parameters["ki"], 2)
+    (1, 24.93)
+    """
     settings = settings or ConvexSettings()
-    main = _design(spec, settings, nlp)
-    bounds = spec.controller.all_bounds()
-    if "ki" not in bounds or bounds["ki"][0] != 0.0 or bounds["ki"][1] == 0.0:
+    jobs, combine = _jobs(spec, settings, nlp)
+    if len(jobs) == 2 and integral_only(spec):  # the second design is needed only when the first fails
+        return [lambda: design_convex(spec, settings, nlp)], lambda results: results[0]
+    return jobs, combine
+
+
+def _jobs(spec: Spec, settings: ConvexSettings, nlp: bool | str
+          ) -> tuple[list[Callable[[], DesignResult]], Callable[[list[DesignResult]], DesignResult]]:
+    without = without_integral_action(spec)
+    if without is None:
+        return [lambda: _design(spec, settings, nlp)], lambda results: results[0]
+    if len(without.controller.free_parameters()) == 1:
+        def alternative() -> DesignResult:
+            return design_scalar(without)
+    else:
+        def alternative() -> DesignResult:
+            return design_convex(without)
+    return [lambda: _design(spec, settings, nlp), alternative], lambda results: _choose(spec, *results)
+
+
+def _may_need_alternative(spec: Spec, main: DesignResult) -> bool:
+    """False when the design with integral action wins whatever the other finds."""
+    return not (main.feasible and integral_only(spec))
+
+
+def _choose(spec: Spec, main: DesignResult, alt: DesignResult | None = None) -> DesignResult:
+    """The design with integral action unless the one without it is feasible and better."""
+    if alt is None or not _may_need_alternative(spec, main):
         return main
-    terms = objective_terms(spec)
-    if main.feasible and all(n in ("integral_gain", "low_frequency_gain") and s == "maximize"
-                             for n, s, _ in terms):
-        return main  # without integral action these objectives are 0 (or finite): never better
-    without = spec.model_copy(update={"controller": spec.controller.model_copy(
-        update={"bounds": {**bounds, "ki": (0.0, 0.0)}})})
-    alt = design_scalar(without) if len(without.controller.free_parameters()) == 1 else design_convex(without)
     if alt.feasible and (not main.feasible or _better(alt, main)):
         alt.method = (main.method + "; the same structure without integral action (ki = 0) did better: "
                       + alt.method)
@@ -101,20 +147,6 @@ def design_convex(spec: Spec, settings: ConvexSettings | None = None, nlp: bool 
 def _better(a: DesignResult, b: DesignResult) -> bool:
     va, vb = a.objective["value"], b.objective["value"]
     return va > vb if a.objective["sense"] == "maximize" else va < vb
-
-
-def objective_terms(spec: Spec) -> list[tuple[str, str, float]]:
-    """The spec's objective as ``(measure, sense, weight)`` terms; minimum peak |S| when it has none.
-
-    Examples
-    --------
-    >>> from synth.spec import parse_spec
-    >>> spec = parse_spec({"name": "pi", "plant": {"tf": "1/(s+1)"}, "controller": {"type": "PI"},
-    ...                    "requirements": [{"type": "bandwidth", "min": 1.0}]})
-    >>> objective_terms(spec)
-    [('peak_sensitivity', 'minimize', 1.0)]
-    """
-    return spec.objective.terms() if spec.objective else [("peak_sensitivity", "minimize", 1.0)]
 
 
 def _structural_values(lo: float, hi: float) -> list[float]:

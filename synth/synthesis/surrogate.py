@@ -28,7 +28,7 @@ from synth.requirements import NoLimitCycle, PeakComplementary, PeakSensitivity,
 from synth.requirements.base import Requirement, db, fmt
 from synth.results import CERTIFICATE_PER_DECADE, Certificate, DesignResult, objective_label
 from synth.spec import Spec
-from synth.synthesis.multi import objective_terms
+from synth.synthesis.integral_action import objective_terms
 
 __all__ = ["BISECTIONS", "CERTIFIED_ONLY", "LINE_STEPS", "RESOLUTION_DB", "certified_only", "design_certified",
            "surrogate_spec"]
