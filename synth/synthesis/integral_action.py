@@ -33,7 +33,7 @@ def without_integral_action(spec: Spec) -> Spec | None:
     --------
     >>> from synth.spec import parse_spec
     >>> spec = parse_spec({"name": "pi", "plant": {"tf": "1/(s+1)"}, "controller": {"type": "PI",
-    ...                    "bounds": {"kp": [0, 5], "ki": [0, 2]}}, "requirements": []})
+    ...                    "bounds": {"kp": [0, 5], "ki": [0, 2]}}, "requirements": [{"type": "bandwidth", "min": 1.0}]})
     >>> without_integral_action(spec).controller.all_bounds()["ki"]
     (0.0, 0.0)
     """
@@ -52,7 +52,8 @@ def integral_only(spec: Spec) -> bool:
     --------
     >>> from synth.spec import parse_spec
     >>> integral_only(parse_spec({"name": "pi", "plant": {"tf": "1/(s+1)"}, "controller": {"type": "PI"},
-    ...                           "requirements": [], "objective": {"maximize": "integral_gain"}}))
+    ...                           "requirements": [{"type": "bandwidth", "min": 1.0}],
+    ...                           "objective": {"maximize": "integral_gain"}}))
     True
     """
     return all(n in ("integral_gain", "low_frequency_gain") and s == "maximize" for n, s, _ in objective_terms(spec))
