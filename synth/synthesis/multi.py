@@ -49,6 +49,7 @@ from synth.synthesis.nlp import polish
 from synth.synthesis.nlp_forms import NLP_FORMS
 from synth.synthesis.parametrization import parametrize
 from synth.synthesis.scalar import design_scalar
+from synth.synthesis.screen import SCREEN_ITERATIONS, SCREEN_POINTS, screen_starts
 
 __all__ = ["STRUCTURAL", "STRUCTURAL_REFINEMENTS", "certificate_density", "conflict_set", "convex_runs",
            "design_convex", "design_convex_jobs", "exact_forms", "infeasible_verdict", "objective_terms", "polish_redundant"]
@@ -357,6 +358,17 @@ def _design(spec: Spec, settings: ConvexSettings, nlp: bool | str) -> DesignResu
         stages.append(f"NLP polish (casadi + IPOPT, {res.iterations} iterations, {res.status})")
         found.extend(("nlp", c) for c in reversed(res.candidates))
     candidates, passed = _certify_best(spec, found, terms, per_decade, cache)
+    if passed is None and nlp:  # the local stages found nothing that certifies: starts from the whole box
+        starts = screen_starts(spec)
+        for c in starts:
+            res = polish(list(spec.requirements), spec.plants(), c, spec.controller.all_bounds(), terms,
+                         runs[0][0].grid, settings.per_decade, settings.stability_level, rounds=3,
+                         max_iter=SCREEN_ITERATIONS)
+            found.extend([("screen", c), *(("nlp from screen", r) for r in reversed(res.candidates))])
+        stages.append(f"random screen of the bounds ({SCREEN_POINTS} controllers, every requirement and plant): "
+                      f"NLP polish from the {len(starts)} least violating (at most 3 rounds of {SCREEN_ITERATIONS} "
+                      "iterations each)")
+        candidates, passed = _certify_best(spec, found, terms, per_decade, cache)
     method = "; ".join(stages) + f"; certificate: dense re-check, {per_decade} points per decade"
     if passed is not None:
         stage, controller, certificate = passed

@@ -121,7 +121,8 @@ def _add_objective(b: NLPBuilder, terms: list[tuple[str, str, float]], plants: l
 
 def polish(requirements: list[Requirement], plants: list[Plant], start: Controller,
            bounds: dict[str, tuple[float, float]], objective: list[tuple[str, str, float]], grid: np.ndarray,
-           per_decade: int = 40, stability_level: float = 0.05, rounds: int = 6) -> NLPResult:
+           per_decade: int = 40, stability_level: float = 0.05, rounds: int = 6,
+           max_iter: int | None = None) -> NLPResult:
     """Improve ``start`` with IPOPT on the exact requirements; see the module docstring.
 
     Parameters
@@ -136,6 +137,8 @@ def polish(requirements: list[Requirement], plants: list[Plant], start: Controll
         Terms of the objective (see :meth:`synth.spec.ObjectiveSpec.terms`).
     grid : ndarray
         Frequency grid (rad/s) for peak-type requirements and stability keeping.
+    max_iter : int, optional
+        IPOPT's iteration limit per round (default :data:`IPOPT_OPTIONS`'s).
 
     Returns
     -------
@@ -174,7 +177,7 @@ def polish(requirements: list[Requirement], plants: list[Plant], start: Controll
             _, L = loop_response(ctrl, p, grid)
             b.geq((1.0 + L).abs2() - stability_level**2)
         _add_objective(b, objective, plants, grid, current)
-        x, stats = b.solve()
+        x, stats = b.solve(None if max_iter is None else {"ipopt.max_iter": max_iter})
         iterations += int(stats.get("iter_count", 0))
         status = str(stats.get("return_status"))
         success = bool(stats.get("success"))

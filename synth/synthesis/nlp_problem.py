@@ -134,10 +134,11 @@ class NLPBuilder:
         self.lbg.extend([0.0] * expr.numel())
         self.ubg.extend([upper] * expr.numel())
 
-    def solve(self) -> tuple[np.ndarray, dict[str, Any]]:
+    def solve(self, options: dict[str, Any] | None = None) -> tuple[np.ndarray, dict[str, Any]]:
+        """Solve with :data:`IPOPT_OPTIONS` updated by ``options``; the solution and IPOPT's statistics."""
         x = ca.vertcat(*self.x)
         g = ca.vertcat(*self.g) if self.g else SYM(0, 1)
-        solver = ca.nlpsol("polish", "ipopt", {"x": x, "f": self.f, "g": g}, IPOPT_OPTIONS)
+        solver = ca.nlpsol("polish", "ipopt", {"x": x, "f": self.f, "g": g}, {**IPOPT_OPTIONS, **(options or {})})
         res = solver(x0=np.concatenate(self.x0), lbx=np.concatenate(self.lbx), ubx=np.concatenate(self.ubx),
                      lbg=np.array(self.lbg), ubg=np.array(self.ubg))
         return np.asarray(res["x"]).ravel(), solver.stats()
