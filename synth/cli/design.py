@@ -63,6 +63,7 @@ def run(args: argparse.Namespace) -> int:
     from synth.design import design, design_jobs
     from synth.forked import run_beside
     from synth.outputs import dump_json, write_json
+    from synth.report.studies import spec_studies
     from synth.requirements.base import fmt
     from synth.spec import load_spec
 
@@ -75,8 +76,10 @@ def run(args: argparse.Namespace) -> int:
         result = design(spec)
     else:  # the design on the other core while this one loads the report's modules (synth.forked)
         jobs, combine = design_jobs(spec)  # a PI/PID with and without integral action: two jobs
-        results, curves = run_beside(jobs, lambda: _prepare_report(spec))
-        result = combine(results)
+        studies = spec_studies(spec)  # and the report's studies that need the spec alone
+        results, curves = run_beside([*jobs, *(job for _, job in studies)], lambda: _prepare_report(spec))
+        result = combine(results[:len(jobs)])
+        studied = {name: value for (name, _), value in zip(studies, results[len(jobs):])}
     say = (lambda *a: None) if args.quiet or args.json == "-" else print
     out_dir = Path(args.out) if args.out else Path("reports") / spec.name
     data = None
@@ -86,7 +89,8 @@ def run(args: argparse.Namespace) -> int:
         command = "synth design " + shlex.quote(args.spec)
         if args.out:
             command += f" --out {shlex.quote(args.out)}"
-        files = write_design_report(spec, result, out_dir, command=command, force=args.force, curves=curves)
+        files = write_design_report(spec, result, out_dir, command=command, force=args.force, curves=curves,
+                                    studies=studied)
         import json
 
         data = json.loads(files.result_json.read_text(encoding="utf-8"))

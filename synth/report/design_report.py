@@ -35,10 +35,11 @@ class ReportFiles:
     figures: dict[str, Path]
 
 
-def report_data(spec: Spec, result: DesignResult, keep: dict[str, Any] | None = None) -> dict[str, Any]:
+def report_data(spec: Spec, result: DesignResult, keep: dict[str, Any] | None = None,
+                studies: dict[str, Any] | None = None) -> dict[str, Any]:
     """Everything ``result.json`` holds: the design result, the reference controller's check and
     the comparisons with published numbers; floats to 12 significant digits, no wall-clock times (the same
-    inputs give the same bytes).
+    inputs give the same bytes). ``studies`` holds results of :func:`spec_studies`' jobs computed already.
 
     Examples
     --------
@@ -64,10 +65,17 @@ def report_data(spec: Spec, result: DesignResult, keep: dict[str, Any] | None = 
     if spec.simulation is not None:  # nonlinear step check (issue 5): logic in synth.report.simulation_report
         from synth.report.simulation_report import simulation_report
 
-        data["simulation"] = simulation_report(spec, shown, reference_controller(spec)).data
+        studies = studies or {}
+        data["simulation"] = simulation_report(spec, shown, reference_controller(spec),
+                                               studies=studies.get("simulation")).data
         from synth.gap.x4_case import gap_case_applies, x4_gap_case
 
-        if gap_case_applies(spec):  # seed 1's gap diagnosed on the simulated rig (issue 6): synth.gap.x4_case
+        if "gap_case" in studies:
+            case, objects = studies["gap_case"]
+            data["sim_to_real_gap"] = case
+            if keep is not None:
+                keep.update(objects)
+        elif gap_case_applies(spec):  # seed 1's gap diagnosed on the simulated rig (issue 6): synth.gap.x4_case
             data["sim_to_real_gap"] = x4_gap_case(spec, objects=keep)
     if spec.analysis.paper is not None:  # the seed paper's own section (issue 19): synth.report.paper_section
         from synth.report.paper_section import paper_section_data
@@ -206,13 +214,15 @@ def _num(x: Any) -> float | None:
 
 def write_design_report(spec: Spec, result: DesignResult, out_dir: str | Path, *, command: str = "",
                         force: bool = False,
-                        curves: dict[str, tuple[np.ndarray, np.ndarray]] | None = None) -> ReportFiles:
+                        curves: dict[str, tuple[np.ndarray, np.ndarray]] | None = None,
+                        studies: dict[str, Any] | None = None) -> ReportFiles:
     """Write ``result.json``, ``report.html`` and figures for a design into ``out_dir``.
 
     Files synth wrote earlier are replaced; any other existing file of the
     same name is left alone (:class:`~synth.errors.OutputExistsError`) unless
     ``force`` is given. ``curves`` are the gain-set figure's :func:`slack_curves` when the caller has them
-    already (the design command computes them beside the design).
+    already (the design command computes them beside the design), ``studies`` the results of
+    :func:`synth.report.studies.spec_studies`' jobs.
 
     Examples
     --------
@@ -245,7 +255,7 @@ def write_design_report(spec: Spec, result: DesignResult, out_dir: str | Path, *
     objects: dict[str, Any] = {}
 
     def own_work() -> tuple[dict[str, Any], dict[str, Path]]:
-        data = report_data(spec, result, keep=objects)
+        data = report_data(spec, result, keep=objects, studies=studies)
         return data, _analysis_figures(spec, data, objects, shown, ref, marks, out)
 
     drawn_by_worker, (data, figs) = run_beside([job for _, job in jobs], own_work)

@@ -59,11 +59,15 @@ _CACHE: dict[tuple[str, str, str], SimulationReport] = {}
 
 
 def simulation_report(spec: Spec, design: Controller | None, reference: Controller | None,
-                      progress: Callable[[int, int], None] | None = None) -> SimulationReport:
+                      progress: Callable[[int, int], None] | None = None,
+                      studies: SimulationReport | None = None) -> SimulationReport:
     """The nonlinear section for ``spec`` (which must have a ``simulation:`` block).
 
     Results are cached per spec and controllers, so the JSON and the figures of one report share
-    one computation.
+    one computation. With a reference controller, everything but the design's own step runs (the
+    reference's runs, the onset study and the published statements) depends on the spec and the reference
+    alone: ``studies`` is that part, ``simulation_report(spec, None, reference)``, when the caller computed
+    it already (the command line does, on the other core, while the design runs).
 
     Examples
     --------
@@ -81,10 +85,20 @@ def simulation_report(spec: Spec, design: Controller | None, reference: Controll
     if key in _CACHE:
         return _CACHE[key]
     plant = spec.nominal_plant()
-    step = sim.default_step()
-    disturbances = sim.build_disturbances()
-    u_unit = plant.input.unit or "input units"
     y_unit = plant.output.unit or "output units"
+    if design is None and studies is not None:
+        return studies
+    if design is not None and reference is not None:
+        part = studies if studies is not None else simulation_report(spec, None, reference, progress)
+        runs, data = _step_runs(spec, "design", design)
+        report = SimulationReport({**part.data, "runs": {"design": data, **part.data["runs"]}},
+                                  {"design": runs, **part.runs}, part.onset, part.rise_vs_rate)
+        report.data["verdict"] = _verdict(report.data, y_unit)
+        _CACHE.clear()
+        _CACHE[key] = report
+        return report
+    step = sim.default_step()
+    u_unit = plant.input.unit or "input units"
     report = SimulationReport({
         "step": list(step), "step_time": sim.step_time, "horizon": sim.horizon, "seed": sim.seed,
         "units": {"input": u_unit, "output": y_unit},
@@ -94,15 +108,7 @@ def simulation_report(spec: Spec, design: Controller | None, reference: Controll
     for label, ctrl in (("design", design), ("reference", reference)):
         if ctrl is None:
             continue
-        loop = sim.build_loop(plant, ctrl, label)
-        runs = {
-            "nonlinear": simulate_step(loop, *step, sim.horizon, sim.step_time, disturbances, sim.seed),
-            "linear": simulate_step(loop.linear(), *step, sim.horizon, sim.step_time, disturbances, sim.seed),
-        }
-        report.runs[label] = runs
-        metrics = {k: nonlinear_step_metrics(r, sim.step_time, min_amplitude=sim.limit_cycle.min_amplitude,
-                                             window=sim.limit_cycle.window).to_dict() for k, r in runs.items()}
-        report.data["runs"][label] = {"controller": str(ctrl), "loop": loop.to_dict(), **metrics}
+        report.runs[label], report.data["runs"][label] = _step_runs(spec, label, ctrl)
     report.data["verdict"] = _verdict(report.data, y_unit)
     probe = reference or design
     if sim.onset is not None and probe is not None and probe.type == "P":
@@ -118,6 +124,22 @@ def simulation_report(spec: Spec, design: Controller | None, reference: Controll
     _CACHE.clear()
     _CACHE[key] = report
     return report
+
+
+def _step_runs(spec: Spec, label: str, ctrl: Controller) -> tuple[dict[str, SimResult], dict[str, Any]]:
+    """The nonlinear and the linear step run of one controller, and their numbers for ``result.json``."""
+    sim = spec.simulation
+    assert sim is not None
+    step = sim.default_step()
+    disturbances = sim.build_disturbances()
+    loop = sim.build_loop(spec.nominal_plant(), ctrl, label)
+    runs = {
+        "nonlinear": simulate_step(loop, *step, sim.horizon, sim.step_time, disturbances, sim.seed),
+        "linear": simulate_step(loop.linear(), *step, sim.horizon, sim.step_time, disturbances, sim.seed),
+    }
+    metrics = {k: nonlinear_step_metrics(r, sim.step_time, min_amplitude=sim.limit_cycle.min_amplitude,
+                                         window=sim.limit_cycle.window).to_dict() for k, r in runs.items()}
+    return runs, {"controller": str(ctrl), "loop": loop.to_dict(), **metrics}
 
 
 def _assumptions(sim: SimulationSpec, plant: Any, u: str, y: str) -> list[str]:
