@@ -49,13 +49,17 @@ from synth.synthesis.nlp import polish
 from synth.synthesis.nlp_forms import NLP_FORMS
 from synth.synthesis.parametrization import parametrize
 from synth.synthesis.scalar import design_scalar
-from synth.synthesis.screen import SCREEN_ITERATIONS, SCREEN_POINTS, screen_starts
+from synth.synthesis.screen import SCREEN_ITERATIONS, SCREEN_POINTS, screen_improving, screen_starts
 
 __all__ = ["STRUCTURAL", "STRUCTURAL_REFINEMENTS", "certificate_density", "conflict_set", "convex_runs",
            "design_convex", "design_convex_jobs", "exact_forms", "infeasible_verdict", "objective_terms", "polish_redundant"]
 
 STRUCTURAL = {"PID": "tf", "leadlag": "p"}
 """The structural parameter of each controller type that the convex stage holds at a few fixed values."""
+
+IMPROVEMENT = 0.01
+"""A screened controller is a start for another NLP polish when it scores this much (relative) better than the
+certified design."""
 
 STRUCTURAL_REFINEMENTS = 2
 """Times the structural grid (three values over the bounds) is bisected around its best run: a feasible set
@@ -358,6 +362,18 @@ def _design(spec: Spec, settings: ConvexSettings, nlp: bool | str) -> DesignResu
         stages.append(f"NLP polish (casadi + IPOPT, {res.iterations} iterations, {res.status})")
         found.extend(("nlp", c) for c in reversed(res.candidates))
     candidates, passed = _certify_best(spec, found, terms, per_decade, cache)
+    if passed is not None and nlp and spec.objective is not None:  # a local optimum? better points elsewhere
+        value = score(Loop(nominal, passed[1]), terms)
+        starts = screen_improving(spec, terms, value + IMPROVEMENT * max(abs(value), 1e-12))
+        for c in starts:
+            res = polish(list(spec.requirements), spec.plants(), c, spec.controller.all_bounds(), terms,
+                         runs[0][0].grid, settings.per_decade, settings.stability_level, rounds=3,
+                         max_iter=SCREEN_ITERATIONS)
+            found.extend([("screen", c), *(("nlp from screen", r) for r in reversed(res.candidates))])
+        stages.append(f"random screen of the bounds ({SCREEN_POINTS} controllers): {len(starts)} scored more "
+                      "than 1 % better on its grid" + (", NLP polish from each" if starts else ""))
+        if starts:
+            candidates, passed = _certify_best(spec, found, terms, per_decade, cache)
     if passed is None and nlp:  # the local stages found nothing that certifies: starts from the whole box
         starts = screen_starts(spec)
         for c in starts:

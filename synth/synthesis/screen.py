@@ -19,10 +19,14 @@ from synth.controllers import Controller
 from synth.loop_batch import LoopBatch
 from synth.spec import Spec
 
-__all__ = ["SCREEN_ITERATIONS", "SCREEN_POINTS", "screen_points", "screen_starts"]
+__all__ = ["SCREEN_ITERATIONS", "SCREEN_POINTS", "screen_improving", "screen_points", "screen_starts"]
 
 SCREEN_POINTS = 384
 """Controllers drawn by the screen."""
+
+STABILITY_BASED = ("margins", "delay_margin")
+"""Requirement types whose batch form counts every loop's closed-loop roots (milliseconds per loop): the
+improvement screen evaluates them last, on the few controllers that passed the rest and score better."""
 
 SCREEN_ITERATIONS = 300
 """IPOPT iterations per round of a polish from a screened start (a start far from any optimum must not cost
@@ -87,3 +91,55 @@ def screen_starts(spec: Spec, keep: int = 3, n: int = SCREEN_POINTS) -> list[Con
             worst = np.fmin(worst, np.where(np.isnan(slack), -np.inf, slack))
     order = [i for i in np.argsort(-worst, kind="stable") if np.isfinite(worst[i]) or worst[i] > 0]
     return [controllers[i] for i in order[:keep]]
+
+
+def screen_improving(spec: Spec, terms: list[tuple[str, str, float]], above: float, keep: int = 2,
+                     n: int = SCREEN_POINTS) -> list[Controller]:
+    """Up to ``keep`` controllers of :func:`screen_points` that meet every requirement on the screen's grid,
+    keep every closed loop stable and score above ``above`` (:func:`synth.objectives.score` on the nominal
+    plant), best first: starts for the NLP where the local stages' design may be a local optimum.
+
+    Examples
+    --------
+    >>> from synth.spec import parse_spec
+    >>> spec = parse_spec({"name": "pi", "plant": {"tf": "10/((s+1)*(s+5))"}, "requirements": [{"type":
+    ...                    "peak_sensitivity", "max_db": 6}], "controller": {"type": "PI", "bounds": {"kp": [0, 5],
+    ...                    "ki": [0, 5]}}, "objective": {"maximize": "integral_gain"}})
+    >>> [c.parameters["ki"] > 4.0 for c in screen_improving(spec, [("integral_gain", "maximize", 1.0)], 4.0)]
+    [True, True]
+    """
+    from synth.loop import Loop
+    from synth.objectives import score
+
+    controllers = screen_points(spec, n)
+    plants, nominal = spec.plants(), spec.nominal_plant()
+    light = [r for r in spec.requirements if r.type not in STABILITY_BASED]
+    heavy = [r for r in spec.requirements if r.type in STABILITY_BASED]
+    idx = _meeting(controllers, np.arange(len(controllers)), light, plants)
+    scored = []
+    for i in idx:  # the objective before the requirements that count closed-loop roots (the costly part)
+        with np.errstate(all="ignore"):
+            value = score(Loop(nominal, controllers[i]), terms)
+        if np.isfinite(value) and value > above:
+            scored.append((value, int(i)))
+    idx = set(_meeting(controllers, np.array([i for _, i in scored], int), heavy, plants).tolist())
+    out: list[Controller] = []
+    for _, i in sorted(scored, reverse=True):
+        if i in idx and all(Loop(p, controllers[i]).stability().stable for p in plants):
+            out.append(controllers[i])
+            if len(out) == keep:
+                break
+    return out
+
+
+def _meeting(controllers: list[Controller], idx: np.ndarray, requirements: list, plants: list) -> np.ndarray:
+    """The indices among ``idx`` whose controllers meet every requirement on every plant on the screen's grid
+    (each requirement evaluated on the survivors of the ones before)."""
+    for req in requirements:
+        for plant in plants:
+            if idx.size == 0:
+                return idx
+            with np.errstate(all="ignore"):
+                slack = np.asarray(req.batch_slack(LoopBatch(plant, [controllers[i] for i in idx]), 20), float)
+            idx = idx[slack >= 0]  # NaN: not met
+    return idx
