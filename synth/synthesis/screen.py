@@ -19,7 +19,7 @@ from synth.controllers import Controller
 from synth.loop_batch import LoopBatch
 from synth.spec import Spec
 
-__all__ = ["SCREEN_ITERATIONS", "SCREEN_POINTS", "screen_improving", "screen_points", "screen_starts"]
+__all__ = ["PARAMETER_MEASURES", "SCREEN_ITERATIONS", "SCREEN_POINTS", "screen_improving", "screen_points", "screen_starts"]
 
 SCREEN_POINTS = 384
 """Controllers drawn by the screen."""
@@ -27,6 +27,9 @@ SCREEN_POINTS = 384
 STABILITY_BASED = ("margins", "delay_margin")
 """Requirement types whose batch form counts every loop's closed-loop roots (milliseconds per loop): the
 improvement screen evaluates them last, on the few controllers that passed the rest and score better."""
+
+PARAMETER_MEASURES = ("integral_gain", "low_frequency_gain")
+"""Objective measures read off the controller's parameters: scored before any requirement is evaluated."""
 
 SCREEN_ITERATIONS = 300
 """IPOPT iterations per round of a polish from a screened start (a start far from any optimum must not cost
@@ -115,13 +118,18 @@ def screen_improving(spec: Spec, terms: list[tuple[str, str, float]], above: flo
     plants, nominal = spec.plants(), spec.nominal_plant()
     light = [r for r in spec.requirements if r.type not in STABILITY_BASED]
     heavy = [r for r in spec.requirements if r.type in STABILITY_BASED]
-    idx = _meeting(controllers, np.arange(len(controllers)), light, plants)
+    idx = np.arange(len(controllers))
+    if not all(name in PARAMETER_MEASURES for name, _, _ in terms):  # else the score is cheaper than any slack
+        idx = _meeting(controllers, idx, light, plants)
     scored = []
     for i in idx:  # the objective before the requirements that count closed-loop roots (the costly part)
         with np.errstate(all="ignore"):
             value = score(Loop(nominal, controllers[i]), terms)
         if np.isfinite(value) and value > above:
             scored.append((value, int(i)))
+    if all(name in PARAMETER_MEASURES for name, _, _ in terms):
+        idx = _meeting(controllers, np.array([i for _, i in scored], int), light, plants)
+        scored = [(v, i) for v, i in scored if i in set(idx.tolist())]
     idx = set(_meeting(controllers, np.array([i for _, i in scored], int), heavy, plants).tolist())
     out: list[Controller] = []
     for _, i in sorted(scored, reverse=True):
