@@ -64,3 +64,17 @@ def test_screened_starts_are_stable_and_improving_ones_score_better() -> None:
     for c in screen_improving(spec, terms, 3.0):
         assert score(Loop(spec.nominal_plant(), c), terms) > 3.0
         assert synth.check(spec, c).feasible or min(r.slack for r in synth.check(spec, c).requirements) > -0.05
+
+
+def test_design_jobs_with_and_without_integral_action_combine_to_the_serial_design() -> None:
+    from synth.design import design, design_jobs
+
+    spec = parse_spec({"name": "pi", "plant": {"tf": "4/((s+1)*(s+3))", "delay": 0.05},
+                       "controller": {"type": "PI", "bounds": {"kp": [0, 10], "ki": [0, 20]}},
+                       "requirements": [{"type": "peak_sensitivity", "max_db": 6}],
+                       "objective": {"maximize": "bandwidth"}})
+    jobs, combine = design_jobs(spec)
+    assert len(jobs) == 2  # bandwidth can be larger without integral action: both designs run
+    combined, serial = combine([job() for job in jobs]), design(spec)
+    assert combined.controller.parameters == serial.controller.parameters
+    assert combined.objective["value"] == serial.objective["value"] > 0
