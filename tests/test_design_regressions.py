@@ -188,3 +188,20 @@ def test_leadlag_on_an_unstable_plant_skips_a_pole_value_without_a_stabilizing_s
     d = _design(spec)
     assert d.feasible
     assert check_point(num, den, 0.0, spec, d.controller.parameters).feasible(1e-3)
+
+
+def test_a_linearization_that_is_infinite_on_the_grid_is_not_a_crash() -> None:
+    """Seed 1 problem #170 of benchmarks/design_problems.py (rational controller, integrator, lightly damped
+    pair): a convex iterate put a pole on a grid frequency and the cone's linearization held NaN, which cvxpy
+    refused ("Parameter value must be real"). The point now bounds nothing for that iteration; the answer is
+    the reference's (no feasible point found by either)."""
+    import warnings
+
+    from benchmarks.design_problems import problem
+    from synth import design, parse_spec
+
+    p = problem(1, 170)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        result = design(parse_spec(p.spec))
+    assert not result.feasible and result.verdict

@@ -222,10 +222,14 @@ class RatioBound(Form):
         on = np.ones(mag.size, bool) if self.active is None else self.active(rho_c)
         kappa = self._kappa(rho_c)
         on = on & np.isfinite(kappa)  # an infinite kappa bounds nothing (e.g. |T| >= l T0 / 0 where T(0) = 0)
-        scale = np.where(on, kappa / mag, 0.0)  # kappa |V_c| / |V_c|^2
+        with np.errstate(all="ignore"):
+            scale = np.where(on, kappa / mag, 0.0)  # kappa |V_c| / |V_c|^2
+            R = np.real(np.conj(Vc)[:, None] * self.V.Q) * scale[:, None]
+            c = np.real(np.conj(Vc) * self.V.q0) * scale
+        on = on & np.all(np.isfinite(R), axis=1) & np.isfinite(c)  # V infinite at a pole on the grid: no bound
         self.on.value = on.astype(float)
-        self.R.value = np.real(np.conj(Vc)[:, None] * self.V.Q) * scale[:, None]
-        self.c.value = np.where(on, np.real(np.conj(Vc) * self.V.q0) * scale, 1.0)
+        self.R.value = np.where(on[:, None], R, 0.0)
+        self.c.value = np.where(on, c, 1.0)
         self.w.value = np.where(on, kappa * mag, 1.0)
 
     def price(self) -> float:
