@@ -29,7 +29,8 @@ from synth.results import (
 from synth.spec import Spec
 from synth.synthesis.gainset import GainSet, ScalarFamily, feasible_gain_set
 
-__all__ = ["INWARD", "design_scalar", "feasible_verdict", "infeasible_verdict", "scalar_family", "stabilizing_text"]
+__all__ = ["INWARD", "RETREAT_STEPS", "design_scalar", "feasible_verdict", "infeasible_verdict", "scalar_family",
+           "stabilizing_text"]
 
 
 def _optimize_scalar(f: Callable[[float], float], intervals: list[tuple[float, float]]) -> tuple[float, float]:
@@ -59,6 +60,11 @@ def _optimize_scalar(f: Callable[[float], float], intervals: list[tuple[float, f
 INWARD = 1e-6
 """Relative step by which a design at an end set by a requirement is moved into the feasible set
 (the end itself has zero slack up to rounding)."""
+
+
+RETREAT_STEPS = 24
+"""Bisection steps from an optimum that failed the dense re-check towards the middle of its interval (the
+distance to the passing point shrinks 2^24-fold)."""
 
 
 def _inside(x: float, gain_set: GainSet, unstable: Callable[[float], bool]) -> float:
@@ -171,8 +177,17 @@ def _design_without_reference(spec: Spec) -> tuple[DesignResult, GainSet | None]
                  "description": "no objective in the spec: the largest smallest slack"}
     else:
         label = objective_label(spec, Loop(nominal, controller))
-    final = check(spec, controller, SEARCH_PER_DECADE)
     cert_check = check(spec, controller, CERTIFICATE_PER_DECADE)
+    if not cert_check.feasible:  # an edge the search grid placed past a sharp peak: move into the set
+        inner = _retreat(x, gain_set, lambda v: check(spec, family.controller(v), CERTIFICATE_PER_DECADE).feasible)
+        if inner is not None:
+            x, controller = inner, family.controller(inner)
+            cert_check = check(spec, controller, CERTIFICATE_PER_DECADE)
+            method += (f"; the optimum at the set's end failed the dense re-check, so it moved into the set to the "
+                       f"last point that passes it (bisection, {RETREAT_STEPS} checks)")
+            label = objective_label(spec, Loop(nominal, controller)) if objective is not None else {
+                **label, "value": float(score(x))}
+    final = check(spec, controller, SEARCH_PER_DECADE)
     certificate = Certificate(cert_check.feasible, CERTIFICATE_PER_DECADE, cert_check)
     feasible = certificate.passed
     result = DesignResult(spec.name, feasible, controller if feasible else None, final, label,
@@ -181,6 +196,22 @@ def _design_without_reference(spec: Spec) -> tuple[DesignResult, GainSet | None]
         f"The optimum {controller} failed the dense re-check ("
         + "; ".join(r.message for r in cert_check.failed()) + "): not reported as a solution.")
     return result, gain_set
+
+
+def _retreat(x: float, gain_set: GainSet, passes: Callable[[float], bool]) -> float | None:
+    """The point nearest ``x`` towards the middle of its interval that ``passes`` (bisection between ``x`` and
+    the interval's middle, :data:`RETREAT_STEPS` checks), or None when the middle fails too."""
+    for iv in gain_set.intervals:
+        if iv.lo <= x <= iv.hi:
+            good = 0.5 * (iv.lo + iv.hi)
+            if not passes(good):
+                return None
+            bad = x
+            for _ in range(RETREAT_STEPS):
+                mid = 0.5 * (good + bad)
+                good, bad = (mid, bad) if passes(mid) else (good, mid)
+            return good
+    return None
 
 
 def _ends(names: list[str]) -> str:
