@@ -79,6 +79,8 @@ class StabilityResult:
         """
         if self.stable:
             return f"closed loop stable ({self.method})"
+        if self.near_axis is not None and self.unstable_poles == 0:
+            return f"closed loop not certified stable ({self.method})"
         if self.near_axis is not None:
             return (f"closed loop not stable in practice: {self.unstable_poles} root(s) within {self.near_axis:.3g} "
                     f"of the imaginary axis (Re s > -{self.near_axis:.3g}; {self.method})")
@@ -228,7 +230,12 @@ def closed_loop_stability(num: np.ndarray, den: np.ndarray, delay: float = 0.0, 
     exact = _count(num, den, delay)
     if floor <= 0.0 or not exact.stable:
         return exact
-    moved = _count(shifted(num, floor) * np.exp(floor * delay), shifted(den, floor), delay)
+    try:
+        moved = _count(shifted(num, floor) * np.exp(floor * delay), shifted(den, floor), delay)
+    except RuntimeError:  # open-loop poles within the floor of the origin: the shifted count cannot be trusted
+        return StabilityResult(False, 0, exact.open_loop_unstable_poles, exact.method + "; the count on the loop "
+                               "shifted by the stability floor failed (open-loop poles within the floor of the "
+                               "origin): not certified stable", None, float(floor))
     if moved.stable:
         return exact
     return StabilityResult(False, moved.unstable_poles, exact.open_loop_unstable_poles, exact.method,
@@ -260,6 +267,9 @@ def _count(num: np.ndarray, den: np.ndarray, delay: float) -> StabilityResult:
             float(np.abs(marginal[0].imag)) if marginal.size else None,
         )
 
+    if not n_origin and abs(den[-1] + num[-1]) <= 1e-12 * max(abs(den[-1]), abs(num[-1])):
+        # 1 + L(0) = 0: a closed-loop root at s = 0 (e.g. a gain on the edge of the stability floor)
+        return StabilityResult(False, 1, n_rhp, "Nyquist argument principle, exact delay", 0.0)
     c_inf = num[0] / den[0] if num.size == den.size else 0.0
     if abs(c_inf) >= 1.0:
         raise ModelError(
