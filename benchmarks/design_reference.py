@@ -308,7 +308,8 @@ class LoopModel:
             ph = np.degrees(np.angle(Lf(x)))
             this = (ph + 360.0) % 360.0 - 180.0
             pm = min(pm, this)
-            dm = min(dm, np.radians(this) / x) if this > 0 else 0.0
+            lag = (ph + 180.0) % 360.0  # extra phase lag that puts this crossing on -1: the PM in [0, 360)
+            dm = min(dm, np.radians(lag) / x)
         return float(gm), float(pm), float(dm)
 
 
