@@ -98,8 +98,9 @@ def stability_boundaries(
     w_max = max(w_a, w_b, hi_scale) * 1.2
     w_min = 1e-4 * lo_scale
     grid = [np.geomspace(w_min, w_max, int(100 * np.log10(w_max / w_min)) + 2)]
-    if delay > 0:
-        grid.append(np.linspace(0.0, w_max, int(np.ceil(w_max * delay / PHASE_STEP)) + 2)[1:])
+    if delay > 0:  # the delay's phase, sampled finely up to the last frequency where |L0 + rho L1| can be 1
+        w_lin = min(w_max, max(w_a, w_b) * 1.2)
+        grid.append(np.linspace(0.0, w_lin, int(np.ceil(w_lin * delay / PHASE_STEP)) + 2)[1:])
     w = np.unique(np.concatenate(grid))
     hv = h(w)
     scale = np.max(np.abs(hv)) if hv.size else 1.0

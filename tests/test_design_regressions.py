@@ -226,3 +226,19 @@ def test_an_optimum_at_an_edge_past_a_sharp_peak_moves_into_the_set() -> None:
     kp = result.controller.parameters["kp"]
     assert result.controller.parameters["ki"] == 0.0 and 0.00619 < kp < 0.0062003
     assert check_point(p.num, p.den, p.delay, p.spec, dict(result.controller.parameters)).feasible(1e-3)
+
+
+def test_stability_boundaries_of_a_controller_with_a_far_corner_stay_small() -> None:
+    """The delay's phase grid of the D-decomposition runs only up to the last frequency where
+    ``|L0 + rho L1|`` can reach 1, not up to the controller's highest corner: a PI with kp = 1e-12 (zero at
+    ki/kp = 1e13 rad/s) behind a 16 ms delay asked for 4.7e11 grid points (3.4 TiB) when the X-4 PI
+    trade-off sweep's polish met one."""
+    from synth.controllers import Controller
+    from synth.plant import Plant
+
+    G = Plant.from_string("23*(s+0.43)/((s+9.6)*(s+0.54))", delay=0.016)
+    loop = Loop(G, Controller("PI", {"kp": 1e-12, "ki": 10.0}))
+    k_lo, k_hi, _, w_hi = loop.gain_factors
+    s = 1j * w_hi  # the upper gain limit checked by hand: L(j w_hi) on the negative real axis, |L| = 1/k_hi
+    L = (1e-12 + 10.0 / s) * 23 * (s + 0.43) / ((s + 9.6) * (s + 0.54)) * np.exp(-0.016 * s)
+    assert k_lo == 0.0 and abs(np.angle(L)) > np.pi - 1e-9 and abs(abs(L) * k_hi - 1.0) < 1e-9
