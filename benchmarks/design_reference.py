@@ -235,10 +235,11 @@ class LoopModel:
                 bw = bandwidth()
                 ev.values[key] = bw
                 sl = []
-                if r.get("min") is not None:
-                    sl.append(np.log(bw / r["min"]))
-                if r.get("max") is not None:
-                    sl.append(np.log(r["max"] / bw))
+                with np.errstate(divide="ignore"):  # bw = 0 (|T| never reaches the level): log 0 = -inf
+                    if r.get("min") is not None:
+                        sl.append(np.log(bw / r["min"]))
+                    if r.get("max") is not None:
+                        sl.append(np.log(r["max"] / bw) if bw > 0 else np.inf)
                 ev.slacks[key] = float(min(sl))
             elif t in ("sensitivity", "peak_sensitivity", "peak_complementary", "peak_control_sensitivity"):
                 name = {"sensitivity": "S", "peak_sensitivity": "S", "peak_complementary": "T",
