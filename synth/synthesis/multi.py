@@ -327,6 +327,18 @@ def _certify_best(spec: Spec, found: list[tuple[str, Controller]], terms: list[t
     return [(*found[k], certified[k]) for k in range(len(found))], None
 
 
+def _polished_from(spec: Spec, starts: list[Controller], terms: list[tuple[str, str, float]], grid: np.ndarray,
+                   settings: ConvexSettings) -> list[tuple[str, Controller]]:
+    """Screened starts and what a short NLP polish (3 rounds of :data:`SCREEN_ITERATIONS`) made of each, as
+    candidates for the certificate."""
+    out: list[tuple[str, Controller]] = []
+    for c in starts:
+        res = polish(list(spec.requirements), spec.plants(), c, spec.controller.all_bounds(), terms, grid,
+                     settings.per_decade, settings.stability_level, rounds=3, max_iter=SCREEN_ITERATIONS)
+        out.extend([("screen", c), *(("nlp from screen", r) for r in reversed(res.candidates))])
+    return out
+
+
 def _design(spec: Spec, settings: ConvexSettings, nlp: bool | str) -> DesignResult:
     terms = objective_terms(spec)
     runs = convex_runs(spec, settings)
@@ -365,22 +377,14 @@ def _design(spec: Spec, settings: ConvexSettings, nlp: bool | str) -> DesignResu
     if passed is not None and nlp and spec.objective is not None:  # a local optimum? better points elsewhere
         value = score(Loop(nominal, passed[1]), terms)
         starts = screen_improving(spec, terms, value + IMPROVEMENT * max(abs(value), 1e-12))
-        for c in starts:
-            res = polish(list(spec.requirements), spec.plants(), c, spec.controller.all_bounds(), terms,
-                         runs[0][0].grid, settings.per_decade, settings.stability_level, rounds=3,
-                         max_iter=SCREEN_ITERATIONS)
-            found.extend([("screen", c), *(("nlp from screen", r) for r in reversed(res.candidates))])
+        found.extend(_polished_from(spec, starts, terms, runs[0][0].grid, settings))
         stages.append(f"random screen of the bounds ({SCREEN_POINTS} controllers): {len(starts)} scored more "
                       "than 1 % better on its grid" + (", NLP polish from each" if starts else ""))
         if starts:
             candidates, passed = _certify_best(spec, found, terms, per_decade, cache)
     if passed is None and nlp:  # the local stages found nothing that certifies: starts from the whole box
         starts = screen_starts(spec)
-        for c in starts:
-            res = polish(list(spec.requirements), spec.plants(), c, spec.controller.all_bounds(), terms,
-                         runs[0][0].grid, settings.per_decade, settings.stability_level, rounds=3,
-                         max_iter=SCREEN_ITERATIONS)
-            found.extend([("screen", c), *(("nlp from screen", r) for r in reversed(res.candidates))])
+        found.extend(_polished_from(spec, starts, terms, runs[0][0].grid, settings))
         stages.append(f"random screen of the bounds ({SCREEN_POINTS} controllers, every requirement and plant): "
                       f"NLP polish from the {len(starts)} least violating (at most 3 rounds of {SCREEN_ITERATIONS} "
                       "iterations each)")
