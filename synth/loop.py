@@ -228,6 +228,9 @@ class Loop:
             return float("nan")
         level = t0 * BANDWIDTH_LEVEL
         lo, hi = self.frequency_range
+        crossovers = self.gain_crossovers()
+        if crossovers.size:  # a low-gain loop crosses over far below every corner: |T| falls there first
+            lo = min(lo, float(np.min(crossovers)) / 100.0)
         grid = log_grid(lo, hi * 10, per_decade)
         cross = crossings(lambda w: np.abs(self.T(w)), level, grid)
         below = np.abs(self.T(grid)) < level

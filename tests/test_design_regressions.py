@@ -242,3 +242,22 @@ def test_stability_boundaries_of_a_controller_with_a_far_corner_stay_small() -> 
     s = 1j * w_hi  # the upper gain limit checked by hand: L(j w_hi) on the negative real axis, |L| = 1/k_hi
     L = (1e-12 + 10.0 / s) * 23 * (s + 0.43) / ((s + 9.6) * (s + 0.54)) * np.exp(-0.016 * s)
     assert k_lo == 0.0 and abs(np.angle(L)) > np.pi - 1e-9 and abs(abs(L) * k_hi - 1.0) < 1e-9
+
+
+def test_bandwidth_of_a_low_gain_loop_crossing_over_below_every_corner() -> None:
+    """Seed 1 #109 (PID with tiny gains on a resonance near 208 rad/s): the loop is ki G(0)/s far below every
+    corner, so |T| falls 3 dB at about ki G(0) = 0.026 rad/s (an integrator loop k/s has bandwidth k). The
+    grid started two decades below the corners and saw only a later dip at 149 rad/s, so the certificate
+    passed a design whose bandwidth is 0.026 rad/s against a 113 rad/s floor (the reference's false
+    feasible). Scalar and vectorized forms now agree with the closed form."""
+    from synth.controllers import Controller
+    from synth.loop_batch import LoopBatch
+    from synth.plant import Plant
+    from synth.requirements import Bandwidth
+
+    G = Plant.from_string("42962*1/((s^2+264.659*s+43267.3))", delay=0.0628232)
+    c = Controller("PID", {"kp": 0.000638425, "ki": 0.0262802, "kd": 0.00311755, "tf": 0.00236301})
+    k = 0.0262802 * 42962 / 43267.3
+    assert abs(Loop(G, c).bandwidth() / k - 1.0) < 0.01
+    req = Bandwidth(min=113.331, max=327.726)
+    assert req.batch_slack(LoopBatch(G, [c]))[0] == pytest.approx(req.slack(Loop(G, c)), rel=1e-6) < -8.0

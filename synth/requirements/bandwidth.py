@@ -78,7 +78,8 @@ class Bandwidth(Requirement):
 
         t0 = batch.T0()
         ranges = batch.frequency_ranges
-        grid = log_grids(ranges[:, 0], ranges[:, 1] * 10, per_decade)
+        lowest = np.array([np.min(w) / 100.0 if w.size else np.inf for w in batch.gain_crossovers()])
+        grid = log_grids(np.fmin(ranges[:, 0], lowest), ranges[:, 1] * 10, per_decade)  # as Loop.bandwidth
         cross, below = batch_first_crossing(lambda w: np.abs(batch.T(w)), t0 * BANDWIDTH_LEVEL, grid)
         wb = np.where(np.isnan(cross), np.where(below, grid[:, 0], np.inf), cross)
         wb = np.where((t0 == 0.0) | ~np.isfinite(t0), np.nan, wb)
