@@ -262,3 +262,21 @@ def test_bandwidth_of_a_low_gain_loop_crossing_over_below_every_corner() -> None
     req = Bandwidth(min=113.331, max=327.726)
     scalar = req.slack(Loop(G, c))
     assert scalar < -8.0 and req.batch_slack(LoopBatch(G, [c]))[0] == pytest.approx(scalar, rel=1e-6)
+
+
+def test_a_stabilizing_start_with_some_gains_at_their_lower_bounds() -> None:
+    """Seed 1 #192 (PID on a plant with an unstable pole, an integrator and a lightly damped pair): none of the
+    300 random starts with every gain positive stabilizes, and the design used to decline ("found no
+    stabilizing controller"); the reference holds kp = 0.066, ki = 0, kd = 0.011. Starts with a random half
+    of the gains at their lower bounds find one, and the design passes the reference's dense check."""
+    import warnings
+
+    from benchmarks.design_problems import problem
+
+    p = problem(1, 192)
+    assert "unstable" in p.features and "integrator" in p.features
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        result = synth.design(synth.parse_spec(p.spec))
+    assert result.feasible, result.verdict
+    assert check_point(p.num, p.den, p.delay, p.spec, dict(result.controller.parameters)).feasible(1e-3)

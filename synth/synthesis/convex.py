@@ -266,7 +266,8 @@ class ConvexDesigner:
         lo, hi = self.par.box()
         rng = np.random.default_rng(seed)
         candidates = itertools.chain([np.clip(initial, lo, hi)] if initial is not None else [], [self.par.start()],
-                                     (self.par.random(rng) for _ in range(300)))
+                                     (self.par.random(rng) for _ in range(300)),
+                                     (self._pinned(self.par.random(rng), lo, rng) for _ in range(300)))
         any_found = False
         for c in candidates:
             if c is not None and self._stable(np.asarray(c, float)):
@@ -275,6 +276,15 @@ class ConvexDesigner:
         if not any_found:
             raise SynthError("found no stabilizing controller in the bounds to start from; give "
                              "controller.initial or widen the bounds", where="controller")
+
+    @staticmethod
+    def _pinned(c: np.ndarray | None, lo: np.ndarray, rng: np.random.Generator) -> np.ndarray | None:
+        """``c`` with a random half of its parameters at their lower bounds (a PID whose stabilizing set
+        needs ki = 0 on an unstable plant with an integrator is never drawn with every gain positive)."""
+        if c is None:
+            return None
+        pin = rng.random(c.size) < 0.5
+        return np.where(pin & np.isfinite(lo), lo, c)
 
     def start(self, initial: np.ndarray | None = None) -> np.ndarray:
         """The first stabilizing start (see :meth:`starts`)."""
