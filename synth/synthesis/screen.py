@@ -63,6 +63,9 @@ def screen_points(spec: Spec, n: int = SCREEN_POINTS) -> list[Controller]:
             logs = np.exp(rng.uniform(np.log(floor), np.log(hi), n))
             uniform = np.where(np.arange(n) % 2 == 1, logs, uniform)
         columns[k] = uniform
+    pinned = (np.arange(n) % 3 == 2)[:, None] & (rng.random((n, len(names))) < 0.5)  # a third: half the
+    for j, k in enumerate(names):  # parameters at their lower bounds (a0 = 0: an integrator; ki = 0)
+        columns[k] = np.where(pinned[:, j], float(bounds[k][0]), columns[k])
     kind = spec.controller.type
     return [Controller(kind, {k: float(columns[k][i]) for k in names}) for i in range(n)]
 
