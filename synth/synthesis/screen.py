@@ -12,6 +12,7 @@ seeded by the spec's parameter box, so a design is reproducible.
 from __future__ import annotations
 
 import zlib
+from collections.abc import Callable
 
 import numpy as np
 
@@ -37,16 +38,17 @@ a minute: the polish from the convex answer keeps the full limit)."""
 
 
 def screen_points(spec: Spec, n: int = SCREEN_POINTS) -> list[Controller]:
-    """``n`` controllers drawn over the spec's parameter box (seeded by the box itself).
+    """``n`` controllers drawn over the spec's parameter box (seeded by the box itself), then ``n // 3`` copies
+    of the first ones with a random half of their parameters at the lower bounds.
 
     Examples
     --------
     >>> from synth.spec import parse_spec
     >>> spec = parse_spec({"name": "pi", "plant": {"tf": "1/(s+1)"}, "requirements": [{"type": "bandwidth",
     ...                    "min": 1.0}], "controller": {"type": "PI", "bounds": {"kp": [0, 10], "ki": [0, 5]}}})
-    >>> points = screen_points(spec, 8)
+    >>> points = screen_points(spec, 9)
     >>> len(points), all(0 <= c.parameters["kp"] <= 10 and 0 <= c.parameters["ki"] <= 5 for c in points)
-    (8, True)
+    (12, True)
     """
     bounds = spec.controller.all_bounds()
     names = sorted(bounds)
@@ -63,16 +65,31 @@ def screen_points(spec: Spec, n: int = SCREEN_POINTS) -> list[Controller]:
             logs = np.exp(rng.uniform(np.log(floor), np.log(hi), n))
             uniform = np.where(np.arange(n) % 2 == 1, logs, uniform)
         columns[k] = uniform
-    pinned = (np.arange(n) % 3 == 2)[:, None] & (rng.random((n, len(names))) < 0.5)  # a third: half the
-    for j, k in enumerate(names):  # parameters at their lower bounds (a0 = 0: an integrator; ki = 0)
-        columns[k] = np.where(pinned[:, j], float(bounds[k][0]), columns[k])
+    extra = n // 3  # copies of the first points with a random half of their parameters at the lower bounds
+    pinned = rng.random((extra, len(names))) < 0.5  # (a0 = 0: an integrator; ki = 0), never drawn exactly
+    for j, k in enumerate(names):
+        columns[k] = np.concatenate([columns[k], np.where(pinned[:, j], float(bounds[k][0]), columns[k][:extra])])
     kind = spec.controller.type
-    return [Controller(kind, {k: float(columns[k][i]) for k in names}) for i in range(n)]
+    return [Controller(kind, {k: float(columns[k][i]) for k in names}) for i in range(n + extra)]
+
+
+def _pick(order: list[int], n: int, keep: int, usable: Callable[[int], bool]) -> list[int]:
+    """The first ``keep`` usable indices of ``order`` among the drawn points (``< n``), and the first usable
+    one among the pinned copies (``>= n``): the pinned points add a start, they never displace one."""
+    drawn = [i for i in order if i < n]
+    pinned = [i for i in order if i >= n]
+    out: list[int] = []
+    for i in drawn:
+        if len(out) == keep:
+            break
+        if usable(i):
+            out.append(i)
+    return out + next(([i] for i in pinned if usable(i)), [])
 
 
 def screen_starts(spec: Spec, keep: int = 3, n: int = SCREEN_POINTS) -> list[Controller]:
     """The ``keep`` stable controllers of :func:`screen_points` with the largest worst slack (feasible ones
-    first), best first; fewer when fewer are stable on every plant.
+    first), best first, and the best of the pinned copies; fewer when fewer are stable on every plant.
 
     Examples
     --------
@@ -95,13 +112,14 @@ def screen_starts(spec: Spec, keep: int = 3, n: int = SCREEN_POINTS) -> list[Con
             with np.errstate(all="ignore"):
                 slack = np.asarray(req.batch_slack(batch, 20), float)
             worst = np.fmin(worst, np.where(np.isnan(slack), -np.inf, slack))
-    order = [i for i in np.argsort(-worst, kind="stable") if np.isfinite(worst[i]) or worst[i] > 0]
-    return [controllers[i] for i in order[:keep]]
+    order = [int(i) for i in np.argsort(-worst, kind="stable")]
+    return [controllers[i] for i in _pick(order, n, keep, lambda i: bool(np.isfinite(worst[i]) or worst[i] > 0))]
 
 
 def screen_improving(spec: Spec, terms: list[tuple[str, str, float]], above: float, keep: int = 2,
                      n: int = SCREEN_POINTS) -> list[Controller]:
-    """Up to ``keep`` controllers of :func:`screen_points` that meet every requirement on the screen's grid,
+    """Up to ``keep`` controllers of :func:`screen_points` (and one of its pinned copies) that meet every
+    requirement on the screen's grid,
     keep every closed loop stable and score above ``above`` (:func:`synth.objectives.score` on the nominal
     plant), best first: starts for the NLP where the local stages' design may be a local optimum.
 
@@ -134,13 +152,9 @@ def screen_improving(spec: Spec, terms: list[tuple[str, str, float]], above: flo
         idx = _meeting(controllers, np.array([i for _, i in scored], int), light, plants)
         scored = [(v, i) for v, i in scored if i in set(idx.tolist())]
     idx = set(_meeting(controllers, np.array([i for _, i in scored], int), heavy, plants).tolist())
-    out: list[Controller] = []
-    for _, i in sorted(scored, reverse=True):
-        if i in idx and all(Loop(p, controllers[i]).stability().stable for p in plants):
-            out.append(controllers[i])
-            if len(out) == keep:
-                break
-    return out
+    order = [i for _, i in sorted(scored, reverse=True)]
+    return [controllers[i] for i in _pick(order, n, keep, lambda i: i in idx and all(
+        Loop(p, controllers[i]).stability().stable for p in plants))]
 
 
 def _meeting(controllers: list[Controller], idx: np.ndarray, requirements: list, plants: list) -> np.ndarray:
