@@ -418,10 +418,15 @@ def _design(spec: Spec, settings: ConvexSettings, nlp: bool | str) -> DesignResu
                           extras=extras)
     result.extras["diagnosis"] = worst.diagnosis.to_dict()
     nlp_note = ""
-    if candidates:  # the NLP returned something from the infeasible start, and it failed the certificate
-        stage, controller, certificate = candidates[-1]
+    from_closest = [c for c in candidates if c[0] == "nlp"]
+    if from_closest:  # the NLP returned something from the infeasible start, and it failed the certificate
+        stage, controller, certificate = from_closest[-1]
         nlp_note = (f" The NLP started from the closest design ended at {controller}, which fails the "
                     "certificate (" + "; ".join(r.message for r in certificate.check.failed()) + ").")
+    screened = sum(1 for c in candidates if c[0] in ("screen", "nlp from screen"))
+    if screened:
+        nlp_note += (f" {screened} more candidate(s) from the random screen of the bounds and NLP polishes from "
+                     "them fail it too.")
     result.verdict = infeasible_verdict(worst, compromise) + nlp_note + reference_verdict(spec, ref)
     return result
 
