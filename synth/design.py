@@ -74,13 +74,13 @@ def design_jobs(spec: Spec) -> tuple[list[Callable[[], DesignResult]], Callable[
         return [lambda: design(spec)], lambda results: results[0]
 
     def with_integral_action() -> DesignResult:  # cvxpy and casadi are imported in the job, on its core
-        from synth.synthesis.multi import design_convex_jobs
+        from synth.synthesis.multi import design_with_integral_action
 
-        return design_convex_jobs(spec)[0][0]()
+        return design_with_integral_action(spec)
 
     def combine(results: list[DesignResult]) -> DesignResult:
-        from synth.synthesis.multi import design_convex_jobs
+        from synth.synthesis.multi import choose
 
-        return design_convex_jobs(spec)[1](results)
+        return choose(spec, *results)
 
     return [with_integral_action, lambda: design(without)], combine

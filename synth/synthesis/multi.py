@@ -20,7 +20,6 @@ readings) and the better certified design wins.
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from typing import Any
 
 import numpy as np
@@ -51,8 +50,9 @@ from synth.synthesis.parametrization import parametrize
 from synth.synthesis.scalar import design_scalar
 from synth.synthesis.screen import SCREEN_ITERATIONS, SCREEN_POINTS, screen_improving, screen_starts
 
-__all__ = ["STRUCTURAL", "STRUCTURAL_REFINEMENTS", "certificate_density", "conflict_set", "convex_runs",
-           "design_convex", "design_convex_jobs", "exact_forms", "infeasible_verdict", "objective_terms", "polish_redundant"]
+__all__ = ["STRUCTURAL", "STRUCTURAL_REFINEMENTS", "certificate_density", "choose", "conflict_set", "convex_runs",
+           "design_convex", "design_with_integral_action", "exact_forms", "infeasible_verdict", "objective_terms",
+           "polish_redundant"]
 
 STRUCTURAL = {"PID": "tf", "leadlag": "p"}
 """The structural parameter of each controller type that the convex stage holds at a few fixed values."""
@@ -85,20 +85,18 @@ def design_convex(spec: Spec, settings: ConvexSettings | None = None, nlp: bool 
     >>> r.feasible, round(r.controller.parameters["ki"], 2)
     (True, 24.93)
     """
-    jobs, combine = _jobs(spec, settings or ConvexSettings(), nlp)
-    results = [jobs[0]()]
-    if len(jobs) == 2 and _may_need_alternative(spec, results[0]):  # else the alternative cannot win
-        results.append(jobs[1]())
-    return combine(results)
+    settings = settings or ConvexSettings()
+    main = _design(spec, settings, nlp)
+    without = without_integral_action(spec)
+    if without is None or not _may_need_alternative(spec, main):  # else the alternative cannot win
+        return main
+    alt = design_scalar(without) if len(without.controller.free_parameters()) == 1 else design_convex(without)
+    return choose(spec, main, alt)
 
 
-def design_convex_jobs(spec: Spec, settings: ConvexSettings | None = None, nlp: bool | str = True
-                       ) -> tuple[list[Callable[[], DesignResult]], Callable[[list[DesignResult]], DesignResult]]:
-    """:func:`design_convex` as independent jobs and the step that combines their results.
-
-    When the integral gain may be zero, the structure without it is a second design, independent of the
-    first: the two can run on two cores (:func:`synth.forked.run_beside`). ``combine`` makes the same
-    choice :func:`design_convex` makes (given the first job's result alone, it returns it).
+def design_with_integral_action(spec: Spec) -> DesignResult:
+    """The design of the spec as written (default settings), without :func:`design_convex`'s second design
+    with ``ki = 0``: one of the two jobs of :func:`synth.design.design_jobs`, combined by :func:`choose`.
 
     Examples
     --------
@@ -107,29 +105,10 @@ def design_convex_jobs(spec: Spec, settings: ConvexSettings | None = None, nlp: 
     ...                    "controller": {"type": "PI", "bounds": {"kp": [0, 10], "ki": [0, 200]}},
     ...                    "requirements": [{"type": "peak_sensitivity", "max_db": 6}],
     ...                    "objective": {"maximize": "integral_gain"}})
-    >>> jobs, combine = design_convex_jobs(spec)  # maximize ki: without it only if this fails, so one job
-    >>> len(jobs), round(combine([job() for job in jobs]).controller.parameters["ki"], 2)
-    (1, 24.93)
+    >>> round(design_with_integral_action(spec).controller.parameters["ki"], 2)
+    24.93
     """
-    settings = settings or ConvexSettings()
-    jobs, combine = _jobs(spec, settings, nlp)
-    if len(jobs) == 2 and integral_only(spec):  # the second design is needed only when the first fails
-        return [lambda: design_convex(spec, settings, nlp)], lambda results: results[0]
-    return jobs, combine
-
-
-def _jobs(spec: Spec, settings: ConvexSettings, nlp: bool | str
-          ) -> tuple[list[Callable[[], DesignResult]], Callable[[list[DesignResult]], DesignResult]]:
-    without = without_integral_action(spec)
-    if without is None:
-        return [lambda: _design(spec, settings, nlp)], lambda results: results[0]
-    if len(without.controller.free_parameters()) == 1:
-        def alternative() -> DesignResult:
-            return design_scalar(without)
-    else:
-        def alternative() -> DesignResult:
-            return design_convex(without)
-    return [lambda: _design(spec, settings, nlp), alternative], lambda results: _choose(spec, *results)
+    return _design(spec, ConvexSettings(), True)
 
 
 def _may_need_alternative(spec: Spec, main: DesignResult) -> bool:
@@ -137,9 +116,20 @@ def _may_need_alternative(spec: Spec, main: DesignResult) -> bool:
     return not (main.feasible and integral_only(spec))
 
 
-def _choose(spec: Spec, main: DesignResult, alt: DesignResult | None = None) -> DesignResult:
-    """The design with integral action unless the one without it is feasible and better."""
-    if alt is None or not _may_need_alternative(spec, main):
+def choose(spec: Spec, main: DesignResult, alt: DesignResult) -> DesignResult:
+    """``main`` (designed with integral action) unless ``alt`` (the same structure with ``ki = 0``) is feasible
+    and scores better; the choice :func:`design_convex` makes.
+
+    Examples
+    --------
+    >>> from synth.spec import parse_spec
+    >>> spec = parse_spec({"name": "pi", "plant": {"tf": "1/(s+1)"}, "controller": {"type": "PI"},
+    ...                    "requirements": [{"type": "bandwidth", "min": 1.0}]})
+    >>> no = DesignResult("pi", False, None, None, None, None, None, None, "")
+    >>> choose(spec, no, no) is no
+    True
+    """
+    if not _may_need_alternative(spec, main):
         return main
     if alt.feasible and (not main.feasible or _better(alt, main)):
         alt.method = (main.method + "; the same structure without integral action (ki = 0) did better: "

@@ -150,7 +150,8 @@ def screen_improving(spec: Spec, terms: list[tuple[str, str, float]], above: flo
             scored.append((value, int(i)))
     if all(name in PARAMETER_MEASURES for name, _, _ in terms):
         idx = _meeting(controllers, np.array([i for _, i in scored], int), light, plants)
-        scored = [(v, i) for v, i in scored if i in set(idx.tolist())]
+        meeting = set(idx.tolist())
+        scored = [(v, i) for v, i in scored if i in meeting]
     idx = set(_meeting(controllers, np.array([i for _, i in scored], int), heavy, plants).tolist())
     order = [i for _, i in sorted(scored, reverse=True)]
     return [controllers[i] for i in _pick(order, n, keep, lambda i: i in idx and all(
