@@ -10,10 +10,10 @@ the simulation error ``sum_k (y_k - yhat_k)^2`` with
 
 - the linear part ``G_aug`` (nominal coefficients, effect factor parameters
   such as a lag's ``tau``, a resonance's ``wn, zeta``, and the delay for the
-  ``delay`` effect) by casadi/IPOPT through
-  :func:`synth.ident.timefit.fit_structure` (exact zero-order-hold
-  discretization with fractional delay, Gauss-Newton Hessian), started at the
-  nominal coefficients;
+  ``delay`` effect) by :func:`synth.ident.timefit.fit_structure` with its
+  convolution solver (exact zero-order-hold discretization with fractional
+  delay, Levenberg-Marquardt on exact sensitivities), started at the nominal
+  coefficients;
 - the input block ``N`` (rate limit, saturation, dead zone, backlash,
   quantizer: not smooth in their parameter) by the effect's deterministic grid
   and then a search in the log of the parameter between the best grid point's
@@ -225,11 +225,13 @@ def _linear_fit(plant: Plant, effect: Effect, params: Params, t: np.ndarray, v: 
     if fit_delay:
         init["delay"] = plant.delay + float(params.get("delay", 0.0))
     rec = record_from_arrays(t, v, y)
-    res = fit_structure(rec, full, delay="fit" if fit_delay else plant.delay, initial=init, weights=weights)
+    # the re-fits are many and share a structure: the convolution solver builds no symbolic graph per fit
+    res = fit_structure(rec, full, delay="fit" if fit_delay else plant.delay, initial=init, weights=weights,
+                        solver="convolution")
     bounds = _stable_bounds(plant, start)
     if bounds and any(res.parameters[k] < 0.0 for k in bounds):  # rare: again with the bounds (IPOPT is slower)
         res = fit_structure(rec, full, delay="fit" if fit_delay else plant.delay, initial=init, weights=weights,
-                            lower=bounds)
+                            lower=bounds)  # IPOPT: an interior point never lands on the bound (an integrator)
     new = dict(params)
     ci: dict[str, tuple[float, float]] = {}
     names = [k for k in effect.factor_names if k != "delay"]
