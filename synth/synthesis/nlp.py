@@ -165,8 +165,12 @@ def polish(requirements: list[Requirement], plants: list[Plant], start: Controll
     extra = np.array([])
     success = False
     solved: list[Controller] = []
-    for rnd in range(rounds):
-        ctrl = SymbolicController(current.type, current, bounds)
+    radius: float | None = None  # a trust region once a step has jumped out of the stabilizing set
+    shrinks = 0
+    for rnd in range(rounds + MAX_SHRINKS):
+        if rnd - shrinks >= rounds:
+            break
+        ctrl = SymbolicController(current.type, current, bounds, _trust_box(bounds, current, radius))
         b = NLPBuilder(ctrl)
         ctx = NLPContext(grid, extra, per_decade, current)
         for req in requirements:
@@ -185,20 +189,27 @@ def polish(requirements: list[Requirement], plants: list[Plant], start: Controll
         history.append({"round": rnd, "status": status, "controller": str(candidate)})
         if not success:
             break
+        if not _stable(plants, candidate):  # |1 + L| >= level on the grid, yet a step jumped over the boundary
+            history[-1]["unstable"] = True
+            if shrinks == MAX_SHRINKS:
+                success = False
+                break
+            radius, shrinks = (1.0 if radius is None else radius / 4), shrinks + 1
+            continue
         solved.insert(0, candidate)
-        moved = _crossovers_changed(current, candidate, plants)
         between = _violated_frequencies(requirements, plants, candidate)
-        from synth.objectives import score as _score
-
-        gain = _score(Loop(plants[0], candidate), objective) - _score(Loop(plants[0], current), objective)
-        improved = gain > 1e-6 * max(1.0, abs(_score(Loop(plants[0], current), objective)))
-        current = candidate
+        between = np.concatenate([between, _missed_peaks(objective, plants, candidate, np.union1d(grid, extra))])
         if between.size:
             extra = np.unique(np.concatenate([extra, between, between * (1 - 1e-3), between * (1 + 1e-3)]))
-        # crossovers are re-detected every round: a round that still improved may have been held back by
-        # the crossover variables' boxes around the previous design
-        if not moved and not between.size and not improved:
+        # the NLP is built around this round's start (its crossovers, boxes of the crossover and bandwidth
+        # variables): another round from the candidate is needed when its crossovers changed or a helper
+        # variable ended on its box; otherwise the same NLP from the candidate would end where it is
+        if _crossovers_changed(current, candidate, plants) or _at_helper_box(b, x, len(ctrl.free)):
+            current = candidate
+        elif not between.size:
             break
+        # else violated only between grid points: the same start again with those frequencies added (an interior
+        # point method restarted at an optimum, its constraints active, wanders; cf. the servo PID in benchmarks)
     value = None
     if solved:
         from synth.objectives import score
@@ -207,6 +218,66 @@ def polish(requirements: list[Requirement], plants: list[Plant], start: Controll
         value = score(Loop(plants[0], current), objective)
     return NLPResult(bool(solved), status, current, value, len(history), iterations,
                      time.perf_counter() - t_start, history, solved)
+
+
+MAX_SHRINKS = 3
+"""Times a round is repeated in a smaller trust region after its answer left the stabilizing set."""
+
+
+def _trust_box(bounds: dict[str, tuple[float, float]], at: Controller, radius: float | None,
+               ) -> dict[str, tuple[float, float]] | None:
+    """``bounds`` cut to ``at +- radius (|value| + 1 % of the range)`` (None: no trust region)."""
+    if radius is None:
+        return None
+    box = {}
+    for k, (lo, hi) in bounds.items():
+        x = float(at.parameters[k])
+        half = radius * (abs(x) + 0.01 * (hi - lo if np.isfinite(hi - lo) else max(abs(x), 1.0)))
+        box[k] = (lo, hi) if lo == hi else (max(lo, x - half), min(hi, x + half))
+    return box
+
+
+def _stable(plants: list[Plant], c: Controller) -> bool:
+    """Closed loop stable on every plant (the exact count; "not certified" counts as unstable)."""
+    for p in plants:
+        try:
+            if not Loop(p, c).stability().stable:
+                return False
+        except (ArithmeticError, ValueError, RuntimeError):
+            return False
+    return True
+
+
+def _at_helper_box(b: NLPBuilder, x: np.ndarray, n_controller: int, tol: float = 1e-6) -> bool:
+    """Whether a helper variable of the solved NLP (those after the controller's ``n_controller``) ended on its
+    box (within ``tol`` of its size)."""
+    lo, hi = np.concatenate(b.lbx)[n_controller:], np.concatenate(b.ubx)[n_controller:]
+    v = x[n_controller:]
+    size = tol * np.maximum(np.abs(v), 1e-12)
+    return bool(np.any((v - lo <= size) | (hi - v <= size)))
+
+
+_PEAK_CURVES = {"peak_sensitivity": "S", "peak_complementary": "T", "control_effort": "KS"}
+
+
+def _missed_peaks(objective: list[tuple[str, str, float]], plants: list[Plant], c: Controller, grid: np.ndarray,
+                  tol_db: float = 0.01) -> np.ndarray:
+    """Frequencies of a peak-type objective's maximum (on any plant) that the NLP's grid misses by more than
+    ``tol_db``: the NLP minimized the peak it could see."""
+    from synth.freqgrid import log_grid, peak
+
+    out = []
+    for name, _, _ in objective:
+        if name not in _PEAK_CURVES:
+            continue
+        for p in plants:
+            curve = getattr(Loop(p, c), _PEAK_CURVES[name])
+            with np.errstate(all="ignore"):
+                true, w = peak(lambda v, f=curve: np.abs(f(v)), log_grid(grid[0], grid[-1], 160))
+                seen = float(np.max(np.abs(curve(grid))))
+            if np.isfinite(true) and 20 * np.log10(true / max(seen, 1e-300)) > tol_db:
+                out.append(w)
+    return np.array(out, float)
 
 
 def _violated_frequencies(requirements: list[Requirement], plants: list[Plant], c: Controller) -> np.ndarray:

@@ -37,8 +37,10 @@ TIGHT = 1.0 - 2 * BACKOFF
 class SymbolicController:
     """A controller whose free parameters are casadi symbols, scaled by their starting magnitudes."""
 
-    def __init__(self, ctype: str, start: Controller, bounds: dict[str, tuple[float, float]]) -> None:
+    def __init__(self, ctype: str, start: Controller, bounds: dict[str, tuple[float, float]],
+                 box: dict[str, tuple[float, float]] | None = None) -> None:
         self.ctype = ctype
+        self.box = box or bounds  # the variables' bounds this time (a trust region inside ``bounds``)
         kind = start.kind
         self.free = [p for p in kind.parameters if bounds[p][0] < bounds[p][1]]
         self.fixed = {p: bounds[p][0] for p in kind.parameters if bounds[p][0] == bounds[p][1]}
@@ -53,10 +55,10 @@ class SymbolicController:
         self.values = {**{p: self.u[i] * self.scale[i] for i, p in enumerate(self.free)}, **self.fixed}
 
     def lbx(self) -> np.ndarray:
-        return np.array([self.bounds[p][0] for p in self.free]) / self.scale
+        return np.array([self.box[p][0] for p in self.free]) / self.scale
 
     def ubx(self) -> np.ndarray:
-        return np.array([self.bounds[p][1] for p in self.free]) / self.scale
+        return np.array([self.box[p][1] for p in self.free]) / self.scale
 
     def response(self, w: Any) -> Cx:
         """``C(j w)`` for a numeric or symbolic ``w`` (> 0)."""
