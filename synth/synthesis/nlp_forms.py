@@ -34,6 +34,7 @@ from synth.requirements import (
 )
 from synth.requirements.base import Requirement, magnitude
 from synth.synthesis.form_registry import FormRegistry
+from synth.synthesis.nlp_peaks import PEAK_TIGHT, track_peaks
 from synth.synthesis.nlp_problem import (
     BACKOFF,
     TIGHT,
@@ -85,6 +86,14 @@ class NLPContext:
     extra: np.ndarray
     per_decade: int
     start: Controller
+    track: tuple[Controller, ...] = ()
+    """Other designs whose sharp peaks the NLP tracks (the last answer, when it failed between grid points)."""
+
+    def band(self, req: Any) -> tuple[float, float]:
+        """The requirement's band, or the design grid's range."""
+        band = getattr(req, "band", None)
+        lo, hi = (float(self.grid[0]), float(self.grid[-1])) if band is None else (float(band[0]), float(band[1]))
+        return max(lo, float(self.grid[0]) * 1e-3), min(hi, float(self.grid[-1]) * 1e3)
 
     def points(self, req: Any) -> np.ndarray:
         """The requirement's band (the design grid without one), with the extra frequencies inside it."""
@@ -97,6 +106,7 @@ def _sensitivity(b: NLPBuilder, req: Sensitivity | PeakSensitivity, plant: Plant
     m2 = req.linear_bound("max_db") ** 2 * TIGHT
     _, L = loop_response(b.ctrl, plant, ctx.points(req))
     b.geq(m2 * (1.0 + L).abs2() - 1.0)
+    track_peaks(b, plant, [ctx.start, *ctx.track], "S", req.linear_bound("max_db"), ctx.band(req), PEAK_TIGHT)
 
 
 @nlp_form(StaticSensitivity, exact=True)
@@ -111,12 +121,14 @@ def _static_sensitivity(b: NLPBuilder, req: StaticSensitivity, plant: Plant, ctx
 def _peak_complementary(b: NLPBuilder, req: PeakComplementary, plant: Plant, ctx: NLPContext) -> None:
     _, L = loop_response(b.ctrl, plant, ctx.points(req))
     b.geq((1.0 + L).abs2() - L.abs2() / (req.linear_bound("max_db") ** 2 * TIGHT))
+    track_peaks(b, plant, [ctx.start, *ctx.track], "T", req.linear_bound("max_db"), ctx.band(req), PEAK_TIGHT)
 
 
 @nlp_form(PeakControlSensitivity, exact=True)
 def _peak_control_sensitivity(b: NLPBuilder, req: PeakControlSensitivity, plant: Plant, ctx: NLPContext) -> None:
     C, L = loop_response(b.ctrl, plant, ctx.points(req))
     b.geq((1.0 + L).abs2() - C.abs2() / (req.linear_bound("max_db") ** 2 * TIGHT))
+    track_peaks(b, plant, [ctx.start, *ctx.track], "KS", req.linear_bound("max_db"), ctx.band(req), PEAK_TIGHT)
 
 
 @nlp_form(SlewRate, exact=True)
@@ -154,7 +166,8 @@ def _margins(b: NLPBuilder, req: MarginsRequirement, plant: Plant, ctx: NLPConte
         if req.phase_margin_deg is not None:
             b.geq((1.0 + L).abs2() - 4 * np.sin(np.radians(req.phase_margin_deg * (1 + BACKOFF)) / 2) ** 2)
         if req.delay_margin is not None:
-            b.geq((1.0 + L).abs2() - 4 * ca.sin(ca.fmin(v * req.delay_margin, np.pi) / 2) ** 2)
+            tau = req.delay_margin * (1 + 10 * BACKOFF)  # tightened as the delay_margin requirement's form
+            b.geq((1.0 + L).abs2() - 4 * ca.sin(ca.fmin(v * tau, np.pi) / 2) ** 2)
     if req.gain_margin_db is not None:
         g = magnitude(req.gain_margin_db * (1 + BACKOFF))
         for wp in phase_crossovers(loop):  # the upper gain limit: crossings inside the unit circle, right of -1/g

@@ -1,0 +1,94 @@
+"""Peaks of ``|S|``, ``|T|`` and ``|KS|`` tracked exactly in the NLP, between its grid points.
+
+A peak bound imposed on a frequency grid is met on the grid; a sharp peak (a lightly damped closed-loop
+pole, controller zeros near the axis) is narrower than the grid's spacing and the optimizer moves it between
+the points, where the certificate finds it violated. Each local maximum of the start design's curve near the
+bound becomes a variable frequency ``w_k`` held at a stationary point of the curve,
+``d log|F(j w)|^2 / d log w = 0`` (as a gain crossover is held by ``|L| = 1``), in a box around its start,
+and the bound is imposed at ``w_k``: the peak itself is bounded wherever the design moves it.
+"""
+
+from __future__ import annotations
+
+import casadi as ca
+import numpy as np
+
+from synth.controllers import Controller
+from synth.freqgrid import log_grid
+from synth.loop import Loop
+from synth.plant import Plant
+from synth.synthesis.nlp_problem import NLPBuilder, loop_response
+
+__all__ = ["PEAK_TIGHT", "peak_frequencies", "track_peaks"]
+
+CURVES = ("S", "T", "KS")
+
+NEAR_DB = 3.0
+"""Local maxima of the start design within this many dB of the bound (or above it) are tracked."""
+
+BOX = 1.5
+"""A tracked peak frequency stays within ``[w0 / BOX, BOX w0]`` in one round."""
+
+PER_DECADE = 160
+
+PEAK_TIGHT = 1.0 - 2e-6
+"""Tightening of a tracked peak's squared bound: the peak is exact there, so it needs far less than the grid's
+:data:`~synth.synthesis.nlp_problem.TIGHT` (which covers what lies between the points), only IPOPT's tolerance."""
+
+
+def peak_frequencies(plant: Plant, start: Controller, curve: str, bound: float,
+                     band: tuple[float, float]) -> np.ndarray:
+    """Local maxima of ``|curve|`` (``"S"``, ``"T"`` or ``"KS"``) of the loop at ``start`` inside ``band`` that
+    come within :data:`NEAR_DB` of the linear ``bound``, refined to a relative 1e-6.
+
+    Examples
+    --------
+    >>> from synth.plant import Plant; from synth.controllers import Controller
+    >>> G = Plant.from_string("1/(s^2+0.04*s+1)")
+    >>> [round(float(w), 3) for w in peak_frequencies(G, Controller("P", {"kp": 0.5}), "T", 1.0, (0.01, 100))]
+    [1.224]
+    """
+    loop = Loop(plant, start)
+    f = getattr(loop, curve)
+    lo, hi = max(band[0], 1e-9), band[1]
+    if not hi > lo:
+        return np.array([])
+    w = log_grid(lo, hi, PER_DECADE)
+    with np.errstate(all="ignore"):
+        v = np.abs(f(w))
+    inner = np.flatnonzero((v[1:-1] > v[:-2]) & (v[1:-1] >= v[2:])) + 1
+    inner = inner[np.isfinite(v[inner]) & (v[inner] >= bound * 10 ** (-NEAR_DB / 20))]
+    out = []
+    for i in inner:
+        a, b = np.log(w[i - 1]), np.log(w[i + 1])
+        for _ in range(40):  # golden section on log w
+            c, d = b - 0.618 * (b - a), a + 0.618 * (b - a)
+            with np.errstate(all="ignore"):
+                if abs(f(np.exp(c))) >= abs(f(np.exp(d))):
+                    b = d
+                else:
+                    a = c
+        out.append(np.exp(0.5 * (a + b)))
+    return np.array(out, float)
+
+
+def track_peaks(b: NLPBuilder, plant: Plant, designs: list[Controller], curve: str, bound: float,
+                band: tuple[float, float], tight: float) -> None:
+    """Add a tracked peak of ``|curve|`` with ``|curve(j w_k)|^2 <= tight bound^2`` for each local maximum near
+    the bound (:func:`peak_frequencies`) of each of ``designs`` (the round's start, and the last answer whose
+    peaks rose between the grid points); peaks within 1 % of one already tracked are tracked once."""
+    found: list[float] = []
+    for design in designs:
+        for w in peak_frequencies(plant, design, curve, bound, band):
+            if all(abs(np.log(w / f)) > 0.01 for f in found):
+                found.append(float(w))
+    for w0 in found:
+        v = b.var("w_peak", float(w0), max(w0 / BOX, band[0]), min(w0 * BOX, band[1]))
+        C, L = loop_response(b.ctrl, plant, v)
+        top = {"S": None, "T": L, "KS": C}[curve]
+        log_f = -ca.log((1.0 + L).abs2()) if top is None else ca.log(top.abs2()) - ca.log((1.0 + L).abs2())
+        b.eq(ca.jacobian(log_f, v) * v)  # a stationary point of the curve: d log|F|^2 / d log w = 0
+        if top is None:
+            b.geq(bound**2 * tight * (1.0 + L).abs2() - 1.0)
+        else:
+            b.geq((1.0 + L).abs2() - top.abs2() / (bound**2 * tight))
