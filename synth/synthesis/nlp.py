@@ -60,7 +60,9 @@ class NLPResult:
     solve_time: float
     history: list[dict[str, Any]] = field(default_factory=list)
     candidates: list[Controller] = field(default_factory=list)
-    """The design of every round IPOPT solved, last first (a later round that fails keeps the earlier ones)."""
+    """The design of every round IPOPT solved, last first (a later round that fails keeps the earlier ones), and
+    where an unconverged round stopped at a stable loop (first): every one is only a candidate for the
+    certificate."""
 
     def to_dict(self) -> dict[str, Any]:
         return {"success": self.success, "status": self.status, "controller": self.controller.to_dict(),
@@ -143,8 +145,9 @@ def polish(requirements: list[Requirement], plants: list[Plant], start: Controll
     Returns
     -------
     NLPResult
-        ``success`` means IPOPT converged in at least one round (``candidates`` holds each such round's
-        design, ``controller`` the last); the caller still certifies the design.
+        ``success`` means IPOPT converged in at least one round; ``candidates`` holds each such round's design
+        and, when a round stopped unconverged (an iteration limit) at a stable loop, where it stopped;
+        ``controller`` is the last of them. The caller certifies every candidate.
 
     Examples
     --------
@@ -163,7 +166,7 @@ def polish(requirements: list[Requirement], plants: list[Plant], start: Controll
     status = "not run"
     grid = np.asarray(grid, float)
     extra = np.array([])
-    success = False
+    success = converged = False
     solved: list[Controller] = []
     radius: float | None = None  # a trust region once a step has jumped out of the stabilizing set
     shrinks = 0
@@ -188,7 +191,11 @@ def polish(requirements: list[Requirement], plants: list[Plant], start: Controll
         success = bool(stats.get("success"))
         candidate = ctrl.controller(x[: len(ctrl.free)])
         history.append({"round": rnd, "status": status, "controller": str(candidate)})
-        if not success:
+        converged = converged or success
+        if not success:  # where IPOPT stopped may still pass: the certificate decides, as for every candidate
+            if np.all(np.isfinite(x)) and _stable(plants, candidate):
+                solved.insert(0, candidate)
+                history[-1]["offered"] = True
             break
         if not _stable(plants, candidate):  # |1 + L| >= level on the grid, yet a step jumped over the boundary
             history[-1]["unstable"] = True
@@ -206,7 +213,10 @@ def polish(requirements: list[Requirement], plants: list[Plant], start: Controll
         # the NLP is built around this round's start (its crossovers, boxes of the crossover and bandwidth
         # variables): another round from the candidate is needed when its crossovers changed or a helper
         # variable ended on its box; otherwise the same NLP from the candidate would end where it is
-        if _crossovers_changed(current, candidate, plants) or _at_helper_box(b, x, len(ctrl.free)):
+        trust_edge = radius is not None and _at_trust_edge(ctrl, candidate)
+        if trust_edge:  # the trust region held the step back: the next one may go further
+            radius *= 4
+        if _crossovers_changed(current, candidate, plants) or _at_helper_box(b, x, len(ctrl.free)) or trust_edge:
             current = candidate
         elif not between.size:
             break
@@ -218,7 +228,7 @@ def polish(requirements: list[Requirement], plants: list[Plant], start: Controll
 
         current = solved[0]
         value = score(Loop(plants[0], current), objective)
-    return NLPResult(bool(solved), status, current, value, len(history), iterations,
+    return NLPResult(converged, status, current, value, len(history), iterations,
                      time.perf_counter() - t_start, history, solved)
 
 
@@ -237,6 +247,16 @@ def _trust_box(bounds: dict[str, tuple[float, float]], at: Controller, radius: f
         half = radius * (abs(x) + 0.01 * (hi - lo if np.isfinite(hi - lo) else max(abs(x), 1.0)))
         box[k] = (lo, hi) if lo == hi else (max(lo, x - half), min(hi, x + half))
     return box
+
+
+def _at_trust_edge(ctrl: SymbolicController, c: Controller, tol: float = 1e-6) -> bool:
+    """Whether a free parameter of ``c`` sits on the trust region's edge where it is inside the bounds."""
+    for k in ctrl.free:
+        (lo, hi), (blo, bhi), v = ctrl.box[k], ctrl.bounds[k], float(c.parameters[k])
+        size = tol * max(abs(v), hi - lo, 1e-12)
+        if (lo > blo and v - lo <= size) or (hi < bhi and hi - v <= size):
+            return True
+    return False
 
 
 def _stable(plants: list[Plant], c: Controller) -> bool:
