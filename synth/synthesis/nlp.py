@@ -28,6 +28,17 @@ not convex are exact here: the bandwidth is a variable ``wb`` with
 ``|1 + L| >= gamma``. Crossovers are re-detected after each solve (at most a few
 rounds), and the result is only accepted by the caller after the dense
 certificate.
+
+Rounds. Each NLP is built around its start design: its gain and phase crossovers (variables in boxes
+around them), the local maxima of ``|S|``, ``|T|``, ``|KS|`` near a peak bound (variables held at a
+stationary point of the curve, :mod:`synth.synthesis.nlp_peaks`, so a peak narrower than the grid's spacing
+is bounded where it is) and points around every lightly damped root of the loop. Another round starts from
+the answer when its crossovers changed or a helper variable ended on its box; an answer violated only between
+grid points is solved again from the same start with those frequencies (and the answer's sharp peaks) added,
+since an interior-point method restarted at an optimum with its constraints active wanders. An answer whose
+closed loop is unstable (a step jumped over the thin region where ``|1 + L|`` is small on the grid) is
+discarded and the round repeated in a trust region around its start, which grows again when it held a step
+back. Where IPOPT stopped unconverged at a stable loop is offered to the certificate like every candidate.
 """
 
 import time
