@@ -39,7 +39,8 @@ a minute: the polish from the convex answer keeps the full limit)."""
 
 def screen_points(spec: Spec, n: int = SCREEN_POINTS) -> list[Controller]:
     """``n`` controllers drawn over the spec's parameter box (seeded by the box itself), then ``n // 3`` copies
-    of the first ones with a random half of their parameters at the lower bounds.
+    of the first ones with a random half of their parameters at the lower bounds and ``n // 3`` copies of the
+    next ones with a random half at the upper bounds.
 
     Examples
     --------
@@ -48,7 +49,7 @@ def screen_points(spec: Spec, n: int = SCREEN_POINTS) -> list[Controller]:
     ...                    "min": 1.0}], "controller": {"type": "PI", "bounds": {"kp": [0, 10], "ki": [0, 5]}}})
     >>> points = screen_points(spec, 9)
     >>> len(points), all(0 <= c.parameters["kp"] <= 10 and 0 <= c.parameters["ki"] <= 5 for c in points)
-    (12, True)
+    (15, True)
     """
     bounds = spec.controller.all_bounds()
     names = sorted(bounds)
@@ -67,29 +68,37 @@ def screen_points(spec: Spec, n: int = SCREEN_POINTS) -> list[Controller]:
         columns[k] = uniform
     extra = n // 3  # copies of the first points with a random half of their parameters at the lower bounds
     pinned = rng.random((extra, len(names))) < 0.5  # (a0 = 0: an integrator; ki = 0), never drawn exactly
+    upper = rng.random((extra, len(names))) < 0.5  # and copies with a random half at the upper bounds (an
+    # optimum in a corner of the box: the largest gain and pole a lead-lag may have)
     for j, k in enumerate(names):
-        columns[k] = np.concatenate([columns[k], np.where(pinned[:, j], float(bounds[k][0]), columns[k][:extra])])
+        columns[k] = np.concatenate([columns[k], np.where(pinned[:, j], float(bounds[k][0]), columns[k][:extra]),
+                                     np.where(upper[:, j], float(bounds[k][1]), columns[k][extra:2 * extra])])
     kind = spec.controller.type
-    return [Controller(kind, {k: float(columns[k][i]) for k in names}) for i in range(n + extra)]
+    return [Controller(kind, {k: float(columns[k][i]) for k in names}) for i in range(n + 2 * extra)]
 
 
 def _pick(order: list[int], n: int, keep: int, usable: Callable[[int], bool]) -> list[int]:
     """The first ``keep`` usable indices of ``order`` among the drawn points (``< n``), and the first usable
-    one among the pinned copies (``>= n``): the pinned points add a start, they never displace one."""
+    one among each group of pinned copies (at lower bounds, ``n .. n + n // 3``; at upper bounds, after): the
+    pinned points add starts, they never displace one."""
     drawn = [i for i in order if i < n]
-    pinned = [i for i in order if i >= n]
     out: list[int] = []
     for i in drawn:
         if len(out) == keep:
             break
         if usable(i):
             out.append(i)
-    return out + next(([i] for i in pinned if usable(i)), [])
+    extra = max(n // 3, 1)
+    for group in range(2):
+        pinned = (i for i in order if n + group * extra <= i < n + (group + 1) * extra)
+        out += next(([i] for i in pinned if usable(i)), [])
+    return out
 
 
 def screen_starts(spec: Spec, keep: int = 3, n: int = SCREEN_POINTS) -> list[Controller]:
     """The ``keep`` stable controllers of :func:`screen_points` with the largest worst slack (feasible ones
-    first), best first, and the best of the pinned copies; fewer when fewer are stable on every plant.
+    first), best first, and the best of each group of pinned copies; fewer when fewer are stable on every
+    plant.
 
     Examples
     --------
@@ -118,7 +127,7 @@ def screen_starts(spec: Spec, keep: int = 3, n: int = SCREEN_POINTS) -> list[Con
 
 def screen_improving(spec: Spec, terms: list[tuple[str, str, float]], above: float, keep: int = 2,
                      n: int = SCREEN_POINTS) -> list[Controller]:
-    """Up to ``keep`` controllers of :func:`screen_points` (and one of its pinned copies) that meet every
+    """Up to ``keep`` controllers of :func:`screen_points` (and one of each group of its pinned copies) that meet every
     requirement on the screen's grid,
     keep every closed loop stable and score above ``above`` (:func:`synth.objectives.score` on the nominal
     plant), best first: starts for the NLP where the local stages' design may be a local optimum.
@@ -130,7 +139,7 @@ def screen_improving(spec: Spec, terms: list[tuple[str, str, float]], above: flo
     ...                    "peak_sensitivity", "max_db": 6}], "controller": {"type": "PI", "bounds": {"kp": [0, 5],
     ...                    "ki": [0, 5]}}, "objective": {"maximize": "integral_gain"}})
     >>> [c.parameters["ki"] > 4.0 for c in screen_improving(spec, [("integral_gain", "maximize", 1.0)], 4.0)]
-    [True, True]
+    [True, True, True]
     """
     from synth.loop import Loop
     from synth.objectives import score
