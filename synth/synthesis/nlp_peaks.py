@@ -58,18 +58,13 @@ def peak_frequencies(plant: Plant, start: Controller, curve: str, bound: float,
         v = np.abs(f(w))
     inner = np.flatnonzero((v[1:-1] > v[:-2]) & (v[1:-1] >= v[2:])) + 1
     inner = inner[np.isfinite(v[inner]) & (v[inner] >= bound * 10 ** (-NEAR_DB / 20))]
-    out = []
-    for i in inner:
-        a, b = np.log(w[i - 1]), np.log(w[i + 1])
-        for _ in range(40):  # golden section on log w
-            c, d = b - 0.618 * (b - a), a + 0.618 * (b - a)
-            with np.errstate(all="ignore"):
-                if abs(f(np.exp(c))) >= abs(f(np.exp(d))):
-                    b = d
-                else:
-                    a = c
-        out.append(np.exp(0.5 * (a + b)))
-    return np.array(out, float)
+    a, b = np.log(w[inner - 1]), np.log(w[inner + 1])
+    for _ in range(40):  # golden section on log w, every peak at once
+        c, d = b - 0.618 * (b - a), a + 0.618 * (b - a)
+        with np.errstate(all="ignore"):
+            left = np.abs(f(np.exp(c))) >= np.abs(f(np.exp(d)))
+        a, b = np.where(left, a, c), np.where(left, d, b)
+    return np.exp(0.5 * (a + b))
 
 
 def track_peaks(b: NLPBuilder, plant: Plant, designs: list[Controller], curve: str, bound: float,
