@@ -53,6 +53,7 @@ from synth.loop import BANDWIDTH_LEVEL, Loop
 from synth.plant import Plant
 from synth.requirements.base import Requirement
 from synth.synthesis.nlp_forms import NLP_FORMS, NLPContext
+from synth.synthesis.nlp_peaks import resonance_points
 from synth.synthesis.nlp_problem import NLPBuilder, SymbolicController, loop_response, phase_crossovers, t0_squared
 
 __all__ = ["NLPResult", "polish"]
@@ -177,7 +178,7 @@ def polish(requirements: list[Requirement], plants: list[Plant], start: Controll
     status = "not run"
     grid = np.asarray(grid, float)
     extra = np.array([])
-    success = converged = False
+    converged = False
     solved: list[Controller] = []
     radius: float | None = None  # a trust region once a step has jumped out of the stabilizing set
     shrinks = 0
@@ -186,7 +187,7 @@ def polish(requirements: list[Requirement], plants: list[Plant], start: Controll
             break
         ctrl = SymbolicController(current.type, current, bounds, _trust_box(bounds, current, radius))
         b = NLPBuilder(ctrl)
-        ctx = NLPContext(grid, np.union1d(extra, _resonance_points(plants, current, grid)), per_decade, current,
+        ctx = NLPContext(grid, np.union1d(extra, resonance_points(plants, current, grid)), per_decade, current,
                          tuple(solved[:1]) if solved and solved[0] is not current else ())
         for req in requirements:
             build = NLP_FORMS.entry(req).build
@@ -211,7 +212,6 @@ def polish(requirements: list[Requirement], plants: list[Plant], start: Controll
         if not _stable(plants, candidate):  # |1 + L| >= level on the grid, yet a step jumped over the boundary
             history[-1]["unstable"] = True
             if shrinks == MAX_SHRINKS:
-                success = False
                 break
             radius, shrinks = (1.0 if radius is None else radius / 4), shrinks + 1
             continue
@@ -220,7 +220,7 @@ def polish(requirements: list[Requirement], plants: list[Plant], start: Controll
         between = np.concatenate([between, _missed_peaks(objective, plants, candidate, np.union1d(grid, extra))])
         if between.size:  # and the candidate's sharp features, which the next answer moves only a little
             extra = np.unique(np.concatenate([extra, between, between * (1 - 1e-3), between * (1 + 1e-3),
-                                              _resonance_points(plants, candidate, grid)]))
+                                              resonance_points(plants, candidate, grid)]))
         # the NLP is built around this round's start (its crossovers, boxes of the crossover and bandwidth
         # variables): another round from the candidate is needed when its crossovers changed or a helper
         # variable ended on its box; otherwise the same NLP from the candidate would end where it is
@@ -288,32 +288,6 @@ def _at_helper_box(b: NLPBuilder, x: np.ndarray, n_controller: int, tol: float =
     v = x[n_controller:]
     size = tol * np.maximum(np.abs(v), 1e-12)
     return bool(np.any((v - lo <= size) | (hi - v <= size)))
-
-
-def _resonance_points(plants: list[Plant], c: Controller, grid: np.ndarray, damping: float = 0.3,
-                      half_width: int = 6) -> np.ndarray:
-    """Frequencies that resolve every lightly damped root of the loop at ``c`` (plant and controller poles and
-    zeros, closed-loop poles with the delay left out): ``|r| exp(k zeta / 2)`` for ``|k| <= half_width``. A
-    peak of ``|S|`` or ``|T|`` is about ``2 zeta`` wide in relative frequency, narrower than the design grid's
-    spacing for ``zeta`` under about 0.03, and it moves with the design between grid points."""
-    cn, cd = c.tf()
-    roots = []
-    for p in plants:
-        num, den = np.polymul(cn, p.num), np.polymul(cd, p.den)
-        closed = np.polyadd(den, num)
-        for poly in (num, den, closed):
-            poly = np.trim_zeros(np.asarray(poly, float), "f")
-            if poly.size > 1 and np.all(np.isfinite(poly)):
-                roots.extend(np.roots(poly))
-    out = []
-    for r in roots:
-        size = abs(r)
-        if size <= 0 or not grid[0] <= size <= grid[-1] or abs(r.imag) < 1e-9 * size:
-            continue
-        zeta = abs(r.real) / size
-        if zeta < damping:
-            out.append(size * np.exp(np.arange(-half_width, half_width + 1) * max(zeta, 1e-3) / 2))
-    return np.unique(np.concatenate(out)) if out else np.array([])
 
 
 _PEAK_CURVES = {"peak_sensitivity": "S", "peak_complementary": "T", "control_effort": "KS"}
