@@ -26,7 +26,7 @@ def spec_studies(spec: Spec) -> list[tuple[str, Callable[[], Any]]]:
     --------
     >>> from synth.spec import load_spec
     >>> [name for name, _ in spec_studies(load_spec("specs/x4_rotor.yaml"))]
-    ['gap_case', 'simulation']
+    ['simulation', 'gap_case']
     """
     jobs: list[tuple[str, Callable[[], Any]]] = []
     ref = reference_controller(spec)
@@ -34,7 +34,14 @@ def spec_studies(spec: Spec) -> list[tuple[str, Callable[[], Any]]]:
         return jobs
     from synth.gap.x4_case import gap_case_applies
 
-    if gap_case_applies(spec):  # the heavier first: the other core starts on it
+    if ref is not None:  # the heavier first (the onset study): the other core starts on it
+        def simulation() -> Any:
+            from synth.report.simulation_report import simulation_report
+
+            return simulation_report(spec, None, ref)
+
+        jobs.append(("simulation", simulation))
+    if gap_case_applies(spec):
         def gap_case() -> tuple[dict[str, Any], dict[str, Any]]:
             from synth.gap.x4_case import x4_gap_case
 
@@ -42,11 +49,4 @@ def spec_studies(spec: Spec) -> list[tuple[str, Callable[[], Any]]]:
             return x4_gap_case(spec, objects=objects), objects
 
         jobs.append(("gap_case", gap_case))
-    if ref is not None:
-        def simulation() -> Any:
-            from synth.report.simulation_report import simulation_report
-
-            return simulation_report(spec, None, ref)
-
-        jobs.append(("simulation", simulation))
     return jobs

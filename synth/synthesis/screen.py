@@ -161,10 +161,34 @@ def screen_improving(spec: Spec, terms: list[tuple[str, str, float]], above: flo
         idx = _meeting(controllers, np.array([i for _, i in scored], int), light, plants)
         meeting = set(idx.tolist())
         scored = [(v, i) for v, i in scored if i in meeting]
-    idx = set(_meeting(controllers, np.array([i for _, i in scored], int), heavy, plants).tolist())
     order = [i for _, i in sorted(scored, reverse=True)]
-    return [controllers[i] for i in _pick(order, n, keep, lambda i: i in idx and all(
+    meets_heavy = _InScoreOrder(order, n, lambda chunk: _meeting(controllers, chunk, heavy, plants))
+    return [controllers[i] for i in _pick(order, n, keep, lambda i: meets_heavy(i) and all(
         Loop(p, controllers[i]).stability().stable for p in plants))]
+
+
+class _InScoreOrder:
+    """``_meeting`` for the stability-based requirements, evaluated lazily: asked about index ``i``, it
+    evaluates ``i`` and the next unevaluated indices of ``order`` in ``i``'s group (drawn or one group of
+    pinned copies, as :func:`_pick` scans them), ``CHUNK`` at a time, and remembers the answers. The pick
+    stops after a few usable points, so most of the costly root counts are never made."""
+
+    CHUNK = 12
+
+    def __init__(self, order: list[int], n: int, meeting: Callable[[np.ndarray], np.ndarray]) -> None:
+        extra = max(n // 3, 1)
+        self._group = lambda i: 0 if i < n else 1 + min((i - n) // extra, 1)
+        self._order, self._meeting = order, meeting
+        self._known: dict[int, bool] = {}
+
+    def __call__(self, i: int) -> bool:
+        if i not in self._known:
+            g = self._group(i)
+            start = self._order.index(i)
+            chunk = [j for j in self._order[start:] if self._group(j) == g and j not in self._known][:self.CHUNK]
+            passed = set(self._meeting(np.array(chunk, int)).tolist())
+            self._known.update({j: j in passed for j in chunk})
+        return self._known[i]
 
 
 def _meeting(controllers: list[Controller], idx: np.ndarray, requirements: list, plants: list) -> np.ndarray:
