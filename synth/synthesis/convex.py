@@ -393,7 +393,7 @@ class ConvexDesigner:
             cap = magnitude(best) if name in ("peak_complementary", "control_effort") else best
             lo, hi = np.log(cap), np.log(cap) - np.log(1e3)
         if self._bracket is not None:  # a refinement round: the optimum moved little, search near it
-            width = max(abs(self._bracket[1] - self._bracket[0]), 1e-3) * 20
+            width = max(abs(self._bracket[1] - self._bracket[0]), self.settings.bisection_tolerance) * 20
             hi = lo + np.sign(hi - lo) * min(abs(hi - lo), width)
         for step in range(self.settings.bisection_steps):
             level = float(np.exp(0.5 * (lo + hi)))
@@ -421,7 +421,7 @@ class ConvexDesigner:
             else:
                 hi = np.log(level)
             history.append({"phase": 2, "iteration": step, "level": level, "feasible": ok, "objective": best})
-            if abs(hi - lo) < 1e-4:
+            if abs(hi - lo) < self.settings.bisection_tolerance:
                 break
         self._bracket = (lo, hi)
         return best_rho, best

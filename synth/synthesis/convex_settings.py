@@ -30,6 +30,11 @@ class ConvexSettings:
     stability_level : float
         Every iterate keeps ``|1 + L| >= stability_level`` on the grid (|S| <= 26 dB
         for 0.05), which keeps the closed loop stable along each step.
+    bisection_steps : int
+        Most levels the objective's bisection tries per run.
+    bisection_tolerance : float
+        The bisection stops when its bracket on the objective's logarithm is narrower than this (1e-3:
+        0.1 % of the objective; the NLP polish that follows refines the answer to its own tolerance).
     """
 
     per_decade: int = 40
@@ -38,7 +43,7 @@ class ConvexSettings:
     tolerance: float = 1e-6
     stability_level: float = 0.05
     bisection_steps: int = 18
-
+    bisection_tolerance: float = 1e-3
 
 
 def design_grid(plants: list[Plant], requirements: list[Requirement], settings: ConvexSettings) -> np.ndarray:
