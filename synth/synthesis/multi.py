@@ -46,6 +46,7 @@ from synth.synthesis.convex_settings import ConvexSettings
 from synth.synthesis.integral_action import integral_only, objective_terms, without_integral_action
 from synth.synthesis.nlp import polish
 from synth.synthesis.nlp_forms import NLP_FORMS
+from synth.synthesis.optimality import optimality_of
 from synth.synthesis.parametrization import parametrize
 from synth.synthesis.scalar import design_scalar
 from synth.synthesis.screen import SCREEN_ITERATIONS, SCREEN_POINTS, screen_improving, screen_starts
@@ -318,13 +319,14 @@ def _certify_best(spec: Spec, found: list[tuple[str, Controller]], terms: list[t
 
 
 def _polished_from(spec: Spec, starts: list[Controller], terms: list[tuple[str, str, float]], grid: np.ndarray,
-                   settings: ConvexSettings) -> list[tuple[str, Controller]]:
+                   settings: ConvexSettings, unconverged: set[str]) -> list[tuple[str, Controller]]:
     """Screened starts and what a short NLP polish (3 rounds of :data:`SCREEN_ITERATIONS`) made of each, as
-    candidates for the certificate."""
+    candidates for the certificate; where a polish stopped unconverged joins ``unconverged`` (as text)."""
     out: list[tuple[str, Controller]] = []
     for c in starts:
         res = polish(list(spec.requirements), spec.plants(), c, spec.controller.all_bounds(), terms, grid,
                      settings.per_decade, settings.stability_level, rounds=3, max_iter=SCREEN_ITERATIONS)
+        unconverged.update(h["controller"] for h in res.history if h.get("offered"))
         out.extend([("screen", c), *(("nlp from screen", r) for r in reversed(res.candidates))])
     return out
 
@@ -338,6 +340,8 @@ def _design(spec: Spec, settings: ConvexSettings, nlp: bool | str) -> DesignResu
                                            if conv.status == "optimal"]
     feasible_runs = [(d, r) for d, r in runs if r.status == "optimal"]
     extras: dict[str, Any] = {"synthesis": {"convex": [r.to_dict() for _, r in runs]}}
+    unconverged = {str(r.controller) for _, r in runs if r.status == "optimal" and not r.converged}
+    screened = ""
     ref = reference_check(spec)
     stages = [f"convex-concave (cvxpy + Clarabel) on {runs[0][1].grid_points} frequency points x "
               f"{len(spec.plants())} plant(s), {sum(r.solves for _, r in runs)} convex solves"]
@@ -363,18 +367,22 @@ def _design(spec: Spec, settings: ConvexSettings, nlp: bool | str) -> DesignResu
         extras["synthesis"]["nlp"] = res.to_dict()
         stages.append(f"NLP polish (casadi + IPOPT, {res.iterations} iterations, {res.status})")
         found.extend(("nlp", c) for c in reversed(res.candidates))
+        unconverged.update(h["controller"] for h in res.history if h.get("offered"))
     candidates, passed = _certify_best(spec, found, terms, per_decade, cache)
     if passed is not None and nlp and spec.objective is not None:  # a local optimum? better points elsewhere
         value = score(Loop(nominal, passed[1]), terms)
         starts = screen_improving(spec, terms, value + IMPROVEMENT * max(abs(value), 1e-12))
-        found.extend(_polished_from(spec, starts, terms, runs[0][0].grid, settings))
+        found.extend(_polished_from(spec, starts, terms, runs[0][0].grid, settings, unconverged))
         stages.append(f"random screen of the bounds ({SCREEN_POINTS} controllers): {len(starts)} scored more "
                       "than 1 % better on its grid" + (", NLP polish from each" if starts else ""))
+        screened = (f"a random screen of {SCREEN_POINTS} controllers over the bounds found "
+                    + (f"{len(starts)} scoring more than 1 % better on its grid, polished" if starts
+                       else "none scoring more than 1 % better on its grid"))
         if starts:
             candidates, passed = _certify_best(spec, found, terms, per_decade, cache)
     if passed is None and nlp:  # the local stages found nothing that certifies: starts from the whole box
         starts = screen_starts(spec)
-        found.extend(_polished_from(spec, starts, terms, runs[0][0].grid, settings))
+        found.extend(_polished_from(spec, starts, terms, runs[0][0].grid, settings, unconverged))
         stages.append(f"random screen of the bounds ({SCREEN_POINTS} controllers, every requirement and plant): "
                       f"NLP polish from the {len(starts)} least violating (at most 3 rounds of {SCREEN_ITERATIONS} "
                       "iterations each)")
@@ -387,10 +395,13 @@ def _design(spec: Spec, settings: ConvexSettings, nlp: bool | str) -> DesignResu
             "value": float(-score(Loop(nominal, controller), terms)),
             "note": "no objective in the spec: the most robust design (smallest peak |S|) is returned"}
         extras["synthesis"]["chosen"] = stage
+        optimality = optimality_of(stage, str(controller), unconverged, screened)
+        extras["synthesis"]["optimality"] = optimality.to_dict()
         result = DesignResult(spec.name, True, controller, check(spec, controller), label, None, certificate,
                               None, method + f"; chosen: {stage}", reference=ref, extras=extras)
         result.verdict = (f"{controller} meets all {len(spec.requirements)} requirements and keeps the loop "
                           f"stable on {len(spec.plants())} plant(s) ({_describe(spec, label)}).") \
+            + (f" Optimality: {optimality.basis}." if spec.objective is not None else "") \
             + reference_verdict(spec, ref)
         return result
     if feasible_runs:  # optimal on the grid but none survives the certificate

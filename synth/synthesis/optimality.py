@@ -1,0 +1,81 @@
+"""What a certified design's optimality rests on: which stage produced it and whether that stage converged.
+
+The certificate proves a design feasible; it says nothing about how good it is. A design from an IPOPT
+round that converged is a local optimum of the NLP on the design grid; where IPOPT stopped at its iteration
+limit, or the convex-concave iteration stopped before its tolerance, the design is feasible but not shown to
+be a local optimum. The verdict and ``result.json`` (``synthesis.optimality``) say which.
+"""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass
+
+__all__ = ["Optimality", "optimality_of"]
+
+_METHODS = {"convex": "the convex-concave iteration", "nlp": "the NLP polish (IPOPT)",
+            "nlp from screen": "the NLP polish (IPOPT) from a screened start"}
+
+
+@dataclass(frozen=True)
+class Optimality:
+    """The evidence for a design's optimality.
+
+    Attributes
+    ----------
+    local : bool
+        The stage that produced the design converged (a KKT point of its problem on the design grid).
+    stage : str
+        That stage (``"convex"``, ``"nlp"``, ``"nlp from screen"`` or ``"screen"``).
+    basis : str
+        One sentence, for the verdict.
+    """
+
+    local: bool
+    stage: str
+    basis: str
+
+    def to_dict(self) -> dict[str, object]:
+        """JSON-ready dict.
+
+        Examples
+        --------
+        >>> Optimality(True, "nlp", "a local optimum").to_dict()["local"]
+        True
+        """
+        return asdict(self)
+
+
+def optimality_of(stage: str, controller: str, unconverged: set[str], screened: str = "") -> Optimality:
+    """The optimality evidence of the design ``controller`` (its text) chosen from ``stage``.
+
+    Parameters
+    ----------
+    stage : str
+        The stage the certificate chose the design from.
+    controller : str
+        ``str(controller)`` of the chosen design.
+    unconverged : set of str
+        The designs (as text) that a stage returned without converging: where IPOPT stopped at its iteration
+        limit, or a convex-concave run that ended before its tolerance.
+    screened : str
+        What the random screen of the bounds found beyond the local stages (one clause), if it ran.
+
+    Examples
+    --------
+    >>> optimality_of("nlp", "PI(kp=1, ki=2)", set()).basis
+    'a local optimum on the design grid (the NLP polish (IPOPT) converged)'
+    >>> o = optimality_of("nlp", "PI(kp=1, ki=2)", {"PI(kp=1, ki=2)"})
+    >>> o.local, o.basis[:76]
+    (False, 'not shown to be a local optimum (the NLP polish (IPOPT) stopped at its itera')
+    """
+    method = _METHODS.get(stage, stage)
+    if stage == "screen":
+        return Optimality(False, stage, "not optimized: a point of the random screen of the bounds, certified"
+                          + (f"; {screened}" if screened else ""))
+    if controller in unconverged:
+        why = f"{method} stopped at its iteration limit" if stage.startswith("nlp") else \
+            f"{method} stopped before its tolerance"
+        return Optimality(False, stage, f"not shown to be a local optimum ({why}); the design is "
+                          "certified feasible, a better one may exist" + (f"; {screened}" if screened else ""))
+    return Optimality(True, stage, f"a local optimum on the design grid ({method} converged)"
+                      + (f"; {screened}" if screened else ""))

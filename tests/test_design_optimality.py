@@ -1,0 +1,63 @@
+"""Every design verdict says what its optimality rests on (issue 15, item 5).
+
+The certificate proves a design feasible; whether it is a local optimum depends on whether the stage that
+produced it converged. A design claimed locally optimal must be one: no feasible point close to it, checked
+by the benchmark's independent reference (``benchmarks.design_reference.check_point``: its own dense grid,
+exact delay, Nyquist count), scores better. A design from a stage that stopped early says so.
+"""
+
+import numpy as np
+import pytest
+
+from synth.design import design
+from synth.spec import parse_spec
+
+SERVO = {"name": "servo_pid", "plant": {"tf": "400/(s*(s^2+4*s+400))", "delay": 0.002},
+         "controller": {"type": "PID", "bounds": {"kp": [0, 5], "ki": [0, 5], "kd": [0, 0.5], "tf": [0.005, 0.005]}},
+         "requirements": [{"type": "peak_sensitivity", "max_db": 6},
+                          {"type": "margins", "gain_margin_db": 6, "phase_margin_deg": 40},
+                          {"type": "bandwidth", "min": 2}],
+         "objective": {"maximize": "bandwidth"}}
+
+# seed 3, problem 58 of benchmarks/design_problems.py: an unstable plant and a rational controller whose
+# NLP polish does not improve on the convex stage; the convex bisection does not end at a KKT point
+UNSTABLE_RATIONAL = {"name": "rand_3_58", "plant": {"tf": "9.19378*1/((s-4.3995))", "delay": 0.0},
+                     "controller": {"type": "rational", "order": [1, 2], "bounds": {
+                         "b0": [-6582.29, 6582.29], "b1": [-815.368, 815.368], "a0": [0.0, 29326.5],
+                         "a1": [0.0, 3632.76]}},
+                     "requirements": [{"type": "peak_sensitivity", "max_db": 8.51655},
+                                      {"type": "sensitivity_static", "max_db": -11.5947},
+                                      {"type": "peak_complementary", "max_db": 5.88887}],
+                     "objective": {"maximize": "bandwidth"}}
+
+
+def test_a_design_claimed_locally_optimal_has_no_better_feasible_neighbour():
+    reference = pytest.importorskip("benchmarks.design_reference")
+    from synth.plant import Plant
+
+    d = design(parse_spec(SERVO))
+    optimality = d.extras["synthesis"]["optimality"]
+    assert d.feasible and optimality["local"] is True
+    assert "Optimality: a local optimum on the design grid" in d.verdict
+    assert "random screen of 384 controllers" in optimality["basis"]
+    plant = Plant.from_string(SERVO["plant"]["tf"])
+    best = dict(d.controller.parameters)
+    here = reference.check_point(plant.num, plant.den, 0.002, SERVO, best)
+    assert here.feasible(1e-6)
+    rng = np.random.default_rng(0)
+    better = 0
+    for _ in range(60):  # random points within 2 % of each free parameter, inside the bounds
+        trial = {k: (float(np.clip(v * (1 + 0.02 * rng.uniform(-1, 1)), *SERVO["controller"]["bounds"][k]))
+                     if k != "tf" else v) for k, v in best.items()}
+        e = reference.check_point(plant.num, plant.den, 0.002, SERVO, trial)
+        if e.feasible(1e-6) and e.objective > here.objective * (1 + 1e-3):
+            better += 1
+    assert better == 0
+
+
+def test_a_design_from_a_stage_that_stopped_early_says_it_is_not_shown_optimal():
+    d = design(parse_spec(UNSTABLE_RATIONAL))
+    optimality = d.extras["synthesis"]["optimality"]
+    assert d.feasible
+    assert optimality["local"] is False
+    assert "not shown to be a local optimum" in d.verdict and "a better one may exist" in d.verdict
