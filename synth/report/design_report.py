@@ -128,9 +128,44 @@ def _design_figure_jobs(spec: Spec, result: DesignResult, loops: list[tuple[str,
     return jobs
 
 
+def _study_figure_jobs(spec: Spec, studies: dict[str, Any] | None, out: OutputDir) -> list[tuple[str, Any]]:
+    """``(key, job)`` for the figures of what is known before the report's own work: seed 1's gap case when the
+    command computed it beside the design, and the seed paper's section (the spec alone); each job returns
+    ``({figure key: path}, None, the file names it claimed)`` like :func:`_design_figure_jobs`' jobs."""
+
+    def job(draw: Any) -> Any:
+        def run() -> tuple[dict[str, Path], None, list[str]]:
+            before = len(out.written)
+            figs = draw()
+            return figs, None, list(out.written[before:])
+        return run
+
+    jobs: list[tuple[str, Any]] = []
+    objects = (studies or {}).get("gap_case", (None, {}))[1]
+    if "diagnosis" in objects:
+        jobs.append(("gap_case", job(lambda: _gap_figures(objects["diagnosis"], out))))
+    if spec.analysis.paper is not None:
+        from synth.report.paper_section import paper_section_figures
+
+        jobs.append(("paper", job(lambda: paper_section_figures(spec, out))))
+    return jobs
+
+
+def _gap_figures(diag: Any, out: OutputDir) -> dict[str, Path]:
+    """Seed 1's gap case: the gap map and the before/after overlay of the simulated rig."""
+    from synth.figure_files import save_figure
+    from synth.gap.overlay import overlay_figure
+    from synth.gap.where.gapmap import write_gap_map
+
+    return {"gap_map": write_gap_map(diag.localization, out.claim("gap_map.png"), diag.plant),
+            "gap_overlay": save_figure(overlay_figure(diag.attribution), out.claim("gap_overlay.png"))}
+
+
 def _analysis_figures(spec: Spec, data: dict[str, Any], objects: dict[str, Any], shown: Controller | None,
-                      ref: Controller | None, marks: dict[str, float], out: OutputDir) -> dict[str, Path]:
-    """The figures drawn from ``report_data``'s results (delay table, simulations, gap case, paper section)."""
+                      ref: Controller | None, marks: dict[str, float], out: OutputDir,
+                      elsewhere: frozenset[str] = frozenset()) -> dict[str, Path]:
+    """The figures drawn from ``report_data``'s results (delay table, simulations, gap case, paper section),
+    except the groups (``"gap_case"``, ``"paper"``) the worker draws (:func:`_study_figure_jobs`)."""
     figs: dict[str, Path] = {}
     delay_table = data["analysis"].get("delay_table")
     if delay_table:
@@ -140,15 +175,9 @@ def _analysis_figures(spec: Spec, data: dict[str, Any], objects: dict[str, Any],
         from synth.report.simulation_report import simulation_figures
 
         figs.update(simulation_figures(spec, shown, ref, out, marks))
-    if "diagnosis" in objects:  # the seed-1 gap case: gap map and before/after overlay of the simulated rig
-        from synth.figure_files import save_figure
-        from synth.gap.overlay import overlay_figure
-        from synth.gap.where.gapmap import write_gap_map
-
-        diag = objects["diagnosis"]
-        figs["gap_map"] = write_gap_map(diag.localization, out.claim("gap_map.png"), diag.plant)
-        figs["gap_overlay"] = save_figure(overlay_figure(diag.attribution), out.claim("gap_overlay.png"))
-    if spec.analysis.paper is not None:  # the seed paper's own section (issue 19), if the spec asks
+    if "diagnosis" in objects and "gap_case" not in elsewhere:  # the seed-1 gap case (simulated rig)
+        figs.update(_gap_figures(objects["diagnosis"], out))
+    if spec.analysis.paper is not None and "paper" not in elsewhere:  # the seed paper's own section (issue 19)
         from synth.report.paper_section import paper_section_figures
 
         figs.update(paper_section_figures(spec, out))
@@ -252,11 +281,14 @@ def write_design_report(spec: Spec, result: DesignResult, out_dir: str | Path, *
     result_data = reproducible(to_jsonable(result.to_dict()))
     # figures that need only the design: drawn by a forked worker while this process computes report_data
     jobs = _design_figure_jobs(spec, result, loops, marks, ref, result_data, out, curves)
+    study_jobs = _study_figure_jobs(spec, studies, out)  # the worker also draws what needs no report data
+    jobs += study_jobs
     objects: dict[str, Any] = {}
 
     def own_work() -> tuple[dict[str, Any], dict[str, Path]]:
         data = report_data(spec, result, keep=objects, studies=studies)
-        return data, _analysis_figures(spec, data, objects, shown, ref, marks, out)
+        return data, _analysis_figures(spec, data, objects, shown, ref, marks, out,
+                                       frozenset(key for key, _ in study_jobs))
 
     drawn_by_worker, (data, figs) = run_beside([job for _, job in jobs], own_work)
     bounds: dict[str, list[dict[str, Any]]] = {}  # figure -> the requirement bounds it draws
@@ -266,6 +298,8 @@ def write_design_report(spec: Spec, result: DesignResult, out_dir: str | Path, *
             out.claim(name)
         if key.startswith("region:"):
             plane.append(path)
+        elif isinstance(path, dict):  # a study's group of figures
+            figs.update(path)
         elif path is not None:
             figs[key] = path
         if drawn is not None:
