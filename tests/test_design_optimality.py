@@ -36,7 +36,7 @@ def test_a_design_claimed_locally_optimal_has_no_better_feasible_neighbour():
     from synth.plant import Plant
 
     d = design(parse_spec(SERVO))
-    optimality = d.extras["synthesis"]["optimality"]
+    optimality = d.extras["optimality"]
     assert d.feasible and optimality["local"] is True
     assert "Optimality: a local optimum on the design grid" in d.verdict
     assert "random screen of 384 controllers" in optimality["basis"]
@@ -57,7 +57,20 @@ def test_a_design_claimed_locally_optimal_has_no_better_feasible_neighbour():
 
 def test_a_design_from_a_stage_that_stopped_early_says_it_is_not_shown_optimal():
     d = design(parse_spec(UNSTABLE_RATIONAL))
-    optimality = d.extras["synthesis"]["optimality"]
+    optimality = d.extras["optimality"]
     assert d.feasible
     assert optimality["local"] is False
     assert "not shown to be a local optimum" in d.verdict and "a better one may exist" in d.verdict
+
+
+def test_a_one_parameter_design_is_optimized_over_its_exact_feasible_set():
+    spec = parse_spec({"name": "p", "plant": {"tf": "120/((s+4)*(s+60))", "delay": 0.005},
+                       "controller": {"type": "P", "bounds": {"kp": [0, 30]}},
+                       "requirements": [{"type": "margins", "gain_margin_db": 6, "phase_margin_deg": 45}],
+                       "objective": {"maximize": "bandwidth"}})
+    d = design(spec)
+    assert d.extras["optimality"]["stage"] == "exact feasible set"
+    assert "Optimality: the objective maximized over the exact feasible set of kp" in d.verdict
+    (_lo, hi), = d.gain_set.as_list()
+    # bandwidth grows with kp here: the optimum is the set's upper end (moved inward by at most 1e-6)
+    assert d.controller.parameters["kp"] == pytest.approx(hi, rel=1e-5)

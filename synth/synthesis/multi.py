@@ -396,7 +396,7 @@ def _design(spec: Spec, settings: ConvexSettings, nlp: bool | str) -> DesignResu
             "note": "no objective in the spec: the most robust design (smallest peak |S|) is returned"}
         extras["synthesis"]["chosen"] = stage
         optimality = optimality_of(stage, str(controller), unconverged, screened)
-        extras["synthesis"]["optimality"] = optimality.to_dict()
+        extras["optimality"] = optimality.to_dict()
         result = DesignResult(spec.name, True, controller, check(spec, controller), label, None, certificate,
                               None, method + f"; chosen: {stage}", reference=ref, extras=extras)
         result.verdict = (f"{controller} meets all {len(spec.requirements)} requirements and keeps the loop "

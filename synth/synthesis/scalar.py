@@ -28,9 +28,14 @@ from synth.results import (
 )
 from synth.spec import Spec
 from synth.synthesis.gainset import GainSet, ScalarFamily, feasible_gain_set
+from synth.synthesis.optimality import Optimality
 
 __all__ = ["INWARD", "RETREAT_STEPS", "design_scalar", "feasible_verdict", "infeasible_verdict", "scalar_family",
            "stabilizing_text"]
+
+
+SCALAR_GRID = 61
+"""Points per interval of the feasible set at which the objective is evaluated before Brent's method."""
 
 
 def _optimize_scalar(f: Callable[[float], float], intervals: list[tuple[float, float]]) -> tuple[float, float]:
@@ -42,7 +47,7 @@ def _optimize_scalar(f: Callable[[float], float], intervals: list[tuple[float, f
         if hi <= lo:
             cand = [lo]
         else:
-            cand = list(np.linspace(lo, hi, 61))
+            cand = list(np.linspace(lo, hi, SCALAR_GRID))
         vals = [f(x) for x in cand]
         i = int(np.nanargmax(vals))
         x, v = cand[i], vals[i]
@@ -195,6 +200,12 @@ def _design_without_reference(spec: Spec) -> tuple[DesignResult, GainSet | None]
     result.verdict = feasible_verdict(result, family) if feasible else (
         f"The optimum {controller} failed the dense re-check ("
         + "; ".join(r.message for r in cert_check.failed()) + "): not reported as a solution.")
+    if feasible and objective is not None:
+        optimality = Optimality(True, "exact feasible set", f"the objective maximized over the exact feasible set of "
+                                f"{family.parameter} ({SCALAR_GRID} points per interval, then Brent's method around "
+                                "the best)")
+        result.extras["optimality"] = optimality.to_dict()
+        result.verdict += f" Optimality: {optimality.basis}."
     return result, gain_set
 
 
