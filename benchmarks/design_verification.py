@@ -83,6 +83,7 @@ def run_problem(p: Problem, *, time_limit: float = 120.0, budget: float = 1.0) -
             d = synth.design(synth.parse_spec(p.spec))
         rec["synth_status"] = "feasible" if d.feasible else "infeasible"
         rec["synth_verdict"] = d.verdict
+        rec["synth_optimality"] = (d.extras or {}).get("optimality")
     except _TimeoutError:
         rec["synth_status"] = "timeout"
     except Exception as e:
@@ -208,6 +209,13 @@ def summarize(records: list[dict[str, Any]]) -> list[tuple[str, str]]:
         if kept.size:
             rows.append((f"the same where the reference's best keeps min |1 + L| >= {keeping:g} (as synth's "
                          "designs do)", f"{np.mean(kept <= 0.01) * 100:.1f} % of {kept.size}"))
+        for claim, label in ((True, "a local optimum"), (False, "not shown to be a local optimum")):
+            said = np.array([r["objective_gap"] for r in records if "objective_gap" in r
+                             and r["outcome"] == "agree feasible" and not r.get("degenerate")
+                             and (r.get("synth_optimality") or {}).get("local") is claim])
+            if said.size:
+                rows.append((f"the same where synth's verdict says '{label}'",
+                             f"{np.mean(said <= 0.01) * 100:.1f} % of {said.size} (worst {said.max() * 100:.2f} %)"))
     rows.append(("gaps left out: the reference's best has |T(0)| < 0.01 (bandwidth ill-posed)", str(n_deg)))
     rows.append(("synth design time, median / p95 [s]", f"{np.median(ts):.2f} / {np.percentile(ts, 95):.2f}"))
     rows.append(("reference time, median / p95 [s]", f"{np.median(tr):.2f} / {np.percentile(tr, 95):.2f}"))
