@@ -38,7 +38,7 @@ def test_a_design_claimed_locally_optimal_has_no_better_feasible_neighbour():
     d = design(parse_spec(SERVO))
     optimality = d.extras["optimality"]
     assert d.feasible and optimality["local"] is True
-    assert "Optimality: a local optimum on the design grid" in d.verdict
+    assert "Optimality: a local optimum on the design grid, keeping |1 + L| >= 0.05 on it" in d.verdict
     assert "random screen of 384 controllers" in optimality["basis"]
     plant = Plant.from_string(SERVO["plant"]["tf"])
     best = dict(d.controller.parameters)

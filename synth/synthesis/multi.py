@@ -395,7 +395,7 @@ def _design(spec: Spec, settings: ConvexSettings, nlp: bool | str) -> DesignResu
             "value": float(-score(Loop(nominal, controller), terms)),
             "note": "no objective in the spec: the most robust design (smallest peak |S|) is returned"}
         extras["synthesis"]["chosen"] = stage
-        optimality = optimality_of(stage, str(controller), unconverged, screened)
+        optimality = optimality_of(stage, str(controller), unconverged, screened, settings.stability_level)
         extras["optimality"] = optimality.to_dict()
         result = DesignResult(spec.name, True, controller, check(spec, controller), label, None, certificate,
                               None, method + f"; chosen: {stage}", reference=ref, extras=extras)

@@ -45,7 +45,8 @@ class Optimality:
         return asdict(self)
 
 
-def optimality_of(stage: str, controller: str, unconverged: set[str], screened: str = "") -> Optimality:
+def optimality_of(stage: str, controller: str, unconverged: set[str], screened: str = "",
+                  keeping: float | None = None) -> Optimality:
     """The optimality evidence of the design ``controller`` (its text) chosen from ``stage``.
 
     Parameters
@@ -59,11 +60,14 @@ def optimality_of(stage: str, controller: str, unconverged: set[str], screened: 
         limit, or a convex-concave run that ended before its tolerance.
     screened : str
         What the random screen of the bounds found beyond the local stages (one clause), if it ran.
+    keeping : float, optional
+        The ``|1 + L|`` every iterate keeps on the grid (:class:`~synth.synthesis.convex_settings.ConvexSettings`'
+        ``stability_level``): the local optimum is one of the problem with that constraint added.
 
     Examples
     --------
-    >>> optimality_of("nlp", "PI(kp=1, ki=2)", set()).basis
-    'a local optimum on the design grid (the NLP polish (IPOPT) converged)'
+    >>> optimality_of("nlp", "PI(kp=1, ki=2)", set(), keeping=0.05).basis
+    'a local optimum on the design grid, keeping |1 + L| >= 0.05 on it (the NLP polish (IPOPT) converged)'
     >>> o = optimality_of("nlp", "PI(kp=1, ki=2)", {"PI(kp=1, ki=2)"})
     >>> o.local, o.basis[:76]
     (False, 'not shown to be a local optimum (the NLP polish (IPOPT) stopped at its itera')
@@ -77,5 +81,6 @@ def optimality_of(stage: str, controller: str, unconverged: set[str], screened: 
             f"{method} stopped before its tolerance"
         return Optimality(False, stage, f"not shown to be a local optimum ({why}); the design is "
                           "certified feasible, a better one may exist" + (f"; {screened}" if screened else ""))
-    return Optimality(True, stage, f"a local optimum on the design grid ({method} converged)"
+    kept = f", keeping |1 + L| >= {keeping:g} on it" if keeping else ""
+    return Optimality(True, stage, f"a local optimum on the design grid{kept} ({method} converged)"
                       + (f"; {screened}" if screened else ""))
