@@ -17,10 +17,12 @@ from __future__ import annotations
 from functools import cache
 from typing import Any
 
+import numpy as np
 import pytest
 
 from benchmarks.design_problems import problem
-from benchmarks.design_verification import degenerate_reference, run_problem
+from benchmarks.design_reference import check_point
+from benchmarks.design_verification import _gap, degenerate_reference, run_problem
 
 SEED = 2026
 SAMPLE = [
@@ -58,6 +60,29 @@ def test_objective_within_one_percent_in_95_percent_of_the_sample() -> None:
     assert len(gaps) >= 5
     assert sum(g <= 0.01 for g in gaps) >= 0.95 * len(gaps), [(i, k, round(r.get("objective_gap", 0), 4)) for i, k in SAMPLE
                                                              for r in [_record(i, k)]]
+
+
+def test_a_claimed_local_optimum_has_no_better_feasible_neighbour() -> None:
+    """Where synth's verdict says "a local optimum" (of its grid problem keeping |1 + L| >= 0.05, or over the
+    exact feasible set of one parameter), no point within 1 % of each free parameter that passes the
+    reference's dense check without tolerance and keeps |1 + L| >= 0.05 is better by more than 0.1 %."""
+    claimed = 0
+    for index, kind in SAMPLE:
+        rec = _record(index, kind)
+        if not (rec.get("synth_optimality") or {}).get("local") or "synth_params" not in rec:
+            continue
+        claimed += 1
+        p = problem(SEED, index, controllers=(kind,))
+        bounds = p.spec["controller"]["bounds"]
+        here = check_point(p.num, p.den, p.delay, p.spec, rec["synth_params"])
+        rng = np.random.default_rng(index)
+        for _ in range(30):
+            trial = {k: float(np.clip(v * (1 + 0.01 * rng.uniform(-1, 1)), *bounds[k])) if k in bounds else v
+                     for k, v in rec["synth_params"].items()}
+            e = check_point(p.num, p.den, p.delay, p.spec, trial)
+            if e.feasible(0.0) and (e.values.get("min|1+L|") or 0.0) >= 0.05 and e.objective is not None:
+                assert _gap(p.spec, e.objective, here.objective) <= 1e-3, (index, kind, rec["synth_params"], trial)
+    assert claimed >= 10
 
 
 def test_sample_covers_every_structure_and_plant_kind() -> None:
