@@ -78,7 +78,7 @@ def optimality_of(stage: str, controller: str, unconverged: set[str], screened: 
                           + (f"; {screened}" if screened else ""))
     if controller in unconverged:
         why = f"{method} stopped at its iteration limit" if stage.startswith("nlp") else \
-            f"{method} stopped before its tolerance"
+            f"{method} ended without a KKT point (a bisection on the objective, or its iteration limit)"
         return Optimality(False, stage, f"not shown to be a local optimum ({why}); the design is "
                           "certified feasible, a better one may exist" + (f"; {screened}" if screened else ""))
     kept = f", keeping |1 + L| >= {keeping:g} on it" if keeping else ""
