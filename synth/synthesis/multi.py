@@ -48,6 +48,7 @@ from synth.synthesis.nlp import polish
 from synth.synthesis.nlp_forms import NLP_FORMS
 from synth.synthesis.optimality import optimality_of
 from synth.synthesis.parametrization import parametrize
+from synth.synthesis.pattern import compass_search
 from synth.synthesis.scalar import design_scalar
 from synth.synthesis.screen import SCREEN_ITERATIONS, SCREEN_POINTS, screen_improving, screen_starts
 
@@ -387,6 +388,14 @@ def _design(spec: Spec, settings: ConvexSettings, nlp: bool | str) -> DesignResu
                       f"NLP polish from the {len(starts)} least violating (at most 3 rounds of {SCREEN_ITERATIONS} "
                       "iterations each)")
         candidates, passed = _certify_best(spec, found, terms, per_decade, cache)
+    if passed is not None and passed[0] == "screen" and spec.objective is not None:
+        # a raw screened point is the best certified design: every NLP polish from the screen failed there
+        searched = compass_search(spec, passed[1], terms)
+        stages.append(f"compass search on the exact check from the screened point ({searched.checks} checks, "
+                      f"{'improved' if searched.improved else 'no improvement'})")
+        if searched.improved:
+            found.append(("pattern search", searched.controller))
+            candidates, passed = _certify_best(spec, found, terms, per_decade, cache)
     method = "; ".join(stages) + f"; certificate: dense re-check, {per_decade} points per decade"
     if passed is not None:
         stage, controller, certificate = passed

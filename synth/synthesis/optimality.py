@@ -25,7 +25,7 @@ class Optimality:
     local : bool
         The stage that produced the design converged (a KKT point of its problem on the design grid).
     stage : str
-        That stage (``"convex"``, ``"nlp"``, ``"nlp from screen"`` or ``"screen"``).
+        That stage (``"convex"``, ``"nlp"``, ``"nlp from screen"``, ``"screen"`` or ``"pattern search"``).
     basis : str
         One sentence, for the verdict.
     """
@@ -73,6 +73,10 @@ def optimality_of(stage: str, controller: str, unconverged: set[str], screened: 
     (False, 'not shown to be a local optimum (the NLP polish (IPOPT) stopped at its itera')
     """
     method = _METHODS.get(stage, stage)
+    if stage == "pattern search":
+        return Optimality(False, stage, "not shown to be a local optimum (a compass search on the exact check "
+                          "improved a screened point, where every NLP polish had failed); the design is certified "
+                          "feasible, a better one may exist" + (f"; {screened}" if screened else ""))
     if stage == "screen":
         return Optimality(False, stage, "not optimized: a point of the random screen of the bounds, certified"
                           + (f"; {screened}" if screened else ""))

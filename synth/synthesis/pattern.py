@@ -1,0 +1,134 @@
+"""A derivative-free fallback: compass search on the exact check, from a design the NLP could not polish.
+
+The NLP polish moves a design by gradients of requirements on a grid. Where every polish from the screen's
+starts failed (each answer left the stabilizing set, or IPOPT stalled), the screen's own point was the best
+certified design: a random point of the box, not optimized. Compass search improves it using only what the
+certificate itself trusts: :func:`synth.check.check` (every requirement, exact closed-loop stability with
+the delay) and the objective's score. Each free parameter is moved up and down by its step; a move is kept
+when the moved design passes the check and scores better (or as well, with more slack: a parameter the
+objective does not read still makes room); when no move helps, every step is halved. It is
+slow (one check per trial) and finds only a local improvement, which is why it runs only there.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from synth.check import check
+from synth.controllers import Controller
+from synth.loop import Loop
+from synth.objectives import score
+from synth.results import SEARCH_PER_DECADE
+from synth.spec import Spec
+
+__all__ = ["PATTERN_CHECKS", "PatternResult", "compass_search"]
+
+PATTERN_CHECKS = 160
+"""Most checks a compass search makes."""
+
+
+@dataclass(frozen=True)
+class PatternResult:
+    """Outcome of :func:`compass_search`.
+
+    Attributes
+    ----------
+    controller : Controller
+        The best design found (the start when nothing improved it).
+    improved : bool
+        Whether a move improved the start.
+    checks : int
+        Checks made.
+    final_step : float
+        The largest remaining step, relative to each parameter's scale, when the search ended.
+    """
+
+    controller: Controller
+    improved: bool
+    checks: int
+    final_step: float
+
+
+def compass_search(spec: Spec, start: Controller, terms: list[tuple[str, str, float]],
+                   max_checks: int = PATTERN_CHECKS, first_step: float = 0.1, min_step: float = 1e-4,
+                   per_decade: int = SEARCH_PER_DECADE) -> PatternResult:
+    """Improve ``start`` (which should pass the check) by compass search over the spec's free parameters.
+
+    Parameters
+    ----------
+    spec : Spec
+    start : Controller
+    terms : list of (name, sense, weight)
+        The objective (:func:`synth.synthesis.integral_action.objective_terms`).
+    max_checks : int
+        Budget of checks.
+    first_step, min_step : float
+        Initial and smallest step, relative to each parameter's scale (its value plus 1 % of its range).
+    per_decade : int
+        Density of the checks (the caller certifies the answer at its own density).
+
+    Returns
+    -------
+    PatternResult
+
+    Examples
+    --------
+    >>> from synth.spec import parse_spec
+    >>> spec = parse_spec({"name": "pi", "plant": {"tf": "10/((s+1)*(s+5))"}, "requirements": [{"type":
+    ...                    "peak_sensitivity", "max_db": 6}], "controller": {"type": "PI", "bounds": {"kp": [0, 5],
+    ...                    "ki": [0, 20]}}, "objective": {"maximize": "integral_gain"}})
+    >>> r = compass_search(spec, Controller("PI", {"kp": 1.0, "ki": 2.0}), [("integral_gain", "maximize", 1.0)])
+    >>> r.improved, r.controller.parameters["ki"] > 5.0
+    (True, True)
+    """
+    bounds = spec.controller.all_bounds()
+    free = [k for k in sorted(bounds) if bounds[k][0] < bounds[k][1]]
+    nominal = spec.nominal_plant()
+    x = {k: float(v) for k, v in start.parameters.items()}
+    checks = 0
+
+    def value(params: dict[str, float]) -> tuple[float, float]:
+        """(objective score, smallest requirement slack); (-inf, -inf) when the check fails."""
+        nonlocal checks
+        checks += 1
+        c = Controller(start.type, params)
+        with np.errstate(all="ignore"):
+            result = check(spec, c, per_decade)
+            if not result.feasible:
+                return -np.inf, -np.inf
+            return float(score(Loop(nominal, c), terms)), min(r.slack for r in result.requirements)
+
+    def better(a: tuple[float, float], b: tuple[float, float]) -> bool:
+        """A better score, or the same score with more slack (a move along a parameter the objective does not
+        read, e.g. kp when maximizing ki, makes room for the next move of the one it reads)."""
+        tie = 1e-12 * max(abs(a[0]), abs(b[0]), 1.0)
+        return a[0] > b[0] + tie or (abs(a[0] - b[0]) <= tie and a[1] > b[1])
+
+    best = value(x)
+    if not np.isfinite(best[0]) or not free:
+        return PatternResult(start, False, checks, 0.0)
+    scale = {k: abs(x[k]) + 0.01 * (bounds[k][1] - bounds[k][0]) for k in free}
+    step = {k: first_step for k in free}
+    improved = False
+    while checks < max_checks and max(step.values()) >= min_step:
+        moved = False
+        for k in free:
+            for sign in (1.0, -1.0):
+                if checks >= max_checks:
+                    break
+                trial = dict(x)
+                trial[k] = float(np.clip(x[k] + sign * step[k] * scale[k], *bounds[k]))
+                if trial[k] == x[k]:
+                    continue
+                v = value(trial)
+                if better(v, best):
+                    x, moved = trial, True
+                    improved = improved or v[0] > best[0]
+                    best = v
+                    step[k] *= 2.0  # a move that helps is tried further next time
+                    break
+        if not moved:
+            step = {k: s / 2.0 for k, s in step.items()}
+    return PatternResult(Controller(start.type, x), improved, checks, max(step.values()))
