@@ -388,14 +388,20 @@ def _design(spec: Spec, settings: ConvexSettings, nlp: bool | str) -> DesignResu
                       f"NLP polish from the {len(starts)} least violating (at most 3 rounds of {SCREEN_ITERATIONS} "
                       "iterations each)")
         candidates, passed = _certify_best(spec, found, terms, per_decade, cache)
-    if passed is not None and passed[0] == "screen" and spec.objective is not None:
-        # a raw screened point is the best certified design: every NLP polish from the screen failed there
-        searched = compass_search(spec, passed[1], terms)
-        stages.append(f"compass search on the exact check from the screened point ({searched.checks} checks, "
-                      f"{'improved' if searched.improved else 'no improvement'})")
-        if searched.improved:
-            found.append(("pattern search", searched.controller))
+    searched = ""
+    if passed is not None and spec.objective is not None \
+            and not optimality_of(passed[0], str(passed[1]), unconverged).local:
+        # the best certified design is not a converged stage's answer (a raw screened point, an IPOPT round
+        # stopped at its limit, a convex bisection): compass search on the exact check from it
+        search = compass_search(spec, passed[1], terms)
+        stages.append(f"compass search on the exact check from the {passed[0]} design ({search.checks} checks, "
+                      f"{'improved' if search.improved else 'no improvement'})")
+        if search.improved:
+            found.append(("pattern search", search.controller))
             candidates, passed = _certify_best(spec, found, terms, per_decade, cache)
+        if passed is not None and passed[0] != "pattern search":
+            searched = (f"a compass search on the exact check from it found no better point (steps down to "
+                        f"{search.final_step:.0e} of each parameter's scale, {search.checks} checks)")
     method = "; ".join(stages) + f"; certificate: dense re-check, {per_decade} points per decade"
     if passed is not None:
         stage, controller, certificate = passed
@@ -404,7 +410,8 @@ def _design(spec: Spec, settings: ConvexSettings, nlp: bool | str) -> DesignResu
             "value": float(-score(Loop(nominal, controller), terms)),
             "note": "no objective in the spec: the most robust design (smallest peak |S|) is returned"}
         extras["synthesis"]["chosen"] = stage
-        optimality = optimality_of(stage, str(controller), unconverged, screened, settings.stability_level)
+        optimality = optimality_of(stage, str(controller), unconverged, "; ".join(x for x in (searched, screened) if x),
+                                   settings.stability_level)
         extras["optimality"] = optimality.to_dict()
         result = DesignResult(spec.name, True, controller, check(spec, controller), label, None, certificate,
                               None, method + f"; chosen: {stage}", reference=ref, extras=extras)

@@ -59,7 +59,8 @@ def optimality_of(stage: str, controller: str, unconverged: set[str], screened: 
         The designs (as text) that a stage returned without converging: where IPOPT stopped at its iteration
         limit, or a convex-concave run that ended before its tolerance.
     screened : str
-        What the random screen of the bounds found beyond the local stages (one clause), if it ran.
+        What the compass search and the random screen of the bounds found beyond the local stages (clauses), if
+        they ran.
     keeping : float, optional
         The ``|1 + L|`` every iterate keeps on the grid (:class:`~synth.synthesis.convex_settings.ConvexSettings`'
         ``stability_level``): the local optimum is one of the problem with that constraint added.
@@ -75,8 +76,8 @@ def optimality_of(stage: str, controller: str, unconverged: set[str], screened: 
     method = _METHODS.get(stage, stage)
     if stage == "pattern search":
         return Optimality(False, stage, "not shown to be a local optimum (a compass search on the exact check "
-                          "improved a screened point, where every NLP polish had failed); the design is certified "
-                          "feasible, a better one may exist" + (f"; {screened}" if screened else ""))
+                          "improved the best design of the stages before, none of which converged); the design is "
+                          "certified feasible, a better one may exist" + (f"; {screened}" if screened else ""))
     if stage == "screen":
         return Optimality(False, stage, "not optimized: a point of the random screen of the bounds, certified"
                           + (f"; {screened}" if screened else ""))
