@@ -252,6 +252,7 @@ def screen_effect(effect: Effect, bases: list[tuple[str, Plant]], t_tr: np.ndarr
         g_best = min(grid, key=lambda g: run(g))
         if key_name is not None:
             g_best = _golden(run, grid, g_best, key_name)
+        g_best = effect.refine_screen(run, g_best, t_tr, u_tr, base)
         points += len(tried)
         ssr = run(g_best)
         if best is None or ssr < best[0]:

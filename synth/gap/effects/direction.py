@@ -21,6 +21,7 @@ Not a default candidate (:attr:`DirectionEffect.excluded_because`).
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import ClassVar
 
@@ -29,7 +30,7 @@ import numpy as np
 from synth.gap.effects.base import Effect, Params, slowest_pole
 from synth.plant import Plant
 
-__all__ = ["DirectionEffect", "directional_block"]
+__all__ = ["DirectionEffect", "compass_search", "directional_block"]
 
 
 def _lag_piece(x: float, target: float, h: float, tau_up: float, tau_down: float) -> tuple[float, float]:
@@ -129,6 +130,70 @@ def directional_block(u: np.ndarray, dt: float, params: Params) -> tuple[np.ndar
     return v, vd, dn
 
 
+def compass_search(cost: Callable[[Params], float], start: Params, names: tuple[str, ...], floor: float,
+                   upper: dict[str, float], factor: float = 4.0, tol: float = 1.03, budget: int = 160) -> Params:
+    """Coordinate-wise pattern search of nonnegative parameters in log steps, switching them on and off.
+
+    Each parameter in turn is multiplied and divided by the current factor (one at ``0`` is tried at
+    ``floor``, one below ``floor`` times the factor also at ``0``); the first move that lowers the cost
+    is taken. When no parameter moves the factor shrinks to its square root, until it is below ``tol``
+    or ``budget`` points are spent.
+
+    Parameters
+    ----------
+    cost : callable
+        Cost of a parameter point.
+    start : dict
+        Starting point (every name of ``names`` in it).
+    names : tuple of str
+        The parameters searched (>= 0).
+    floor : float
+        The value a parameter switched on from 0 starts at.
+    upper : dict
+        Largest value of each parameter (missing: unbounded).
+    factor, tol : float
+        First step factor and the smallest (> 1).
+    budget : int
+        Most cost evaluations.
+
+    Returns
+    -------
+    dict
+        The best point found (``start`` if none is better).
+
+    Examples
+    --------
+    >>> f = lambda p: (p["a"] - 0.3) ** 2 + (p["b"] - 0.02) ** 2
+    >>> best = compass_search(f, {"a": 0.1, "b": 0.0}, ("a", "b"), 0.001, {})
+    >>> round(best["a"], 2), round(best["b"], 3)
+    (0.3, 0.02)
+    """
+    x = dict(start)
+    fx = cost(x)
+    used = 1
+    step = factor
+    while step > tol and used < budget:
+        moved = False
+        for k in names:
+            v = x[k]
+            tries = [v * step, v / step] if v > 0 else [floor]
+            if 0 < v < floor * step:
+                tries.append(0.0)
+            for c in tries:
+                c = min(c, upper.get(k, np.inf))
+                if c == v or used >= budget:
+                    continue
+                y = {**x, k: float(c)}
+                fy = cost(y)
+                used += 1
+                if fy < fx:
+                    x, fx, moved = y, fy, True
+                    break
+        if not moved:
+            step = float(np.sqrt(step))
+    return x
+
+
 @dataclass(frozen=True)
 class DirectionEffect(Effect):
     """Separate latency, time constant and gain for rising and falling commands (:func:`directional_block`).
@@ -176,6 +241,19 @@ class DirectionEffect(Effect):
         grid = [{**off, "tau_up": a, "tau_down": b} for a in taus for b in taus if a != b]
         grid += [{**off, "delay_up": a, "delay_down": b} for a in delays for b in delays if a != b]
         return [dict(g) for g in grid]
+
+    def refine_screen(self, cost: Callable[[Params], float], best: Params, t: np.ndarray, u: np.ndarray,
+                      plant: Plant) -> Params:
+        """Compass search in all four time parameters from the screen's best point (:func:`compass_search`).
+
+        The grid holds either the time constants or the latencies nonzero, never both, and the
+        golden-section search moves ``tau_up`` alone; a drive with a slow rise, a fast fall and a
+        latency of its own lies between them. The interval means of :func:`directional_block` make the
+        cost continuous in every parameter, latencies included, so a local search can walk there.
+        """
+        dt = float(t[1] - t[0])
+        hi = {k: b for k, (_, b) in self.bounds(t, u, plant).items() if k in self.grid_names}
+        return compass_search(cost, best, self.grid_names, 0.1 * dt, hi)
 
     def input_map(self, u: np.ndarray, dt: float, params: Params) -> np.ndarray:
         return directional_block(u, dt, params)[0]
