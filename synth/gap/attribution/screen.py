@@ -25,7 +25,9 @@ the screen cannot make is what the effect needs.
 A quantizer's step and offset are searched densely and jointly instead
 (:func:`synth.gap.effects.quantization.quantizer_grid`): each effect gives its own search points
 (:meth:`synth.gap.effects.base.Effect.screen_grid`) and says whether a golden-section search refines
-them (``golden_search``).
+them (``golden_search``). An effect whose grid parameters act together searches them all from the best
+point found (:meth:`synth.gap.effects.base.Effect.refine_screen`; the direction effect's four time
+parameters, by a pattern search).
 """
 
 from __future__ import annotations

@@ -15,6 +15,11 @@ whose torque-to-speed gain differs between the directions. The gain of the risin
 nominal gain (re-fitted), so only the ratio of the falling direction's to it is a parameter; likewise
 the rising direction's input offset is the output constant's, and ``offset_down`` is the falling
 direction's difference to it (a drive whose friction differs by direction).
+The drive is continuous in time (latencies at any point within a sample, the lag between samples);
+the held-input plant gets its mean over each sample interval (:func:`directional_block`), so the
+model follows the continuous drive closely even where a time constant or a latency is shorter than a
+sample, and its output is continuous in every parameter: the screen searches the four time parameters
+together from its best grid point (:meth:`DirectionEffect.refine_screen`, a pattern search).
 Not a default candidate (:attr:`DirectionEffect.excluded_because`).
 """
 
@@ -28,9 +33,10 @@ from typing import ClassVar
 import numpy as np
 
 from synth.gap.effects.base import Effect, Params, slowest_pole
+from synth.gap.effects.search import pattern_search
 from synth.plant import Plant
 
-__all__ = ["DirectionEffect", "compass_search", "directional_block"]
+__all__ = ["DirectionEffect", "directional_block"]
 
 
 def _lag_piece(x: float, target: float, h: float, tau_up: float, tau_down: float) -> tuple[float, float]:
@@ -130,70 +136,6 @@ def directional_block(u: np.ndarray, dt: float, params: Params) -> tuple[np.ndar
     return v, vd, dn
 
 
-def compass_search(cost: Callable[[Params], float], start: Params, names: tuple[str, ...], floor: float,
-                   upper: dict[str, float], factor: float = 4.0, tol: float = 1.03, budget: int = 160) -> Params:
-    """Coordinate-wise pattern search of nonnegative parameters in log steps, switching them on and off.
-
-    Each parameter in turn is multiplied and divided by the current factor (one at ``0`` is tried at
-    ``floor``, one below ``floor`` times the factor also at ``0``); the first move that lowers the cost
-    is taken. When no parameter moves the factor shrinks to its square root, until it is below ``tol``
-    or ``budget`` points are spent.
-
-    Parameters
-    ----------
-    cost : callable
-        Cost of a parameter point.
-    start : dict
-        Starting point (every name of ``names`` in it).
-    names : tuple of str
-        The parameters searched (>= 0).
-    floor : float
-        The value a parameter switched on from 0 starts at.
-    upper : dict
-        Largest value of each parameter (missing: unbounded).
-    factor, tol : float
-        First step factor and the smallest (> 1).
-    budget : int
-        Most cost evaluations.
-
-    Returns
-    -------
-    dict
-        The best point found (``start`` if none is better).
-
-    Examples
-    --------
-    >>> f = lambda p: (p["a"] - 0.3) ** 2 + (p["b"] - 0.02) ** 2
-    >>> best = compass_search(f, {"a": 0.1, "b": 0.0}, ("a", "b"), 0.001, {})
-    >>> round(best["a"], 2), round(best["b"], 3)
-    (0.3, 0.02)
-    """
-    x = dict(start)
-    fx = cost(x)
-    used = 1
-    step = factor
-    while step > tol and used < budget:
-        moved = False
-        for k in names:
-            v = x[k]
-            tries = [v * step, v / step] if v > 0 else [floor]
-            if 0 < v < floor * step:
-                tries.append(0.0)
-            for c in tries:
-                c = min(c, upper.get(k, np.inf))
-                if c == v or used >= budget:
-                    continue
-                y = {**x, k: float(c)}
-                fy = cost(y)
-                used += 1
-                if fy < fx:
-                    x, fx, moved = y, fy, True
-                    break
-        if not moved:
-            step = float(np.sqrt(step))
-    return x
-
-
 @dataclass(frozen=True)
 class DirectionEffect(Effect):
     """Separate latency, time constant and gain for rising and falling commands (:func:`directional_block`).
@@ -244,16 +186,26 @@ class DirectionEffect(Effect):
 
     def refine_screen(self, cost: Callable[[Params], float], best: Params, t: np.ndarray, u: np.ndarray,
                       plant: Plant) -> Params:
-        """Compass search in all four time parameters from the screen's best point (:func:`compass_search`).
+        """Pattern search in all four time parameters (:func:`synth.gap.effects.search.pattern_search`).
 
         The grid holds either the time constants or the latencies nonzero, never both, and the
         golden-section search moves ``tau_up`` alone; a drive with a slow rise, a fast fall and a
         latency of its own lies between them. The interval means of :func:`directional_block` make the
-        cost continuous in every parameter, latencies included, so a local search can walk there.
+        cost continuous in every parameter, latencies included, so a local search can walk there. It
+        starts from the best point and from the best grid point of the other kind (time constants or
+        latencies; the grid's cost is cached), a latency and a time constant being two routes to the
+        same slowness.
         """
         dt = float(t[1] - t[0])
-        hi = {k: b for k, (_, b) in self.bounds(t, u, plant).items() if k in self.grid_names}
-        return compass_search(cost, best, self.grid_names, 0.1 * dt, hi)
+        upper = {k: b for k, (_, b) in self.bounds(t, u, plant).items() if k in self.grid_names}
+        starts = [best]
+        kinds = (("tau_up", "tau_down"), ("delay_up", "delay_down"))
+        kind = next((ks for ks in kinds if any(best.get(k, 0.0) > 0 for k in ks)), kinds[0])
+        others = [g for g in self.grid(t, u, plant) if not any(g.get(k, 0.0) > 0 for k in kind)]
+        if others:
+            starts.append(min(others, key=cost))
+        found = [pattern_search(cost, {**self.off(), **g}, self.grid_names, 0.1 * dt, upper) for g in starts]
+        return min([best, *found], key=cost)
 
     def input_map(self, u: np.ndarray, dt: float, params: Params) -> np.ndarray:
         return directional_block(u, dt, params)[0]
