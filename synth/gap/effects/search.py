@@ -70,6 +70,9 @@ def pattern_search(cost: Callable[[Params], float], start: Params, names: tuple[
     def clip(z: np.ndarray) -> np.ndarray:
         return np.minimum(np.maximum(z, lo), hi)
 
+    def better(a: float, b: float) -> bool:  # beyond round-off: log and exp do not return a point exactly
+        return a < b - 1e-9 * abs(b)
+
     def explore(base: np.ndarray, f_base: float, h: float) -> tuple[np.ndarray, float]:
         z, fz = base.copy(), f_base
         for i in range(len(names)):
@@ -81,7 +84,7 @@ def pattern_search(cost: Callable[[Params], float], start: Params, names: tuple[
                 if y[i] == z[i]:
                     continue
                 fy = f(y)
-                if fy < fz:
+                if better(fy, fz):
                     z, fz = y, fy
                     break
         return z, fz
@@ -91,14 +94,14 @@ def pattern_search(cost: Callable[[Params], float], start: Params, names: tuple[
     h = float(np.log(step))
     while h > np.log(tol) and used < budget:
         zn, fn = explore(z, fz, h)
-        if fn >= fz:
+        if not better(fn, fz):
             h /= 2.0
             continue
         while used < budget:  # pattern moves: on along the net move while exploring around it helps
             zp = clip(zn + (zn - z))
             z, fz = zn, fn
             zq, fq = explore(zp, f(zp), h)
-            if fq >= fz:
+            if not better(fq, fz):
                 break
             zn, fn = zq, fq
     return point(z)
