@@ -25,7 +25,9 @@ the screen cannot make is what the effect needs.
 A quantizer's step and offset are searched densely and jointly instead
 (:func:`synth.gap.effects.quantization.quantizer_grid`): each effect gives its own search points
 (:meth:`synth.gap.effects.base.Effect.screen_grid`) and says whether a golden-section search refines
-them (``golden_search``).
+them (``golden_search``). An effect whose grid parameters act together searches them all from the best
+point found (:meth:`synth.gap.effects.base.Effect.refine_screen`; the direction effect's four time
+parameters, by a pattern search).
 """
 
 from __future__ import annotations
@@ -252,6 +254,7 @@ def screen_effect(effect: Effect, bases: list[tuple[str, Plant]], t_tr: np.ndarr
         g_best = min(grid, key=lambda g: run(g))
         if key_name is not None:
             g_best = _golden(run, grid, g_best, key_name)
+        g_best = effect.refine_screen(run, g_best, t_tr, u_tr, base)
         points += len(tried)
         ssr = run(g_best)
         if best is None or ssr < best[0]:

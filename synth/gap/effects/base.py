@@ -27,6 +27,7 @@ linear fit until the error settles).
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any, ClassVar
 
@@ -242,6 +243,38 @@ class Effect:
         {'width': 0.04}
         """
         return self.screen_points(self.grid(t, u, plant), t, plant)
+
+    def refine_screen(self, cost: Callable[[Params], float], best: Params, t: np.ndarray, u: np.ndarray,
+                      plant: Plant) -> Params:
+        """A local search of the screen from its best point so far (default: none, the point itself).
+
+        The screen's golden-section search moves one grid parameter; an effect whose grid parameters
+        act together (several of them nonzero at once) searches them here.
+
+        Parameters
+        ----------
+        cost : callable
+            The screen's training SSR of a parameter point (cached, milliseconds per new point).
+        best : dict
+            The best point of the grid and the golden-section search.
+        t, u : numpy.ndarray
+            Training record's time [s] and command.
+        plant : Plant
+            The linear model whose denominator the screen holds.
+
+        Returns
+        -------
+        dict
+            The point to keep (never worse than ``best``).
+
+        Examples
+        --------
+        >>> from synth.gap.effects.actuator import RateLimitEffect
+        >>> RateLimitEffect().refine_screen(lambda p: 0.0, {"rate": 2.0}, np.arange(3.0), np.zeros(3),
+        ...                                 Plant.from_string("1"))
+        {'rate': 2.0}
+        """
+        return best
 
     def seed_grid(self, point: Params, u_train: np.ndarray | None = None) -> list[Params]:
         """The joint re-fit's grid started at the screened ``point``: it and its neighbours (+-15 % in the key).
