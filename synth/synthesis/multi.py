@@ -48,7 +48,7 @@ from synth.synthesis.nlp import polish
 from synth.synthesis.nlp_forms import NLP_FORMS
 from synth.synthesis.optimality import optimality_of
 from synth.synthesis.parametrization import parametrize
-from synth.synthesis.pattern import compass_search
+from synth.synthesis.pattern import pattern_search
 from synth.synthesis.scalar import design_scalar
 from synth.synthesis.screen import SCREEN_ITERATIONS, SCREEN_POINTS, screen_improving, screen_starts
 
@@ -392,15 +392,15 @@ def _design(spec: Spec, settings: ConvexSettings, nlp: bool | str) -> DesignResu
     if passed is not None and spec.objective is not None \
             and not optimality_of(passed[0], str(passed[1]), unconverged).local:
         # the best certified design is not a converged stage's answer (a raw screened point, an IPOPT round
-        # stopped at its limit, a convex bisection): compass search on the exact check from it
-        search = compass_search(spec, passed[1], terms)
-        stages.append(f"compass search on the exact check from the {passed[0]} design ({search.checks} checks, "
+        # stopped at its limit, a convex bisection): pattern search on the exact check from it
+        search = pattern_search(spec, passed[1], terms)
+        stages.append(f"pattern search on the exact check from the {passed[0]} design ({search.checks} checks, "
                       f"{'improved' if search.improved else 'no improvement'})")
         if search.improved:
             found.append(("pattern search", search.controller))
             candidates, passed = _certify_best(spec, found, terms, per_decade, cache)
         if passed is not None and passed[0] != "pattern search":
-            searched = (f"a compass search on the exact check from it found no better point (steps down to "
+            searched = (f"a pattern search on the exact check from it found no better point (steps down to "
                         f"{search.final_step:.0e} of each parameter's scale, {search.checks} checks)")
     method = "; ".join(stages) + f"; certificate: dense re-check, {per_decade} points per decade"
     if passed is not None:

@@ -59,7 +59,7 @@ def optimality_of(stage: str, controller: str, unconverged: set[str], screened: 
         The designs (as text) that a stage returned without converging: where IPOPT stopped at its iteration
         limit, or a convex-concave run that ended before its tolerance.
     screened : str
-        What the compass search and the random screen of the bounds found beyond the local stages (clauses), if
+        What the pattern search and the random screen of the bounds found beyond the local stages (clauses), if
         they ran.
     keeping : float, optional
         The ``|1 + L|`` every iterate keeps on the grid (:class:`~synth.synthesis.convex_settings.ConvexSettings`'
@@ -75,7 +75,7 @@ def optimality_of(stage: str, controller: str, unconverged: set[str], screened: 
     """
     method = _METHODS.get(stage, stage)
     if stage == "pattern search":
-        return Optimality(False, stage, "not shown to be a local optimum (a compass search on the exact check "
+        return Optimality(False, stage, "not shown to be a local optimum (a pattern search on the exact check "
                           "improved the best design of the stages before, none of which converged); the design is "
                           "certified feasible, a better one may exist" + (f"; {screened}" if screened else ""))
     if stage == "screen":

@@ -1,13 +1,13 @@
-"""A derivative-free fallback: compass search on the exact check, from a design the NLP could not polish.
+"""A derivative-free fallback: pattern search on the exact check, from a design the NLP could not polish.
 
 The NLP polish moves a design by gradients of requirements on a grid. Where every polish from the screen's
 starts failed (each answer left the stabilizing set, or IPOPT stalled), the screen's own point was the best
-certified design: a random point of the box, not optimized. Compass search improves it using only what the
+certified design: a random point of the box, not optimized. Pattern search improves it using only what the
 certificate itself trusts: :func:`synth.check.check` (every requirement, exact closed-loop stability with
-the delay) and the objective's score. Each free parameter is moved up and down by its step; a move is kept
-when the moved design passes the check and scores better (or as well, with more slack: a parameter the
-objective does not read still makes room); when no move helps, every step is halved. It is
-slow (one check per trial) and finds only a local improvement, which is why it runs only there.
+the delay) and the objective's score, by Hooke and Jeeves' pattern search (:func:`synth.search.hooke_jeeves`)
+in each parameter's scale: a move is kept when the moved design passes the check and scores better (or as
+well, with more slack: a parameter the objective does not read still makes room). It is slow (one check per
+trial) and finds only a local improvement, which is why it runs only there.
 """
 
 from __future__ import annotations
@@ -21,17 +21,18 @@ from synth.controllers import Controller
 from synth.loop import Loop
 from synth.objectives import score
 from synth.results import SEARCH_PER_DECADE
+from synth.search import hooke_jeeves
 from synth.spec import Spec
 
-__all__ = ["PATTERN_CHECKS", "PatternResult", "compass_search"]
+__all__ = ["PATTERN_CHECKS", "PatternResult", "pattern_search"]
 
 PATTERN_CHECKS = 160
-"""Most checks a compass search makes."""
+"""Most checks a pattern search makes."""
 
 
 @dataclass(frozen=True)
 class PatternResult:
-    """Outcome of :func:`compass_search`.
+    """Outcome of :func:`pattern_search`.
 
     Attributes
     ----------
@@ -51,10 +52,10 @@ class PatternResult:
     final_step: float
 
 
-def compass_search(spec: Spec, start: Controller, terms: list[tuple[str, str, float]],
+def pattern_search(spec: Spec, start: Controller, terms: list[tuple[str, str, float]],
                    max_checks: int = PATTERN_CHECKS, first_step: float = 0.1, min_step: float = 1e-4,
                    per_decade: int = SEARCH_PER_DECADE) -> PatternResult:
-    """Improve ``start`` (which should pass the check) by compass search over the spec's free parameters.
+    """Improve ``start`` (which should pass the check) by pattern search over the spec's free parameters.
 
     Parameters
     ----------
@@ -79,7 +80,7 @@ def compass_search(spec: Spec, start: Controller, terms: list[tuple[str, str, fl
     >>> spec = parse_spec({"name": "pi", "plant": {"tf": "10/((s+1)*(s+5))"}, "requirements": [{"type":
     ...                    "peak_sensitivity", "max_db": 6}], "controller": {"type": "PI", "bounds": {"kp": [0, 5],
     ...                    "ki": [0, 20]}}, "objective": {"maximize": "integral_gain"}})
-    >>> r = compass_search(spec, Controller("PI", {"kp": 1.0, "ki": 2.0}), [("integral_gain", "maximize", 1.0)])
+    >>> r = pattern_search(spec, Controller("PI", {"kp": 1.0, "ki": 2.0}), [("integral_gain", "maximize", 1.0)])
     >>> r.improved, r.controller.parameters["ki"] > 5.0
     (True, True)
     """
@@ -106,29 +107,17 @@ def compass_search(spec: Spec, start: Controller, terms: list[tuple[str, str, fl
         tie = 1e-12 * max(abs(a[0]), abs(b[0]), 1.0)
         return a[0] > b[0] + tie or (abs(a[0] - b[0]) <= tie and a[1] > b[1])
 
-    best = value(x)
-    if not np.isfinite(best[0]) or not free:
+    first = value(x)
+    if not np.isfinite(first[0]) or not free:
         return PatternResult(start, False, checks, 0.0)
-    scale = {k: abs(x[k]) + 0.01 * (bounds[k][1] - bounds[k][0]) for k in free}
-    step = {k: first_step for k in free}
-    improved = False
-    while checks < max_checks and max(step.values()) >= min_step:
-        moved = False
-        for k in free:
-            for sign in (1.0, -1.0):
-                if checks >= max_checks:
-                    break
-                trial = dict(x)
-                trial[k] = float(np.clip(x[k] + sign * step[k] * scale[k], *bounds[k]))
-                if trial[k] == x[k]:
-                    continue
-                v = value(trial)
-                if better(v, best):
-                    x, moved = trial, True
-                    improved = improved or v[0] > best[0]
-                    best = v
-                    step[k] *= 2.0  # a move that helps is tried further next time
-                    break
-        if not moved:
-            step = {k: s / 2.0 for k, s in step.items()}
-    return PatternResult(Controller(start.type, x), improved, checks, max(step.values()))
+    scale = np.array([abs(x[k]) + 0.01 * (bounds[k][1] - bounds[k][0]) for k in free])
+    lo = np.array([bounds[k][0] for k in free]) / scale
+    hi = np.array([bounds[k][1] for k in free]) / scale
+
+    def at(z: np.ndarray) -> dict[str, float]:
+        return {**x, **{k: float(np.clip(zi * si, *bounds[k])) for k, zi, si in zip(free, z, scale)}}
+
+    z0 = np.array([x[k] for k in free]) / scale
+    found = hooke_jeeves(lambda z: value(at(z)), z0, lo, hi, better, first_step, min_step, max_checks - 1)
+    improved = found.value[0] > first[0] and better(found.value, first)
+    return PatternResult(Controller(start.type, at(found.z)) if improved else start, improved, checks, found.step)

@@ -1,9 +1,8 @@
 """A local search of several nonnegative scale parameters at once (time constants, latencies).
 
-:func:`pattern_search` is Hooke and Jeeves' pattern search in ``z = log(p + floor)``: a parameter at
-0 sits at the lower end of its coordinate and is switched on by the same steps that scale a nonzero
-one. Exploratory moves try each coordinate in turn; after a successful sweep the search jumps on
-along the sweep's net move (the pattern), which walks along the ridges two parameters that trade off
+:func:`pattern_search` is Hooke and Jeeves' pattern search (:func:`synth.search.hooke_jeeves`) in
+``z = log(p + floor)``: a parameter at 0 sits at the lower end of its coordinate and is switched on by the
+same steps that scale a nonzero one. Its pattern moves walk along the ridges two parameters that trade off
 (a latency and a time constant) make, where moves of one coordinate at a time would crawl.
 """
 
@@ -12,6 +11,8 @@ from __future__ import annotations
 from collections.abc import Callable
 
 import numpy as np
+
+from synth.search import hooke_jeeves
 
 __all__ = ["pattern_search"]
 
@@ -55,53 +56,14 @@ def pattern_search(cost: Callable[[Params], float], start: Params, names: tuple[
     """
     if floor <= 0 or step <= 1 or tol <= 1:
         raise ValueError("need floor > 0, step > 1 and tol > 1")
-    lo = float(np.log(floor))
+    lo = np.full(len(names), float(np.log(floor)))
     hi = np.array([np.log(upper.get(k, np.inf) + floor) for k in names])
-    used = 0
 
     def point(z: np.ndarray) -> Params:
         return {**start, **{k: float(max(np.exp(zi) - floor, 0.0)) for k, zi in zip(names, z)}}
 
-    def f(z: np.ndarray) -> float:
-        nonlocal used
-        used += 1
-        return float(cost(point(z)))
-
-    def clip(z: np.ndarray) -> np.ndarray:
-        return np.minimum(np.maximum(z, lo), hi)
-
-    def better(a: float, b: float) -> bool:  # beyond round-off: log and exp do not return a point exactly
-        return a < b - 1e-9 * abs(b)
-
-    def explore(base: np.ndarray, f_base: float, h: float) -> tuple[np.ndarray, float]:
-        z, fz = base.copy(), f_base
-        for i in range(len(names)):
-            for s in (h, -h):
-                if used >= budget:
-                    return z, fz
-                y = z.copy()
-                y[i] = min(max(y[i] + s, lo), hi[i])
-                if y[i] == z[i]:
-                    continue
-                fy = f(y)
-                if better(fy, fz):
-                    z, fz = y, fy
-                    break
-        return z, fz
-
-    z = clip(np.array([np.log(max(start[k], 0.0) + floor) for k in names]))
-    fz = f(z)
-    h = float(np.log(step))
-    while h > np.log(tol) and used < budget:
-        zn, fn = explore(z, fz, h)
-        if not better(fn, fz):
-            h /= 2.0
-            continue
-        while used < budget:  # pattern moves: on along the net move while exploring around it helps
-            zp = clip(zn + (zn - z))
-            z, fz = zn, fn
-            zq, fq = explore(zp, f(zp), h)
-            if not better(fq, fz):
-                break
-            zn, fn = zq, fq
-    return point(z)
+    z0 = np.array([np.log(max(start[k], 0.0) + floor) for k in names])
+    found = hooke_jeeves(lambda z: float(cost(point(z))), z0, lo, hi,
+                         lambda a, b: a < b - 1e-9 * abs(b),  # beyond round-off: log and exp are not exact
+                         float(np.log(step)), float(np.log(tol)), budget)
+    return point(found.z)
