@@ -8,8 +8,9 @@ from typing import Any
 import numpy as np
 
 from synth.controllers import Controller
+from synth.errors import SynthError
 
-__all__ = ["ConvexResult", "Diagnosis", "RequirementConflict"]
+__all__ = ["ConvexResult", "Diagnosis", "RequirementConflict", "infeasible_verdict"]
 
 
 @dataclass
@@ -89,3 +90,35 @@ class ConvexResult:
             "history": self.history,
             "diagnosis": self.diagnosis.to_dict() if self.diagnosis else None,
         }
+
+
+def infeasible_verdict(convex: ConvexResult, compromise: Any = None) -> str:
+    """Plain-language explanation of an infeasible design from the convex stage's diagnosis (``compromise``, the
+    check of the closest design, is not read: kept for callers that pass it).
+
+    Examples
+    --------
+    >>> c = Controller("P", {"kp": 1.0})
+    >>> why = Diagnosis(0.3, [RequirementConflict("bandwidth", 0.3, 2.0, True, -0.3, "bandwidth 1 < 2 rad/s")], [], c)
+    >>> infeasible_verdict(ConvexResult("infeasible", c, np.ones(1), None, 3, 3, 0.1, diagnosis=why))[-81:]
+    'Conflicting requirements (a minimal set that cannot be met together): bandwidth.'
+    """
+    diag = convex.diagnosis
+    if diag is None:
+        raise SynthError("no diagnosis for a design that was not found infeasible")
+    parts = [f"The requirements cannot all be met within the controller bounds (convex-concave from "
+             f"{convex.starts_tried} stabilizing start(s), then NLP from the closest design, found none)."]
+    violated = [c for c in diag.conflicts if c.violated]
+    pushing = [c for c in diag.conflicts if not c.violated and c.name in diag.conflicting()]
+    if violated:
+        parts.append("The closest design (least total violation) still violates: "
+                     + "; ".join(f"{c.name} (slack {c.exact_slack:+.3g} Np: {c.message})" for c in violated)
+                     + ".")
+    if pushing:
+        parts.append("Met there but pushing against them (dual price > 0): "
+                     + ", ".join(f"{c.name} (price {c.price:.3g})" for c in pushing) + ".")
+    if diag.bounds_active:
+        parts.append("Active parameter bounds: " + ", ".join(diag.bounds_active) + ".")
+    parts.append("Conflicting requirements (a minimal set that cannot be met together): "
+                 + ", ".join(diag.conflicting()) + ".")
+    return " ".join(parts)

@@ -24,7 +24,7 @@ from typing import Any
 
 import numpy as np
 
-from synth.check import CheckResult, check
+from synth.check import check
 from synth.controllers import Controller
 from synth.errors import SynthError
 from synth.loop import Loop
@@ -41,7 +41,7 @@ from synth.results import (
 from synth.spec import Spec
 from synth.synthesis.convex import ConvexDesigner
 from synth.synthesis.convex_forms import CONVEX_FORMS
-from synth.synthesis.convex_results import ConvexResult
+from synth.synthesis.convex_results import ConvexResult, infeasible_verdict
 from synth.synthesis.convex_settings import ConvexSettings
 from synth.synthesis.integral_action import integral_only, objective_terms, without_integral_action
 from synth.synthesis.nlp import polish
@@ -480,26 +480,3 @@ def _describe(spec: Spec, label: dict) -> str:
     if spec.objective is None:
         return f"smallest peak |S|: {fmt(label['value'])} dB"
     return f"{spec.objective.describe()}: {fmt(label['value'])} {label['unit']}".rstrip()
-
-
-def infeasible_verdict(convex: ConvexResult, compromise: CheckResult | None = None) -> str:
-    """Plain-language explanation of an infeasible design."""
-    diag = convex.diagnosis
-    if diag is None:
-        raise SynthError("no diagnosis for a design that was not found infeasible")
-    parts = [f"The requirements cannot all be met within the controller bounds (convex-concave from "
-             f"{convex.starts_tried} stabilizing start(s), then NLP from the closest design, found none)."]
-    violated = [c for c in diag.conflicts if c.violated]
-    pushing = [c for c in diag.conflicts if not c.violated and c.name in diag.conflicting()]
-    if violated:
-        parts.append("The closest design (least total violation) still violates: "
-                     + "; ".join(f"{c.name} (slack {c.exact_slack:+.3g} Np: {c.message})" for c in violated)
-                     + ".")
-    if pushing:
-        parts.append("Met there but pushing against them (dual price > 0): "
-                     + ", ".join(f"{c.name} (price {c.price:.3g})" for c in pushing) + ".")
-    if diag.bounds_active:
-        parts.append("Active parameter bounds: " + ", ".join(diag.bounds_active) + ".")
-    parts.append("Conflicting requirements (a minimal set that cannot be met together): "
-                 + ", ".join(diag.conflicting()) + ".")
-    return " ".join(parts)
