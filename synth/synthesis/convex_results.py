@@ -100,7 +100,7 @@ def infeasible_verdict(convex: ConvexResult, compromise: Any = None) -> str:
     --------
     >>> c = Controller("P", {"kp": 1.0})
     >>> why = Diagnosis(0.3, [RequirementConflict("bandwidth", 0.3, 2.0, True, -0.3, "bandwidth 1 < 2 rad/s")], [], c)
-    >>> infeasible_verdict(ConvexResult("infeasible", c, np.ones(1), None, 3, 3, 0.1, diagnosis=why))[-81:]
+    >>> infeasible_verdict(ConvexResult("infeasible", c, np.ones(1), None, 3, 3, 0.1, diagnosis=why))[-80:]
     'Conflicting requirements (a minimal set that cannot be met together): bandwidth.'
     """
     diag = convex.diagnosis
