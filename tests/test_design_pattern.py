@@ -52,3 +52,24 @@ def test_pattern_search_moves_a_parameter_the_objective_does_not_read_to_make_ro
     best = design(spec).controller.parameters["ki"]  # the certified NLP design: 8.12
     assert result.controller.parameters["ki"] == pytest.approx(best, rel=0.01)
     assert result.controller.parameters["kp"] > 4.0
+
+
+def test_a_check_that_cannot_be_made_is_a_failed_trial_not_a_crash(monkeypatch):
+    # seed 3 problem 1: a trial's Nyquist count did not converge (RuntimeError) and ended the design
+    import synth.synthesis.pattern as pattern
+
+    spec = parse_spec({"name": "pi", "plant": {"tf": "10/((s+1)*(s+5))"},
+                       "requirements": [{"type": "peak_sensitivity", "max_db": 6}],
+                       "controller": {"type": "PI", "bounds": {"kp": [0, 5], "ki": [0, 20]}},
+                       "objective": {"maximize": "integral_gain"}})
+    real = pattern.check
+
+    def flaky(spec_, c, per_decade=80):
+        if c.parameters["kp"] > 1.2:
+            raise RuntimeError("Nyquist count failed to converge (winding -2.000)")
+        return real(spec_, c, per_decade)
+
+    monkeypatch.setattr(pattern, "check", flaky)
+    result = pattern.pattern_search(spec, Controller("PI", {"kp": 1.0, "ki": 2.0}),
+                                    [("integral_gain", "maximize", 1.0)])
+    assert result.improved and result.controller.parameters["kp"] <= 1.2

@@ -18,6 +18,7 @@ import numpy as np
 
 from synth.check import check
 from synth.controllers import Controller
+from synth.errors import SynthError
 from synth.loop import Loop
 from synth.objectives import score
 from synth.results import SEARCH_PER_DECADE
@@ -91,15 +92,19 @@ def pattern_search(spec: Spec, start: Controller, terms: list[tuple[str, str, fl
     checks = 0
 
     def value(params: dict[str, float]) -> tuple[float, float]:
-        """(objective score, smallest requirement slack); (-inf, -inf) when the check fails."""
+        """(objective score, smallest requirement slack); (-inf, -inf) when the check fails or cannot be made
+        (e.g. a Nyquist count that does not converge)."""
         nonlocal checks
         checks += 1
         c = Controller(start.type, params)
-        with np.errstate(all="ignore"):
-            result = check(spec, c, per_decade)
-            if not result.feasible:
-                return -np.inf, -np.inf
-            return float(score(Loop(nominal, c), terms)), min(r.slack for r in result.requirements)
+        try:
+            with np.errstate(all="ignore"):
+                result = check(spec, c, per_decade)
+                if not result.feasible:
+                    return -np.inf, -np.inf
+                return float(score(Loop(nominal, c), terms)), min(r.slack for r in result.requirements)
+        except (ArithmeticError, ValueError, RuntimeError, SynthError):  # a count that failed: not certified
+            return -np.inf, -np.inf
 
     def better(a: tuple[float, float], b: tuple[float, float]) -> bool:
         """A better score, or the same score with more slack (a move along a parameter the objective does not
