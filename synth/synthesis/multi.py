@@ -393,7 +393,7 @@ def _design(spec: Spec, settings: ConvexSettings, nlp: bool | str) -> DesignResu
             and not optimality_of(passed[0], str(passed[1]), unconverged).local:
         # the best certified design is not a converged stage's answer (a raw screened point, an IPOPT round
         # stopped at its limit, a convex bisection): pattern search on the exact check from it
-        search = pattern_search(spec, passed[1], terms)
+        search = pattern_search(spec, passed[1], terms, keeping=settings.stability_level)
         stages.append(f"pattern search on the exact check from the {passed[0]} design ({search.checks} checks, "
                       f"{'improved' if search.improved else 'no improvement'})")
         if search.improved:

@@ -24,6 +24,7 @@ from synth.objectives import score
 from synth.results import SEARCH_PER_DECADE
 from synth.search import hooke_jeeves
 from synth.spec import Spec
+from synth.synthesis.convex_settings import ConvexSettings, design_grid
 
 __all__ = ["PATTERN_CHECKS", "PatternResult", "pattern_search"]
 
@@ -55,7 +56,7 @@ class PatternResult:
 
 def pattern_search(spec: Spec, start: Controller, terms: list[tuple[str, str, float]],
                    max_checks: int = PATTERN_CHECKS, first_step: float = 0.1, min_step: float = 1e-4,
-                   per_decade: int = SEARCH_PER_DECADE) -> PatternResult:
+                   per_decade: int = SEARCH_PER_DECADE, keeping: float = 0.0) -> PatternResult:
     """Improve ``start`` (which should pass the check) by pattern search over the spec's free parameters.
 
     Parameters
@@ -70,6 +71,10 @@ def pattern_search(spec: Spec, start: Controller, terms: list[tuple[str, str, fl
         Initial and smallest step, relative to each parameter's scale (its value plus 1 % of its range).
     per_decade : int
         Density of the checks (the caller certifies the answer at its own density).
+    keeping : float
+        Smallest ``|1 + L|`` a move may leave on every plant (on the design grid at ``per_decade``): the
+        stability keeping of the convex and NLP stages (:class:`~synth.synthesis.convex_settings.ConvexSettings`'
+        ``stability_level``), so that the search does not walk a design to the edge of stability.
 
     Returns
     -------
@@ -90,6 +95,7 @@ def pattern_search(spec: Spec, start: Controller, terms: list[tuple[str, str, fl
     nominal = spec.nominal_plant()
     x = {k: float(v) for k, v in start.parameters.items()}
     checks = 0
+    grid = design_grid(spec.plants(), list(spec.requirements), ConvexSettings(per_decade=per_decade))
 
     def value(params: dict[str, float]) -> tuple[float, float]:
         """(objective score, smallest requirement slack); (-inf, -inf) when the check fails or cannot be made
@@ -100,7 +106,8 @@ def pattern_search(spec: Spec, start: Controller, terms: list[tuple[str, str, fl
         try:
             with np.errstate(all="ignore"):
                 result = check(spec, c, per_decade)
-                if not result.feasible:
+                if not result.feasible or (keeping > 0 and min(
+                        float(np.min(np.abs(1.0 + Loop(p, c).L(grid)))) for p in spec.plants()) < keeping):
                     return -np.inf, -np.inf
                 return float(score(Loop(nominal, c), terms)), min(r.slack for r in result.requirements)
         except (ArithmeticError, ValueError, RuntimeError, SynthError):  # a count that failed: not certified
