@@ -12,7 +12,7 @@ import pytest
 from benchmarks.gap.reference import TruePlant, simulate_reference
 from synth.data import record_from_arrays
 from synth.gap.attribution.heldout import DiagnoseOptions, diagnose_effects
-from synth.gap.attribution.screen import _Design, screen_effect
+from synth.gap.attribution.screen import EffectDesign, screen_effect
 from synth.gap.effects import make_effect
 from synth.gap.effects.direction import directional_block
 from synth.gap.effects.search import pattern_search
@@ -72,7 +72,7 @@ def test_screen_reaches_a_slow_rise_with_a_latency_and_a_fast_fall():
     eff = make_effect("direction")
     nominal = Plant.from_string("2.06/(0.194*s+1)")
     screened = screen_effect(eff, [("nominal", nominal)], t, u, y, t, u)
-    at_truth = _Design(eff, nominal, [(t, u), (t, u)]).fit({**eff.off(), **truth}, y)[0]
+    at_truth = EffectDesign(eff, nominal, [(t, u), (t, u)]).fit({**eff.off(), **truth}, y)[0]
     assert screened.ssr < 1.5 * at_truth, (screened.ssr, at_truth)  # the grid and one golden key alone: 100 x
 
 

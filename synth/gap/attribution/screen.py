@@ -43,7 +43,7 @@ from synth.gap.effects.base import Effect, Params, unit_numerators
 from synth.ident.simulate import simulate_plant
 from synth.plant import Plant
 
-__all__ = ["ScreenedFit", "screen_effect"]
+__all__ = ["EffectDesign", "ScreenedFit", "screen_effect"]
 
 _GOLDEN_STEPS = 14
 
@@ -134,8 +134,22 @@ def _denominator_directions(plant: Plant) -> list[Plant]:
     return out
 
 
-class _Design:
-    """Least-squares design of one effect on one denominator: columns on the training and evaluated records."""
+class EffectDesign:
+    """Least-squares design of one effect on one denominator: columns on the training and evaluated records.
+
+    :meth:`fit` gives the training SSR of the nominal's numerator, the effect's basis and the output constant
+    re-fitted with the effect's grid parameters held at ``params`` (what the screen compares across its grid).
+
+    Examples
+    --------
+    >>> from synth.gap.effects.registry import make_effect
+    >>> t = np.arange(0.0, 3.0, 0.01); u = (t > 0.5).astype(float)
+    >>> plant = Plant.from_string("2/(s+1)")
+    >>> y = simulate_plant(plant, t, np.r_[np.zeros(20), u[:-20]])  # the plant behind a 0.2 s delay
+    >>> design = EffectDesign(make_effect("delay"), plant, [(t, u), (t, u)])
+    >>> design.fit({"delay": 0.2}, y)[0] < 1e-12 < design.fit({"delay": 0.0}, y)[0]
+    True
+    """
 
     def __init__(self, effect: Effect, base: Plant, records: list[tuple[np.ndarray, np.ndarray]],
                  mask: np.ndarray | None = None) -> None:
@@ -227,18 +241,18 @@ def screen_effect(effect: Effect, bases: list[tuple[str, Plant]], t_tr: np.ndarr
     (4.0, True)
     """
     t_tr, u_tr, y_tr = (np.asarray(a, float) for a in (t_tr, u_tr, y_tr))
-    best: tuple[float, Params, np.ndarray, int, str, _Design] | None = None
+    best: tuple[float, Params, np.ndarray, int, str, EffectDesign] | None = None
     points = 0
     ssr_held, params_held = np.inf, {}
     for base_name, base in bases:
-        design = _Design(effect, base, [(t_tr, u_tr), (t_ev, u_ev)], mask)
+        design = EffectDesign(effect, base, [(t_tr, u_tr), (t_ev, u_ev)], mask)
         try:
             grid = effect.screen_grid(t_tr, u_tr, y_tr, base, mask)
         except ModelError:
             continue
         tried: dict[tuple[tuple[str, float], ...], tuple[float, np.ndarray, int]] = {}
 
-        def run(g: Params, design: _Design = design, tried: dict = tried) -> float:
+        def run(g: Params, design: EffectDesign = design, tried: dict = tried) -> float:
             nonlocal ssr_held, params_held
             key = tuple(sorted(g.items()))
             if key not in tried:
