@@ -161,8 +161,35 @@ def identify(record: RecordLike, structure: Structure | str, delay: str | float 
     if by_direction and not two_ways:
         raise DataError("by direction needs a step train with up and down steps (averaged, not average='none')",
                         where=record.source)
-    fit = fit_structure(data, structure, delay, sensor, periodic, check=True)
     whole = ""
+    try:
+        fit = fit_structure(data, structure, delay, sensor, periodic, check=True)
+        failed = "" if avg is None or not _unstable(fit.measured) else \
+            f"its model is unstable ({fit.measured.to_string(4)}) although the steps settle"
+    except FitError as exc:
+        if avg is None or average != "auto" or by_direction:
+            raise
+        failed, fit, error = str(exc), None, exc
+    if failed and average == "auto" and not by_direction:
+        # the average's fit failed (e.g. IPOPT at its limit on a few short edge windows, or a diverged pole):
+        # the whole record, which holds the same steps and assumes less, from its own deterministic start
+        try:
+            whole_fit = fit_structure(record, structure, delay, sensor, False, check=True)
+        except FitError as whole_error:
+            if fit is None:
+                raise error from None  # both failed: the average's reason is the one to read
+            raise FitError(f"fit of {structure.formula!r} failed: the {avg.mode} average's {failed}, and the "
+                           f"whole record's fit failed too ({whole_error}); try another structure, a fixed delay "
+                           "or a shorter part of the record", where=record.source) from None
+        if not _unstable(whole_fit.measured):
+            return IdentifyResult(record, whole_fit, avg, None, "", False,
+                                  f"the fit of the {avg.mode} average failed ({failed}); fitted the whole record "
+                                  "instead, from rest")
+        if fit is None:
+            raise FitError(f"fit of {structure.formula!r} failed: the {avg.mode} average's fit failed ({failed}) "
+                           f"and the whole record's model is unstable ({whole_fit.measured.to_string(4)}); try "
+                           "another structure, a fixed delay or a shorter part of the record", where=record.source)
+    assert fit is not None
     if avg is not None and avg.mode == "edge" and average == "auto":
         fit, whole = _refit_unsettled(record, avg, fit, structure, delay, sensor)
     elif avg is not None and avg.mode == "cycle" and average == "auto":
@@ -176,6 +203,13 @@ def identify(record: RecordLike, structure: Structure | str, delay: str | float 
                 raise
             note = f"up and down steps not compared: {exc}"
     return IdentifyResult(record, fit, avg, directions, note, by_direction, whole)
+
+
+def _unstable(plant: Plant) -> bool:
+    """A pole in the open right half-plane (a step train's average fitted by a diverging model)."""
+    den = np.trim_zeros(np.asarray(plant.den, float), "f")
+    roots = np.roots(den) if den.size > 1 else np.array([])
+    return bool(np.any(roots.real > 1e-9 * np.maximum(np.abs(roots), 1e-12)))
 
 
 def settling_time(plant: Plant, fraction: float = np.exp(-5.0)) -> float:
