@@ -400,8 +400,10 @@ def _design(spec: Spec, settings: ConvexSettings, nlp: bool | str) -> DesignResu
             found.append(("pattern search", search.controller))
             candidates, passed = _certify_best(spec, found, terms, per_decade, cache)
         if passed is not None and passed[0] != "pattern search":
-            searched = (f"a pattern search on the exact check from it found no better point (steps down to "
-                        f"{search.final_step:.0e} of each parameter's scale, {search.checks} checks)")
+            searched = ("a pattern search on the exact check from it found a better point that failed the dense "
+                        "certificate" if search.improved else "a pattern search on the exact check from it found no "
+                        f"better point (steps down to {search.final_step:.0e} of each parameter's scale, "
+                        f"{search.checks} checks)")
     method = "; ".join(stages) + f"; certificate: dense re-check, {per_decade} points per decade"
     if passed is not None:
         stage, controller, certificate = passed
