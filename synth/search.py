@@ -32,7 +32,8 @@ class SearchResult(Generic[V]):
 
 
 def hooke_jeeves(f: Callable[[np.ndarray], V], z0: np.ndarray, lo: np.ndarray, hi: np.ndarray,
-                 better: Callable[[V, V], bool], step: float, min_step: float, budget: int) -> SearchResult[V]:
+                 better: Callable[[V, V], bool], step: float, min_step: float, budget: int,
+                 start_value: V | None = None) -> SearchResult[V]:
     """Search ``f`` from ``z0`` within ``[lo, hi]`` for a point ``better`` than the others found.
 
     Parameters
@@ -50,6 +51,8 @@ def hooke_jeeves(f: Callable[[np.ndarray], V], z0: np.ndarray, lo: np.ndarray, h
         ``min_step``.
     budget : int
         Most evaluations of ``f``.
+    start_value : optional
+        ``f(z0)`` when the caller has it already (``z0`` inside the box): not evaluated again.
 
     Returns
     -------
@@ -88,7 +91,7 @@ def hooke_jeeves(f: Callable[[np.ndarray], V], z0: np.ndarray, lo: np.ndarray, h
         return z, vz
 
     z = np.minimum(np.maximum(np.asarray(z0, float), lo), hi)
-    vz = value(z)
+    vz = value(z) if start_value is None else start_value
     h = float(step)
     while h > min_step and used < budget:
         zn, vn = explore(z, vz, h)

@@ -3,7 +3,7 @@
 The certificate proves a design feasible; it says nothing about how good it is. A design from an IPOPT
 round that converged is a local optimum of the NLP on the design grid; where IPOPT stopped at its iteration
 limit, or the convex-concave iteration stopped before its tolerance, the design is feasible but not shown to
-be a local optimum. The verdict and ``result.json`` (``synthesis.optimality``) say which.
+be a local optimum. The verdict and ``result.json`` (``optimality``) say which.
 """
 
 from __future__ import annotations

@@ -130,6 +130,7 @@ def pattern_search(spec: Spec, start: Controller, terms: list[tuple[str, str, fl
         return {**x, **{k: float(np.clip(zi * si, *bounds[k])) for k, zi, si in zip(free, z, scale)}}
 
     z0 = np.array([x[k] for k in free]) / scale
-    found = hooke_jeeves(lambda z: value(at(z)), z0, lo, hi, better, first_step, min_step, max_checks - 1)
+    found = hooke_jeeves(lambda z: value(at(z)), z0, lo, hi, better, first_step, min_step, max_checks - 2,
+                         start_value=first)  # the start is checked once, above
     improved = found.value[0] > first[0] and better(found.value, first)
     return PatternResult(Controller(start.type, at(found.z)) if improved else start, improved, checks, found.step)
