@@ -64,6 +64,36 @@ def test_reference_and_synth_agree_within_a_sample_on_continuous_effects(seeded_
         assert effect > 1e-3 * np.ptp(y_lin) and diff < 0.15 * effect, (name, diff / effect)
 
 
+@pytest.mark.parametrize("family", ["first_order", "resonant", "third_order"])
+def test_superposition_agrees_with_the_piecewise_integration_and_the_exact_sampling(family):
+    """The linear effects' fast path (one step response, superposed) against the piecewise ``solve_ivp``
+    integration (one call per command change) and, without delay, the exact zero-order-hold recursion."""
+    from scipy.linalg import expm
+
+    from benchmarks.gap.problems import supply_voltage
+
+    rng = np.random.default_rng(8)
+    draw = random_plant(rng, family, 1000)
+    t, u = experiment(rng, "noise", draw, 1000)
+    v = supply_voltage(rng, t, u, draw.settle)
+    span = np.ptp(simulate_reference(draw.plant, t, u))
+    for name, params in {None: {}, "delay": {"delay": 2.37 * (t[1] - t[0])}, "lag": {"tau": 0.5 * draw.fast},
+                         "backlash": {"width": 0.2 * np.ptp(u)},
+                         "measured_sag": {"sag": 0.5, "v_nominal": 12.6, "u_rest": float(u.min())}}.items():
+        fast = simulate_reference(draw.plant, t, u, name, params, aux=v)
+        slow = simulate_reference(draw.plant, t, u, name, params, aux=v, method="piecewise")
+        assert np.max(np.abs(fast - slow)) < 1e-8 * span, name
+    P = TruePlant(draw.plant.num, draw.plant.den)
+    A, B, C, D = P.state_space()
+    m = A.shape[0]
+    M = expm(np.block([[A, B[:, None]], [np.zeros((1, m + 1))]]) * (t[1] - t[0]))
+    x, y = -np.linalg.solve(A, B * u[0]), np.empty(t.size)
+    for k in range(t.size):  # the output at a sample sees the value held before it
+        y[k] = C @ x + D * u[max(k - 1, 0)]
+        x = M[:m, :m] @ x + M[:m, m] * u[k]
+    assert np.max(np.abs(simulate_reference(P, t, u) - y)) < 1e-10 * span
+
+
 def test_seeded_benchmark_sample_is_named_with_its_shrinkage():
     """Two seeded problems of the benchmark, each diagnosed with four of its candidates (all of them: 10-40 s)."""
     lengths = (1000,)

@@ -18,7 +18,17 @@ between samples (a DAC), delayed exactly, and every effect is applied in continu
 * an output drift ``slope (t - t0)`` is added to the samples.
 
 The state is integrated piece by piece between breakpoints (sample times, delayed command changes,
-rate-limit arrivals) with RK45 at ``rtol = 1e-9``, so no discontinuity falls inside a step.
+rate-limit arrivals) with DOP853 at ``rtol = 1e-9``, so no discontinuity falls inside a step.
+
+When the effect leaves the plant linear in what reaches it (no effect, a delay, a lag, a resonance, a
+static map of the held command, a drift; :data:`LINEAR_EFFECTS`), the output is instead the
+superposition of the held command's changes, each times the plant's step response from rest, delayed
+exactly: ``y_k = G(0) w_0 + sum_j (w_j - w_j-1) s(t_k - t_j - delay)``. The step response ``s`` is
+integrated by one ``solve_ivp`` call (same method, ``rtol = 1e-12``, evaluated at ``m dt - delay``; beyond 40
+of the slowest time constants it is ``G(0)``, the transient below 4e-18 of it) and the sum is an FFT
+convolution. Same truth, one smooth integration instead of one per command change: a 100,000-sample
+noise record takes about a second instead of 20-40 s; the two agree within 1e-9 of the output's range
+(``tests/test_gap_generalize.py``; ``method="piecewise"`` forces the piecewise integration).
 """
 
 from __future__ import annotations
@@ -28,11 +38,20 @@ from dataclasses import dataclass
 
 import numpy as np
 from scipy.integrate import solve_ivp
+from scipy.signal import fftconvolve
 
 __all__ = ["TruePlant", "simulate_reference"]
 
 METHOD = "DOP853"
 RTOL = 1e-9
+LINEAR_EFFECTS: frozenset[str | None] = frozenset({None, "delay", "lag", "resonance", "saturation", "deadzone",
+                                                    "backlash", "quantization", "static_nonlinearity", "drift",
+                                                    "measured_sag"})
+"""Effects after which the plant is linear in the held (mapped) command: simulated by superposition."""
+STEP_RTOL = 1e-12
+"""The step response's tolerance: one integration serves every change, so it is held tighter than ``RTOL``."""
+SETTLED = 40.0
+"""Slowest time constants after which the step response's transient is taken as zero (``exp(-40)``)."""
 
 
 @dataclass(frozen=True)
@@ -114,8 +133,44 @@ def _static_map(effect: str | None, params: dict[str, float], u: np.ndarray, aux
     return u
 
 
+def step_response(plant: TruePlant, tau: np.ndarray) -> np.ndarray:
+    """The unit step response from rest, without the delay, at the increasing times ``tau > 0`` (``solve_ivp``).
+
+    Examples
+    --------
+    >>> s = step_response(TruePlant((2.0,), (0.5, 1.0)), np.array([0.5, 1.0]))
+    >>> bool(np.allclose(s, 2.0 * (1.0 - np.exp(-np.array([1.0, 2.0]))), rtol=1e-9))
+    True
+    """
+    A, B, C, D = plant.state_space()
+    out = np.full(tau.size, plant.gain)
+    slowest = float(np.min(-np.linalg.eigvals(A).real))
+    live = tau <= SETTLED / slowest
+    if not np.any(live):
+        return out
+    x_end = -np.linalg.solve(A, B)
+    sol = solve_ivp(lambda _, x: A @ x + B, (0.0, float(tau[live][-1])), np.zeros(A.shape[0]), method=METHOD,
+                    rtol=STEP_RTOL, atol=1e-14 * (1.0 + float(np.max(np.abs(x_end)))), t_eval=tau[live])
+    if not sol.success:
+        raise RuntimeError(f"reference step response failed: {sol.message}")
+    out[live] = C @ sol.y + D
+    return out
+
+
+def _superposed(plant: TruePlant, t: np.ndarray, w: np.ndarray, delay: float) -> np.ndarray:
+    """Output of the linear ``plant`` to the held ``w`` (from rest at ``w[0]``), by superposition of its changes."""
+    dt = float(t[1] - t[0])
+    lag = np.arange(t.size) * dt - delay  # time since a change at lag m reached the plant
+    on = lag > 1e-9 * dt  # a change arriving at a sample time acts after it, as in the piecewise integration
+    h = np.zeros(t.size)
+    h[on] = step_response(plant, lag[on])
+    dw = np.diff(w, prepend=w[0])
+    return plant.gain * w[0] + fftconvolve(dw, h)[:t.size]
+
+
 def simulate_reference(plant: TruePlant, t: np.ndarray, u: np.ndarray, effect: str | None = None,
-                       params: dict[str, float] | None = None, aux: np.ndarray | None = None) -> np.ndarray:
+                       params: dict[str, float] | None = None, aux: np.ndarray | None = None,
+                       method: str = "auto") -> np.ndarray:
     """Output samples ``y(t_k)`` of ``plant`` with ``effect`` driven by the held command ``u``, from rest at ``u[0]``.
 
     Parameters
@@ -132,6 +187,9 @@ def simulate_reference(plant: TruePlant, t: np.ndarray, u: np.ndarray, effect: s
         ``v_nominal`` and ``u_rest``).
     aux : numpy.ndarray, optional
         The supply voltage sample by sample (``measured_sag``).
+    method : str
+        ``"auto"``: superposition for :data:`LINEAR_EFFECTS`, piecewise integration otherwise;
+        ``"piecewise"``: piecewise integration always.
 
     Returns
     -------
@@ -160,6 +218,9 @@ def simulate_reference(plant: TruePlant, t: np.ndarray, u: np.ndarray, effect: s
     k0 = G.gain
     n = A.shape[0]
     v = _static_map(effect, p, np.asarray(u, float), aux)
+    if method == "auto" and effect in LINEAR_EFFECTS:
+        out = _superposed(G, t, v, delay)
+        return out + p["slope"] * (t - t[0]) if effect == "drift" else out
     times = t + delay  # when each held value reaches the plant (or the dynamic effect)
     extra = 1 if effect in ("rate_limit", "supply_sag", "direction") else 0
     if effect == "direction":  # each change arrives by its direction's latency
