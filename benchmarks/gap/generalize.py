@@ -16,10 +16,11 @@ change the verdict). What is counted, as in :mod:`benchmarks.gap.score`:
   against the same re-fit of the nominal alone on the same held-out half.
 
 Goals: top-1 >= 90 %, false alarms <= 5 %, mean shrinkage error <= 0.05, reported per plant family,
-length, experiment, effect and severity.
+length, experiment, effect and severity; the time per diagnosis per length.
 
-Run:  python benchmarks/gap/generalize.py --seed 11 --lengths 1000,3000 [--full] [--workers 2] [--every 1]
-(``--full``: the lengths 1,000, 3,000, 10,000, 30,000 and 100,000).
+Run:  python benchmarks/gap/generalize.py --seed 15 [--lengths 1000,3000] [--workers 2] [--every 1]
+(default lengths 1,000, 3,000, 10,000, 30,000 and 100,000 samples, rotating over the cases; ``--lengths``
+for a quick run on short records).
 """
 
 from __future__ import annotations
@@ -120,6 +121,16 @@ def _rate(rows: list[dict[str, Any]]) -> list[int]:
     return [int(sum(r["correct"] for r in rows)), len(rows)]
 
 
+def _times_per_length(rows: list[dict[str, Any]]) -> dict[str, list[float]]:
+    """Per record length: cases, mean, median and max seconds of the diagnosis, mean seconds of the generation."""
+    groups: dict[int, list[dict[str, Any]]] = defaultdict(list)
+    for r in rows:
+        groups[int(r["samples"])].append(r)
+    return {str(n): [len(g), float(np.mean([r["seconds"] for r in g])), float(np.median([r["seconds"] for r in g])),
+                     float(np.max([r["seconds"] for r in g])), float(np.mean([r["seconds_generate"] for r in g]))]
+            for n, g in sorted(groups.items())}
+
+
 def summarize(rows: list[dict[str, Any]]) -> dict[str, Any]:
     """Rates overall and per family, length, experiment, effect and severity; confusion; times."""
     eff = [r for r in rows if r["effect"] is not None]
@@ -153,6 +164,7 @@ def summarize(rows: list[dict[str, Any]]) -> dict[str, Any]:
         "confusion": [[a, b, n] for (a, b), n in sorted(Counter((r["truth"], r["first"]) for r in rows).items())],
         "seconds_mean": float(np.mean([r["seconds"] for r in rows])),
         "seconds_max": float(np.max([r["seconds"] for r in rows])),
+        "seconds_per_length": _times_per_length(rows),
         "errors": [[r["index"], r["error"]] for r in rows if r["error"]],
     }
 
@@ -188,7 +200,11 @@ def render(s: dict[str, Any], command: str, wall: float, lengths: tuple[int, ...
             e = s["shrinkage_error_per"].get(key, {}).get(k)
             lines.append(f"| {k} | {c} | {n} | {'' if e is None else f'{e:.3f}'} |")
         lines.append("")
-    lines += ["## Misses", "", "| case | effect | severity | family | experiment | samples | named first | "
+    lines += ["## Time per diagnosis per length", "", "| length [samples] | cases | mean [s] | median [s] | max [s] | "
+              "generation and truth, mean [s] |", "|---|---|---|---|---|---|"]
+    lines += [f"| {k} | {c} | {m:.1f} | {md:.1f} | {mx:.1f} | {g:.1f} |"
+              for k, (c, m, md, mx, g) in s.get("seconds_per_length", {}).items()]
+    lines += ["", "## Misses", "", "| case | effect | severity | family | experiment | samples | named first | "
               "reached RMS / noise | true shrinkage |", "|---|---|---|---|---|---|---|---|---|"]
     lines += ["| " + " | ".join(map(str, m)) + " |" for m in s["misses"]]
     lines += ["", f"False alarms: {s['false_alarms'] or 'none'}. Errors: {s['errors'] or 'none'}.", ""]
@@ -199,8 +215,9 @@ def main(argv: list[str] | None = None) -> None:
     """CLI."""
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--seed", type=int, default=11)
-    ap.add_argument("--lengths", default="1000,3000", help="record lengths, comma-separated (default 1000,3000)")
-    ap.add_argument("--full", action="store_true", help="lengths 1,000 to 100,000 (slow)")
+    ap.add_argument("--lengths", default=",".join(map(str, LENGTHS_FULL)),
+                    help="record lengths, comma-separated (default 1000,3000,10000,30000,100000)")
+    ap.add_argument("--full", action="store_true", help="the default lengths (kept for older commands)")
     ap.add_argument("--every", type=int, default=1, help="every n-th case only")
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--out", type=Path, default=OUT)
@@ -211,8 +228,7 @@ def main(argv: list[str] | None = None) -> None:
     lengths = LENGTHS_FULL if args.full else tuple(int(x) for x in args.lengths.split(","))
     args.out.mkdir(parents=True, exist_ok=True)
     partial = args.out / f"rows_seed{args.seed}.jsonl"
-    command = (f"python benchmarks/gap/generalize.py --seed {args.seed} "
-               + ("--full" if args.full else f"--lengths {args.lengths}")
+    command = (f"python benchmarks/gap/generalize.py --seed {args.seed} --lengths {','.join(map(str, lengths))}"
                + (f" --every {args.every}" if args.every != 1 else ""))
     t0 = time.perf_counter()
     if args.from_rows:  # re-render what a run (finished or not) wrote

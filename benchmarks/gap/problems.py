@@ -273,6 +273,11 @@ def case_list(lengths: tuple[int, ...], n_free: int = 12) -> list[tuple[str | No
     """``(effect, severity, samples, family, experiment)`` of every case: each effect at each severity, then
     ``n_free`` effect-free cases; lengths, families and experiments rotate so that each effect meets several.
 
+    The length of effect ``e`` at severity ``s`` (indices) is ``lengths[(e + s) % len(lengths)]``: with five
+    lengths every effect meets every length once and every length every severity three times (a rotation by
+    the case index alone would tie each length to one severity). For one, two or four lengths this is the
+    case index's rotation, so the cases of the earlier two-length runs (seeds 11-14) are unchanged.
+
     Examples
     --------
     >>> cases = case_list((1000, 2000))
@@ -281,9 +286,9 @@ def case_list(lengths: tuple[int, ...], n_free: int = 12) -> list[tuple[str | No
     """
     out: list[tuple[str | None, float, int, str, str]] = []
     i = 0
-    for effect in EFFECT_NAMES:
-        for sev in SEVERITIES:
-            out.append((effect, sev, lengths[i % len(lengths)], FAMILIES[(i // 3) % len(FAMILIES)],
+    for e, effect in enumerate(EFFECT_NAMES):
+        for s, sev in enumerate(SEVERITIES):
+            out.append((effect, sev, lengths[(e + s) % len(lengths)], FAMILIES[(i // 3) % len(FAMILIES)],
                         EXPERIMENTS[i % len(EXPERIMENTS)]))
             i += 1
     for j in range(n_free):
