@@ -22,8 +22,9 @@ ROOT = Path(__file__).resolve().parents[1]
 
 @pytest.fixture(scope="module")
 def big_csv(tmp_path_factory):
-    """20,000 samples with a rate limit: the joint re-fits on 2 workers take several seconds."""
-    t = np.arange(0, 200, 0.01)
+    """100,000 samples with a rate limit: the diagnosis runs about 6 s on 2 quiet cores, 4 s of it after the
+    workers start (20,000 samples left well under a second on a loaded machine: the run could end first)."""
+    t = np.arange(0, 1000, 0.01)
     u = np.where((t % 2) >= 1, 100.0, 0.0) * (1 + 0.5 * np.sin(0.1 * t))
     y = simulate_plant(Plant.from_string(PLANT), t, RateLimit(400.0).apply(u, 0.01))
     y = y + 0.2 * np.random.default_rng(0).normal(size=t.size)
