@@ -14,7 +14,7 @@ from typing import Any
 import numpy as np
 
 from synth.controllers import Controller, as_controller
-from synth.freqgrid import characteristic_range, crossings, log_grid
+from synth.freqgrid import characteristic_range, first_fall, log_grid
 from synth.plant import Plant, as_plant
 from synth.polynomials import dc_value, format_factored, magnitude_squared_in_w2, trim
 from synth.stability import StabilityResult, closed_loop_stability, stability_floor
@@ -220,7 +220,8 @@ class Loop:
     def bandwidth(self, per_decade: int = 80) -> float:
         """Closed-loop bandwidth: first frequency where ``|T|`` falls 3 dB below ``|T(0)|`` (rad/s).
 
-        The level is ``|T(0)| * 10**(-3/20)`` (python-control's convention).
+        The level is ``|T(0)| * 10**(-3/20)`` (python-control's convention); a dip below it narrower than the
+        grid counts (:func:`synth.freqgrid.first_fall`).
         Returns ``nan`` when ``T(0) = 0`` and ``inf`` when ``|T|`` never falls that far.
         """
         t0 = self.T0()
@@ -231,12 +232,7 @@ class Loop:
         crossovers = self.gain_crossovers()
         if crossovers.size:  # a low-gain loop crosses over far below every corner: |T| falls there first
             lo = min(lo, float(np.min(crossovers)) / 100.0)
-        grid = log_grid(lo, hi * 10, per_decade)
-        cross = crossings(lambda w: np.abs(self.T(w)), level, grid)
-        below = np.abs(self.T(grid)) < level
-        if cross.size == 0:
-            return float("inf") if not below[0] else float(grid[0])
-        return float(cross[0])
+        return first_fall(lambda w: np.abs(self.T(w)), level, log_grid(lo, hi * 10, per_decade))
 
     # ------------------------------------------------------------------ stability
     @cached_property
