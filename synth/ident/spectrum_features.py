@@ -116,10 +116,12 @@ def running_median_db(S: np.ndarray, min_half: int = 8, fraction: float = 0.05) 
     """
     db = 10 * np.log10(np.maximum(S, np.finfo(float).tiny))
     n = db.size
+    k = np.arange(n)
+    half = np.minimum.reduce([np.maximum(min_half, (fraction * (k + 1)).astype(int)), k, n - 1 - k])
     out = np.empty(n)
-    for k in range(n):
-        h = min(max(min_half, int(fraction * (k + 1))), k, n - 1 - k)
-        out[k] = np.median(db[k - h:k + h + 1])
+    for h in np.unique(half):  # one vectorized median per window width
+        at = k[half == h]
+        out[at] = np.median(np.lib.stride_tricks.sliding_window_view(db, 2 * h + 1)[at - h], axis=1)
     return out
 
 
