@@ -81,7 +81,7 @@ class Bandwidth(Requirement):
         lowest = np.array([np.min(w) / 100.0 if w.size else np.inf for w in batch.gain_crossovers()])
         grid = log_grids(np.fmin(ranges[:, 0], lowest), ranges[:, 1] * 10, per_decade)  # as Loop.bandwidth
         cross, below = batch_first_crossing(lambda w: np.abs(batch.T(w)), t0 * BANDWIDTH_LEVEL, grid)
-        wb = np.where(np.isnan(cross), np.where(below, grid[:, 0], np.inf), cross)
+        wb = np.where(below, grid[:, 0], np.where(np.isnan(cross), np.inf, cross))  # as first_fall
         wb = np.where((t0 == 0.0) | ~np.isfinite(t0), np.nan, wb)
         slack = np.full(wb.shape, np.inf)
         with np.errstate(divide="ignore", invalid="ignore"):
