@@ -22,6 +22,7 @@ import numpy as np
 
 from synth.errors import ModelError
 from synth.gap.effects.base import Effect, Params, command_span, log_grid, slowest_pole
+from synth.gap.effects.block_memo import run_block
 from synth.plant import Plant
 from synth.sim.blocks import Backlash, DeadZone, RateLimit, Saturation
 
@@ -61,7 +62,7 @@ class RateLimitEffect(Effect):
 
     def input_map(self, u: np.ndarray, dt: float, params: Params) -> np.ndarray:
         rate = params.get("rate", np.inf)
-        return u if not np.isfinite(rate) else RateLimit(rate).apply(u, dt)
+        return u if not np.isfinite(rate) else run_block(RateLimit(rate), u, dt)
 
 
 @dataclass(frozen=True)
@@ -219,7 +220,7 @@ class DeadzoneEffect(Effect):
 
     def input_map(self, u: np.ndarray, dt: float, params: Params) -> np.ndarray:
         w = params.get("width", 0.0)
-        return u if w <= 0 else DeadZone(w, params.get("center", 0.0)).apply(u, dt)
+        return u if w <= 0 else run_block(DeadZone(w, params.get("center", 0.0)), u, dt)
 
 
 @dataclass(frozen=True)
@@ -249,4 +250,4 @@ class BacklashEffect(Effect):
 
     def input_map(self, u: np.ndarray, dt: float, params: Params) -> np.ndarray:
         w = params.get("width", 0.0)
-        return u if w <= 0 else Backlash(w).apply(u, dt)
+        return u if w <= 0 else run_block(Backlash(w), u, dt)
