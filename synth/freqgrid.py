@@ -152,10 +152,10 @@ def crossings(curve: Curve, level: float, grid: np.ndarray) -> np.ndarray:
 
 def first_fall(curve: Curve, level: float, grid: np.ndarray) -> float:
     """Lowest frequency in the grid's span where ``curve(w)`` falls below ``level``, a dip narrower than the
-    grid's spacing included: every local minimum on the grid before the first sampled crossing is refined by
-    golden-section search between its neighbours, and where it goes below ``level`` the crossing on its way
-    down is found by bisection. ``inf`` when the curve never falls below ``level``; ``grid[0]`` when it
-    starts below.
+    grid's spacing included (:func:`batch_first_crossing` on one row: every local minimum on the grid before the
+    first sampled crossing is refined between its neighbours, and where it goes below ``level`` the crossing on
+    its way down is found by bisection). ``inf`` when the curve never falls below ``level``; ``grid[0]`` when
+    it starts below; ``grid`` positive.
 
     Examples
     --------
@@ -167,23 +167,11 @@ def first_fall(curve: Curve, level: float, grid: np.ndarray) -> float:
     (True, 2.0442)
     """
     grid = np.asarray(grid, dtype=float)
-    values = np.asarray(curve(grid), dtype=float)
-    if values[0] < level:
+    cross, below = batch_first_crossing(lambda w: np.asarray(curve(w.ravel()), dtype=float).reshape(w.shape),
+                                        np.array([float(level)]), grid[None, :])
+    if below[0]:
         return float(grid[0])
-    cross = crossings(curve, level, grid)
-    first = float(cross[0]) if cross.size else np.inf
-    end = int(np.searchsorted(grid, first)) if np.isfinite(first) else grid.size
-    minima = np.flatnonzero((values[1:end - 1] <= values[:end - 2]) & (values[1:end - 1] <= values[2:end])) + 1
-    if minima.size == 0:
-        return first
-    a, b = grid[minima - 1][None, :], grid[minima + 1][None, :]
-    low, at = _bracketed_min(lambda x: np.asarray(curve(x.ravel()), dtype=float).reshape(x.shape),
-                             a, grid[minima][None, :], b)
-    for k in np.flatnonzero(low[0] < level):  # in grid order: the first dip below the level is the answer
-        lo, hi = float(a[0, k]), float(at[0, k])
-        down = crossings(curve, level, np.array([lo, hi]))
-        return float(down[0]) if down.size else hi
-    return first
+    return float(cross[0]) if np.isfinite(cross[0]) else np.inf
 
 # ------------------------------------------------------------------ vectorized: one curve per row
 
@@ -316,9 +304,9 @@ def batch_peak(curve: Curve, grid: np.ndarray, tol_db: float = 3.0, top: int = 3
 
 
 def batch_first_crossing(curve: Curve, level: np.ndarray, grid: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Lowest frequency of each row where ``curve(w) - level`` changes sign (as :func:`crossings`' first
-    element) on a positive ``grid`` ``(n, m)``; ``nan`` where none. Also returns whether each row starts
-    below ``level``.
+    """Lowest frequency of each row where ``curve(w)`` falls below ``level`` on a positive ``grid`` ``(n, m)``:
+    the first sign change of ``curve(w) - level``, or an earlier dip below ``level`` between grid points;
+    ``nan`` where none. Also returns whether each row starts below ``level``.
 
     Examples
     --------
@@ -347,10 +335,9 @@ def batch_first_crossing(curve: Curve, level: np.ndarray, grid: np.ndarray) -> t
     return np.where(np.isfinite(root), root, np.nan), g[:, 0] < 0
 
 
-def _batch_dips(curve: Curve, level: np.ndarray, grid: np.ndarray, g: np.ndarray, end: np.ndarray,
-                top: int = 3) -> np.ndarray:
+def _batch_dips(curve: Curve, level: np.ndarray, grid: np.ndarray, g: np.ndarray, end: np.ndarray) -> np.ndarray:
     """Per row, where ``curve`` first goes below ``level`` inside a dip narrower than the grid before column
-    ``end`` (as :func:`first_fall`; the ``top`` lowest local minima of ``g = curve - level`` are refined);
+    ``end`` (every local minimum of ``g = curve - level`` above zero is refined by :func:`_bracketed_min`);
     ``inf`` where none does."""
     n, m = g.shape
     is_min = np.zeros((n, m), bool)
@@ -359,7 +346,7 @@ def _batch_dips(curve: Curve, level: np.ndarray, grid: np.ndarray, g: np.ndarray
     if not is_min.any():
         return np.full(n, np.inf)
     score = np.where(is_min, g, np.inf)
-    order = np.argsort(score, axis=1, kind="stable")[:, :top]
+    order = np.argsort(score, axis=1, kind="stable")[:, :int(is_min.sum(axis=1).max())]
     valid = np.isfinite(np.take_along_axis(score, order, axis=1))
     j = np.where(valid, order, 1)
     rows = np.arange(n)[:, None]
