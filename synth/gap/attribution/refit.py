@@ -46,7 +46,9 @@ import numpy as np
 
 from synth.data.record import record_from_arrays
 from synth.errors import DataError, ModelError
+from synth.gap.attribution.convergence import cannot_reach
 from synth.gap.attribution.golden import golden_section, log_bracket, parabolic_section
+from synth.gap.attribution.profile import profile_interval, profile_level
 from synth.gap.effects.base import Effect, Params
 from synth.ident.simulate import simulate_plant
 from synth.ident.timefit import fit_structure
@@ -54,7 +56,6 @@ from synth.plant import Plant
 
 __all__ = ["AugmentedFit", "fit_augmented", "monomial", "nominal_structure"]
 
-_CHI2_1_95 = 3.841458820694124
 _ROUNDS = 12  # most alternations of the casadi fit and the least-squares basis step
 _ROUNDS_TOL = 1e-6  # ... stopped when the training SSR changes less than this (relative)
 _GOLDEN = 12  # most golden-section evaluations after the grid
@@ -313,7 +314,8 @@ def _basis_step(effect: Effect, G: Plant, params: Params, t: np.ndarray, u: np.n
 
 
 def _fit_point(plant: Plant, effect: Effect, params: Params, t: np.ndarray, u: np.ndarray, y: np.ndarray,
-               formula: str, start: dict[str, float], weights: np.ndarray | None = None) -> _Point:
+               formula: str, start: dict[str, float], weights: np.ndarray | None = None,
+               warm: bool = False) -> _Point:
     """One point of the effect's search: the alternation below from both block orders when the effect has basis
     parameters, the lower training SSR kept.
 
@@ -323,17 +325,24 @@ def _fit_point(plant: Plant, effect: Effect, params: Params, t: np.ndarray, u: n
     little (a drift fitted at a quarter of its slope, its training error above the truth's). Started with the
     basis' least squares against the nominal model (the basis first), the effect takes its own signal before the
     plant can. Neither order is better on every record, and the effect's parameters are nested, so both are
-    fitted and the lower training SSR wins.
+    fitted and the lower training SSR wins. The second stops early once its SSR is heading
+    (:func:`synth.gap.attribution.convergence.cannot_reach`) to within one noise variance ``SSR/N`` of the
+    first's or above: mostly the two orders end at the same point, the second after a longer climb. A ``warm``
+    start (``params`` and ``start`` from a fitted point, basis parameters included) is past that choice: the
+    plant-first order alone continues from it.
     """
     first = _alternate(plant, effect, params, t, u, y, formula, start, weights, basis_first=False)
-    if not effect.basis_names:
+    if not effect.basis_names or warm:
         return first
-    second = _alternate(plant, effect, params, t, u, y, formula, start, weights, basis_first=True)
+    n = y.size if weights is None else int(np.sum(np.asarray(weights) > 0))
+    beat = first.ssr * (1.0 - 1.0 / max(n, 1)) if np.isfinite(first.ssr) else None
+    second = _alternate(plant, effect, params, t, u, y, formula, start, weights, basis_first=True, beat=beat)
     return second if second.ssr < first.ssr else first
 
 
 def _alternate(plant: Plant, effect: Effect, params: Params, t: np.ndarray, u: np.ndarray, y: np.ndarray,
-               formula: str, start: dict[str, float], weights: np.ndarray | None, basis_first: bool) -> _Point:
+               formula: str, start: dict[str, float], weights: np.ndarray | None, basis_first: bool,
+               beat: float | None = None) -> _Point:
     dt = float((t[-1] - t[0]) / (t.size - 1))
     p = {**effect.off(), **params}
     G, nominal, ci, solver, offset = plant, dict(start), {}, {}, 0.0
@@ -342,7 +351,7 @@ def _alternate(plant: Plant, effect: Effect, params: Params, t: np.ndarray, u: n
     output_side = type(effect).output_map is not Effect.output_map
     iterate = bool(effect.basis_names) or output_side or effect.needs_plant
     rounds = _ROUNDS if iterate else 1
-    last = np.inf
+    costs: list[float] = []
     target = y
     try:
         if basis_first:  # the basis' least squares against the nominal model, before any casadi fit
@@ -362,9 +371,11 @@ def _alternate(plant: Plant, effect: Effect, params: Params, t: np.ndarray, u: n
                     y_lin = _Linear(effect).apply(G, t, u, p, offset=offset)
                     target = effect.censor(y, y_lin, p)
                 ssr = _ssr(y, effect.apply(G, t, u, p, offset=offset), mask)
-                if abs(last - ssr) <= _ROUNDS_TOL * max(ssr, 1e-300):
+                if costs and abs(costs[-1] - ssr) <= _ROUNDS_TOL * max(ssr, 1e-300):
                     break
-                last = ssr
+                costs.append(ssr)
+                if beat is not None and cannot_reach(costs, beat):  # no better than the other order's point
+                    break
     except (DataError, ModelError, np.linalg.LinAlgError, RuntimeError) as exc:
         return _Point(p, np.inf, plant, 0.0, dict(start), {}, {"status": f"failed: {exc}"})
     ssr = _ssr(y, effect.apply(G, t, u, p, offset=offset), mask)
@@ -390,31 +401,6 @@ class _Linear:
         for name, psi in zip(eff.basis_names, eff.output_basis(t)):
             y = y + params.get(name, 0.0) * psi
         return y
-
-
-def _profile_ci(points: list[_Point], best: _Point, name: str, n: int) -> tuple[float, float]:
-    """Profile interval of a grid parameter in log: SSR within chi2_1(0.95) SSR_min/N of the best."""
-    pts = sorted(((p.params[name], p.ssr) for p in points if name in p.params and np.isfinite(p.ssr)
-                  and p.params[name] > 0 and np.isfinite(p.params[name])), key=lambda x: x[0])
-    level = best.ssr * (1.0 + _CHI2_1_95 / n)
-    x0 = best.params[name]
-    if not pts or not (np.isfinite(x0) and x0 > 0):
-        return (float(x0), float(x0))
-    xs = np.log([p[0] for p in pts])
-    ss = np.array([p[1] for p in pts])
-    i0 = int(np.argmin(np.abs(xs - np.log(x0))))
-
-    def walk(step: int) -> float:
-        i = i0
-        while 0 <= i + step < xs.size and ss[i + step] <= level:
-            i += step
-        j = i + step
-        if not 0 <= j < xs.size:
-            return float(np.exp(xs[i]))
-        frac = (level - ss[i]) / (ss[j] - ss[i]) if ss[j] != ss[i] else 0.0
-        return float(np.exp(xs[i] + frac * (xs[j] - xs[i])))
-
-    return walk(-1), walk(1)
 
 
 def fit_augmented(plant: Plant, t: np.ndarray, u: np.ndarray, y: np.ndarray, effect: Effect | None = None,
@@ -489,19 +475,21 @@ def fit_augmented(plant: Plant, t: np.ndarray, u: np.ndarray, y: np.ndarray, eff
     if key is not None:
         same = [p for p in points if p.key == key]
         if refine:
-            extra = _golden(plant, eff, best, same, key, t, u, y, formula, start_values, weights)
+            extra = _golden(plant, eff, best, same, key, t, u, y, formula, start_values, n_fit, weights)
             for p in extra:
                 p.key = key
             points += extra
             same += extra
             best = min(points, key=lambda p: p.ssr)
-        ci[key] = _profile_ci(same, best, key, n_fit)
+        ci[key] = profile_interval([(p.params.get(key, np.nan), p.ssr) for p in same],
+                                       (best.params[key], best.ssr), n_fit)
     return AugmentedFit(effect, best.plant, best.params, best.offset, best.nominal, ci, best.ssr, n_fit,
                         [(p.params, p.ssr) for p in points], best.solver)
 
 
 def _golden(plant: Plant, eff: Effect, best: _Point, same: list[_Point], key: str, t: np.ndarray, u: np.ndarray,
-            y: np.ndarray, formula: str, start: dict[str, float], weights: np.ndarray | None = None) -> list[_Point]:
+            y: np.ndarray, formula: str, start: dict[str, float], n: int,
+            weights: np.ndarray | None = None) -> list[_Point]:
     """Search in log(key) between the best grid point's neighbours (one grid step beyond an end).
 
     Parabolic interpolation through the best point and its neighbours
@@ -515,11 +503,12 @@ def _golden(plant: Plant, eff: Effect, best: _Point, same: list[_Point], key: st
     # warm start at the best point: its basis parameters and nominal coefficients (the alternation of a basis
     # effect then needs a round or two instead of up to _ROUNDS)
     base = dict(best.params)
-    warm = {k: v for k, v in best.nominal.items() if k in start}
+    warm_start = {k: v for k, v in best.nominal.items() if k in start}
     out: list[_Point] = []
 
     def f(x: float) -> float:
-        pt = _fit_point(plant, eff, {**base, key: float(np.exp(x))}, t, u, y, formula, warm, weights)
+        pt = _fit_point(plant, eff, {**base, key: float(np.exp(x))}, t, u, y, formula, warm_start, weights,
+                        warm=True)
         out.append(pt)
         return pt.ssr
 
@@ -527,6 +516,9 @@ def _golden(plant: Plant, eff: Effect, best: _Point, same: list[_Point], key: st
     ssr = {float(np.log(p.params[key])): p.ssr for p in same if np.isfinite(p.params.get(key, np.nan))
            and p.params[key] > 0}
     a, b = bracket
+    level = profile_level(best.ssr, n)
+    if all(x in ssr and ssr[x] <= level for x in (a, b)):  # flat at the noise between the neighbours
+        return []
     missing = [x for x in (a, b) if x not in ssr]
     if len(missing) == 1 and a < x0 < b:  # the best is at an end of the grid: fit the step beyond it first
         ssr[missing[0]] = f(missing[0])
