@@ -231,10 +231,12 @@ class ConvolutionProblem:
     # --------------------------------------------------------------- solving
 
     def solve(self, x0: np.ndarray, par: _Inputs, nonnegative_f: bool = False,
-              lower: np.ndarray | None = None) -> tuple[np.ndarray, float, dict[str, Any]]:
+              lower: np.ndarray | None = None, rtol: float = 0.0) -> tuple[np.ndarray, float, dict[str, Any]]:
         """Levenberg-Marquardt from ``x0``: the decision variables, the sum of squared residuals and a status.
 
-        The status strings are IPOPT's (``Solve_Succeeded``, ``Maximum_Iterations_Exceeded``,
+        Converged when the Gauss-Newton decrease of the SSR still available is below ``1e-8`` of the noise
+        variance ``SSR/dof``, or below ``rtol`` times the SSR (a caller that iterates fits to a looser tolerance
+        of its own). The status strings are IPOPT's (``Solve_Succeeded``, ``Maximum_Iterations_Exceeded``,
         ``Diverging_Iterates``), so :func:`synth.ident.fit_failure.fit_failure` reads them alike.
         """
         lb = -np.inf * np.ones(x0.size)
@@ -259,7 +261,7 @@ class ConvolutionProblem:
             except np.linalg.LinAlgError:
                 gn = np.zeros_like(g)
             remaining = float(g @ gn)  # the Gauss-Newton decrease of the SSR still available
-            if remaining <= 1e-8 * ssr / dof or remaining <= 1e-15 * ssr:
+            if remaining <= 1e-8 * ssr / dof or remaining <= max(1e-15, rtol) * ssr:
                 status = "Solve_Succeeded"
                 break
             accepted = False

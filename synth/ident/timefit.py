@@ -238,7 +238,8 @@ def fit_structure(record: Record, structure: Structure | str, delay: str | float
                   sensor: Plant | str | None = None, periodic: bool = False,
                   initial: dict[str, float] | None = None,
                   lower: dict[str, float] | None = None,
-                  weights: np.ndarray | None = None, check: bool = False, solver: str = "auto") -> TimeFitResult:
+                  weights: np.ndarray | None = None, check: bool = False, solver: str = "auto",
+                  rtol: float = 0.0) -> TimeFitResult:
     """Fit a structure to a record by simulation error (casadi + IPOPT).
 
     Parameters
@@ -276,6 +277,9 @@ def fit_structure(record: Record, structure: Structure | str, delay: str | float
         cost evaluated by FFT convolution and solved by Levenberg-Marquardt
         (:class:`~synth.ident.convolution_problem.ConvolutionProblem`), whose cost does not grow with
         a symbolic graph; ``"auto"``: the convolution above ``LONG_RECORD`` samples.
+    rtol : float
+        Convolution solver only: also converged when the SSR decrease still available is below ``rtol`` times
+        the SSR (for callers that alternate fits to a tolerance of their own); default 0, to the noise floor.
 
     Returns
     -------
@@ -363,6 +367,8 @@ def fit_structure(record: Record, structure: Structure | str, delay: str | float
         raise ModelError(f"bounds for parameters not in the structure: {', '.join(unknown)}", where="lower")
     lb = None if not lower else np.array([float(lower.get(k, -np.inf)) for k in st.parameters])
 
+    solve_options = {"rtol": rtol} if isinstance(prob, ConvolutionProblem) else {}
+
     def run(theta_start: np.ndarray, d_start: float) -> tuple[np.ndarray, float, int, dict[str, Any], int]:
         m = int(np.floor(d_start / dt + 1e-9))
         f = d_start - m * dt
@@ -371,7 +377,8 @@ def fit_structure(record: Record, structure: Structure | str, delay: str | float
         while True:
             if fit_delay:
                 x0 = np.r_[xi, f, b_start]
-                xs, ssr, st_info = prob.solve(x0, prob.inputs(w, m), nonnegative_f=(m == 0), lower=lb)
+                xs, ssr, st_info = prob.solve(x0, prob.inputs(w, m), nonnegative_f=(m == 0), lower=lb,
+                                              **solve_options)
                 iters += st_info["iterations"]
                 fx = float(xs[len(xi)])
                 seen.add(m)
@@ -382,7 +389,8 @@ def fit_structure(record: Record, structure: Structure | str, delay: str | float
                     continue
             else:
                 fixed_f = d_start - m * dt
-                xs, ssr, st_info = prob.solve(np.r_[xi, b_start], prob.inputs(w, m, fixed_f), lower=lb)
+                xs, ssr, st_info = prob.solve(np.r_[xi, b_start], prob.inputs(w, m, fixed_f), lower=lb,
+                                              **solve_options)
                 iters += st_info["iterations"]
             st_info["iterations"] = iters
             return xs, ssr, m, st_info, shifts

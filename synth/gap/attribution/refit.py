@@ -228,7 +228,7 @@ def _linear_fit(plant: Plant, effect: Effect, params: Params, t: np.ndarray, v: 
     rec = record_from_arrays(t, v, y)
     # the re-fits are many and share a structure: the convolution solver builds no symbolic graph per fit
     res = fit_structure(rec, full, delay="fit" if fit_delay else plant.delay, initial=init, weights=weights,
-                        solver="convolution")
+                        solver="convolution", rtol=0.1 * _ROUNDS_TOL)  # finer than the alternation needs
     bounds = _stable_bounds(plant, start)
     if bounds and any(res.parameters[k] < 0.0 for k in bounds):  # rare: again with the bounds (IPOPT is slower)
         res = fit_structure(rec, full, delay="fit" if fit_delay else plant.delay, initial=init, weights=weights,
