@@ -14,13 +14,19 @@ comparable number; on an idle 2-core machine the wall time lies between half of 
 baseline is the same script run in a ``git worktree`` of ``--baseline-ref`` (default: ``HEAD``), in a
 temporary folder, right after this version's run of the same case, so both columns see the same load.
 
-Run:  python benchmarks/gap/diagnose_speed.py [--sizes 2000 20000 100000 1000000] [--effects ...]
+How time grows: for each pair of consecutive sizes, the ratio of each effect's time (summed over ``--seeds``
+records) and of the total over the effects, beside the ratio of the sample counts. One record per size is a noisy
+measure of growth: which candidates the screen carries into the joint re-fit differs from record to record (a
+supply-sag candidate costs several times a quantizer's), so ``--seeds`` draws several records of each size.
+
+Run:  python benchmarks/gap/diagnose_speed.py [--sizes 2000 20000 100000 1000000] [--effects ...] [--seeds 1]
       [--baseline-ref REF | --no-baseline] [--timeout 600] [--baseline-max 100000] [--jobs 1]
 """
 
 from __future__ import annotations
 
 import argparse
+import itertools
 import json
 import os
 import subprocess
@@ -88,8 +94,8 @@ def case(effect: str, n: int, seed: int = 0) -> tuple[Record, Record]:
     return out[0], out[1]
 
 
-def run_one(effect: str, n: int, workers: int = 2) -> dict[str, object]:
-    """Time one diagnosis of the ``effect`` case of ``n`` samples (this checkout's code)."""
+def run_one(effect: str, n: int, workers: int = 2, seed: int = 0) -> dict[str, object]:
+    """Time one diagnosis of the ``effect`` case of ``n`` samples, record ``seed`` (this checkout's code)."""
     import resource
 
     from synth.gap.diagnose import diagnose
@@ -98,7 +104,7 @@ def run_one(effect: str, n: int, workers: int = 2) -> dict[str, object]:
         return sum(r.ru_utime + r.ru_stime for r in (resource.getrusage(resource.RUSAGE_SELF),
                                                       resource.getrusage(resource.RUSAGE_CHILDREN)))
 
-    rec, val = case(effect, n)
+    rec, val = case(effect, n, seed)
     t0, c0 = time.perf_counter(), cpu()
     fd = os.dup(2)
     try:  # casadi writes its warnings to file descriptor 2
@@ -111,13 +117,13 @@ def run_one(effect: str, n: int, workers: int = 2) -> dict[str, object]:
     return {"seconds": time.perf_counter() - t0, "cpu": cpu() - c0, "verdict": list(dg.verdict["effects"])}
 
 
-def timed(tree: Path, effect: str, n: int, timeout: float) -> dict[str, object]:
+def timed(tree: Path, effect: str, n: int, timeout: float, seed: int = 0) -> dict[str, object]:
     """One diagnosis by the code in ``tree`` (this checkout or the baseline worktree), in a fresh process.
 
     ``seconds`` is the diagnosis alone (no imports, no record generation); ``None`` when it did not finish
     within ``timeout`` seconds or failed (``verdict`` then says which).
     """
-    cmd = [sys.executable, str(tree / "benchmarks/gap/diagnose_speed.py"), "--one", effect, str(n)]
+    cmd = [sys.executable, str(tree / "benchmarks/gap/diagnose_speed.py"), "--one", effect, str(n), str(seed)]
     env = dict(os.environ, PYTHONPATH=str(tree))
     try:
         out = subprocess.run(cmd, cwd=tree, env=env, capture_output=True, text=True, timeout=timeout, check=False)
@@ -138,10 +144,11 @@ def main(argv: list[str] | None = None) -> None:
     ap.add_argument("--timeout", type=float, default=600.0, help="seconds one diagnosis may take (each version)")
     ap.add_argument("--baseline-max", type=int, default=100000, help="largest size the baseline is run at")
     ap.add_argument("--jobs", type=int, default=1, help="diagnoses run at once (compare CPU times then)")
-    ap.add_argument("--one", nargs=2, metavar=("EFFECT", "N"), help=argparse.SUPPRESS)
+    ap.add_argument("--seeds", type=int, default=1, help="records per effect and size")
+    ap.add_argument("--one", nargs=3, metavar=("EFFECT", "N", "SEED"), help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
     if args.one:
-        print(json.dumps(run_one(args.one[0], int(args.one[1]))))
+        print(json.dumps(run_one(args.one[0], int(args.one[1]), seed=int(args.one[2]))))
         return
     tmp = None
     if not args.no_baseline:
@@ -149,24 +156,24 @@ def main(argv: list[str] | None = None) -> None:
         tree = Path(tmp.name) / "tree"
         subprocess.run(["git", "worktree", "add", "--detach", str(tree), args.baseline_ref], cwd=ROOT, check=True,
                        capture_output=True)
-        if not (tree / "benchmarks/gap/diagnose_speed.py").exists():  # the script itself is new: run this one there
-            (tree / "benchmarks/gap/diagnose_speed.py").write_text(Path(__file__).read_text())
-    tasks = [(where, effect, n) for n in args.sizes for effect in args.effects
+        # the same cases and timing in both trees: this script runs there too (only `synth` differs)
+        (tree / "benchmarks/gap/diagnose_speed.py").write_text(Path(__file__).read_text())
+    tasks = [(where, effect, n, seed) for n in args.sizes for effect in args.effects for seed in range(args.seeds)
              for where in ("new", *(("old",) if tmp is not None and n <= args.baseline_max else ()))]
-    results: dict[tuple[str, str, int], dict[str, object]] = {}
+    results: dict[tuple[str, str, int, int], dict[str, object]] = {}
 
-    def work(task: tuple[str, str, int]) -> None:
-        where, effect, n = task
-        results[task] = timed(ROOT if where == "new" else tree, effect, n, args.timeout)
-        print(f"{where} {effect} {n}: {results[task]}", file=sys.stderr, flush=True)
+    def work(task: tuple[str, str, int, int]) -> None:
+        where, effect, n, seed = task
+        results[task] = timed(ROOT if where == "new" else tree, effect, n, args.timeout, seed)
+        print(f"{where} {effect} {n} #{seed}: {results[task]}", file=sys.stderr, flush=True)
 
     try:
         from concurrent.futures import ThreadPoolExecutor
 
         with ThreadPoolExecutor(args.jobs) as pool:
             list(pool.map(work, tasks))
-        rows = [(effect, n, results[("new", effect, n)], results.get(("old", effect, n)))
-                for n in args.sizes for effect in args.effects]
+        rows = [(effect, n, results[("new", effect, n, seed)], results.get(("old", effect, n, seed)), seed)
+                for n in args.sizes for effect in args.effects for seed in range(args.seeds)]
     finally:
         if tmp is not None:
             subprocess.run(["git", "worktree", "remove", "--force", str(tree)], cwd=ROOT, check=False,
@@ -181,11 +188,12 @@ def main(argv: list[str] | None = None) -> None:
                 ", ".join(res["verdict"]) or "(none)")
 
     ref = "" if args.no_baseline else f" ({args.baseline_ref})"
-    print(f"| samples (+0.8 n validation) | effect | wall [s] | CPU [s] | verdict | baseline{ref} wall [s] | "
+    print(f"| samples (+0.8 n validation) | effect | record | wall [s] | CPU [s] | verdict | baseline{ref} wall [s] | "
           "baseline CPU [s] | baseline verdict |")
-    print("|---|---|---|---|---|---|---|---|")
-    for effect, n, new, old in rows:
-        print(f"| {n} | {effect} | {' | '.join(cell(new))} | {' | '.join(cell(old))} |")
+    print("|---|---|---|---|---|---|---|---|---|")
+    for effect, n, new, old, seed in rows:
+        print(f"| {n} | {effect} | {seed} | {' | '.join(cell(new))} | {' | '.join(cell(old))} |")
+    print_growth(rows, args.sizes, args.effects)
     for n in args.sizes:
         for label, k in (("this version", 2), ("baseline", 3)):
             for what in ("seconds", "cpu"):
@@ -194,6 +202,23 @@ def main(argv: list[str] | None = None) -> None:
                     med, worst = (f"{x:.1f} s" if np.isfinite(x) else "not done" for x in (np.median(ts), max(ts)))
                     print(f"{n} samples, {label}, {'wall' if what == 'seconds' else 'CPU'}: median {med}, "
                           f"worst {worst} ({len(ts)} records)")
+
+
+def print_growth(rows: list[tuple], sizes: list[int], effects: list[str]) -> None:
+    """Ratio of CPU times between consecutive sizes, per effect (summed over its records) and in total."""
+    sizes = sorted(sizes)
+    for a, b in itertools.pairwise(sizes):
+        per = {}
+        for eff in effects:
+            ta = [r[2].get("cpu") for r in rows if r[0] == eff and r[1] == a]
+            tb = [r[2].get("cpu") for r in rows if r[0] == eff and r[1] == b]
+            if ta and tb and None not in ta + tb:
+                per[eff] = (sum(ta), sum(tb))
+        if not per:
+            continue
+        total = sum(x[1] for x in per.values()) / sum(x[0] for x in per.values())
+        cells = ", ".join(f"{eff} {tb / ta:.1f}x" for eff, (ta, tb) in per.items())
+        print(f"CPU time from {a} to {b} samples ({b / a:.0f}x the samples): {cells}; all effects {total:.1f}x")
 
 
 if __name__ == "__main__":
