@@ -39,6 +39,7 @@ import numpy as np
 
 from synth.errors import ModelError
 from synth.gap.attribution.golden import golden_section, log_bracket
+from synth.gap.attribution.tall_lsq import TallLeastSquares
 from synth.gap.effects.base import Effect, Params, unit_numerators
 from synth.ident.simulate import simulate_plant
 from synth.plant import Plant
@@ -177,20 +178,15 @@ class EffectDesign:
         X, k_num = self.columns(params, t_tr, u_tr)
         if self.mask is not None:  # only the fitted samples count
             X, y = X[self.mask], y[self.mask]
-        if not np.all(np.isfinite(X)):
+        ls = TallLeastSquares(X, y)  # one Gram matrix for both fits
+        if not ls.finite:
             return np.inf, np.zeros(X.shape[1]), k_num, np.inf
-        scale = np.maximum(np.sqrt(np.sum(X**2, axis=0)), 1e-300)
-        coef, *_ = np.linalg.lstsq(X / scale, y, rcond=None)
-        coef = coef / scale
-        r = y - X @ coef
+        coef, ssr = ls.fit()
         n_dir = len(self.directions)
         if not n_dir:
-            return float(r @ r), coef, k_num, float(r @ r)
+            return ssr, coef, k_num, ssr
         held = np.r_[np.arange(X.shape[1] - 1 - n_dir), X.shape[1] - 1]  # every column but the directions
-        Xh = X[:, held] / scale[held]
-        coef_h, *_ = np.linalg.lstsq(Xh, y, rcond=None)
-        r_h = y - Xh @ coef_h
-        return float(r @ r), coef, k_num, float(r_h @ r_h)
+        return ssr, coef, k_num, ls.fit(held)[1]
 
     def evaluate(self, params: Params, coef: np.ndarray, t: np.ndarray, u: np.ndarray) -> np.ndarray:
         X, _ = self.columns(params, t, u)
