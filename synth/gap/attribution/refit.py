@@ -315,7 +315,7 @@ def _basis_step(effect: Effect, G: Plant, params: Params, t: np.ndarray, u: np.n
 
 def _fit_point(plant: Plant, effect: Effect, params: Params, t: np.ndarray, u: np.ndarray, y: np.ndarray,
                formula: str, start: dict[str, float], weights: np.ndarray | None = None,
-               warm: bool = False) -> _Point:
+               warm: bool = False, early_stop: bool = True) -> _Point:
     """One point of the effect's search: the alternation below from both block orders when the effect has basis
     parameters, the lower training SSR kept.
 
@@ -335,7 +335,7 @@ def _fit_point(plant: Plant, effect: Effect, params: Params, t: np.ndarray, u: n
     if not effect.basis_names or warm:
         return first
     n = y.size if weights is None else int(np.sum(np.asarray(weights) > 0))
-    beat = first.ssr * (1.0 - 1.0 / max(n, 1)) if np.isfinite(first.ssr) else None
+    beat = first.ssr * (1.0 - 1.0 / max(n, 1)) if np.isfinite(first.ssr) and early_stop else None
     second = _alternate(plant, effect, params, t, u, y, formula, start, weights, basis_first=True, beat=beat)
     return second if second.ssr < first.ssr else first
 
@@ -405,7 +405,8 @@ class _Linear:
 
 def fit_augmented(plant: Plant, t: np.ndarray, u: np.ndarray, y: np.ndarray, effect: Effect | None = None,
                   refine: bool = True, start: Plant | None = None,
-                  weights: np.ndarray | None = None, grid: list[Params] | None = None) -> AugmentedFit:
+                  weights: np.ndarray | None = None, grid: list[Params] | None = None,
+                  early_stop: bool = True) -> AugmentedFit:
     """Re-fit the nominal coefficients jointly with one effect's parameters on a (training) record.
 
     Parameters
@@ -427,6 +428,9 @@ def fit_augmented(plant: Plant, t: np.ndarray, u: np.ndarray, y: np.ndarray, eff
     grid : list of dict, optional
         Starting points of the effect's search (e.g. around a screened point) instead of its
         own grid (:meth:`synth.gap.effects.Effect.data_grid`).
+    early_stop : bool
+        Stop an effect's second block order (basis first) once its extrapolated training SSR cannot come
+        within one noise variance below the first's; ``False`` runs both to convergence (for checking).
 
     Returns
     -------
@@ -464,7 +468,8 @@ def fit_augmented(plant: Plant, t: np.ndarray, u: np.ndarray, y: np.ndarray, eff
         if weights.shape != y.shape or not np.all((weights == 0) | (weights == 1)):
             raise ModelError(f"weights must be {y.size} values of 0 or 1", where="weights")
     n_fit = int(y.size if weights is None else np.sum(weights > 0))
-    points = [_fit_point(plant, eff, g, t, u, y, formula, start_values, weights) for g in grid]
+    points = [_fit_point(plant, eff, g, t, u, y, formula, start_values, weights, early_stop=early_stop)
+              for g in grid]
     for g, p in zip(grid, points):
         p.key = next((k for k in eff.grid_names if k in g), None)
     best = min(points, key=lambda p: p.ssr)
