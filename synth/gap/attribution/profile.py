@@ -11,9 +11,11 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from synth.distributions import chi2_ppf
+
 __all__ = ["CHI2_1_95", "profile_interval", "profile_level"]
 
-CHI2_1_95 = 3.841458820694124  # 95 % quantile of chi-square with one degree of freedom
+CHI2_1_95 = float(chi2_ppf(0.95, 1))  # 95 % quantile of chi-square with one degree of freedom
 
 
 def profile_level(best_ssr: float, n: int) -> float:
