@@ -27,7 +27,6 @@ import time
 from collections.abc import Iterator
 from typing import Any
 
-import cvxpy as cp
 import numpy as np
 
 from synth.check import evaluate_all
@@ -46,6 +45,7 @@ from synth.synthesis.convex_forms import (
 )
 from synth.synthesis.convex_results import ConvexResult, Diagnosis, RequirementConflict
 from synth.synthesis.convex_settings import ConvexSettings, design_grid
+from synth.synthesis.cvxpy_loader import cp
 from synth.synthesis.objective_forms import CoefficientRatioFloor, Level, ReturnDifferenceFloor
 from synth.synthesis.parametrization import Parametrization
 

@@ -44,7 +44,6 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
-import cvxpy as cp
 import numpy as np
 
 from synth.freqgrid import band_grid
@@ -66,6 +65,7 @@ from synth.requirements import (
 )
 from synth.requirements.base import Requirement, magnitude
 from synth.requirements.control_sensitivity import PeakControlSensitivity
+from synth.synthesis.cvxpy_loader import cp
 from synth.synthesis.form_registry import FormRegistry
 from synth.synthesis.parametrization import Affine, Parametrization
 

@@ -3,10 +3,10 @@ lower bound on ``|1 + L|``; the integral or DC gain of a rational controller at 
 
 from __future__ import annotations
 
-import cvxpy as cp
 import numpy as np
 
 from synth.synthesis.convex_forms import Form, Points
+from synth.synthesis.cvxpy_loader import cp
 from synth.synthesis.parametrization import Parametrization
 
 __all__ = ["CoefficientRatioFloor", "Level", "ReturnDifferenceFloor"]
