@@ -46,6 +46,7 @@ from synth.synthesis.convex_forms import (
 from synth.synthesis.convex_results import ConvexResult, Diagnosis, RequirementConflict
 from synth.synthesis.convex_settings import ConvexSettings, design_grid
 from synth.synthesis.cvxpy_loader import cp
+from synth.synthesis.delay_grid import controller_gain_bound
 from synth.synthesis.objective_forms import CoefficientRatioFloor, Level, ReturnDifferenceFloor
 from synth.synthesis.parametrization import Parametrization
 
@@ -95,7 +96,7 @@ class ConvexDesigner:
         self.requirements, self.names, self.plants, self.par = requirements, names, plants, par
         self.objective = objective or ("peak_sensitivity", "minimize")
         self.settings = settings or ConvexSettings()
-        self.grid = design_grid(plants, requirements, self.settings)
+        self.grid = design_grid(plants, requirements, self.settings, controller_gain_bound(par))
         self.solves = 0
         self.solve_time = 0.0
         self.round = 0

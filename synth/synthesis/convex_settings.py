@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -9,6 +10,7 @@ import numpy as np
 from synth.freqgrid import characteristic_range, log_grid
 from synth.plant import Plant
 from synth.requirements.base import Requirement
+from synth.synthesis.delay_grid import delay_points
 
 __all__ = ["ConvexSettings", "design_grid"]
 
@@ -46,8 +48,22 @@ class ConvexSettings:
     bisection_tolerance: float = 1e-3
 
 
-def design_grid(plants: list[Plant], requirements: list[Requirement], settings: ConvexSettings) -> np.ndarray:
-    """Log grid covering every plant's dynamics and every requirement's band."""
+def design_grid(plants: list[Plant], requirements: list[Requirement], settings: ConvexSettings,
+                gain_bound: Callable[[np.ndarray], np.ndarray] | None = None) -> np.ndarray:
+    """Log grid covering every plant's dynamics and every requirement's band, with the evenly spaced points of
+    :func:`synth.synthesis.delay_grid.delay_points` where the longest delay needs them (``gain_bound``: an
+    upper bound on the controller's gain, :func:`~synth.synthesis.delay_grid.controller_gain_bound`).
+
+    Examples
+    --------
+    >>> from synth.requirements import PeakSensitivity
+    >>> req = [PeakSensitivity(type="peak_sensitivity", max_db=6)]
+    >>> plant = Plant.from_string("1/(s+1)", delay=4.0)
+    >>> plain = design_grid([plant], req, ConvexSettings())
+    >>> with_delay = design_grid([plant], req, ConvexSettings(), lambda w: 5.0 + 0 * w)
+    >>> with_delay.size - plain.size > 0, bool(np.all(np.isin(plain, with_delay)))
+    (True, True)
+    """
     lo, hi = np.inf, 0.0
     for p in plants:
         a, b = characteristic_range(p.num, p.den, delay=p.delay)
@@ -61,6 +77,5 @@ def design_grid(plants: list[Plant], requirements: list[Requirement], settings: 
             v = getattr(r, key, None) if bound.unit == "rad/s" else None
             if v:
                 lo, hi = min(lo, v / 100), max(hi, v * 100)
-    if settings.n_points:
-        return np.geomspace(lo, hi, settings.n_points)
-    return log_grid(lo, hi, settings.per_decade)
+    grid = np.geomspace(lo, hi, settings.n_points) if settings.n_points else log_grid(lo, hi, settings.per_decade)
+    return np.union1d(grid, delay_points(plants, grid, gain_bound))

@@ -12,6 +12,7 @@ trial) and finds only a local improvement, which is why it runs only there.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -25,6 +26,8 @@ from synth.results import SEARCH_PER_DECADE
 from synth.search import hooke_jeeves
 from synth.spec import Spec
 from synth.synthesis.convex_settings import ConvexSettings, design_grid
+from synth.synthesis.delay_grid import controller_gain_bound
+from synth.synthesis.parametrization import parametrize
 
 __all__ = ["PATTERN_CHECKS", "PatternResult", "pattern_search"]
 
@@ -95,7 +98,8 @@ def pattern_search(spec: Spec, start: Controller, terms: list[tuple[str, str, fl
     nominal = spec.nominal_plant()
     x = {k: float(v) for k, v in start.parameters.items()}
     checks = 0
-    grid = design_grid(spec.plants(), list(spec.requirements), ConvexSettings(per_decade=per_decade))
+    grid = design_grid(spec.plants(), list(spec.requirements), ConvexSettings(per_decade=per_decade),
+                       _gain_bound(spec))
 
     def value(params: dict[str, float]) -> tuple[float, float]:
         """(objective score, smallest requirement slack); (-inf, -inf) when the check fails or cannot be made
@@ -134,3 +138,11 @@ def pattern_search(spec: Spec, start: Controller, terms: list[tuple[str, str, fl
                          start_value=first)  # the start is checked once, above
     improved = found.value[0] > first[0] and better(found.value, first)
     return PatternResult(Controller(start.type, at(found.z)) if improved else start, improved, checks, found.step)
+
+
+def _gain_bound(spec: Spec) -> Callable[[np.ndarray], np.ndarray] | None:
+    """The controller's gain bound for the delay points of the grid (None when its type has none)."""
+    try:
+        return controller_gain_bound(parametrize(spec.controller.type, spec.controller.all_bounds()))
+    except (SynthError, KeyError):  # a free PID filter or lead-lag pole: no linear parametrization
+        return None

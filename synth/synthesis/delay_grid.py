@@ -1,0 +1,115 @@
+"""Design-grid frequencies that resolve a long plant delay where the loop gain can matter.
+
+A log grid of 40 points per decade steps by about 6 % in frequency. A delay ``tau`` turns the loop's phase
+by ``w tau``, so above ``w = pi/4 / (0.06 tau)`` the phase turns by more than pi/4 between neighbouring grid
+points; for a delay of several seconds that happens below 1 rad/s. There the grid sees an aliased
+``L(jw)``: a closed-loop pole can cross the imaginary axis between grid points unseen, and a design stage
+whose constraints live on the grid can walk out of the stabilizing set (seen in the design benchmark: a PID
+on a plant with a 4.3 s delay, whose every NLP round ended at an unstable loop).
+
+The points added are evenly spaced, ``pi/4 / tau`` apart, from where the log grid first under-resolves the
+delay up to the log-grid point above the highest frequency at which the loop gain can still reach
+:data:`LOOP_GAIN_FLOOR` for some controller in the bounds. Above that the delay's phase cannot matter: with
+``|L| < 0.1`` the return difference ``|1 + L|`` stays within 10 % of 1 whatever the phase (|S| within 0.9 dB
+of 0 dB, |T| below -19 dB), so no closed-loop pole crosses there and no sensitivity peak hides there. The
+bound on the controller's gain comes from its parametrization (:func:`controller_gain_bound`); a rational
+controller has none (its denominator's coefficients do not bound ``1/|D(jw)|``), so its grid is left as it is.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import numpy as np
+
+from synth.plant import Plant
+
+__all__ = ["DELAY_STEP", "LOOP_GAIN_FLOOR", "MAX_DELAY_POINTS", "controller_gain_bound", "delay_points"]
+
+DELAY_STEP = np.pi / 4
+"""Largest turn of the longest delay's phase (rad) between neighbouring design frequencies."""
+
+LOOP_GAIN_FLOOR = 0.1
+"""Loop gain below which the delay's phase cannot move a design's verdict (see the module docstring)."""
+
+MAX_DELAY_POINTS = 400
+"""Most frequencies :func:`delay_points` adds."""
+
+_DENSER = 8
+"""The plant's gain is taken on a grid this many times denser than the design grid (a lightly damped mode's
+peak between two grid points counts)."""
+
+
+def controller_gain_bound(par: object) -> Callable[[np.ndarray], np.ndarray] | None:
+    """An upper bound on ``|C(jw)|`` over the parametrization's box, or None when it has none.
+
+    For a controller linear in its parameters, ``C = sum rho_k phi_k``, the triangle inequality gives
+    ``|C(jw)| <= sum_k max(|lo_k|, |hi_k|) |phi_k(jw)|``.
+
+    Examples
+    --------
+    >>> from synth.synthesis.parametrization import parametrize
+    >>> bound = controller_gain_bound(parametrize("PI", {"kp": (0, 2), "ki": (-1, 4)}))
+    >>> bound(np.array([1.0, 4.0])).round(3)  # 2 + 4/w
+    array([6., 3.])
+    >>> controller_gain_bound(parametrize("rational", {}, order=(1, 1))) is None
+    True
+    """
+    basis = getattr(par, "basis", None)
+    box = getattr(par, "box", None)
+    if basis is None or box is None:
+        return None
+    lo, hi = box()
+    reach = np.maximum(np.abs(lo), np.abs(hi))
+    if not np.all(np.isfinite(reach)):
+        return None
+    return lambda w: np.abs(basis(np.asarray(w, float))) @ reach
+
+
+def delay_points(plants: list[Plant], grid: np.ndarray,
+                 gain_bound: Callable[[np.ndarray], np.ndarray] | None) -> np.ndarray:
+    """Evenly spaced frequencies (rad/s) that resolve the longest plant delay on ``grid`` where the loop
+    gain can reach :data:`LOOP_GAIN_FLOOR` (see the module docstring); empty when none is needed.
+
+    Parameters
+    ----------
+    plants : list of Plant
+    grid : ndarray
+        The log design grid (rad/s, increasing).
+    gain_bound : callable or None
+        ``w -> upper bound on |C(jw)|`` over the controller's bounds (:func:`controller_gain_bound`);
+        None adds nothing.
+
+    Examples
+    --------
+    >>> g = np.geomspace(0.01, 100.0, 161)
+    >>> pid = lambda w: 2.0 + 1.0 / w + 5.0 * w / np.abs(1 + 0.1j * w)  # kp 2, ki 1, kd 5, tf 0.1
+    >>> extra = delay_points([Plant.from_string("1/(s+1)", delay=4.0)], g, pid)
+    >>> round(float(extra[0]), 2), round(float(extra[1] - extra[0]), 4), extra.size  # |L| > 0.1 to 100: the cap
+    (3.55, 0.1963, 400)
+    >>> p_only = delay_points([Plant.from_string("1/(s+1)", delay=4.0)], g, lambda w: 2.0 + 0 * w)
+    >>> round(float(p_only[-1]), 1)  # |L| = 2/|1 + jw| reaches 0.1 at w = 20
+    19.9
+    >>> delay_points([Plant.from_string("1/(s+1)", delay=4.0)], g, lambda w: 0.2 + 0 * w).size  # below 0.1 there
+    0
+    >>> delay_points([Plant.from_string("1/(s+1)")], g, pid).size
+    0
+    """
+    tau = max((p.delay for p in plants), default=0.0)
+    if tau <= 0 or gain_bound is None or grid.size < 2:
+        return np.array([])
+    step = DELAY_STEP / tau
+    coarse = np.flatnonzero(np.diff(grid) > step)
+    if coarse.size == 0:
+        return np.array([])
+    start = float(grid[coarse[0]])
+    dense = np.geomspace(start, float(grid[-1]), max(2, _DENSER * (grid.size - int(coarse[0]))))
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        plant_gain = np.max([np.abs(p.freqresp(dense)) for p in plants], axis=0)
+        loop_gain = np.nan_to_num(gain_bound(dense) * plant_gain, nan=np.inf, posinf=np.inf)
+    reach = np.flatnonzero(loop_gain >= LOOP_GAIN_FLOOR)
+    if reach.size == 0:
+        return np.array([])
+    last = float(dense[reach[-1]])  # the grid points around the last frequency that can reach the floor
+    stop = float(grid[min(int(np.searchsorted(grid, last)), grid.size - 1)])
+    return np.arange(start + step, stop, step)[:MAX_DELAY_POINTS]
