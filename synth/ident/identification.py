@@ -233,14 +233,27 @@ def _refit_unsettled(record: Record, avg: StepAverage, fit: TimeFitResult, struc
         return fit, ""
     skip = min(settle, 0.25 * record.duration)
     weights = ((record.t - record.t[0]) >= skip).astype(float)
-    initial = {**fit.parameters}
-    try:
-        whole = fit_structure(record, structure, delay, sensor, False, initial=initial, weights=weights, check=True)
-    except (DataError, FitError) as exc:
-        return fit, f"the edge windows ({window:.3g} s) are shorter than the model's settling time ({settle:.3g} s); " \
-                    f"the whole-record fit failed ({exc}), so the edge fit is kept (biased)"
+    # the edge fit is the natural start, unless the average pulled a pole or zero beyond the record's Nyquist
+    # frequency, which no sampled record resolves: then the whole record's own deterministic start comes first
+    roots = np.concatenate([fit.plant.poles(), fit.plant.zeros()])
+    beyond = bool(np.any(np.abs(roots) > np.pi / record.dt))
+    starts = [("its own start", None), ("the edge fit", {**fit.parameters})]
+    failures = []
+    for name, initial in starts if beyond else starts[::-1]:
+        try:
+            whole = fit_structure(record, structure, delay, sensor, False, initial=initial, weights=weights,
+                                  check=True)
+            break
+        except (DataError, FitError) as exc:
+            failures.append(f"from {name}: {exc}")
+    else:
+        return fit, f"the edge windows ({window:.3g} s) are shorter than the model's settling time " \
+                    f"({settle:.3g} s); the whole-record fit failed ({'; '.join(failures)}), so the edge fit is " \
+                    f"kept (biased)"
+    start = f"from {name}" + (f" (it failed {failures[0]})" if failures else "")
     return whole, (f"the edge windows ({window:.3g} s) are shorter than the model's settling time ({settle:.3g} s): "
-                   f"fitted the whole record instead, the first {skip:.3g} s (start-up from an unknown state) weighted 0")
+                   f"fitted the whole record instead {start}, the first {skip:.3g} s (start-up from an unknown "
+                   f"state) weighted 0")
 
 
 def _refit_from_rest(record: Record, avg: StepAverage, fit: TimeFitResult, structure: Structure,
