@@ -366,6 +366,7 @@ def main() -> None:
     ap.add_argument("--seeds", type=int, default=20)
     ap.add_argument("--samples", type=int, default=16000, help="samples per record (200 Hz)")
     ap.add_argument("--first", type=int, default=0, help="first case (to split the run over processes)")
+    ap.add_argument("--only", type=int, nargs="+", metavar="CASE", help="only these cases (instead of --first/--cases)")
     ap.add_argument("--json", help="write the per-case results here")
     ap.add_argument("--merge", nargs="+", metavar="JSON", help="only print the table of these result files")
     args = ap.parse_args()
@@ -375,14 +376,15 @@ def main() -> None:
         return
     results = []
     t0 = time.perf_counter()
-    for i in range(args.first, args.first + args.cases):
+    chosen = args.only if args.only else range(args.first, args.first + args.cases)
+    for i in chosen:
         case = make_case(i, args.samples)
         results.append(run_case(case, args.seeds))
         print(f"case {i}: {case.label()} done ({time.perf_counter() - t0:.0f} s)", file=sys.stderr, flush=True)
         if args.json:
             Path(args.json).write_text(json.dumps(results, indent=1))
     print(summary(results))
-    print(f"\n{args.cases} cases x {args.seeds} seeds, {args.samples} samples each: {time.perf_counter() - t0:.0f} s")
+    print(f"\n{len(results)} cases x {args.seeds} seeds, {args.samples} samples each: {time.perf_counter() - t0:.0f} s")
 
 
 if __name__ == "__main__":
