@@ -66,8 +66,23 @@ def _gap(spec: dict[str, Any], ref_obj: float, synth_obj: float) -> float:
     return float(10 ** ((synth_obj - ref_obj) / 20) - 1.0)
 
 
-def run_problem(p: Problem, *, time_limit: float = 120.0, budget: float = 1.0) -> dict[str, Any]:
-    """Design, reference and cross-checks for one problem; a JSON-ready record."""
+class _StoredReference:
+    """The part of a reference result :func:`run_problem` reads, from a stored record."""
+
+    def __init__(self, feasible: bool, best: dict[str, Any] | None) -> None:
+        self.feasible = feasible
+        self.best = None if not best else _StoredPoint(best["objective"], best["params"])
+
+
+class _StoredPoint:
+    def __init__(self, objective: float | None, params: dict[str, float]) -> None:
+        self.objective, self.params = objective, params
+
+
+def run_problem(p: Problem, *, time_limit: float = 120.0, budget: float = 1.0,
+                stored: dict[str, Any] | None = None) -> dict[str, Any]:
+    """Design, reference and cross-checks for one problem; a JSON-ready record. With ``stored`` (a record of
+    an earlier run of the same problem) the reference is taken from it instead of searched again."""
     import synth
 
     rec: dict[str, Any] = {"index": p.index, "spec": p.spec, "features": p.features,
@@ -94,13 +109,18 @@ def run_problem(p: Problem, *, time_limit: float = 120.0, budget: float = 1.0) -
         signal.signal(signal.SIGPROF, old)
     rec["synth_seconds"] = time.perf_counter() - t0
     rec["synth_cpu_seconds"] = time.process_time() - c0
-    c0 = time.process_time()
-    r = reference(p.num, p.den, p.delay, p.spec, budget=budget, seed=p.index)
-    rec["ref_seconds"] = r.seconds
-    rec["ref_cpu_seconds"] = time.process_time() - c0
-    rec["ref_feasible"] = r.feasible
-    rec["ref_method"] = r.method
-    rec["ref_best"] = None if r.best is None else r.best.to_dict()
+    if stored is None:
+        c0 = time.process_time()
+        r = reference(p.num, p.den, p.delay, p.spec, budget=budget, seed=p.index)
+        rec["ref_seconds"] = r.seconds
+        rec["ref_cpu_seconds"] = time.process_time() - c0
+        rec["ref_feasible"] = r.feasible
+        rec["ref_method"] = r.method
+        rec["ref_best"] = None if r.best is None else r.best.to_dict()
+    else:  # synth re-run against a reference stored by an earlier run of the same problem
+        for key in ("ref_seconds", "ref_cpu_seconds", "ref_feasible", "ref_method", "ref_best"):
+            rec[key] = stored.get(key)
+        r = _StoredReference(bool(stored["ref_feasible"]), stored.get("ref_best"))
     if d is not None and d.feasible:
         params = dict(d.controller.parameters)
         rec["synth_params"] = params
@@ -240,6 +260,9 @@ def main() -> None:
     ap.add_argument("--budget", type=float, default=1.0, help="scales the reference's search")
     ap.add_argument("--quick", action="store_true", help="10 problems")
     ap.add_argument("--summarize", type=Path, nargs="+", help="only re-read (and re-classify) JSON-lines files")
+    ap.add_argument("--rerun", type=Path, nargs="+", metavar="JSONL",
+                    help="re-run synth only on the problems of these records, against their stored references")
+    ap.add_argument("--controller", help="with --rerun: only problems of this controller type")
     args = ap.parse_args()
     from tqdm import tqdm
 
@@ -250,6 +273,18 @@ def main() -> None:
         for rec in records:
             rec["outcome"] = classify(rec)
         records.sort(key=lambda r: r["index"])
+    elif args.rerun:
+        stored = [json.loads(line) for path in args.rerun for line in path.read_text().splitlines() if line.strip()]
+        stored = [r for r in stored if args.controller in (None, r["controller"])]
+        seed = int(stored[0]["spec"]["name"].split("_")[1]) if stored else args.seed
+        problems = generate(max((r["index"] for r in stored), default=-1) + 1, seed)
+        fh = args.json.open("w") if args.json else None
+        for old in tqdm(sorted(stored, key=lambda r: r["index"]), desc="synth re-run"):
+            rec = run_problem(problems[old["index"]], time_limit=args.time_limit, stored=old)
+            records.append(rec)
+            if fh:
+                fh.write(json.dumps(rec, default=float) + "\n")
+                fh.flush()
     else:
         n = 10 if args.quick else args.n
         problems = generate(args.start + n, args.seed)[args.start:]
