@@ -61,7 +61,7 @@ def test_no_points_without_delay_or_for_a_rational_controller():
     assert np.array_equal(design_grid([no_delay], REQ, ConvexSettings(), controller_gain_bound(pid)),
                           design_grid([no_delay], REQ, ConvexSettings()))
     with_delay = design_grid([plant], REQ, ConvexSettings(), controller_gain_bound(pid))
-    assert with_delay.size - plain.size >= MAX_DELAY_POINTS - 2  # |L| stays above 0.1 to the grid's top: the cap
+    assert with_delay.size - plain.size >= MAX_DELAY_POINTS - 2  # |L| stays above the floor to the grid's top: the cap
 
 
 def test_gain_bound_is_an_upper_bound_and_tight_at_a_corner():

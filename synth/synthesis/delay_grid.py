@@ -9,11 +9,14 @@ on a plant with a 4.3 s delay, whose every NLP round ended at an unstable loop).
 
 The points added are evenly spaced, ``pi/4 / tau`` apart, from where the log grid first under-resolves the
 delay up to the log-grid point above the highest frequency at which the loop gain can still reach
-:data:`LOOP_GAIN_FLOOR` for some controller in the bounds. Above that the delay's phase cannot matter: with
-``|L| < 0.1`` the return difference ``|1 + L|`` stays within 10 % of 1 whatever the phase (|S| within 0.9 dB
-of 0 dB, |T| below -19 dB), so no closed-loop pole crosses there and no sensitivity peak hides there. The
-bound on the controller's gain comes from its parametrization (:func:`controller_gain_bound`); a rational
-controller has none (its denominator's coefficients do not bound ``1/|D(jw)|``), so its grid is left as it is.
+:data:`LOOP_GAIN_FLOOR` for some controller in the bounds. Where ``|L| < 0.5`` the point ``L = -1`` is out of
+reach whatever the phase: ``|1 + L| > 0.5``, so no closed-loop pole crosses the axis there, the stages' own
+keeping of ``|1 + L| >= 0.05`` cannot bind, |S| stays below 6 dB and |T| below 0 dB. The points are an aid to
+the design stages, not to correctness: every design is certified on a grid 20 times denser than the design
+grid, which resolves the delay, and a requirement with a tighter bound (a peak |S| below 6 dB) is checked
+there. The bound on the controller's gain comes from its parametrization (:func:`controller_gain_bound`); a
+rational controller has none (its denominator's coefficients do not bound ``1/|D(jw)|``), so its grid is left
+as it is.
 """
 
 from __future__ import annotations
@@ -29,8 +32,11 @@ __all__ = ["DELAY_STEP", "LOOP_GAIN_FLOOR", "MAX_DELAY_POINTS", "controller_gain
 DELAY_STEP = np.pi / 4
 """Largest turn of the longest delay's phase (rad) between neighbouring design frequencies."""
 
-LOOP_GAIN_FLOOR = 0.1
-"""Loop gain below which the delay's phase cannot move a design's verdict (see the module docstring)."""
+LOOP_GAIN_FLOOR = 0.5
+"""Loop gain below which the delay's phase keeps ``L`` away from -1 (see the module docstring). 0.1 (|1 + L|
+within 10 % of 1) was tried first: more points moved the design stages' paths, and on the benchmark's seed 1
+problem 105 (PID, 42 ms delay) the polish ended 30 % lower; at 0.5 that design is within 0.1 % of the
+reference and seed 5 problem 20 within 3 % (18 % on the log grid alone)."""
 
 MAX_DELAY_POINTS = 400
 """Most frequencies :func:`delay_points` adds."""
@@ -85,12 +91,12 @@ def delay_points(plants: list[Plant], grid: np.ndarray,
     >>> g = np.geomspace(0.01, 100.0, 161)
     >>> pid = lambda w: 2.0 + 1.0 / w + 5.0 * w / np.abs(1 + 0.1j * w)  # kp 2, ki 1, kd 5, tf 0.1
     >>> extra = delay_points([Plant.from_string("1/(s+1)", delay=4.0)], g, pid)
-    >>> round(float(extra[0]), 2), round(float(extra[1] - extra[0]), 4), extra.size  # |L| > 0.1 to 100: the cap
+    >>> round(float(extra[0]), 2), round(float(extra[1] - extra[0]), 4), extra.size  # |L| > 0.5 to 100: the cap
     (3.55, 0.1963, 400)
     >>> p_only = delay_points([Plant.from_string("1/(s+1)", delay=4.0)], g, lambda w: 2.0 + 0 * w)
-    >>> round(float(p_only[-1]), 1)  # |L| = 2/|1 + jw| reaches 0.1 at w = 20
-    19.9
-    >>> delay_points([Plant.from_string("1/(s+1)", delay=4.0)], g, lambda w: 0.2 + 0 * w).size  # below 0.1 there
+    >>> round(float(p_only[-1]), 1)  # |L| = 2/|1 + jw| falls to 0.5 at w = 3.9
+    3.9
+    >>> delay_points([Plant.from_string("1/(s+1)", delay=4.0)], g, lambda w: 0.2 + 0 * w).size  # below 0.5 there
     0
     >>> delay_points([Plant.from_string("1/(s+1)")], g, pid).size
     0
