@@ -7,16 +7,16 @@ points; for a delay of several seconds that happens below 1 rad/s. There the gri
 whose constraints live on the grid can walk out of the stabilizing set (seen in the design benchmark: a PID
 on a plant with a 4.3 s delay, whose every NLP round ended at an unstable loop).
 
-The points added are evenly spaced, ``pi/4 / tau`` apart, from where the log grid first under-resolves the
-delay up to the log-grid point above the highest frequency at which the loop gain can still reach
+The points added are evenly spaced, ``pi/4 / tau`` apart, from where the log grid first under-resolves the delay
+up to the log-grid point above the highest frequency at which the loop gain can still reach
 :data:`LOOP_GAIN_FLOOR` for some controller in the bounds. Where ``|L| < 0.5`` the point ``L = -1`` is out of
 reach whatever the phase: ``|1 + L| > 0.5``, so no closed-loop pole crosses the axis there, the stages' own
 keeping of ``|1 + L| >= 0.05`` cannot bind, |S| stays below 6 dB and |T| below 0 dB. The points are an aid to
 the design stages, not to correctness: every design is certified on a grid at least 20 times denser than the
 design grid (steps of at most 0.3 %, which resolve the delay's phase to pi/4 up to ``w = 270/tau``), and a
-requirement with a tighter bound (a peak |S| below 6 dB) is checked there. The bound on the controller's gain comes from its parametrization (:func:`controller_gain_bound`); a
-rational controller has none (its denominator's coefficients do not bound ``1/|D(jw)|``), so its grid is left
-as it is.
+requirement with a tighter bound (a peak |S| below 6 dB) is checked there. The bound on the controller's gain
+comes from its parametrization (:func:`controller_gain_bound`); a rational controller has none (its
+denominator's coefficients do not bound ``1/|D(jw)|``), so its grid is left as it is.
 """
 
 from __future__ import annotations
