@@ -26,6 +26,7 @@ from collections.abc import Callable
 import numpy as np
 
 from synth.plant import Plant
+from synth.synthesis.parametrization import LinearParametrization, Parametrization
 
 __all__ = ["DELAY_STEP", "LOOP_GAIN_FLOOR", "MAX_DELAY_POINTS", "controller_gain_bound", "delay_points"]
 
@@ -46,7 +47,7 @@ _DENSER = 8
 peak between two grid points counts)."""
 
 
-def controller_gain_bound(par: object) -> Callable[[np.ndarray], np.ndarray] | None:
+def controller_gain_bound(par: Parametrization) -> Callable[[np.ndarray], np.ndarray] | None:
     """An upper bound on ``|C(jw)|`` over the parametrization's box, or None when it has none.
 
     For a controller linear in its parameters, ``C = sum rho_k phi_k``, the triangle inequality gives
@@ -61,15 +62,13 @@ def controller_gain_bound(par: object) -> Callable[[np.ndarray], np.ndarray] | N
     >>> controller_gain_bound(parametrize("rational", {}, order=(1, 1))) is None
     True
     """
-    basis = getattr(par, "basis", None)
-    box = getattr(par, "box", None)
-    if basis is None or box is None:
+    if not isinstance(par, LinearParametrization):
         return None
-    lo, hi = box()
+    lo, hi = par.box()
     reach = np.maximum(np.abs(lo), np.abs(hi))
     if not np.all(np.isfinite(reach)):
         return None
-    return lambda w: np.abs(basis(np.asarray(w, float))) @ reach
+    return lambda w: np.abs(par.basis(np.asarray(w, float))) @ reach
 
 
 def delay_points(plants: list[Plant], grid: np.ndarray,
