@@ -116,6 +116,7 @@ def _truth(rng: np.random.Generator, kind: str) -> tuple[str, dict[str, float]]:
             break
     if cancel:  # a zero within 5-15 % of a pole
         zs[0] = poles[int(rng.integers(order))] * float(rng.uniform(1.05, 1.15)) ** float(rng.choice([-1, 1]))
+    zs = sorted(zs)  # labelled in ascending order, as the poles, and as :func:`matched` orders the fits
     k = float(np.prod(poles) / np.prod(zs) * rng.uniform(0.5, 2.0)) if zs else float(np.prod(poles) * rng.uniform(0.5, 2))
     pn = [f"p{i + 1}" for i in range(order)]
     zn = ["z"] if zeros == 1 else [f"z{i + 1}" for i in range(zeros)]
