@@ -185,6 +185,10 @@ def harmonic_balance(L: Callable[[np.ndarray], np.ndarray], N: Callable[[float, 
     For each ``w`` on a log grid the amplitude with ``|N(A, w)| = 1/|L(jw)|`` is found
     (``|N|`` must fall monotonically with ``A``, as for saturation and rate limit); the phase
     balance ``arg(L N) = -pi`` is then bracketed along ``w`` and refined with Brent's method.
+    The grid's amplitudes are found to 1 % (each search starts next to the previous frequency's
+    answer); every bracket is re-evaluated to full precision, with its neighbours where a sign
+    moved, before it is refined (``tests/test_harmonic_balance_random.py`` holds this to a search
+    at full precision everywhere).
 
     Parameters
     ----------
@@ -204,39 +208,73 @@ def harmonic_balance(L: Callable[[np.ndarray], np.ndarray], N: Callable[[float, 
     """
     from scipy.optimize import brentq
 
-    a_lo, a_hi = a_range
+    lo, hi = np.log(a_range[0]), np.log(a_range[1])
 
-    def amplitude(w: float) -> float | None:
+    seen: dict[tuple[float, float], complex] = {}  # N at the amplitudes the last root search tried
+
+    def n_at(a: float, w: float) -> complex:
+        if (a, w) not in seen:
+            seen[(a, w)] = N(a, w)
+        return seen[(a, w)]
+
+    def amplitude(w: float, tol: float = 1e-10, guess: float | None = None) -> float | None:
         target = 1.0 / abs(L(np.array([w]))[0])
-        f = lambda a: abs(N(a, w)) - target  # noqa: E731
-        f_lo, f_hi = f(a_lo), f(a_hi)
+        seen.clear()
+        f = lambda u: abs(n_at(float(np.exp(u)), w)) - target  # noqa: E731  (in log A: |N| ~ a power of A)
+        if guess is not None:  # a neighbouring frequency's amplitude: a narrow bracket around it first
+            g_lo, g_hi = max(lo, np.log(guess) - 0.7), min(hi, np.log(guess) + 0.7)
+            f_lo, f_hi = f(g_lo), f(g_hi)
+            if f_lo >= 0 >= f_hi:
+                return float(np.exp(g_lo if f_lo == 0 else brentq(f, g_lo, g_hi, xtol=tol, rtol=1e-12)))
+        f_lo, f_hi = f(lo), f(hi)
         if f_lo < 0 or f_hi > 0:
             return None
-        if f_lo == 0:
-            return a_lo
-        return brentq(f, a_lo, a_hi, xtol=1e-12 * a_hi, rtol=1e-12)
+        return float(np.exp(lo if f_lo == 0 else brentq(f, lo, hi, xtol=tol, rtol=1e-12)))
 
-    def residual(w: float) -> float | None:
-        a = amplitude(w)
+    def residual(w: float, tol: float = 1e-10, guess: float | None = None) -> tuple[float | None, float | None]:
+        a = amplitude(w, tol, guess)
         if a is None:
-            return None
-        z = L(np.array([w]))[0] * N(a, w)
-        return float(np.angle(-z))  # 0 at the balance, wrapped to (-pi, pi]
+            return None, None
+        z = L(np.array([w]))[0] * n_at(a, w)
+        return float(np.angle(-z)), a  # 0 at the balance, wrapped to (-pi, pi]
 
+    def crossing(r0: float | None, r1: float | None) -> bool:
+        return r0 is not None and r1 is not None and np.sign(r0) != np.sign(r1) and abs(r0 - r1) <= np.pi
+
+    # the grid locates sign changes with amplitudes to 1 % (the phase barely moves with A), each from its
+    # neighbour's; every bracket is then re-evaluated to full precision (and its neighbours, should a sign
+    # flip with the precision) before Brent's method refines it
     ws = np.geomspace(*w_range, points)
-    res = [residual(w) for w in ws]
+    coarse: list[float | None] = []
+    last: float | None = None
+    for w in ws:
+        r, last = residual(w, 1e-2, last)
+        coarse.append(r)
+    tight: dict[int, tuple[float | None, float | None]] = {}
+
+    def fine(i: int) -> float | None:
+        if i not in tight:
+            tight[i] = residual(ws[i])
+        return tight[i][0]
+
+    refined: set[int] = set()
     found: list[PredictedCycle] = []
     for i in range(points - 1):
-        r0, r1 = res[i], res[i + 1]
-        if r0 is None or r1 is None or np.sign(r0) == np.sign(r1) or abs(r0 - r1) > np.pi:
+        if not crossing(coarse[i], coarse[i + 1]):
             continue
-        w_star = brentq(lambda w: residual(w) or 0.0, ws[i], ws[i + 1], xtol=1e-12 * ws[i + 1], rtol=1e-12)
-        a_star = amplitude(w_star)
-        if a_star is None:
-            continue
-        found.append(PredictedCycle(float(a_star), float(w_star), float(2 * np.pi / w_star),
-                                    _loeb_stable(L, N, a_star, w_star)))
-    return found
+        for j in (i, i - 1, i + 1):
+            if j in refined or not 0 <= j < points - 1 or not crossing(fine(j), fine(j + 1)):
+                continue
+            refined.add(j)
+            guess = tight[j][1]
+            w_star = brentq(lambda w, g=guess: residual(w, guess=g)[0] or 0.0, ws[j], ws[j + 1],
+                            xtol=1e-12 * ws[j + 1], rtol=1e-12)
+            a_star = amplitude(w_star, guess=guess)
+            if a_star is None:
+                continue
+            found.append(PredictedCycle(float(a_star), float(w_star), float(2 * np.pi / w_star),
+                                        _loeb_stable(L, N, a_star, w_star)))
+    return sorted(found, key=lambda c: c.frequency)
 
 
 def _loeb_stable(L: Callable[[np.ndarray], np.ndarray], N: Callable[[float, float], complex], a: float,
