@@ -8,7 +8,7 @@ run by one call of the compiled loop (``synth.sim._kernel.run_loop``).
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, is_dataclass
 from typing import Any
 
 import numpy as np
@@ -89,6 +89,30 @@ def _reference_array(reference: Reference, t: np.ndarray, n_pre: int) -> tuple[n
     return np.concatenate([np.full(n_pre, rest), r]), rest
 
 
+_PLANTS: dict[tuple[Any, ...], tuple[Any, Any, np.ndarray]] = {}
+"""Discretized plant cores already built in this process (a gain sweep changes only the controller)."""
+
+
+def _discrete_plant(plant: Any, act_f: list[Block], sen_f: list[Block], op: Any, dt: float,
+                    delay: float) -> tuple[Any, Any, np.ndarray]:
+    """The plant core with the folded blocks, its zero-order hold with the loop delay and the disturbance
+    inputs' hold: built once per plant, folded blocks (dataclasses: their repr is their value), operating
+    point, sample time and delay. The arrays are shared between the variants that use them; nothing
+    writes into them."""
+    key = (plant.num.tobytes(), plant.den.tobytes(), repr(act_f), repr(sen_f), repr(op), dt, delay)
+    cacheable = all(is_dataclass(b) for b in (*act_f, *sen_f)) and is_dataclass(op)
+    if cacheable and key in _PLANTS:
+        return _PLANTS[key]
+    core = plant_core(plant, act_f, sen_f, op)
+    dz = delayed_zoh(core.A, core.B[:, 0], dt, delay)
+    _, Bd = zoh(core.A, core.B[:, 1:], dt)
+    if cacheable:
+        if len(_PLANTS) >= 64:
+            _PLANTS.clear()
+        _PLANTS[key] = (core, dz, Bd)
+    return core, dz, Bd
+
+
 def _compile(loop: Any, mode: int, ref: np.ndarray, rest: float, d_in: np.ndarray, d_out: np.ndarray,
              rng: np.random.Generator) -> _Compiled:
     dt = loop.dt
@@ -98,10 +122,8 @@ def _compile(loop: Any, mode: int, ref: np.ndarray, rest: float, d_in: np.ndarra
     na_fold, ns_fold = fold_counts(act, sen)
     act_x, act_f = act[: len(act) - na_fold], act[len(act) - na_fold:]
     sen_f, sen_x = sen[:ns_fold], sen[ns_fold:]
-    core = plant_core(loop.plant, act_f, sen_f, op)
+    core, dz, Bd = _discrete_plant(loop.plant, act_f, sen_f, op, dt, loop.total_delay)
     n = core.A.shape[0]
-    dz = delayed_zoh(core.A, core.B[:, 0], dt, loop.total_delay)
-    _, Bd = zoh(core.A, core.B[:, 1:], dt)
     d_in = d_in + core.input_offset
 
     # controller
