@@ -13,6 +13,7 @@ live in :mod:`synth.results`.
 from __future__ import annotations
 
 from collections.abc import Callable
+from typing import Any
 
 from synth.results import DesignResult
 from synth.spec import Spec
@@ -51,25 +52,30 @@ def design(spec: Spec) -> DesignResult:
     return design_certified(spec, design_convex)
 
 
-def design_jobs(spec: Spec) -> tuple[list[Callable[[], DesignResult]], Callable[[list[DesignResult]], DesignResult]]:
+def design_jobs(spec: Spec) -> tuple[list[Callable[[], Any]], Callable[[list[Any]], DesignResult]]:
     """:func:`design` as independent jobs and the step that combines their results into its answer.
 
     A PI or PID whose integral gain may be zero is designed with and without integral action; the two
     designs are independent, so the command line runs them on two cores (:func:`synth.forked.run_beside`).
-    Everything else is one job. ``combine(results)`` is what :func:`design` returns.
+    One free parameter: the design and the check of the spec's reference controller. Everything else is
+    one job. ``combine(results)`` is what :func:`design` returns.
 
     Examples
     --------
     >>> from synth.spec import load_spec
     >>> jobs, combine = design_jobs(load_spec("specs/x4_rotor.yaml"))
     >>> len(jobs), combine([job() for job in jobs]).controller.parameters["kp"]
-    (1, 20.0)
+    (2, 20.0)
     """
     from synth.synthesis.integral_action import integral_only, without_integral_action
     from synth.synthesis.surrogate import certified_only
 
+    if len(spec.controller.free_parameters()) == 1:  # the design and the reference controller's check
+        from synth.synthesis.scalar import scalar_jobs
+
+        return scalar_jobs(spec)
     without = without_integral_action(spec)
-    if len(spec.controller.free_parameters()) == 1 or certified_only(spec) or without is None \
+    if certified_only(spec) or without is None \
             or integral_only(spec):  # maximize ki: the design without it only runs when this one fails
         return [lambda: design(spec)], lambda results: results[0]
 

@@ -8,6 +8,7 @@ stability, and a design that fails that certificate is not reported as a solutio
 from __future__ import annotations
 
 from collections.abc import Callable
+from typing import Any
 
 import numpy as np
 
@@ -31,7 +32,7 @@ from synth.synthesis.gainset import GainSet, ScalarFamily, feasible_gain_set
 from synth.synthesis.optimality import Optimality
 
 __all__ = ["INWARD", "RETREAT_STEPS", "design_scalar", "feasible_verdict", "infeasible_verdict", "scalar_family",
-           "stabilizing_text"]
+           "scalar_jobs", "stabilizing_text"]
 
 
 SCALAR_GRID = 61
@@ -137,11 +138,31 @@ def design_scalar(spec: Spec) -> DesignResult:
     >>> result.feasible, result.controller.parameters["kp"], result.gain_set.contains(3.0)
     (True, 20.0, True)
     """
-    (reference,), (result, verdict_gain_set) = run_beside([lambda: reference_check(spec)],
-                                                          lambda: _design_without_reference(spec))
-    result.reference = reference
-    result.verdict += reference_verdict(spec, reference, verdict_gain_set)
-    return result
+    jobs, combine = scalar_jobs(spec)
+    (reference,), designed = run_beside(jobs[1:], jobs[0])
+    return combine([designed, reference])
+
+
+def scalar_jobs(spec: Spec) -> tuple[list[Callable[[], Any]], Callable[[list[Any]], DesignResult]]:
+    """:func:`design_scalar` as two independent jobs, the design and the check of the spec's reference
+    controller, and the step that combines their results (the command line runs the jobs on two cores
+    beside the report's own preparation: :func:`synth.design.design_jobs`).
+
+    Examples
+    --------
+    >>> from synth.spec import load_spec
+    >>> jobs, combine = scalar_jobs(load_spec("specs/x4_rotor.yaml"))
+    >>> result = combine([job() for job in jobs])
+    >>> result.controller.parameters["kp"], result.reference.controller.parameters["kp"]
+    (20.0, 3.0)
+    """
+    def combine(results: list[Any]) -> DesignResult:
+        (result, verdict_gain_set), reference = results
+        result.reference = reference
+        result.verdict += reference_verdict(spec, reference, verdict_gain_set)
+        return result
+
+    return [lambda: _design_without_reference(spec), lambda: reference_check(spec)], combine
 
 
 def _design_without_reference(spec: Spec) -> tuple[DesignResult, GainSet | None]:
