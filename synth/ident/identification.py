@@ -259,17 +259,31 @@ def _refit_unsettled(record: Record, avg: StepAverage, fit: TimeFitResult, struc
 def _refit_from_rest(record: Record, avg: StepAverage, fit: TimeFitResult, structure: Structure,
                      delay: str | float | None, sensor: Plant | str | None) -> tuple[TimeFitResult, str]:
     """A periodic train entered from rest (constant input for longer than the model's settling time): fit the whole
-    record from the periodic fit, its start-up transient included, the constant start weighted 0."""
+    record from the periodic fit, its start-up transient included, the constant start weighted 0.
+
+    The periodic average says little about a mode that a near cancellation hides, so its fit may put that mode
+    far too slow, and the constant start then looks too short for the plant to have been at rest. The whole
+    record is fitted then too (the constant start weighted 0) and kept when its own model settles within the
+    constant start: the rest it assumes holds for the model it gives. Otherwise the periodic fit stays."""
     settle = settling_time(fit.measured)
     first = float(record.t[avg.steps.index[0]] - record.t[0])
-    if not np.isfinite(settle) or first < settle:
+    if not np.isfinite(settle) or first <= 0:
         return fit, ""
-    weights = ((record.t - record.t[0]) >= settle).astype(float)
+    skip = min(settle, first)
+    weights = ((record.t - record.t[0]) >= skip).astype(float)
     try:
         whole = fit_structure(record, structure, delay, sensor, False, initial={**fit.parameters}, weights=weights,
                               check=True)
     except (DataError, FitError) as exc:
-        return fit, f"the whole-record fit from rest failed ({exc}), so the periodic fit is kept"
-    return whole, (f"the input is constant for {first:.3g} s before the train, longer than the model's settling time "
-                   f"({settle:.3g} s): fitted the whole record, the start-up transient from rest included, the first "
-                   f"{settle:.3g} s weighted 0")
+        return fit, (f"the whole-record fit from rest failed ({exc}), so the periodic fit is kept" if first >= settle
+                     else "")
+    if first >= settle:
+        return whole, (f"the input is constant for {first:.3g} s before the train, longer than the model's settling "
+                       f"time ({settle:.3g} s): fitted the whole record, the start-up transient from rest included, "
+                       f"the first {settle:.3g} s weighted 0")
+    settle_whole = settling_time(whole.measured)
+    if not settle_whole <= first:
+        return fit, ""
+    return whole, (f"the periodic fit's model settles in {settle:.3g} s, longer than the {first:.3g} s of constant "
+                   f"input before the train, but the whole record's fit (the constant start weighted 0) settles in "
+                   f"{settle_whole:.3g} s, within it: that fit is kept, the start-up transient from rest included")
