@@ -111,7 +111,9 @@ def identify(record: RecordLike, structure: Structure | str, delay: str | float 
         A periodic train that starts after the input has been constant for longer than the fitted
         model's settling time is refitted on the whole record from the periodic fit (the start-up
         transient from rest carries information that the periodic average drops; the constant
-        start, up to one settling time, is weighted 0; ``whole_record_note`` says so).
+        start, up to one settling time, is weighted 0; ``whole_record_note`` says so). When the
+        periodic fit's model settles slower than that, the whole record is fitted all the same and
+        kept if its own model settles within the constant start.
         Edge windows assume the plant at rest before each step: when the fitted model's
         settling time (:func:`settling_time`) is longer than a window, the whole record is
         fitted instead, started from the edge fit, with its start-up (one settling time, at most
