@@ -190,9 +190,14 @@ def log_grids(w_lo: np.ndarray, w_hi: np.ndarray, per_decade: int = DEFAULT_PER_
     """
     w_lo, w_hi = np.asarray(w_lo, float), np.asarray(w_hi, float)
     pairs, inverse = np.unique(np.column_stack([w_lo, w_hi]), axis=0, return_inverse=True)
-    grids = [log_grid(a, b, per_decade) for a, b in pairs]
-    m = max(g.size for g in grids)
-    padded = np.array([np.pad(g, (0, m - g.size), mode="edge") for g in grids])
+    lo, hi = pairs[:, 0], pairs[:, 1]
+    sizes = np.maximum(2, np.ceil(per_decade * np.log10(hi / lo)).astype(int) + 1)
+    # np.geomspace's own arithmetic, all rows at once: 10 ** (log10 lo + k step), the ends set exactly
+    log_lo, log_hi = np.log10(lo), np.log10(hi)
+    k = np.arange(int(sizes.max()), dtype=float)
+    padded = 10.0 ** (k[None, :] * ((log_hi - log_lo) / (sizes - 1))[:, None] + log_lo[:, None])
+    padded[:, 0] = lo
+    padded[k[None, :] >= (sizes - 1)[:, None]] = np.repeat(hi, sizes.max() - sizes + 1)
     return padded[np.ravel(inverse)]
 
 
