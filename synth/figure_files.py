@@ -9,12 +9,15 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 
-__all__ = ["METADATA", "save_figure"]
+__all__ = ["DPI", "METADATA", "save_figure"]
 
 METADATA = {"Software": "synth"}
 
+DPI = 110
+"""Resolution of every report figure (dots per inch)."""
 
-def save_figure(fig: plt.Figure, path: str | Path, dpi: int = 110) -> Path:
+
+def save_figure(fig: plt.Figure, path: str | Path, dpi: int = DPI) -> Path:
     """Lay out, write ``path`` as PNG (creating its folder) and close ``fig``.
 
     Examples

@@ -356,9 +356,9 @@ def feasibility_map(spec: Any, design_controller: Any, path: Path, n: int = 45,
 
 
 def warm_up() -> None:
-    """Draw one small log-axis figure into memory: matplotlib's font lookup and its tick-label (mathtext)
-    parser are set up once, about 0.25 s, here rather than in the first report figure (the design command
-    does this on one core while the design runs on the other).
+    """Draw one log-log figure into memory: matplotlib's font lookup and its tick-label (mathtext) parser are
+    set up once, and the labels 10^-6 ... 10^8 parsed at the figures' dpi, here rather than in the report's
+    figures (the design command does this on one core while the design runs on the other).
 
     Examples
     --------
@@ -366,10 +366,15 @@ def warm_up() -> None:
     """
     import io
 
-    fig, ax = plt.subplots(figsize=(2, 1.5))
-    ax.semilogx([1.0, 100.0], [0.0, 1.0], label="x")
+    from synth.figure_files import DPI
+
+    # the tick labels of log axes (10^k, mathtext) parsed at the dpi the figures are written at: matplotlib
+    # keeps each parse, and the report's figures are drawn in this process or in a child forked from it
+    fig, ax = plt.subplots(figsize=(6, 4))
+    ax.loglog([1e-6, 1e8], [1e-6, 1e8], label="x")
     ax.set_xlabel("x [rad/s]")
     ax.legend()
+    fig.set_dpi(DPI)
     fig.tight_layout()
-    fig.savefig(io.BytesIO(), format="png", dpi=50)
+    fig.savefig(io.BytesIO(), format="png", dpi=DPI)
     plt.close(fig)
