@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from synth.synthesis.convex_forms import Form, Points
+from synth.synthesis.convex_bounds import Form, Points
 from synth.synthesis.cvxpy_loader import cp
 from synth.synthesis.parametrization import Parametrization
 
