@@ -281,6 +281,6 @@ def screened_coefficients(plant: Plant) -> dict[str, float]:
     >>> sorted(screened_coefficients(Plant.from_string("2/(0.2*s+1)")))
     ['d0', 'delay', 'n0']
     """
-    from synth.gap.attribution.refit import nominal_structure
+    from synth.gap.attribution.nominal import nominal_structure
 
     return nominal_structure(plant)[1] | {"delay": plant.delay}

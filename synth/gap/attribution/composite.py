@@ -57,7 +57,7 @@ _UNIT = Plant(np.array([1.0]), np.array([1.0]))
 
 def _poly(coeffs: np.ndarray) -> str:
     """A polynomial in ``s`` with numeric coefficients, as the structure parser reads it."""
-    from synth.gap.attribution.refit import monomial
+    from synth.gap.attribution.nominal import monomial
 
     deg = coeffs.size - 1
     terms = [f"({float(c)!r})" + (f"*{monomial(deg - i)}" if deg - i else "") for i, c in enumerate(coeffs) if c != 0.0]

@@ -48,6 +48,7 @@ from synth.data.record import record_from_arrays
 from synth.errors import DataError, ModelError
 from synth.gap.attribution.convergence import cannot_reach
 from synth.gap.attribution.golden import golden_section, log_bracket, parabolic_section
+from synth.gap.attribution.nominal import monomial, nominal_structure, plant_from_values
 from synth.gap.attribution.profile import profile_interval, profile_level
 from synth.gap.effects.base import Effect, Params
 from synth.ident.simulate import simulate_plant
@@ -60,61 +61,6 @@ _ROUNDS = 12  # most alternations of the casadi fit and the least-squares basis 
 _ROUNDS_TOL = 1e-6  # ... stopped when the training SSR changes less than this (relative)
 _GOLDEN = 12  # most golden-section evaluations after the grid
 _GOLDEN_TOL = 0.002  # ... or until the bracket is this narrow in log (0.2 %: finer than a long record's profile interval)
-
-
-def monomial(power: int) -> str:
-    """``s^power`` as the structure parser reads it (``""`` for power 0).
-
-    Examples
-    --------
-    >>> [monomial(k) for k in range(3)]
-    ['', 's', 's^2']
-    """
-    return "" if power == 0 else ("s" if power == 1 else f"s^{power}")
-
-
-def nominal_structure(plant: Plant) -> tuple[str, dict[str, float]]:
-    """Structure formula in the plant's nonzero coefficients (monic denominator) and their values.
-
-    Examples
-    --------
-    >>> nominal_structure(Plant.from_string("23*(s+0.43)/((s+9.6)*(s+0.54))"))[0]
-    '(n1*s+n0)/(s^2+d1*s+d0)'
-    >>> nominal_structure(Plant.from_string("2/(s*(0.5*s+1))"))
-    ('(n0)/(s^2+d1*s)', {'n0': 4.0, 'd1': 2.0})
-    """
-    num, den = plant.num, plant.den
-    values: dict[str, float] = {}
-
-    def poly(coeffs: np.ndarray, prefix: str, monic: bool) -> str:
-        deg = coeffs.size - 1
-        terms = []
-        for i, c in enumerate(coeffs):
-            power = deg - i
-            if c == 0.0:
-                continue
-            mono = monomial(power)
-            if monic and i == 0:
-                terms.append(mono or "1")
-                continue
-            name = f"{prefix}{power}"
-            values[name] = float(c)
-            terms.append(f"{name}*{mono}" if mono else name)
-        return "+".join(terms) if terms else "0"
-
-    text_num = poly(num, "n", False)
-    text_den = poly(den, "d", True)
-    if text_num == "0":
-        raise ModelError("the nominal model is zero; nothing to re-fit", where="plant")
-    return f"({text_num})/({text_den})", values
-
-
-def _plant_from(plant: Plant, values: dict[str, float], delay: float) -> Plant:
-    num = np.array([values.get(f"n{plant.num.size - 1 - i}", 0.0) if c != 0.0 else 0.0
-                    for i, c in enumerate(plant.num)])
-    den = np.array([1.0 if i == 0 else (values.get(f"d{plant.den.size - 1 - i}", 0.0) if c != 0.0 else 0.0)
-                    for i, c in enumerate(plant.den)])
-    return Plant(num, den, max(0.0, delay), plant.input, plant.output, "re-fitted")
 
 
 @dataclass(frozen=True)
@@ -247,7 +193,7 @@ def _linear_fit(plant: Plant, effect: Effect, params: Params, t: np.ndarray, v: 
         ci["delay"] = (lo - plant.delay, hi - plant.delay)
     nominal = {k: float(res.parameters[k]) for k in start}
     nominal["delay"] = plant.delay  # an extra delay is the effect's parameter, not the nominal's
-    return _plant_from(plant, nominal, plant.delay), new, nominal, ci, dict(res.solver)
+    return plant_from_values(plant, nominal, plant.delay), new, nominal, ci, dict(res.solver)
 
 
 def _stable_bounds(plant: Plant, start: dict[str, float]) -> dict[str, float] | None:
