@@ -50,8 +50,9 @@ def _prepare_report(spec: Any) -> dict[str, Any] | None:
 
         paper_section_data(spec)
     curves = slack_curves(spec) if len(spec.controller.free_parameters()) == 1 else None
-    if spec.simulation is not None or any(hasattr(r, "simulation") for r in spec.requirements):  # their types
-        # simulate (a describing-function verdict is confirmed by simulated steps even without a simulation block)
+    # a requirement type with a simulation field simulates (a no_limit_cycle verdict is confirmed by simulated
+    # steps even when the spec has no simulation block)
+    if spec.simulation is not None or any(hasattr(r, "simulation") for r in spec.requirements):
         from synth.sim.verdict import warm_up as warm_simulation
 
         warm_simulation()
