@@ -112,8 +112,9 @@ def identify(record: RecordLike, structure: Structure | str, delay: str | float 
         model's settling time is refitted on the whole record from the periodic fit (the start-up
         transient from rest carries information that the periodic average drops; the constant
         start, up to one settling time, is weighted 0; ``whole_record_note`` says so). When the
-        periodic fit's model settles slower than that, the whole record is fitted all the same and
-        kept if its own model settles within the constant start.
+        periodic fit's model settles slower than that and has a weakly identifiable parameter, the
+        whole record is fitted all the same and kept if its own model settles within the constant
+        start.
         Edge windows assume the plant at rest before each step: when the fitted model's
         settling time (:func:`settling_time`) is longer than a window, the whole record is
         fitted instead, started from the edge fit, with its start-up (one settling time, at most
@@ -264,12 +265,13 @@ def _refit_from_rest(record: Record, avg: StepAverage, fit: TimeFitResult, struc
     record from the periodic fit, its start-up transient included, the constant start weighted 0.
 
     The periodic average says little about a mode that a near cancellation hides, so its fit may put that mode
-    far too slow, and the constant start then looks too short for the plant to have been at rest. The whole
-    record is fitted then too (the constant start weighted 0) and kept when its own model settles within the
-    constant start: the rest it assumes holds for the model it gives. Otherwise the periodic fit stays."""
+    far too slow (and flag it weakly identifiable), and the constant start then looks too short for the plant
+    to have been at rest. When the periodic fit has a weakly identifiable parameter, the whole record is fitted
+    then too (the constant start weighted 0) and kept when its own model settles within the constant start:
+    the rest it assumes holds for the model it gives. Otherwise the periodic fit stays."""
     settle = settling_time(fit.measured)
     first = float(record.t[avg.steps.index[0]] - record.t[0])
-    if not np.isfinite(settle) or first <= 0:
+    if not np.isfinite(settle) or first <= 0 or (first < settle and not fit.weak):
         return fit, ""
     skip = min(settle, first)
     weights = ((record.t - record.t[0]) >= skip).astype(float)
