@@ -23,7 +23,8 @@ whose model does not settle between steps, or that starts from rest, is fitted
 on the whole record. Any other record is fitted as it is. Prints each parameter
 with its standard error and 95 % interval and the fit percent, and marks a
 parameter the record cannot pin down as weak (its correlation partner and
-interval; also in the JSON, "weakly_identifiable"); writes identify.json, fit.png
+interval; also in the JSON, "weakly_identifiable"), and a parameter correlated 0.9 or more with a weak
+one as tied to it ("tied_to_weak"); writes identify.json, fit.png
 (data, model, residuals) and train.png into --out (default
 reports/identify/<data file stem>/). Files synth did not write are never
 overwritten (use --force).
@@ -179,13 +180,17 @@ def _print(result: Any, args: argparse.Namespace, json_path: Path, figures: list
               f"(noise std {avg.noise_std_before:.3g} -> {avg.noise_std_after:.3g}, step {avg.step_size:.4g})")
     if result.whole_record_note:
         print(result.whole_record_note)
-    weak = fit.weak
+    weak, tied = fit.weak, fit.tied
     for row in rows:
         if any(w.name == row[0] for w in weak):
             row[0] += " (weak)"
+        elif any(t.name == row[0] for t in tied):
+            row[0] += " (tied to weak)"
     print(table(["parameter", "value", "std", "95 % interval"], rows))
     for w in weak:
         print(w.text() + ": the record cannot pin it down; do not use it as a confident number")
+    for t in tied:
+        print(t.text())
     print(f"fit {fit.fit_percent:.2f} %, residual std {fit.residual_std:.3g}, "
           f"IPOPT {fit.solver.get('status')} ({fit.solver.get('iterations')} iterations)")
     print(f"plant: {fit.plant.to_string()}")

@@ -40,7 +40,7 @@ from synth.distributions import t_ppf
 from synth.errors import DataError, FitError, ModelError
 from synth.ident.convolution_problem import ConvolutionProblem
 from synth.ident.fit_failure import LIMIT_STATUSES, fit_failure
-from synth.ident.identifiability import WeakParameter, weak_parameters
+from synth.ident.identifiability import TiedParameter, WeakParameter, tied_to_weak, weak_parameters
 from synth.ident.sim_error_problem import SimulationErrorProblem
 from synth.ident.srivc import linear_initial_model, map_to_structure
 from synth.ident.structure import Structure, parse_structure
@@ -139,6 +139,22 @@ class TimeFitResult:
         return weak_parameters(self.names, {**self.parameters, "offset": self.offset}, self.covariance, self.ci95,
                                delay_name, dt)
 
+    @property
+    def tied(self) -> list[TiedParameter]:
+        """Parameters not flagged weak whose standard error rests on a weak one's
+        (:func:`synth.ident.identifiability.tied_to_weak`); empty when nothing is weak.
+
+        Examples
+        --------
+        >>> from synth.data import record_from_arrays
+        >>> from synth.ident.simulate import simulate_plant
+        >>> t = np.arange(0, 4, 0.01); u = np.where(t >= 0.5, 1.0, 0.0)
+        >>> y = simulate_plant(Plant.from_string("2/(s+3)"), t, u) + 0.01 * np.random.default_rng(0).normal(size=t.size)
+        >>> fit_structure(record_from_arrays(t, u, y), "k/(s+p)").tied
+        []
+        """
+        return tied_to_weak(self.names, {**self.parameters, "offset": self.offset}, self.covariance, self.weak)
+
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready result: ``parameters``, ``std``, ``ci95``, ``fit_percent``, ``tf`` and more.
 
@@ -174,6 +190,7 @@ class TimeFitResult:
             "initial": dict(self.initial),
             "solver": dict(self.solver),
             "weakly_identifiable": [w.to_dict() for w in self.weak],
+            "tied_to_weak": [t.to_dict() for t in self.tied],
         }
 
 
