@@ -93,16 +93,17 @@ def _tf_rise_time(tf: str, horizon: float = 20.0) -> float:
     on the exact response ``y(t) = C e^(M t) [0; 1] + D`` (``M = [[A, B], [0, 0]]``) by Brent."""
     from scipy.linalg import expm
     from scipy.optimize import brentq
-    from scipy.signal import tf2ss
+
+    from synth.statespace import tf_to_ss  # not scipy.signal's tf2ss: its import costs 0.5 s
 
     p = Plant.from_string(tf)
-    A, B, C, D = tf2ss(p.num, p.den)
+    A, B, C, D = tf_to_ss(p.num, p.den)
     n = A.shape[0]
     M = np.zeros((n + 1, n + 1))
-    M[:n, :n], M[:n, n] = A, B[:, 0]
+    M[:n, :n], M[:n, n] = A, B
 
     def y(t: float) -> float:
-        return float(C[0] @ expm(M * t)[:n, n] + D[0, 0])
+        return float(C @ expm(M * t)[:n, n] + D)
 
     t = np.linspace(0.0, horizon, 4001)
     step = expm(M * (t[1] - t[0]))  # exact for the constant input: x(t + dt) = e^(M dt) x(t)
@@ -110,7 +111,7 @@ def _tf_rise_time(tf: str, horizon: float = 20.0) -> float:
     states[0] = np.eye(n + 1)[n]
     for k in range(1, t.size):
         states[k] = step @ states[k - 1]
-    values = states[:, :n] @ C[0] + D[0, 0]
+    values = states[:, :n] @ C + D
     final = p.dc_gain()
 
     def first_cross(level: float) -> float:

@@ -4,7 +4,10 @@ Conventions (as :mod:`synth.sim.signals`): one-sided PSD in ``unit^2/(rad/s)`` o
 so that the variance is ``integral_0^inf S(w) dw``; in dB, ``10 log10(S)`` re 1 ``unit^2/(rad/s)``.
 
 Hann window, 50 % overlap, mean removed per segment; several records (same sample interval) are
-averaged segment by segment. The DC bin is dropped.
+averaged segment by segment. The DC bin is dropped. The estimate is ``scipy.signal.welch``'s (periodic
+Hann window, whole segments only, density scaling, mean over segments), computed here with numpy's FFT:
+importing ``scipy.signal`` costs about 0.5 s, more than the seed paper's section it serves in the design
+command (``tests/test_welch.py`` holds the two together).
 """
 
 from __future__ import annotations
@@ -12,7 +15,6 @@ from __future__ import annotations
 from collections.abc import Sequence
 
 import numpy as np
-from scipy import signal as sps
 
 from synth.errors import DataError
 
@@ -91,14 +93,30 @@ def welch_psd(signals: Sequence[np.ndarray], dt: float, segment: float | None = 
                         f"{need:.4g} s", where="psd")
     total, count = None, 0
     for x in signals:
-        x = np.asarray(x, float)
-        f, p = sps.welch(x, fs=1.0 / dt, window="hann", nperseg=nper, noverlap=nper // 2, detrend=detrend,
-                         scaling="density")
-        k = 1 + (x.size - nper) // (nper - nper // 2)
+        p, k = _periodogram_mean(np.asarray(x, float), dt, nper, detrend)
         total = p * k if total is None else total + p * k
         count += k
+    f = np.fft.rfftfreq(nper, dt)
     S = total / count / (2 * np.pi)
     return 2 * np.pi * f[1:], S[1:], count
+
+
+def _periodogram_mean(x: np.ndarray, dt: float, nper: int, detrend: str) -> tuple[np.ndarray, int]:
+    """One-sided PSD [unit^2/Hz] of ``x``: the mean of the periodograms of its whole ``nper``-sample segments
+    (hop ``nper - nper // 2``), each detrended and Hann-windowed (periodic window), and their count."""
+    step = nper - nper // 2
+    count = 1 + (x.size - nper) // step
+    segments = np.lib.stride_tricks.sliding_window_view(x, nper)[::step][:count]
+    if detrend == "linear":
+        n = np.arange(nper, dtype=float)
+        basis = np.column_stack([n - n.mean(), np.ones(nper)])
+        segments = segments - (basis @ np.linalg.lstsq(basis, segments.T, rcond=None)[0]).T
+    else:
+        segments = segments - segments.mean(axis=1, keepdims=True)
+    window = 0.5 - 0.5 * np.cos(2.0 * np.pi * np.arange(nper) / nper)
+    spectra = np.abs(np.fft.rfft(segments * window, axis=1)) ** 2 * (dt / np.sum(window**2))
+    spectra[:, 1:-1 if nper % 2 == 0 else None] *= 2.0
+    return spectra.mean(axis=0), count
 
 
 def effective_dof(segments: int) -> float:
