@@ -266,10 +266,9 @@ def harmonic_balance(L: Callable[[np.ndarray], np.ndarray], N: Callable[[float, 
             if j in refined or not 0 <= j < points - 1 or not crossing(fine(j), fine(j + 1)):
                 continue
             refined.add(j)
-            guess = tight[j][1]
-            w_star = brentq(lambda w, g=guess: residual(w, guess=g)[0] or 0.0, ws[j], ws[j + 1],
-                            xtol=1e-12 * ws[j + 1], rtol=1e-12)
-            a_star = amplitude(w_star, guess=guess)
+            # full searches, as fine(): the ends then give Brent's method the very values that bracketed
+            w_star = brentq(lambda w: residual(w)[0] or 0.0, ws[j], ws[j + 1], xtol=1e-12 * ws[j + 1], rtol=1e-12)
+            a_star = amplitude(w_star)
             if a_star is None:
                 continue
             found.append(PredictedCycle(float(a_star), float(w_star), float(2 * np.pi / w_star),
