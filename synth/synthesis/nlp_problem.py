@@ -80,9 +80,10 @@ class SymbolicController:
         raise NotImplementedError(self.ctype)
 
     def dc(self) -> Any | None:
-        """``C(0)`` (None with integral action)."""
+        """``C(0)`` (None with integral action). A PI or PID whose ``ki`` is fixed at 0 (the design without
+        integral action) has none: ``C(0) = kp``."""
         v = self.values
-        if self.ctype == "P":
+        if self.ctype == "P" or (self.ctype in ("PI", "PID") and self.fixed.get("ki") == 0.0):
             return v["kp"]
         if self.ctype == "leadlag":
             return v["k"] * v["z"] / v["p"]

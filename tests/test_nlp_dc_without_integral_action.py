@@ -1,0 +1,57 @@
+"""The NLP's bandwidth measures |T| against T(0) (``t0_squared``). A PI or PID designed without integral action
+(``ki`` fixed at 0, the second design of every PI/PID spec) has a finite T(0) = kp G(0) / (1 + kp G(0)); the
+NLP used 1, as with integral action, and so polished PD designs for the wrong bandwidth."""
+
+from __future__ import annotations
+
+import warnings
+
+import casadi as ca
+import numpy as np
+import pytest
+
+import synth
+from benchmarks.design_problems import generate
+from synth.controllers import Controller
+from synth.loop import Loop
+from synth.objectives import score
+from synth.plant import Plant
+from synth.synthesis.convex_settings import ConvexSettings, design_grid
+from synth.synthesis.delay_grid import controller_gain_bound
+from synth.synthesis.nlp import polish
+from synth.synthesis.nlp_problem import SymbolicController, t0_squared
+from synth.synthesis.parametrization import parametrize
+
+
+@pytest.mark.parametrize("kind", ["PI", "PID"])
+def test_t0_of_a_design_without_integral_action_is_the_loops_own(kind):
+    plant = Plant.from_string("38969.4*(1-s/205.74)/((s+21.7238)*(s+609.62))", delay=0.0077)
+    params = {"kp": 0.4, "ki": 0.0} | ({"kd": 0.003, "tf": 0.0016} if kind == "PID" else {})
+    bounds = {"kp": (0.0, 18.0), "ki": (0.0, 0.0)} | ({"kd": (0.0, 0.3), "tf": (0.0016, 0.0016)} if kind == "PID"
+                                                       else {})
+    start = Controller(kind, params)
+    ctrl = SymbolicController(kind, start, bounds)
+    value = float(ca.Function("t0", [ctrl.u], [t0_squared(ctrl, plant)])(ctrl.u0))
+    assert value == pytest.approx(Loop(plant, start).T0() ** 2, rel=1e-12)  # 0.541**2, not 1
+    free = SymbolicController(kind, start, {**bounds, "ki": (0.0, 100.0)})
+    assert t0_squared(free, plant) == 1.0  # with integral action (ki > 0 is designed separately from ki = 0)
+
+
+def test_pd_polish_reaches_the_reference_optimum():
+    # the design benchmark's seed 8 #272 (a right-half-plane zero, 7.7 ms delay, maximize bandwidth under
+    # |KS| <= 9.8 dB and |S| <= -7 dB below 2.5 rad/s): the reference's best PD is kp 0.4253, kd 0.00319 at
+    # 293.06 rad/s; the polish of synth's design without integral action from kp 1.06, kd 0.0020 (243.2 rad/s)
+    # stopped at 243.2 rad/s with T(0) taken as 1
+    p = generate(273, 8)[272]
+    spec = synth.parse_spec(p.spec)
+    bounds = {k: tuple(v) for k, v in p.spec["controller"]["bounds"].items()} | {"ki": (0.0, 0.0)}
+    plants, reqs, terms = spec.plants(), list(spec.requirements), spec.objective.terms()
+    grid = design_grid(plants, reqs, ConvexSettings(), controller_gain_bound(parametrize("PID", bounds)))
+    start = Controller("PID", {"kp": 1.061279552563334, "ki": 0.0, "kd": 0.0019940850455683803, "tf": 0.0015914})
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        result = polish(reqs, plants, start, bounds, terms, grid)
+        assert result.success
+        assert synth.check(spec, result.controller, 400).feasible
+    assert score(Loop(plants[0], result.controller), terms) >= 293.06 * (1 - 1e-3)
+    assert np.isclose(result.controller.parameters["kp"], 0.4253, rtol=0.01)
