@@ -126,9 +126,7 @@ def weak_parameters(names: list[str], values: dict[str, float], covariance: np.n
     idx = [i for i, n in enumerate(names) if n != "offset"]
     if not idx or cov.shape != (len(names), len(names)):
         return []
-    sd = np.sqrt(np.clip(np.diag(cov), 0.0, None))
-    with np.errstate(all="ignore"):
-        corr = cov / np.outer(sd, sd)
+    sd, corr = _std_and_correlation(cov)
     out = []
     for i in idx:
         name = names[i]
@@ -218,9 +216,7 @@ def tied_to_weak(names: list[str], values: dict[str, float], covariance: np.ndar
     flagged = {w.name for w in weak}
     if not flagged or cov.shape != (len(names), len(names)):
         return []
-    sd = np.sqrt(np.clip(np.diag(cov), 0.0, None))
-    with np.errstate(all="ignore"):
-        corr = cov / np.outer(sd, sd)
+    sd, corr = _std_and_correlation(cov)
     out = []
     for i, name in enumerate(names):
         if name in flagged or name == "offset":
@@ -232,3 +228,10 @@ def tied_to_weak(names: list[str], values: dict[str, float], covariance: np.ndar
         if size >= TIED_TO_WEAK:
             out.append(TiedParameter(name, float(values[name]), float(sd[i]), names[j], float(corr[i, j])))
     return out
+
+
+def _std_and_correlation(cov: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Standard errors and the correlation matrix of a covariance (nan where a standard error is 0)."""
+    sd = np.sqrt(np.clip(np.diag(cov), 0.0, None))
+    with np.errstate(all="ignore"):
+        return sd, cov / np.outer(sd, sd)

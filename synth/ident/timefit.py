@@ -147,11 +147,10 @@ class TimeFitResult:
         Examples
         --------
         >>> from synth.data import record_from_arrays
-        >>> from synth.ident.simulate import simulate_plant
-        >>> t = np.arange(0, 4, 0.01); u = np.where(t >= 0.5, 1.0, 0.0)
-        >>> y = simulate_plant(Plant.from_string("2/(s+3)"), t, u) + 0.01 * np.random.default_rng(0).normal(size=t.size)
-        >>> fit_structure(record_from_arrays(t, u, y), "k/(s+p)").tied
-        []
+        >>> t = np.arange(0, 3, 0.01); y = (2 / 3) * (1 - np.exp(-3 * np.clip(t - 0.5, 0, None)))
+        >>> fit = fit_structure(record_from_arrays(t, (t >= 0.5) * 1.0, y), "k/(s+p)")
+        >>> fit.weak, fit.tied
+        ([], [])
         """
         return tied_to_weak(self.names, {**self.parameters, "offset": self.offset}, self.covariance, self.weak)
 
