@@ -55,3 +55,17 @@ def test_pd_polish_reaches_the_reference_optimum():
         assert synth.check(spec, result.controller, 400).feasible
     assert score(Loop(plants[0], result.controller), terms) >= 293.06 * (1 - 1e-3)
     assert np.isclose(result.controller.parameters["kp"], 0.4253, rtol=0.01)
+
+
+@pytest.mark.parametrize("kind, params, bounds", [
+    ("PID", {"kp": 1.0, "ki": 0.0, "kd": 0.01, "tf": 0.005},
+     {"kp": (0.0, 5.0), "ki": (0.0, 0.0), "kd": (0.0, 0.5), "tf": (0.005, 0.005)}),
+    ("leadlag", {"k": 2.0, "z": 1.0, "p": 10.0}, {"k": (0.0, 10.0), "z": (0.1, 10.0), "p": (1.0, 100.0)}),
+])
+def test_t0_behind_an_integrating_plant_is_one(kind, params, bounds):
+    # the servo of benchmarks/cli_speed.py: G(0) is infinite, so T(0) = 1 whatever the controller's C(0) (the
+    # first version of the fix above gave inf/inf = nan there, and IPOPT stopped on NaN constraints)
+    plant = Plant.from_string("400/(s*(s^2+4*s+400))", delay=0.002)
+    ctrl = SymbolicController(kind, Controller(kind, params), bounds)
+    assert t0_squared(ctrl, plant) == 1.0
+    assert Loop(plant, Controller(kind, params)).T0() == pytest.approx(1.0)

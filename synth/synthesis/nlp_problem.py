@@ -166,11 +166,12 @@ def loop_response(ctrl: SymbolicController, plant: Plant, w: Any) -> tuple[Cx, C
 
 
 def t0_squared(ctrl: SymbolicController, plant: Plant) -> Any:
-    """``|T(0)|^2`` in the symbols (1 with integral action)."""
+    """``|T(0)|^2`` in the symbols (1 with integral action, in the controller or in the plant)."""
     dc = ctrl.dc()
-    if dc is None:
+    g0 = plant.dc_gain()
+    if dc is None or not np.isfinite(g0):  # an integrator in the plant: T(0) = 1 for any controller gain
         return 1.0
-    l0 = dc * plant.dc_gain()
+    l0 = dc * g0
     return (l0 / (1.0 + l0)) ** 2
 
 
