@@ -104,9 +104,7 @@ def welch_psd(signals: Sequence[np.ndarray], dt: float, segment: float | None = 
 def _periodogram_mean(x: np.ndarray, dt: float, nper: int, detrend: str) -> tuple[np.ndarray, int]:
     """One-sided PSD [unit^2/Hz] of ``x``: the mean of the periodograms of its whole ``nper``-sample segments
     (hop ``nper - nper // 2``), each detrended and Hann-windowed (periodic window), and their count."""
-    step = nper - nper // 2
-    count = 1 + (x.size - nper) // step
-    segments = np.lib.stride_tricks.sliding_window_view(x, nper)[::step][:count]
+    segments = np.lib.stride_tricks.sliding_window_view(x, nper)[::nper - nper // 2]
     if detrend == "linear":
         n = np.arange(nper, dtype=float)
         basis = np.column_stack([n - n.mean(), np.ones(nper)])
@@ -116,7 +114,7 @@ def _periodogram_mean(x: np.ndarray, dt: float, nper: int, detrend: str) -> tupl
     window = 0.5 - 0.5 * np.cos(2.0 * np.pi * np.arange(nper) / nper)
     spectra = np.abs(np.fft.rfft(segments * window, axis=1)) ** 2 * (dt / np.sum(window**2))
     spectra[:, 1:-1 if nper % 2 == 0 else None] *= 2.0
-    return spectra.mean(axis=0), count
+    return spectra.mean(axis=0), segments.shape[0]
 
 
 def effective_dof(segments: int) -> float:

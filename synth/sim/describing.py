@@ -250,12 +250,12 @@ def harmonic_balance(L: Callable[[np.ndarray], np.ndarray], N: Callable[[float, 
     for w in ws:
         r, last = residual(w, 1e-2, last)
         coarse.append(r)
-    tight: dict[int, tuple[float | None, float | None]] = {}
+    tight: dict[int, float | None] = {}
 
     def fine(i: int) -> float | None:
         if i not in tight:
-            tight[i] = residual(ws[i])
-        return tight[i][0]
+            tight[i] = residual(ws[i])[0]
+        return tight[i]
 
     refined: set[int] = set()
     found: list[PredictedCycle] = []
