@@ -11,8 +11,9 @@ from __future__ import annotations
 
 import numpy as np
 from scipy.linalg import expm
+from scipy.linalg.lapack import dtbtrs
 
-__all__ = ["generalized_bilinear", "tf_to_ss", "zoh"]
+__all__ = ["generalized_bilinear", "lfilter", "ss_to_tf", "tf_to_ss", "zoh"]
 
 
 def tf_to_ss(num: np.ndarray, den: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
@@ -96,3 +97,47 @@ def generalized_bilinear(A: np.ndarray, B: np.ndarray, C: np.ndarray, D: float, 
     Cd = np.linalg.solve(lhs.T, np.asarray(C, float))
     Dd = float(D + alpha * (np.asarray(C, float) @ Bd))
     return Ad, Bd, Cd, Dd
+
+
+def ss_to_tf(A: np.ndarray, B: np.ndarray, C: np.ndarray, D: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
+    """Numerator and denominator (highest power first, monic denominator) of ``C (zI - A)^-1 B + D`` for a
+    SISO state space with ``B`` and ``C`` vectors: ``den = det(zI - A)``, ``num = det(zI - A + B C) - den +
+    D den`` (the identity ``scipy.signal.ss2tf`` uses).
+
+    Examples
+    --------
+    >>> num, den = ss_to_tf(np.array([[0.5]]), np.array([1.0]), np.array([2.0]))
+    >>> num.tolist(), den.tolist()  # 2 / (z - 0.5)
+    ([0.0, 2.0], [1.0, -0.5])
+    """
+    A = np.atleast_2d(np.asarray(A, float))
+    den = np.poly(A)
+    num = np.poly(A - np.outer(np.asarray(B, float), np.asarray(C, float))) - den + D * den
+    return num, den
+
+
+def lfilter(b: np.ndarray, a: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """Output of the discrete filter ``b(z^-1) / a(z^-1)`` for the input ``x`` from rest (coefficients in
+    powers of ``z^-1``, as ``scipy.signal.lfilter`` with no initial conditions): the numerator by convolution,
+    then the recursion ``sum_k a_k y[n-k] = (b * x)[n]`` as the forward substitution of a lower-triangular
+    banded system (LAPACK ``dtbtrs``).
+
+    Examples
+    --------
+    >>> lfilter(np.array([1.0]), np.array([1.0, -0.5]), np.array([1.0, 0.0, 0.0, 0.0])).tolist()
+    [1.0, 0.5, 0.25, 0.125]
+    """
+    b = np.atleast_1d(np.asarray(b, float))
+    a = np.atleast_1d(np.asarray(a, float))
+    x = np.asarray(x, float)
+    if a[0] == 0.0:
+        raise ValueError("the filter's leading denominator coefficient is zero")
+    b, a = b / a[0], a / a[0]
+    rhs = np.convolve(x, b)[:x.size]
+    if a.size == 1 or x.size == 0:
+        return rhs
+    band = np.repeat(a[:, None], x.size, axis=1)  # band storage of the lower-triangular Toeplitz matrix
+    y, info = dtbtrs(band, rhs[:, None], uplo="L")
+    if info != 0:
+        raise ValueError(f"LAPACK dtbtrs failed (info {info})")
+    return y[:, 0]

@@ -104,4 +104,4 @@ def test_dc_motor_record_gap_lies_where_the_step_response_arrives():
     # the largest residual window is where the response arrives (the record overshoots ~1.4 %, the model cannot)
     first = loc.where.time.windows[0]
     assert 3.5 <= first.t0 and first.t1 <= 4.6 and first.share > 0.2
-    assert steps[0].record.overshoot_percent > 1.0 and steps[0].model.overshoot_percent == 0.0
+    assert steps[0].record.overshoot_percent > 1.0 and steps[0].model.overshoot_percent < 1e-9  # rounding only

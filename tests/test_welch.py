@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 from scipy import signal
 
-from synth.ident.welch import welch_psd
+from synth.ident.welch import welch_coherence, welch_density, welch_psd
 
 
 @pytest.mark.parametrize("detrend", ["constant", "linear"])
@@ -33,3 +33,22 @@ def test_several_records_are_averaged_segment_by_segment():
     ka, kb = 1 + (5000 - 256) // 128, 1 + (3000 - 256) // 128
     assert count == ka + kb
     np.testing.assert_allclose(S, (ka * pa[1:] + kb * pb[1:]) / (ka + kb) / (2 * np.pi), rtol=1e-9)
+
+
+def test_welch_density_and_coherence_are_scipys():
+    """The gap diagnosis's spectra (any overlap, odd and even segments) against scipy.signal's welch and
+    coherence."""
+    rng = np.random.default_rng(11)
+    for _ in range(12):
+        n, dt = int(rng.integers(64, 20000)), float(10 ** rng.uniform(-4, -1))
+        nper = int(rng.integers(8, n // 2 + 1))
+        hop = int(rng.integers(1, nper + 1))
+        u = rng.normal(size=n) + 2.0
+        y = np.convolve(u, rng.normal(size=5), mode="same") + 0.5 * rng.normal(size=n)
+        f, p = welch_density(u, dt, nper, hop)
+        fs, ps = signal.welch(u, fs=1.0 / dt, window="hann", nperseg=nper, noverlap=nper - hop)
+        np.testing.assert_allclose(f, fs, rtol=1e-12)
+        np.testing.assert_allclose(p, ps, rtol=1e-9, atol=1e-12 * float(np.max(ps)))
+        f, g = welch_coherence(u, y, dt, nper, hop)
+        fs, gs = signal.coherence(u, y, fs=1.0 / dt, window="hann", nperseg=nper, noverlap=nper - hop)
+        np.testing.assert_allclose(g[1:], gs[1:], rtol=1e-8, atol=1e-12)

@@ -18,7 +18,7 @@ import numpy as np
 
 from synth.errors import DataError
 
-__all__ = ["effective_dof", "unit_squared", "welch_psd"]
+__all__ = ["effective_dof", "segment_spectra", "unit_squared", "welch_coherence", "welch_density", "welch_psd"]
 
 #: correlation of adjacent 50 %-overlapped Hann segments' estimates (Welch 1967), for the degrees of freedom
 _HANN_OVERLAP_CORRELATION = 0.167
@@ -104,7 +104,23 @@ def welch_psd(signals: Sequence[np.ndarray], dt: float, segment: float | None = 
 def _periodogram_mean(x: np.ndarray, dt: float, nper: int, detrend: str) -> tuple[np.ndarray, int]:
     """One-sided PSD [unit^2/Hz] of ``x``: the mean of the periodograms of its whole ``nper``-sample segments
     (hop ``nper - nper // 2``), each detrended and Hann-windowed (periodic window), and their count."""
-    segments = np.lib.stride_tricks.sliding_window_view(x, nper)[::nper - nper // 2]
+    spectra = segment_spectra(x, dt, nper, nper - nper // 2, detrend)
+    return _one_sided(np.mean(np.abs(spectra) ** 2, axis=0), nper), spectra.shape[0]
+
+
+def segment_spectra(x: np.ndarray, dt: float, nper: int, hop: int, detrend: str = "constant") -> np.ndarray:
+    """FFTs of the whole ``nper``-sample segments of ``x`` that start ``hop`` samples apart (one row each),
+    each segment detrended and Hann-windowed (periodic window), scaled so that ``|X|^2`` is the segment's
+    two-sided periodogram [unit^2/Hz] on ``numpy.fft.rfftfreq(nper, dt)``.
+
+    Examples
+    --------
+    >>> x = np.random.default_rng(0).normal(size=4096)
+    >>> X = segment_spectra(x, 0.001, 256, 128)
+    >>> X.shape, round(float(np.mean(np.abs(X) ** 2)) / 0.001, 1)  # white, variance 1: two-sided S = dt
+    ((31, 129), 1.0)
+    """
+    segments = np.lib.stride_tricks.sliding_window_view(np.asarray(x, float), nper)[::hop]
     if detrend == "linear":
         n = np.arange(nper, dtype=float)
         basis = np.column_stack([n - n.mean(), np.ones(nper)])
@@ -112,9 +128,50 @@ def _periodogram_mean(x: np.ndarray, dt: float, nper: int, detrend: str) -> tupl
     else:
         segments = segments - segments.mean(axis=1, keepdims=True)
     window = 0.5 - 0.5 * np.cos(2.0 * np.pi * np.arange(nper) / nper)
-    spectra = np.abs(np.fft.rfft(segments * window, axis=1)) ** 2 * (dt / np.sum(window**2))
-    spectra[:, 1:-1 if nper % 2 == 0 else None] *= 2.0
-    return spectra.mean(axis=0), segments.shape[0]
+    return np.fft.rfft(segments * window, axis=1) * np.sqrt(dt / np.sum(window**2))
+
+
+def _one_sided(two_sided: np.ndarray, nper: int) -> np.ndarray:
+    """Fold a two-sided density on ``rfftfreq(nper)`` into the one-sided one (every bin but DC and Nyquist
+    doubled)."""
+    out = np.array(two_sided, float)
+    out[1:-1 if nper % 2 == 0 else None] *= 2.0
+    return out
+
+
+def welch_density(x: np.ndarray, dt: float, nper: int, hop: int) -> tuple[np.ndarray, np.ndarray]:
+    """One-sided Welch PSD [unit^2/Hz] of ``x`` on ``f`` [Hz] (DC included), segments of ``nper`` samples
+    ``hop`` apart, mean removed from each: ``scipy.signal.welch``'s density with a Hann window.
+
+    Examples
+    --------
+    >>> x = np.random.default_rng(1).normal(size=20000)
+    >>> f, p = welch_density(x, 0.01, 500, 250)
+    >>> float(f[1]), round(float(np.mean(p[1:-1])) / (2 * 0.01), 1)  # white, variance 1: p = 2 dt
+    (0.2, 1.0)
+    """
+    spectra = segment_spectra(x, dt, nper, hop)
+    return np.fft.rfftfreq(nper, dt), _one_sided(np.mean(np.abs(spectra) ** 2, axis=0), nper)
+
+
+def welch_coherence(x: np.ndarray, y: np.ndarray, dt: float, nper: int, hop: int) -> tuple[np.ndarray, np.ndarray]:
+    """Magnitude-squared coherence of ``x`` and ``y`` on ``f`` [Hz] from Welch averages (Hann segments of
+    ``nper`` samples ``hop`` apart, mean removed): ``scipy.signal.coherence``'s estimate. A bin where a
+    signal has no power gives NaN.
+
+    Examples
+    --------
+    >>> rng = np.random.default_rng(2)
+    >>> u = rng.normal(size=8000)
+    >>> f, g = welch_coherence(u, u + 0.1 * rng.normal(size=8000), 0.01, 400, 400)
+    >>> bool(np.all(g[1:] > 0.95))
+    True
+    """
+    X, Y = segment_spectra(x, dt, nper, hop), segment_spectra(y, dt, nper, hop)
+    pxy = np.mean(np.conj(X) * Y, axis=0)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        g = np.abs(pxy) ** 2 / (np.mean(np.abs(X) ** 2, axis=0) * np.mean(np.abs(Y) ** 2, axis=0))
+    return np.fft.rfftfreq(nper, dt), g
 
 
 def effective_dof(segments: int) -> float:

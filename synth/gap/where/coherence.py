@@ -15,9 +15,9 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-from scipy.signal import coherence as welch_coherence
 
 from synth.errors import DataError
+from synth.ident.welch import welch_coherence
 
 __all__ = ["Coherence", "coherence_threshold", "input_residual_coherence"]
 
@@ -105,7 +105,7 @@ def input_residual_coherence(u: np.ndarray, e: np.ndarray, dt: float, n_segments
         raise DataError(f"need at least 2 segments of 8 samples ({u.size} samples, {n_segments} segments)",
                         where="n_segments")
     with np.errstate(divide="ignore", invalid="ignore"):  # bins where a segment has no power: coherence 0
-        f, g = welch_coherence(u, e, fs=1.0 / dt, window="hann", nperseg=nper, noverlap=0, detrend="constant")
+        f, g = welch_coherence(u, e, dt, nper, nper)
     keep = f > 0
     return Coherence(2 * np.pi * f[keep], np.nan_to_num(g[keep]), coherence_threshold(n_segments, alpha),
                      n_segments, alpha)

@@ -20,12 +20,12 @@ from typing import Any
 
 import numpy as np
 from scipy.integrate import cumulative_trapezoid
-from scipy.signal import welch
 
 from synth.gap.where.coherence import Coherence, input_residual_coherence
 from synth.gap.where.error_model import ErrorModel, fit_error_model
 from synth.gap.where.residual import ModelResidual
 from synth.gap.where.xcorr import CrossCorrelation, prewhitened_xcorr
+from synth.ident.welch import welch_density
 from synth.plant import Plant
 
 __all__ = ["FrequencyBand", "FrequencyLocalization", "localize_frequency", "significant_bands"]
@@ -179,8 +179,8 @@ def localize_frequency(residual: ModelResidual, max_lag: int = 50, n_segments: i
     coh = input_residual_coherence(u, e, dt, n_segments=n_segments, alpha=alpha)
     model = fit_error_model(u, e, dt, na=na, nb=nb, level=level)
     nper = max(8, u.size // n_segments)
-    f, pe = welch(e - e.mean(), fs=1.0 / dt, window="hann", nperseg=nper, noverlap=nper // 2)
-    _, pu = welch(u - u.mean(), fs=1.0 / dt, window="hann", nperseg=nper, noverlap=nper // 2)
+    f, pe = welch_density(e - e.mean(), dt, nper, nper - nper // 2)
+    _, pu = welch_density(u - u.mean(), dt, nper, nper - nper // 2)
     w = 2.0 * np.pi * f
     pe, pu = pe / (2.0 * np.pi), pu / (2.0 * np.pi)
     relevant = None

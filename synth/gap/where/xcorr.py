@@ -22,7 +22,6 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
-from scipy.signal import lfilter
 
 from synth.distributions import norm_ppf
 from synth.errors import DataError
@@ -163,8 +162,8 @@ def prewhitened_xcorr(u: np.ndarray, e: np.ndarray, dt: float, max_lag: int = 50
         raise DataError(f"must be in (0, 1), got {alpha!r}", where="alpha")
     a = fit_ar(u, max_order) if prewhiten else np.array([1.0])
     p = a.size - 1
-    fu = lfilter(a, [1.0], u - u.mean())[p:]
-    fe = lfilter(a, [1.0], e - e.mean())[p:]
+    fu = np.convolve(u - u.mean(), a)[p:u.size]  # the whitening filter (FIR), from the p-th sample on
+    fe = np.convolve(e - e.mean(), a)[p:e.size]
     n = fu.size
     max_lag = int(min(max_lag, n // 4))
     if max_lag < 1:
