@@ -369,7 +369,9 @@ def _design(spec: Spec, settings: ConvexSettings, nlp: bool | str) -> DesignResu
         res = polish(list(spec.requirements), spec.plants(), start.controller, spec.controller.all_bounds(),
                      terms, start_designer.grid, settings.per_decade, settings.stability_level)
         extras["synthesis"]["nlp"] = res.to_dict()
-        stages.append(f"NLP polish (casadi + IPOPT, {res.iterations} iterations, {res.status})")
+        exact = " (limited-memory BFGS; exact Hessian after it stopped at its iteration limit)" \
+            if any("exact_hessian" in h for h in res.history) else ""
+        stages.append(f"NLP polish (casadi + IPOPT{exact}, {res.iterations} iterations, {res.status})")
         found.extend(("nlp", c) for c in reversed(res.candidates))
         unconverged.update(h["controller"] for h in res.history if h.get("offered"))
     candidates, passed = _certify_best(spec, found, terms, per_decade, cache)

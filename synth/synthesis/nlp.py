@@ -39,6 +39,8 @@ since an interior-point method restarted at an optimum with its constraints acti
 closed loop is unstable (a step jumped over the thin region where ``|1 + L|`` is small on the grid) is
 discarded and the round repeated in a trust region around its start, which grows again when it held a step
 back. Where IPOPT stopped unconverged at a stable loop is offered to the certificate like every candidate.
+IPOPT runs with a limited-memory BFGS Hessian; a round that stops at the iteration limit (the quasi-Newton
+steps can crawl along curved active constraints) is continued from where it stopped with the exact Hessian.
 """
 
 import time
@@ -181,6 +183,7 @@ def polish(requirements: list[Requirement], plants: list[Plant], start: Controll
     converged = False
     solved: list[Controller] = []
     radius: float | None = None  # a trust region once a step has jumped out of the stabilizing set
+    exact_from_now = False
     shrinks = 0
     for rnd in range(rounds + MAX_SHRINKS):
         if rnd - shrinks >= rounds:
@@ -197,12 +200,31 @@ def polish(requirements: list[Requirement], plants: list[Plant], start: Controll
             _, L = loop_response(ctrl, p, grid)
             b.geq((1.0 + L).abs2() - stability_level**2)
         _add_objective(b, objective, plants, grid, current)
-        x, stats = b.solve(None if max_iter is None else {"ipopt.max_iter": max_iter})
+        if exact_from_now:  # an earlier round's quasi-Newton steps crawled: this problem gets the exact Hessian
+            x, stats = b.solve(EXACT_HESSIAN)
+        else:
+            x, stats = b.solve(None if max_iter is None else {"ipopt.max_iter": max_iter})
         iterations += int(stats.get("iter_count", 0))
+        exact = max_iter is None and not exact_from_now \
+            and str(stats.get("return_status")) == "Maximum_Iterations_Exceeded" and bool(np.all(np.isfinite(x)))
+        if exact:
+            # limited-memory BFGS can crawl along a curved active set in steps of a constant size: the same NLP
+            # with the exact Hessian, from where it stopped (not for the screen's short polishes), and so the
+            # rounds after it; where the crawl stopped stays a candidate
+            exact_from_now = True
+            stopped = ctrl.controller(x[: len(ctrl.free)])
+            if _stable(plants, stopped):
+                solved.insert(0, stopped)
+                history.append({"round": rnd, "status": str(stats.get("return_status")), "controller": str(stopped),
+                                "offered": True})
+            x, stats = b.solve(EXACT_HESSIAN, x)
+            iterations += int(stats.get("iter_count", 0))
         status = str(stats.get("return_status"))
         success = bool(stats.get("success"))
         candidate = ctrl.controller(x[: len(ctrl.free)])
-        history.append({"round": rnd, "status": status, "controller": str(candidate)})
+        history.append({"round": rnd, "status": status, "controller": str(candidate),
+                        **({"exact_hessian": "after limited-memory BFGS stopped at its iteration limit"}
+                           if exact_from_now else {})})
         converged = converged or success
         if not success:  # where IPOPT stopped may still pass: the certificate decides, as for every candidate
             if np.all(np.isfinite(x)) and _stable(plants, candidate):
@@ -239,12 +261,17 @@ def polish(requirements: list[Requirement], plants: list[Plant], start: Controll
 
         current = solved[0]
         value = score(Loop(plants[0], current), objective)
-    return NLPResult(converged, status, current, value, len(history), iterations,
+    return NLPResult(converged, status, current, value, len({h["round"] for h in history}), iterations,
                      time.perf_counter() - t_start, history, solved)
 
 
 MAX_SHRINKS = 3
 """Times a round is repeated in a smaller trust region after its answer left the stabilizing set."""
+
+EXACT_ITERATIONS = 500
+"""IPOPT's iteration limit when a round that stopped at its limit goes on with the exact Hessian."""
+
+EXACT_HESSIAN = {"ipopt.hessian_approximation": "exact", "ipopt.max_iter": EXACT_ITERATIONS}
 
 
 def _trust_box(bounds: dict[str, tuple[float, float]], at: Controller, radius: float | None,

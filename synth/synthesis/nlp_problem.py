@@ -97,7 +97,10 @@ class SymbolicController:
         return self.values["ki"]
 
     def controller(self, u: np.ndarray) -> Controller:
-        vals = {**{p: float(u[i] * self.scale[i]) for i, p in enumerate(self.free)}, **self.fixed}
+        """The controller at the scaled variables ``u``, each parameter clipped into its bounds (IPOPT may end
+        a relative 1e-8 outside them)."""
+        vals = {**{p: float(np.clip(u[i] * self.scale[i], *self.bounds[p])) for i, p in enumerate(self.free)},
+                **self.fixed}
         return Controller(self.ctype, vals)
 
 
@@ -137,13 +140,15 @@ class NLPBuilder:
         self.lbg.extend([0.0] * expr.numel())
         self.ubg.extend([upper] * expr.numel())
 
-    def solve(self, options: dict[str, Any] | None = None) -> tuple[np.ndarray, dict[str, Any]]:
-        """Solve with :data:`IPOPT_OPTIONS` updated by ``options``; the solution and IPOPT's statistics."""
+    def solve(self, options: dict[str, Any] | None = None, x0: np.ndarray | None = None,
+              ) -> tuple[np.ndarray, dict[str, Any]]:
+        """Solve with :data:`IPOPT_OPTIONS` updated by ``options`` from ``x0`` (default: the variables' starts);
+        the solution and IPOPT's statistics."""
         x = ca.vertcat(*self.x)
         g = ca.vertcat(*self.g) if self.g else SYM(0, 1)
         solver = ca.nlpsol("polish", "ipopt", {"x": x, "f": self.f, "g": g}, {**IPOPT_OPTIONS, **(options or {})})
-        res = solver(x0=np.concatenate(self.x0), lbx=np.concatenate(self.lbx), ubx=np.concatenate(self.ubx),
-                     lbg=np.array(self.lbg), ubg=np.array(self.ubg))
+        res = solver(x0=np.concatenate(self.x0) if x0 is None else x0, lbx=np.concatenate(self.lbx),
+                     ubx=np.concatenate(self.ubx), lbg=np.array(self.lbg), ubg=np.array(self.ubg))
         return np.asarray(res["x"]).ravel(), solver.stats()
 
 
