@@ -291,17 +291,9 @@ def column_root_counts(family: Any, plants: list[Any], values: np.ndarray) -> np
     if parts is None:
         return np.array([[Loop(p, family.controller(float(v))).stability().unstable_poles for v in values]
                          for p in plants], dtype=int)
-    c0, c1 = (_cancel_origin(*part) for part in parts)
+    c0, c1 = parts  # each with its common factors s cancelled
     return np.array([affine_root_counts(c0 if np.any(c0[0]) else None, c1, p.num, p.den, p.delay, values,
                                         stability_floor(p.num, p.den, p.delay)) for p in plants], dtype=int)
-
-
-def _cancel_origin(num: np.ndarray, den: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    num, den = np.trim_zeros(np.asarray(num, float), "f"), np.trim_zeros(np.asarray(den, float), "f")
-    num = num if num.size else np.array([0.0])
-    while num.size > 1 and den.size > 1 and num[-1] == 0.0 and den[-1] == 0.0:
-        num, den = num[:-1], den[:-1]
-    return num, den
 
 
 def combine_grids(parts: list[tuple[str, str, np.ndarray, np.ndarray, np.ndarray]],

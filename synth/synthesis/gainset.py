@@ -28,6 +28,7 @@ from synth.plant import Plant
 from synth.requirements.base import Requirement, unique_names
 from synth.stability import stability_floor
 from synth.stability_sets import affine_stability_intervals
+from synth.synthesis.intervals import intersect, remove, union
 
 __all__ = [
     "EXACT_BAND",
@@ -115,7 +116,7 @@ class GainSet:
         out = []
         for i, a in enumerate(names):
             for b in names[i + 1:]:
-                if self.per_requirement[a] and self.per_requirement[b] and not _intersect(
+                if self.per_requirement[a] and self.per_requirement[b] and not intersect(
                     self.per_requirement[a], self.per_requirement[b]
                 ):
                     out.append((a, b))
@@ -139,16 +140,6 @@ class GainSet:
         }
 
 
-def _intersect(a: list[tuple[float, float]], b: list[tuple[float, float]]) -> list[tuple[float, float]]:
-    out = []
-    for lo1, hi1 in a:
-        for lo2, hi2 in b:
-            lo, hi = max(lo1, lo2), min(hi1, hi2)
-            if lo <= hi:
-                out.append((lo, hi))
-    return sorted(out)
-
-
 class ScalarFamily:
     """Controllers of one type where one parameter varies and the others are fixed."""
 
@@ -161,7 +152,9 @@ class ScalarFamily:
 
     def affine_parts(self, lo: float, hi: float):
         """``(C0, C1)`` with ``C = C0 + rho C1`` if the controller is affine in the parameter, else None."""
-        pts = np.linspace(lo, hi, 3) if hi > lo else np.array([lo, lo + 1.0, lo + 2.0])
+        # three points inside (lo, hi]: at a zero gain the transfer function's form can differ (PI with ki = 0
+        # is kp / 1 for kp > 0 but 0 / s at kp = 0), which would hide an affine family
+        pts = lo + (hi - lo) * np.array([0.25, 0.5, 1.0]) if hi > lo else np.array([lo, lo + 1.0, lo + 2.0])
         try:
             tfs = [self.controller(p).tf() for p in pts]
         except Exception:
@@ -175,7 +168,26 @@ class ScalarFamily:
         base = nums[0] - pts[0] * slope
         if not np.allclose(base + pts[2] * slope, nums[2], rtol=1e-9, atol=1e-12):
             return None
-        return (base, dens[0]), (slope, dens[0])
+        # each part with its common factors s cancelled: a PI with ki = 0 is kp s / s, whose s is no pole
+        return cancel_origin(base, dens[0]), cancel_origin(slope, dens[0])
+
+
+def cancel_origin(num: np.ndarray, den: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``num / den`` (highest power first) with the factors ``s`` common to both cancelled (leading zeros
+    trimmed; a zero numerator is ``[0.0]``).
+
+    Examples
+    --------
+    >>> [a.tolist() for a in cancel_origin(np.array([1.0, 0.0]), np.array([1.0, 0.0]))]  # s / s
+    [[1.0], [1.0]]
+    >>> [a.tolist() for a in cancel_origin(np.array([0.0, 2.0]), np.array([1.0, 0.0]))]  # 2 / s stays
+    [[2.0], [1.0, 0.0]]
+    """
+    num, den = np.trim_zeros(np.asarray(num, float), "f"), np.trim_zeros(np.asarray(den, float), "f")
+    num = num if num.size else np.array([0.0])
+    while num.size > 1 and den.size > 1 and num[-1] == 0.0 and den[-1] == 0.0:
+        num, den = num[:-1], den[:-1]
+    return num, den
 
 
 def stability_set(family: ScalarFamily, plants: list[Plant], lo: float, hi: float) -> list[tuple[float, float]]:
@@ -190,7 +202,7 @@ def stability_set(family: ScalarFamily, plants: list[Plant], lo: float, hi: floa
                 c0, c1, plant.num, plant.den, plant.delay, lo, hi, floor=stability_floor(plant.num, plant.den, plant.delay))]
         else:
             ivs = _boolean_set(lambda v, p=plant: Loop(p, family.controller(v)).stability().stable, lo, hi)
-        total = ivs if total is None else _intersect(total, ivs)
+        total = ivs if total is None else intersect(total, ivs)
     return total or []
 
 
@@ -380,11 +392,13 @@ def feasible_gain_set(
     for name, req in zip(names, requirements):
         slack_fns[name] = slack_fn(req)
         batch_fns[name] = (lambda values, r=req: fast.slack(r, values)) if vectorized else None
-        sets[name] = requirement_set(slack_fns[name], lo, hi, n_bracket, batch_fns[name])
+        sets[name] = _resolved_in_stable_intervals(
+            requirement_set(slack_fns[name], lo, hi, n_bracket, batch_fns[name]), sets["stability"], lo, hi,
+            lambda a, b, f=slack_fns[name], g=batch_fns[name]: requirement_set(f, a, b, n_bracket, g), n_bracket)
 
     total: list[tuple[float, float]] = [(lo, hi)]
     for ivs in sets.values():
-        total = _intersect(total, ivs)
+        total = intersect(total, ivs)
     intervals = []
     for a, b in total:
         intervals.append(GainInterval(a, b, _binding(a, sets, lo, hi, slack_fns, family, batch_fns),
@@ -396,6 +410,25 @@ def feasible_gain_set(
             outside[name] = requirement_set(slack_fns[name], wide_lo, hi * 10 if hi > 0 else hi + 10, n_bracket,
                                             batch_fns[name])
     return GainSet(family.parameter, (lo, hi), intervals, sets, outside)
+
+
+MIN_POINTS_INSIDE = 20
+"""Bracketing points a stabilizing interval must hold for the requirement grid over the whole range to be
+trusted there; a narrower one is bracketed on a grid of its own."""
+
+
+def _resolved_in_stable_intervals(ivs: list[tuple[float, float]], stable: list[tuple[float, float]], lo: float,
+                                  hi: float, inside: Callable[[float, float], list[tuple[float, float]]],
+                                  n: int) -> list[tuple[float, float]]:
+    """A requirement's set ``ivs`` (bracketed over ``[lo, hi]``) with each stabilizing interval that the grid
+    resolves with fewer than :data:`MIN_POINTS_INSIDE` points bracketed again on a grid of its own
+    (``inside(a, b)``): the feasible set lies inside the stabilizing set, so that is where the requirements
+    must be resolved (a stabilizing interval of 1e-5 of the range holds no point of the whole range's grid)."""
+    grid = _grid(lo, hi, n)
+    for a, b in stable:
+        if b > a and np.count_nonzero((grid > a) & (grid < b)) < MIN_POINTS_INSIDE:
+            ivs = union(remove(ivs, a, b), inside(a, b))
+    return ivs
 
 
 def _binding(x: float, sets: dict[str, list[tuple[float, float]]], lo: float, hi: float,

@@ -78,7 +78,7 @@ def _inside(x: float, gain_set: GainSet, unstable: Callable[[float], bool]) -> f
     end where the loop is not stable (a closed-loop root on the axis, e.g. kp = 0 on a plant with an integrator:
     the stabilizing set is open there)."""
     for iv in gain_set.intervals:
-        step = INWARD * max(1.0, abs(x), iv.hi - iv.lo)
+        step = INWARD * max(abs(x), iv.hi - iv.lo)  # relative: a gain of 5e-5 moves by 5e-11, not by 1e-6
         lo_req = any(not b.startswith("bounds") for b in iv.lo_binding) or (abs(x - iv.lo) <= step and unstable(iv.lo))
         hi_req = (any(not b.startswith("bounds") for b in iv.hi_binding)
                   and not any(b.startswith("bounds") for b in iv.hi_binding)) or (
