@@ -66,5 +66,6 @@ def test_design_without_integral_action_reaches_the_reference():
         result = design(without_integral_action(spec))
     assert result.feasible
     (lo, hi), = result.gain_set.as_list()
+    assert lo < 1e-8  # the stabilizing set starts at the stability floor above kp = 0
     assert hi == pytest.approx(REFERENCE_KP, rel=2e-3)  # the peak |S| bound ends the sliver
     assert result.controller.parameters["kp"] == pytest.approx(hi, rel=1e-5)  # moved inward relatively

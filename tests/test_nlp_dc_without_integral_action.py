@@ -69,3 +69,17 @@ def test_t0_behind_an_integrating_plant_is_one(kind, params, bounds):
     ctrl = SymbolicController(kind, Controller(kind, params), bounds)
     assert t0_squared(ctrl, plant) == 1.0
     assert Loop(plant, Controller(kind, params)).T0() == pytest.approx(1.0)
+
+
+def test_t0_of_a_rational_controller_whose_a0_reaches_zero():
+    # seed 8 #190: the reference's best rational controller has a0 = 0 (an integrator). T(0) was written with
+    # C(0) = b0 / a0, so a polish started there had NaN in its Jacobian and stopped; now n G0 / (d + n G0)
+    plant = Plant.from_string("0.201541/(s-0.0942153)", delay=0.0726835)
+    bounds = {"b0": (-4.85, 4.85), "b1": (-27.2, 27.2), "b2": (-152.9, 152.9), "a0": (0.0, 14.3), "a1": (0.0, 80.2)}
+    for a0 in (0.0, 0.3):
+        start = Controller("rational", {"b0": 0.469, "b1": 16.38, "b2": -1.074, "a0": a0, "a1": 5.11})
+        ctrl = SymbolicController("rational", start, bounds)
+        t0 = t0_squared(ctrl, plant)
+        value, jac = ca.Function("t0", [ctrl.u], [t0, ca.jacobian(t0, ctrl.u)])(ctrl.u0)
+        assert float(value) == pytest.approx(Loop(plant, start).T0() ** 2, rel=1e-9)
+        assert np.all(np.isfinite(np.asarray(jac)))

@@ -403,8 +403,16 @@ def _design(spec: Spec, settings: ConvexSettings, nlp: bool | str) -> DesignResu
                       f"{'improved' if search.improved else 'no improvement'})")
         if search.improved:
             found.append(("pattern search", search.controller))
+            if nlp:  # the polish again, from a start better than the stages had (seed 8 #190: 0.31 -> 1.0 rad/s)
+                res = polish(list(spec.requirements), spec.plants(), search.controller,
+                             spec.controller.all_bounds(), terms, runs[0][0].grid, settings.per_decade,
+                             settings.stability_level)
+                found.extend(("nlp from pattern search", c) for c in reversed(res.candidates))
+                unconverged.update(h["controller"] for h in res.history if h.get("offered"))
+                stages.append(f"NLP polish from the pattern search's design ({res.iterations} iterations, "
+                              f"{res.status})")
             candidates, passed = _certify_best(spec, found, terms, per_decade, cache)
-        if passed is not None and passed[0] != "pattern search":
+        if passed is not None and passed[0] not in ("pattern search", "nlp from pattern search"):
             searched = ("a pattern search on the exact check from it found a better point that failed the dense "
                         "certificate" if search.improved else "a pattern search on the exact check from it found no "
                         f"better point (steps down to {search.final_step:.0e} of each parameter's scale, "

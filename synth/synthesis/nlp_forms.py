@@ -111,10 +111,11 @@ def _sensitivity(b: NLPBuilder, req: Sensitivity | PeakSensitivity, plant: Plant
 
 @nlp_form(StaticSensitivity, exact=True)
 def _static_sensitivity(b: NLPBuilder, req: StaticSensitivity, plant: Plant, ctx: NLPContext) -> None:
-    dc = b.ctrl.dc()
-    if dc is not None:
+    parts = b.ctrl.dc_parts()
+    if parts is not None:  # |1 + g n/d| >= 1/m written as (d + g n)^2 >= d^2 / m^2: no division where d reaches 0
+        n, d = parts
         g = req.plant_gain if req.plant_gain is not None else plant.dc_gain()
-        b.geq(TIGHT / req.linear_bound("max_db") ** 2 * (1.0 + g * dc) ** 2 - 1.0)
+        b.geq(TIGHT / req.linear_bound("max_db") ** 2 * (d + g * n) ** 2 - d**2)
 
 
 @nlp_form(PeakComplementary, exact=True)

@@ -82,13 +82,19 @@ class SymbolicController:
     def dc(self) -> Any | None:
         """``C(0)`` (None with integral action). A PI or PID whose ``ki`` is fixed at 0 (the design without
         integral action) has none: ``C(0) = kp``."""
+        parts = self.dc_parts()
+        return None if parts is None else parts[0] if isinstance(parts[1], float) else parts[0] / parts[1]
+
+    def dc_parts(self) -> tuple[Any, Any] | None:
+        """``C(0)`` as ``(numerator, denominator)`` (None with integral action), so that a rational
+        controller's free ``a0`` may reach 0 (an integrator) without a division by zero in the NLP."""
         v = self.values
         if self.ctype == "P" or (self.ctype in ("PI", "PID") and self.fixed.get("ki") == 0.0):
-            return v["kp"]
+            return v["kp"], 1.0
         if self.ctype == "leadlag":
-            return v["k"] * v["z"] / v["p"]
+            return v["k"] * v["z"], v["p"]
         if self.ctype == RATIONAL and not (self.fixed.get("a0") == 0.0):
-            return v["b0"] / v["a0"]
+            return v["b0"], v["a0"]
         return None
 
     def integral_gain(self) -> Any:
@@ -172,12 +178,12 @@ def loop_response(ctrl: SymbolicController, plant: Plant, w: Any) -> tuple[Cx, C
 
 def t0_squared(ctrl: SymbolicController, plant: Plant) -> Any:
     """``|T(0)|^2`` in the symbols (1 with integral action, in the controller or in the plant)."""
-    dc = ctrl.dc()
+    parts = ctrl.dc_parts()
     g0 = plant.dc_gain()
-    if dc is None or not np.isfinite(g0):  # an integrator in the plant: T(0) = 1 for any controller gain
+    if parts is None or not np.isfinite(g0):  # an integrator in the plant: T(0) = 1 for any controller gain
         return 1.0
-    l0 = dc * g0
-    return (l0 / (1.0 + l0)) ** 2
+    n0 = parts[0] * g0  # T(0) = n G(0) / (d + n G(0)) with C(0) = n / d: 1 where d reaches 0 (an integrator)
+    return (n0 / (parts[1] + n0)) ** 2
 
 
 def phase_crossovers(loop: Loop) -> np.ndarray:

@@ -13,7 +13,8 @@ from dataclasses import asdict, dataclass
 __all__ = ["Optimality", "optimality_of"]
 
 _METHODS = {"convex": "the convex-concave iteration", "nlp": "the NLP polish (IPOPT)",
-            "nlp from screen": "the NLP polish (IPOPT) from a screened start"}
+            "nlp from screen": "the NLP polish (IPOPT) from a screened start",
+            "nlp from pattern search": "the NLP polish (IPOPT) from the pattern search's design"}
 
 
 @dataclass(frozen=True)
