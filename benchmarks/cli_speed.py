@@ -6,8 +6,11 @@ there, alternately baseline and current, and the best of ``--repeat`` runs is ke
 the minimum is the least disturbed run). Every command is run once untimed first on each side, so
 first-use work (the synthetic X-4 record, numba's compile cache, the identification kept on disk by
 :mod:`synth.ident.result_cache`) is excluded ("warm"); one row runs the main job with that cache off, so the
-identification is timed too. CPU time (user + system of the command) is printed beside the wall time: on a
-loaded machine it moves far less than the wall time.
+identification is timed too. Python's bytecode cache counts as first-use work too: the commands run without
+``PYTHONDONTWRITEBYTECODE`` (which some shells and containers set), so the warm-up writes ``__pycache__`` on
+both sides as an installed copy's first run does, and no timed run recompiles synth's modules. CPU time
+(user + system of the command) is printed beside the wall time: on a loaded machine it moves far less than
+the wall time.
 
 Run:  python benchmarks/cli_speed.py [--repeat 3] [--baseline-ref main | --baseline DIR] [--quick]
 """
@@ -109,7 +112,8 @@ def run(root: Path, args: list[str], tmp: Path) -> tuple[float, float]:
     extra = dict(a.split("=", 1) for a in args if "=" in a and a.split("=", 1)[0].isupper())
     args = [a for a in args if not ("=" in a and a.split("=", 1)[0].isupper())]
     argv = [sys.executable, "-m", "synth", *[a.replace("{out}", str(out / "r")) for a in args]]
-    env = {**os.environ, "PYTHONPATH": str(root), **extra}
+    env = {**{k: v for k, v in os.environ.items() if k != "PYTHONDONTWRITEBYTECODE"},  # as a user's install
+           "PYTHONPATH": str(root), **extra}
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
     t0 = time.perf_counter()
     proc = subprocess.run(argv, cwd=root, env=env, capture_output=True, text=True)
