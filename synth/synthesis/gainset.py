@@ -152,9 +152,9 @@ class ScalarFamily:
 
     def affine_parts(self, lo: float, hi: float):
         """``(C0, C1)`` with ``C = C0 + rho C1`` if the controller is affine in the parameter, else None."""
-        # three points inside (lo, hi]: at a zero gain the transfer function's form can differ (PI with ki = 0
-        # is kp / 1 for kp > 0 but 0 / s at kp = 0), which would hide an affine family
-        pts = lo + (hi - lo) * np.array([0.25, 0.5, 1.0]) if hi > lo else np.array([lo, lo + 1.0, lo + 2.0])
+        # three points inside (lo, hi), none at a round fraction: at a zero gain the transfer function's form
+        # can differ (PI with ki = 0 is kp / 1 for kp > 0 but 0 / s at kp = 0), which would hide an affine family
+        pts = lo + (hi - lo) * np.array([0.2871, 0.6213, 0.9137]) if hi > lo else np.array([lo, lo + 1.0, lo + 2.0])
         try:
             tfs = [self.controller(p).tf() for p in pts]
         except Exception:
