@@ -93,19 +93,14 @@ def welch_psd(signals: Sequence[np.ndarray], dt: float, segment: float | None = 
                         f"{need:.4g} s", where="psd")
     total, count = None, 0
     for x in signals:
-        p, k = _periodogram_mean(np.asarray(x, float), dt, nper, detrend)
+        x = np.asarray(x, float)
+        _, p = welch_density(x, dt, nper, nper - nper // 2, detrend)
+        k = 1 + (x.size - nper) // (nper - nper // 2)  # whole segments
         total = p * k if total is None else total + p * k
         count += k
     f = np.fft.rfftfreq(nper, dt)
     S = total / count / (2 * np.pi)
     return 2 * np.pi * f[1:], S[1:], count
-
-
-def _periodogram_mean(x: np.ndarray, dt: float, nper: int, detrend: str) -> tuple[np.ndarray, int]:
-    """One-sided PSD [unit^2/Hz] of ``x``: the mean of the periodograms of its whole ``nper``-sample segments
-    (hop ``nper - nper // 2``), each detrended and Hann-windowed (periodic window), and their count."""
-    spectra = segment_spectra(x, dt, nper, nper - nper // 2, detrend)
-    return _one_sided(np.mean(np.abs(spectra) ** 2, axis=0), nper), spectra.shape[0]
 
 
 def segment_spectra(x: np.ndarray, dt: float, nper: int, hop: int, detrend: str = "constant") -> np.ndarray:
@@ -139,9 +134,10 @@ def _one_sided(two_sided: np.ndarray, nper: int) -> np.ndarray:
     return out
 
 
-def welch_density(x: np.ndarray, dt: float, nper: int, hop: int) -> tuple[np.ndarray, np.ndarray]:
+def welch_density(x: np.ndarray, dt: float, nper: int, hop: int, detrend: str = "constant",
+                  ) -> tuple[np.ndarray, np.ndarray]:
     """One-sided Welch PSD [unit^2/Hz] of ``x`` on ``f`` [Hz] (DC included), segments of ``nper`` samples
-    ``hop`` apart, mean removed from each: ``scipy.signal.welch``'s density with a Hann window.
+    ``hop`` apart, each detrended: ``scipy.signal.welch``'s density with a Hann window.
 
     Examples
     --------
@@ -150,7 +146,7 @@ def welch_density(x: np.ndarray, dt: float, nper: int, hop: int) -> tuple[np.nda
     >>> float(f[1]), round(float(np.mean(p[1:-1])) / (2 * 0.01), 1)  # white, variance 1: p = 2 dt
     (0.2, 1.0)
     """
-    spectra = segment_spectra(x, dt, nper, hop)
+    spectra = segment_spectra(x, dt, nper, hop, detrend)
     return np.fft.rfftfreq(nper, dt), _one_sided(np.mean(np.abs(spectra) ** 2, axis=0), nper)
 
 

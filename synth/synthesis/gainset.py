@@ -386,15 +386,17 @@ def feasible_gain_set(
             return min(req.slack(Loop(p, c)) for p in plants)
         return f
 
+    narrow = _under_resolved(sets["stability"], lo, hi, n_bracket)
     fast = SlackBatch(family, plants)
     slack_fns = {}
     batch_fns = {}
     for name, req in zip(names, requirements):
         slack_fns[name] = slack_fn(req)
         batch_fns[name] = (lambda values, r=req: fast.slack(r, values)) if vectorized else None
-        sets[name] = _resolved_in_stable_intervals(
-            requirement_set(slack_fns[name], lo, hi, n_bracket, batch_fns[name]), sets["stability"], lo, hi,
-            lambda a, b, f=slack_fns[name], g=batch_fns[name]: requirement_set(f, a, b, n_bracket, g), n_bracket)
+        sets[name] = requirement_set(slack_fns[name], lo, hi, n_bracket, batch_fns[name])
+        for a, b in narrow:  # the feasible set lies inside the stabilizing set: resolve the requirement there
+            sets[name] = union(remove(sets[name], a, b), requirement_set(slack_fns[name], a, b, n_bracket,
+                                                                         batch_fns[name]))
 
     total: list[tuple[float, float]] = [(lo, hi)]
     for ivs in sets.values():
@@ -417,18 +419,12 @@ MIN_POINTS_INSIDE = 20
 trusted there; a narrower one is bracketed on a grid of its own."""
 
 
-def _resolved_in_stable_intervals(ivs: list[tuple[float, float]], stable: list[tuple[float, float]], lo: float,
-                                  hi: float, inside: Callable[[float, float], list[tuple[float, float]]],
-                                  n: int) -> list[tuple[float, float]]:
-    """A requirement's set ``ivs`` (bracketed over ``[lo, hi]``) with each stabilizing interval that the grid
-    resolves with fewer than :data:`MIN_POINTS_INSIDE` points bracketed again on a grid of its own
-    (``inside(a, b)``): the feasible set lies inside the stabilizing set, so that is where the requirements
-    must be resolved (a stabilizing interval of 1e-5 of the range holds no point of the whole range's grid)."""
+def _under_resolved(stable: list[tuple[float, float]], lo: float, hi: float, n: int) -> list[tuple[float, float]]:
+    """The stabilizing intervals that the bracketing grid over ``[lo, hi]`` (``n`` points) resolves with fewer
+    than :data:`MIN_POINTS_INSIDE` points (a stabilizing interval of 1e-5 of the range holds none): each
+    requirement is bracketed again on a grid of its own there."""
     grid = _grid(lo, hi, n)
-    for a, b in stable:
-        if b > a and np.count_nonzero((grid > a) & (grid < b)) < MIN_POINTS_INSIDE:
-            ivs = union(remove(ivs, a, b), inside(a, b))
-    return ivs
+    return [(a, b) for a, b in stable if b > a and np.count_nonzero((grid > a) & (grid < b)) < MIN_POINTS_INSIDE]
 
 
 def _binding(x: float, sets: dict[str, list[tuple[float, float]]], lo: float, hi: float,
