@@ -77,22 +77,46 @@ def screen_points(spec: Spec, n: int = SCREEN_POINTS) -> list[Controller]:
     return [Controller(kind, {k: float(columns[k][i]) for k in names}) for i in range(n + 2 * extra)]
 
 
-def _pick(order: list[int], n: int, keep: int, usable: Callable[[int], bool]) -> list[int]:
+def _pick(order: list[int], n: int, keep: int, usable: Callable[[int], bool],
+          key: Callable[[int], object] = lambda i: i) -> list[int]:
     """The first ``keep`` usable indices of ``order`` among the drawn points (``< n``), and the first usable
     one among each group of pinned copies (at lower bounds, ``n .. n + n // 3``; at upper bounds, after): the
-    pinned points add starts, they never displace one."""
+    pinned points add starts, they never displace one. An index whose ``key`` (its controller's parameters)
+    equals a picked one's is passed over: a copy whose draw pinned no parameter is its original again, and a
+    second polish from it would repeat the first.
+
+    Examples
+    --------
+    >>> _pick([0, 4, 1, 5], 4, 2, lambda i: True)
+    [0, 1, 4, 5]
+    >>> _pick([0, 4, 1, 5], 4, 2, lambda i: True, key=lambda i: i % 4)  # copy 4 is point 0 again, 5 is 1
+    [0, 1]
+    """
+    picked: set[object] = set()
+
+    def take(i: int) -> bool:
+        if key(i) in picked or not usable(i):
+            return False
+        picked.add(key(i))
+        return True
+
     drawn = [i for i in order if i < n]
     out: list[int] = []
     for i in drawn:
         if len(out) == keep:
             break
-        if usable(i):
+        if take(i):
             out.append(i)
     extra = max(n // 3, 1)
     for group in range(2):
         pinned = (i for i in order if n + group * extra <= i < n + (group + 1) * extra)
-        out += next(([i] for i in pinned if usable(i)), [])
+        out += next(([i] for i in pinned if take(i)), [])
     return out
+
+
+def _parameters(controllers: list[Controller]) -> Callable[[int], object]:
+    """The key of :func:`_pick`: controller ``i``'s parameter values."""
+    return lambda i: tuple(sorted(controllers[i].parameters.items()))
 
 
 def screen_starts(spec: Spec, keep: int = 3, n: int = SCREEN_POINTS) -> list[Controller]:
@@ -122,7 +146,8 @@ def screen_starts(spec: Spec, keep: int = 3, n: int = SCREEN_POINTS) -> list[Con
                 slack = np.asarray(req.batch_slack(batch, 20), float)
             worst = np.fmin(worst, np.where(np.isnan(slack), -np.inf, slack))
     order = [int(i) for i in np.argsort(-worst, kind="stable")]
-    return [controllers[i] for i in _pick(order, n, keep, lambda i: bool(np.isfinite(worst[i]) or worst[i] > 0))]
+    return [controllers[i] for i in _pick(order, n, keep, lambda i: bool(np.isfinite(worst[i]) or worst[i] > 0),
+                                          _parameters(controllers))]
 
 
 def screen_improving(spec: Spec, terms: list[tuple[str, str, float]], above: float, keep: int = 2,
@@ -164,7 +189,7 @@ def screen_improving(spec: Spec, terms: list[tuple[str, str, float]], above: flo
     order = [i for _, i in sorted(scored, reverse=True)]
     meets_heavy = _InScoreOrder(order, n, lambda chunk: _meeting(controllers, chunk, heavy, plants))
     return [controllers[i] for i in _pick(order, n, keep, lambda i: meets_heavy(i) and all(
-        Loop(p, controllers[i]).stability().stable for p in plants))]
+        Loop(p, controllers[i]).stability().stable for p in plants), _parameters(controllers))]
 
 
 class _InScoreOrder:
