@@ -34,6 +34,7 @@ from synth.errors import SynthError
 from synth.plant import Plant
 from synth.requirements.base import Requirement, magnitude
 from synth.stability import closed_loop_stability, stability_floor
+from synth.synthesis.axis_starts import SCANNED_TYPES, axis_starts
 from synth.synthesis.convex_forms import (
     T0,
     Form,
@@ -57,6 +58,9 @@ _OK = {cp.OPTIMAL, cp.OPTIMAL_INACCURATE}
 GRID_TOLERANCE = 1e-9
 """Largest relative violation of a (backed-off) form on the design grid that still counts as met: the
 solver meets the linearized cones to its own accuracy, and every form is tightened by 1e-4."""
+
+RANDOM_STARTS = 300
+"""Random controllers drawn for a stabilizing start, and as many with half their parameters at the lower bounds."""
 
 
 class ConvexDesigner:
@@ -267,16 +271,20 @@ class ConvexDesigner:
         lo, hi = self.par.box()
         rng = np.random.default_rng(seed)
         candidates = itertools.chain([np.clip(initial, lo, hi)] if initial is not None else [], [self.par.start()],
-                                     (self.par.random(rng) for _ in range(300)),
-                                     (self._pinned(self.par.random(rng), lo, rng) for _ in range(300)))
+                                     (self.par.random(rng) for _ in range(RANDOM_STARTS)),
+                                     (self._pinned(self.par.random(rng), lo, rng) for _ in range(RANDOM_STARTS)),
+                                     axis_starts(self.par, self.plants))  # a thin stabilizing slab
         any_found = False
         for c in candidates:
             if c is not None and self._stable(np.asarray(c, float)):
                 any_found = True
                 yield np.asarray(c, float)
         if not any_found:
-            raise SynthError("found no stabilizing controller in the bounds to start from; give "
-                             "controller.initial or widen the bounds", where="controller")
+            scanned = " and the exact stabilizing set of each gain alone, the others at 0," \
+                if self.par.ctype in SCANNED_TYPES else ""
+            raise SynthError(f"found no stabilizing controller to start from: {2 * RANDOM_STARTS} random "
+                             f"controllers in the bounds{scanned} gave none; give controller.initial or widen "
+                             "the bounds", where="controller")
 
     @staticmethod
     def _pinned(c: np.ndarray | None, lo: np.ndarray, rng: np.random.Generator) -> np.ndarray | None:

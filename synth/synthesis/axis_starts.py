@@ -1,0 +1,69 @@
+"""Stabilizing starts from exact one-parameter scans: each gain alone, the others at zero.
+
+The convex stage needs a stabilizing controller to start from, and draws them at random in the bounds. Where
+the stabilizing set is a thin slab of the box that random draws miss, such as a plant with an unstable pole
+left of a right-half-plane zero that only a negative gain in a narrow range stabilizes, the exact
+stabilizing set of each gain alone (the other gains at the value nearest zero in their bounds, the
+structural parameters as fixed by the parametrization) is computed by D-decomposition
+(:func:`synth.synthesis.gainset.stability_set`) and the middle of every interval is offered as a start.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+
+import numpy as np
+
+from synth.plant import Plant
+from synth.synthesis.gainset import ScalarFamily, stability_set
+from synth.synthesis.parametrization import Parametrization
+
+__all__ = ["axis_starts", "interval_middle"]
+
+SCANNED_TYPES = ("P", "PI", "PID")
+"""Controller types whose convex parameters are their own gains (a lead-lag's are ``k`` and ``k z``)."""
+
+
+def interval_middle(lo: float, hi: float) -> float:
+    """A point well inside ``[lo, hi]``: the geometric middle of an interval of one sign spanning more than a
+    factor 10, else the arithmetic middle.
+
+    Examples
+    --------
+    >>> interval_middle(-2.0, -1.5), interval_middle(1e-4, 1.0)
+    (-1.75, 0.01)
+    """
+    if lo * hi > 0 and max(abs(lo), abs(hi)) > 10 * min(abs(lo), abs(hi)):
+        return float(np.sign(lo) * np.sqrt(lo * hi))
+    return 0.5 * (lo + hi)
+
+
+def axis_starts(par: Parametrization, plants: list[Plant]) -> Iterator[np.ndarray]:
+    """``rho`` at the middle of every exact stabilizing interval of each gain alone (see the module
+    docstring), gain by gain, for P, PI and PID controllers (nothing for other types).
+
+    Examples
+    --------
+    >>> from synth.synthesis.parametrization import parametrize
+    >>> par = parametrize("PID", {"kp": (-10, 10), "ki": (-5, 5), "kd": (0, 1), "tf": (0.01, 0.01)})
+    >>> starts = list(axis_starts(par, [Plant.from_string("(s-2)/((s-1)*(s+3))")]))
+    >>> [float(v) for v in starts[0].round(6)]  # kp in (-2, -1.5) alone stabilizes
+    [-1.75, 0.0, 0.0]
+    """
+    if par.ctype not in SCANNED_TYPES:
+        return
+    lo, hi = par.box()
+    nearest_zero = np.clip(0.0, lo, hi)
+    for i, name in enumerate(par.names):
+        if not (np.isfinite(lo[i]) and np.isfinite(hi[i])) or lo[i] >= hi[i]:
+            continue
+        fixed = {**par.fixed, **{n: float(nearest_zero[j]) for j, n in enumerate(par.names) if j != i}}
+        family = ScalarFamily(par.ctype, name, fixed)
+        try:
+            intervals = stability_set(family, plants, float(lo[i]), float(hi[i]))
+        except (ArithmeticError, ValueError, RuntimeError):
+            continue
+        for a, b in intervals:
+            rho = nearest_zero.astype(float).copy()
+            rho[i] = interval_middle(a, b)
+            yield rho
