@@ -15,6 +15,7 @@ import gc
 import importlib
 import pkgutil
 import sys
+import warnings
 from collections.abc import Sequence
 
 from synth.errors import SynthError
@@ -87,7 +88,12 @@ def main(argv: Sequence[str] | None = None) -> int:
         parser.print_help()
         return EXIT_BAD_INPUT
     try:
-        return int(args._run(args))
+        with warnings.catch_warnings():
+            if not sys.warnoptions:  # the libraries' numerical warnings (cvxpy's "may be inaccurate" on one
+                # convex step, numpy's overflow while a trial design is simulated) are not the user's to act on:
+                # every verdict says what it rests on; -W or PYTHONWARNINGS shows them
+                warnings.simplefilter("ignore")
+            return int(args._run(args))
     except SynthError as exc:
         print(f"synth {args.command}: error: {exc}", file=sys.stderr)
         return EXIT_BAD_INPUT
