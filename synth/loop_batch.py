@@ -13,6 +13,14 @@ import numpy as np
 from synth.controllers import Controller, as_controller
 from synth.freqgrid import corner_frequencies, log_grids
 from synth.plant import Plant, as_plant
+from synth.polynomial_rows import (
+    pad_sub,
+    row_axis_parts,
+    row_magnitude_squared,
+    row_poly_product,
+    row_product,
+    row_roots,
+)
 from synth.polynomials import dc_value
 from synth.rootfind import bisect_roots
 
@@ -96,8 +104,8 @@ class LoopBatch:
 
     def _set_plant(self, plant: Plant) -> None:
         self.plant = plant
-        self.num = _row_product(self.cnum, plant.num)
-        self.den = _row_product(self.cden, plant.den)
+        self.num = row_product(self.cnum, plant.num)
+        self.den = row_product(self.cden, plant.den)
         self._l0 = dc_value(self.num, self.den)  # L(0), the exact limit (s cancels first)
         p_lo, p_hi = corner_frequencies(plant.num, plant.den)
         if plant.delay > 0:
@@ -283,9 +291,9 @@ class LoopBatch:
         >>> [w.round(4) for w in b.gain_crossovers()]
         [array([9.9499]), array([], dtype=float64)]
         """
-        q = _pad_sub(_row_magnitude_squared(self.num), _row_magnitude_squared(self.den))
+        q = pad_sub(row_magnitude_squared(self.num), row_magnitude_squared(self.den))
         out = []
-        for r in _row_roots(q):
+        for r in row_roots(q):
             keep = (np.abs(r.imag) <= 1e-9 * (1 + np.abs(r.real))) & (r.real > 0)
             out.append(np.sort(np.sqrt(r[keep].real)))
         return out
@@ -372,10 +380,10 @@ class LoopBatch:
     def _rational_boundary_gains(self) -> np.ndarray:
         """Without a delay: ``-1/L(jw)`` at every exact phase crossover with ``Re L < 0`` (real roots of
         ``Im num(jw) conj(den(jw))``, batched polynomial roots), one row per loop, NaN-padded."""
-        nr, ni = _row_axis_parts(self.num)
-        dr, di = _row_axis_parts(self.den)
-        h = _pad_sub(_row_poly_product(ni, dr), _row_poly_product(nr, di))
-        roots = _row_roots(h)
+        nr, ni = row_axis_parts(self.num)
+        dr, di = row_axis_parts(self.den)
+        h = pad_sub(row_poly_product(ni, dr), row_poly_product(nr, di))
+        roots = row_roots(h)
         rows = np.concatenate([np.full(r.size, i) for i, r in enumerate(roots)]).astype(int)
         if rows.size == 0:
             return np.full((len(self), 1), np.nan)
@@ -430,7 +438,7 @@ def _row_corners(*rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     n = rows[0].shape[0]
     lo, hi = np.full(n, np.inf), np.full(n, -np.inf)
     for r in rows:
-        for i, roots in enumerate(_row_roots(r)):
+        for i, roots in enumerate(row_roots(r)):
             mags = np.abs(roots)
             mags = mags[mags > 1e-12]
             if mags.size:
@@ -449,64 +457,16 @@ def _ragged(rows: np.ndarray, values: np.ndarray, n: int) -> np.ndarray:
     return out
 
 
-def _row_magnitude_squared(rows: np.ndarray) -> np.ndarray:
-    """Row-wise :func:`synth.polynomials.magnitude_squared_in_w2` (zero-padded on the left)."""
-    k = rows.shape[1]
-    mirrored = rows * (-1.0) ** np.arange(k - 1, -1, -1)
-    q = np.zeros((rows.shape[0], 2 * k - 1))
-    for j in range(k):
-        q[:, j:j + k] += rows * mirrored[:, j:j + 1]
-    even = q[:, ::-1][:, 0::2] * (-1.0) ** np.arange((2 * k) // 2)
-    return even[:, ::-1]
 
 
-def _row_axis_parts(rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Real and imaginary parts of ``p(jw)`` as real polynomials in ``w`` (row-wise)."""
-    k = rows.shape[1]
-    power = np.arange(k - 1, -1, -1)
-    unit = 1j ** power
-    return rows * np.round(unit.real), rows * np.round(unit.imag)
 
 
-def _row_poly_product(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    out = np.zeros((a.shape[0], a.shape[1] + b.shape[1] - 1))
-    for j in range(b.shape[1]):
-        out[:, j:j + a.shape[1]] += a * b[:, j:j + 1]
-    return out
 
 
-def _pad_sub(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    width = max(a.shape[1], b.shape[1])
-    return np.pad(a, ((0, 0), (width - a.shape[1], 0))) - np.pad(b, ((0, 0), (width - b.shape[1], 0)))
 
 
-def _row_roots(rows: np.ndarray) -> list[np.ndarray]:
-    """Roots of each row's polynomial (leading zeros dropped), one batched eigenvalue problem per degree."""
-    lead = np.argmax(rows != 0, axis=1)
-    zero = ~np.any(rows != 0, axis=1)
-    degree = np.where(zero, 0, rows.shape[1] - 1 - lead)
-    out: list[np.ndarray] = [np.zeros(0, complex)] * rows.shape[0]
-    for d in np.unique(degree):
-        sel = np.flatnonzero(degree == d)
-        if d < 1:
-            continue
-        coeffs = np.array([rows[i, lead[i]:] for i in sel])
-        comp = np.zeros((len(sel), d, d))
-        comp[:, 0, :] = -coeffs[:, 1:] / coeffs[:, :1]
-        comp[:, np.arange(1, d), np.arange(d - 1)] = 1.0
-        roots = np.linalg.eigvals(comp)
-        for j, i in enumerate(sel):
-            out[i] = roots[j]
-    return out
 
 
-def _row_product(rows: np.ndarray, poly: np.ndarray) -> np.ndarray:
-    """Each row's polynomial times ``poly`` (rows zero-padded on the left)."""
-    poly = np.asarray(poly, dtype=float)
-    out = np.zeros((rows.shape[0], rows.shape[1] + poly.size - 1))
-    for j, c in enumerate(poly):
-        out[:, j:j + rows.shape[1]] += rows * c
-    return out
 
 
 def _infinite(x: np.ndarray) -> np.ndarray:

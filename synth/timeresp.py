@@ -6,7 +6,7 @@ loop is simulated on a fine grid whose step divides the delay and is at most
 1/20000 of the horizon and :data:`STEP_PER_CROSSOVER` over the highest
 gain-crossover frequency, the plant and controller held constant over each
 step (zero-order hold); the error is of the order of the step and the step is
-reported. Long runs are compiled (:mod:`synth.sim.linear_step`).
+reported. Long runs are compiled (:mod:`synth.delayed_step`).
 """
 
 from __future__ import annotations
@@ -175,7 +175,7 @@ def _delayed_step(loop: Loop, t_end: float, n: int) -> tuple[np.ndarray, np.ndar
         if steps <= NUMPY_STEPS:
             y_hist = _loop_in_numpy(*args)
         else:
-            from synth.sim.linear_step import delayed_loop  # numba: compiled once, cached on disk
+            from synth.delayed_step import delayed_loop  # numba: compiled once, cached on disk
 
             y_hist = delayed_loop(*args)
     t_sim = np.arange(steps + 1) * dt
@@ -184,7 +184,7 @@ def _delayed_step(loop: Loop, t_end: float, n: int) -> tuple[np.ndarray, np.ndar
 
 
 def _loop_in_numpy(Ac, Bc, Cc, Dc, Ap, Bp, Cp, Dp, m: int, steps: int) -> np.ndarray:
-    """:func:`synth.sim.linear_step.delayed_loop` in numpy, step by step (no compilation, nor numba's import)."""
+    """:func:`synth.delayed_step.delayed_loop` in numpy, step by step (no compilation, nor numba's import)."""
     xc = np.zeros(Ac.shape[0])
     xp = np.zeros(Ap.shape[0])
     buffer = np.zeros(m)  # u[k - m] is read at step k

@@ -22,7 +22,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from synth.sim._jit import jit
+from synth.jit import jit
 from synth.sim._steps import block_step
 from synth.sim.layout import NOISE, SENSOR_BIT
 

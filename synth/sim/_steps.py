@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from synth.sim._jit import jit
+from synth.jit import jit
 from synth.sim.layout import (
     BACKLASH,
     DEAD_ZONE,

@@ -30,7 +30,7 @@ from typing import Any
 
 import numpy as np
 
-from synth.sim._jit import jit
+from synth.jit import jit
 
 __all__ = ["REPEAT", "SAMPLED_HYSTERESIS", "Oscillation", "cycle_table", "detect_oscillation", "repeats",
            "repetition_error"]

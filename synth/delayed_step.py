@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from synth.sim._jit import jit
+from synth.jit import jit
 
 __all__ = ["delayed_loop"]
 

@@ -12,6 +12,8 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Any
 
+__all__ = ["HAVE_NUMBA", "jit"]
+
 try:  # pragma: no cover - exercised implicitly
     from numba import njit as _njit
 

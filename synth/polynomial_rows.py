@@ -1,0 +1,106 @@
+"""Polynomials as the rows of one array (highest power first, zero-padded on the left): products, roots and
+magnitudes of many polynomials at once (:class:`synth.loop_batch.LoopBatch`)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = ["pad_sub", "row_axis_parts", "row_magnitude_squared", "row_poly_product", "row_product", "row_roots"]
+
+
+def row_magnitude_squared(rows: np.ndarray) -> np.ndarray:
+    """Row-wise :func:`synth.polynomials.magnitude_squared_in_w2`: ``|p(jw)|^2`` as a polynomial in ``w^2``.
+
+    Examples
+    --------
+    >>> row_magnitude_squared(np.array([[1.0, 2.0]])).tolist()  # |jw + 2|^2 = w^2 + 4
+    [[1.0, 4.0]]
+    """
+    k = rows.shape[1]
+    mirrored = rows * (-1.0) ** np.arange(k - 1, -1, -1)
+    q = np.zeros((rows.shape[0], 2 * k - 1))
+    for j in range(k):
+        q[:, j:j + k] += rows * mirrored[:, j:j + 1]
+    even = q[:, ::-1][:, 0::2] * (-1.0) ** np.arange((2 * k) // 2)
+    return even[:, ::-1]
+
+
+def row_axis_parts(rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Real and imaginary parts of ``p(jw)`` as real polynomials in ``w`` (row-wise).
+
+    Examples
+    --------
+    >>> [a.tolist() for a in row_axis_parts(np.array([[1.0, 2.0]]))]  # jw + 2: real 2, imaginary w
+    [[[0.0, 2.0]], [[1.0, 0.0]]]
+    """
+    k = rows.shape[1]
+    power = np.arange(k - 1, -1, -1)
+    unit = 1j ** power
+    return rows * np.round(unit.real), rows * np.round(unit.imag)
+
+
+def row_poly_product(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Row ``i`` of ``a`` times row ``i`` of ``b``.
+
+    Examples
+    --------
+    >>> row_poly_product(np.array([[1.0, 1.0]]), np.array([[1.0, 2.0]])).tolist()  # (s + 1)(s + 2)
+    [[1.0, 3.0, 2.0]]
+    """
+    out = np.zeros((a.shape[0], a.shape[1] + b.shape[1] - 1))
+    for j in range(b.shape[1]):
+        out[:, j:j + a.shape[1]] += a * b[:, j:j + 1]
+    return out
+
+
+def pad_sub(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """``a - b`` row by row, the narrower one zero-padded on the left.
+
+    Examples
+    --------
+    >>> pad_sub(np.array([[1.0, 0.0, 1.0]]), np.array([[2.0, 3.0]])).tolist()
+    [[1.0, -2.0, -2.0]]
+    """
+    width = max(a.shape[1], b.shape[1])
+    return np.pad(a, ((0, 0), (width - a.shape[1], 0))) - np.pad(b, ((0, 0), (width - b.shape[1], 0)))
+
+
+def row_roots(rows: np.ndarray) -> list[np.ndarray]:
+    """Roots of each row's polynomial (leading zeros dropped), one batched eigenvalue problem per degree.
+
+    Examples
+    --------
+    >>> [np.sort(r.real).round(6).tolist() for r in row_roots(np.array([[0.0, 1.0, 1.0], [1.0, 3.0, 2.0]]))]
+    [[-1.0], [-2.0, -1.0]]
+    """
+    lead = np.argmax(rows != 0, axis=1)
+    zero = ~np.any(rows != 0, axis=1)
+    degree = np.where(zero, 0, rows.shape[1] - 1 - lead)
+    out: list[np.ndarray] = [np.zeros(0, complex)] * rows.shape[0]
+    for d in np.unique(degree):
+        sel = np.flatnonzero(degree == d)
+        if d < 1:
+            continue
+        coeffs = np.array([rows[i, lead[i]:] for i in sel])
+        comp = np.zeros((len(sel), d, d))
+        comp[:, 0, :] = -coeffs[:, 1:] / coeffs[:, :1]
+        comp[:, np.arange(1, d), np.arange(d - 1)] = 1.0
+        roots = np.linalg.eigvals(comp)
+        for j, i in enumerate(sel):
+            out[i] = roots[j]
+    return out
+
+
+def row_product(rows: np.ndarray, poly: np.ndarray) -> np.ndarray:
+    """Each row's polynomial times ``poly`` (rows zero-padded on the left).
+
+    Examples
+    --------
+    >>> row_product(np.array([[1.0, 1.0]]), np.array([2.0, 0.0])).tolist()  # (s + 1) 2s
+    [[2.0, 2.0, 0.0]]
+    """
+    poly = np.asarray(poly, dtype=float)
+    out = np.zeros((rows.shape[0], rows.shape[1] + poly.size - 1))
+    for j, c in enumerate(poly):
+        out[:, j:j + rows.shape[1]] += rows * c
+    return out
