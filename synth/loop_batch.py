@@ -5,7 +5,6 @@ the report's slack curves and feasibility maps (see :meth:`synth.requirements.ba
 
 from __future__ import annotations
 
-from functools import cached_property
 from typing import Any
 
 import numpy as np
@@ -112,25 +111,8 @@ class LoopBatch:
             p_lo, p_hi = min(p_lo, 1.0 / plant.delay), max(p_hi, 1.0 / plant.delay)
         lo, hi = np.fmin(self._corner_lo, p_lo), np.fmax(self._corner_hi, p_hi)
         none = np.isnan(lo)
-        self._corner_ranges = np.column_stack([np.where(none, 1e-2, lo / 100.0), np.where(none, 1e2, hi * 100.0)])
-        self.__dict__.pop("frequency_ranges", None)
-
-    @cached_property
-    def frequency_ranges(self) -> np.ndarray:
-        """Each loop's :attr:`Loop.frequency_range`, ``(n, 2)``: two decades beyond its corners, ``1/delay`` and
-        its gain crossovers.
-
-        Examples
-        --------
-        >>> b = LoopBatch(Plant.from_string("1.15/s"), [Controller("PI", {"kp": 1.46, "ki": 0.00168})])
-        >>> bool(b.frequency_ranges[0, 1] > 100 * 1.67)  # the crossover, above the integral corner's range
-        True
-        """
-        ranges = self._corner_ranges.copy()
-        for i, crossovers in enumerate(self.gain_crossovers()):
-            if crossovers.size:
-                ranges[i] = min(ranges[i, 0], crossovers[0] / 100.0), max(ranges[i, 1], crossovers[-1] * 100.0)
-        return ranges
+        self.frequency_ranges = np.column_stack([np.where(none, 1e-2, lo / 100.0), np.where(none, 1e2, hi * 100.0)])
+        """Each loop's :attr:`Loop.frequency_range`, ``(n, 2)``."""
 
     def closed_loop_unstable(self) -> np.ndarray:
         """Per loop, whether a closed-loop root lies in the closed right half-plane (exact, by count:
