@@ -95,9 +95,10 @@ def _pick(order: list[int], n: int, keep: int, usable: Callable[[int], bool],
     picked: set[object] = set()
 
     def take(i: int) -> bool:
-        if key(i) in picked or not usable(i):
+        k = key(i)
+        if k in picked or not usable(i):
             return False
-        picked.add(key(i))
+        picked.add(k)
         return True
 
     drawn = [i for i in order if i < n]
