@@ -9,9 +9,11 @@ reference's dense check of synth's design. Outcomes:
 - ``false feasible``: synth's design fails the reference's dense check (slack below ``-TOL``); when the
   only failure is a closed-loop pole within the reference's ``eps`` of the imaginary axis that a check with
   ``eps`` a million times smaller calls stable, it is counted apart ("pole within eps of the axis");
-- ``undetermined``: synth found a design that failed its own dense re-check, or hit the time limit (CPU
-  time of the process, so that the outcome does not depend on the machine's load);
-- ``declined``: synth answered with one of its one-line errors (e.g. no stabilizing start found);
+- ``undetermined``: synth's design answered "undetermined" (it found no stabilizing start, or its best design
+  failed its own dense re-check), or hit the time limit (CPU time of the process, so that the outcome does not
+  depend on the machine's load);
+- ``declined``: synth answered with one of its one-line errors (records made before the "undetermined" answer
+  hold "no stabilizing start found" here);
 - ``error``: synth raised anything else (a crash);
 - ``agree``: both feasible (objective compared) or both infeasible (the reference's failure to find a
   point is evidence, not proof);
@@ -96,7 +98,7 @@ def run_problem(p: Problem, *, time_limit: float = 120.0, budget: float = 1.0,
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             d = synth.design(synth.parse_spec(p.spec))
-        rec["synth_status"] = "feasible" if d.feasible else "infeasible"
+        rec["synth_status"] = d.status  # feasible, infeasible or undetermined
         rec["synth_verdict"] = d.verdict
         rec["synth_optimality"] = (d.extras or {}).get("optimality")
     except _TimeoutError:
@@ -132,8 +134,6 @@ def run_problem(p: Problem, *, time_limit: float = 120.0, budget: float = 1.0,
             rec["synth_stable_with_eps_1e-12"] = check_point(p.num, p.den, p.delay, p.spec, params, 1e-12).stable
         if p.spec.get("objective") and r.feasible and e.objective is not None:
             rec["objective_gap"] = _gap(p.spec, r.best.objective, e.objective)  # type: ignore[union-attr]
-    if d is not None and not d.feasible and "failed the dense re-check" in (d.verdict or ""):
-        rec["synth_status"] = "undetermined"
     if r.feasible and rec["synth_status"] != "feasible":
         try:
             with warnings.catch_warnings():

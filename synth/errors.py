@@ -8,7 +8,7 @@ wrong, so the command line can print it as-is and exit with code 2.
 
 from __future__ import annotations
 
-__all__ = ["DataError", "FitError", "ModelError", "OutputExistsError", "SpecError", "SynthError"]
+__all__ = ["DataError", "FitError", "ModelError", "NoStabilizingStartError", "OutputExistsError", "SpecError", "SynthError"]
 
 
 class SynthError(Exception):
@@ -62,6 +62,21 @@ class DataError(SynthError):
 
 class OutputExistsError(SynthError):
     """Writing would overwrite a file that synth did not write."""
+
+
+class NoStabilizingStartError(SynthError):
+    """A search of the controller's bounds found no controller that stabilizes the loop.
+
+    Not bad input: the spec is valid, and the bounds may hold no stabilizing controller at all. The
+    message says what was searched; :func:`synth.design.design` turns it into an "undetermined" design
+    verdict (exit 3 from the command line), since a search that found nothing proves nothing.
+
+    Examples
+    --------
+    >>> err = NoStabilizingStartError("600 random controllers in the bounds gave none", where="controller")
+    >>> isinstance(err, SynthError), str(err)
+    (True, 'controller: 600 random controllers in the bounds gave none')
+    """
 
 
 class FitError(SynthError, RuntimeError):

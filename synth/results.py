@@ -23,6 +23,7 @@ if TYPE_CHECKING:
 
 __all__ = [
     "CERTIFICATE_PER_DECADE",
+    "DESIGN_STATUSES",
     "SEARCH_PER_DECADE",
     "Certificate",
     "DesignResult",
@@ -77,6 +78,10 @@ class Certificate:
         }
 
 
+DESIGN_STATUSES = ("feasible", "infeasible", "undetermined")
+"""The answers of a design: found and certified; shown impossible as far as searched; not decided."""
+
+
 @dataclass
 class DesignResult:
     """Outcome of :func:`synth.design.design`.
@@ -108,13 +113,19 @@ class DesignResult:
         Plain-language summary.
     extras : dict
         Method-specific records (the convex and NLP stages, a diagnosis), merged into :meth:`to_dict`.
+    status : str
+        ``"feasible"``, ``"infeasible"`` (the search's evidence says no controller in the bounds meets
+        the requirements) or ``"undetermined"`` (the search could not decide: no stabilizing controller
+        was found to start from, or the best design failed its dense re-check). Defaults from ``feasible``.
 
     Examples
     --------
     >>> from synth.controllers import Controller
     >>> r = DesignResult("demo", True, Controller("P", {"kp": 3.0}), None, None, None, None, verdict="ok")
     >>> sorted(r.to_dict())
-    ['controller', 'feasible', 'method', 'objective', 'requirements', 'spec', 'verdict']
+    ['controller', 'feasible', 'method', 'objective', 'requirements', 'spec', 'status', 'verdict']
+    >>> DesignResult("demo", False, None, None, None, None, None, status="undetermined").status
+    'undetermined'
     """
 
     spec: str
@@ -129,6 +140,13 @@ class DesignResult:
     verdict: str = ""
     reference: CheckResult | None = None
     extras: dict[str, Any] = field(default_factory=dict)
+    status: str = ""
+
+    def __post_init__(self) -> None:
+        if not self.status:
+            self.status = "feasible" if self.feasible else "infeasible"
+        if self.status not in DESIGN_STATUSES or (self.status == "feasible") != self.feasible:
+            raise ValueError(f"status {self.status!r} does not go with feasible={self.feasible}")
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready dict; ``requirements`` and ``gain_set`` at top level as the CLI contract asks."""
@@ -136,6 +154,7 @@ class DesignResult:
         out: dict[str, Any] = {
             "spec": self.spec,
             "feasible": self.feasible,
+            "status": self.status,
             "verdict": self.verdict,
             "method": self.method,
             "controller": self.controller.to_dict() if self.controller else None,

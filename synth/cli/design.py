@@ -8,7 +8,7 @@ import sys
 from pathlib import Path
 from typing import Any
 
-__all__ = ["COMMAND", "DESCRIPTION", "HELP", "ORDER", "add_arguments", "run"]
+__all__ = ["COMMAND", "DESCRIPTION", "EXIT_CODES", "HELP", "ORDER", "add_arguments", "run"]
 
 COMMAND = "design"
 ORDER = 20
@@ -24,7 +24,13 @@ example:
   synth design specs/x4_rotor.yaml
   synth design specs/x4_rotor_strict.yaml --json strict.json
 
-exit codes: 0 designed, 1 infeasible, 2 bad input"""
+exit codes: 0 designed, 1 infeasible, 2 bad input, 3 undetermined (no
+stabilizing controller found to start from, or the best design failed its
+dense re-check: the search could not decide)"""
+
+
+EXIT_CODES = {"feasible": 0, "infeasible": 1, "undetermined": 3}
+"""The command's exit code for each design status (2 is bad input)."""
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
@@ -106,7 +112,7 @@ def run(args: argparse.Namespace) -> int:
             sys.stdout.write(dump_json(payload))
         else:
             write_json(args.json, payload, force=args.force)
-    say(f"{spec.name}: {'FEASIBLE' if result.feasible else 'INFEASIBLE'}")
+    say(f"{spec.name}: {result.status.upper()}")
     say(result.verdict)
     if result.gain_set is not None:
         gs = result.gain_set
@@ -120,4 +126,4 @@ def run(args: argparse.Namespace) -> int:
         print_requirements(shown.requirements, list(spec.requirements), sys.stdout)
     if not args.no_report:
         say(f"\nreport: {out_dir / 'report.html'}")
-    return 0 if result.feasible else 1
+    return EXIT_CODES[result.status]

@@ -82,7 +82,8 @@ def run(args: argparse.Namespace) -> int:
     elif args.json:
         write_json(args.json, result.to_dict(), force=args.force)
     if not args.quiet and args.json != "-":
-        rows = [[*(fmt(p.values[s.path]) for s in sweeps), "yes" if p.feasible else "no", fmt(p.objective),
+        rows = [[*(fmt(p.values[s.path]) for s in sweeps), {"feasible": "yes", "infeasible": "no"}.get(p.status, p.status),
+                 fmt(p.objective),
                  ", ".join(p.binding), "*" if p.pareto else ""] for p in result.points]
         print(table([s.path for s in sweeps] + ["feasible", "objective", "binding", "Pareto"], rows))
         print(f"\n{sum(p.feasible for p in result.points)} of {len(result.points)} feasible; "

@@ -16,7 +16,7 @@ from synth.reference import compare
 from synth.report import figures
 from synth.report.templating import render, reproducible, unit_text
 from synth.requirements import SlewRate
-from synth.requirements.base import Requirement, fmt
+from synth.requirements.base import Requirement, fmt, unique_names
 from synth.results import DesignResult, reference_controller
 from synth.spec import Spec
 from synth.synthesis.gainset import SlackBatch
@@ -320,7 +320,7 @@ def write_design_report(spec: Spec, result: DesignResult, out_dir: str | Path, *
         plant=data["analysis"]["plant"],
         structure=spec.controller.kind().formula + "; bounds "
         + ", ".join(f"{k} in [{fmt(a)}, {fmt(b)}]" for k, (a, b) in spec.controller.all_bounds().items()),
-        columns=columns, rows=rows, gain=gain,
+        columns=columns, rows=rows, gain=gain, unevaluated=[] if rows else unique_names(list(spec.requirements)),
         figures={k: v.name for k, v in figs.items()},
         loops=data["analysis"]["loops"],
         published=(data["analysis"].get("reference") or {}).get("published_closed_loops", []),

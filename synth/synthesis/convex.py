@@ -30,7 +30,7 @@ from typing import Any
 import numpy as np
 
 from synth.check import evaluate_all
-from synth.errors import SynthError
+from synth.errors import NoStabilizingStartError, SynthError
 from synth.plant import Plant
 from synth.requirements.base import Requirement, magnitude
 from synth.stability import closed_loop_stability, stability_floor
@@ -280,11 +280,11 @@ class ConvexDesigner:
                 any_found = True
                 yield np.asarray(c, float)
         if not any_found:
-            scanned = " and the exact stabilizing set of each gain alone, the others at 0," \
+            scanned = " and the exact stabilizing set of each gain alone (the others at their values nearest 0)" \
                 if self.par.ctype in SCANNED_TYPES else ""
-            raise SynthError(f"found no stabilizing controller to start from: {2 * RANDOM_STARTS} random "
-                             f"controllers in the bounds{scanned} gave none; give controller.initial or widen "
-                             "the bounds", where="controller")
+            raise NoStabilizingStartError(f"found no stabilizing controller to start from: {2 * RANDOM_STARTS} "
+                                          f"random controllers in the bounds{scanned} gave none; give "
+                                          "controller.initial or widen the bounds", where="controller")
 
     @staticmethod
     def _pinned(c: np.ndarray | None, lo: np.ndarray, rng: np.random.Generator) -> np.ndarray | None:

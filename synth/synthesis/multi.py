@@ -1,21 +1,16 @@
 """Design with several free parameters: convex stage, NLP polish, certificate, diagnosis.
 
-1. **Convex** (:mod:`synth.synthesis.convex`) on the linear parametrization. A
-   PID filter ``tf`` or lead-lag pole ``p`` that is free is held at a few
-   log-spaced values and the best is kept.
-2. **NLP polish** (:mod:`synth.synthesis.nlp`) from the convex answer, every
-   parameter free, requirements and objective exact. It is skipped when it
-   cannot add anything: the convex stage converged to a KKT point of the very
-   problem the NLP would solve (see :func:`polish_redundant`) and that answer
-   passed the certificate.
-3. **Certificate**: each candidate is re-checked on a grid 20 times denser
-   (plus refined peaks and crossings) and for exact closed-loop stability;
-   the best candidate that passes is the design. None passing means no
-   solution is reported.
+1. **Convex** (:mod:`synth.synthesis.convex`) on the linear parametrization. A PID filter ``tf`` or lead-lag
+   pole ``p`` that is free is held at a few log-spaced values and the best is kept.
+2. **NLP polish** (:mod:`synth.synthesis.nlp`) from the convex answer, every parameter free, requirements and
+   objective exact. It is skipped when it cannot add anything: the convex stage converged to a KKT point of
+   the very problem the NLP would solve (see :func:`polish_redundant`) and that answer passed the certificate.
+3. **Certificate**: each candidate is re-checked on a grid 20 times denser (plus refined peaks and crossings)
+   and for exact closed-loop stability; the best candidate that passes is the design. None passing means no
+   solution is reported, and the answer is "undetermined", as it is when no stabilizing start is found.
 
-When the integral gain may be zero, the structure without it is designed
-too (a type-0 loop has ``|T(0)| < 1``, which changes the bandwidth and static
-readings) and the better certified design wins.
+When the integral gain may be zero, the structure without it is designed too (a type-0 loop has
+``|T(0)| < 1``, which changes the bandwidth and static readings) and the better certified design wins.
 """
 
 from __future__ import annotations
@@ -26,7 +21,7 @@ import numpy as np
 
 from synth.check import check
 from synth.controllers import Controller
-from synth.errors import SynthError
+from synth.errors import NoStabilizingStartError, SynthError
 from synth.loop import Loop
 from synth.objectives import score
 from synth.requirements.base import Requirement, fmt, unique_names
@@ -46,6 +41,7 @@ from synth.synthesis.convex_settings import ConvexSettings
 from synth.synthesis.integral_action import integral_only, objective_terms, without_integral_action
 from synth.synthesis.nlp import polish
 from synth.synthesis.nlp_forms import NLP_FORMS
+from synth.synthesis.no_start import no_start_result
 from synth.synthesis.optimality import optimality_of
 from synth.synthesis.parametrization import parametrize
 from synth.synthesis.pattern import pattern_search
@@ -337,7 +333,10 @@ def _polished_from(spec: Spec, starts: list[Controller], terms: list[tuple[str, 
 
 def _design(spec: Spec, settings: ConvexSettings, nlp: bool | str) -> DesignResult:
     terms = objective_terms(spec)
-    runs = convex_runs(spec, settings)
+    try:
+        runs = convex_runs(spec, settings)
+    except NoStabilizingStartError as e:
+        return no_start_result(spec, e)
     per_decade = certificate_density(settings, [d.grid for d, _ in runs])
     nominal = spec.nominal_plant()
     found: list[tuple[str, Controller]] = [("convex", conv.controller) for _, conv in runs
@@ -438,7 +437,7 @@ def _design(spec: Spec, settings: ConvexSettings, nlp: bool | str) -> DesignResu
     if feasible_runs:  # optimal on the grid but none survives the certificate
         stage, controller, certificate = candidates[-1]
         result = DesignResult(spec.name, False, None, check(spec, controller), None, None, certificate, None,
-                              method, reference=ref, extras=extras)
+                              method, reference=ref, extras=extras, status="undetermined")
         result.verdict = (f"The best design found, {controller} ({stage}), failed the dense re-check ("
                           + "; ".join(r.message for r in certificate.check.failed())
                           + "): not reported as a solution.") + reference_verdict(spec, ref)

@@ -166,7 +166,8 @@ def stricter_when(data: dict[str, Any], path: str) -> int:
 
 @dataclass
 class TradeoffPoint:
-    """The design at one point of the sweep."""
+    """The design at one point of the sweep. ``status``: the design's (``feasible``, ``infeasible`` or
+    ``undetermined``), or ``not designed`` when the point's spec or its design raised an error."""
 
     values: dict[str, float]
     feasible: bool
@@ -177,6 +178,11 @@ class TradeoffPoint:
     verdict: str
     seconds: float
     pareto: bool = False
+    status: str = ""
+
+    def __post_init__(self) -> None:
+        if not self.status:
+            self.status = "feasible" if self.feasible else "infeasible"
 
     def to_dict(self) -> dict[str, Any]:
         return asdict(self)
@@ -236,16 +242,17 @@ def design_point(data: dict[str, Any], sweeps: list[Sweep], values: tuple[float,
         spec = Spec.model_validate_json(json.dumps(point), strict=True)
         result = design(spec)
     except SynthError as exc:
-        return TradeoffPoint(labels, False, None, None, [], {}, f"not designed: {exc}", time.perf_counter() - t0)
+        return TradeoffPoint(labels, False, None, None, [], {}, f"not designed: {exc}", time.perf_counter() - t0,
+                             status="not designed")
     except Exception as exc:
         return TradeoffPoint(labels, False, None, None, [], {}, f"not designed: {exc}".splitlines()[0],
-                             time.perf_counter() - t0)
+                             time.perf_counter() - t0, status="not designed")
     shown = result.check or result.compromise
     slacks = {r.label: r.slack for r in shown.requirements} if shown else {}
     controller = result.controller.parameters if result.controller else None
     objective = result.objective["value"] if result.objective else None
     return TradeoffPoint(labels, result.feasible, objective, controller, _binding(result), slacks,
-                         result.verdict, time.perf_counter() - t0)
+                         result.verdict, time.perf_counter() - t0, status=result.status)
 
 
 def design_chunk(data: dict[str, Any], sweeps: list[Sweep], chunk: list[tuple[float, ...]]) -> list[TradeoffPoint]:
