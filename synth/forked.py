@@ -20,6 +20,8 @@ import sys
 from collections.abc import Callable, Sequence
 from typing import Any, TypeVar
 
+from synth.progress import use_child_slot
+
 __all__ = ["allow_fork", "run_beside"]
 
 T = TypeVar("T")
@@ -78,6 +80,7 @@ def run_beside(jobs: Sequence[Callable[[], Any]], own_work: Callable[[], T]) -> 
             os.close(read_end)
             _die_with_parent()
             _ALLOWED[0] = False  # two cores: a job's own run_beside calls run serially in the child
+            use_child_slot()  # the stages this child announces show beside the parent's
             payload = pickle.dumps(_run_tickets(jobs, tickets_read), protocol=pickle.HIGHEST_PROTOCOL)
             with os.fdopen(write_end, "wb") as pipe:
                 pipe.write(payload)

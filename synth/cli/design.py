@@ -3,10 +3,13 @@
 from __future__ import annotations
 
 import argparse
+import json
 import shlex
 import sys
 from pathlib import Path
 from typing import Any
+
+from synth.progress import announce
 
 __all__ = ["COMMAND", "DESCRIPTION", "EXIT_CODES", "HELP", "ORDER", "add_arguments", "run"]
 
@@ -65,13 +68,38 @@ def _prepare_report(spec: Any) -> dict[str, Any] | None:
     return curves
 
 
-def run(args: argparse.Namespace) -> int:
-    from synth.cli._outputs import check_outputs, spec_name
-    from synth.cli._table import print_requirements
+def _design_and_report(args: argparse.Namespace, spec: Any) -> tuple[Any, dict[str, Any] | None, Path]:
+    """The design, and unless ``--no-report`` the report's files: the result, result.json's content (None
+    without a report) and the report folder."""
     from synth.design import design, design_jobs
     from synth.forked import run_beside
-    from synth.outputs import dump_json, write_json
     from synth.report.studies import spec_studies
+
+    out_dir = Path(args.out) if args.out else Path("reports") / spec.name
+    if args.no_report:
+        return design(spec), None, out_dir
+    jobs, combine = design_jobs(spec)  # a PI/PID with and without integral action: two jobs
+    studies = spec_studies(spec)  # and the report's studies that need the spec alone
+    # the design on the other core while this one loads the report's modules (synth.forked)
+    results, curves = run_beside([*jobs, *(job for _, job in studies)], lambda: _prepare_report(spec))
+    result = combine(results[:len(jobs)])
+    studied = {name: value for (name, _), value in zip(studies, results[len(jobs):])}
+    from synth.report.design_report import write_design_report
+
+    announce("writing the report")
+    command = "synth design " + shlex.quote(args.spec)
+    if args.out:
+        command += f" --out {shlex.quote(args.out)}"
+    files = write_design_report(spec, result, out_dir, command=command, force=args.force, curves=curves,
+                                studies=studied)
+    return result, json.loads(files.result_json.read_text(encoding="utf-8")), out_dir
+
+
+def run(args: argparse.Namespace) -> int:
+    from synth.cli._outputs import check_outputs, spec_name
+    from synth.cli._progress import StageLine
+    from synth.cli._table import print_requirements
+    from synth.outputs import dump_json, write_json
     from synth.requirements.base import fmt
     from synth.spec import load_spec
 
@@ -79,29 +107,9 @@ def run(args: argparse.Namespace) -> int:
     folder = None if args.no_report or not name else (Path(args.out) if args.out else Path("reports") / name)
     check_outputs(folder, ["result.json", "report.html"], [args.json], args.force)
     spec = load_spec(args.spec)
-    curves = None
-    if args.no_report:
-        result = design(spec)
-    else:  # the design on the other core while this one loads the report's modules (synth.forked)
-        jobs, combine = design_jobs(spec)  # a PI/PID with and without integral action: two jobs
-        studies = spec_studies(spec)  # and the report's studies that need the spec alone
-        results, curves = run_beside([*jobs, *(job for _, job in studies)], lambda: _prepare_report(spec))
-        result = combine(results[:len(jobs)])
-        studied = {name: value for (name, _), value in zip(studies, results[len(jobs):])}
     say = (lambda *a: None) if args.quiet or args.json == "-" else print
-    out_dir = Path(args.out) if args.out else Path("reports") / spec.name
-    data = None
-    if not args.no_report:
-        from synth.report.design_report import write_design_report
-
-        command = "synth design " + shlex.quote(args.spec)
-        if args.out:
-            command += f" --out {shlex.quote(args.out)}"
-        files = write_design_report(spec, result, out_dir, command=command, force=args.force, curves=curves,
-                                    studies=studied)
-        import json
-
-        data = json.loads(files.result_json.read_text(encoding="utf-8"))
+    with StageLine("design", enabled=False if args.quiet or args.json == "-" else None):
+        result, data, out_dir = _design_and_report(args, spec)
     if args.json:
         if data is None:
             from synth.report.design_report import report_data

@@ -75,7 +75,7 @@ def convex_form(requirement: type[Requirement], *, exact: bool) -> Callable[[Cal
 
     ``exact``: the form is the requirement's own set on the same frequencies as the NLP form (an inner
     approximation that touches it at the linearization point with the same gradient), so the NLP
-    polish cannot improve on a converged convex answer (:func:`synth.synthesis.multi.polish_redundant`).
+    polish cannot improve on a converged convex answer (:func:`synth.synthesis.polish_skip.polish_redundant`).
 
     Examples
     --------

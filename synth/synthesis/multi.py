@@ -24,7 +24,8 @@ from synth.controllers import Controller
 from synth.errors import NoStabilizingStartError, SynthError
 from synth.loop import Loop
 from synth.objectives import score
-from synth.requirements.base import Requirement, fmt, unique_names
+from synth.progress import announce, within
+from synth.requirements.base import fmt, unique_names
 from synth.results import (
     CERTIFICATE_PER_DECADE,
     Certificate,
@@ -35,16 +36,15 @@ from synth.results import (
 )
 from synth.spec import Spec
 from synth.synthesis.convex import ConvexDesigner
-from synth.synthesis.convex_forms import CONVEX_FORMS
 from synth.synthesis.convex_results import ConvexResult, infeasible_verdict
 from synth.synthesis.convex_settings import ConvexSettings
 from synth.synthesis.integral_action import integral_only, objective_terms, without_integral_action
 from synth.synthesis.nlp import polish
-from synth.synthesis.nlp_forms import NLP_FORMS
 from synth.synthesis.no_start import no_start_result
 from synth.synthesis.optimality import optimality_of
 from synth.synthesis.parametrization import parametrize
 from synth.synthesis.pattern import pattern_search
+from synth.synthesis.polish_skip import exact_forms, polish_redundant
 from synth.synthesis.scalar import design_scalar
 from synth.synthesis.screen import SCREEN_ITERATIONS, SCREEN_POINTS, screen_improving, screen_starts
 
@@ -91,7 +91,8 @@ def design_convex(spec: Spec, settings: ConvexSettings | None = None, nlp: bool 
     without = without_integral_action(spec)
     if without is None or not _may_need_alternative(spec, main):  # else the alternative cannot win
         return main
-    alt = design_scalar(without) if len(without.controller.free_parameters()) == 1 else design_convex(without)
+    with within("without integral action"):
+        alt = design_scalar(without) if len(without.controller.free_parameters()) == 1 else design_convex(without)
     return choose(spec, main, alt)
 
 
@@ -178,6 +179,7 @@ def convex_runs(spec: Spec, settings: ConvexSettings) -> list[tuple[ConvexDesign
     tried: dict[float, tuple[ConvexDesigner, ConvexResult]] = {}
 
     def run(v: float | None) -> None:
+        announce("convex stage" + (f", {key} = {fmt(v)} (run {len(tried) + 1})" if key else ""))
         b = dict(bounds) if key is None else {**bounds, key: (v, v)}
         par = parametrize(ctype, b, spec.controller.order, w0)
         designer = ConvexDesigner(requirements, names, spec.plants(), par, (name, sense), settings)
@@ -230,46 +232,6 @@ def _reference_frequency(spec: Spec) -> float:
     p = spec.nominal_plant()
     lo, hi = characteristic_range(p.num, p.den, delay=p.delay)
     return float(np.sqrt(lo * hi))
-
-
-def exact_forms(requirement: Requirement) -> bool:
-    """Whether the requirement's convex form and NLP form are both registered as exact: the same set on
-    the same frequencies (:data:`~synth.synthesis.convex_forms.CONVEX_FORMS`,
-    :data:`~synth.synthesis.nlp_forms.NLP_FORMS`).
-
-    Examples
-    --------
-    >>> from synth.requirements import Bandwidth, PeakSensitivity
-    >>> exact_forms(PeakSensitivity(max_db=6)), exact_forms(Bandwidth(min=10))
-    (True, False)
-    """
-    return CONVEX_FORMS.entry(requirement).exact and NLP_FORMS.entry(requirement).exact
-
-
-def polish_redundant(spec: Spec, runs: list[ConvexResult]) -> str | None:
-    """Why the NLP polish cannot improve on the convex answer, or None when it might.
-
-    The polish is redundant when the convex stage ended at a KKT point of the problem the polish
-    would solve: one convex run (no structural parameter to vary) of a P, PI or PID controller, whose
-    parameters are then exactly the NLP's variables; every requirement with :func:`exact_forms`, whose
-    inner approximations touch the exact constraints at the linearization point with the same gradient
-    (the NLP imposes them on the same design and band grids, squared); a linear objective (the integral
-    or low-frequency gain), solved directly; and a converged phase 2 (the last convex problem, built
-    around the answer, could not improve it beyond the tolerance, and the dense check found nothing
-    between the grid points). IPOPT started at a KKT point stays there: the polish would return the
-    same design to its tolerance (tests/test_synthesis_polish.py compares both).
-    """
-    terms = objective_terms(spec)
-    if len(runs) != 1 or runs[0].status != "optimal" or not runs[0].converged:
-        return None
-    if spec.controller.type not in ("P", "PI", "PID"):
-        return None
-    if not all(exact_forms(r) for r in spec.requirements):
-        return None
-    if len(terms) != 1 or terms[0][0] not in ("integral_gain", "low_frequency_gain"):
-        return None
-    return ("the convex answer is a KKT point of the polish's own problem: same parameters, requirements "
-            "with exact convex forms, linear objective, converged")
 
 
 def certificate_density(settings: ConvexSettings, grids: list[np.ndarray]) -> int:
@@ -365,6 +327,7 @@ def _design(spec: Spec, settings: ConvexSettings, nlp: bool | str) -> DesignResu
                                         key=lambda dr: score(Loop(nominal, dr[1].controller), terms))
         else:
             start_designer, start = min(runs, key=lambda dr: dr[1].diagnosis.total_slack)
+        announce("NLP polish (casadi + IPOPT)")
         res = polish(list(spec.requirements), spec.plants(), start.controller, spec.controller.all_bounds(),
                      terms, start_designer.grid, settings.per_decade, settings.stability_level)
         extras["synthesis"]["nlp"] = res.to_dict()
@@ -376,6 +339,7 @@ def _design(spec: Spec, settings: ConvexSettings, nlp: bool | str) -> DesignResu
     candidates, passed = _certify_best(spec, found, terms, per_decade, cache)
     if passed is not None and nlp and spec.objective is not None:  # a local optimum? better points elsewhere
         value = score(Loop(nominal, passed[1]), terms)
+        announce(f"screen of {SCREEN_POINTS} controllers for better starts")
         starts = screen_improving(spec, terms, value + IMPROVEMENT * max(abs(value), 1e-12))
         found.extend(_polished_from(spec, starts, terms, runs[0][0].grid, settings, unconverged))
         stages.append(f"random screen of the bounds ({SCREEN_POINTS} controllers): {len(starts)} scored more "
@@ -386,6 +350,7 @@ def _design(spec: Spec, settings: ConvexSettings, nlp: bool | str) -> DesignResu
         if starts:
             candidates, passed = _certify_best(spec, found, terms, per_decade, cache)
     if passed is None and nlp:  # the local stages found nothing that certifies: starts from the whole box
+        announce(f"nothing certified: screen of {SCREEN_POINTS} controllers")
         starts = screen_starts(spec)
         found.extend(_polished_from(spec, starts, terms, runs[0][0].grid, settings, unconverged))
         stages.append(f"random screen of the bounds ({SCREEN_POINTS} controllers, every requirement and plant): "
@@ -397,6 +362,7 @@ def _design(spec: Spec, settings: ConvexSettings, nlp: bool | str) -> DesignResu
             and not optimality_of(passed[0], str(passed[1]), unconverged).local:
         # the best certified design is not a converged stage's answer (a raw screened point, an IPOPT round
         # stopped at its limit, a convex bisection): pattern search on the exact check from it
+        announce("pattern search")
         search = pattern_search(spec, passed[1], terms, keeping=settings.stability_level)
         stages.append(f"pattern search on the exact check from the {passed[0]} design ({search.checks} checks, "
                       f"{'improved' if search.improved else 'no improvement'})")

@@ -17,6 +17,7 @@ from synth.errors import SynthError
 from synth.forked import run_beside
 from synth.loop import Loop
 from synth.objectives import score as objective_score
+from synth.progress import announce
 from synth.requirements.base import fmt
 from synth.results import (
     CERTIFICATE_PER_DECADE,
@@ -171,6 +172,7 @@ def _design_without_reference(spec: Spec) -> tuple[DesignResult, GainSet | None]
     family, bounds = scalar_family(spec)
     requirements = list(spec.requirements)
     plants = spec.plants()
+    announce(f"exact feasible set of {family.parameter} over {len(plants)} plant(s)")
     gain_set = feasible_gain_set(requirements, plants, family, bounds)
     method = f"exact feasible set of {family.parameter} ({gain_set.method}); objective maximized over it"
     objective = spec.objective

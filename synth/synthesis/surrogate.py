@@ -24,6 +24,7 @@ from synth.check import check
 from synth.controllers import Controller
 from synth.loop import Loop
 from synth.objectives import score
+from synth.progress import within
 from synth.requirements import NoLimitCycle, PeakComplementary, PeakSensitivity, StepResponse
 from synth.requirements.base import Requirement, db, fmt
 from synth.results import CERTIFICATE_PER_DECADE, Certificate, DesignResult, objective_label
@@ -122,7 +123,8 @@ def design_certified(spec: Spec, design_fn: Callable[[Spec], DesignResult]) -> D
     hard = certified_only(spec)
     if not hard:
         return design_fn(spec)
-    free = design_fn(surrogate_spec(spec, None))
+    with within(f"outer loop 1/{BISECTIONS + 3} (no surrogate bound)"):
+        free = design_fn(surrogate_spec(spec, None))
     if not free.feasible:  # the other requirements already fail: nothing for the surrogate to add
         return design_fn(spec)
     if check(spec, free.controller).feasible:
@@ -132,7 +134,8 @@ def design_certified(spec: Spec, design_fn: Callable[[Spec], DesignResult]) -> D
     best, tried, over = None, 1, free.controller
     level = float(np.clip(_start_level(hard), tight + 0.2, max(loose - 0.2, tight + 0.2)))
     for _ in range(BISECTIONS + 2):
-        trial = design_fn(surrogate_spec(spec, level))
+        with within(f"outer loop {tried + 1}/{BISECTIONS + 3} (surrogate bound {level:.2f} dB)"):
+            trial = design_fn(surrogate_spec(spec, level))
         tried += 1
         designed = trial.feasible and "alternatives" not in trial.extras  # not the structure's fallback
         if designed and check(spec, trial.controller).feasible:  # the certificate re-checks the chosen one

@@ -1,0 +1,84 @@
+"""``synth design`` shows what it is doing while it runs (a live line on a terminal's standard error).
+
+A multi-parameter design can run for minutes in a forked child; before, the terminal stayed blank until the
+verdict. The stages are announced through shared memory (:mod:`synth.progress`), so the line also shows the
+child's stage, and it is cleared before the verdict is printed.
+"""
+
+import io
+import time
+
+from synth import progress
+from synth.cli import _progress, main
+from synth.forked import allow_fork, run_beside
+
+
+def test_a_forked_childs_stage_is_seen_by_the_parent():
+    progress.enable()
+    allow_fork(True)
+    try:
+        def child() -> int:
+            progress.announce("child at work")
+            time.sleep(1.0)
+            return 1
+
+        def parent() -> list[str]:
+            deadline = time.monotonic() + 5.0
+            while time.monotonic() < deadline and "child at work" not in progress.current():
+                time.sleep(0.01)
+            return progress.current()
+
+        (value,), seen = run_beside([child], parent)
+    finally:
+        allow_fork(False)
+        progress.disable()
+    assert value == 1 and "child at work" in seen
+
+
+def test_nested_stages_and_nothing_recorded_when_disabled():
+    progress.announce("ignored")
+    assert progress.current() == []
+    progress.enable()
+    try:
+        with progress.within("outer loop 2/9"):
+            with progress.within("without integral action"):
+                progress.announce("NLP polish")
+                assert progress.current() == ["outer loop 2/9 > without integral action > NLP polish"]
+        progress.announce("x" * 500)
+        assert len(progress.current()[0].encode()) == progress.WIDTH
+    finally:
+        progress.disable()
+
+
+def _terminal_stderr(monkeypatch) -> io.StringIO:
+    """Standard error that says it is a terminal, and a line that appears at once (set in the test body:
+    pytest's capture re-takes the streams after fixtures run)."""
+    stream = io.StringIO()
+    stream.isatty = lambda: True  # type: ignore[method-assign]
+    monkeypatch.setattr("sys.stderr", stream)
+    monkeypatch.setattr(_progress, "DELAY", 0.0)
+    return stream
+
+
+def test_design_shows_its_stages_on_a_terminal_and_clears_the_line(tmp_path, monkeypatch, capsys):
+    terminal_stderr = _terminal_stderr(monkeypatch)
+    spec = tmp_path / "pid.yaml"
+    spec.write_text("name: pid\nplant: {tf: \"2/((s+1)*(s+2))\", delay: 0.05}\ncontroller: {type: PID, bounds: "
+                    "{kp: [0, 20], ki: [0, 20], kd: [0, 5], tf: [0.01, 0.01]}}\nrequirements:\n"
+                    "  - {type: peak_sensitivity, max_db: 6}\nobjective: {maximize: bandwidth}\n", encoding="utf-8")
+    code = main(["design", str(spec), "--no-report"])
+    shown = terminal_stderr.getvalue()
+    assert code == 0
+    assert "\rdesign: convex stage, tf = 0.01 (run 1) [0:" in shown and "NLP polish" in shown
+    assert shown.endswith("\r")  # the last write blanks the line before the verdict
+    assert "pid: FEASIBLE" in capsys.readouterr().out
+    assert progress.current() == []  # the block is gone after the command
+
+
+def test_quiet_design_draws_nothing(tmp_path, monkeypatch):
+    terminal_stderr = _terminal_stderr(monkeypatch)
+    spec = tmp_path / "p.yaml"
+    spec.write_text("name: p\nplant: {tf: \"1/(s+1)\"}\ncontroller: {type: PI}\nrequirements:\n"
+                    "  - {type: peak_sensitivity, max_db: 6}\n", encoding="utf-8")
+    assert main(["design", str(spec), "--no-report", "--quiet"]) == 0
+    assert terminal_stderr.getvalue() == ""
