@@ -24,6 +24,8 @@ from benchmarks.design_problems import problem
 from benchmarks.design_reference import check_point
 from benchmarks.design_verification import _gap, degenerate_reference, run_problem
 
+pytestmark = pytest.mark.xdist_group("design_verification")  # one worker: the records are cached per process
+
 SEED = 2026
 SAMPLE = [
     (6, "P"), (10, "P"), (12, "P"), (16, "P"), (18, "P"), (22, "P"), (24, "P"), (28, "P"), (30, "P"), (34, "P"),

@@ -369,6 +369,7 @@ def _design(spec: Spec, settings: ConvexSettings, nlp: bool | str) -> DesignResu
         if search.improved:
             found.append(("pattern search", search.controller))
             if nlp:  # the polish again, from a start better than the stages had (seed 8 #190: 0.31 -> 1.0 rad/s)
+                announce("NLP polish from the pattern search's design")
                 res = polish(list(spec.requirements), spec.plants(), search.controller,
                              spec.controller.all_bounds(), terms, runs[0][0].grid, settings.per_decade,
                              settings.stability_level)
