@@ -11,11 +11,14 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
+import numpy as np
+
 from synth.check import CheckResult, check
 from synth.controllers import Controller
-from synth.loop import Loop
+from synth.loop import BANDWIDTH_LEVEL, Loop
 from synth.objectives import measure
 from synth.objectives import score as objective_score
+from synth.requirements.base import fmt
 from synth.spec import Spec
 
 if TYPE_CHECKING:
@@ -28,6 +31,7 @@ __all__ = [
     "Certificate",
     "DesignResult",
     "objective_label",
+    "objective_note",
     "reference_check",
     "reference_controller",
     "reference_verdict",
@@ -190,11 +194,32 @@ def objective_label(spec: Spec, loop: Loop) -> dict[str, Any]:
     assert obj is not None
     if obj.weighted is None:
         m = measure(obj.name)
-        return {"name": m.name, "sense": obj.sense, "unit": m.unit, "description": m.description,
-                "value": float(m.evaluate(loop))}
+        label = {"name": m.name, "sense": obj.sense, "unit": m.unit, "description": m.description,
+                 "value": float(m.evaluate(loop))}
+        t0 = abs(loop.T0())
+        if m.name == "bandwidth" and np.isfinite(t0) and t0 < BANDWIDTH_LEVEL:
+            label["note"] = (f"this bandwidth is measured 3 dB below |T(0)| = {fmt(t0, 3)} ({fmt(20 * np.log10(t0), 3)} "
+                             f"dB): the loop does not follow slow references (a unit reference step settles at "
+                             f"{fmt(t0, 3)}); bound the static sensitivity or require integral action to exclude such "
+                             "designs") if t0 > 0 else "T(0) = 0: the loop does not follow slow references at all"
+        return label
     parts = {n: float(measure(n).evaluate(loop)) for n, _, _ in obj.terms()}
     return {"name": "weighted", "sense": "maximize", "unit": "", "description": obj.describe(),
             "value": objective_score(loop, obj.terms()), "terms": parts}
+
+
+def objective_note(label: dict[str, Any] | None) -> str:
+    """The sentence a design's verdict adds when its objective's value needs a caveat (see
+    :func:`objective_label`'s ``note``), else "".
+
+    Examples
+    --------
+    >>> objective_note({"name": "bandwidth", "note": "T(0) = 0: the loop does not track at all"})
+    ' Note: T(0) = 0: the loop does not track at all.'
+    >>> objective_note({"name": "bandwidth"})
+    ''
+    """
+    return f" Note: {label['note']}." if label and label.get("note") else ""
 
 
 def reference_verdict(spec: Spec, ref: CheckResult | None, gain_set: GainSet | None = None) -> str:

@@ -31,6 +31,7 @@ from synth.results import (
     Certificate,
     DesignResult,
     objective_label,
+    objective_note,
     reference_check,
     reference_verdict,
 )
@@ -397,7 +398,7 @@ def _design(spec: Spec, settings: ConvexSettings, nlp: bool | str) -> DesignResu
         result = DesignResult(spec.name, True, controller, check(spec, controller), label, None, certificate,
                               None, method + f"; chosen: {stage}", reference=ref, extras=extras)
         result.verdict = (f"{controller} meets all {len(spec.requirements)} requirements and keeps the loop "
-                          f"stable on {len(spec.plants())} plant(s) ({_describe(spec, label)}).") \
+                          f"stable on {len(spec.plants())} plant(s) ({_describe(spec, label)}).") + objective_note(label) \
             + (f" Optimality: {optimality.basis}." if spec.objective is not None else "") \
             + reference_verdict(spec, ref)
         return result

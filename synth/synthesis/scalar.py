@@ -25,6 +25,7 @@ from synth.results import (
     Certificate,
     DesignResult,
     objective_label,
+    objective_note,
     reference_check,
     reference_verdict,
 )
@@ -272,7 +273,7 @@ def feasible_verdict(result: DesignResult, family: ScalarFamily) -> str:
     obj = result.objective
     return (f"{result.controller} meets all {len(result.check.requirements) - 1} requirements and keeps the "
             f"loop stable ({obj['sense']} {obj['name']}: {fmt(obj['value'])} {obj['unit']}). "
-            f"Feasible {p}: {sets}.") + stabilizing_text(gs)
+            f"Feasible {p}: {sets}.") + objective_note(obj) + stabilizing_text(gs)
 
 
 def stabilizing_text(gs: GainSet) -> str:

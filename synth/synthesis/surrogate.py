@@ -27,7 +27,7 @@ from synth.objectives import score
 from synth.progress import within
 from synth.requirements import NoLimitCycle, PeakComplementary, PeakSensitivity, StepResponse
 from synth.requirements.base import Requirement, db, fmt
-from synth.results import CERTIFICATE_PER_DECADE, Certificate, DesignResult, objective_label
+from synth.results import CERTIFICATE_PER_DECADE, Certificate, DesignResult, objective_label, objective_note
 from synth.spec import Spec
 from synth.synthesis.integral_action import objective_terms
 
@@ -214,5 +214,5 @@ def _certified(spec: Spec, result: DesignResult, level: float | None, tried: int
                        result.method + f"; requirements with no solver form ({hard}): {how}; certificate: every "
                        "requirement re-checked exactly", reference=result.reference, extras=extras)
     out.verdict = (f"{chosen} meets all {len(spec.requirements)} requirements and keeps the loop "
-                   f"stable on {len(spec.plants())} plant(s); {hard}: {how}.")
+                   f"stable on {len(spec.plants())} plant(s); {hard}: {how}.") + objective_note(objective)
     return out
