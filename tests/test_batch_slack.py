@@ -75,6 +75,7 @@ def _same(a: np.ndarray, b: np.ndarray) -> bool:
                 and np.all(np.abs(a[finite] - b[finite]) <= TOL))
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("seed", [0, 1, 2])
 @pytest.mark.parametrize("delay", [False, True])
 def test_batch_form_agrees_with_the_scalar_fallback_on_every_type(seed: int, delay: bool):
@@ -258,6 +259,7 @@ def test_limit_cycle_margin_of_a_scaled_loop_is_the_direct_one():
             assert got == pytest.approx(k, rel=1e-9), (plant, c)
 
 
+@pytest.mark.slow
 def test_margins_batch_matches_the_scalar_slack_on_unstable_and_conditionally_stable_loops():
     """Two-sided gain margins (a lower limit on open-loop unstable plants), negative phase margins and delay
     margins past a negative phase margin: the vectorized margins equal the scalar ones loop by loop, and the

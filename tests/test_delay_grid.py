@@ -77,6 +77,7 @@ def test_gain_bound_is_an_upper_bound_and_tight_at_a_corner():
     assert worst[0] / bound[0] > 0.99
 
 
+@pytest.mark.slow
 def test_pid_behind_a_long_delay_designs_near_the_reference_optimum():
     """Design benchmark seed 5, problem 20: PID, a 4.27 s delay, maximize bandwidth. On the log grid alone
     every NLP round ended at a loop unstable between grid points and the design was 18 % below the

@@ -1,11 +1,14 @@
 """A lead-lag's free pole: the structural grid is bisected finely enough to find an optimum between its first
 three values (synth.synthesis.multi.STRUCTURAL_REFINEMENTS)."""
 
+import pytest
+
 import synth
 from benchmarks.design_problems import problem
 from benchmarks.design_reference import check_point
 
 
+@pytest.mark.slow
 def test_leadlag_whose_optimum_has_the_zero_at_its_bound():
     # design benchmark seed 8, problem 166: k (s+z)/(s+p) on 3.5e6/(s (s+307) (s+46.6)), |KS| <= 32.6 dB,
     # maximize bandwidth. The reference's many-start search (benchmarks/design_reference.py) found 368.71 rad/s

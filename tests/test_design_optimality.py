@@ -56,6 +56,7 @@ def test_a_design_claimed_locally_optimal_has_no_better_feasible_neighbour():
     assert better == 0
 
 
+@pytest.mark.slow
 def test_a_design_from_a_stage_that_stopped_early_says_it_is_not_shown_optimal():
     d = design(parse_spec(UNSTABLE_RATIONAL))
     optimality = d.extras["optimality"]

@@ -71,6 +71,7 @@ def test_rational_controller_on_an_easy_unstable_plant_finds_a_stabilizing_start
     assert 20 * np.log10(abs(1 / (1 + 0.476481 * b0 / a0))) <= -14.9419 + 1e-6
 
 
+@pytest.mark.slow
 def test_leadlag_feasible_between_the_structural_grid_values() -> None:
     """Problem 16 of seed 0: feasible only for a pole p in about [100, 500] of [1.09, 1087]; the convex stage held
     p at three values (1.09, 34.4, 1087) and answered infeasible. It now bisects p around its best run."""
@@ -222,6 +223,7 @@ def test_a_linearization_that_is_infinite_on_the_grid_is_not_a_crash(monkeypatch
     assert [r.status for _, r in runs] == ["infeasible"]
 
 
+@pytest.mark.slow
 def test_an_optimum_at_an_edge_past_a_sharp_peak_moves_into_the_set() -> None:
     """Seed 1 problem #45 (PI on a lightly damped plant with a 0.22 s delay, peak |KS| <= 26.4 dB, maximize
     bandwidth): the structure without integral action is one parameter; the bracketed end of its feasible set,
@@ -279,6 +281,7 @@ def test_bandwidth_of_a_low_gain_loop_crossing_over_below_every_corner() -> None
     assert scalar < -8.0 and req.batch_slack(LoopBatch(G, [c]))[0] == pytest.approx(scalar, rel=1e-6)
 
 
+@pytest.mark.slow
 def test_a_stabilizing_start_with_some_gains_at_their_lower_bounds() -> None:
     """Seed 1 #192 (PID on a plant with an unstable pole, an integrator and a lightly damped pair): none of the
     300 random starts with every gain positive stabilizes, and the design used to decline ("found no

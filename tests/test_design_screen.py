@@ -11,6 +11,7 @@ from __future__ import annotations
 import warnings
 
 import numpy as np
+import pytest
 
 import synth
 from benchmarks.design_problems import problem
@@ -27,6 +28,7 @@ def _design(index: int) -> tuple[object, object]:
         return p, synth.design(synth.parse_spec(p.spec))
 
 
+@pytest.mark.slow
 def test_false_infeasible_pid_on_an_unstable_plant_is_now_a_design_the_reference_accepts() -> None:
     # the design with integral action alone (the job that finds it; the one without runs the same stages again)
     from synth.design import design_jobs
@@ -41,6 +43,7 @@ def test_false_infeasible_pid_on_an_unstable_plant_is_now_a_design_the_reference
     assert check_point(p.num, p.den, p.delay, p.spec, dict(d.controller.parameters)).feasible(1e-3)
 
 
+@pytest.mark.slow
 def test_local_optimum_of_a_rational_design_is_left_for_a_screened_start() -> None:
     rec = run_problem(problem(1, 19), time_limit=120.0, budget=0.3)
     assert rec["outcome"] == "agree feasible"

@@ -24,7 +24,8 @@ from benchmarks.design_problems import problem
 from benchmarks.design_reference import check_point
 from benchmarks.design_verification import _gap, degenerate_reference, run_problem
 
-pytestmark = pytest.mark.xdist_group("design_verification")  # one worker: the records are cached per process
+pytestmark = [pytest.mark.xdist_group("design_verification"),  # one worker: the records are cached per process
+              pytest.mark.slow]
 
 SEED = 2026
 SAMPLE = [

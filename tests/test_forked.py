@@ -76,6 +76,7 @@ def test_off_means_serial_in_this_process():
     assert pid == os.getpid()
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(("spec", "figure"), [("specs/x4_rotor_pi.yaml", "feasible_region.png"),
                                               ("specs/x4_rotor.yaml", "oscillation_onset.png")])
 def test_design_outputs_are_the_same_bytes_forked_or_serial(tmp_path: Path, spec: str, figure: str):

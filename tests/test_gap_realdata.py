@@ -100,6 +100,7 @@ def test_dcmotor_saturation_is_named_from_the_clipped_voltage_in_the_record():
 NO_LOAD = ("06_dc_step_5_15_00.mat", "09_dc_step_20_25_00.mat", "12_dc_step_20_25_00.mat")
 
 
+@pytest.mark.slow
 def test_dcmotor_delay_is_confirmed_by_the_round_robin_over_the_no_load_runs():
     runs = [dcmotor_record(shared_path(*DC, name)) for name in NO_LOAD]
     fit = fit_structure(runs[0], "k/((T1*s+1)*(T2*s+1))", delay=0.0, initial={"k": 245.0, "T1": 0.2, "T2": 0.1},

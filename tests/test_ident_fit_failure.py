@@ -36,6 +36,7 @@ def test_a_delay_fitted_below_zero_names_the_fit_not_the_option():
     assert "delay" in info.value.parameters and info.value.parameters["delay"] < 0
 
 
+@pytest.mark.slow
 def test_iteration_limit_on_noise_fails_with_the_solver_status():
     """IPOPT crawls on the flat cost of noise: stopped at the limit (the status is kept) and not above noise."""
     with pytest.raises(FitError, match="no more of the output than noise") as info:

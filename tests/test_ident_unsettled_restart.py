@@ -2,11 +2,13 @@
 starts from its own deterministic start, not from that pole (synth.ident.identification)."""
 
 import numpy as np
+import pytest
 
 from benchmarks.ident_crb import DT, make_case, sensor_text
 from synth.ident import identify
 
 
+@pytest.mark.slow
 def test_whole_record_refit_ignores_an_edge_fit_beyond_nyquist():
     # the Cramer-Rao benchmark's case 44 (k (s+z)/((s+p1)(s+p2)), delay fitted, behind a known sensor, an
     # aperiodic train whose edges do not settle), noise seed 2: the 0.36 s edge average fitted

@@ -103,6 +103,7 @@ def test_step_response_matches_the_second_order_closed_forms(zeta):
     assert r.details["settled"] and r.details["horizon"] > 0
 
 
+@pytest.mark.slow
 def test_step_response_feasible_set_matches_a_dense_grid():
     spec = parse_spec({"name": "st", "plant": {"tf": CUBIC}, "controller": {"type": "P", "bounds": {"kp": [0.05, 3]}},
                        "requirements": [{"type": "step_response", "max_overshoot": 10}],

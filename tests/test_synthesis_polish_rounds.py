@@ -70,6 +70,7 @@ def test_a_step_out_of_the_stabilizing_set_is_repeated_in_a_trust_region() -> No
         assert e.stable, c
 
 
+@pytest.mark.slow
 def test_an_unconverged_round_that_passes_is_a_design() -> None:
     """Benchmark seed 1, problem 105 (unstable plant with a right-half-plane zero and a 42 ms delay, PID,
     maximize bandwidth): the round that reaches the reference's optimum stops at IPOPT's iteration limit; its

@@ -28,6 +28,7 @@ objective: {{maximize: integral_gain}}"""))
     assert rational.controller.parameters["b1"] == pytest.approx(pi.controller.parameters["kp"], rel=2e-2)
 
 
+@pytest.mark.slow
 def test_second_order_rational_meets_margins_exactly():
     spec = parse_spec(f"""
 name: r2
