@@ -223,26 +223,55 @@ def test_a_linearization_that_is_infinite_on_the_grid_is_not_a_crash(monkeypatch
     assert [r.status for _, r in runs] == ["infeasible"]
 
 
-@pytest.mark.slow
 def test_an_optimum_at_an_edge_past_a_sharp_peak_moves_into_the_set() -> None:
     """Seed 1 problem #45 (PI on a lightly damped plant with a 0.22 s delay, peak |KS| <= 26.4 dB, maximize
     bandwidth): the structure without integral action is one parameter; the bracketed end of its feasible set,
     kp = 0.0062003, lies past a resonance of |KS| so sharp that the dense re-check fails there (33.8 dB), and
     the design used to end "not reported as a solution". It now bisects into the set to the last kp that
-    passes, which the independent reference's dense check accepts, and the PI design takes it (the reference's
-    best is kp = 0.00619788, ki = 0)."""
+    passes, which the independent reference's dense check accepts (the reference's best is kp = 0.00619788,
+    ki = 0). The one-parameter design is run alone: the whole PI design, which takes this one, spends 30 s more
+    on the PI structure that loses. On today's code the optimum, 0.00619788, lies inside the set and the move
+    into the set is not needed here; ``test_the_move_into_the_set_stops_at_the_last_passing_value`` holds that
+    step to its contract."""
     import warnings
 
     from benchmarks.design_problems import problem
+    from synth.synthesis.integral_action import without_integral_action
+    from synth.synthesis.scalar import design_scalar
 
     p = problem(1, 45)
+    without = without_integral_action(synth.parse_spec(p.spec))
+    assert without is not None and without.controller.free_parameters() == ["kp"]
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        result = synth.design(synth.parse_spec(p.spec))
+        result = design_scalar(without)
     assert result.feasible, result.verdict
     kp = result.controller.parameters["kp"]
     assert result.controller.parameters["ki"] == 0.0 and 0.00619 < kp < 0.0062003
     assert check_point(p.num, p.den, p.delay, p.spec, dict(result.controller.parameters)).feasible(1e-3)
+
+
+@pytest.mark.parametrize("edge", [0.30, 0.5001, 0.9999])
+def test_the_move_into_the_set_stops_at_the_last_passing_value(edge: float) -> None:
+    """The scalar design's move into the set: an optimum at the set's end ``x = 1`` whose dense re-check fails
+    beyond ``edge`` goes back towards the interval's middle to the last value that passes, within 2^-24 of the
+    distance; when the middle fails too, there is no such value."""
+    from synth.synthesis.gainset import GainInterval, GainSet
+    from synth.synthesis.scalar import RETREAT_STEPS, _retreat
+
+    gs = GainSet("kp", (0.0, 1.0), [GainInterval(0.0, 1.0, ["bounds"], ["sensitivity"])], {})
+    calls = []
+
+    def passes(v: float) -> bool:
+        calls.append(v)
+        return v <= edge
+
+    x = _retreat(1.0, gs, passes)
+    if edge < 0.5:
+        assert x is None and calls == [0.5]
+        return
+    assert x is not None and x <= edge and edge - x <= 0.5 * 2.0**-RETREAT_STEPS * (1 + 1e-9)
+    assert len(calls) == RETREAT_STEPS + 1
 
 
 def test_stability_boundaries_of_a_controller_with_a_far_corner_stay_small() -> None:
