@@ -4,17 +4,23 @@ A design can run for minutes in a forked child (:mod:`synth.forked`) while the c
 Stages announce themselves with :func:`announce`; the text lands in a small block of shared memory that the
 command line's progress display reads (:func:`current`). Each process writes its own slot: the parent's is
 0, a forked child's is 1 (:func:`use_child_slot`, called by :func:`synth.forked.run_beside` in the child).
-Nothing is shared or written until :func:`enable` made the block (the command line does); a library caller
-pays one ``None`` check per stage.
+Nothing is shared or written until :func:`enable` made the block (the command line does, through
+:class:`StageLine`, which redraws one line on a terminal's standard error with the stages and the elapsed time);
+a library caller pays one ``None`` check per stage.
 """
 
 from __future__ import annotations
 
 import mmap
+import shutil
+import sys
+import threading
+import time
 from collections.abc import Iterator
 from contextlib import contextmanager
+from typing import Any, TextIO
 
-__all__ = ["WIDTH", "announce", "current", "disable", "enable", "use_child_slot", "within"]
+__all__ = ["DELAY", "WIDTH", "StageLine", "announce", "current", "disable", "enable", "use_child_slot", "within"]
 
 SLOTS = 2
 """One slot for the command's process, one for its forked child."""
@@ -105,3 +111,64 @@ def current() -> list[str]:
         return []
     texts = (board[i * WIDTH:(i + 1) * WIDTH].rstrip(b"\0").decode("utf-8", "ignore") for i in range(SLOTS))
     return [t for t in texts if t]
+
+
+DELAY = 2.0
+"""Seconds before the line appears: a short run stays quiet."""
+
+
+class StageLine:
+    """Within the block, show ``label: <stages> [elapsed]`` on ``stream`` (standard error by default).
+
+    Examples
+    --------
+    >>> import io
+    >>> out = io.StringIO()
+    >>> with StageLine("design", enabled=True, stream=out, delay=0.0, interval=0.01):
+    ...     announce("convex stage"); time.sleep(0.1)
+    >>> "design: convex stage [" in out.getvalue()
+    True
+    """
+
+    def __init__(self, label: str, enabled: bool | None = None, stream: TextIO | None = None,
+                 delay: float | None = None, interval: float = 0.5) -> None:
+        self.stream = stream or sys.stderr
+        self.enabled = self.stream.isatty() if enabled is None else enabled
+        self.label, self.delay, self.interval = label, DELAY if delay is None else delay, interval
+        self.stop = threading.Event()
+        self.width = 0
+
+    def __enter__(self) -> StageLine:
+        if self.enabled:
+            enable()  # before any fork: the children write into the same block
+            self.t0 = time.monotonic()
+            self.thread = threading.Thread(target=self._draw, daemon=True)
+            self.thread.start()
+        return self
+
+    def _draw(self) -> None:
+        if self.stop.wait(self.delay):
+            return
+        while True:
+            elapsed = int(time.monotonic() - self.t0)
+            clock = f" [{elapsed // 60}:{elapsed % 60:02d}]"
+            room = shutil.get_terminal_size().columns - 1 - len(clock)
+            line = f"{self.label}: {' | '.join(current()) or 'starting'}"
+            if len(line) > room:  # the innermost stage is the news: cut the front
+                line = "..." + line[len(line) - room + 3:]
+            line += clock
+            self.stream.write("\r" + line.ljust(self.width))
+            self.stream.flush()
+            self.width = max(self.width, len(line))
+            if self.stop.wait(self.interval):
+                return
+
+    def __exit__(self, *exc: Any) -> None:
+        if not self.enabled:
+            return
+        self.stop.set()
+        self.thread.join()
+        if self.width:
+            self.stream.write("\r" + " " * self.width + "\r")  # the line goes away: the verdict follows
+            self.stream.flush()
+        disable()

@@ -9,7 +9,7 @@ import io
 import time
 
 from synth import progress
-from synth.cli import _progress, main
+from synth.cli import main
 from synth.forked import allow_fork, run_beside
 
 
@@ -56,7 +56,7 @@ def _terminal_stderr(monkeypatch) -> io.StringIO:
     stream = io.StringIO()
     stream.isatty = lambda: True  # type: ignore[method-assign]
     monkeypatch.setattr("sys.stderr", stream)
-    monkeypatch.setattr(_progress, "DELAY", 0.0)
+    monkeypatch.setattr(progress, "DELAY", 0.0)
     return stream
 
 

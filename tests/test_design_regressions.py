@@ -257,7 +257,7 @@ def test_the_move_into_the_set_stops_at_the_last_passing_value(edge: float) -> N
     beyond ``edge`` goes back towards the interval's middle to the last value that passes, within 2^-24 of the
     distance; when the middle fails too, there is no such value."""
     from synth.synthesis.gainset import GainInterval, GainSet
-    from synth.synthesis.scalar import RETREAT_STEPS, _retreat
+    from synth.synthesis.scalar import RETREAT_STEPS, move_into_set
 
     gs = GainSet("kp", (0.0, 1.0), [GainInterval(0.0, 1.0, ["bounds"], ["sensitivity"])], {})
     calls = []
@@ -266,7 +266,7 @@ def test_the_move_into_the_set_stops_at_the_last_passing_value(edge: float) -> N
         calls.append(v)
         return v <= edge
 
-    x = _retreat(1.0, gs, passes)
+    x = move_into_set(1.0, gs, passes)
     if edge < 0.5:
         assert x is None and calls == [0.5]
         return

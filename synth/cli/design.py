@@ -97,9 +97,9 @@ def _design_and_report(args: argparse.Namespace, spec: Any) -> tuple[Any, dict[s
 
 def run(args: argparse.Namespace) -> int:
     from synth.cli._outputs import check_outputs, spec_name
-    from synth.cli._progress import StageLine
     from synth.cli._table import print_requirements
     from synth.outputs import dump_json, write_json
+    from synth.progress import StageLine
     from synth.requirements.base import fmt
     from synth.spec import load_spec
 

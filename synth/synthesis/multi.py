@@ -48,6 +48,7 @@ from synth.synthesis.pattern import pattern_search
 from synth.synthesis.polish_skip import exact_forms, polish_redundant
 from synth.synthesis.scalar import design_scalar
 from synth.synthesis.screen import SCREEN_ITERATIONS, SCREEN_POINTS, screen_improving, screen_starts
+from synth.synthesis.stabilizing_slices import open_loop_unstable, slices_text, stabilizing_slices
 
 __all__ = ["STRUCTURAL", "STRUCTURAL_REFINEMENTS", "certificate_density", "choose", "conflict_set", "convex_runs",
            "design_convex", "design_with_integral_action", "exact_forms", "infeasible_verdict", "objective_terms",
@@ -395,11 +396,14 @@ def _design(spec: Spec, settings: ConvexSettings, nlp: bool | str) -> DesignResu
         optimality = optimality_of(stage, str(controller), unconverged, "; ".join(x for x in (searched, screened) if x),
                                    settings.stability_level)
         extras["optimality"] = optimality.to_dict()
+        slices = stabilizing_slices(spec, controller) if open_loop_unstable(spec) else {}
+        if slices:
+            extras["stabilizing_slices"] = {k: [list(iv) for iv in v] for k, v in slices.items()}
         result = DesignResult(spec.name, True, controller, check(spec, controller), label, None, certificate,
                               None, method + f"; chosen: {stage}", reference=ref, extras=extras)
         result.verdict = (f"{controller} meets all {len(spec.requirements)} requirements and keeps the loop "
                           f"stable on {len(spec.plants())} plant(s) ({_describe(spec, label)}).") + objective_note(label) \
-            + (f" Optimality: {optimality.basis}." if spec.objective is not None else "") \
+            + (f" Optimality: {optimality.basis}." if spec.objective is not None else "") + slices_text(slices) \
             + reference_verdict(spec, ref)
         return result
     if feasible_runs:  # optimal on the grid but none survives the certificate

@@ -33,8 +33,8 @@ from synth.spec import Spec
 from synth.synthesis.gainset import GainSet, ScalarFamily, feasible_gain_set
 from synth.synthesis.optimality import Optimality
 
-__all__ = ["INWARD", "RETREAT_STEPS", "design_scalar", "feasible_verdict", "infeasible_verdict", "scalar_family",
-           "scalar_jobs", "stabilizing_text"]
+__all__ = ["INWARD", "RETREAT_STEPS", "design_scalar", "feasible_verdict", "infeasible_verdict", "move_into_set",
+           "scalar_family", "scalar_jobs", "stabilizing_text"]
 
 
 SCALAR_GRID = 61
@@ -208,7 +208,7 @@ def _design_without_reference(spec: Spec) -> tuple[DesignResult, GainSet | None]
         label = objective_label(spec, Loop(nominal, controller))
     cert_check = check(spec, controller, CERTIFICATE_PER_DECADE)
     if not cert_check.feasible:  # an edge the search grid placed past a sharp peak: move into the set
-        inner = _retreat(x, gain_set, lambda v: check(spec, family.controller(v), CERTIFICATE_PER_DECADE).feasible)
+        inner = move_into_set(x, gain_set, lambda v: check(spec, family.controller(v), CERTIFICATE_PER_DECADE).feasible)
         if inner is not None:
             x, controller = inner, family.controller(inner)
             cert_check = check(spec, controller, CERTIFICATE_PER_DECADE)
@@ -233,9 +233,18 @@ def _design_without_reference(spec: Spec) -> tuple[DesignResult, GainSet | None]
     return result, gain_set
 
 
-def _retreat(x: float, gain_set: GainSet, passes: Callable[[float], bool]) -> float | None:
+def move_into_set(x: float, gain_set: GainSet, passes: Callable[[float], bool]) -> float | None:
     """The point nearest ``x`` towards the middle of its interval that ``passes`` (bisection between ``x`` and
-    the interval's middle, :data:`RETREAT_STEPS` checks), or None when the middle fails too."""
+    the interval's middle, :data:`RETREAT_STEPS` checks), or None when the middle fails too: where an optimum
+    at the feasible set's end fails the dense re-check, the design moves back into the set.
+
+    Examples
+    --------
+    >>> from synth.synthesis.gainset import GainInterval
+    >>> gs = GainSet("kp", (0.0, 1.0), [GainInterval(0.0, 1.0, [], [])], {})
+    >>> round(move_into_set(1.0, gs, lambda v: v <= 0.8), 6), move_into_set(1.0, gs, lambda v: v < 0.4)
+    (0.8, None)
+    """
     for iv in gain_set.intervals:
         if iv.lo <= x <= iv.hi:
             good = 0.5 * (iv.lo + iv.hi)
