@@ -223,10 +223,15 @@ class _SignalsRaise:
     """Within the block, SIGTERM and SIGINT raise :class:`Interrupted` in the main thread (handlers restored after)."""
 
     def __enter__(self) -> None:
+        import os
         import signal
         import threading
 
+        owner = os.getpid()
+
         def handler(signum: int, frame: Any) -> None:
+            if os.getpid() != owner:  # a worker forked with this handler, hit before it set its own: leave quietly
+                os._exit(128 + signum)  # (the command reports the interruption; a traceback here would be noise)
             raise Interrupted(signum)
 
         self.old = {}
