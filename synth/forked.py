@@ -20,7 +20,7 @@ import sys
 from collections.abc import Callable, Sequence
 from typing import Any, TypeVar
 
-from synth.progress import use_child_slot
+from synth.progress import clear, use_child_slot
 
 __all__ = ["allow_fork", "run_beside"]
 
@@ -82,6 +82,7 @@ def run_beside(jobs: Sequence[Callable[[], Any]], own_work: Callable[[], T]) -> 
             _ALLOWED[0] = False  # two cores: a job's own run_beside calls run serially in the child
             use_child_slot()  # the stages this child announces show beside the parent's
             payload = pickle.dumps(_run_tickets(jobs, tickets_read), protocol=pickle.HIGHEST_PROTOCOL)
+            clear()  # the progress line stops showing this child's last stage
             with os.fdopen(write_end, "wb") as pipe:
                 pipe.write(payload)
             status = 0

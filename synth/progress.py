@@ -20,7 +20,7 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from typing import Any, TextIO
 
-__all__ = ["DELAY", "WIDTH", "StageLine", "announce", "current", "disable", "enable", "use_child_slot", "within"]
+__all__ = ["DELAY", "WIDTH", "StageLine", "announce", "clear", "current", "disable", "enable", "use_child_slot", "within"]
 
 SLOTS = 2
 """One slot for the command's process, one for its forked child."""
@@ -96,6 +96,20 @@ def within(text: str) -> Iterator[None]:
         yield
     finally:
         _WITHIN.pop()
+
+
+def clear() -> None:
+    """Empty this process's slot (a forked child that finished its jobs: its last stage is no longer news).
+
+    Examples
+    --------
+    >>> enable(); announce("NLP polish"); clear(); current()
+    []
+    >>> disable()
+    """
+    board = _BOARD[0]
+    if board is not None:
+        board[_SLOT[0] * WIDTH:(_SLOT[0] + 1) * WIDTH] = bytes(WIDTH)
 
 
 def current() -> list[str]:

@@ -29,10 +29,12 @@ def test_a_forked_childs_stage_is_seen_by_the_parent():
             return progress.current()
 
         (value,), seen = run_beside([child], parent)
+        after = progress.current()
     finally:
         allow_fork(False)
         progress.disable()
     assert value == 1 and "child at work" in seen
+    assert after == []  # the finished child's stage is cleared
 
 
 def test_nested_stages_and_nothing_recorded_when_disabled():
