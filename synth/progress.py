@@ -20,7 +20,8 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from typing import Any, TextIO
 
-__all__ = ["DELAY", "WIDTH", "StageLine", "announce", "clear", "current", "disable", "enable", "use_child_slot", "within"]
+__all__ = ["DELAY", "INTERVAL", "WIDTH", "StageLine", "announce", "clear", "current", "disable", "enable",
+           "use_child_slot", "within"]
 
 SLOTS = 2
 """One slot for the command's process, one for its forked child."""
@@ -130,6 +131,9 @@ def current() -> list[str]:
 DELAY = 2.0
 """Seconds before the line appears: a short run stays quiet."""
 
+INTERVAL = 0.5
+"""Seconds between redraws of the line."""
+
 
 class StageLine:
     """Within the block, show ``label: <stages> [elapsed]`` on ``stream`` (standard error by default).
@@ -145,10 +149,11 @@ class StageLine:
     """
 
     def __init__(self, label: str, enabled: bool | None = None, stream: TextIO | None = None,
-                 delay: float | None = None, interval: float = 0.5) -> None:
+                 delay: float | None = None, interval: float | None = None) -> None:
         self.stream = stream or sys.stderr
         self.enabled = self.stream.isatty() if enabled is None else enabled
-        self.label, self.delay, self.interval = label, DELAY if delay is None else delay, interval
+        self.label, self.delay = label, DELAY if delay is None else delay
+        self.interval = INTERVAL if interval is None else interval
         self.stop = threading.Event()
         self.width = 0
 

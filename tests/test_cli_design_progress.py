@@ -59,6 +59,7 @@ def _terminal_stderr(monkeypatch) -> io.StringIO:
     stream.isatty = lambda: True  # type: ignore[method-assign]
     monkeypatch.setattr("sys.stderr", stream)
     monkeypatch.setattr(progress, "DELAY", 0.0)
+    monkeypatch.setattr(progress, "INTERVAL", 0.002)  # a warm worker designs the PI in a few tenths of a second
     return stream
 
 
