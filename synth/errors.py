@@ -78,6 +78,15 @@ class NoStabilizingStartError(SynthError):
     (True, 'controller: 600 random controllers in the bounds gave none')
     """
 
+    def __init__(self, message: str, where: str | None = None, searched: str | None = None) -> None:
+        super().__init__(message, where)
+        self.searched = searched or self.message  # what the search covered, for the undetermined verdict
+
+    def located(self, where: str) -> NoStabilizingStartError:
+        """Return a copy with ``where`` prefixed, keeping what was searched."""
+        inner = f"{where}: {self.where}" if self.where else where
+        return NoStabilizingStartError(self.message, where=inner, searched=self.searched)
+
 
 class FitError(SynthError, RuntimeError):
     """A fit ran but failed: it diverged, hit the iteration limit, or its result is not a model of the record.

@@ -282,9 +282,10 @@ class ConvexDesigner:
         if not any_found:
             scanned = " and the exact stabilizing set of each gain alone (the others at their values nearest 0)" \
                 if self.par.ctype in SCANNED_TYPES else ""
-            raise NoStabilizingStartError(f"found no stabilizing controller to start from: {2 * RANDOM_STARTS} "
-                                          f"random controllers in the bounds{scanned} gave none; give "
-                                          "controller.initial or widen the bounds", where="controller")
+            searched = (f"{2 * RANDOM_STARTS} random controllers in the bounds{scanned} gave none; give "
+                        "controller.initial or widen the bounds")
+            raise NoStabilizingStartError(f"found no stabilizing controller to start from: {searched}",
+                                          where="controller", searched=searched)
 
     @staticmethod
     def _pinned(c: np.ndarray | None, lo: np.ndarray, rng: np.random.Generator) -> np.ndarray | None:

@@ -26,7 +26,7 @@ def no_start_result(spec: Spec, error: NoStabilizingStartError) -> DesignResult:
     ('undetermined', False, 'No controller in the bounds')
     """
     ref = reference_check(spec)
-    searched = error.message.split(": ", 1)[-1]
+    searched = error.searched
     n = len(spec.plants())
     on = "the plant" if n == 1 else f"all {n} plants"
     verdict = (f"No controller in the bounds was found that stabilizes the loop on {on}, so no "

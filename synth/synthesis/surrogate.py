@@ -22,6 +22,7 @@ import numpy as np
 
 from synth.check import check
 from synth.controllers import Controller
+from synth.errors import NoStabilizingStartError
 from synth.loop import Loop
 from synth.objectives import score
 from synth.progress import within
@@ -30,6 +31,7 @@ from synth.requirements.base import Requirement, db, fmt
 from synth.results import CERTIFICATE_PER_DECADE, Certificate, DesignResult, objective_label, objective_note
 from synth.spec import Spec
 from synth.synthesis.integral_action import objective_terms
+from synth.synthesis.no_start import no_start_result
 
 __all__ = ["BISECTIONS", "CERTIFIED_ONLY", "LINE_STEPS", "RESOLUTION_DB", "certified_only", "design_certified",
            "surrogate_spec"]
@@ -125,6 +127,9 @@ def design_certified(spec: Spec, design_fn: Callable[[Spec], DesignResult]) -> D
         return design_fn(spec)
     with within(f"outer loop 1/{BISECTIONS + 3} (no surrogate bound)"):
         free = design_fn(surrogate_spec(spec, None))
+    no_start = free.extras.get("undetermined", {})
+    if no_start.get("reason") == "no stabilizing start":  # same plants and bounds, same seeded search: same answer
+        return no_start_result(spec, NoStabilizingStartError(no_start["searched"], searched=no_start["searched"]))
     if not free.feasible:  # the other requirements already fail: nothing for the surrogate to add
         return design_fn(spec)
     if check(spec, free.controller).feasible:
