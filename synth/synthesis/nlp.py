@@ -201,7 +201,7 @@ def polish(requirements: list[Requirement], plants: list[Plant], start: Controll
             b.geq((1.0 + L).abs2() - stability_level**2)
         _add_objective(b, objective, plants, grid, current)
         if exact_from_now:  # an earlier round's quasi-Newton steps crawled: this problem gets the exact Hessian
-            x, stats = b.solve(EXACT_HESSIAN)
+            x, stats = b.solve(EXACT_HESSIAN, expand=True)
         else:
             x, stats = b.solve(None if max_iter is None else {"ipopt.max_iter": max_iter})
         iterations += int(stats.get("iter_count", 0))
@@ -217,7 +217,7 @@ def polish(requirements: list[Requirement], plants: list[Plant], start: Controll
                 solved.insert(0, stopped)
                 history.append({"round": rnd, "status": str(stats.get("return_status")), "controller": str(stopped),
                                 "offered": True})
-            x, stats = b.solve(EXACT_HESSIAN, x)
+            x, stats = b.solve(EXACT_HESSIAN, x, expand=True)
             iterations += int(stats.get("iter_count", 0))
         status = str(stats.get("return_status"))
         success = bool(stats.get("success"))

@@ -13,7 +13,7 @@ from synth.loop import Loop
 from synth.plant import Plant
 from synth.synthesis.cxcomplex import Cx, delay_jw, polyval_jw
 
-__all__ = ["BACKOFF", "IPOPT_OPTIONS", "SYM", "TIGHT", "NLPBuilder", "SymbolicController", "loop_response",
+__all__ = ["BACKOFF", "IPOPT_OPTIONS", "SCALAR_FORM", "SYM", "TIGHT", "NLPBuilder", "SymbolicController", "loop_response",
            "phase_crossovers", "t0_squared"]
 
 SYM = ca.MX
@@ -25,6 +25,10 @@ IPOPT_OPTIONS = {"ipopt.print_level": 0, "print_time": False, "ipopt.sb": "yes",
                  "ipopt.hessian_approximation": "limited-memory",
                  "ipopt.tol": 1e-9, "ipopt.constr_viol_tol": 1e-9}
 
+
+SCALAR_FORM = True
+"""Whether ``NLPBuilder.solve(expand=True)`` evaluates the problem as scalar expressions; False keeps every solve
+in matrix expressions (the baseline of ``benchmarks/polish_scalar_form.py``)."""
 
 BACKOFF = 1e-4
 """Relative tightening of magnitude bounds (as in the convex stage): about 0.001 dB."""
@@ -146,13 +150,17 @@ class NLPBuilder:
         self.lbg.extend([0.0] * expr.numel())
         self.ubg.extend([upper] * expr.numel())
 
-    def solve(self, options: dict[str, Any] | None = None, x0: np.ndarray | None = None,
+    def solve(self, options: dict[str, Any] | None = None, x0: np.ndarray | None = None, expand: bool = False,
               ) -> tuple[np.ndarray, dict[str, Any]]:
         """Solve with :data:`IPOPT_OPTIONS` updated by ``options`` from ``x0`` (default: the variables' starts);
-        the solution and IPOPT's statistics."""
+        the solution and IPOPT's statistics. ``expand`` evaluates the problem as scalar expressions (casadi's
+        SX): 0.05-0.25 s more to build; the exact Hessian's evaluation is much faster so (a second-order
+        rational controller's design: 72 -> 54 s of CPU), while the limited-memory solves gained on some
+        problems and lost on others (``benchmarks/polish_scalar_form.py``), so they keep the matrix form."""
         x = ca.vertcat(*self.x)
         g = ca.vertcat(*self.g) if self.g else SYM(0, 1)
-        solver = ca.nlpsol("polish", "ipopt", {"x": x, "f": self.f, "g": g}, {**IPOPT_OPTIONS, **(options or {})})
+        solver = ca.nlpsol("polish", "ipopt", {"x": x, "f": self.f, "g": g}, {**IPOPT_OPTIONS, **(options or {}),
+                                                                            "expand": expand and SCALAR_FORM})
         res = solver(x0=np.concatenate(self.x0) if x0 is None else x0, lbx=np.concatenate(self.lbx),
                      ubx=np.concatenate(self.ubx), lbg=np.array(self.lbg), ubg=np.array(self.ubg))
         return np.asarray(res["x"]).ravel(), solver.stats()
