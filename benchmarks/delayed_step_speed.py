@@ -24,8 +24,7 @@ from synth.controllers import Controller
 from synth.delayed_blocks import delayed_loop_in_blocks
 from synth.loop import Loop
 from synth.plant import Plant
-from synth.statespace import tf_to_ss, zoh
-from synth.timeresp import BLOCK_FROM, STEP_PER_CROSSOVER, default_horizon
+from synth.timeresp import BLOCK_FROM, default_horizon, delayed_loop_stepped, discrete_loop
 
 
 def _loop(rng: np.random.Generator) -> Loop | None:
@@ -41,53 +40,18 @@ def _loop(rng: np.random.Generator) -> Loop | None:
     return loop if loop.stability().stable else None
 
 
-def _args(loop: Loop) -> tuple:
-    """The discrete loop ``synth.timeresp`` simulates (its step rule), as the three kernels take it."""
-    t_end = default_horizon(loop)
-    dt = t_end / 20000
-    crossovers = loop.gain_crossovers()
-    if crossovers.size:
-        dt = min(dt, STEP_PER_CROSSOVER / float(np.max(crossovers)))
-    m = max(1, int(np.ceil(loop.delay / dt)))
-    dt = loop.delay / m
-    steps = int(np.ceil(t_end / dt))
-
-    def discrete(num: np.ndarray, den: np.ndarray) -> tuple:
-        if len(np.trim_zeros(den, "f")) == 1:
-            return np.zeros((0, 0)), np.zeros(0), np.zeros(0), float(num[-1] / np.trim_zeros(den, "f")[0])
-        A, B, C, D = tf_to_ss(num, den)
-        Ad, Bd = zoh(A, B, dt)
-        return Ad, Bd[:, 0], np.asarray(C, float).ravel(), float(np.ravel(D)[0])
-
-    return (*discrete(*loop.controller.tf()), *discrete(loop.plant.num, loop.plant.den), m, steps)
-
-
-def _stepped_in_numpy(Ac, Bc, Cc, Dc, Ap, Bp, Cp, Dp, m, steps):  # the baseline: one Python step per sample
-    xc, xp, buffer, y_hist = np.zeros(Ac.shape[0]), np.zeros(Ap.shape[0]), np.zeros(m), np.empty(steps + 1)
-    for k in range(steps + 1):
-        ud = buffer[k % m]
-        y = (float(Cp @ xp) if Ap.size else 0.0) + Dp * ud
-        y_hist[k] = y
-        e = 1.0 - y
-        buffer[k % m] = (float(Cc @ xc) if Ac.size else 0.0) + Dc * e
-        if Ac.size:
-            xc = Ac @ xc + Bc * e
-        if Ap.size:
-            xp = Ap @ xp + Bp * ud
-    return y_hist
-
-
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--n", type=int, default=60)
     args = parser.parse_args()
     rng = np.random.default_rng(0)
-    loops: list[Loop] = []
-    while len(loops) < args.n:
+    cases: list[tuple] = []  # each loop as synth.timeresp simulates it: the kernels' arguments
+    while len(cases) < args.n:
         loop = _loop(rng)
-        if loop is not None and _args(loop)[-2] >= BLOCK_FROM and _args(loop)[-1] <= 200_000:
-            loops.append(loop)
-    cases = [_args(loop) for loop in loops]
+        if loop is not None:
+            kernel_args = discrete_loop(loop, default_horizon(loop))[0]
+            if kernel_args[-2] >= BLOCK_FROM and kernel_args[-1] <= 200_000:
+                cases.append(kernel_args)
     t = time.perf_counter()
     from synth.delayed_step import delayed_loop  # numba's import is part of its first call
 
@@ -97,7 +61,7 @@ def main() -> None:
     worst = 0.0
     for a in cases:
         outs = {}
-        for name, fn in zip(times, (_stepped_in_numpy, delayed_loop, delayed_loop_in_blocks)):
+        for name, fn in zip(times, (delayed_loop_stepped, delayed_loop, delayed_loop_in_blocks)):
             t = time.perf_counter()
             outs[name] = np.asarray(fn(*a))
             times[name].append(time.perf_counter() - t)

@@ -21,7 +21,8 @@ from synth.loop import Loop
 from synth.polynomials import trim
 from synth.statespace import tf_to_ss, zoh
 
-__all__ = ["StepMetrics", "default_horizon", "exact_step", "step_metrics", "step_response"]
+__all__ = ["StepMetrics", "default_horizon", "delayed_loop_stepped", "discrete_loop", "exact_step",
+           "step_metrics", "step_response"]
 
 
 @dataclass(frozen=True)
@@ -163,7 +164,18 @@ MAX_STEPS = 4_000_000
 """Most simulation steps of one delayed step response (the compiled loop takes about 10 ms per million)."""
 
 
-def _delayed_step(loop: Loop, t_end: float, n: int) -> tuple[np.ndarray, np.ndarray, float]:
+def discrete_loop(loop: Loop, t_end: float) -> tuple[tuple, float]:
+    """The delayed loop as :func:`step_response` simulates it over ``t_end``: the arguments of
+    :func:`synth.delayed_blocks.delayed_loop_in_blocks` (controller and plant held over the step, the delay
+    in steps, the number of steps) and the step.
+
+    Examples
+    --------
+    >>> from synth.plant import Plant; from synth.controllers import Controller
+    >>> args, dt = discrete_loop(Loop(Plant.from_string("1/(s+1)", delay=0.1), Controller("P", {"kp": 0.5})), 4.0)
+    >>> args[-2:], dt
+    ((500, 20000), 0.0002)
+    """
     crossovers = loop.gain_crossovers()
     dt_target = t_end / 20000
     if crossovers.size:
@@ -180,11 +192,17 @@ def _delayed_step(loop: Loop, t_end: float, n: int) -> tuple[np.ndarray, np.ndar
     Ap, Bp, Cp, Dp = _zoh(loop.plant.num, loop.plant.den, dt)
     args = (Ac, Bc, np.asarray(Cc, float).ravel(), float(np.ravel(Dc)[0]), Ap, Bp, np.asarray(Cp, float).ravel(),
             float(np.ravel(Dp)[0]), m, steps)
+    return args, dt
+
+
+def _delayed_step(loop: Loop, t_end: float, n: int) -> tuple[np.ndarray, np.ndarray, float]:
+    args, dt = discrete_loop(loop, t_end)
+    m, steps = args[-2:]
     with np.errstate(over="ignore", invalid="ignore"):
         if m >= BLOCK_FROM and steps <= BLOCK_STEPS:
             y_hist = delayed_loop_in_blocks(*args)
         elif steps <= NUMPY_STEPS:
-            y_hist = _loop_in_numpy(*args)
+            y_hist = delayed_loop_stepped(*args)
         else:
             from synth.delayed_step import delayed_loop  # numba: compiled once, cached on disk
 
@@ -194,8 +212,17 @@ def _delayed_step(loop: Loop, t_end: float, n: int) -> tuple[np.ndarray, np.ndar
     return t, np.interp(t, t_sim, y_hist), dt
 
 
-def _loop_in_numpy(Ac, Bc, Cc, Dc, Ap, Bp, Cp, Dp, m: int, steps: int) -> np.ndarray:
-    """:func:`synth.delayed_step.delayed_loop` in numpy, step by step (no compilation, nor numba's import)."""
+def delayed_loop_stepped(Ac, Bc, Cc, Dc, Ap, Bp, Cp, Dp, m: int, steps: int) -> np.ndarray:
+    """:func:`synth.delayed_step.delayed_loop` in numpy, step by step (no compilation, nor numba's import).
+
+    Examples
+    --------
+    >>> e = np.exp(-0.01)  # 1/(s+1) held over 10 ms, a gain of 1, 5 steps of delay: y settles at 1/2
+    >>> y = delayed_loop_stepped(np.zeros((0, 0)), np.zeros(0), np.zeros(0), 1.0, np.array([[e]]),
+    ...                          np.array([1 - e]), np.array([1.0]), 0.0, 5, 3000)
+    >>> round(float(y[-1]), 6)
+    0.5
+    """
     xc = np.zeros(Ac.shape[0])
     xp = np.zeros(Ap.shape[0])
     buffer = np.zeros(m)  # u[k - m] is read at step k

@@ -53,8 +53,8 @@ def test_blocks_agree_with_the_loop_stepped_sample_by_sample(seed: int):
 
 
 def test_a_static_loop_settles_at_its_closed_form():
-    # gain 2 in the loop, 10 steps of delay: y alternates blocks of 0 and 2 (1 - y) until ... a static loop
-    # with gain g > 1 diverges, with g = 0.5 it settles at g / (1 + g) = 1/3, each block 1 - 1/2 of the last
+    # a static gain g = 0.5 behind 10 steps of delay: y is constant over each block of 10 and
+    # y_k = g (1 - y_{k-1}), so y_k = (1 - (-g)^k) / 3, settling at g / (1 + g) = 1/3
     y = delayed_loop_in_blocks(np.zeros((0, 0)), np.zeros(0), np.zeros(0), 0.5, np.zeros((0, 0)), np.zeros(0),
                                np.zeros(0), 1.0, 10, 2000)
     blocks = y[: 2000 // 10 * 10].reshape(-1, 10)

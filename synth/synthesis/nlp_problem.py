@@ -155,7 +155,7 @@ class NLPBuilder:
         """Solve with :data:`IPOPT_OPTIONS` updated by ``options`` from ``x0`` (default: the variables' starts);
         the solution and IPOPT's statistics. ``expand`` evaluates the problem as scalar expressions (casadi's
         SX): 0.05-0.25 s more to build; the exact Hessian's evaluation is much faster so (a second-order
-        rational controller's design: 72 -> 54 s of CPU), while the limited-memory solves gained on some
+        rational controller's design: 78.8 -> 60.4 s of CPU), while the limited-memory solves gained on some
         problems and lost on others (``benchmarks/polish_scalar_form.py``), so they keep the matrix form."""
         x = ca.vertcat(*self.x)
         g = ca.vertcat(*self.g) if self.g else SYM(0, 1)
