@@ -38,7 +38,8 @@ grid points is solved again from the same start with those frequencies (and the 
 since an interior-point method restarted at an optimum with its constraints active wanders. An answer whose
 closed loop is unstable (a step jumped over the thin region where ``|1 + L|`` is small on the grid) is
 discarded and the round repeated in a trust region around its start, which grows again when it held a step
-back. Where IPOPT stopped unconverged at a stable loop is offered to the certificate like every candidate.
+back; from then on every close approach of the start's Nyquist curve to -1 is held on its side
+(:mod:`synth.synthesis.nlp_sides`), so that the next answers cannot cross it between the grid's points either. Where IPOPT stopped unconverged at a stable loop is offered to the certificate like every candidate.
 IPOPT runs with a limited-memory BFGS Hessian; a round that stops at the iteration limit (the quasi-Newton
 steps can crawl along curved active constraints) is continued from where it stopped with the exact Hessian.
 """
@@ -57,6 +58,7 @@ from synth.requirements.base import Requirement
 from synth.synthesis.nlp_forms import NLP_FORMS, NLPContext
 from synth.synthesis.nlp_peaks import resonance_points
 from synth.synthesis.nlp_problem import NLPBuilder, SymbolicController, loop_response, phase_crossovers, t0_squared
+from synth.synthesis.nlp_sides import hold_sides
 
 __all__ = ["NLPResult", "polish"]
 
@@ -184,6 +186,7 @@ def polish(requirements: list[Requirement], plants: list[Plant], start: Controll
     solved: list[Controller] = []
     radius: float | None = None  # a trust region once a step has jumped out of the stabilizing set
     exact_from_now = False
+    hold_sides_now = HOLD_SIDES == "always"
     shrinks = 0
     for rnd in range(rounds + MAX_SHRINKS):
         if rnd - shrinks >= rounds:
@@ -199,6 +202,8 @@ def polish(requirements: list[Requirement], plants: list[Plant], start: Controll
         for p in plants:  # keep |1 + L| away from zero: no closed-loop pole crosses the axis on the grid
             _, L = loop_response(ctrl, p, grid)
             b.geq((1.0 + L).abs2() - stability_level**2)
+            if hold_sides_now:  # an earlier answer crossed -1: the start's close approaches keep their side
+                hold_sides(b, p, current, (float(grid[0]), float(grid[-1])), stability_level)
         _add_objective(b, objective, plants, grid, current)
         if exact_from_now:  # an earlier round's quasi-Newton steps crawled: this problem gets the exact Hessian
             x, stats = b.solve(EXACT_HESSIAN, expand=True)
@@ -233,6 +238,7 @@ def polish(requirements: list[Requirement], plants: list[Plant], start: Controll
             break
         if not _stable(plants, candidate):  # |1 + L| >= level on the grid, yet a step jumped over the boundary
             history[-1]["unstable"] = True
+            hold_sides_now = HOLD_SIDES != "never"
             if shrinks == MAX_SHRINKS:
                 break
             radius, shrinks = (1.0 if radius is None else radius / 4), shrinks + 1
@@ -264,6 +270,11 @@ def polish(requirements: list[Requirement], plants: list[Plant], start: Controll
     return NLPResult(converged, status, current, value, len({h["round"] for h in history}), iterations,
                      time.perf_counter() - t_start, history, solved)
 
+
+HOLD_SIDES = "after_unstable"
+"""When the polish holds the start's close approaches to -1 on their side (:mod:`synth.synthesis.nlp_sides`):
+``"after_unstable"`` (from the round after an answer whose closed loop was unstable), ``"always"`` or ``"never"``
+(the behaviour before, for comparisons)."""
 
 MAX_SHRINKS = 3
 """Times a round is repeated in a smaller trust region after its answer left the stabilizing set."""
