@@ -1,5 +1,6 @@
 """An infeasible spec names the requirements that conflict, with prices, and returns no solution."""
 
+import json
 
 from synth.design import design
 from synth.spec import parse_spec
@@ -32,21 +33,6 @@ objective: {{maximize: integral_gain}}
     assert result.compromise is not None and not result.compromise.feasible
 
 
-def test_requirement_unreachable_alone_is_the_whole_conflict():
-    # -15 dB up to 30 rad/s: brute force gives -8.1 dB at best for any stable PI loop with this delay
-    spec = parse_spec(f"""
-name: alone
-plant: {{tf: "{X4}", delay: 0.02}}
-controller: {{type: PI, bounds: {{kp: [0, 20], ki: [0, 500]}}}}
-requirements:
-  - {{type: sensitivity, max_db: -15, band: [0, 30]}}
-  - {{type: peak_sensitivity, max_db: 6}}
-""")
-    result = design(spec)
-    assert not result.feasible
-    assert result.extras["diagnosis"]["conflicting"] == ["sensitivity"]
-
-
 def test_relaxing_the_conflict_makes_it_feasible():
     spec = parse_spec(f"""
 name: relaxed
@@ -62,9 +48,10 @@ objective: {{maximize: integral_gain}}
     assert result.check.requirements[1].value <= -15.0
 
 
-def test_infeasible_cli_exit_code(run_cli, tmp_path):
-    path = tmp_path / "conflict.yaml"
-    path.write_text(f"""name: conflict
+def test_requirement_unreachable_alone_is_the_whole_conflict_and_the_cli_exits_1(run_cli, tmp_path):
+    # -15 dB up to 30 rad/s: brute force gives -8.1 dB at best for any stable PI loop with this delay
+    path = tmp_path / "alone.yaml"
+    path.write_text(f"""name: alone
 plant: {{tf: "{X4}", delay: 0.02}}
 controller: {{type: PI, bounds: {{kp: [0, 20], ki: [0, 500]}}}}
 requirements:
@@ -74,3 +61,5 @@ requirements:
     res = run_cli("design", str(path), "--out", str(tmp_path / "r"))
     assert res.code == 1 and "INFEASIBLE" in res.out and "Conflicting requirements" in res.out
     assert (tmp_path / "r" / "report.html").exists()
+    result = json.loads((tmp_path / "r" / "result.json").read_text())
+    assert not result["feasible"] and result["diagnosis"]["conflicting"] == ["sensitivity"]
