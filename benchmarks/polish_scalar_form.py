@@ -14,13 +14,13 @@ Run:  python benchmarks/polish_scalar_form.py [--seed9 8]
 from __future__ import annotations
 
 import argparse
-import json
 import statistics
-import subprocess
 import sys
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+from benchmarks.design_child import run_design
 
 X4 = "23*(s+0.43)/((s+9.6)*(s+0.54))"
 
@@ -38,31 +38,6 @@ SPECS = {
                          {"type": "peak_sensitivity", "max_db": 6}]},
 }
 
-CHILD = """
-import json, sys, time, warnings
-warnings.simplefilter("ignore")
-sys.path.insert(0, {root!r})
-import synth.synthesis.nlp_problem as nlp_problem
-nlp_problem.SCALAR_FORM = {scalar}
-from synth.forked import allow_fork
-from synth import design, parse_spec
-allow_fork(False)
-spec = {spec}
-if isinstance(spec, list):
-    from benchmarks.design_problems import problem
-    spec = problem(*spec).spec
-t = time.process_time()
-r = design(parse_spec(spec))
-print(json.dumps({{"cpu": time.process_time() - t, "status": r.status, "controller": str(r.controller)}}))
-"""
-
-
-def _run(spec: object, scalar: bool) -> dict:
-    code = CHILD.format(root=str(ROOT), scalar=scalar, spec=repr(spec))
-    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT, check=True)
-    return json.loads(done.stdout.strip().splitlines()[-1])
-
-
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--seed9", type=int, default=8, help="how many of seed 9's first problems")
@@ -73,7 +48,8 @@ def main() -> None:
     print("|---|---|---|---|---|")
     ratios = []
     for name, spec in cases.items():
-        base, new = _run(spec, False), _run(spec, True)
+        base, new = (run_design(spec, f"import synth.synthesis.nlp_problem as m; m.SCALAR_FORM = {scalar}")
+                     for scalar in (False, True))
         same = base["status"] == new["status"] and base["controller"] == new["controller"]
         ratio = new["cpu"] / base["cpu"]
         ratios.append(ratio)

@@ -63,6 +63,7 @@ def test_a_polish_whose_answers_crossed_minus_one_now_climbs_to_the_bound() -> N
     assert nlp.HOLD_SIDES == "after_unstable"
     r = nlp.polish([], [plant], start, bounds, [("integral_gain", "maximize", 1.0)], np.geomspace(0.01, 100, 250))
     assert r.history[0].get("unstable")
+    assert any(h.get("held_approaches_to_minus_one") for h in r.history[1:])  # once a start came near -1
     best = max(r.candidates, key=lambda c: c.parameters["ki"])
     assert best.parameters["ki"] > 9.9
     assert _pade_stable(plant, best)

@@ -39,7 +39,8 @@ since an interior-point method restarted at an optimum with its constraints acti
 closed loop is unstable (a step jumped over the thin region where ``|1 + L|`` is small on the grid) is
 discarded and the round repeated in a trust region around its start, which grows again when it held a step
 back; from then on every close approach of the start's Nyquist curve to -1 is held on its side
-(:mod:`synth.synthesis.nlp_sides`), so that the next answers cannot cross it between the grid's points either. Where IPOPT stopped unconverged at a stable loop is offered to the certificate like every candidate.
+(:mod:`synth.synthesis.nlp_sides`), so that the next answers cannot cross it between the grid's points
+either. Where IPOPT stopped unconverged at a stable loop is offered to the certificate like every candidate.
 IPOPT runs with a limited-memory BFGS Hessian; a round that stops at the iteration limit (the quasi-Newton
 steps can crawl along curved active constraints) is continued from where it stopped with the exact Hessian.
 """
@@ -199,11 +200,12 @@ def polish(requirements: list[Requirement], plants: list[Plant], start: Controll
             build = NLP_FORMS.entry(req).build
             for plant in plants:
                 build(b, req, plant, ctx)
+        held = 0
         for p in plants:  # keep |1 + L| away from zero: no closed-loop pole crosses the axis on the grid
             _, L = loop_response(ctrl, p, grid)
             b.geq((1.0 + L).abs2() - stability_level**2)
             if hold_sides_now:  # an earlier answer crossed -1: the start's close approaches keep their side
-                hold_sides(b, p, current, (float(grid[0]), float(grid[-1])), stability_level)
+                held += hold_sides(b, p, current, (float(grid[0]), float(grid[-1])), stability_level)
         _add_objective(b, objective, plants, grid, current)
         if exact_from_now:  # an earlier round's quasi-Newton steps crawled: this problem gets the exact Hessian
             x, stats = b.solve(EXACT_HESSIAN, expand=True)
@@ -229,7 +231,7 @@ def polish(requirements: list[Requirement], plants: list[Plant], start: Controll
         candidate = ctrl.controller(x[: len(ctrl.free)])
         history.append({"round": rnd, "status": status, "controller": str(candidate),
                         **({"exact_hessian": "after limited-memory BFGS stopped at its iteration limit"}
-                           if exact_from_now else {})})
+                           if exact_from_now else {}), **({"held_approaches_to_minus_one": held} if held else {})})
         converged = converged or success
         if not success:  # where IPOPT stopped may still pass: the certificate decides, as for every candidate
             if np.all(np.isfinite(x)) and _stable(plants, candidate):
