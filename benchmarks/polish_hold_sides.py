@@ -19,14 +19,13 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from benchmarks.design_child import run_design
-from benchmarks.design_problems import problem
+from benchmarks.design_problems import Problem, problem
 from benchmarks.design_reference import check_point
 
 
-def _checked(seed: int, index: int, record: dict) -> str:
+def _checked(p: Problem, record: dict) -> str:
     if record["objective"] is None:
         return record["status"]
-    p = problem(seed, index)
     ok = check_point(p.num, p.den, p.delay, p.spec, record["parameters"]).feasible(1e-3)
     return f"{record['objective']:.6g}" + ("" if ok else " (FAILS the reference check)")
 
@@ -50,7 +49,8 @@ def main() -> None:
         totals[0] += base["cpu"]
         totals[1] += new["cpu"]
         same = base["status"] == new["status"] and base["controller"] == new["controller"]
-        print(f"| seed {seed} #{index} | {_checked(seed, index, base)} | {_checked(seed, index, new)} | "
+        p = problem(seed, index)
+        print(f"| seed {seed} #{index} | {_checked(p, base)} | {_checked(p, new)} | "
               f"{base['cpu']:.1f} | {new['cpu']:.1f} | {'yes' if same else 'no'} |", flush=True)
     print(f"\nCPU over {len(cases)} problems: {totals[0]:.1f} s (never) / {totals[1]:.1f} s (after an unstable answer)")
 

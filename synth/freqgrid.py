@@ -15,7 +15,8 @@ import numpy as np
 from synth.rootfind import bisect_roots
 
 __all__ = ["DEFAULT_PER_DECADE", "Curve", "band_grid", "band_grids", "batch_first_crossing", "batch_peak",
-           "characteristic_range", "corner_frequencies", "crossings", "first_fall", "log_grid", "log_grids", "peak"]
+           "characteristic_range", "corner_frequencies", "crossings", "first_fall", "log_grid", "log_grids", "peak",
+           "refine_maxima"]
 
 Curve = Callable[[np.ndarray], np.ndarray]
 
@@ -110,13 +111,30 @@ def peak(curve: Curve, grid: np.ndarray, tol_db: float = 3.0) -> tuple[float, fl
     candidates = np.array([int(i) for i in interior if values[i] >= best_v * 10 ** (-tol_db / 20)][:20], dtype=int)
     if candidates.size == 0:
         return best_v, best_w
-    a, b = grid[candidates - 1][None, :], grid[candidates + 1][None, :]
-    v, w = _golden_max(lambda x: np.asarray(curve(x.ravel()), dtype=float).reshape(x.shape), a, b, a > 0)
+    v, w = refine_maxima(curve, grid, candidates)
     v = np.where(np.isnan(v), -np.inf, v)
-    j = int(np.argmax(v[0]))
-    if v[0, j] > best_v:
-        best_v, best_w = float(v[0, j]), float(w[0, j])
+    j = int(np.argmax(v))
+    if v[j] > best_v:
+        best_v, best_w = float(v[j]), float(w[j])
     return best_v, best_w
+
+
+def refine_maxima(curve: Curve, grid: np.ndarray, index: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Local maxima ``grid[index]`` of a real ``curve(w)`` refined by golden-section search between their
+    neighbours (on ``log w`` where the interval is positive), all at once: ``(values, w)``.
+
+    Examples
+    --------
+    >>> f = lambda w: -np.abs(w - 2.0)
+    >>> v, w = refine_maxima(f, np.array([1.0, 1.5, 2.2, 3.0]), np.array([2]))
+    >>> round(float(w[0]), 6)
+    2.0
+    """
+    grid = np.asarray(grid, dtype=float)
+    index = np.asarray(index, dtype=int)
+    a, b = grid[index - 1][None, :], grid[index + 1][None, :]
+    v, w = _golden_max(lambda x: np.asarray(curve(x.ravel()), dtype=float).reshape(x.shape), a, b, a > 0)
+    return v[0], w[0]
 
 
 def crossings(curve: Curve, level: float, grid: np.ndarray) -> np.ndarray:

@@ -16,7 +16,7 @@ import casadi as ca
 import numpy as np
 
 from synth.controllers import Controller
-from synth.freqgrid import log_grid
+from synth.freqgrid import log_grid, refine_maxima
 from synth.loop import Loop
 from synth.plant import Plant
 from synth.synthesis.nlp_problem import NLPBuilder, loop_response
@@ -52,18 +52,12 @@ def close_approaches(plant: Plant, start: Controller, band: tuple[float, float],
     w = log_grid(max(band[0], 1e-9), band[1], PER_DECADE)
     with np.errstate(all="ignore"):
         d = np.abs(1.0 + loop.L(w))
-    inner = np.flatnonzero((d[1:-1] < d[:-2]) & (d[1:-1] <= d[2:])) + 1
-    inner = inner[np.isfinite(d[inner]) & (d[inner] < near)]
+        inner = np.flatnonzero((d[1:-1] < d[:-2]) & (d[1:-1] <= d[2:])) + 1
+        inner = inner[np.isfinite(d[inner]) & (d[inner] < near)]
+        _, refined = refine_maxima(lambda x: -np.abs(1.0 + loop.L(x)), w, inner)  # the minima of |1 + L|
     peaks = np.flatnonzero((d[1:-1] > d[:-2]) & (d[1:-1] >= d[2:])) + 1
     out = []
-    for i in inner:
-        a, b = np.log(w[i - 1]), np.log(w[i + 1])
-        for _ in range(40):  # golden section on log w
-            c, e = b - 0.618 * (b - a), a + 0.618 * (b - a)
-            with np.errstate(all="ignore"):
-                dc, de = np.abs(1.0 + loop.L(np.exp(np.array([c, e]))))
-            a, b = (a, e) if dc <= de else (c, b)
-        w0 = float(np.exp(0.5 * (a + b)))
+    for i, w0 in zip(inner, refined.tolist()):
         below, above = peaks[peaks < i], peaks[peaks > i]
         lo = max(float(w[below[-1]]) if below.size else band[0], w0 / BOX, band[0])
         hi = min(float(w[above[0]]) if above.size else band[1], w0 * BOX, band[1])
