@@ -15,8 +15,8 @@ import numpy as np
 from synth.rootfind import bisect_roots
 
 __all__ = ["DEFAULT_PER_DECADE", "Curve", "band_grid", "band_grids", "batch_first_crossing", "batch_peak",
-           "characteristic_range", "corner_frequencies", "crossings", "first_fall", "log_grid", "log_grids", "peak",
-           "refine_maxima"]
+           "characteristic_range", "corner_frequencies", "crossings", "first_fall", "log_grid", "log_grids",
+           "neighbour_brackets", "peak", "refine_maxima", "resolving_grid"]
 
 Curve = Callable[[np.ndarray], np.ndarray]
 
@@ -117,6 +117,57 @@ def peak(curve: Curve, grid: np.ndarray, tol_db: float = 3.0) -> tuple[float, fl
     if v[j] > best_v:
         best_v, best_w = float(v[j]), float(w[j])
     return best_v, best_w
+
+
+def resolving_grid(w_lo: float, w_hi: float, per_decade: int, max_step: float | None = None,
+                   max_points: int = 20_000, even_until: float | None = None) -> np.ndarray:
+    """A log grid on ``[w_lo, w_hi]`` with evenly spaced points added wherever its spacing exceeds ``max_step``
+    (rad/s), up to ``even_until`` (default ``w_hi``) and at most ``max_points`` of them: a curve that ripples in
+    ``w`` (a delay ``tau`` turns the phase by ``w tau``) is resolved at every frequency, not only where the log
+    grid is fine enough.
+
+    Examples
+    --------
+    >>> g = resolving_grid(0.1, 100.0, 10, max_step=1.0)
+    >>> bool(np.all(np.diff(g) <= 1.0 + 1e-12)), g.size > 100, log_grid(0.1, 100.0, 10).size
+    (True, True, 31)
+    """
+    grid = log_grid(w_lo, w_hi, per_decade)
+    if max_step is None or not np.isfinite(max_step) or max_step <= 0:
+        return grid
+    coarse = np.flatnonzero(np.diff(grid) > max_step)
+    if coarse.size == 0:
+        return grid
+    top = float(grid[-1]) if even_until is None else min(float(even_until), float(grid[-1]))
+    even = np.arange(float(grid[coarse[0]]) + max_step, top, max_step)[:max_points]
+    return np.union1d(grid, even)
+
+
+def neighbour_brackets(grid: np.ndarray, values: np.ndarray, index: np.ndarray, refined: np.ndarray,
+                       band: tuple[float, float], factor: float) -> tuple[np.ndarray, np.ndarray]:
+    """For each local maximum ``values[index]`` (refined to ``refined``), the interval up to the grid's
+    neighbouring local minima on either side, within ``factor`` of the maximum and inside ``band``: where the
+    curve has that one maximum, so a stationary point held in it is that maximum (pass ``-values`` for
+    minima). Returns ``(lo, hi)``.
+
+    Examples
+    --------
+    >>> w = np.linspace(1.0, 10.0, 901)
+    >>> v = np.cos(2 * np.pi * w)  # maxima at integers, minima half-way
+    >>> lo, hi = neighbour_brackets(w, v, np.array([400]), np.array([5.0]), (1.0, 10.0), 1.5)
+    >>> float(lo[0]), float(hi[0])
+    (4.5, 5.5)
+    """
+    grid, values = np.asarray(grid, float), np.asarray(values, float)
+    index, refined = np.asarray(index, int), np.asarray(refined, float)
+    troughs = np.flatnonzero((values[1:-1] < values[:-2]) & (values[1:-1] <= values[2:])) + 1
+    k = np.searchsorted(troughs, index)
+    below = np.where(k > 0, grid[troughs[np.maximum(k - 1, 0)]] if troughs.size else band[0], band[0])
+    above = np.where(k < troughs.size, grid[troughs[np.minimum(k, max(troughs.size - 1, 0))]]
+                     if troughs.size else band[1], band[1])
+    lo = np.maximum.reduce([below, refined / factor, np.full(refined.shape, band[0])])
+    hi = np.minimum.reduce([above, refined * factor, np.full(refined.shape, band[1])])
+    return lo, hi
 
 
 def refine_maxima(curve: Curve, grid: np.ndarray, index: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -95,3 +95,33 @@ def test_an_unconverged_round_that_passes_is_a_design() -> None:
                                                    "ki": 0.0825534196736773, "kd": 0.1728805498179204})
     assert mine.feasible(1e-3) and ref.feasible(1e-3)
     assert mine.objective >= 0.99 * ref.objective
+
+
+@pytest.mark.parametrize("seed", range(8))
+def test_peak_brackets_of_a_long_delay_hold_one_maximum_each_and_miss_none(seed: int) -> None:
+    """A delay of 1-10 s makes |S| ripple about 2 pi / delay apart, finer than a log grid at high frequency.
+    Against a dense linear grid (64 points per ripple): every local maximum of |S| within 3 dB of the bound
+    (away from that threshold) is found, and each bracket holds exactly one local maximum of the dense curve:
+    the stationary point the NLP holds there is that peak."""
+    from synth.synthesis.nlp_peaks import NEAR_DB, peak_brackets
+
+    rng = np.random.default_rng(seed)
+    delay = float(rng.uniform(1.0, 10.0))
+    poles = rng.uniform(0.2, 3.0, rng.integers(1, 3))
+    plant = synth.Plant(np.array([float(np.prod(poles))]), np.poly(-poles), delay=delay)
+    c = synth.Controller("PI", {"kp": float(rng.uniform(0.2, 0.6)), "ki": float(rng.uniform(0.0, 0.1))})
+    band, bound = (0.01, 30.0), 10 ** (float(rng.uniform(1.0, 4.0)) / 20)
+    found = peak_brackets(plant, c, "S", bound, band)
+    w = np.linspace(band[0], band[1], int(64 * band[1] * delay / (2 * np.pi)))
+    s = np.abs(Loop(plant, c).S(w))
+    peaks = np.flatnonzero((s[1:-1] > s[:-2]) & (s[1:-1] >= s[2:])) + 1
+    level = bound * 10 ** (-NEAR_DB / 20)
+    clear = w[peaks[np.abs(20 * np.log10(s[peaks] / level)) > 0.05]]
+    above = w[peaks[s[peaks] > level]]
+    clear_above = [x for x in clear if x in above]
+    assert len(clear_above) >= 3  # the case has many ripples near the bound
+    for x in clear_above:
+        assert any(lo <= x <= hi for _, lo, hi in found), x
+    for w0, lo, hi in found:
+        inside = w[peaks][(w[peaks] >= lo) & (w[peaks] <= hi)]
+        assert inside.size == 1 and abs(inside[0] - w0) <= 2 * (w[1] - w[0]), (w0, lo, hi, inside)

@@ -14,18 +14,20 @@ import casadi as ca
 import numpy as np
 
 from synth.controllers import Controller
-from synth.freqgrid import log_grid
+from synth.freqgrid import neighbour_brackets, refine_maxima, resolving_grid
 from synth.loop import Loop
 from synth.plant import Plant
+from synth.synthesis.delay_grid import DELAY_STEP
 from synth.synthesis.nlp_problem import NLPBuilder, loop_response
 
-__all__ = ["PEAK_TIGHT", "peak_frequencies", "resonance_points", "track_peaks"]
+__all__ = ["PEAK_TIGHT", "peak_brackets", "peak_frequencies", "resonance_points", "track_peaks"]
 
 NEAR_DB = 3.0
 """Local maxima of the start design within this many dB of the bound (or above it) are tracked."""
 
 BOX = 1.5
-"""A tracked peak frequency stays within ``[w0 / BOX, BOX w0]`` in one round."""
+"""A tracked peak frequency stays between the start curve's neighbouring minima and within ``[w0 / BOX, BOX w0]``
+in one round."""
 
 PER_DECADE = 160
 
@@ -37,7 +39,7 @@ PEAK_TIGHT = 1.0 - 2e-6
 def peak_frequencies(plant: Plant, start: Controller, curve: str, bound: float,
                      band: tuple[float, float]) -> np.ndarray:
     """Local maxima of ``|curve|`` (``"S"``, ``"T"`` or ``"KS"``) of the loop at ``start`` inside ``band`` that
-    come within :data:`NEAR_DB` of the linear ``bound``, refined to a relative 1e-6.
+    come within :data:`NEAR_DB` of the linear ``bound``, refined by golden section (:func:`peak_brackets`).
 
     Examples
     --------
@@ -46,23 +48,40 @@ def peak_frequencies(plant: Plant, start: Controller, curve: str, bound: float,
     >>> [round(float(w), 3) for w in peak_frequencies(G, Controller("P", {"kp": 0.5}), "T", 1.0, (0.01, 100))]
     [1.224]
     """
+    return np.array([w for w, _, _ in peak_brackets(plant, start, curve, bound, band)], float)
+
+
+def peak_brackets(plant: Plant, start: Controller, curve: str, bound: float,
+                  band: tuple[float, float]) -> list[tuple[float, float, float]]:
+    """``(w, lo, hi)`` for each local maximum ``w`` of ``|curve|`` of the loop at ``start`` inside ``band`` within
+    :data:`NEAR_DB` of ``bound``: ``[lo, hi]`` reaches the neighbouring minima (at most a factor :data:`BOX`
+    away), where the stationary point held in the NLP is that maximum and no other. The curve is searched on a
+    log grid with the plant delay's ripple resolved (steps of at most ``pi/4 / delay``): on the log grid alone a
+    long delay's peaks alias, and a box of a factor 1.5 holds dozens of them.
+
+    Examples
+    --------
+    >>> from synth.plant import Plant; from synth.controllers import Controller
+    >>> G = Plant.from_string("1/(s+1)", delay=5.0)  # peaks where w 5 + atan(w) = pi, 3 pi, ...
+    >>> [(round(w, 2), round(lo, 2), round(hi, 2)) for w, lo, hi in
+    ...  peak_brackets(G, Controller("P", {"kp": 0.5}), "S", 1.5, (0.01, 10.0))][:3]
+    [(0.52, 0.35, 0.79), (1.67, 1.11, 2.27), (2.88, 2.27, 3.5)]
+    """
     loop = Loop(plant, start)
     f = getattr(loop, curve)
     lo, hi = max(band[0], 1e-9), band[1]
     if not hi > lo:
-        return np.array([])
-    w = log_grid(lo, hi, PER_DECADE)
+        return []
+    w = resolving_grid(lo, hi, PER_DECADE, DELAY_STEP / plant.delay if plant.delay > 0 else None)
     with np.errstate(all="ignore"):
         v = np.abs(f(w))
-    inner = np.flatnonzero((v[1:-1] > v[:-2]) & (v[1:-1] >= v[2:])) + 1
-    inner = inner[np.isfinite(v[inner]) & (v[inner] >= bound * 10 ** (-NEAR_DB / 20))]
-    a, b = np.log(w[inner - 1]), np.log(w[inner + 1])
-    for _ in range(40):  # golden section on log w, every peak at once
-        c, d = b - 0.618 * (b - a), a + 0.618 * (b - a)
-        with np.errstate(all="ignore"):
-            left = np.abs(f(np.exp(c))) >= np.abs(f(np.exp(d)))
-        a, b = np.where(left, a, c), np.where(left, d, b)
-    return np.exp(0.5 * (a + b))
+        inner = np.flatnonzero((v[1:-1] > v[:-2]) & (v[1:-1] >= v[2:])) + 1
+        inner = inner[np.isfinite(v[inner]) & (v[inner] >= bound * 10 ** (-NEAR_DB / 20))]
+        if inner.size == 0:
+            return []
+        _, refined = refine_maxima(lambda x: np.abs(f(x)), w, inner)
+    box_lo, box_hi = neighbour_brackets(w, v, inner, refined, (lo, hi), BOX)
+    return [(float(a), float(b), float(c)) for a, b, c in zip(refined, box_lo, box_hi)]
 
 
 def track_peaks(b: NLPBuilder, plant: Plant, designs: list[Controller], curve: str, bound: float,
@@ -70,13 +89,13 @@ def track_peaks(b: NLPBuilder, plant: Plant, designs: list[Controller], curve: s
     """Add a tracked peak of ``|curve|`` with ``|curve(j w_k)|^2 <= tight bound^2`` for each local maximum near
     the bound (:func:`peak_frequencies`) of each of ``designs`` (the round's start, and the last answer whose
     peaks rose between the grid points); peaks within 1 % of one already tracked are tracked once."""
-    found: list[float] = []
+    found: list[tuple[float, float, float]] = []
     for design in designs:
-        for w in peak_frequencies(plant, design, curve, bound, band):
-            if all(abs(np.log(w / f)) > 0.01 for f in found):
-                found.append(float(w))
-    for w0 in found:
-        v = b.var("w_peak", float(w0), max(w0 / BOX, band[0]), min(w0 * BOX, band[1]))
+        for w, lo, hi in peak_brackets(plant, design, curve, bound, band):
+            if all(abs(np.log(w / f[0])) > 0.01 for f in found):
+                found.append((w, lo, hi))
+    for w0, lo, hi in found:
+        v = b.var("w_peak", w0, lo, hi)
         C, L = loop_response(b.ctrl, plant, v)
         top = {"S": None, "T": L, "KS": C}[curve]
         log_f = -ca.log((1.0 + L).abs2()) if top is None else ca.log(top.abs2()) - ca.log((1.0 + L).abs2())

@@ -16,9 +16,10 @@ import casadi as ca
 import numpy as np
 
 from synth.controllers import Controller
-from synth.freqgrid import log_grid, refine_maxima
+from synth.freqgrid import neighbour_brackets, refine_maxima, resolving_grid
 from synth.loop import Loop
 from synth.plant import Plant
+from synth.synthesis.delay_grid import DELAY_STEP
 from synth.synthesis.nlp_problem import NLPBuilder, loop_response
 
 __all__ = ["NEAR", "close_approaches", "hold_sides"]
@@ -27,7 +28,8 @@ NEAR = 0.5
 """Local minima of ``|1 + L|`` of the start closer than this to -1 are held on their side."""
 
 PER_DECADE = 400
-"""Density of the log grid on which the close approaches are found (then refined by golden section)."""
+"""Density of the log grid on which the close approaches are found (then refined by golden section); a plant
+delay's ripple is resolved on it as well (steps of at most ``pi/4 / delay``)."""
 
 BOX = 1.5
 """A held approach's frequency stays between the neighbouring maxima of ``|1 + L|`` and within this factor."""
@@ -49,18 +51,17 @@ def close_approaches(plant: Plant, start: Controller, band: tuple[float, float],
     [1.0]
     """
     loop = Loop(plant, start)
-    w = log_grid(max(band[0], 1e-9), band[1], PER_DECADE)
+    w = resolving_grid(max(band[0], 1e-9), band[1], PER_DECADE, DELAY_STEP / plant.delay if plant.delay > 0 else None)
     with np.errstate(all="ignore"):
         d = np.abs(1.0 + loop.L(w))
         inner = np.flatnonzero((d[1:-1] < d[:-2]) & (d[1:-1] <= d[2:])) + 1
         inner = inner[np.isfinite(d[inner]) & (d[inner] < near)]
+        if inner.size == 0:
+            return []
         _, refined = refine_maxima(lambda x: -np.abs(1.0 + loop.L(x)), w, inner)  # the minima of |1 + L|
-    peaks = np.flatnonzero((d[1:-1] > d[:-2]) & (d[1:-1] >= d[2:])) + 1
+    box_lo, box_hi = neighbour_brackets(w, -d, inner, refined, band, BOX)
     out = []
-    for i, w0 in zip(inner, refined.tolist()):
-        below, above = peaks[peaks < i], peaks[peaks > i]
-        lo = max(float(w[below[-1]]) if below.size else band[0], w0 / BOX, band[0])
-        hi = min(float(w[above[0]]) if above.size else band[1], w0 * BOX, band[1])
+    for w0, lo, hi in zip(refined.tolist(), box_lo.tolist(), box_hi.tolist()):
         h = 1e-6 * w0
         with np.errstate(all="ignore"):
             up, down, at = loop.L(np.array([w0 + h, w0 - h, w0]))
