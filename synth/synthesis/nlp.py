@@ -30,9 +30,12 @@ rounds), and the result is only accepted by the caller after the dense
 certificate.
 
 Rounds. Each NLP is built around its start design: its gain and phase crossovers (variables in boxes
-around them), the local maxima of ``|S|``, ``|T|``, ``|KS|`` near a peak bound (variables held at a
-stationary point of the curve, :mod:`synth.synthesis.nlp_peaks`, so a peak narrower than the grid's spacing
-is bounded where it is) and points around every lightly damped root of the loop. Another round starts from
+around them that reach half-way to the neighbouring crossings, so that a held crossing cannot slide onto
+another; with a delay the phase crossings are found on a grid that resolves the delay's phase, and those far
+below the gain margin's bound are left out, :func:`~synth.synthesis.nlp_problem.phase_crossings`), the
+local maxima of ``|S|``, ``|T|``, ``|KS|`` near a peak bound (variables held at a stationary point of the
+curve between its neighbouring minima, :mod:`synth.synthesis.nlp_peaks`, so a peak narrower than the grid's
+spacing is bounded where it is) and points around every lightly damped root of the loop. Another round starts from
 the answer when its crossovers changed or a helper variable ended on its box; an answer violated only between
 grid points is solved again from the same start with those frequencies (and the answer's sharp peaks) added,
 since an interior-point method restarted at an optimum with its constraints active wanders. An answer whose

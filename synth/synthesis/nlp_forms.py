@@ -40,11 +40,19 @@ from synth.synthesis.nlp_problem import (
     TIGHT,
     NLPBuilder,
     loop_response,
-    phase_crossovers,
+    phase_crossings,
     t0_squared,
 )
 
 __all__ = ["NLP_FORMS", "NLPContext", "nlp_form"]
+
+def _between_neighbours(w: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """For sorted positive frequencies, the interval of each up to half-way (in ``log w``) to its neighbours
+    (0 and infinity at the ends): a crossing held in it cannot slide onto another."""
+    w = np.asarray(w, float)
+    mids = np.sqrt(w[:-1] * w[1:])
+    return np.concatenate([[0.0], mids]), np.concatenate([mids, [np.inf]])
+
 
 def _positive(w: np.ndarray) -> np.ndarray:
     return w[w > 0]
@@ -59,6 +67,11 @@ def _band(req: Any, grid: np.ndarray, extra: np.ndarray, per_decade: int) -> np.
     inside = extra[(extra >= band[0]) & (extra <= band[1])]
     return np.unique(np.concatenate([w, inside]))
 
+
+MAX_HELD_CROSSINGS = 40
+"""Most crossings of the negative real axis the margins form holds per plant (those closest to -1/g): a long
+delay behind a loop gain that fades slowly crosses the axis hundreds of times within 10 dB of the bound; the
+others are left to the certificate and to the next round."""
 
 NLP_FORMS = FormRegistry("NLP")
 """The NLP form of each requirement type (filled by :func:`nlp_form` below)."""
@@ -160,8 +173,9 @@ def _margins(b: NLPBuilder, req: MarginsRequirement, plant: Plant, ctx: NLPConte
     # the certificate (hence exact=False)
     loop = Loop(plant, ctx.start)
     ctrl = b.ctrl
-    for wc in loop.gain_crossovers():
-        v = b.var("wc", float(wc), wc / 3.0, 3.0 * wc)
+    crossovers = loop.gain_crossovers()
+    for wc, lo, hi in zip(crossovers, *_between_neighbours(crossovers)):
+        v = b.var("wc", float(wc), max(wc / 3.0, lo), min(3.0 * wc, hi))
         _, L = loop_response(ctrl, plant, v)
         b.eq(L.abs2() - 1.0)
         if req.phase_margin_deg is not None:
@@ -171,8 +185,12 @@ def _margins(b: NLPBuilder, req: MarginsRequirement, plant: Plant, ctx: NLPConte
             b.geq((1.0 + L).abs2() - 4 * ca.sin(ca.fmin(v * tau, np.pi) / 2) ** 2)
     if req.gain_margin_db is not None:
         g = magnitude(req.gain_margin_db * (1 + BACKOFF))
-        for wp in phase_crossovers(loop):  # the upper gain limit: crossings inside the unit circle, right of -1/g
-            v = b.var("wp", float(wp), wp / 3.0, 3.0 * wp)
+        # the upper gain limit: crossings inside the unit circle stay right of -1/g; held are those within 10 dB
+        # of that bound (the closest MAX_HELD_CROSSINGS), each between its neighbouring zeros of Im L
+        crossing, below, above = phase_crossings(loop, 1.0 / (g * np.sqrt(10.0)))
+        closest = np.sort(np.argsort(-np.abs(loop.L(crossing)), kind="stable")[:MAX_HELD_CROSSINGS])
+        for wp, lo, hi in zip(crossing[closest], below[closest], above[closest]):
+            v = b.var("wp", float(wp), max(wp / 3.0, lo), min(3.0 * wp, hi))
             _, L = loop_response(ctrl, plant, v)
             b.eq(L.im)
             b.geq(L.re + 1.0 / g)

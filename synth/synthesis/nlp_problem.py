@@ -13,8 +13,20 @@ from synth.loop import Loop
 from synth.plant import Plant
 from synth.synthesis.cxcomplex import Cx, delay_jw, polyval_jw
 
-__all__ = ["BACKOFF", "IPOPT_OPTIONS", "SCALAR_FORM", "SYM", "TIGHT", "NLPBuilder", "SymbolicController", "loop_response",
-           "phase_crossovers", "t0_squared"]
+__all__ = [
+    "BACKOFF",
+    "IPOPT_OPTIONS",
+    "PHASE_CROSSOVER_FLOOR",
+    "SCALAR_FORM",
+    "SYM",
+    "TIGHT",
+    "NLPBuilder",
+    "SymbolicController",
+    "loop_response",
+    "phase_crossings",
+    "phase_crossovers",
+    "t0_squared",
+]
 
 SYM = ca.MX
 """Symbol type of the NLP. Matrix expressions: a requirement on n frequencies is a handful of vector
@@ -194,15 +206,62 @@ def t0_squared(ctrl: SymbolicController, plant: Plant) -> Any:
     return (n0 / (parts[1] + n0)) ** 2
 
 
-def phase_crossovers(loop: Loop) -> np.ndarray:
-    """Frequencies where ``L`` crosses the negative real axis inside the unit circle."""
-    from synth.freqgrid import crossings, log_grid
+PHASE_CROSSOVER_FLOOR = 0.1
+"""Crossings of the negative real axis where ``|L|`` is below this (-20 dB) are not counted as the NLP's
+crossovers (a new round starts when their number changes); the margins form holds those within 10 dB of its
+gain margin bound. A long delay crosses the axis every ``pi/delay`` rad/s up to where ``|L|`` fades, hundreds
+of times for a biproper controller."""
+
+
+def phase_crossovers(loop: Loop, floor: float = PHASE_CROSSOVER_FLOOR) -> np.ndarray:
+    """Frequencies where ``L`` crosses the negative real axis inside the unit circle with ``|L| >= floor``
+    (:func:`phase_crossings`).
+
+    Examples
+    --------
+    >>> from synth.plant import Plant
+    >>> from synth.controllers import Controller
+    >>> loop = Loop(Plant.from_string("1/(s+1)", delay=1.0), Controller("P", {"kp": 0.5}))
+    >>> phase_crossovers(loop, 0.05).round(3)  # w + atan(w) = pi, 3 pi, ...: |L| = 0.5/sqrt(1 + w^2) to w = 10
+    array([2.029, 7.979])
+    >>> phase_crossovers(loop).round(3)  # |L| >= 0.1 to w = 4.9
+    array([2.029])
+    """
+    return phase_crossings(loop, floor)[0]
+
+
+def phase_crossings(loop: Loop, floor: float = PHASE_CROSSOVER_FLOOR,
+                    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(w, lo, hi)``: the crossings of the negative real axis inside the unit circle where ``|L| >= floor``,
+    and for each the interval up to the neighbouring zeros of ``Im L`` (half-way, in ``log w``), where it is the
+    only zero. With a delay the grid resolves the delay's phase (steps of ``pi/4 / delay``) wherever ``|L|``
+    reaches ``floor``: a log grid alone aliases the crossings of a long delay.
+
+    Examples
+    --------
+    >>> from synth.plant import Plant
+    >>> from synth.controllers import Controller
+    >>> loop = Loop(Plant.from_string("1/(s+1)", delay=1.0), Controller("P", {"kp": 0.5}))
+    >>> w, lo, hi = phase_crossings(loop, 0.05)
+    >>> bool(np.all((lo < w) & (w < hi))), bool(hi[0] <= lo[1])
+    (True, True)
+    """
+    from synth.freqgrid import crossings, log_grid, resolving_grid
+    from synth.synthesis.delay_grid import DELAY_STEP
 
     lo, hi = loop.frequency_range
     grid = log_grid(lo, hi * 10, 200)
-    imag = crossings(lambda w: np.imag(loop.L(w)), 0.0, grid)
-    L = loop.L(imag)
-    keep = (np.real(L) < 0) & (np.abs(L) < 1.0)
-    return imag[keep]
-
-
+    if loop.delay > 0:
+        with np.errstate(all="ignore"):
+            reach = np.flatnonzero(np.abs(loop.L(grid)) >= floor / 4)  # and the zeros next to the last one
+        if reach.size:
+            grid = resolving_grid(lo, hi * 10, 200, DELAY_STEP / loop.delay, max_points=500_000,
+                                  even_until=float(grid[min(int(reach[-1]) + 1, grid.size - 1)]))
+    with np.errstate(all="ignore"):
+        zeros = crossings(lambda w: np.imag(loop.L(w)), 0.0, grid)
+        L = loop.L(zeros)
+    keep = np.flatnonzero((np.real(L) < 0) & (np.abs(L) < 1.0) & (np.abs(L) >= floor))
+    w = zeros[keep]
+    below = np.where(keep > 0, np.sqrt(zeros[np.maximum(keep - 1, 0)] * w), lo)
+    above = np.where(keep < zeros.size - 1, np.sqrt(zeros[np.minimum(keep + 1, zeros.size - 1)] * w), hi * 10)
+    return w, below, above
