@@ -44,7 +44,7 @@ from synth.synthesis.nlp_problem import (
     t0_squared,
 )
 
-__all__ = ["NLP_FORMS", "NLPContext", "nlp_form"]
+__all__ = ["MAX_HELD_CROSSINGS", "NLP_FORMS", "NLPContext", "nlp_form"]
 
 def _between_neighbours(w: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """For sorted positive frequencies, the interval of each up to half-way (in ``log w``) to its neighbours

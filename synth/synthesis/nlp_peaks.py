@@ -20,7 +20,7 @@ from synth.plant import Plant
 from synth.synthesis.delay_grid import DELAY_STEP
 from synth.synthesis.nlp_problem import NLPBuilder, loop_response
 
-__all__ = ["PEAK_TIGHT", "peak_brackets", "peak_frequencies", "resonance_points", "track_peaks"]
+__all__ = ["NEAR_DB", "PEAK_TIGHT", "peak_brackets", "peak_frequencies", "resonance_points", "track_peaks"]
 
 NEAR_DB = 3.0
 """Local maxima of the start design within this many dB of the bound (or above it) are tracked."""
