@@ -46,6 +46,7 @@ from synth.synthesis.nlp_problem import (
 
 __all__ = ["MAX_HELD_CROSSINGS", "NLP_FORMS", "NLPContext", "nlp_form"]
 
+
 def _between_neighbours(w: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """For sorted positive frequencies, the interval of each up to half-way (in ``log w``) to its neighbours
     (0 and infinity at the ends): a crossing held in it cannot slide onto another."""
