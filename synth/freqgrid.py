@@ -15,8 +15,8 @@ import numpy as np
 from synth.rootfind import bisect_roots
 
 __all__ = ["DEFAULT_PER_DECADE", "Curve", "band_grid", "band_grids", "batch_first_crossing", "batch_peak",
-           "characteristic_range", "corner_frequencies", "crossings", "first_fall", "log_grid", "log_grids",
-           "neighbour_brackets", "peak", "refine_maxima", "resolving_grid"]
+           "bracketed_maxima", "characteristic_range", "corner_frequencies", "crossings", "first_fall", "log_grid",
+           "log_grids", "neighbour_brackets", "peak", "refine_maxima", "resolving_grid"]
 
 Curve = Callable[[np.ndarray], np.ndarray]
 
@@ -159,15 +159,38 @@ def neighbour_brackets(grid: np.ndarray, values: np.ndarray, index: np.ndarray, 
     (4.5, 5.5)
     """
     grid, values = np.asarray(grid, float), np.asarray(values, float)
-    index, refined = np.asarray(index, int), np.asarray(refined, float)
+    refined = np.asarray(refined, float)
     troughs = np.flatnonzero((values[1:-1] < values[:-2]) & (values[1:-1] <= values[2:])) + 1
-    k = np.searchsorted(troughs, index)
-    below = np.where(k > 0, grid[troughs[np.maximum(k - 1, 0)]] if troughs.size else band[0], band[0])
-    above = np.where(k < troughs.size, grid[troughs[np.minimum(k, max(troughs.size - 1, 0))]]
-                     if troughs.size else band[1], band[1])
-    lo = np.maximum.reduce([below, refined / factor, np.full(refined.shape, band[0])])
-    hi = np.minimum.reduce([above, refined * factor, np.full(refined.shape, band[1])])
+    edges = np.concatenate([[band[0]], grid[troughs], [band[1]]])  # the band's ends stand for missing minima
+    k = np.searchsorted(troughs, np.asarray(index, int))
+    lo = np.maximum(np.maximum(edges[k], refined / factor), band[0])
+    hi = np.minimum(np.minimum(edges[k + 1], refined * factor), band[1])
     return lo, hi
+
+
+def bracketed_maxima(curve: Curve, grid: np.ndarray, keep: Callable[[np.ndarray], np.ndarray],
+                     band: tuple[float, float], factor: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The local maxima of a real ``curve`` on ``grid`` whose values pass ``keep``, refined by golden section
+    (:func:`refine_maxima`), each with its interval up to the neighbouring minima (:func:`neighbour_brackets`):
+    ``(w, lo, hi)``, empty when none passes.
+
+    Examples
+    --------
+    >>> w = np.linspace(1.0, 10.0, 901)
+    >>> f = lambda x: np.cos(2 * np.pi * x) * x  # maxima near the integers, growing
+    >>> peaks, lo, hi = bracketed_maxima(f, w, lambda v: v > 7.5, (1.0, 10.0), 1.5)
+    >>> peaks.round(3).tolist(), lo.round(2).tolist(), hi.round(2).tolist()
+    ([8.003, 9.003], [7.5, 8.5], [8.5, 9.5])
+    """
+    with np.errstate(all="ignore"):
+        values = np.asarray(curve(grid), dtype=float)
+        inner = np.flatnonzero((values[1:-1] > values[:-2]) & (values[1:-1] >= values[2:])) + 1
+        inner = inner[np.isfinite(values[inner]) & keep(values[inner])]
+        if inner.size == 0:
+            return np.array([]), np.array([]), np.array([])
+        _, refined = refine_maxima(curve, grid, inner)
+    lo, hi = neighbour_brackets(grid, values, inner, refined, band, factor)
+    return refined, lo, hi
 
 
 def refine_maxima(curve: Curve, grid: np.ndarray, index: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

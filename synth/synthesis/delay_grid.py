@@ -28,7 +28,8 @@ import numpy as np
 from synth.plant import Plant
 from synth.synthesis.parametrization import LinearParametrization, Parametrization
 
-__all__ = ["DELAY_STEP", "LOOP_GAIN_FLOOR", "MAX_DELAY_POINTS", "controller_gain_bound", "delay_points"]
+__all__ = ["DELAY_STEP", "LOOP_GAIN_FLOOR", "MAX_DELAY_POINTS", "controller_gain_bound", "delay_points",
+           "delay_resolving_step"]
 
 DELAY_STEP = np.pi / 4
 """Largest turn of the longest delay's phase (rad) between neighbouring design frequencies."""
@@ -45,6 +46,18 @@ MAX_DELAY_POINTS = 400
 _DENSER = 8
 """The plant's gain is taken on a grid this many times denser than the design grid (a lightly damped mode's
 peak between two grid points counts)."""
+
+
+def delay_resolving_step(delay: float) -> float | None:
+    """The largest frequency step (rad/s) that turns a ``delay``'s phase by :data:`DELAY_STEP`; None without a
+    delay (for :func:`synth.freqgrid.resolving_grid`).
+
+    Examples
+    --------
+    >>> round(delay_resolving_step(2.0), 4), delay_resolving_step(0.0)
+    (0.3927, None)
+    """
+    return DELAY_STEP / delay if delay > 0 else None
 
 
 def controller_gain_bound(par: Parametrization) -> Callable[[np.ndarray], np.ndarray] | None:

@@ -14,10 +14,10 @@ import casadi as ca
 import numpy as np
 
 from synth.controllers import Controller
-from synth.freqgrid import neighbour_brackets, refine_maxima, resolving_grid
+from synth.freqgrid import bracketed_maxima, resolving_grid
 from synth.loop import Loop
 from synth.plant import Plant
-from synth.synthesis.delay_grid import DELAY_STEP
+from synth.synthesis.delay_grid import delay_resolving_step
 from synth.synthesis.nlp_problem import NLPBuilder, loop_response
 
 __all__ = ["NEAR_DB", "PEAK_TIGHT", "peak_brackets", "peak_frequencies", "resonance_points", "track_peaks"]
@@ -72,16 +72,10 @@ def peak_brackets(plant: Plant, start: Controller, curve: str, bound: float,
     lo, hi = max(band[0], 1e-9), band[1]
     if not hi > lo:
         return []
-    w = resolving_grid(lo, hi, PER_DECADE, DELAY_STEP / plant.delay if plant.delay > 0 else None)
-    with np.errstate(all="ignore"):
-        v = np.abs(f(w))
-        inner = np.flatnonzero((v[1:-1] > v[:-2]) & (v[1:-1] >= v[2:])) + 1
-        inner = inner[np.isfinite(v[inner]) & (v[inner] >= bound * 10 ** (-NEAR_DB / 20))]
-        if inner.size == 0:
-            return []
-        _, refined = refine_maxima(lambda x: np.abs(f(x)), w, inner)
-    box_lo, box_hi = neighbour_brackets(w, v, inner, refined, (lo, hi), BOX)
-    return [(float(a), float(b), float(c)) for a, b, c in zip(refined, box_lo, box_hi)]
+    w = resolving_grid(lo, hi, PER_DECADE, delay_resolving_step(plant.delay))
+    level = bound * 10 ** (-NEAR_DB / 20)
+    found = bracketed_maxima(lambda x: np.abs(f(x)), w, lambda v: v >= level, (lo, hi), BOX)
+    return [(float(a), float(b), float(c)) for a, b, c in zip(*found)]
 
 
 def track_peaks(b: NLPBuilder, plant: Plant, designs: list[Controller], curve: str, bound: float,

@@ -247,7 +247,7 @@ def phase_crossings(loop: Loop, floor: float = PHASE_CROSSOVER_FLOOR,
     (True, True)
     """
     from synth.freqgrid import crossings, log_grid, resolving_grid
-    from synth.synthesis.delay_grid import DELAY_STEP
+    from synth.synthesis.delay_grid import delay_resolving_step
 
     lo, hi = loop.frequency_range
     grid = log_grid(lo, hi * 10, 200)
@@ -255,7 +255,7 @@ def phase_crossings(loop: Loop, floor: float = PHASE_CROSSOVER_FLOOR,
         with np.errstate(all="ignore"):
             reach = np.flatnonzero(np.abs(loop.L(grid)) >= floor / 4)  # and the zeros next to the last one
         if reach.size:
-            grid = resolving_grid(lo, hi * 10, 200, DELAY_STEP / loop.delay, max_points=500_000,
+            grid = resolving_grid(lo, hi * 10, 200, delay_resolving_step(loop.delay), max_points=500_000,
                                   even_until=float(grid[min(int(reach[-1]) + 1, grid.size - 1)]))
     with np.errstate(all="ignore"):
         zeros = crossings(lambda w: np.imag(loop.L(w)), 0.0, grid)

@@ -16,10 +16,10 @@ import casadi as ca
 import numpy as np
 
 from synth.controllers import Controller
-from synth.freqgrid import neighbour_brackets, refine_maxima, resolving_grid
+from synth.freqgrid import bracketed_maxima, resolving_grid
 from synth.loop import Loop
 from synth.plant import Plant
-from synth.synthesis.delay_grid import DELAY_STEP
+from synth.synthesis.delay_grid import delay_resolving_step
 from synth.synthesis.nlp_problem import NLPBuilder, loop_response
 
 __all__ = ["NEAR", "close_approaches", "hold_sides"]
@@ -51,17 +51,10 @@ def close_approaches(plant: Plant, start: Controller, band: tuple[float, float],
     [1.0]
     """
     loop = Loop(plant, start)
-    w = resolving_grid(max(band[0], 1e-9), band[1], PER_DECADE, DELAY_STEP / plant.delay if plant.delay > 0 else None)
-    with np.errstate(all="ignore"):
-        d = np.abs(1.0 + loop.L(w))
-        inner = np.flatnonzero((d[1:-1] < d[:-2]) & (d[1:-1] <= d[2:])) + 1
-        inner = inner[np.isfinite(d[inner]) & (d[inner] < near)]
-        if inner.size == 0:
-            return []
-        _, refined = refine_maxima(lambda x: -np.abs(1.0 + loop.L(x)), w, inner)  # the minima of |1 + L|
-    box_lo, box_hi = neighbour_brackets(w, -d, inner, refined, band, BOX)
+    w = resolving_grid(max(band[0], 1e-9), band[1], PER_DECADE, delay_resolving_step(plant.delay))
+    minima = bracketed_maxima(lambda x: -np.abs(1.0 + loop.L(x)), w, lambda v: -v < near, band, BOX)
     out = []
-    for w0, lo, hi in zip(refined.tolist(), box_lo.tolist(), box_hi.tolist()):
+    for w0, lo, hi in zip(*(m.tolist() for m in minima)):
         h = 1e-6 * w0
         with np.errstate(all="ignore"):
             up, down, at = loop.L(np.array([w0 + h, w0 - h, w0]))
