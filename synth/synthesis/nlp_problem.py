@@ -35,7 +35,13 @@ milliseconds instead of a tenth of a second for a few thousand constraints."""
 
 IPOPT_OPTIONS = {"ipopt.print_level": 0, "print_time": False, "ipopt.sb": "yes", "ipopt.max_iter": 1500,
                  "ipopt.hessian_approximation": "limited-memory",
-                 "ipopt.tol": 1e-9, "ipopt.constr_viol_tol": 1e-9}
+                 "ipopt.tol": 1e-9, "ipopt.constr_viol_tol": 1e-9, "ipopt.mu_max": 1e-3}
+"""IPOPT's options for the polish. ``mu_max`` caps the barrier parameter of the adaptive strategy (IPOPT's
+choice under the limited-memory Hessian). A polish starts from a design that already meets the requirements,
+usually near an optimum; with hundreds of grid constraints, the barrier terms of a large ``mu`` outweigh the
+objective and pulled the iterates far from that start, which then took hundreds of small steps to come back
+(the servo PID of ``benchmarks/cli_speed.py``: 714 iterations instead of 8; seed 8 #272's PD polish: 2,289
+instead of 54, the same answers; benchmarks/README.md, session 18)."""
 
 
 SCALAR_FORM = True
