@@ -38,13 +38,16 @@ curve between its neighbouring minima, :mod:`synth.synthesis.nlp_peaks`, so a pe
 spacing is bounded where it is) and points around every lightly damped root of the loop. Another round starts from
 the answer when its crossovers changed or a helper variable ended on its box; an answer violated only between
 grid points is solved again from the same start with those frequencies (and the answer's sharp peaks) added,
-since an interior-point method restarted at an optimum with its constraints active wanders. An answer whose
+since an interior-point method restarted at an optimum with its constraints active wanders. A peak objective's
+maximum that the answer has off the grid (searched where the score searches it, which reaches below the grid
+where ``|S|`` rises towards ``|S(0)|``) is bounded in the next round's objective. An answer whose
 closed loop is unstable (a step jumped over the thin region where ``|1 + L|`` is small on the grid) is
 discarded and the round repeated in a trust region around its start, which grows again when it held a step
 back; from then on every close approach of the start's Nyquist curve to -1 is held on its side
 (:mod:`synth.synthesis.nlp_sides`), so that the next answers cannot cross it between the grid's points
 either. Where IPOPT stopped unconverged at a stable loop is offered to the certificate like every candidate.
-IPOPT runs with a limited-memory BFGS Hessian; a round that stops at the iteration limit (the quasi-Newton
+IPOPT runs with a limited-memory BFGS Hessian and its adaptive barrier parameter capped
+(:data:`~synth.synthesis.nlp_problem.IPOPT_OPTIONS`); a round that stops at the iteration limit (the quasi-Newton
 steps can crawl along curved active constraints) is continued from where it stopped with the exact Hessian.
 """
 
@@ -90,8 +93,10 @@ class NLPResult:
                 "solve_time": self.solve_time, "history": self.history}
 
 
-def _term(b: NLPBuilder, name: str, plants: list[Plant], grid: np.ndarray, start: Controller) -> Any:
-    """The measure ``name`` as a casadi expression in its natural unit (adds helper variables)."""
+def _term(b: NLPBuilder, name: str, plants: list[Plant], grid: np.ndarray, start: Controller,
+          peaks_at: np.ndarray) -> Any:
+    """The measure ``name`` as a casadi expression in its natural unit (adds helper variables); a peak is
+    bounded on ``grid`` and at ``peaks_at`` (the maxima earlier rounds' answers had off the grid)."""
     ctrl = b.ctrl
     plant = plants[0]
     loop0 = Loop(plant, start)
@@ -110,6 +115,7 @@ def _term(b: NLPBuilder, name: str, plants: list[Plant], grid: np.ndarray, start
         else:
             b.geq(L.abs2() - 1.0)
         return v
+    grid = np.union1d(grid, peaks_at)  # for the peaks below; a bandwidth or crossover stays within the grid's range
     if name == "peak_sensitivity":
         ms0 = float(np.max(np.abs(loop0.S(grid))))
         gamma = b.var("gamma", 1.0 / ms0, 1e-6, 1.0)
@@ -130,13 +136,13 @@ def _term(b: NLPBuilder, name: str, plants: list[Plant], grid: np.ndarray, start
 
 
 def _add_objective(b: NLPBuilder, terms: list[tuple[str, str, float]], plants: list[Plant], grid: np.ndarray,
-                   start: Controller) -> None:
+                   start: Controller, peaks_at: np.ndarray) -> None:
     """Minimize ``-sum(w s f)`` scaled by its value at the start (``s`` = +1 maximize, -1 minimize)."""
     from synth.objectives import score
 
     total = 0.0
     for name, sense, weight in terms:
-        total = total + weight * (1.0 if sense == "maximize" else -1.0) * _term(b, name, plants, grid, start)
+        total = total + weight * (1.0 if sense == "maximize" else -1.0) * _term(b, name, plants, grid, start, peaks_at)
     scale = max(abs(score(Loop(plants[0], start), terms)), 1e-6)
     b.f = -total / scale
 
@@ -186,6 +192,7 @@ def polish(requirements: list[Requirement], plants: list[Plant], start: Controll
     status = "not run"
     grid = np.asarray(grid, float)
     extra = np.array([])
+    missed = np.array([])  # maxima of a peak objective that earlier answers had off the grid
     converged = False
     solved: list[Controller] = []
     radius: float | None = None  # a trust region once a step has jumped out of the stabilizing set
@@ -209,7 +216,7 @@ def polish(requirements: list[Requirement], plants: list[Plant], start: Controll
             b.geq((1.0 + L).abs2() - stability_level**2)
             if hold_sides_now:  # an earlier answer crossed -1: the start's close approaches keep their side
                 held += hold_sides(b, p, current, (float(grid[0]), float(grid[-1])), stability_level)
-        _add_objective(b, objective, plants, grid, current)
+        _add_objective(b, objective, plants, grid, current, missed)
         if exact_from_now:  # an earlier round's quasi-Newton steps crawled: this problem gets the exact Hessian
             x, stats = b.solve(EXACT_HESSIAN, expand=True)
         else:
@@ -250,7 +257,9 @@ def polish(requirements: list[Requirement], plants: list[Plant], start: Controll
             continue
         solved.insert(0, candidate)
         between = _violated_frequencies(requirements, plants, candidate)
-        between = np.concatenate([between, _missed_peaks(objective, plants, candidate, np.union1d(grid, extra))])
+        peaks = _missed_peaks(objective, plants, candidate, np.union1d(np.union1d(grid, extra), missed))
+        missed = np.unique(np.concatenate([missed, peaks, peaks * (1 - 1e-3), peaks * (1 + 1e-3)]))
+        between = np.concatenate([between, peaks])
         if between.size:  # and the candidate's sharp features, which the next answer moves only a little
             extra = np.unique(np.concatenate([extra, between, between * (1 - 1e-3), between * (1 + 1e-3),
                                               resonance_points(plants, candidate, grid)]))
@@ -339,7 +348,9 @@ _PEAK_CURVES = {"peak_sensitivity": "S", "peak_complementary": "T", "control_eff
 def _missed_peaks(objective: list[tuple[str, str, float]], plants: list[Plant], c: Controller, grid: np.ndarray,
                   tol_db: float = 0.01) -> np.ndarray:
     """Frequencies of a peak-type objective's maximum (on any plant) that the NLP's grid misses by more than
-    ``tol_db``: the NLP minimized the peak it could see."""
+    ``tol_db``: the NLP minimized the peak it could see. The maximum is searched where the objective's score
+    searches it (:attr:`Loop.frequency_range`, to ten times its top), which may reach beyond the grid: below it
+    where ``|S|`` rises towards ``|S(0)|``."""
     from synth.freqgrid import log_grid, peak
 
     out = []
@@ -347,9 +358,11 @@ def _missed_peaks(objective: list[tuple[str, str, float]], plants: list[Plant], 
         if name not in _PEAK_CURVES:
             continue
         for p in plants:
-            curve = getattr(Loop(p, c), _PEAK_CURVES[name])
+            loop = Loop(p, c)
+            curve = getattr(loop, _PEAK_CURVES[name])
+            lo, hi = loop.frequency_range
             with np.errstate(all="ignore"):
-                true, w = peak(lambda v, f=curve: np.abs(f(v)), log_grid(grid[0], grid[-1], 160))
+                true, w = peak(lambda v, f=curve: np.abs(f(v)), np.union1d(log_grid(lo, 10 * hi, 160), grid))
                 seen = float(np.max(np.abs(curve(grid))))
             if np.isfinite(true) and 20 * np.log10(true / max(seen, 1e-300)) > tol_db:
                 out.append(w)
