@@ -73,3 +73,43 @@ def test_a_check_that_cannot_be_made_is_a_failed_trial_not_a_crash(monkeypatch):
     result = pattern.pattern_search(spec, Controller("PI", {"kp": 1.0, "ki": 2.0}),
                                     [("integral_gain", "maximize", 1.0)])
     assert result.improved and result.controller.parameters["kp"] <= 1.2
+
+
+def test_a_start_closer_to_minus_one_than_the_keeping_level_is_searched_not_returned():
+    """Seed 11, problem 152 (unstable plant, rational (2, 3) controller, maximize bandwidth): the convex stage's
+    design keeps |1 + L| >= 0.05 on its own grid, yet comes to 0.022 of -1 between its points. The search kept
+    0.05 on a denser grid, so the start itself failed and the search returned after one check ("steps down to
+    0e+00"). The start's own distance is now the floor: the search moves, and no accepted move comes closer to
+    -1 than the start (dense |1 + L| from the polynomials)."""
+    import numpy as np
+
+    import synth
+    from synth.loop import Loop
+    from synth.objectives import score
+
+    spec = parse_spec({"name": "rand_11_152", "plant": {"tf": "741.841*1/((s-2.6612)*(s+81.7929))"},
+                       "controller": {"type": "rational", "order": [2, 3],
+                                      "bounds": {"b0": [-58778.1, 58778.1], "b1": [-6820.15, 6820.15],
+                                                 "b2": [-791.356, 791.356], "a0": [0.0, 864169.0],
+                                                 "a1": [0.0, 100271.0], "a2": [0.0, 11634.7]}},
+                       "requirements": [{"type": "sensitivity", "max_db": -7.28717, "band": [0.0, 1.01303]},
+                                        {"type": "sensitivity_static", "max_db": -24.1099}],
+                       "objective": {"maximize": "bandwidth"}})
+    start = Controller("rational", {"b0": 44245.08023049825, "b1": 6788.779154205124, "b2": 790.7513040857376,
+                                    "a0": 209.1817078145316, "a1": 4308.801793225167, "a2": 48.354781621968606})
+    w = np.geomspace(1e-3, 1e5, 200_001)
+
+    def closest(c: Controller) -> float:
+        cn, cd = c.tf()
+        s = 1j * w
+        return float(np.min(np.abs(1.0 + 741.841 * np.polyval(cn, s)
+                                   / (np.polyval([1.0, 81.7929 - 2.6612, -2.6612 * 81.7929], s) * np.polyval(cd, s)))))
+
+    assert closest(start) < 0.05
+    terms = objective_terms(spec)
+    result = pattern_search(spec, start, terms, keeping=0.05)
+    assert result.improved and result.checks > 1
+    assert synth.check(spec, result.controller, 400).feasible
+    plant = spec.nominal_plant()
+    assert score(Loop(plant, result.controller), terms) > score(Loop(plant, start), terms)
+    assert closest(result.controller) >= 0.9 * closest(start)

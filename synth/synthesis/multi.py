@@ -384,7 +384,8 @@ def _design(spec: Spec, settings: ConvexSettings, nlp: bool | str) -> DesignResu
             searched = ("a pattern search on the exact check from it found a better point that failed the dense "
                         "certificate" if search.improved else "a pattern search on the exact check from it found no "
                         f"better point (steps down to {search.final_step:.0e} of each parameter's scale, "
-                        f"{search.checks} checks)")
+                        f"{search.checks} checks)" if search.checks > 1 else "a pattern search on the exact check "
+                        "could not start from it (it fails the search's own check)")
     method = "; ".join(stages) + f"; certificate: dense re-check, {per_decade} points per decade"
     if passed is not None:
         stage, controller, certificate = passed

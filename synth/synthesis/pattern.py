@@ -77,7 +77,9 @@ def pattern_search(spec: Spec, start: Controller, terms: list[tuple[str, str, fl
     keeping : float
         Smallest ``|1 + L|`` a move may leave on every plant (on the design grid at ``per_decade``): the
         stability keeping of the convex and NLP stages (:class:`~synth.synthesis.convex_settings.ConvexSettings`'
-        ``stability_level``), so that the search does not walk a design to the edge of stability.
+        ``stability_level``), so that the search does not walk a design to the edge of stability. A start that
+        comes closer to -1 on this grid (the stages keep ``|1 + L|`` only on their own grid) sets the floor
+        instead: no move comes closer than the start.
 
     Returns
     -------
@@ -101,6 +103,14 @@ def pattern_search(spec: Spec, start: Controller, terms: list[tuple[str, str, fl
     grid = design_grid(spec.plants(), list(spec.requirements), ConvexSettings(per_decade=per_decade),
                        _gain_bound(spec))
 
+    def closest(c: Controller) -> float:
+        """Smallest ``|1 + L|`` on the grid over the plants."""
+        with np.errstate(all="ignore"):
+            return min(float(np.min(np.abs(1.0 + Loop(p, c).L(grid)))) for p in spec.plants())
+
+    if keeping > 0:  # a start closer to -1 than that (between the stage's own grid points): no move comes closer
+        keeping = min(keeping, closest(start))
+
     def value(params: dict[str, float]) -> tuple[float, float]:
         """(objective score, smallest requirement slack); (-inf, -inf) when the check fails or cannot be made
         (e.g. a Nyquist count that does not converge)."""
@@ -110,8 +120,7 @@ def pattern_search(spec: Spec, start: Controller, terms: list[tuple[str, str, fl
         try:
             with np.errstate(all="ignore"):
                 result = check(spec, c, per_decade)
-                if not result.feasible or (keeping > 0 and min(
-                        float(np.min(np.abs(1.0 + Loop(p, c).L(grid)))) for p in spec.plants()) < keeping):
+                if not result.feasible or (keeping > 0 and closest(c) < keeping):
                     return -np.inf, -np.inf
                 return float(score(Loop(nominal, c), terms)), min(r.slack for r in result.requirements)
         except (ArithmeticError, ValueError, RuntimeError, SynthError):  # a count that failed: not certified
