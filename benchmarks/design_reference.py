@@ -289,11 +289,15 @@ class LoopModel:
         return ev
 
     def margins(self, w: np.ndarray, L: np.ndarray, Lf: Any) -> tuple[float, float, float]:
-        """Upward gain margin (dB, inf beyond 80 dB), smallest phase margin (deg), delay margin (s)."""
+        """Gain margin (dB: the nearer of the upward and the downward one, as docs/spec-format.md defines it for
+        a conditionally stable loop; an upward one beyond 80 dB counts as none), smallest phase margin (deg),
+        delay margin (s)."""
         mag = np.log(np.abs(L))
         ks = []
-        if abs(L[0].imag) < 1e-9 * abs(L[0]) and L[0].real < 0:
-            ks.append(1 / abs(L[0]))
+        with np.errstate(all="ignore"):
+            l0 = complex(Lf(0.0))  # L(0) is real: a phase crossing at w = 0 when it is negative (unstable plant)
+        if np.isfinite(l0) and l0.real < 0:
+            ks.append(1 / abs(l0))
         im = L.imag
         for i in np.nonzero(np.sign(im[:-1]) * np.sign(im[1:]) < 0)[0]:
             if L[i].real < 0 or L[i + 1].real < 0:
@@ -302,7 +306,9 @@ class LoopModel:
                 if lv.real < 0:
                     ks.append(1 / abs(lv))
         up = [k for k in ks if k > 1]
-        gm = 20 * np.log10(min(up)) if up and min(up) < 1e4 else np.inf
+        down = [k for k in ks if k < 1]  # a gain reduction that puts a crossing on -1 destabilizes the loop too
+        gm = min(20 * np.log10(min(up)) if up and min(up) < 1e4 else np.inf,
+                 -20 * np.log10(max(down)) if down else np.inf)
         pm, dm = np.inf, np.inf
         for i in np.nonzero(np.sign(mag[:-1]) * np.sign(mag[1:]) < 0)[0]:
             x = np.exp(brentq(lambda lx: np.log(abs(Lf(np.exp(lx)))), np.log(w[i]), np.log(w[i + 1]), xtol=1e-13))
