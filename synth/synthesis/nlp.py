@@ -258,10 +258,10 @@ def polish(requirements: list[Requirement], plants: list[Plant], start: Controll
         solved.insert(0, candidate)
         between = _violated_frequencies(requirements, plants, candidate)
         peaks = _missed_peaks(objective, plants, candidate, np.union1d(np.union1d(grid, extra), missed))
-        missed = np.unique(np.concatenate([missed, peaks, peaks * (1 - 1e-3), peaks * (1 + 1e-3)]))
+        missed = np.union1d(missed, _with_neighbours(peaks))
         between = np.concatenate([between, peaks])
         if between.size:  # and the candidate's sharp features, which the next answer moves only a little
-            extra = np.unique(np.concatenate([extra, between, between * (1 - 1e-3), between * (1 + 1e-3),
+            extra = np.unique(np.concatenate([extra, _with_neighbours(between),
                                               resonance_points(plants, candidate, grid)]))
         # the NLP is built around this round's start (its crossovers, boxes of the crossover and bandwidth
         # variables): another round from the candidate is needed when its crossovers changed or a helper
@@ -343,6 +343,11 @@ def _at_helper_box(b: NLPBuilder, x: np.ndarray, n_controller: int, tol: float =
 
 
 _PEAK_CURVES = {"peak_sensitivity": "S", "peak_complementary": "T", "control_effort": "KS"}
+
+
+def _with_neighbours(w: np.ndarray) -> np.ndarray:
+    """``w`` and the points 0.1 % either side of each (a feature the next answer moves only a little)."""
+    return np.concatenate([w, w * (1 - 1e-3), w * (1 + 1e-3)])
 
 
 def _missed_peaks(objective: list[tuple[str, str, float]], plants: list[Plant], c: Controller, grid: np.ndarray,
