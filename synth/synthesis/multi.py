@@ -21,6 +21,7 @@ import numpy as np
 
 from synth.check import check
 from synth.controllers import Controller
+from synth.edge import edge_distance
 from synth.errors import NoStabilizingStartError, SynthError
 from synth.loop import Loop
 from synth.objectives import score
@@ -400,12 +401,14 @@ def _design(spec: Spec, settings: ConvexSettings, nlp: bool | str) -> DesignResu
         slices = stabilizing_slices(spec, controller) if open_loop_unstable(spec) else {}
         if slices:
             extras["stabilizing_slices"] = {k: [list(iv) for iv in v] for k, v in slices.items()}
+        edge = edge_distance(spec.plants(), controller, CERTIFICATE_PER_DECADE)
+        extras["edge_of_stability"] = edge.to_dict()
         result = DesignResult(spec.name, True, controller, check(spec, controller), label, None, certificate,
                               None, method + f"; chosen: {stage}", reference=ref, extras=extras)
         result.verdict = (f"{controller} meets all {len(spec.requirements)} requirements and keeps the loop "
                           f"stable on {len(spec.plants())} plant(s) ({_describe(spec, label)}).") + objective_note(label) \
-            + (f" Optimality: {optimality.basis}." if spec.objective is not None else "") + slices_text(slices) \
-            + reference_verdict(spec, ref)
+            + edge.warning() + (f" Optimality: {optimality.basis}." if spec.objective is not None else "") \
+            + slices_text(slices) + reference_verdict(spec, ref)
         return result
     if feasible_runs:  # optimal on the grid but none survives the certificate
         stage, controller, certificate = candidates[-1]

@@ -13,6 +13,7 @@ from typing import Any
 import numpy as np
 
 from synth.check import check
+from synth.edge import edge_distance
 from synth.errors import SynthError
 from synth.forked import run_beside
 from synth.loop import Loop
@@ -224,6 +225,10 @@ def _design_without_reference(spec: Spec) -> tuple[DesignResult, GainSet | None]
     result.verdict = feasible_verdict(result, family) if feasible else (
         f"The optimum {controller} failed the dense re-check ("
         + "; ".join(r.message for r in cert_check.failed()) + "): not reported as a solution.")
+    if feasible:
+        edge = edge_distance(plants, controller, CERTIFICATE_PER_DECADE)
+        result.extras["edge_of_stability"] = edge.to_dict()
+        result.verdict += edge.warning()
     if feasible and objective is not None:
         optimality = Optimality(True, "exact feasible set", f"the objective maximized over the exact feasible set of "
                                 f"{family.parameter} ({SCALAR_GRID} points per interval, then Brent's method around "
