@@ -206,9 +206,43 @@ def refine_maxima(curve: Curve, grid: np.ndarray, index: np.ndarray) -> tuple[np
     """
     grid = np.asarray(grid, dtype=float)
     index = np.asarray(index, dtype=int)
-    a, b = grid[index - 1][None, :], grid[index + 1][None, :]
-    v, w = _golden_max(lambda x: np.asarray(curve(x.ravel()), dtype=float).reshape(x.shape), a, b, a > 0)
-    return v[0], w[0]
+    a, b = grid[index - 1], grid[index + 1]
+    return _zoom_max(lambda x: np.asarray(curve(x.ravel()), dtype=float).reshape(x.shape), a, b, a > 0)
+
+
+def _zoom_max(curve: Callable[[np.ndarray], np.ndarray], a: np.ndarray, b: np.ndarray, log: np.ndarray,
+              points: int = 16, iterations: int = 40) -> tuple[np.ndarray, np.ndarray]:
+    """Maximize ``curve`` on each bracket ``[a, b]`` (1-D arrays; in ``log w`` where ``log``) by zooming grids:
+    ``points`` interior points per bracket, then the bracket shrinks to the best point found so far +- one
+    spacing (a factor ``(points + 1) / 2`` per round), all brackets in one evaluation per round, until each is
+    narrower than 1e-12 relative. Keeps the best point seen, so it ends at a maximum no lower than any sample
+    even where a bracket holds several; ``-inf`` where no sample was a number. For a few brackets this is far fewer calls than golden section (12
+    against 50), each on a short array, which is what costs."""
+    with np.errstate(divide="ignore"):
+        lo = np.where(log, np.log(np.where(log, a, 1.0)), a)
+        hi = np.where(log, np.log(np.where(log, b, 1.0)), b)
+    logc = log[:, None]
+
+    def f(x: np.ndarray) -> np.ndarray:
+        with np.errstate(over="ignore"):
+            v = np.asarray(curve(np.where(logc, np.exp(x), x)), dtype=float)
+        return np.where(np.isnan(v), -np.inf, v)
+
+    steps = np.arange(1, points + 1) / (points + 1)
+    best_x = 0.5 * (lo + hi)
+    best_v = f(best_x[:, None])[:, 0]
+    rows = np.arange(lo.size)
+    for _ in range(iterations):
+        x = lo[:, None] + (hi - lo)[:, None] * steps
+        v = f(x)
+        j = np.argmax(v, axis=1)
+        better = v[rows, j] > best_v
+        best_x, best_v = np.where(better, x[rows, j], best_x), np.where(better, v[rows, j], best_v)
+        h = (hi - lo) / (points + 1)
+        lo, hi = np.maximum(lo, best_x - h), np.minimum(hi, best_x + h)
+        if np.all(hi - lo <= 1e-12 * np.maximum(1.0, np.abs(hi))):
+            break
+    return best_v, np.where(log, np.exp(best_x), best_x)
 
 
 def crossings(curve: Curve, level: float, grid: np.ndarray) -> np.ndarray:
