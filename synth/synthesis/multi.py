@@ -403,7 +403,7 @@ def _design(spec: Spec, settings: ConvexSettings, nlp: bool | str) -> DesignResu
             extras["stabilizing_slices"] = {k: [list(iv) for iv in v] for k, v in slices.items()}
         edge = edge_distance(spec.plants(), controller, CERTIFICATE_PER_DECADE)
         extras["edge_of_stability"] = edge.to_dict()
-        result = DesignResult(spec.name, True, controller, check(spec, controller), label, None, certificate,
+        result = DesignResult(spec.name, True, controller, certificate.check, label, None, certificate,
                               None, method + f"; chosen: {stage}", reference=ref, extras=extras)
         result.verdict = (f"{controller} meets all {len(spec.requirements)} requirements and keeps the loop "
                           f"stable on {len(spec.plants())} plant(s) ({_describe(spec, label)}).") + objective_note(label) \
