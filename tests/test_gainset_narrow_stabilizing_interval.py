@@ -50,8 +50,8 @@ def test_random_slivers_against_the_nyquist_count():
         top = 1.0
         while _stable(plant, top):
             top *= 2.0
-        a, b = 0.0, top
-        for _ in range(60):
+        a, b = (top / 2 if top > 1.0 else 0.0), top  # stable at top / 2: the last doubling passed
+        while b - a > 1e-12 * b:  # to 1e-12 relative, a million times finer than the check below
             a, b = ((a + b) / 2, b) if _stable(plant, (a + b) / 2) else (a, (a + b) / 2)
         scale = b / float(10 ** rng.uniform(-6, -4))  # the bounds [0, 1] then hold the sliver [0, 1e-6..1e-4]
         scaled = Plant(plant.num * scale, plant.den, delay=plant.delay)

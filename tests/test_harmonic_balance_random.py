@@ -18,6 +18,8 @@ def _bisect(f, lo: float, hi: float, steps: int = 80) -> float:
     f_lo = f(lo)
     for _ in range(steps):
         mid = 0.5 * (lo + hi)
+        if mid in (lo, hi):  # adjacent floats: the remaining steps would not move either end (same result, cheaper)
+            break
         f_mid = f(mid)
         if np.sign(f_mid) == np.sign(f_lo):
             lo, f_lo = mid, f_mid

@@ -112,7 +112,7 @@ def test_step_response_feasible_set_matches_a_dense_grid():
     [(lo, hi)] = result.gain_set.as_list()
     T = np.linspace(0, 200, 8001)  # python-control's step response, independent of synth.timeresp
 
-    def overshoot_ok(gains: np.ndarray) -> np.ndarray:
+    def overshoot_ok(gains: np.ndarray, T: np.ndarray = T) -> np.ndarray:
         over = [control.step_info(control.feedback(_tf(CUBIC, k), 1), T=T)["Overshoot"] for k in gains]
         return np.array(over) <= 10.0
 
@@ -120,7 +120,9 @@ def test_step_response_feasible_set_matches_a_dense_grid():
     ok = coarse[overshoot_ok(coarse)]
     assert ok.size and np.all(np.diff(ok) < 0.06)  # one interval from the lower bound
     fine = np.linspace(ok.max(), ok.max() + coarse[1] - coarse[0], 41)  # the edge, resolved 20x finer
-    edge = fine[overshoot_ok(fine)].max()
+    # near the edge (kp 0.80-0.85) the peak comes by 7.2 s: the first 50 s of the same time grid give the same
+    # overshoot (python-control takes the final value from the DC gain) at a quarter of the cost
+    edge = fine[overshoot_ok(fine, T[T <= 50.0])].max()
     assert lo == pytest.approx(0.05) and hi == pytest.approx(edge, abs=2 * (fine[1] - fine[0]))
 
 
