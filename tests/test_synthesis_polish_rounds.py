@@ -86,7 +86,13 @@ def test_a_step_out_of_the_stabilizing_set_is_repeated_in_a_trust_region(mu_max:
 def test_an_unconverged_round_that_passes_is_a_design() -> None:
     """Benchmark seed 1, problem 105 (unstable plant with a right-half-plane zero and a 42 ms delay, PID,
     maximize bandwidth): the round that reaches the reference's optimum stops at IPOPT's iteration limit; its
-    stable iterate is offered to the certificate and passes, within 1 % of the reference's best design."""
+    stable iterate is offered to the certificate and passes, within 1 % of the reference's best design. (Since
+    the polish's barrier cap of session 19 the chosen round converges: the test now guards the design's
+    quality on this problem, not the unconverged path itself.) The design with integral action is run alone
+    (the first job of synth.design.design_jobs; synth.design's answer here): the one without it (ki = 0) ends
+    infeasible."""
+    from synth.design import design_jobs
+
     spec = {"name": "p105", "plant": {"tf": "24.4063*(1-s/5.49139)*(s+33.6887)/((s-0.719713)*(s+2.53304)*(s+30.132))",
                                       "delay": 0.0418484},
             "controller": {"type": "PID", "bounds": {"kp": [0.0, 5.81268], "ki": [0.0, 35.4934], "kd": [0.0, 0.951929],
@@ -96,9 +102,11 @@ def test_an_unconverged_round_that_passes_is_a_design() -> None:
                               "band": [0.0610621, 25.8063]},
                              {"type": "margins", "phase_margin_deg": 20.2337}],
             "objective": {"maximize": "bandwidth"}}
+    jobs, _ = design_jobs(synth.parse_spec(spec))
+    assert len(jobs) == 2
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        d = synth.design(synth.parse_spec(spec))
+        d = jobs[0]()
     assert d.feasible
     num = np.polymul([-24.4063 / 5.49139, 24.4063], [1.0, 33.6887])
     den = np.polymul(np.polymul([1.0, -0.719713], [1.0, 2.53304]), [1.0, 30.132])
