@@ -7,6 +7,11 @@ import os
 from contextlib import redirect_stderr, redirect_stdout
 from pathlib import Path
 
+# One BLAS thread per process: the suite runs one pytest worker per core (xdist), and OpenBLAS's own threads in
+# each worker would compete with the other worker for the same cores (set before anything imports numpy; the
+# workers and the commands the tests start inherit it).
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+
 import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
