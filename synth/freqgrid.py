@@ -216,8 +216,8 @@ def _zoom_max(curve: Callable[[np.ndarray], np.ndarray], a: np.ndarray, b: np.nd
     ``points`` interior points per bracket, then the bracket shrinks to the best point found so far +- one
     spacing (a factor ``(points + 1) / 2`` per round), all brackets in one evaluation per round, until each is
     narrower than 1e-12 relative. Keeps the best point seen, so it ends at a maximum no lower than any sample
-    even where a bracket holds several; ``-inf`` where no sample was a number. For a few brackets this is far fewer calls than golden section (12
-    against 50), each on a short array, which is what costs."""
+    even where a bracket holds several; ``-inf`` where no sample was a number. For a few brackets this is far
+    fewer calls than golden section (12 against 50), each on a short array, which is what costs."""
     with np.errstate(divide="ignore"):
         lo = np.where(log, np.log(np.where(log, a, 1.0)), a)
         hi = np.where(log, np.log(np.where(log, b, 1.0)), b)
