@@ -222,7 +222,13 @@ class NoLimitCycle(Requirement):
         if key not in _UNIT_GAIN_FACTORS:
             if len(_UNIT_GAIN_FACTORS) >= 4096:
                 _UNIT_GAIN_FACTORS.clear()
-            _UNIT_GAIN_FACTORS[key] = critical_gain_factor(lambda x: loop.L(x) / gain, w, self.delay, self.kinds())
+            # the unit-gain loop itself, not ``loop.L / gain``: the rounding of that quotient (and so the
+            # refined minimum) would depend on the gain that came first, and results on the order of evaluation
+            from synth.loop import Loop
+
+            unit = Loop((np.polymul(cnum / gain, loop.plant.num), np.polymul(cden, loop.plant.den)), "P(1)",
+                        delay=loop.plant.delay)
+            _UNIT_GAIN_FACTORS[key] = critical_gain_factor(unit.L, w, self.delay, self.kinds())
         k, wk, tau = _UNIT_GAIN_FACTORS[key]
         return w, (k / gain, wk, tau)
 
