@@ -7,7 +7,7 @@ import pytest
 
 from synth.data import record_from_arrays
 from synth.errors import FitError, SynthError
-from synth.ident.fit_failure import fit_failure
+from synth.ident.fit_failure import LIMIT_STATUSES, fit_failure
 from synth.ident.identification import identify
 from synth.ident.simulate import simulate_plant
 from synth.ident.timefit import fit_structure
@@ -25,7 +25,10 @@ def test_noise_only_record_is_no_model():
     """The output does not respond to the input: the first-order fit explains no more than noise."""
     with pytest.raises(FitError, match=r"fit of 'K/\(T\*s\+1\)' failed: .*try another structure") as info:
         identify((T, U, _noise_only()), "K/(T*s+1)")
-    assert isinstance(info.value, SynthError) and info.value.status == "Solve_Succeeded"
+    # the failure is the F-test's, not the solver's: it converged, or stopped at its iteration limit within the
+    # fit's uncertainty of the optimum (which one depends on the CPU's floating-point kernels)
+    assert isinstance(info.value, SynthError) and info.value.status in ("Solve_Succeeded", *LIMIT_STATUSES)
+    assert "F-test p = " in str(info.value) and "IPOPT stopped" not in str(info.value)
     assert "noise" in str(info.value) and "\n" not in str(info.value)
 
 
