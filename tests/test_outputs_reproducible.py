@@ -44,7 +44,9 @@ def test_the_main_job_twice_gives_the_same_bytes_as_the_committed_report(tmp_pat
 
 @pytest.mark.parametrize(("name", "a", "b", "same"), [
     ("r.json", b'{"kp": 3.65879497462, "m": "C(0) = 3.659"}', b'{"kp": 3.65879492864, "m": "C(0) = 3.659"}', True),
-    ("r.json", b'{"kp": 3.6587}', b'{"kp": 3.6588}', False),
+    ("r.json", b'{"kp": 3.6587}', b'{"kp": 3.6589}', False),
+    ("r.json", b'{"settling_time": 0.943}', b'{"settling_time": 0.944}', True),  # one sample of 1 ms
+    ("r.json", b'{"settling_time": 0.943}', b'{"settling_time": 0.945}', False),
     ("r.json", b'{"m": "met"}', b'{"m": "NOT met"}', False),
     ("r.json", b'{"kp": 3.0, "ki": 1.0}', b'{"kp": 3.0}', False),
     ("r.html", b"<td>473.3 rad/s</td>", b"<td>473.4 rad/s</td>", True),  # a rounding straddle in the last digit
@@ -73,3 +75,32 @@ def test_an_image_with_a_moved_curve_is_a_change(tmp_path) -> None:
 
     assert same_content("f.png", png(0.0), png(0.0))
     assert not same_content("f.png", png(0.0), png(0.2))
+
+
+
+def test_an_image_with_one_digit_changed_is_a_change_and_a_spine_one_pixel_over_is_not() -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    def png(label: str) -> bytes:
+        fig, ax = plt.subplots(figsize=(8, 6), dpi=110)
+        x = np.linspace(0, 1, 50)
+        ax.plot(x, x, label=label)
+        ax.legend()
+        buf = io.BytesIO()
+        fig.savefig(buf, format="png", metadata={"Software": None})
+        plt.close(fig)
+        return buf.getvalue()
+
+    def spine(column: int) -> bytes:  # a white 600 x 800 image with a black vertical line, 2 pixels wide
+        img = np.ones((600, 800, 3))
+        img[40:560, column:column + 2] = 0.0
+        buf = io.BytesIO()
+        plt.imsave(buf, img, format="png")
+        return buf.getvalue()
+
+    assert not same_content("f.png", png("peaks at 1354"), png("peaks at 1355"))
+    assert same_content("f.png", spine(500), spine(501))  # snapped to the next pixel
+    assert not same_content("f.png", spine(500), spine(503))
