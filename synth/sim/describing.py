@@ -310,11 +310,16 @@ def sampled_loop_response(loop: Any, w: Any) -> np.ndarray:
 
 def _loop_parts(loop: Any, w: Any) -> np.ndarray:
     """Rows: controller, plant core (actuator output to sensed output), sensor chain."""
+    return _loop_parts_of(loop)(w)
+
+
+def _loop_parts_of(loop: Any) -> Callable[[Any], np.ndarray]:
+    """:func:`_loop_parts` of ``loop`` as a function of the frequencies, with the discretizations done once (a
+    harmonic balance asks for one frequency at a time, hundreds of times)."""
     from synth.sim.blocks import Delay, Dynamics, SampleHold
     from synth.sim.discretize import delayed_zoh, discretize_controller, zoh
     from synth.sim.folding import fold_counts, plant_core
 
-    w = np.atleast_1d(np.asarray(w, float))
     dt = loop.dt
     act = [b for b in loop.actuator if not isinstance(b, Delay)]
     sen = [b for b in loop.sensor if not isinstance(b, Delay)]
@@ -325,8 +330,14 @@ def _loop_parts(loop: Any, w: Any) -> np.ndarray:
     num, den = loop.controller.tf()
     tc = loop.controller_period
     Ac, Bc, Cc, Dc = discretize_controller(num, den, tc, loop.discretization)
-    z = np.exp(1j * w * dt)
-    zc = np.exp(1j * w * tc)
+    sensors: list[tuple[str, Any]] = []
+    for b in sen[ns:]:
+        if isinstance(b, SampleHold):
+            sensors.append(("hold", max(0.0, 1.0 / b.rate - dt)))
+        elif isinstance(b, Dynamics):
+            A_, B_, C_, D_ = b.state_space()
+            Ad, Bd = zoh(A_, B_[:, None], dt)
+            sensors.append(("dynamics", (Ad, Bd, C_, D_)))
 
     def resolvent(zs: np.ndarray, A: np.ndarray, B: np.ndarray) -> np.ndarray:
         """``(z I - A)^-1 B`` at every ``z`` (``B`` one column, or one column per ``z``), batched."""
@@ -334,24 +345,29 @@ def _loop_parts(loop: Any, w: Any) -> np.ndarray:
         rhs = np.broadcast_to(B, (zs.size, A.shape[0])) if B.ndim == 1 else B
         return np.linalg.solve(M, rhs[..., None])[..., 0]
 
-    shift = z ** (-dz.steps - 1)
-    if n:
-        X = resolvent(z, dz.Ad, dz.B_early[None, :] + dz.B_late[None, :] * z[:, None])
-        P = (X @ core.C[1]) * shift + core.D[1, 0] * shift
-    else:
-        P = core.D[1, 0] * shift
-    C = Dc + (resolvent(zc, Ac, Bc) @ Cc if Ac.size else 0.0)
-    S = np.ones(w.size, complex)
-    for b in sen[ns:]:
-        if isinstance(b, SampleHold):
-            S = S * np.exp(-1j * w * max(0.0, 1.0 / b.rate - dt) / 2)
-        elif isinstance(b, Dynamics):
-            A_, B_, C_, D_ = b.state_space()
-            Ad, Bd = zoh(A_, B_[:, None], dt)
-            S = S * (D_ + (resolvent(z, Ad, Bd[:, 0]) @ C_ if Ad.size else 0.0))
-    out = np.empty((3, w.size), complex)
-    out[0], out[1], out[2] = C, P, S
-    return out
+    def parts(w: Any) -> np.ndarray:
+        w = np.atleast_1d(np.asarray(w, float))
+        z = np.exp(1j * w * dt)
+        zc = np.exp(1j * w * tc)
+        shift = z ** (-dz.steps - 1)
+        if n:
+            X = resolvent(z, dz.Ad, dz.B_early[None, :] + dz.B_late[None, :] * z[:, None])
+            P = (X @ core.C[1]) * shift + core.D[1, 0] * shift
+        else:
+            P = core.D[1, 0] * shift
+        C = Dc + (resolvent(zc, Ac, Bc) @ Cc if Ac.size else 0.0)
+        S = np.ones(w.size, complex)
+        for kind, data in sensors:
+            if kind == "hold":
+                S = S * np.exp(-1j * w * data / 2)
+            else:
+                Ad, Bd, C_, D_ = data
+                S = S * (D_ + (resolvent(z, Ad, Bd[:, 0]) @ C_ if Ad.size else 0.0))
+        out = np.empty((3, w.size), complex)
+        out[0], out[1], out[2] = C, P, S
+        return out
+
+    return parts
 
 
 @dataclass(frozen=True)
@@ -414,12 +430,14 @@ def predict_loop_cycles(loop: Any, bias: float, w_range: tuple[float, float] | N
     def N(a: float, w: float) -> complex:
         return numeric_df(chain, a, w, bias=bias, points=160, periods=8)
 
+    parts = _loop_parts_of(loop)
+
     def L(w: np.ndarray) -> np.ndarray:
-        return sampled_loop_response(loop, w)
+        return np.prod(parts(w), axis=0)
 
     out = []
     for c in harmonic_balance(L, N, w_range, a_range, points):
-        _, P, S = _loop_parts(loop, [c.frequency])[:, 0]
+        _, P, S = parts([c.frequency])[:, 0]
         gain = abs(N(c.amplitude, c.frequency)) * abs(P * S)
         out.append(LoopCyclePrediction(c, float(c.amplitude * gain), bias))
     return out
