@@ -257,12 +257,24 @@ def _manifest_files(folder: Path) -> set[str]:
 
 
 def _check_creatable(path: Path) -> None:
-    """Refuse at once a folder that cannot be created or written (before any computation)."""
-    probe = path
+    """Refuse at once a folder that cannot be created or written (before any computation): the folder itself if
+    it exists, and the nearest existing folder above it (where the staging folder goes), each tried by making
+    and removing an empty folder in it (permission bits say nothing for root, nor on /proc or a read-only
+    mount)."""
+    probe = path.parent if path.parent != path else path
     while not probe.exists():
         probe = probe.parent
-    if not probe.is_dir() or not os.access(probe, os.W_OK | os.X_OK):
-        raise OutputExistsError(f"cannot write here ({probe} is not a writable folder)", where=str(path))
+    for folder in ([path] if path.is_dir() else []) + [probe]:
+        if not folder.is_dir() or not os.access(folder, os.W_OK | os.X_OK) or not _can_make_folder_in(folder):
+            raise OutputExistsError(f"cannot write here ({folder} is not a writable folder)", where=str(path))
+
+
+def _can_make_folder_in(folder: Path) -> bool:
+    try:
+        os.rmdir(tempfile.mkdtemp(prefix=".synth-probe.", dir=folder))
+    except OSError:
+        return False
+    return True
 
 
 def atomic_write_text(path: str | Path, text: str) -> Path:

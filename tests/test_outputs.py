@@ -84,6 +84,18 @@ def test_a_folder_that_cannot_be_created_is_refused_at_once(tmp_path):
         OutputDir(tmp_path / "afile" / "rep")
 
 
+@pytest.mark.skipif(not Path("/proc/self").is_dir(), reason="needs Linux's /proc (a folder nothing can be made in)")
+def test_a_folder_nothing_can_be_made_in_is_refused_whatever_its_permission_bits_say(tmp_path):
+    # /proc's bits say writable to root, yet mkdir there fails: synth used to find out only when it wrote the
+    # report, after the design, with a traceback
+    with pytest.raises(OutputExistsError, match=r"cannot write here \(/proc is not a writable folder\)"):
+        OutputDir(Path("/proc/synth-report"))
+    with pytest.raises(OutputExistsError, match="cannot write here"):
+        OutputDir(Path("/proc/synth/deeper/report"))
+    OutputDir(tmp_path / "new" / "report")  # a folder that can be made: no refusal, and nothing left behind
+    assert list(tmp_path.iterdir()) == []
+
+
 def test_a_file_where_the_folder_should_be_is_refused(tmp_path):
     (tmp_path / "rep").write_text("x")
     with pytest.raises(OutputExistsError, match="not a directory"):

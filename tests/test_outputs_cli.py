@@ -136,3 +136,19 @@ def test_a_folder_synth_cannot_write_is_reported_before_computing(command, input
         code, err = _run(argv)
     assert code == 2 and "cannot write here" in err and err.count("\n") == 1, err
     assert _listing(tmp_path) == ["afile"]
+
+
+def test_a_write_the_file_system_refuses_midway_is_one_line_and_exit_2(inputs, tmp_path, monkeypatch):
+    import errno
+
+    import synth.outputs
+
+    target = tmp_path / "out.json"
+
+    def full(path, *args, **kwargs):
+        raise OSError(errno.ENOSPC, "No space left on device", str(path))
+
+    monkeypatch.setattr(synth.outputs, "write_json", full)
+    code, err = _run(["design", str(inputs / "tiny.yaml"), "--no-report", "--json", str(target)])
+    assert code == 2 and err == f"synth design: error: {target}: No space left on device\n", err
+    assert not target.exists()

@@ -30,6 +30,7 @@ def check_outputs(folder: str | Path | None, names: Iterable[str] = (), files: I
     >>> sorted(p.name for p in d.iterdir())  # nothing written
     ['report.html']
     """
+    from synth.errors import OutputExistsError
     from synth.outputs import OutputDir, check_writable
 
     if folder is not None:
@@ -39,7 +40,10 @@ def check_outputs(folder: str | Path | None, names: Iterable[str] = (), files: I
             continue
         path = Path(file)
         check_writable(path, force)
-        OutputDir(path.parent)  # the folder it goes in can be created and written
+        try:
+            OutputDir(path.parent)  # the folder it goes in can be created and written
+        except OutputExistsError as exc:  # named by the file the user gave
+            raise OutputExistsError(exc.message, where=str(path)) from None
 
 
 def spec_name(path: str) -> str | None:
