@@ -56,6 +56,10 @@ class StabilityResult:
     near_axis : float or None
         Set when the only roots that make the loop not stable lie left of the axis but within this
         distance of it (``Re s > -near_axis``; see :data:`STABILITY_FLOOR`).
+    neutral_gain : float or None
+        ``|L(j inf)|`` of a biproper loop with a delay when it is 1 or more (a neutral-type loop): the
+        closed loop then has infinitely many roots whose real parts tend to ``ln|L(j inf)| / delay >= 0``,
+        counted as one unstable root in ``unstable_poles``; no delay-robust stability is possible.
     """
 
     stable: bool
@@ -64,6 +68,7 @@ class StabilityResult:
     method: str
     marginal_frequency: float | None = None
     near_axis: float | None = None
+    neutral_gain: float | None = None
 
     def to_dict(self) -> dict:
         """JSON-ready dict."""
@@ -79,6 +84,10 @@ class StabilityResult:
         """
         if self.stable:
             return f"closed loop stable ({self.method})"
+        if self.neutral_gain is not None:
+            where = "in the right half-plane" if self.neutral_gain > 1.0 else "accumulating at the imaginary axis"
+            return (f"closed loop UNSTABLE: |L(j inf)| = {self.neutral_gain:.4g} >= 1 with a delay (neutral type), "
+                    f"infinitely many roots {where}")
         if self.near_axis is not None and self.unstable_poles == 0:
             return f"closed loop not certified stable ({self.method})"
         if self.near_axis is not None:
@@ -210,8 +219,8 @@ def closed_loop_stability(num: np.ndarray, den: np.ndarray, delay: float = 0.0, 
     Raises
     ------
     ModelError
-        For an improper loop, or a biproper loop with a delay and
-        ``|L(j inf)| >= 1`` (a neutral-type loop, not stable in any useful sense).
+        For an improper loop. (A biproper loop with a delay and ``|L(j inf)| >= 1`` is a neutral-type
+        loop: not stable, see :attr:`StabilityResult.neutral_gain`.)
 
     Examples
     --------
@@ -271,11 +280,9 @@ def _count(num: np.ndarray, den: np.ndarray, delay: float) -> StabilityResult:
         # 1 + L(0) = 0: a closed-loop root at s = 0 (e.g. a gain on the edge of the stability floor)
         return StabilityResult(False, 1, n_rhp, "Nyquist argument principle, exact delay", 0.0)
     c_inf = num[0] / den[0] if num.size == den.size else 0.0
-    if abs(c_inf) >= 1.0:
-        raise ModelError(
-            f"loop with a delay has |L(j inf)| = {abs(c_inf):.3g} >= 1 (neutral type): "
-            "closed-loop stability is not robust to any delay; make the loop strictly proper"
-        )
+    if abs(c_inf) >= 1.0:  # 1 + c e^{-s delay} -> 0 far out: roots with Re s -> ln|c| / delay >= 0
+        return StabilityResult(False, 1, n_rhp, "neutral-type loop: |L(j inf)| >= 1 with a delay",
+                               neutral_gain=float(abs(c_inf)))
     level = max(0.5, 0.5 * (1.0 + abs(c_inf)))
     w_lo_scale, _ = characteristic_scale(num, den, delay=delay)
     w_top = largest_crossing(num, den, level)

@@ -110,7 +110,22 @@ def stability_boundaries(
     w_cross = np.concatenate([[0.0], bisect_roots(h, w[idx], w[idx + 1]), w[exact]])
     r_cross = rho(w_cross)
     keep = np.isfinite(r_cross) & (np.abs(r_cross) <= rho_max)
-    return sorted(zip(r_cross[keep].tolist(), w_cross[keep].tolist()))
+    found = list(zip(r_cross[keep].tolist(), w_cross[keep].tolist()))
+    if delay > 0:  # a biproper loop turns neutral where |L(j inf)| = 1: roots come in from infinitely far out
+        l0, l1 = _at_infinity(loop0_num, loop0_den), _at_infinity(loop1_num, loop1_den)
+        if np.isfinite(l0) and np.isfinite(l1) and l1 != 0.0:
+            found += [(r, float("inf")) for r in ((1.0 - l0) / l1, (-1.0 - l0) / l1) if abs(r) <= rho_max]
+    return sorted(found)
+
+
+def _at_infinity(num: np.ndarray, den: np.ndarray) -> float:
+    """``lim num(s)/den(s)`` for ``s -> inf`` (``inf`` for an improper ratio)."""
+    num, den = trim(np.asarray(num, float)), trim(np.asarray(den, float))
+    if not np.any(num):
+        return 0.0
+    if num.size > den.size:
+        return float("inf")
+    return float(num[0] / den[0]) if num.size == den.size else 0.0
 
 
 def _combine(c0: Rational | None, c1: Rational, rho: float) -> Rational:

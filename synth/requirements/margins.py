@@ -140,6 +140,8 @@ def unstable_result(req: Requirement, loop: Loop, what: str, **details: Any) -> 
     st = loop.stability()
     if st.marginal_frequency is not None:
         why = f"closed loop marginally stable (a root on the imaginary axis at {fmt(st.marginal_frequency)} rad/s)"
+    elif st.neutral_gain is not None:
+        why = f"closed loop UNSTABLE (|L(j inf)| = {fmt(st.neutral_gain)} >= 1 with a delay: neutral type)"
     else:
         why = f"closed loop UNSTABLE ({st.unstable_poles} root(s) in the closed right half-plane)"
     bound_field = next((f for f in req.bounds if getattr(req, f, None) is not None), None)
