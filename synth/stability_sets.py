@@ -96,10 +96,17 @@ def stability_boundaries(
     w_b = largest_crossing(loop1_num, loop1_den, 0.5 / max(rho_max, 1e-300))
     lo_scale, hi_scale = characteristic_scale(a0, b0, a1, b1, num, den, delay=delay)
     w_max = max(w_a, w_b, hi_scale) * 1.2
+    w_lin = min(w_max, max(w_a, w_b) * 1.2)
+    l0, l1 = _at_infinity(loop0_num, loop0_den), _at_infinity(loop1_num, loop1_den)
+    if delay > 0 and np.isfinite(l0) and np.isfinite(l1) and abs(l0) + rho_max * abs(l1) >= 0.5:
+        # |L0 + rho L1| may stay near 1 at every frequency (a biproper loop): its delayed Nyquist curve then meets
+        # -1 once per 2 pi / delay up to infinity, the rho of these crossings tending monotonically to the neutral
+        # boundaries beyond the corners; two delay periods past ten times the corners hold the first of them
+        w_max = max(w_max, 10.0 * hi_scale + 4.0 * np.pi / delay)
+        w_lin = w_max
     w_min = 1e-4 * lo_scale
     grid = [np.geomspace(w_min, w_max, int(100 * np.log10(w_max / w_min)) + 2)]
     if delay > 0:  # the delay's phase, sampled finely up to the last frequency where |L0 + rho L1| can be 1
-        w_lin = min(w_max, max(w_a, w_b) * 1.2)
         grid.append(np.linspace(0.0, w_lin, int(np.ceil(w_lin * delay / PHASE_STEP)) + 2)[1:])
     w = np.unique(np.concatenate(grid))
     hv = h(w)
@@ -112,7 +119,6 @@ def stability_boundaries(
     keep = np.isfinite(r_cross) & (np.abs(r_cross) <= rho_max)
     found = list(zip(r_cross[keep].tolist(), w_cross[keep].tolist()))
     if delay > 0:  # a biproper loop turns neutral where |L(j inf)| = 1: roots come in from infinitely far out
-        l0, l1 = _at_infinity(loop0_num, loop0_den), _at_infinity(loop1_num, loop1_den)
         if np.isfinite(l0) and np.isfinite(l1) and l1 != 0.0:
             found += [(r, float("inf")) for r in ((1.0 - l0) / l1, (-1.0 - l0) / l1) if abs(r) <= rho_max]
     return sorted(found)

@@ -12,11 +12,12 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from scipy.optimize import fsolve
+from scipy.optimize import brentq, fsolve
 
 from synth.design import design
 from synth.loop import Loop
 from synth.spec import parse_spec
+from synth.stability_sets import affine_stability_intervals
 
 PLANT = "(s+2)/(s+1)"
 DELAY = 0.05
@@ -48,6 +49,25 @@ def test_below_the_neutral_gain_the_loop_is_stable() -> None:
         assert Loop(PLANT, f"P({kp})", delay=DELAY).stability().stable
 
 
+def test_the_stabilizing_set_ends_where_the_first_root_of_the_chain_crosses_the_axis() -> None:
+    # |L| = kp |jw+2|/|jw+1| stays above kp: just below kp = 1 the delayed Nyquist curve meets -1 near
+    # w = pi/DELAY. The reference solves (jw+1) + kp (jw+2) e^{-j w DELAY} = 0 for (w, kp) by Newton.
+    def f(x: np.ndarray) -> list[float]:
+        w, kp = x
+        v = (1j * w + 1) + kp * (1j * w + 2) * np.exp(-1j * w * DELAY)
+        return [v.real, v.imag]
+
+    w_star, kp_star = fsolve(f, [np.pi / DELAY, 1.0], xtol=1e-14)
+    assert 0.999 < kp_star < 1.0
+    [piece] = affine_stability_intervals(None, (np.array([1.0]), np.array([1.0])), np.array([1.0, 2.0]),
+                                         np.array([1.0, 1.0]), DELAY, 0.0, 5.0)
+    assert piece.lo == 0.0 and piece.hi == pytest.approx(kp_star, rel=1e-9)
+    assert piece.hi_frequency == pytest.approx(w_star, rel=1e-6)
+    # the pointwise test agrees on both sides
+    assert Loop(PLANT, f"P({kp_star * (1 - 1e-6)})", delay=DELAY).stability().stable
+    assert not Loop(PLANT, f"P({kp_star * (1 + 1e-6)})", delay=DELAY).stability().stable
+
+
 def test_the_gain_set_ends_at_the_neutral_boundary_and_a_pi_design_proceeds() -> None:
     spec = parse_spec(f"""
 name: biproper_p
@@ -59,9 +79,11 @@ objective: {{maximize: bandwidth}}
 """)
     result = design(spec)
     assert result.status == "feasible"
-    # the gain margin is taken at w -> inf, where |L| = kp: 3 dB needs kp <= 10^(-3/20)
-    assert result.gain_set.as_list()[-1][1] == pytest.approx(10 ** (-3 / 20), rel=1e-6)
-    assert "[0, 1)" in result.verdict
+    # the phase crosses -180 deg near pi/DELAY, where |L| = kp |jw+2|/|jw+1|: 3 dB of gain margin there
+    w180 = brentq(lambda w: np.arctan(w / 2) - np.arctan(w) - DELAY * w + np.pi, 40.0, 80.0, xtol=1e-14)
+    kp_max = 10 ** (-3 / 20) / abs((1j * w180 + 2) / (1j * w180 + 1))
+    assert result.gain_set.as_list()[-1][1] == pytest.approx(kp_max, rel=1e-6)
+    assert "stable only for kp in [0, 0.9996)" in result.verdict
     pi = parse_spec(f"""
 name: biproper_pi
 plant: {{tf: "{PLANT}", delay: {DELAY}}}
