@@ -3,10 +3,10 @@
 Each problem is a spec dict for :func:`synth.parse_spec` plus the plant as plain polynomials, so that an
 independent reference (``benchmarks/design_reference.py``) can evaluate it without synth.
 
-Plants: order 1-5, strictly proper, built from a random choice of features: right-half-plane zeros
-(written ``(1 - s/z)`` so the DC gain stays positive), open-loop unstable real poles ``(s - p)``,
-integrators, lightly damped pairs (damping 0.02 ... 0.7), stable real poles; a gain chosen so that the loop
-crosses over near a target frequency ``wt``; a delay up to half the crossover period ``pi/wt`` (drawn
+Plants: order 1-5, strictly proper (biproper on request: ``biproper=share``), built from a random choice of
+features: right-half-plane zeros (written ``(1 - s/z)`` so the DC gain stays positive), open-loop unstable real
+poles ``(s - p)``, integrators, lightly damped pairs (damping 0.02 ... 0.7), stable real poles; a gain chosen so that
+the loop crosses over near a target frequency ``wt``; a delay up to half the crossover period ``pi/wt`` (drawn
 skewed towards small delays). Controllers: P, PI, PID, leadlag, rational up to order (2, 3), with explicit
 bounds scaled to the plant. Requirements: a random non-empty subset of every registered type, with bounds
 drawn around values that are reachable for some problems and out of reach for others.
@@ -43,7 +43,7 @@ class Problem:
     delay : float
         Plant delay (s).
     features : list of str
-        What the plant has (``rhp_zero``, ``unstable``, ``integrator``, ``light``, ``delay``).
+        What the plant has (``rhp_zero``, ``unstable``, ``integrator``, ``light``, ``delay``, ``biproper``).
     """
 
     index: int
@@ -62,7 +62,8 @@ def _g(x: float) -> str:
     return f"{x:.6g}"
 
 
-def _plant(rng: np.random.Generator, wt: float, simple: bool) -> tuple[list[str], np.ndarray, np.ndarray, list[str]]:
+def _plant(rng: np.random.Generator, wt: float, simple: bool,
+           biproper: np.random.Generator | None = None) -> tuple[list[str], np.ndarray, np.ndarray, list[str]]:
     order = int(rng.integers(1, 3 if simple else 6))
     factors_den: list[str] = []
     factors_num: list[str] = []
@@ -104,6 +105,12 @@ def _plant(rng: np.random.Generator, wt: float, simple: bool) -> tuple[list[str]
         else:
             factors_num.append(f"(s+{_g(z)})")
             num = np.polymul(num, [1.0, z])
+    if biproper is not None:  # as many zeros as poles: |G(j inf)| is finite and nonzero (a direct feedthrough)
+        for _ in range(order - n_zeros):
+            z = float(_g(wt * 10 ** biproper.uniform(-0.5, 1.5)))
+            factors_num.append(f"(s+{_g(z)})")
+            num = np.polymul(num, [1.0, z])
+        feats.append("biproper")
     # gain: |G(j wt)| = 1 so that controller gains of order 1 cross over near wt
     s = 1j * wt
     k = float(_g(1.0 / abs(np.polyval(num, s) / np.polyval(den, s))))
@@ -179,7 +186,8 @@ def _requirements(rng: np.random.Generator, wt: float, kind: str, num: np.ndarra
     return reqs
 
 
-def problem(seed: int, index: int, *, controllers: tuple[str, ...] = CONTROLLERS, simple: bool = False) -> Problem:
+def problem(seed: int, index: int, *, controllers: tuple[str, ...] = CONTROLLERS, simple: bool = False,
+            biproper: float = 0.0) -> Problem:
     """The ``index``-th problem of the sequence ``seed`` (independent of the other indices).
 
     Parameters
@@ -190,6 +198,10 @@ def problem(seed: int, index: int, *, controllers: tuple[str, ...] = CONTROLLERS
         Structures to draw from.
     simple : bool
         Order 1-2 stable plants and cheap requirement types only (for the test suite).
+    biproper : float
+        Share of biproper plants (zeros added up to the plant's order). They are decided and drawn from a stream
+        of their own, so every other draw, and every problem of a sequence with ``biproper=0`` (all results
+        before session 21), stays as it was.
 
     Examples
     --------
@@ -199,7 +211,8 @@ def problem(seed: int, index: int, *, controllers: tuple[str, ...] = CONTROLLERS
     """
     rng = np.random.default_rng([seed, index])
     wt = float(_g(10 ** rng.uniform(-1, 2)))
-    (tf,), num, den, feats = _plant(rng, wt, simple)
+    extra = np.random.default_rng([seed, index, 1])
+    (tf,), num, den, feats = _plant(rng, wt, simple, extra if extra.random() < biproper else None)
     delay = 0.0
     if rng.random() < 0.6:
         delay = float(_g(rng.uniform(0, 1) ** 2 * 0.5 * 2 * np.pi / wt * (0.2 if simple else 1.0)))
@@ -236,8 +249,9 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--n", type=int, default=5)
     ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--biproper", type=float, default=0.0, help="share of biproper plants")
     args = ap.parse_args()
-    for p in generate(args.n, args.seed):
+    for p in generate(args.n, args.seed, biproper=args.biproper):
         print(json.dumps(p.to_dict()))
 
 

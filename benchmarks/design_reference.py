@@ -55,6 +55,12 @@ def controller_polys(ctype: str, order: list[int] | None, p: dict[str, float]) -
             np.array([1.0] + [p[f"a{i}"] for i in range(n - 1, -1, -1)]))
 
 
+def _at_infinity(num: np.ndarray, den: np.ndarray) -> float:
+    """``lim num(s)/den(s)`` for ``s -> inf`` of a proper ratio (0 when strictly proper)."""
+    num, den = _strip(np.asarray(num, float)), _strip(np.asarray(den, float))
+    return float(num[0] / den[0]) if num.size == den.size and np.any(num) else 0.0
+
+
 def _strip(c: np.ndarray) -> np.ndarray:
     c = np.trim_zeros(np.asarray(c, float), "f")
     return c if c.size else np.array([0.0])
@@ -177,9 +183,22 @@ class LoopModel:
             return Evaluation(p, False, 98, dense=dense)
         d_arg = 2.0 * self._arg_change(g["ws"], F, cn, cd)
         P = int(np.sum(np.roots(self.den).real > -self.eps) + np.sum(np.roots(cd).real > -self.eps))
-        Z = round(float(P - d_arg / (2 * np.pi)))
-        if Z != 0 or abs(Ls[-1]) > 0.1:
-            return Evaluation(p, False, max(Z, 1), dense=dense)
+        c_inf = _at_infinity(self.num, self.den) * _at_infinity(cn, cd)
+        if c_inf == 0.0:  # strictly proper: 1 + L -> 1 on the closing arc; the grid must reach where |L| is small
+            Z = round(float(P - d_arg / (2 * np.pi)))
+            if Z != 0 or abs(Ls[-1]) > 0.1:
+                return Evaluation(p, False, max(Z, 1), dense=dense)
+        else:  # biproper: L -> c (times the delay) beyond the corners
+            if 1.0 + c_inf == 0.0 or (self.delay > 0 and abs(c_inf) >= 1.0):
+                # an improper closed loop, or a neutral one (infinitely many roots with Re s -> ln|c|/delay >= 0)
+                return Evaluation(p, False, 97, dense=dense)
+            # the closing arc (Re s > 0, far out): e^{-s delay} shrinks, so 1 + L moves from F(jR) to its conjugate
+            # inside the disk |F - 1| <= |c| (delay) or stays near 1 + c (no delay): the short way round
+            closing = float(np.angle(np.conj(F[-1]) / F[-1]))
+            Z = round(float(P - (d_arg + closing) / (2 * np.pi)))
+            rational_end = Ls[-1] * np.exp(self.delay * ss[-1])
+            if Z != 0 or abs(rational_end - c_inf) > 0.1 * abs(c_inf):  # the grid's end must lie beyond the corners
+                return Evaluation(p, False, max(Z, 1), dense=dense)
         ev = Evaluation(p, True, 0, dense=dense)
         w = g["w"]
         C = np.polyval(cn, 1j * w) / np.polyval(cd, 1j * w)

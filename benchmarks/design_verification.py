@@ -88,6 +88,7 @@ def run_problem(p: Problem, *, time_limit: float = 120.0, budget: float = 1.0,
     import synth
 
     rec: dict[str, Any] = {"index": p.index, "spec": p.spec, "features": p.features,
+                           "num": p.num, "den": p.den, "delay": p.delay,
                            "controller": p.spec["controller"]["type"],
                            "requirements": [r["type"] for r in p.spec["requirements"]]}
     t0, c0 = time.perf_counter(), time.process_time()
@@ -200,10 +201,14 @@ def _degenerate_point(rec: dict[str, Any], params: dict[str, float]) -> bool:
     if not uses:
         return False
     p = rec["spec"]
-    prob = generate(rec["index"] + 1, int(p["name"].split("_")[1]))[rec["index"]]
+    if "num" in rec:  # the record's own plant (records before session 21: regenerated from the seed)
+        num, den = rec["num"], rec["den"]
+    else:
+        prob = generate(rec["index"] + 1, int(p["name"].split("_")[1]))[rec["index"]]
+        num, den = prob.num, prob.den
     cn, cd = controller_polys(p["controller"]["type"], p["controller"].get("order"), params)
     s = 1j * 1e-9
-    L = np.polyval(prob.num, s) / np.polyval(prob.den, s) * np.polyval(cn, s) / np.polyval(cd, s)
+    L = np.polyval(num, s) / np.polyval(den, s) * np.polyval(cn, s) / np.polyval(cd, s)
     return bool(abs(L / (1 + L)) < 0.01)
 
 
@@ -272,6 +277,8 @@ def main() -> None:
     ap.add_argument("--time-limit", type=float, default=120.0, help="per synth.design call [CPU s]")
     ap.add_argument("--budget", type=float, default=1.0, help="scales the reference's search")
     ap.add_argument("--quick", action="store_true", help="10 problems")
+    ap.add_argument("--biproper", type=float, default=0.0,
+                    help="share of biproper plants (their own random stream: 0 keeps every earlier sequence)")
     ap.add_argument("--summarize", type=Path, nargs="+", help="only re-read (and re-classify) JSON-lines files")
     ap.add_argument("--rerun", type=Path, nargs="+", metavar="JSONL",
                     help="re-run synth only on the problems of these records, against their stored references")
@@ -290,7 +297,8 @@ def main() -> None:
         stored = [json.loads(line) for path in args.rerun for line in path.read_text().splitlines() if line.strip()]
         stored = [r for r in stored if args.controller in (None, r["controller"])]
         seed = int(stored[0]["spec"]["name"].split("_")[1]) if stored else args.seed
-        problems = generate(max((r["index"] for r in stored), default=-1) + 1, seed)
+        problems = generate(max((r["index"] for r in stored), default=-1) + 1, seed,
+                            biproper=float(stored[0].get("biproper", 0.0)) if stored else 0.0)
         fh = args.json.open("w") if args.json else None
         for old in tqdm(sorted(stored, key=lambda r: r["index"]), desc="synth re-run"):
             rec = run_problem(problems[old["index"]], time_limit=args.time_limit, stored=old)
@@ -300,10 +308,11 @@ def main() -> None:
                 fh.flush()
     else:
         n = 10 if args.quick else args.n
-        problems = generate(args.start + n, args.seed)[args.start:]
+        problems = generate(args.start + n, args.seed, biproper=args.biproper)[args.start:]
         fh = args.json.open("w") if args.json else None
         for p in tqdm(problems, desc="design verification"):
             rec = run_problem(p, time_limit=args.time_limit, budget=args.budget)
+            rec["biproper"] = args.biproper
             records.append(rec)
             if fh:
                 fh.write(json.dumps(rec, default=float) + "\n")
