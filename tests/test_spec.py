@@ -51,6 +51,9 @@ BAD = {
     "reversed bounds": (EXAMPLE.replace("[0, 20]", "[20, 0]"), "10: controller.bounds: kp: lower bound 20 is above upper bound 0"),
     "empty requirements": (EXAMPLE.split("requirements:")[0] + "requirements: []\n", "requirements: the requirement list is empty"),
     "not yaml": ("name: [x\n", "invalid YAML"),
+    "key twice": (EXAMPLE + "plant: {tf: \"1/(s+1)\"}\n", "16: invalid YAML: key 'plant' given twice (first on line 3)"),
+    "bound twice": (EXAMPLE.replace("{kp: [0, 20]}", "{kp: [0, 20], kp: [0, 3]}"),
+                    "10: invalid YAML: key 'kp' given twice (first on line 10)"),
     "empty file": ("", "the spec file is empty"),
 }
 

@@ -27,7 +27,19 @@ __all__ = ["NO_SOURCE", "SPEC_SUFFIXES", "load_spec", "parse_spec", "parse_text"
 
 
 class _Loader(yaml.SafeLoader):
-    """SafeLoader that also reads ``1e4`` (no dot) as a float, as people write it."""
+    """SafeLoader that also reads ``1e4`` (no dot) as a float, as people write it, and refuses a key given twice in
+    one mapping (plain YAML keeps the last silently: a second ``plant:`` would replace the first unseen)."""
+
+    def construct_mapping(self, node: yaml.MappingNode, deep: bool = False) -> dict[Any, Any]:
+        first: dict[str, int] = {}
+        for key_node, _ in node.value:
+            if isinstance(key_node, yaml.ScalarNode) and key_node.tag != "tag:yaml.org,2002:merge":
+                if key_node.value in first:
+                    raise yaml.constructor.ConstructorError(
+                        None, None, f"key {key_node.value!r} given twice (first on line {first[key_node.value]})",
+                        key_node.start_mark)
+                first[key_node.value] = key_node.start_mark.line + 1
+        return super().construct_mapping(node, deep)
 
 
 _Loader.add_implicit_resolver(
