@@ -180,6 +180,16 @@ def test_text_column_stops_only_when_used(tmp_path):
         load_record(p, "t", "u", "y", aux=["msg"])
 
 
+@pytest.mark.parametrize("body", ["0,0,0,5\n1,1,1,6\n2,1,2,7\n", "0,0,0,5\n1,1,1,x\n2,1,2,7\n"])  # fast, cell by cell
+def test_a_header_written_twice_stops_only_when_used(tmp_path, body):
+    p = tmp_path / "r.csv"
+    p.write_text("t,u,y,y\n" + body)  # which 'y' is the output? once the dict kept the last silently
+    with pytest.raises(DataError, match=r"r.csv: column 'y' appears 2 times in the header \(columns 3, 4\); rename"):
+        load_record(p, "t", "u", "y")
+    table = read_table(p)  # the other columns still load
+    assert table.find("t") == "t" and table.columns["u"].tolist() == [0.0, 1.0, 1.0]
+
+
 def test_ambiguous_name_asks_for_the_unit(tmp_path):
     p = tmp_path / "r.csv"
     p.write_text("t,u,Speed (RPM),Speed (rad/s)\n0,0,0,0\n1,1,10,1.05\n2,1,20,2.1\n")

@@ -272,12 +272,17 @@ def _read_csv(path: Path) -> Table:
     if delimiter is None and len(lines) > 1 and len(_cells(lines[1][1], None)) == 1:
         header = [lines[0][1].strip('"')]  # one column: its header may hold spaces ("speed (rad/s)")
     keep = [i for i, h in enumerate(header) if h]
+    twice = {h: [i + 1 for i in keep if header[i] == h] for h in {header[i] for i in keep}}
+    twice = {h: at for h, at in twice.items() if len(at) > 1}  # a header written twice: which one is meant?
+    keep = [i for i in keep if header[i] not in twice]
     names = [header[i] for i in keep]
     notes = (f"skipped {comments} comment line(s) starting with #",) if comments else ()
+    doubled = {h: f"column '{h}' appears {len(at)} times in the header (columns {', '.join(map(str, at))}); "
+               "rename all but one in the file" for h, at in twice.items()}
     fast = _numeric_body(lines[1:], delimiter, len(header))
     if fast is not None:
         return Table({h: fast[:, i].copy() for i, h in zip(keep, names)}, {h: split_unit(h)[1] for h in names},
-                     str(path), {}, notes)
+                     str(path), doubled, notes)
     values: dict[str, list[float]] = {h: [] for h in names}
     problems: dict[str, str] = {}
     decimal_comma = 0
@@ -299,7 +304,7 @@ def _read_csv(path: Path) -> Table:
                     values[h].append(x)
     notes += (f"read {decimal_comma} decimal comma(s)",) if decimal_comma else ()
     columns = {h: np.asarray(v, float) for h, v in values.items() if h not in problems}
-    return Table(columns, {h: split_unit(h)[1] for h in names}, str(path), problems, notes)
+    return Table(columns, {h: split_unit(h)[1] for h in names}, str(path), {**problems, **doubled}, notes)
 
 
 def _numeric_body(rows: list[tuple[int, str]], delimiter: str | None, width: int) -> np.ndarray | None:
