@@ -382,9 +382,15 @@ class LoopBatch:
         ``|L| >= 0.5/cap`` (with a delay the grid resolves its phase up to there), one row per loop, NaN-padded."""
         ranges = self.frequency_ranges[which]
         grid = log_grids(ranges[:, 0] * 1e-2, ranges[:, 1] * 1e2, per_decade)
+        far = np.abs(self._at_infinity(which))  # |L(j inf)|: a biproper loop's phase crossings never end
         if self.plant.delay > 0:  # a few points per half turn of the delay's phase where |L| >= 0.5/cap
             big = np.abs(self.rows_L(np.repeat(which, grid.shape[1]), grid.ravel())).reshape(grid.shape) >= 0.5 / cap
-            w_top = 1.2 * float(np.max(np.where(big, grid, 0.0)))
+            tops = 1.2 * np.max(np.where(big, grid, 0.0), axis=1)
+            # beyond ten times the corners a biproper loop's crossings tend monotonically to the neutral factor
+            # 1/|L(j inf)| (added below): two delay periods past there hold the first of them
+            tops = np.where(far >= 0.5 / cap, np.minimum(tops, ranges[:, 1] / 10.0 + 4.0 * np.pi / self.plant.delay),
+                            tops)
+            w_top = float(np.max(tops))
             count = min(int(np.ceil(w_top * self.plant.delay / 0.3)) + 2, 20000)
             extra = np.linspace(0.0, w_top, count)[1:]
             grid = np.sort(np.concatenate([grid, np.broadcast_to(extra, (which.size, extra.size))], axis=1), axis=1)
@@ -392,14 +398,34 @@ class LoopBatch:
         L = self.rows_L(rows, grid.ravel()).reshape(grid.shape)
         im = np.where(_infinite(L), np.nan, L.imag)
         local, idx = np.nonzero(np.sign(im[:, :-1]) * np.sign(im[:, 1:]) < 0)
-        if local.size == 0:
-            return np.full((which.size, 1), np.nan)
+        if self.plant.delay > 0 and np.any(far >= 0.5 / cap):  # beyond w_top the log grid aliases the delay's
+            keep = (far[local] < 0.5 / cap) | (grid[local, idx + 1] <= tops[local])  # phase: those are not needed
+            local, idx = local[keep], idx[keep]
         rows = which[local]
-        wc = bisect_roots(lambda w: self.rows_L(rows, w).imag, grid[local, idx], grid[local, idx + 1])
+        wc = bisect_roots(lambda w: self.rows_L(rows, w).imag, grid[local, idx], grid[local, idx + 1]) \
+            if local.size else np.zeros(0)
         Lc = self.rows_L(rows, wc)
         with np.errstate(divide="ignore", invalid="ignore"):
             r = np.where(Lc.real < 0, -1.0 / Lc.real, np.nan)
+        if self.plant.delay > 0:  # the neutral factor: |k L(j inf)| = 1 (infinitely many roots come to the axis)
+            neutral = np.flatnonzero(far > 0)
+            local = np.concatenate([local, neutral])
+            with np.errstate(divide="ignore"):
+                r = np.concatenate([r, 1.0 / far[neutral]])
+        if local.size == 0:
+            return np.full((which.size, 1), np.nan)
         return _ragged(local, r, which.size)
+
+    def _at_infinity(self, which: np.ndarray) -> np.ndarray:
+        """``L(j inf)`` without the delay's phase for the loops ``which``: the ratio of the leading coefficients of
+        a biproper loop, 0 for a strictly proper one."""
+        num, den = self.num[which], self.den[which]
+        deg_n = num.shape[1] - 1 - np.argmax(num != 0, axis=1)
+        deg_d = den.shape[1] - 1 - np.argmax(den != 0, axis=1)
+        lead_n = num[np.arange(len(which)), np.argmax(num != 0, axis=1)]
+        lead_d = den[np.arange(len(which)), np.argmax(den != 0, axis=1)]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            return np.where((deg_n == deg_d) & np.any(num != 0, axis=1), lead_n / lead_d, 0.0)
 
     def rows_L(self, rows: np.ndarray, w: np.ndarray) -> np.ndarray:
         """``L`` of loop ``rows[j]`` at ``w[j]`` for every ``j`` (one frequency per entry), ``(len(w),)``.

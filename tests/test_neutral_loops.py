@@ -14,8 +14,11 @@ import numpy as np
 import pytest
 from scipy.optimize import brentq, fsolve
 
+from synth.controllers import Controller
 from synth.design import design
 from synth.loop import Loop
+from synth.loop_batch import LoopBatch
+from synth.plant import Plant
 from synth.spec import parse_spec
 from synth.stability_sets import affine_stability_intervals
 
@@ -94,3 +97,33 @@ objective: {{maximize: integral_gain}}
 """)
     designed = design(pi)
     assert designed.status == "feasible" and designed.controller.parameters["kp"] < 1.0
+
+
+def test_the_gain_margin_of_a_loop_rising_to_its_limit_is_the_neutral_factor() -> None:
+    # |G| = |jw+1|/|jw+2| rises to 1: the phase crossings' factors 1/|L(w_k)| fall towards 1/0.8 and never reach it;
+    # at the factor 1.25 itself |L(j inf)| = 1 (neutral). Both the batch and the scalar margins say 1.25.
+    plant = Plant.from_string("(s+1)/(s+2)", delay=DELAY)
+    k_lo, k_hi = LoopBatch(plant, [Controller("P", {"kp": 0.8})]).gain_margin_factors()
+    assert k_hi[0] == pytest.approx(1.25, rel=1e-12) and k_lo[0] == 0.0
+    assert Loop(plant, "P(0.8)").margins().gain_margin_db == pytest.approx(20 * np.log10(1.25), rel=1e-12)
+    assert not Loop(plant, "P(1.0)").stability().stable  # 0.8 x 1.25
+
+
+def test_batch_and_scalar_gain_margins_agree_on_random_biproper_delayed_loops() -> None:
+    rng = np.random.default_rng(7)
+    checked = 0
+    for _ in range(12):
+        z, p, g, tau = rng.uniform(0.2, 20), rng.uniform(0.2, 20), rng.uniform(0.3, 3), rng.uniform(0.01, 1.0)
+        plant = Plant.from_string(f"{g:.4g}*(s+{z:.4g})/(s+{p:.4g})", delay=round(tau, 4))
+        controllers = [Controller("PI", {"kp": float(rng.uniform(0.01, 1.2) / g), "ki": float(rng.uniform(0, 2))})
+                       for _ in range(4)]
+        k_lo, k_hi = LoopBatch(plant, controllers).gain_margin_factors()
+        for i, c in enumerate(controllers):
+            loop = Loop(plant, c)
+            if not loop.stability().stable:
+                continue
+            batch = min(20 * np.log10(k_hi[i]) if np.isfinite(k_hi[i]) else np.inf,
+                        -20 * np.log10(k_lo[i]) if k_lo[i] > 0 else np.inf)
+            assert batch == pytest.approx(loop.margins().gain_margin_db, rel=1e-6, abs=1e-9), (plant, c)
+            checked += 1
+    assert checked >= 20
