@@ -170,10 +170,23 @@ class _ReturnDifference:
 
 
 def _segment_phase(F: _ReturnDifference, a: float, b: float, delay: float) -> tuple[float, float]:
-    """Continuous phase change of F(jw) for w from a to b, and min |F| seen."""
+    """Continuous phase change of F(jw) for w from a to b, and min |F| seen.
+
+    The first samples resolve the delay's phase (linear), every decade from two below the loop's lowest
+    corner (40 points each, from ``a`` when it is positive) and each open-loop pole's and zero's band (a cluster
+    of 17 points a quarter of its damping apart): the refinement below halves only steps it can see, so a lightly
+    damped pair between two coarse samples could otherwise hide a whole turn of ``F`` around the origin (seen: a
+    resonant controller's pair at 0.1 rad/s, damping 0.074, sampled at 0, 0.67 and 1.35 rad/s)."""
     pts = [np.linspace(a, b, max(3, int(np.ceil((b - a) * delay / PHASE_STEP)) + 2))]
-    if a > 0:
-        pts.append(np.geomspace(a, b, max(3, int(40 * np.log10(b / a)) + 2)))
+    roots = np.concatenate([np.roots(F.num) if F.num.size > 1 else [], np.roots(F.den) if F.den.size > 1 else []])
+    roots = roots[np.abs(roots) > 0]
+    start = a if a > 0 else (float(np.min(np.abs(roots))) / 100.0 if roots.size else b * 1e-6)
+    if 0 < start < b:
+        pts.append(np.geomspace(start, b, max(3, int(40 * np.log10(b / start)) + 2)))
+    for r in roots:
+        zeta = min(1.0, max(abs(r.real) / abs(r), 1e-9))
+        cluster = abs(r) * (1.0 + zeta / 4.0 * np.arange(-8, 9))
+        pts.append(cluster[(cluster > a) & (cluster < b)])
     w = np.unique(np.concatenate(pts))
     f = F(1j * w)
     for _ in range(60):
