@@ -145,7 +145,8 @@ def test_simulate_cli_issue_example_verdict_json_and_exit_codes(run_cli, tmp_pat
     ("  dt: 0.5\n  horizon: 2\n", "dt 0.5 s must be at most 1/20 of the horizon"),
 ])
 def test_a_simulation_that_cannot_run_is_one_line_and_exit_2(extra, message, run_cli, tmp_path):
-    text = ISSUE + extra
+    given = "  actuator: [{type: saturation, min: -1, max: 1}]\n"
+    text = ISSUE.replace(given, extra) if extra.startswith("  actuator:") else ISSUE + extra  # a key once only
     with pytest.raises(SpecError) as err:
         parse_spec(text, "specs/bad.yaml")
     assert message in str(err.value) and "\n" not in str(err.value)
