@@ -175,8 +175,9 @@ def _design_without_reference(spec: Spec) -> tuple[DesignResult, GainSet | None]
     plants = spec.plants()
     announce(f"exact feasible set of {family.parameter} over {len(plants)} plant(s)")
     gain_set = feasible_gain_set(requirements, plants, family, bounds)
-    method = f"exact feasible set of {family.parameter} ({gain_set.method}); objective maximized over it"
     objective = spec.objective
+    sought = f"{objective.sense}d" if objective is not None else "maximized"  # no objective: the smallest slack
+    method = f"exact feasible set of {family.parameter} ({gain_set.method}); objective {sought} over it"
     nominal = spec.nominal_plant()
 
     if not gain_set.intervals:
@@ -229,7 +230,7 @@ def _design_without_reference(spec: Spec) -> tuple[DesignResult, GainSet | None]
         result.extras["edge_of_stability"] = edge.to_dict()
         result.verdict += edge.warning()
     if feasible and objective is not None:
-        optimality = Optimality(True, "exact feasible set", f"the objective maximized over the exact feasible set of "
+        optimality = Optimality(True, "exact feasible set", f"the objective {sought} over the exact feasible set of "
                                 f"{family.parameter} ({SCALAR_GRID} points per interval, then Brent's method around "
                                 "the best)")
         result.extras["optimality"] = optimality.to_dict()
