@@ -366,15 +366,18 @@ class LoopBatch:
         dr, di = row_axis_parts(self.den)
         h = pad_sub(row_poly_product(ni, dr), row_poly_product(nr, di))
         roots = row_roots(h)
-        rows = np.concatenate([np.full(r.size, i) for i, r in enumerate(roots)]).astype(int)
-        if rows.size == 0:
-            return np.full((len(self), 1), np.nan)
-        wr = np.concatenate(roots)
+        rows = np.concatenate([np.full(r.size, i) for i, r in enumerate(roots)] + [np.zeros(0)]).astype(int)
+        wr = np.concatenate([*roots, np.zeros(0, complex)])
         keep = (np.abs(wr.imag) <= 1e-9 * (1 + np.abs(wr.real))) & (wr.real > 0)
         rows, w = rows[keep], wr.real[keep]
         Lc = self.rows_L(rows, w)
         with np.errstate(divide="ignore", invalid="ignore"):
             r = np.where(Lc.real < 0, -1.0 / Lc.real, np.nan)
+        far = self._at_infinity(np.arange(len(self)))  # a biproper loop's phase crossover at w -> inf
+        ends = np.flatnonzero(far < 0)
+        rows, r = np.concatenate([rows, ends]), np.concatenate([r, -1.0 / far[ends]])
+        if rows.size == 0:
+            return np.full((len(self), 1), np.nan)
         return _ragged(rows, r, len(self))
 
     def _boundary_gains(self, which: np.ndarray, cap: float, per_decade: int) -> np.ndarray:

@@ -278,8 +278,9 @@ def _count(num: np.ndarray, den: np.ndarray, delay: float) -> StabilityResult:
         return StabilityResult(False, shared_origin, n_rhp, "Nyquist argument principle, exact delay", 0.0)
     if delay <= 0.0 or not np.any(num):  # no loop (L = 0): the closed loop keeps the open-loop poles
         char = np.polyadd(den, num)
-        if char.size < den.size or char[0] == 0.0:
-            raise ModelError("closed loop is improper (1 + L has lost its leading term)")
+        if char.size < den.size or char[0] == 0.0:  # L(j inf) = -1: a closed-loop root at infinity (a gain's edge)
+            return StabilityResult(False, 1, n_rhp, "polynomial roots; 1 + L(j inf) = 0, a closed-loop root at "
+                                   "infinity")
         roots = np.roots(trim(char))
         tol = 1e-9 * np.maximum(1.0, np.abs(roots))
         n_bad = int(np.sum(roots.real >= -tol))

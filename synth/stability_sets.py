@@ -118,9 +118,11 @@ def stability_boundaries(
     r_cross = rho(w_cross)
     keep = np.isfinite(r_cross) & (np.abs(r_cross) <= rho_max)
     found = list(zip(r_cross[keep].tolist(), w_cross[keep].tolist()))
-    if delay > 0:  # a biproper loop turns neutral where |L(j inf)| = 1: roots come in from infinitely far out
-        if np.isfinite(l0) and np.isfinite(l1) and l1 != 0.0:
-            found += [(r, float("inf")) for r in ((1.0 - l0) / l1, (-1.0 - l0) / l1) if abs(r) <= rho_max]
+    if np.isfinite(l0) and np.isfinite(l1) and l1 != 0.0:
+        # a biproper loop: roots come in from infinitely far out where L(j inf) = -1 (the characteristic
+        # polynomial loses its leading term), and with a delay where |L(j inf)| = 1 (a neutral loop)
+        ends = ((1.0 - l0) / l1, (-1.0 - l0) / l1) if delay > 0 else ((-1.0 - l0) / l1,)
+        found += [(r, float("inf")) for r in ends if abs(r) <= rho_max]
     return sorted(found)
 
 

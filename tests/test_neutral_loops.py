@@ -127,3 +127,29 @@ def test_batch_and_scalar_gain_margins_agree_on_random_biproper_delayed_loops() 
             assert batch == pytest.approx(loop.margins().gain_margin_db, rel=1e-6, abs=1e-9), (plant, c)
             checked += 1
     assert checked >= 20
+
+
+def test_without_a_delay_a_root_passes_through_infinity_where_l_at_infinity_is_minus_one() -> None:
+    # seed 21 (biproper) #35, a false "infeasible": G(j inf) = -1.4268 (a right-half-plane zero), so 1 + kp G loses
+    # its leading term at kp = 1/1.4268 and a root comes back from infinity in the right half-plane. The
+    # D-decomposition had no boundary there and called all of [0, 21.9] unstable.
+    plant = Plant.from_string("2.96776*(1-s/2.07997)*(s+0.678772)*(s+0.662767)/((s+0.318357)*(s+3.89044)*(s+0.44403))")
+    edge = -1.0 / (plant.num[0] / plant.den[0])
+    [piece] = affine_stability_intervals(None, (np.array([1.0]), np.array([1.0])), plant.num, plant.den, 0.0, 0.0,
+                                         21.8883)
+    assert piece.lo == 0.0 and piece.hi == pytest.approx(edge, rel=1e-12) and piece.hi_frequency == np.inf
+    for kp, stable in ((0.99 * edge, True), (1.01 * edge, False)):  # the reference: numpy's polynomial roots
+        roots = np.roots(np.polyadd(plant.den, kp * plant.num))
+        assert bool(np.all(roots.real < 0)) is stable
+        assert Loop(plant, f"P({kp})").stability().stable is stable
+    assert not Loop(plant, f"P({edge})").stability().stable  # the root at infinity: not bad input
+    # the gain margin counts the phase crossover at w -> inf (L(j inf) < 0): kp = 0.3 has edge/0.3 to go
+    _, k_hi = LoopBatch(plant, [Controller("P", {"kp": 0.3})]).gain_margin_factors()
+    assert k_hi[0] == pytest.approx(edge / 0.3, rel=1e-12)
+    assert Loop(plant, "P(0.3)").margins().gain_margin_db == pytest.approx(20 * np.log10(edge / 0.3), rel=1e-9)
+    result = design(parse_spec({"name": "b35", "plant": {"tf": "2.96776*(1-s/2.07997)*(s+0.678772)*(s+0.662767)/"
+                                                                 "((s+0.318357)*(s+3.89044)*(s+0.44403))"},
+                                "controller": {"type": "P", "bounds": {"kp": [0, 21.8883]}},
+                                "requirements": [{"type": "margins", "phase_margin_deg": 64.4244}],
+                                "objective": {"maximize": "bandwidth"}}))
+    assert result.status == "feasible" and 0.642 < result.gain_set.as_list()[-1][1] <= edge
