@@ -12,6 +12,7 @@ from synth.controllers import Controller
 from synth.freqgrid import peak
 from synth.loop import Loop
 from synth.plant import Plant
+from synth.polynomials import value_at_infinity
 from synth.requirements.base import fmt
 
 __all__ = ["NEAR_EDGE", "EdgeDistance", "edge_distance"]
@@ -133,10 +134,7 @@ def _distance_at_infinity(loop: Loop) -> float:
     >>> _distance_at_infinity(Loop(g, Controller("P", {"kp": 0.5})))
     0.5
     """
-    num, den = np.trim_zeros(loop.num, "f"), np.trim_zeros(loop.den, "f")
-    if num.size < den.size:
-        return 1.0
-    if num.size > den.size:  # improper (an unfiltered derivative): |L| grows without bound
+    k = value_at_infinity(loop.num, loop.den)  # 0 strictly proper; inf improper (an unfiltered derivative)
+    if not np.isfinite(k):
         return float("inf")
-    k = num[0] / den[0]
     return float(abs(1.0 - abs(k)) if loop.delay > 0 else abs(1.0 + k))

@@ -6,7 +6,8 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["dc_value", "format_factored", "largest_crossing", "magnitude_squared_in_w2", "mirror", "shifted", "trim"]
+__all__ = ["dc_value", "format_factored", "largest_crossing", "magnitude_squared_in_w2", "mirror", "shifted", "trim",
+           "value_at_infinity"]
 
 
 def trim(p: np.ndarray) -> np.ndarray:
@@ -50,6 +51,25 @@ def dc_value(num: np.ndarray, den: np.ndarray) -> Any:
         out = np.where(zd > zn, np.inf, np.where(zn > zd, 0.0, vn / vd))
     out = np.where(np.any(num != 0.0, axis=1), out, 0.0)
     return float(out[0]) if one else out
+
+
+def value_at_infinity(num: np.ndarray, den: np.ndarray) -> float:
+    """``lim num(s)/den(s)`` for ``s -> inf``: the ratio of the leading coefficients of a biproper ratio, 0 for a
+    strictly proper one (or a zero numerator), ``inf`` for an improper one.
+
+    Examples
+    --------
+    >>> value_at_infinity(np.array([2.0, 4.0]), np.array([1.0, 1.0]))
+    2.0
+    >>> value_at_infinity(np.array([3.0]), np.array([1.0, 1.0]))
+    0.0
+    """
+    num, den = trim(np.asarray(num, float)), trim(np.asarray(den, float))
+    if not np.any(num):
+        return 0.0
+    if num.size > den.size:
+        return float("inf")
+    return float(num[0] / den[0]) if num.size == den.size else 0.0
 
 
 def shifted(p: np.ndarray, f: float) -> np.ndarray:

@@ -22,7 +22,7 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from synth.errors import ModelError
-from synth.polynomials import largest_crossing, shifted, trim
+from synth.polynomials import largest_crossing, shifted, trim, value_at_infinity
 
 __all__ = [
     "PHASE_STEP",
@@ -159,10 +159,13 @@ def _axis_poles(den: np.ndarray) -> tuple[int, int, list[tuple[float, int]]]:
 
 
 class _ReturnDifference:
-    """F(s) = 1 + num(s)/den(s) * exp(-delay*s)."""
+    """F(s) = 1 + num(s)/den(s) * exp(-delay*s), and the loop's nonzero open-loop poles and zeros (``corners``,
+    where :func:`_segment_phase` samples each segment first)."""
 
     def __init__(self, num: np.ndarray, den: np.ndarray, delay: float) -> None:
         self.num, self.den, self.delay = num, den, delay
+        roots = np.concatenate([np.roots(p) if p.size > 1 else np.zeros(0, complex) for p in (num, den)])
+        self.corners = roots[np.abs(roots) > 0]
 
     def __call__(self, s: np.ndarray) -> np.ndarray:
         with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
@@ -178,8 +181,7 @@ def _segment_phase(F: _ReturnDifference, a: float, b: float, delay: float) -> tu
     damped pair between two coarse samples could otherwise hide a whole turn of ``F`` around the origin (seen: a
     resonant controller's pair at 0.1 rad/s, damping 0.074, sampled at 0, 0.67 and 1.35 rad/s)."""
     pts = [np.linspace(a, b, max(3, int(np.ceil((b - a) * delay / PHASE_STEP)) + 2))]
-    roots = np.concatenate([np.roots(F.num) if F.num.size > 1 else [], np.roots(F.den) if F.den.size > 1 else []])
-    roots = roots[np.abs(roots) > 0]
+    roots = F.corners
     start = a if a > 0 else (float(np.min(np.abs(roots))) / 100.0 if roots.size else b * 1e-6)
     if 0 < start < b:
         pts.append(np.geomspace(start, b, max(3, int(40 * np.log10(b / start)) + 2)))
@@ -293,7 +295,7 @@ def _count(num: np.ndarray, den: np.ndarray, delay: float) -> StabilityResult:
     if not n_origin and abs(den[-1] + num[-1]) <= 1e-12 * max(abs(den[-1]), abs(num[-1])):
         # 1 + L(0) = 0: a closed-loop root at s = 0 (e.g. a gain on the edge of the stability floor)
         return StabilityResult(False, 1, n_rhp, "Nyquist argument principle, exact delay", 0.0)
-    c_inf = num[0] / den[0] if num.size == den.size else 0.0
+    c_inf = value_at_infinity(num, den)
     if abs(c_inf) >= 1.0:  # 1 + c e^{-s delay} -> 0 far out: roots with Re s -> ln|c| / delay >= 0
         return StabilityResult(False, 1, n_rhp, "neutral-type loop: |L(j inf)| >= 1 with a delay",
                                neutral_gain=float(abs(c_inf)))

@@ -15,7 +15,7 @@ from itertools import pairwise
 import numpy as np
 
 from synth.errors import ModelError
-from synth.polynomials import largest_crossing, shifted, trim
+from synth.polynomials import largest_crossing, shifted, trim, value_at_infinity
 from synth.rootfind import bisect_roots
 from synth.stability import PHASE_STEP, Rational, characteristic_scale, closed_loop_stability
 
@@ -97,7 +97,7 @@ def stability_boundaries(
     lo_scale, hi_scale = characteristic_scale(a0, b0, a1, b1, num, den, delay=delay)
     w_max = max(w_a, w_b, hi_scale) * 1.2
     w_lin = min(w_max, max(w_a, w_b) * 1.2)
-    l0, l1 = _at_infinity(loop0_num, loop0_den), _at_infinity(loop1_num, loop1_den)
+    l0, l1 = value_at_infinity(loop0_num, loop0_den), value_at_infinity(loop1_num, loop1_den)
     if delay > 0 and np.isfinite(l0) and np.isfinite(l1) and abs(l0) + rho_max * abs(l1) >= 0.5:
         # |L0 + rho L1| may stay near 1 at every frequency (a biproper loop): its delayed Nyquist curve then meets
         # -1 once per 2 pi / delay up to infinity, the rho of these crossings tending monotonically to the neutral
@@ -125,15 +125,6 @@ def stability_boundaries(
         found += [(r, float("inf")) for r in ends if abs(r) <= rho_max]
     return sorted(found)
 
-
-def _at_infinity(num: np.ndarray, den: np.ndarray) -> float:
-    """``lim num(s)/den(s)`` for ``s -> inf`` (``inf`` for an improper ratio)."""
-    num, den = trim(np.asarray(num, float)), trim(np.asarray(den, float))
-    if not np.any(num):
-        return 0.0
-    if num.size > den.size:
-        return float("inf")
-    return float(num[0] / den[0]) if num.size == den.size else 0.0
 
 
 def _combine(c0: Rational | None, c1: Rational, rho: float) -> Rational:
