@@ -147,7 +147,7 @@ def sample_hold_step(p, s, x, k):
     return s[0], False
 
 
-@jit
+@jit(inline="always")
 def block_step(code, p, s, x, k):
     """Apply block ``code`` with parameters ``p`` and state ``s`` (updated in place) at step ``k``.
 
