@@ -14,7 +14,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["FFT_FROM", "delayed_loop_in_blocks"]
+from synth.statespace import step_from_rest
+
+__all__ = ["FFT_FROM", "delayed_loop_augmented", "delayed_loop_in_blocks"]
 
 FFT_FROM = 512
 """Blocks of at least this many steps convolve by FFT (``O(m log m)``) instead of directly (``O(m^2)``)."""
@@ -89,3 +91,38 @@ def delayed_loop_in_blocks(Ac: np.ndarray, Bc: np.ndarray, Cc: np.ndarray, Dc: f
         xp, xc = plant.state(xp, u_delayed), ctrl.state(xc, e)
         u_delayed = u
     return y_hist
+
+
+def delayed_loop_augmented(Ac: np.ndarray, Bc: np.ndarray, Cc: np.ndarray, Dc: float, Ap: np.ndarray,
+                           Bp: np.ndarray, Cp: np.ndarray, Dp: float, m: int, steps: int) -> np.ndarray:
+    """:func:`delayed_loop_in_blocks` for a short delay: the loop with its ``m`` delayed inputs as states is one
+    discrete system of order ``n_plant + n_controller + m``, stepped from rest by
+    :func:`synth.statespace.step_from_rest` (a block of samples per matrix product, where the delay's own
+    blocks would be only ``m`` samples long).
+
+    Examples
+    --------
+    >>> e = np.exp(-0.01)  # 1/(s+1) held over 10 ms, a gain of 1, 5 steps of delay: y settles at 1/2
+    >>> y = delayed_loop_augmented(np.zeros((0, 0)), np.zeros(0), np.zeros(0), 1.0, np.array([[e]]),
+    ...                            np.array([1 - e]), np.array([1.0]), 0.0, 5, 3000)
+    >>> round(float(y[-1]), 6), float(y[5]), y.size
+    (0.5, 0.0, 3001)
+    """
+    Ap, Bp, Cp = np.asarray(Ap, float), np.asarray(Bp, float).ravel(), np.asarray(Cp, float).ravel()
+    Ac, Bc, Cc = np.asarray(Ac, float), np.asarray(Bc, float).ravel(), np.asarray(Cc, float).ravel()
+    n_p, n_c = Ap.shape[0], Ac.shape[0]
+    size = n_p + n_c + m  # z = [plant state, controller state, u[k-m], ..., u[k-1]]
+    p, c, q = slice(0, n_p), slice(n_p, n_p + n_c), n_p + n_c  # q: the oldest input, the plant's now
+    F = np.zeros((size, size))
+    g = np.zeros(size)
+    h = np.zeros(size)
+    h[p], h[q] = Cp, Dp  # y = Cp xp + Dp u[k-m]; e = 1 - y
+    F[p, p], F[p, q] = Ap, Bp  # xp' = Ap xp + Bp u[k-m]
+    F[c, c] = Ac  # xc' = Ac xc + Bc e
+    F[c, :] -= np.outer(Bc, h)
+    g[c] = Bc
+    F[q:size - 1, q + 1:] = np.eye(m - 1)  # the delay line shifts
+    F[size - 1, c] = Cc  # u = Cc xc + Dc e enters at the young end
+    F[size - 1, :] -= Dc * h
+    g[size - 1] = Dc
+    return step_from_rest(F, g, h, 0.0, steps + 1)

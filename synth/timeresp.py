@@ -16,13 +16,12 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
-from synth.delayed_blocks import delayed_loop_in_blocks
+from synth.delayed_blocks import delayed_loop_augmented, delayed_loop_in_blocks
 from synth.loop import Loop
 from synth.polynomials import trim
-from synth.statespace import tf_to_ss, zoh
+from synth.statespace import step_from_rest, tf_to_ss, zoh
 
-__all__ = ["StepMetrics", "default_horizon", "delayed_loop_stepped", "discrete_loop", "exact_step",
-           "step_metrics", "step_response"]
+__all__ = ["StepMetrics", "default_horizon", "discrete_loop", "exact_step", "step_metrics", "step_response"]
 
 
 @dataclass(frozen=True)
@@ -149,16 +148,15 @@ error and holds it for one step, a lag of half a step, so ``w_c dt = 0.002`` shi
 0.06 deg. With only the horizon setting the step (1/20000 of it), a PI with a slow integral tail, simulated for
 512 s, ran at 25.6 ms steps and overshot 24.9 % where a fine simulation gives 24.0 %."""
 
-NUMPY_STEPS = 40_000
-"""Up to this many steps a delay shorter than :data:`BLOCK_FROM` steps runs step by step in numpy (about 4 us
-per step); longer runs are compiled with numba, whose import alone costs more than this."""
-
-BLOCK_FROM = 4
-"""A delay of at least this many steps runs a delay's length at a time (:mod:`synth.delayed_blocks`): 3 to 40
-times faster than step by step in numpy, faster the longer the delay."""
+AUGMENTED_UP_TO = 128
+"""A delay of at most this many steps runs as one discrete system with the delayed inputs as states
+(:func:`synth.delayed_blocks.delayed_loop_augmented`, 64 samples per matrix product: under 1 ms for 20,000
+steps up to 32 steps of delay, 2.3 ms at 128); a longer one a delay's length at a time
+(:func:`synth.delayed_blocks.delayed_loop_in_blocks`, faster from there on)."""
 
 BLOCK_STEPS = 200_000
-"""Up to this many steps the blocks (0.3 to 3 us per step) take less than numba's import and compilation."""
+"""Up to this many steps a delay longer than :data:`AUGMENTED_UP_TO` steps runs in blocks (0.3 to 3 us per step);
+longer runs are compiled with numba, whose import and loading cost more than the blocks below this."""
 
 MAX_STEPS = 4_000_000
 """Most simulation steps of one delayed step response (the compiled loop takes about 10 ms per million)."""
@@ -199,10 +197,10 @@ def _delayed_step(loop: Loop, t_end: float, n: int) -> tuple[np.ndarray, np.ndar
     args, dt = discrete_loop(loop, t_end)
     m, steps = args[-2:]
     with np.errstate(over="ignore", invalid="ignore"):
-        if m >= BLOCK_FROM and steps <= BLOCK_STEPS:
+        if m <= AUGMENTED_UP_TO:
+            y_hist = delayed_loop_augmented(*args)
+        elif steps <= BLOCK_STEPS:
             y_hist = delayed_loop_in_blocks(*args)
-        elif steps <= NUMPY_STEPS:
-            y_hist = delayed_loop_stepped(*args)
         else:
             from synth.delayed_step import delayed_loop  # numba: compiled once, cached on disk
 
@@ -210,35 +208,6 @@ def _delayed_step(loop: Loop, t_end: float, n: int) -> tuple[np.ndarray, np.ndar
     t_sim = np.arange(steps + 1) * dt
     t = np.linspace(0.0, t_end, n)
     return t, np.interp(t, t_sim, y_hist), dt
-
-
-def delayed_loop_stepped(Ac, Bc, Cc, Dc, Ap, Bp, Cp, Dp, m: int, steps: int) -> np.ndarray:
-    """:func:`synth.delayed_step.delayed_loop` in numpy, step by step (no compilation, nor numba's import).
-
-    Examples
-    --------
-    >>> e = np.exp(-0.01)  # 1/(s+1) held over 10 ms, a gain of 1, 5 steps of delay: y settles at 1/2
-    >>> y = delayed_loop_stepped(np.zeros((0, 0)), np.zeros(0), np.zeros(0), 1.0, np.array([[e]]),
-    ...                          np.array([1 - e]), np.array([1.0]), 0.0, 5, 3000)
-    >>> round(float(y[-1]), 6)
-    0.5
-    """
-    xc = np.zeros(Ac.shape[0])
-    xp = np.zeros(Ap.shape[0])
-    buffer = np.zeros(m)  # u[k - m] is read at step k
-    y_hist = np.empty(steps + 1)
-    for k in range(steps + 1):
-        u_delayed = buffer[k % m]
-        y = (float(Cp @ xp) if Ap.size else 0.0) + Dp * u_delayed
-        y_hist[k] = y
-        e = 1.0 - y
-        u = (float(Cc @ xc) if Ac.size else 0.0) + Dc * e
-        if Ac.size:
-            xc = Ac @ xc + Bc * e
-        if Ap.size:
-            xp = Ap @ xp + Bp * u_delayed
-        buffer[k % m] = u
-    return y_hist
 
 
 def _zoh(num: np.ndarray, den: np.ndarray, dt: float):
@@ -264,10 +233,4 @@ def exact_step(num: np.ndarray, den: np.ndarray, t: np.ndarray) -> np.ndarray:
     if A.size == 0 or t.size < 2:  # a static gain, or only t = 0 (the state starts at rest)
         return np.full(t.size, D)
     Ad, Bd = zoh(A, B, float(t[1] - t[0]))
-    x = np.zeros(A.shape[0])
-    y = np.empty(t.size)
-    bd = Bd[:, 0]
-    for k in range(t.size):
-        y[k] = C @ x + D
-        x = Ad @ x + bd
-    return y
+    return step_from_rest(Ad, Bd[:, 0], np.asarray(C, float), float(D), t.size)
