@@ -35,6 +35,7 @@ from synth.freqgrid import log_grid
 from synth.loop import Loop
 from synth.loop_batch import LoopBatch
 from synth.requirements import Sensitivity, SlewRate, StaticSensitivity
+from synth.requirements.margins import UNSTABLE_SLACK
 from synth.requirements.sensitivity import PeakSensitivity
 from synth.timeresp import default_horizon, step_response
 
@@ -211,18 +212,41 @@ def delay_chart(rows: list[dict[str, Any]], marks: dict[str, float], path: Path)
     return save_figure(fig, path)
 
 
-def feasibility_grid(spec: Any, design_controller: Any, n: int = 45, plants: list[int] | None = None,
+MAP_GRID = 45
+"""Points per parameter of the report's feasibility map."""
+
+MAP_GRID_SCALAR = 21
+"""Points per parameter when a requirement has no vectorized form (a step-response limit: one simulation per
+stable point, about 10 ms each with a delay)."""
+
+
+def map_grid_size(spec: Any) -> int:
+    """The feasibility map's points per parameter: :data:`MAP_GRID`, or :data:`MAP_GRID_SCALAR` when a
+    requirement is evaluated one loop at a time.
+
+    Examples
+    --------
+    >>> from synth.spec import load_spec
+    >>> map_grid_size(load_spec("specs/x4_rotor_pi.yaml"))
+    45
+    """
+    return MAP_GRID if all(type(r).has_batch_form() for r in spec.requirements) else MAP_GRID_SCALAR
+
+
+def feasibility_grid(spec: Any, design_controller: Any, n: int | None = None, plants: list[int] | None = None,
                      ) -> tuple[str, str, np.ndarray, np.ndarray, np.ndarray] | None:
     """The data of :func:`feasibility_map`: ``(xa, xb, A, B, slack)`` with ``slack[0, j, i]`` +1/-1 for a
     stable/unstable loop at ``(A[i], B[j])`` on every plant and ``slack[k + 1, j, i]`` requirement ``k``'s
     worst slack over the plants (None unless the spec has two free parameters). ``plants`` (indices into
     ``spec.plants()``) restricts it to some plants; the grids of a partition of the plants combine into
-    the whole one by :func:`combine_grids` (the report computes one plant per job).
+    the whole one by :func:`combine_grids` (the report computes one plant per job). ``n`` points per parameter
+    (default :func:`map_grid_size`).
 
     Stability is exact: along each column the stabilizing set of the second parameter comes from the
     D-decomposition (:func:`synth.synthesis.gainset.stability_set`). The requirements are evaluated for
     the whole grid at once (:meth:`~synth.requirements.base.Requirement.batch_slack`, 20 points per
-    decade, peaks and crossings refined).
+    decade, peaks and crossings refined); a requirement without a vectorized form only where the loop is stable
+    on that plant (elsewhere its slack is what the check gives an unstable loop).
 
     Examples
     --------
@@ -238,6 +262,7 @@ def feasibility_grid(spec: Any, design_controller: Any, n: int = 45, plants: lis
     free = spec.controller.free_parameters()
     if len(free) != 2 or design_controller is None:
         return None
+    n = map_grid_size(spec) if n is None else n
     bounds = spec.controller.all_bounds()
     (xa, (xa_lo, xa_hi)), (xb, (xb_lo, xb_hi)) = [(p, bounds[p]) for p in free]
     # zoom to the neighbourhood of the design (at most the bounds)
@@ -262,9 +287,20 @@ def feasibility_grid(spec: Any, design_controller: Any, n: int = 45, plants: lis
     batches = [(first if k == 0 else first.with_plant(p)).with_root_counts(counts[k].ravel())
                for k, p in enumerate(plants)]
     for k, req in enumerate(requirements):
-        worst = np.min([req.batch_slack(b, 20) for b in batches], axis=0)
+        worst = np.min([_grid_slack(req, b, counts[i].ravel()) for i, b in enumerate(batches)], axis=0)
         slack[k + 1] = worst.reshape(n, n)
     return xa, xb, A, B, slack
+
+
+def _grid_slack(req: Any, batch: Any, counts: np.ndarray) -> np.ndarray:
+    """``req``'s slack on every loop of ``batch``; one loop at a time only where it is stable (``counts == 0``)
+    when the type has no vectorized form."""
+    if type(req).has_batch_form():
+        return req.batch_slack(batch, 20)
+    out = UNSTABLE_SLACK * np.maximum(counts, 1).astype(float)  # as the check says of an unstable loop
+    for i in np.flatnonzero(counts == 0):
+        out[i] = req.slack(Loop(batch.plant, batch.controllers[i]), 20)
+    return out
 
 
 def column_root_counts(family: Any, plants: list[Any], values: np.ndarray) -> np.ndarray:
@@ -313,7 +349,7 @@ def combine_grids(parts: list[tuple[str, str, np.ndarray, np.ndarray, np.ndarray
     return xa, xb, A, B, np.min([p[4] for p in parts], axis=0)
 
 
-def feasibility_map(spec: Any, design_controller: Any, path: Path, n: int = 45,
+def feasibility_map(spec: Any, design_controller: Any, path: Path, n: int | None = None,
                     reference: Any | None = None,
                     grid: tuple[str, str, np.ndarray, np.ndarray, np.ndarray] | None = None) -> Path | None:
     """For two free parameters: where in the parameter plane each requirement holds (on a grid), the
@@ -341,7 +377,7 @@ def feasibility_map(spec: Any, design_controller: Any, path: Path, n: int = 45,
         ax.plot(reference.parameters[xa], reference.parameters[xb], "ko", mfc="none", ms=10, label="reference")
     ax.set_xlabel(xa)
     ax.set_ylabel(xb)
-    ax.set_title("Feasible parameters (shaded), exact check on a grid")
+    ax.set_title(f"Feasible parameters (shaded), exact check on a {A.size} x {B.size} grid")
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize=8, loc="best")
     return save_figure(fig, path)
