@@ -13,7 +13,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
-from scipy.signal import cont2discrete, tf2ss
+from scipy.signal import cont2discrete, step, tf2ss
 
 from synth.controllers import Controller
 from synth.design import design
@@ -170,7 +170,12 @@ def test_pi_design_with_max_overshoot_against_a_brute_force_grid(seed):
     kps, kis = np.append(kps.ravel(), kp), np.append(kis.ravel(), ki)
     t_end = 20.0 / a
     os_ = _overshoot(_grid_steps(num, den, delay, kps, kis, 2e-3, t_end))
-    assert os_[-1] <= bound + 0.3  # the design, by the independent simulation
+    # the design may sit on the bound: judged by scipy's exact step of the continuous loop (the grid's sampled
+    # controller adds half a sample of lag, 0.3 % of overshoot here), sampled finely enough for the peak
+    closed_num = np.polymul([kp, ki], num)
+    closed_den = np.polyadd(np.polymul([1.0, 0.0], den), closed_num)
+    _, y_exact = step((closed_num, closed_den), T=np.linspace(0.0, t_end, 200_001))
+    assert 100.0 * (y_exact.max() - 1.0) <= bound + 0.01
     feasible = os_[:-1] <= bound - 0.3
     best = kis[:-1][feasible].max()
     assert ki >= 0.7 * best, (ki, best)  # a good design: near the best of the grid
