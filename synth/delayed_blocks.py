@@ -102,11 +102,13 @@ def delayed_loop_augmented(Ac: np.ndarray, Bc: np.ndarray, Cc: np.ndarray, Dc: f
 
     Examples
     --------
-    >>> e = np.exp(-0.01)  # 1/(s+1) held over 10 ms, a gain of 1, 5 steps of delay: y settles at 1/2
-    >>> y = delayed_loop_augmented(np.zeros((0, 0)), np.zeros(0), np.zeros(0), 1.0, np.array([[e]]),
-    ...                            np.array([1 - e]), np.array([1.0]), 0.0, 5, 3000)
-    >>> round(float(y[-1]), 6), float(y[5]), y.size
-    (0.5, 0.0, 3001)
+    A PI (a sum of the errors, held 10 ms) on ``1/(s+1)`` behind 3 steps: the same loop as the delay's blocks give
+
+    >>> e, pi = np.exp(-0.01), (np.array([[1.0]]), np.array([1.0]), np.array([0.01]), 0.5)
+    >>> args = (*pi, np.array([[e]]), np.array([1 - e]), np.array([1.0]), 0.0, 3, 2000)
+    >>> y = delayed_loop_augmented(*args)
+    >>> bool(np.allclose(y, delayed_loop_in_blocks(*args), rtol=0, atol=1e-12)), round(float(y[-1]), 4)
+    (True, 1.0)
     """
     Ap, Bp, Cp = np.asarray(Ap, float), np.asarray(Bp, float).ravel(), np.asarray(Cp, float).ravel()
     Ac, Bc, Cc = np.asarray(Ac, float), np.asarray(Bc, float).ravel(), np.asarray(Cc, float).ravel()
