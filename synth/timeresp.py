@@ -21,7 +21,8 @@ from synth.loop import Loop
 from synth.polynomials import trim
 from synth.statespace import step_from_rest, tf_to_ss, zoh
 
-__all__ = ["StepMetrics", "default_horizon", "discrete_loop", "exact_step", "step_metrics", "step_response"]
+__all__ = ["StepMetrics", "default_horizon", "discrete_loop", "exact_step", "step_metrics", "step_response",
+           "step_tail"]
 
 
 @dataclass(frozen=True)
@@ -116,6 +117,31 @@ def default_horizon(loop: Loop) -> float:
     if len(dominant) > 1 and dominant[-1] / dominant[0] > 50:
         span = 12.0 / dominant[-1]
     return max(span, 20 * loop.delay, 1e-3)
+
+
+def step_tail(loop: Loop, poles: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """The closed loop's step as ``y(t) = T(0) + sum_i c_i e^(p_i t)`` over its poles ``p_i`` (with a delay, the
+    dominant roots :meth:`~synth.loop.Loop.closed_loop_poles` finds): ``(p, |c|)``. ``c_i`` is the residue of
+    ``T(s)/s`` at ``p_i``, ``N(p) e^(-tau p) / (p Delta'(p))`` with ``Delta = D + N e^(-tau s)``; ``inf`` at a
+    repeated root. What is left of the step after ``t`` is at most ``sum |c_i| e^(Re p_i t)`` (a slow pole that a
+    zero nearly cancels creeps after the fast part has settled).
+
+    Examples
+    --------
+    ``T = 1/(s+1)``: ``y = 1 - e^(-t)``, one pole with ``|c| = 1``
+
+    >>> from synth.plant import Plant; from synth.controllers import Controller
+    >>> p, c = step_tail(Loop(Plant.from_string("1/s"), Controller("P", {"kp": 1.0})))
+    >>> p.real.round(6).tolist(), c.round(6).tolist()
+    ([-1.0], [1.0])
+    """
+    p = np.asarray(loop.closed_loop_poles() if poles is None else poles, complex)
+    num, den, tau = loop.num, loop.den, loop.delay
+    e = np.exp(-tau * p)
+    slope = np.polyval(np.polyder(den), p) + (np.polyval(np.polyder(num), p) - tau * np.polyval(num, p)) * e
+    with np.errstate(divide="ignore", invalid="ignore"):
+        c = np.abs(np.polyval(num, p) * e / (p * slope))
+    return p, np.where(np.isfinite(c), c, np.inf)
 
 
 def step_response(loop: Loop, t_end: float | None = None, n: int = 2001) -> tuple[np.ndarray, np.ndarray, float]:
