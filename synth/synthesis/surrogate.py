@@ -33,12 +33,13 @@ from synth.requirements.base import Requirement, db, fmt
 from synth.results import CERTIFICATE_PER_DECADE, Certificate, DesignResult, objective_label, objective_note
 from synth.spec import Spec
 from synth.synthesis.convex_settings import ConvexSettings
+from synth.synthesis.exact_search import exact_search
 from synth.synthesis.integral_action import objective_terms
 from synth.synthesis.no_start import no_start_result
 from synth.synthesis.pattern import pattern_search
 
-__all__ = ["BISECTIONS", "CERTIFIED_ONLY", "LINE_STEPS", "RESOLUTION_DB", "certified_only", "design_certified",
-           "surrogate_spec"]
+__all__ = ["BISECTIONS", "CERTIFIED_ONLY", "LINE_STEPS", "RESOLUTION_DB", "SEARCH_CHECKS", "certified_only",
+           "design_certified", "surrogate_spec"]
 
 CERTIFIED_ONLY = (StepResponse, NoLimitCycle)
 """Requirement types with no convex or NLP form: the certificate (and this loop) enforce them."""
@@ -46,6 +47,9 @@ BISECTIONS = 6
 """Designs of the bisection on the surrogate level after the first (it stops earlier at :data:`RESOLUTION_DB`)."""
 LINE_STEPS = 4
 """Exact checks of the last step, from the chosen design towards the first one that failed."""
+SEARCH_CHECKS = 400
+"""Most checks of the pattern search after the surrogate (it stops earlier at its smallest step): a PID's design
+climbs a ridge of the step limit in three parameters (160 checks left one at ki 1.88 where 400 reach 2.98)."""
 RESOLUTION_DB = 0.1
 """The bisection stops when the passing and the failing levels are this close (dB)."""
 _FLOOR_DB = 0.05  # peak |S| is at least 1 for every loop of relative degree >= 2, peak |T| with integral action
@@ -167,23 +171,18 @@ def design_certified(spec: Spec, design_fn: Callable[[Spec], DesignResult]) -> D
         found = _certified(spec, best[0], best[1], tried, refined, checks) if refined is not None else None
         if found is None or not found.feasible:
             found = _certified(spec, best[0], best[1], tried)
-        if found.feasible and found.controller is not None:
+        if found.feasible:
             # the surrogate bounds peak |S| and |T| where the requirement bounds the time response: its loosest
             # passing level leaves room (a PI with an overshoot limit: ki 8.79 -> 12.9); a pattern search on the
             # exact check from there takes it
-            with within("pattern search on the exact check"):
-                search = pattern_search(spec, found.controller, objective_terms(spec),
-                                        keeping=ConvexSettings().stability_level)
-            if search.improved:
-                moved = _certified(spec, best[0], best[1], tried, search.controller, checks, search.checks)
-                found = moved if moved.feasible else found
+            found = _searched(spec, found, lambda c, n: _certified(spec, best[0], best[1], tried, c, checks, n))
     if found is not None and integral_only:  # the plain design can only do better by dropping integral action
         return found
     plain = design_fn(spec)
     if best is None:
         plain.method += (f"; certified-only requirements ({', '.join(r.type for r in hard)}): no design under "
                          f"peak |S|, |T| <= {fmt(_FLOOR_DB)} dB passes them either")
-        return plain
+        return _last_resort(spec, plain, free, tried)
     assert found is not None
     if plain.feasible and _better(plain, found):
         return plain
@@ -211,17 +210,54 @@ def _toward(spec: Spec, inside: Controller, outside: Controller) -> tuple[Contro
     return found, LINE_STEPS
 
 
+def _last_resort(spec: Spec, plain: DesignResult, free: DesignResult, tried: int) -> DesignResult:
+    """No design under the surrogate passed: the plain design (which meets the requirements, when it does, often
+    only without integral action) improved by a pattern search on the exact check, or what a search of the
+    whole box on the exact check finds (:func:`synth.synthesis.exact_search.exact_search`), whichever scores
+    better and passes the certificate."""
+    opening = f"designed with them ({tried} designs under the surrogate found none that passes)"
+    out = _searched(spec, plain, lambda c, n: _certified(spec, plain, None, tried, c, 0, n, opening))
+    with within("search of the bounds on the exact check"):
+        found = exact_search(spec, (plain if plain.controller is not None else free).controller)
+    if found.controller is None:
+        out.method += (f"; a search of the bounds on the exact check found no controller that passes "
+                       f"({found.samples} sampled, {found.checks} checks)")
+        return out
+    opening = (f"found by a search of the bounds on the exact check ({found.samples} controllers sampled, "
+               f"{found.feasible_samples} passing; pattern search from the best {found.starts}; {found.checks} "
+               f"checks), as {tried} designs under the surrogate found none that passes")
+    searched = _certified(spec, plain, None, tried, found.controller, 0, 0, opening)
+    if searched.feasible and (not out.feasible or _better(searched, out)):
+        return searched
+    return out
+
+
+def _searched(spec: Spec, result: DesignResult, certify: Callable[[Controller, int], DesignResult]) -> DesignResult:
+    """``result``, or what a pattern search on the exact check from its controller found (certified by
+    ``certify(controller, checks)``) when that scores better and passes the certificate."""
+    if not result.feasible or result.controller is None:
+        return result
+    with within("pattern search on the exact check"):
+        search = pattern_search(spec, result.controller, objective_terms(spec), max_checks=SEARCH_CHECKS,
+                                keeping=ConvexSettings().stability_level)
+    if not search.improved:
+        return result
+    moved = certify(search.controller, search.checks)
+    return moved if moved.feasible else result
+
+
 def _certified(spec: Spec, result: DesignResult, level: float | None, tried: int,
-               controller: Controller | None = None, checks: int = 0, searched: int = 0) -> DesignResult:
+               controller: Controller | None = None, checks: int = 0, searched: int = 0,
+               opening: str | None = None) -> DesignResult:
     """``result`` (designed on a surrogate spec), or ``controller`` found from it (by ``checks`` checks on the
     segment towards the first design that failed, then ``searched`` checks of a pattern search), re-checked
-    and certified against ``spec`` itself."""
+    and certified against ``spec`` itself; ``opening`` says how ``result`` was made when not by the surrogate."""
     chosen = controller or result.controller
     cert = check(spec, chosen, CERTIFICATE_PER_DECADE)  # dense; the step response is grid-free
     hard = ", ".join(r.type for r in certified_only(spec))
-    how = ("designed without them and met as designed" if level is None else
-           f"designed with peak |S| and |T| <= {fmt(level)} dB instead, the loosest level at which the exact "
-           f"check passed (bisection, {tried} designs)")
+    how = opening or ("designed without them and met as designed" if level is None else
+                      f"designed with peak |S| and |T| <= {fmt(level)} dB instead, the loosest level at which the "
+                      f"exact check passed (bisection, {tried} designs)")
     if controller is not None and checks:
         how += (f", then moved towards the first design that failed it while the exact check passes "
                 f"(bisection on the segment, {checks} checks)")

@@ -1,0 +1,251 @@
+"""A direct search on the exact check for the few free parameters of a fixed structure (PI, PID, lead-lag): the
+certified outer loop's last resort (:mod:`synth.synthesis.surrogate`) when requirements with no solver form (a
+step-response limit, "no limit cycle") failed every design under the surrogate and the plain design met them
+only by dropping the integral action, or not at all.
+
+Every candidate is judged by :func:`synth.check.check` itself, so whatever the search returns met every
+requirement on every plant as the certificate evaluates them; the search only decides where to look:
+
+1. a scrambled Sobol sample of the parameter box on scales that resolve small values (a parameter's
+   logarithm where its bounds span a decade or more, ``lo + (hi - lo)(10^(4u) - 1)/(10^4 - 1)`` from a bound
+   of zero), another on the plain box, a third around a given design, and that design scaled down towards
+   zero gain (the controller's parameters times ``2^-k``);
+2. the pattern search on the exact check (:func:`synth.synthesis.pattern.pattern_search`, which keeps
+   ``|1 + L|`` as far from zero as the solver stages do) from the best feasible samples a few sample
+   spacings apart.
+
+The search says what it rests on (checks, samples, starts, final step); it finds a design or none, never a
+verdict of infeasibility.
+"""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass
+from typing import Any
+
+import numpy as np
+
+from synth.check import check
+from synth.controllers import Controller
+from synth.errors import SynthError
+from synth.loop import Loop
+from synth.objectives import score
+from synth.spec import Spec
+from synth.synthesis.convex_settings import ConvexSettings
+from synth.synthesis.integral_action import objective_terms
+from synth.synthesis.pattern import PATTERN_CHECKS, pattern_search
+
+__all__ = ["MAX_PARAMETERS", "SearchResult", "exact_search", "parameter_scales"]
+
+MAX_PARAMETERS = 4
+"""The search runs for at most this many free parameters (its sample and its moves grow as ``2^n``)."""
+
+_DECADES = 4.0  # a range from zero is resolved over this many decades below its upper bound
+
+
+@dataclass
+class SearchResult:
+    """What :func:`exact_search` found and what it rests on.
+
+    Attributes
+    ----------
+    controller : Controller or None
+        The best design that passed the exact check (None: no sampled point passed).
+    score : float or None
+        Its objective score (larger is better; :func:`synth.objectives.score`).
+    checks : int
+        Exact checks made (every requirement on every plant).
+    samples : int
+        Points of the initial sample.
+    feasible_samples : int
+        Of those, the ones that passed.
+    starts : int
+        Pattern searches run.
+    final_step : float
+        The smallest step a pattern search ended with (relative to each parameter's scale).
+    """
+
+    controller: Controller | None
+    score: float | None
+    checks: int
+    samples: int
+    feasible_samples: int
+    starts: int
+    final_step: float
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready dict.
+
+        Examples
+        --------
+        >>> SearchResult(None, None, 3, 3, 0, 0, 1.0).to_dict()["checks"]
+        3
+        """
+        out = asdict(self)
+        out["controller"] = None if self.controller is None else str(self.controller)
+        return out
+
+
+def parameter_scales(bounds: dict[str, tuple[float, float]]) -> dict[str, str]:
+    """How each parameter is searched: ``"log"`` (positive bounds a decade or more apart), ``"from_zero"``
+    (from a lower bound of zero, resolved over four decades below the upper) or ``"linear"``.
+
+    Examples
+    --------
+    >>> parameter_scales({"kp": (0.0, 10.0), "ki": (0.1, 100.0), "z": (-1.0, 1.0), "p": (2.0, 3.0)})
+    {'kp': 'from_zero', 'ki': 'log', 'z': 'linear', 'p': 'linear'}
+    """
+    out = {}
+    for p, (lo, hi) in bounds.items():
+        if lo > 0 and hi / lo >= 10:
+            out[p] = "log"
+        elif lo == 0 and hi > 0:
+            out[p] = "from_zero"
+        else:
+            out[p] = "linear"
+    return out
+
+
+class _Box:
+    """The free parameters' box and the map from the unit cube ``u`` to parameter values and back."""
+
+    def __init__(self, spec: Spec) -> None:
+        bounds = spec.controller.all_bounds()
+        self.free = spec.controller.free_parameters()
+        self.bounds = {p: bounds[p] for p in self.free}
+        self.fixed = {p: float(lo) for p, (lo, hi) in bounds.items() if lo >= hi}
+        self.scales = parameter_scales(self.bounds)
+        self.type = spec.controller.type
+
+    def value(self, p: str, u: float) -> float:
+        lo, hi = self.bounds[p]
+        u = min(max(u, 0.0), 1.0)
+        kind = self.scales[p]
+        if kind == "log":
+            return float(lo * (hi / lo) ** u)
+        if kind == "from_zero":
+            return float(hi * (10.0 ** (_DECADES * u) - 1.0) / (10.0**_DECADES - 1.0))
+        return float(lo + (hi - lo) * u)
+
+    def coordinate(self, p: str, v: float) -> float:
+        lo, hi = self.bounds[p]
+        v = min(max(v, lo), hi)
+        kind = self.scales[p]
+        if kind == "log":
+            return float(np.log(v / lo) / np.log(hi / lo))
+        if kind == "from_zero":
+            return float(np.log10(1.0 + v / hi * (10.0**_DECADES - 1.0)) / _DECADES)
+        return float((v - lo) / (hi - lo))
+
+    def controller(self, u: np.ndarray) -> Controller:
+        values = {p: self.value(p, float(x)) for p, x in zip(self.free, u)}
+        return Controller(self.type, {**self.fixed, **values})
+
+    def point(self, c: Controller) -> np.ndarray:
+        return np.array([self.coordinate(p, float(c.parameters[p])) for p in self.free])
+
+
+def exact_search(spec: Spec, near: Controller | None = None, samples: int | None = None,
+                 starts: int = 3, seed: int = 0) -> SearchResult:
+    """Search the spec's parameter box for the best-scoring controller that passes :func:`synth.check.check`.
+
+    Parameters
+    ----------
+    spec : Spec
+        The spec, every requirement included.
+    near : Controller, optional
+        A design to sample around (the design made without the requirements that have no solver form).
+    samples : int, optional
+        Points of each of the box's two Sobol samples (default ``64 * 2^n`` for ``n`` free parameters, at most
+        512).
+    starts : int
+        Pattern searches, from the best feasible samples (distinct points).
+    seed : int
+        Seed of the scrambled Sobol sequences.
+
+    Returns
+    -------
+    SearchResult
+
+    Examples
+    --------
+    A PI with at most 10 % overshoot, maximum integral gain:
+
+    >>> from synth.spec import parse_spec
+    >>> spec = parse_spec({"name": "os", "plant": {"tf": "2/((s+1)*(s+2))"},
+    ...     "controller": {"type": "PI", "bounds": {"kp": [0.01, 5], "ki": [0, 10]}},
+    ...     "requirements": [{"type": "step_response", "max_overshoot": 10}],
+    ...     "objective": {"maximize": "integral_gain"}})
+    >>> found = exact_search(spec)
+    >>> check(spec, found.controller).feasible, round(found.controller.parameters["ki"], 2)
+    (True, 1.76)
+    """
+    from scipy.stats import qmc
+
+    box = _Box(spec)
+    n = len(box.free)
+    if n == 0 or n > MAX_PARAMETERS or not all(np.isfinite(v) for b in box.bounds.values() for v in b):
+        return SearchResult(None, None, 0, 0, 0, 0, 1.0)
+    terms = objective_terms(spec)
+    keeping = ConvexSettings().stability_level
+    nominal = spec.nominal_plant()
+    counter = {"checks": 0}
+
+    def passes(c: Controller) -> bool:
+        counter["checks"] += 1
+        try:
+            with np.errstate(all="ignore"):
+                return check(spec, c).feasible
+        except (ArithmeticError, ValueError, RuntimeError, SynthError):  # a check that cannot be made: not passed
+            return False
+
+    def scored(c: Controller) -> float:
+        try:
+            with np.errstate(all="ignore"):
+                value = score(Loop(nominal, c), terms)
+        except (ArithmeticError, ValueError, RuntimeError, SynthError):
+            return -np.inf
+        return value if np.isfinite(value) else -np.inf
+
+    size = samples or min(512, 64 * 2**n)
+    points = [u for u in qmc.Sobol(n, scramble=True, seed=seed).random(size)]
+    # as many again spread evenly over the plain box: a feasible set in the middle of a long range (kp 0.3-0.4
+    # of [0, 2]) is thin on the scales that resolve small values
+    points += [np.array([box.coordinate(p, box.bounds[p][0] + (box.bounds[p][1] - box.bounds[p][0]) * x)
+                         for p, x in zip(box.free, u)]) for u in qmc.Sobol(n, scramble=True, seed=seed + 2).random(size)]
+    if near is not None and all(p in near.parameters for p in box.free):
+        centre = box.point(near)
+        around = qmc.Sobol(n, scramble=True, seed=seed + 1).random(max(16, size // 4))
+        points += [np.clip(centre + 0.5 * (u - 0.5), 0.0, 1.0) for u in around]
+        for k in range(8):  # the design scaled down towards zero gain
+            points.append(box.point(near.with_parameters(**{p: near.parameters[p] * 2.0**-k for p in box.free
+                                                            if box.scales[p] != "linear"})))
+    feasible = []
+    for u in points:
+        c = box.controller(u)
+        s = scored(c)
+        if np.isfinite(s) and passes(c):
+            feasible.append((s, u))
+    if not feasible:
+        return SearchResult(None, None, counter["checks"], len(points), 0, 0, 1.0)
+    feasible.sort(key=lambda e: -e[0])
+    chosen: list[tuple[float, np.ndarray]] = []
+    for s, u in feasible:  # the best ones, a few sample spacings apart
+        if all(np.max(np.abs(u - v)) > 2.0 / size ** (1.0 / n) for _, v in chosen):
+            chosen.append((s, u))
+        if len(chosen) == starts:
+            break
+    best: tuple[float, Controller, int] | None = None
+    final_step = 1.0
+    for s, u in chosen:
+        found = pattern_search(spec, box.controller(u), terms, max_checks=PATTERN_CHECKS, keeping=keeping)
+        counter["checks"] += found.checks
+        final_step = min(final_step, found.final_step)
+        s = scored(found.controller)
+        if best is None or s > best[0]:
+            best = (s, found.controller, found.checks)
+    assert best is not None
+    return SearchResult(best[1], float(best[0]), counter["checks"], len(points), len(feasible), len(chosen),
+                        final_step)
+
+

@@ -1,0 +1,29 @@
+"""A seeded sample of ``benchmarks/step_design_verification.py``: PI and PID designs under step-response limits
+against a dense grid whose steps come from the closed loop's poles and residues (no synth code).
+
+Each design must meet its limits by the reference's own step, and score at least as well as the best point
+of the grid, within 1 %. Problems of seed 1 chosen for their run time (a few seconds each): two PI, two PID
+(5: the step that crept out of its band after the horizon, a false "feasible" before 8263e06), and a
+biproper plant whose step jumps at t = 0.
+"""
+
+from __future__ import annotations
+
+import pytest
+
+from benchmarks.step_design_verification import outcome, problem, run_one, step_metrics
+
+
+@pytest.mark.parametrize("index", [2, 5, 7, 9, 10])
+def test_step_limited_design_meets_its_limits_and_beats_the_grid(index: int) -> None:
+    row = run_one(1, index)
+    assert outcome(row) == "agree feasible", row
+    assert row["reference"]["feasible_points"] > 0
+    assert row["gap"] <= 0.01, row  # synth's ki at least 99 % of the grid's best
+
+
+def test_the_reference_steps_a_biproper_loop_from_its_jump() -> None:
+    prob = problem(1, 13)  # (12.03 s + 7.01)/(s + 7.21): the closed loop jumps to T(inf) at t = 0
+    num, den = prob["_plant"]
+    m = step_metrics(num, den, "PID", {"kp": 2.27705, "ki": 7425.54, "kd": 0.284521, "tf": 0.0013861337195975208})
+    assert m is not None and m["max_rise_time"] == 0.0 and m["max_overshoot"] == pytest.approx(0.085, abs=0.005)
