@@ -78,6 +78,34 @@ requirements:
 objective: {maximize: bandwidth}
 """
 
+PID_STEP_SPEC = """\
+name: pid_step
+description: "A third-order plant, PID with a fixed derivative filter: overshoot <= 5 %, settling <= 4 s"
+plant:
+  tf: "5/((s+1)*(s+2)*(s+3))"
+controller:
+  type: PID
+  bounds: {kp: [0, 20], ki: [0, 20], kd: [0, 10], tf: [0.01, 0.01]}
+requirements:
+  - {type: step_response, max_overshoot: 5, max_settling_time: 4}
+objective: {maximize: integral_gain}
+"""
+
+PI_STEP_SPEC = """\
+name: x4_pi_step
+description: "X-4 rotor, 20 ms in-loop delay, PI: |S| <= -10 dB on [0.01, 1] rad/s, overshoot <= 10 %"
+plant:
+  tf: "23*(s+0.43)/((s+9.6)*(s+0.54))"
+  delay: 0.02
+controller:
+  type: PI
+  bounds: {kp: [0, 10], ki: [0, 200]}
+requirements:
+  - {type: sensitivity, max_db: -10, band: [0.01, 1]}
+  - {type: step_response, max_overshoot: 10}
+objective: {maximize: integral_gain}
+"""
+
 
 def cases(tmp: Path) -> dict[str, list[str]]:
     """Label -> command arguments after ``python -m synth`` (``{out}`` is replaced by a fresh folder; a leading
@@ -87,6 +115,9 @@ def cases(tmp: Path) -> dict[str, list[str]]:
     p_spec, pid_spec = tmp / "dc_motor_p.yaml", tmp / "servo_pid.yaml"
     p_spec.write_text(P_SPEC, encoding="utf-8")
     pid_spec.write_text(PID_SPEC, encoding="utf-8")
+    pid_step, pi_step = tmp / "pid_step.yaml", tmp / "x4_pi_step.yaml"
+    pid_step.write_text(PID_STEP_SPEC, encoding="utf-8")
+    pi_step.write_text(PI_STEP_SPEC, encoding="utf-8")
     return {
         "synth design specs/x4_rotor_from_data.yaml (README main job)":
             ["design", "specs/x4_rotor_from_data.yaml", "--out", "{out}"],
@@ -100,6 +131,9 @@ def cases(tmp: Path) -> dict[str, list[str]]:
             ["design", "specs/x4_rotor_robust.yaml", "--out", "{out}"],
         "synth design dc_motor_p.yaml (P, with report)": ["design", str(p_spec), "--out", "{out}"],
         "synth design servo_pid.yaml (PID, with report)": ["design", str(pid_spec), "--out", "{out}"],
+        "synth design pid_step.yaml (PID, step-response limits, with report)": ["design", str(pid_step), "--out", "{out}"],
+        "synth design x4_pi_step.yaml (PI, 20 ms delay, overshoot limit, with report)":
+            ["design", str(pi_step), "--out", "{out}"],
         "synth check specs/x4_rotor.yaml --controller P(3)":
             ["check", "specs/x4_rotor.yaml", "--controller", "P(3)"],
     }
