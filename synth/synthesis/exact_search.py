@@ -35,7 +35,7 @@ from synth.synthesis.convex_settings import ConvexSettings
 from synth.synthesis.integral_action import objective_terms
 from synth.synthesis.pattern import PATTERN_CHECKS, pattern_search
 
-__all__ = ["MAX_PARAMETERS", "SearchResult", "exact_search", "parameter_scales"]
+__all__ = ["MAX_PARAMETERS", "ExactSearchResult", "exact_search", "parameter_scales"]
 
 MAX_PARAMETERS = 4
 """The search runs for at most this many free parameters (its sample and its moves grow as ``2^n``)."""
@@ -44,7 +44,7 @@ _DECADES = 4.0  # a range from zero is resolved over this many decades below its
 
 
 @dataclass
-class SearchResult:
+class ExactSearchResult:
     """What :func:`exact_search` found and what it rests on.
 
     Attributes
@@ -78,7 +78,7 @@ class SearchResult:
 
         Examples
         --------
-        >>> SearchResult(None, None, 3, 3, 0, 0, 1.0).to_dict()["checks"]
+        >>> ExactSearchResult(None, None, 3, 3, 0, 0, 1.0).to_dict()["checks"]
         3
         """
         out = asdict(self)
@@ -146,7 +146,7 @@ class _Box:
 
 
 def exact_search(spec: Spec, near: Controller | None = None, samples: int | None = None,
-                 starts: int = 3, seed: int = 0) -> SearchResult:
+                 starts: int = 3, seed: int = 0) -> ExactSearchResult:
     """Search the spec's parameter box for the best-scoring controller that passes :func:`synth.check.check`.
 
     Parameters
@@ -165,7 +165,7 @@ def exact_search(spec: Spec, near: Controller | None = None, samples: int | None
 
     Returns
     -------
-    SearchResult
+    ExactSearchResult
 
     Examples
     --------
@@ -185,7 +185,7 @@ def exact_search(spec: Spec, near: Controller | None = None, samples: int | None
     box = _Box(spec)
     n = len(box.free)
     if n == 0 or n > MAX_PARAMETERS or not all(np.isfinite(v) for b in box.bounds.values() for v in b):
-        return SearchResult(None, None, 0, 0, 0, 0, 1.0)
+        return ExactSearchResult(None, None, 0, 0, 0, 0, 1.0)
     terms = objective_terms(spec)
     keeping = ConvexSettings().stability_level
     nominal = spec.nominal_plant()
@@ -227,7 +227,7 @@ def exact_search(spec: Spec, near: Controller | None = None, samples: int | None
         if np.isfinite(s) and passes(c):
             feasible.append((s, u))
     if not feasible:
-        return SearchResult(None, None, counter["checks"], len(points), 0, 0, 1.0)
+        return ExactSearchResult(None, None, counter["checks"], len(points), 0, 0, 1.0)
     feasible.sort(key=lambda e: -e[0])
     chosen: list[tuple[float, np.ndarray]] = []
     for s, u in feasible:  # the best ones, a few sample spacings apart
@@ -245,7 +245,7 @@ def exact_search(spec: Spec, near: Controller | None = None, samples: int | None
         if best is None or s > best[0]:
             best = (s, found.controller, found.checks)
     assert best is not None
-    return SearchResult(best[1], float(best[0]), counter["checks"], len(points), len(feasible), len(chosen),
+    return ExactSearchResult(best[1], float(best[0]), counter["checks"], len(points), len(feasible), len(chosen),
                         final_step)
 
 

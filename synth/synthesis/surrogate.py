@@ -175,7 +175,8 @@ def design_certified(spec: Spec, design_fn: Callable[[Spec], DesignResult]) -> D
             # the surrogate bounds peak |S| and |T| where the requirement bounds the time response: its loosest
             # passing level leaves room (a PI with an overshoot limit: ki 8.79 -> 12.9); a pattern search on the
             # exact check from there takes it
-            found = _searched(spec, found, lambda c, n: _certified(spec, best[0], best[1], tried, c, checks, n))
+            moved = checks if found.controller is refined else 0  # the segment's checks, when they moved it
+            found = _searched(spec, found, lambda c, n: _certified(spec, best[0], best[1], tried, c, moved, n))
     if found is not None and integral_only:  # the plain design can only do better by dropping integral action
         return found
     plain = design_fn(spec)
