@@ -29,9 +29,9 @@ COMMITTED = sorted(p.relative_to(ROOT) for p in [*ROOT.glob("reports/**/report.h
 CANDIDATES = ["/usr/lib/chromium/chromium", "chromium-headless-shell", "chromium", "chromium-browser",
               "google-chrome"]
 FIGURE_OF = {"sensitivity": "sensitivity", "sensitivity_static": "sensitivity", "peak_sensitivity": "sensitivity",
-             "slew_rate": "bode"}
+             "slew_rate": "bode", "step_response": "step"}
 """Requirement type -> the figure (by its ``alt`` text start) that must draw its bound."""
-ALT = {"sensitivity": "sensitivity", "bode": "Bode magnitude"}
+ALT = {"sensitivity": "sensitivity", "bode": "Bode magnitude", "step": "step responses"}
 
 
 def _chromium() -> str | None:
@@ -171,7 +171,12 @@ def _check_design_page(info: dict, data: dict) -> None:
         assert img is not None and img["bounds"] is not None, f"{req['label']}: no {figure} figure with its bounds"
         drawn = [b for b in img["bounds"] if b["requirement"] == req["label"]]
         assert drawn, f"{req['label']}: bound not drawn on the {figure} figure ({img['bounds']})"
-        if req["type"] != "slew_rate":  # a horizontal line at the bound, in dB
+        if req["type"] == "step_response":  # the limits about the design's final value, in output units
+            details = req["details"]
+            if details.get("overshoot") is not None and "overshoot" in req["message"]:
+                over = [b for b in drawn if b["what"].startswith("overshoot")]
+                assert over and over[0]["y"][0] >= details["final_value"], drawn
+        elif req["type"] != "slew_rate":  # a horizontal line at the bound, in dB
             assert drawn[0]["y"] == [pytest.approx(float(req["bound"]))] * 2, drawn
             if req["type"] == "sensitivity":
                 band = req["details"]["band"]
@@ -205,3 +210,29 @@ def test_the_committed_x4_report_names_the_plant_of_each_number(browser):
     cell = next(c for c in info["plants"] if fmt(bandwidth["value"]) in c["text"])
     assert bandwidth["plant"] in cell["text"]  # ... and the page says so beside the number
     assert f"{fmt(data['objective']['value'])} rad/s on the nominal plant" in info["text"]
+
+
+STEP_SPEC = """name: pi_step
+description: "A PI with an overshoot limit"
+plant: {tf: "2/((s+1)*(s+2))"}
+controller: {type: PI, bounds: {kp: [0.01, 5], ki: [0, 10]}}
+requirements:
+  - {type: step_response, max_overshoot: 10, max_settling_time: 6}
+objective: {maximize: integral_gain}
+"""
+
+
+def test_fresh_report_with_step_limits_draws_them_in_a_browser(browser, tmp_path):
+    from synth.cli import main
+
+    (tmp_path / "step.yaml").write_text(STEP_SPEC)
+    with redirect_stdout(io.StringIO()):
+        assert main(["design", str(tmp_path / "step.yaml"), "--out", str(tmp_path / "report"), "--quiet"]) == 0
+    info = _check_page(browser, tmp_path / "report" / "report.html")
+    data = json.loads((tmp_path / "report" / "result.json").read_text())
+    final = next(r for r in data["requirements"] if r["type"] == "step_response")["details"]["final_value"]
+    step = next(i for i in info["images"] if i["alt"].startswith("step responses"))
+    drawn = {b["what"].split(" ")[0]: b for b in step["bounds"]}
+    assert drawn["overshoot"]["y"] == [pytest.approx(1.1 * final, rel=1e-5)] * 2
+    assert drawn["settling"]["x"][0] == pytest.approx(6.0) and drawn["settling"]["y"] == [
+        pytest.approx(0.98 * final, rel=1e-5), pytest.approx(1.02 * final, rel=1e-5)]

@@ -124,7 +124,8 @@ def _design_figure_jobs(spec: Spec, result: DesignResult, loops: list[tuple[str,
         jobs.append(("sensitivity", job(lambda drawn: figures.sensitivity_plot(
             loops, list(spec.requirements), out.claim("sensitivity.png"), drawn=drawn), True)))
     if loops:
-        jobs.append(("step", job(lambda: figures.step_plot(loops, out.claim("step_response.png")))))
+        jobs.append(("step", job(lambda drawn: figures.step_plot(
+            loops, out.claim("step_response.png"), requirements=list(spec.requirements), drawn=drawn), True)))
     return jobs
 
 

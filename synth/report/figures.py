@@ -6,6 +6,7 @@ of them computes a requirement (the numbers come from the result).
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
@@ -34,7 +35,7 @@ from synth.figure_files import save_figure
 from synth.freqgrid import log_grid
 from synth.loop import Loop
 from synth.loop_batch import LoopBatch
-from synth.requirements import Sensitivity, SlewRate, StaticSensitivity
+from synth.requirements import Sensitivity, SlewRate, StaticSensitivity, StepResponse
 from synth.requirements.margins import UNSTABLE_SLACK
 from synth.requirements.sensitivity import PeakSensitivity
 from synth.timeresp import default_horizon, step_response
@@ -147,12 +148,24 @@ def sensitivity_plot(loops: list[tuple[str, Loop]], requirements: list[Any], pat
 
 
 def step_plot(loops: list[tuple[str, Loop]], path: Path, scale: float = 1.0, unit: str = "",
-              t_end: float | None = None, open_loop: bool = True) -> Path:
-    """Closed-loop responses to a reference step of size ``scale`` (and the plant's open-loop step)."""
+              t_end: float | None = None, open_loop: bool = True, requirements: Sequence[Any] = (),
+              drawn: list[dict[str, Any]] | None = None) -> Path:
+    """Closed-loop responses to a reference step of size ``scale`` (and the plant's open-loop step), with the
+    limits of every linear ``step_response`` requirement drawn about the first loop's final value: the
+    overshoot limit as a line, the settling band from the settling-time limit on, the rise-time limit as a
+    segment of that length from where the first loop passes 10 %.
+
+    ``drawn``, if given, receives one entry per limit drawn (:func:`bound_drawn`).
+    """
+    limits = [r for r in requirements if isinstance(r, StepResponse) and r.under != "simulation"]
     fig, ax = plt.subplots(figsize=(8, 4.2))
     horizon = t_end if t_end is not None else max(default_horizon(loop) for _, loop in loops)
+    if t_end is None:
+        horizon = max([horizon] + [1.25 * r.max_settling_time for r in limits if r.max_settling_time is not None])
+    first: tuple[np.ndarray, np.ndarray] | None = None
     for i, (name, loop) in enumerate(loops):
         t, y, dt = step_response(loop, horizon)
+        first = first or (t, scale * y)
         extra = f" (sampled, dt = {dt:.2g} s)" if dt else ""
         ax.plot(t, scale * y, color=COLORS[i % len(COLORS)], lw=1.8, label=f"closed loop, {name}{extra}")
     if open_loop:
@@ -165,12 +178,41 @@ def step_plot(loops: list[tuple[str, Loop]], path: Path, scale: float = 1.0, uni
         y = np.interp(shift, t, y) * (t >= plant.delay)
         ax.plot(t, scale * y / max(plant.dc_gain(), 1e-300), color="grey", ls=":", lw=1.5,
                 label="open-loop plant, normalized to its DC gain")
+    found = _step_limits(ax, limits, scale * loops[0][1].T0(), horizon, first) if limits and first else []
+    if drawn is not None:
+        drawn.extend(bound_drawn(artist, name, what) for artist, name, what in found)
     ax.set_xlabel("time [s]")
     ax.set_ylabel(f"output [{unit}]" if unit else "output per unit reference step")
     ax.set_title("Linear step response (reference step)")
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize=8, loc="lower right")
     return save_figure(fig, path)
+
+
+def _step_limits(ax: Any, limits: list[Any], final: float, horizon: float,
+                 first: tuple[np.ndarray, np.ndarray]) -> list[tuple[Any, str, str]]:
+    """Draw each step limit about ``final`` (the first loop's final value); ``(artist, requirement, what)``."""
+    found = []
+    for r in limits:
+        if r.max_overshoot is not None:
+            level = final * (1.0 + r.max_overshoot / 100.0)
+            artist = ax.hlines(level, 0.0, horizon, color="#c0392b", lw=2.0,
+                               label=f"overshoot limit {r.max_overshoot:g} % (of the design's final value)")
+            found.append((artist, r.name(), "overshoot limit [output]"))
+        if r.max_settling_time is not None and r.max_settling_time < horizon:
+            band = abs(final) * r.settle_band
+            artist = ax.hlines([final - band, final + band], r.max_settling_time, horizon, color="#8e44ad",
+                               linestyles="dashed", lw=1.4,
+                               label=f"settled within +-{100 * r.settle_band:g} % from {r.max_settling_time:g} s on")
+            found.append((artist, r.name(), "settling band from the settling-time limit [s, output]"))
+        if r.max_rise_time is not None:
+            t, y = first
+            passed = y * np.sign(final) >= 0.1 * abs(final)  # the first loop past 10 % of its final value
+            start = float(t[np.argmax(passed)]) if np.any(passed) else 0.0
+            artist = ax.hlines(0.5 * final, start, start + r.max_rise_time, color="#16a085", lw=2.5,
+                               label=f"rise-time limit {r.max_rise_time:g} s (10-90 %), from the design's 10 % time")
+            found.append((artist, r.name(), "rise-time limit from the 10 % time [s]"))
+    return found
 
 
 def gain_set_plot(parameter: str, bounds: tuple[float, float], curves: dict[str, tuple[np.ndarray, np.ndarray]],
