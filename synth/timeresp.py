@@ -107,10 +107,18 @@ def step_metrics(t: np.ndarray, y: np.ndarray, y0: float = 0.0, y_final: float |
     return StepMetrics(rise, overshoot, settling, yf, float(y0 + peak_frac * change))
 
 
-def default_horizon(loop: Loop) -> float:
+def default_horizon(loop: Loop, poles: np.ndarray | None = None) -> float:
     """A time span that shows the dominant closed-loop dynamics: 12 time constants of the fastest
-    dominant pole, at least 20 delays."""
-    poles = loop.closed_loop_poles()
+    dominant pole, at least 20 delays. ``poles``: the loop's :meth:`~synth.loop.Loop.closed_loop_poles`, when
+    the caller has them (with a delay they cost a Pade model and Newton's method).
+
+    Examples
+    --------
+    >>> from synth.plant import Plant; from synth.controllers import Controller
+    >>> float(default_horizon(Loop(Plant.from_string("1/s"), Controller("P", {"kp": 2.0}))))  # 12 / 2
+    6.0
+    """
+    poles = loop.closed_loop_poles() if poles is None else poles
     fast = [abs(p.real) for p in poles if p.real < 0]
     span = 12.0 / max(fast) if fast else 1.0
     dominant = sorted(fast)

@@ -167,8 +167,9 @@ class StepResponse(Requirement):
         from synth.timeresp import default_horizon, step_metrics, step_response, step_tail
 
         final = loop.T0()
-        horizon = default_horizon(loop)
-        poles, weights = step_tail(loop)
+        poles = loop.closed_loop_poles()  # once: the horizon and the tail's residues both start from them
+        horizon = default_horizon(loop, poles)
+        poles, weights = step_tail(loop, poles)
         band = self.settle_band * abs(final)
 
         def after(h: float) -> float:

@@ -235,17 +235,17 @@ def exact_search(spec: Spec, near: Controller | None = None, samples: int | None
             chosen.append((s, u))
         if len(chosen) == starts:
             break
-    best: tuple[float, Controller, int] | None = None
+    best: tuple[float, Controller] | None = None
     final_step = 1.0
-    for s, u in chosen:
+    for _, u in chosen:
         found = pattern_search(spec, box.controller(u), terms, max_checks=PATTERN_CHECKS, keeping=keeping)
         counter["checks"] += found.checks
         final_step = min(final_step, found.final_step)
         s = scored(found.controller)
         if best is None or s > best[0]:
-            best = (s, found.controller, found.checks)
+            best = (s, found.controller)
     assert best is not None
     return ExactSearchResult(best[1], float(best[0]), counter["checks"], len(points), len(feasible), len(chosen),
-                        final_step)
+                             final_step)
 
 
