@@ -302,23 +302,29 @@ class Loop:
         pn, pd = _pade(self.delay, pade_order)
         seeds = np.roots(trim(np.polyadd(np.polymul(self.den, pd), np.polymul(self.num, pn))))
         dnum, dden = np.polyder(self.num), np.polyder(self.den)
-        found: list[complex] = []
-        for s in seeds:
+        s = seeds.astype(complex)
+        active = np.ones(s.size, dtype=bool)  # Newton's method on every seed at once; each stops on its own
+        with np.errstate(all="ignore"):
             for _ in range(50):
-                e = np.exp(-self.delay * s)
-                f = np.polyval(self.den, s) + np.polyval(self.num, s) * e
-                df = np.polyval(dden, s) + (np.polyval(dnum, s) - self.delay * np.polyval(self.num, s)) * e
-                if df == 0:
+                if not active.any():
                     break
-                step = f / df
-                s = s - step
-                if abs(step) <= 1e-13 * max(1.0, abs(s)):
-                    break
+                z = s[active]
+                e = np.exp(-self.delay * z)
+                f = np.polyval(self.den, z) + np.polyval(self.num, z) * e
+                df = np.polyval(dden, z) + (np.polyval(dnum, z) - self.delay * np.polyval(self.num, z)) * e
+                flat = df == 0
+                step = np.where(flat, 0.0, f / np.where(flat, 1.0, df))
+                z = z - step
+                s[active] = z
+                done = flat | (np.abs(step) <= 1e-13 * np.maximum(1.0, np.abs(z)))
+                active[np.flatnonzero(active)[done]] = False
             e = np.exp(-self.delay * s)
-            resid = abs(np.polyval(self.den, s) + np.polyval(self.num, s) * e)
-            scale = abs(np.polyval(self.den, s)) + abs(np.polyval(self.num, s) * e) + 1e-300
-            if resid <= 1e-9 * scale and not any(abs(s - f0) <= 1e-7 * max(1, abs(s)) for f0 in found):
-                found.append(complex(s))
+            resid = np.abs(np.polyval(self.den, s) + np.polyval(self.num, s) * e)
+            scale = np.abs(np.polyval(self.den, s)) + np.abs(np.polyval(self.num, s) * e) + 1e-300
+        found: list[complex] = []
+        for root, ok in zip(s, resid <= 1e-9 * scale):
+            if ok and not any(abs(root - f0) <= 1e-7 * max(1, abs(root)) for f0 in found):
+                found.append(complex(root))
         roots = np.array(found)
         return roots[np.argsort(-roots.real)]
 
