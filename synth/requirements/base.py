@@ -212,6 +212,9 @@ class Requirement(BaseModel):
     """Other swept fields and their direction: +1 when a larger value makes the requirement stricter."""
     example: ClassVar[dict[str, Any]] = {}
     """A spec-file block of this type (docs, the registry test's round trip)."""
+    costly: ClassVar[bool] = False
+    """Its evaluation simulates (a time response, a describing-function chain): checks that may stop at the
+    first failure (:func:`synth.check.quick_check`) evaluate it last."""
 
     def evaluate(self, loop: Loop, per_decade: int = 80) -> RequirementResult:  # pragma: no cover
         """Evaluate on ``loop``; ``per_decade`` sets the density of the frequency grid."""

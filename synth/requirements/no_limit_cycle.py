@@ -179,6 +179,7 @@ class NoLimitCycle(Requirement):
     confirm: bool = True
     simulation: SimulationSpec | None = None
     title: ClassVar[str] = "no limit cycle"
+    costly: ClassVar[bool] = True
     bounds: ClassVar[dict[str, Bound]] = {"min_gain_margin_db": Bound("lower", "dB")}
     example: ClassVar[dict[str, Any]] = {"type": "no_limit_cycle", "delay": [0.0, 0.01],
                                          "actuator": [{"type": "saturation", "min": -1.0, "max": 1.0}]}

@@ -83,6 +83,7 @@ class StepResponse(Requirement):
     under: Literal["linear", "simulation", "both"] = "linear"
     simulation: SimulationSpec | None = None
     title: ClassVar[str] = "step response"
+    costly: ClassVar[bool] = True
     bounds: ClassVar[dict[str, Bound]] = {"max_overshoot": Bound("upper", "%"),
                                           "max_settling_time": Bound("upper", "s"),
                                           "max_rise_time": Bound("upper", "s")}

@@ -17,7 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from synth.check import check
+from synth.check import quick_check
 from synth.controllers import Controller
 from synth.errors import SynthError
 from synth.loop import Loop
@@ -119,10 +119,10 @@ def pattern_search(spec: Spec, start: Controller, terms: list[tuple[str, str, fl
         c = Controller(start.type, params)
         try:
             with np.errstate(all="ignore"):
-                result = check(spec, c, per_decade)
+                result = quick_check(spec, c, per_decade)
                 if not result.feasible or (keeping > 0 and closest(c) < keeping):
                     return -np.inf, -np.inf
-                return float(score(Loop(nominal, c), terms)), min(r.slack for r in result.requirements)
+                return float(score(Loop(nominal, c), terms)), result.min_slack
         except (ArithmeticError, ValueError, RuntimeError, SynthError):  # a count that failed: not certified
             return -np.inf, -np.inf
 
