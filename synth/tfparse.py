@@ -12,6 +12,7 @@ from __future__ import annotations
 import ast
 import re
 from dataclasses import dataclass
+from functools import lru_cache
 
 import numpy as np
 
@@ -187,6 +188,13 @@ def parse_tf(text: str) -> ParsedTF:
     """
     if not isinstance(text, str) or not text.strip():
         raise ModelError("empty transfer function; write it in s, e.g. '1/(s+1)'")
+    return _parsed(text)
+
+
+@lru_cache(maxsize=256)
+def _parsed(text: str) -> ParsedTF:
+    """:func:`parse_tf` of a non-empty string, kept: a spec's plants are built from their text at every check
+    of a search (1 ms each); the result is frozen, and errors are raised again (not kept)."""
     source = _normalize(text)
     try:
         tree = ast.parse(source, mode="eval")
