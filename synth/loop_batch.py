@@ -139,14 +139,28 @@ class LoopBatch:
         >>> LoopBatch(G, [Controller("P", {"kp": k}) for k in (1.0, 9.0)]).unstable_root_counts().tolist()
         [0, 2]
         """
-        from synth.loop import Loop
-
         if getattr(self, "_counts", None) is None or self._counts_plant is not self.plant:
             counts = self._counts_by_gain()
             if counts is None:
-                counts = np.array([Loop(self.plant, c).stability().unstable_poles for c in self.controllers], int)
+                counts = np.array([loop.stability().unstable_poles for loop in self.loops()], int)
             self._counts, self._counts_plant = counts, self.plant
         return self._counts
+
+    def loops(self) -> list[Any]:
+        """``Loop(plant, c)`` for every controller, made once per plant: what they compute is kept (a count of
+        :meth:`unstable_root_counts` made loop by loop is not made again by a requirement's scalar form).
+
+        Examples
+        --------
+        >>> b = LoopBatch(Plant.from_string("1/(s+1)"), [Controller("P", {"kp": 1.0})])
+        >>> b.loops()[0] is b.loops()[0], b.loops()[0].T0()
+        (True, 0.5)
+        """
+        from synth.loop import Loop
+
+        if getattr(self, "_loops_plant", None) is not self.plant:
+            self._loops, self._loops_plant = [Loop(self.plant, c) for c in self.controllers], self.plant
+        return self._loops
 
     def with_root_counts(self, counts: np.ndarray) -> LoopBatch:
         """The same loops with their :meth:`unstable_root_counts` given (e.g. read off a D-decomposition over

@@ -341,7 +341,7 @@ def _grid_slack(req: Any, batch: Any, counts: np.ndarray) -> np.ndarray:
         return req.batch_slack(batch, 20)
     out = UNSTABLE_SLACK * np.maximum(counts, 1).astype(float)  # as the check says of an unstable loop
     for i in np.flatnonzero(counts == 0):
-        out[i] = req.slack(Loop(batch.plant, batch.controllers[i]), 20)
+        out[i] = req.slack(batch.loops()[i], 20)
     return out
 
 

@@ -250,9 +250,7 @@ class Requirement(BaseModel):
         >>> bool(np.allclose(Bandwidth(min=100).batch_slack(batch), Requirement.batch_slack(Bandwidth(min=100), batch)))
         True
         """
-        from synth.loop import Loop
-
-        return np.array([self.slack(Loop(batch.plant, c), per_decade) for c in batch.controllers], dtype=float)
+        return np.array([self.slack(loop, per_decade) for loop in batch.loops()], dtype=float)
 
     @classmethod
     def has_batch_form(cls) -> bool:
