@@ -57,10 +57,11 @@ class ExactSearchResult:
         Exact checks made (every requirement on every plant).
     samples : int
         Points of the initial sample.
-    feasible_samples : int
-        Of those, the ones that passed.
+    checked_samples : int
+        Of those, the ones checked: in order of score, until the starts were found (a sample a few spacings
+        from a start already taken is not checked: it would not be one).
     starts : int
-        Pattern searches run.
+        Pattern searches run: one from each checked sample that passed.
     final_step : float
         The smallest step a pattern search ended with (relative to each parameter's scale).
     """
@@ -69,7 +70,7 @@ class ExactSearchResult:
     score: float | None
     checks: int
     samples: int
-    feasible_samples: int
+    checked_samples: int
     starts: int
     final_step: float
 
@@ -78,7 +79,7 @@ class ExactSearchResult:
 
         Examples
         --------
-        >>> ExactSearchResult(None, None, 3, 3, 0, 0, 1.0).to_dict()["checks"]
+        >>> ExactSearchResult(None, None, 3, 3, 3, 0, 1.0).to_dict()["checks"]
         3
         """
         out = asdict(self)
@@ -221,21 +222,28 @@ def exact_search(spec: Spec, near: Controller | None = None, samples: int | None
         for k in range(8):  # the design scaled down towards zero gain
             points.append(box.point(near.with_parameters(**{p: near.parameters[p] * 2.0**-k for p in box.free
                                                             if box.scales[p] != "linear"})))
-    feasible = []
+    candidates = []
     for u in points:
         c = box.controller(u)
         s = scored(c)
-        if np.isfinite(s) and passes(c):
-            feasible.append((s, u))
-    if not feasible:
-        return ExactSearchResult(None, None, counter["checks"], len(points), 0, 0, 1.0)
-    feasible.sort(key=lambda e: -e[0])
+        if np.isfinite(s):
+            candidates.append((s, u, c))
+    candidates.sort(key=lambda e: -e[0])  # stable: ties in sample order
+    # the starts are the best-scoring passing samples a few sample spacings apart, so the samples are checked
+    # best first until there are enough of them, and one within a spacing of a start is not checked at all
+    spacing = 2.0 / size ** (1.0 / n)
     chosen: list[tuple[float, np.ndarray]] = []
-    for s, u in feasible:  # the best ones, a few sample spacings apart
-        if all(np.max(np.abs(u - v)) > 2.0 / size ** (1.0 / n) for _, v in chosen):
-            chosen.append((s, u))
+    checked = 0
+    for s, u, c in candidates:
         if len(chosen) == starts:
             break
+        if any(np.max(np.abs(u - v)) <= spacing for _, v in chosen):
+            continue
+        checked += 1
+        if passes(c):
+            chosen.append((s, u))
+    if not chosen:
+        return ExactSearchResult(None, None, counter["checks"], len(points), checked, 0, 1.0)
     best: tuple[float, Controller] | None = None
     final_step = 1.0
     for _, u in chosen:
@@ -246,7 +254,7 @@ def exact_search(spec: Spec, near: Controller | None = None, samples: int | None
         if best is None or s > best[0]:
             best = (s, found.controller)
     assert best is not None
-    return ExactSearchResult(best[1], float(best[0]), counter["checks"], len(points), len(feasible), len(chosen),
+    return ExactSearchResult(best[1], float(best[0]), counter["checks"], len(points), checked, len(chosen),
                              final_step)
 
 

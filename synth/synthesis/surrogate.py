@@ -110,11 +110,14 @@ def _better(a: DesignResult, b: DesignResult) -> bool:
     return va > vb if a.objective["sense"] == "maximize" else va < vb
 
 
-def design_certified(spec: Spec, design_fn: Callable[[Spec], DesignResult]) -> DesignResult:
+def design_certified(spec: Spec, design_fn: Callable[[Spec], DesignResult],
+                     trial_fn: Callable[[Spec], DesignResult] | None = None) -> DesignResult:
     """``design_fn(spec)``, and when the spec has requirements with no solver form that its design could not
     meet (or met only by dropping the integral action), the certified outer loop of this module.
 
     The better of the two certified designs is returned (the plain one when the loop finds nothing).
+    ``trial_fn`` makes the bisection's designs under the surrogate (default ``design_fn``): a cheaper one (the
+    convex stage without the NLP polish) does, since the design it picks is then moved by the exact check.
 
     Examples
     --------
@@ -148,7 +151,7 @@ def design_certified(spec: Spec, design_fn: Callable[[Spec], DesignResult]) -> D
     level = float(np.clip(_start_level(hard), tight + 0.2, max(loose - 0.2, tight + 0.2)))
     for _ in range(BISECTIONS + 2):
         with within(f"outer loop {tried + 1}/{BISECTIONS + 3} (surrogate bound {level:.2f} dB)"):
-            trial = design_fn(surrogate_spec(spec, level))
+            trial = (trial_fn or design_fn)(surrogate_spec(spec, level))
         tried += 1
         designed = trial.feasible and "alternatives" not in trial.extras  # not the structure's fallback
         if designed and check(spec, trial.controller).feasible:  # the certificate re-checks the chosen one
@@ -225,7 +228,8 @@ def _last_resort(spec: Spec, plain: DesignResult, free: DesignResult, tried: int
                        f"({found.samples} sampled, {found.checks} checks)")
         return out
     opening = (f"found by a search of the bounds on the exact check ({found.samples} controllers sampled, "
-               f"{found.feasible_samples} passing; pattern search from the best {found.starts}; {found.checks} "
+               f"{found.checked_samples} checked in order of score; pattern search from the best {found.starts} "
+               f"that passed, a few sample spacings apart; {found.checks} "
                f"checks), as {tried} designs under the surrogate found none that passes")
     searched = _certified(spec, plain, None, tried, found.controller, 0, 0, opening)
     if searched.feasible and (not out.feasible or _better(searched, out)):
