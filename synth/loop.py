@@ -301,7 +301,17 @@ class Loop:
             return roots[np.argsort(-roots.real)]
         pn, pd = _pade(self.delay, pade_order)
         seeds = np.roots(trim(np.polyadd(np.polymul(self.den, pd), np.polymul(self.num, pn))))
-        dnum, dden = np.polyder(self.num), np.polyder(self.den)
+        polys = [self.den, self.num, np.polyder(self.den), np.polyder(self.num)]
+        width = max(p.size for p in polys)
+        rows = np.array([np.concatenate([np.zeros(width - p.size), p]) for p in polys])
+
+        def values(z: np.ndarray) -> np.ndarray:
+            """den, num, den', num' at ``z`` (rows): Horner's rule as ``np.polyval``, the four at once."""
+            y = np.zeros((4, z.size), dtype=complex)
+            for j in range(width):
+                y = y * z + rows[:, j:j + 1]
+            return y
+
         s = seeds.astype(complex)
         active = np.ones(s.size, dtype=bool)  # Newton's method on every seed at once; each stops on its own
         with np.errstate(all="ignore"):
@@ -310,8 +320,9 @@ class Loop:
                     break
                 z = s[active]
                 e = np.exp(-self.delay * z)
-                f = np.polyval(self.den, z) + np.polyval(self.num, z) * e
-                df = np.polyval(dden, z) + (np.polyval(dnum, z) - self.delay * np.polyval(self.num, z)) * e
+                d0, n0, d1, n1 = values(z)
+                f = d0 + n0 * e
+                df = d1 + (n1 - self.delay * n0) * e
                 flat = df == 0
                 step = np.where(flat, 0.0, f / np.where(flat, 1.0, df))
                 z = z - step
@@ -319,8 +330,9 @@ class Loop:
                 done = flat | (np.abs(step) <= 1e-13 * np.maximum(1.0, np.abs(z)))
                 active[np.flatnonzero(active)[done]] = False
             e = np.exp(-self.delay * s)
-            resid = np.abs(np.polyval(self.den, s) + np.polyval(self.num, s) * e)
-            scale = np.abs(np.polyval(self.den, s)) + np.abs(np.polyval(self.num, s) * e) + 1e-300
+            d0, n0 = values(s)[:2]
+            resid = np.abs(d0 + n0 * e)
+            scale = np.abs(d0) + np.abs(n0 * e) + 1e-300
         found: list[complex] = []
         for root, ok in zip(s, resid <= 1e-9 * scale):
             if ok and not any(abs(root - f0) <= 1e-7 * max(1, abs(root)) for f0 in found):
