@@ -22,7 +22,7 @@ from typing import Any
 
 import numpy as np
 
-from synth.check import check
+from synth.check import check, quick_check
 from synth.controllers import Controller
 from synth.errors import NoStabilizingStartError
 from synth.loop import Loop
@@ -143,7 +143,7 @@ def design_certified(spec: Spec, design_fn: Callable[[Spec], DesignResult],
         return no_start_result(spec, NoStabilizingStartError(no_start["searched"], searched=no_start["searched"]))
     if not free.feasible:  # the other requirements already fail: nothing for the surrogate to add
         return design_fn(spec)
-    if check(spec, free.controller).feasible:
+    if quick_check(spec, free.controller).feasible:
         return _certified(spec, free, None, 1)
     loose = _peaks_db(spec, free)  # the free design's level: too loose (it fails the exact check)
     tight = _FLOOR_DB  # no design below this level
@@ -154,7 +154,7 @@ def design_certified(spec: Spec, design_fn: Callable[[Spec], DesignResult],
             trial = (trial_fn or design_fn)(surrogate_spec(spec, level))
         tried += 1
         designed = trial.feasible and "alternatives" not in trial.extras  # not the structure's fallback
-        if designed and check(spec, trial.controller).feasible:  # the certificate re-checks the chosen one
+        if designed and quick_check(spec, trial.controller).feasible:  # the certificate re-checks the chosen one
             if best is None or _better(trial, best[0]):
                 best = (trial, level)
             tight = level  # passes: a looser level may do better
@@ -207,7 +207,7 @@ def _toward(spec: Spec, inside: Controller, outside: Controller) -> tuple[Contro
         t = 0.5 * (lo + hi)
         c = inside.with_parameters(**{p: (1 - t) * inside.parameters[p] + t * outside.parameters[p]
                                       for p in inside.parameters})
-        if check(spec, c).feasible and score(Loop(nominal, c), terms) > base:
+        if quick_check(spec, c).feasible and score(Loop(nominal, c), terms) > base:
             lo, found = t, c
         else:
             hi = t
