@@ -104,9 +104,14 @@ def _design_figure_jobs(spec: Spec, result: DesignResult, loops: list[tuple[str,
     jobs: list[tuple[str, Any]] = []
     if result.gain_set is None and result.controller is not None \
             and len(spec.controller.free_parameters()) == 2:
-        if len(spec.plants()) == 1:
+        size = figures.map_grid_size(spec)
+        if len(spec.plants()) == 1 and size == figures.MAP_GRID:
             jobs.append(("region", job(lambda: figures.feasibility_map(
                 spec, result.controller, out.claim("feasible_region.png"), reference=ref))))
+        elif len(spec.plants()) == 1:  # a requirement simulated point by point: half the columns per job
+            for k, cols in enumerate(((0, size // 2), (size // 2, size))):
+                jobs.append((f"region-columns:{k}", lambda cols=cols: (
+                    figures.feasibility_grid(spec, result.controller, columns=cols), None, [])))
         else:  # the plane's grid one plant per job (both cores share them), drawn when all are in
             for k in range(len(spec.plants())):
                 jobs.append((f"region:{k}", lambda k=k: (
@@ -293,21 +298,24 @@ def write_design_report(spec: Spec, result: DesignResult, out_dir: str | Path, *
 
     drawn_by_worker, (data, figs) = run_beside([job for _, job in jobs], own_work)
     bounds: dict[str, list[dict[str, Any]]] = {}  # figure -> the requirement bounds it draws
-    plane = []
+    plane, halves = [], []
     for (key, _), (path, drawn, claimed) in zip(jobs, drawn_by_worker):
         for name in claimed:  # names the worker claimed in its copy of ``out``
             out.claim(name)
         if key.startswith("region:"):
             plane.append(path)
+        elif key.startswith("region-columns:"):
+            halves.append(path)
         elif isinstance(path, dict):  # a study's group of figures
             figs.update(path)
         elif path is not None:
             figs[key] = path
         if drawn is not None:
             bounds[key] = drawn
-    if plane:
+    if plane or halves:
+        grid = figures.combine_grids(plane) if plane else figures.join_columns(halves)
         figs["region"] = figures.feasibility_map(spec, result.controller, out.claim("feasible_region.png"),
-                                                 reference=ref, grid=figures.combine_grids(plane))
+                                                 reference=ref, grid=grid)
     figs = {key: figs[key] for key in _FIGURE_ORDER if key in figs} | figs
     gain = data.get("gain_set_detail")
 

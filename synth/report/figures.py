@@ -276,13 +276,16 @@ def map_grid_size(spec: Any) -> int:
 
 
 def feasibility_grid(spec: Any, design_controller: Any, n: int | None = None, plants: list[int] | None = None,
-                     ) -> tuple[str, str, np.ndarray, np.ndarray, np.ndarray] | None:
+                     columns: tuple[int, int] | None = None) -> tuple[str, str, np.ndarray, np.ndarray, np.ndarray] | None:
     """The data of :func:`feasibility_map`: ``(xa, xb, A, B, slack)`` with ``slack[0, j, i]`` +1/-1 for a
     stable/unstable loop at ``(A[i], B[j])`` on every plant and ``slack[k + 1, j, i]`` requirement ``k``'s
     worst slack over the plants (None unless the spec has two free parameters). ``plants`` (indices into
     ``spec.plants()``) restricts it to some plants; the grids of a partition of the plants combine into
-    the whole one by :func:`combine_grids` (the report computes one plant per job). ``n`` points per parameter
-    (default :func:`map_grid_size`).
+    the whole one by :func:`combine_grids` (the report computes one plant per job). ``columns = (start, stop)``
+    computes only the first parameter's values ``A[start:stop]`` (each column is computed on its own, so the
+    parts of a partition of the columns put together by :func:`join_columns` are the whole grid; the report
+    splits a one-plant grid of simulated requirements in two jobs). ``n`` points per parameter (default
+    :func:`map_grid_size`).
 
     Stability is exact: along each column the stabilizing set of the second parameter comes from the
     D-decomposition (:func:`synth.synthesis.gainset.stability_set`). The requirements are evaluated for
@@ -312,12 +315,14 @@ def feasibility_grid(spec: Any, design_controller: Any, n: int | None = None, pl
     xb_hi = min(xb_hi, max(2.5 * abs(design_controller.parameters[xb]), xb_lo + 1e-9))
     A = np.linspace(xa_lo, xa_hi, n)
     B = np.linspace(xb_lo, xb_hi, n)
+    if columns is not None:
+        A = A[columns[0]:columns[1]]
     requirements = list(spec.requirements)
-    slack = np.full((len(requirements) + 1, n, n), np.nan)
+    slack = np.full((len(requirements) + 1, n, A.size), np.nan)
     base = dict(design_controller.parameters)
     every = spec.plants()
     plants = every if plants is None else [every[k] for k in plants]
-    counts = np.zeros((len(plants), n, n), dtype=int)  # [plant, j, i]
+    counts = np.zeros((len(plants), n, A.size), dtype=int)  # [plant, j, i]
     for i, a in enumerate(A):
         counts[:, :, i] = column_root_counts(ScalarFamily(design_controller.type, xb, {**base, xa: float(a)}),
                                               plants, B)
@@ -330,7 +335,7 @@ def feasibility_grid(spec: Any, design_controller: Any, n: int | None = None, pl
                for k, p in enumerate(plants)]
     for k, req in enumerate(requirements):
         worst = np.min([_grid_slack(req, b, counts[i].ravel()) for i, b in enumerate(batches)], axis=0)
-        slack[k + 1] = worst.reshape(n, n)
+        slack[k + 1] = worst.reshape(n, A.size)
     return xa, xb, A, B, slack
 
 
@@ -389,6 +394,23 @@ def combine_grids(parts: list[tuple[str, str, np.ndarray, np.ndarray, np.ndarray
     """
     xa, xb, A, B, _ = parts[0]
     return xa, xb, A, B, np.min([p[4] for p in parts], axis=0)
+
+
+def join_columns(parts: list[tuple[str, str, np.ndarray, np.ndarray, np.ndarray]],
+                 ) -> tuple[str, str, np.ndarray, np.ndarray, np.ndarray]:
+    """One :func:`feasibility_grid` from the grids of consecutive column ranges (in order).
+
+    Examples
+    --------
+    >>> from synth.spec import load_spec; from synth.controllers import Controller
+    >>> spec, c = load_spec("specs/x4_rotor_pi.yaml"), Controller("PI", {"kp": 4.0, "ki": 40.0})
+    >>> whole = feasibility_grid(spec, c, n=5)
+    >>> parts = [feasibility_grid(spec, c, n=5, columns=r) for r in ((0, 2), (2, 5))]
+    >>> bool(np.array_equal(join_columns(parts)[4], whole[4], equal_nan=True))
+    True
+    """
+    xa, xb, _, B, _ = parts[0]
+    return xa, xb, np.concatenate([p[2] for p in parts]), B, np.concatenate([p[4] for p in parts], axis=2)
 
 
 def feasibility_map(spec: Any, design_controller: Any, path: Path, n: int | None = None,
