@@ -49,7 +49,8 @@ def design(spec: Spec) -> DesignResult:
     from synth.synthesis.multi import design_convex  # cvxpy and casadi load only for several parameters
     from synth.synthesis.surrogate import design_certified
 
-    return design_certified(spec, design_convex)
+    # the surrogate's bisection only needs to know which level passes: its designs skip the NLP polish
+    return design_certified(spec, design_convex, lambda trial: design_convex(trial, nlp=False))
 
 
 def design_jobs(spec: Spec) -> tuple[list[Callable[[], Any]], Callable[[list[Any]], DesignResult]]:
