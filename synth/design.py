@@ -46,11 +46,11 @@ def design(spec: Spec) -> DesignResult:
     """
     if len(spec.controller.free_parameters()) == 1:
         return design_scalar(spec)
-    from synth.synthesis.multi import design_convex  # cvxpy and casadi load only for several parameters
+    from synth.synthesis.multi import design_convex, design_trial  # cvxpy and casadi: several parameters only
     from synth.synthesis.surrogate import design_certified
 
-    # the surrogate's bisection only needs to know which level passes: its designs skip the NLP polish
-    return design_certified(spec, design_convex, lambda trial: design_convex(trial, nlp=False))
+    # the surrogate's bisection only needs to know which level passes: its designs are the convex stage's alone
+    return design_certified(spec, design_convex, design_trial)
 
 
 def design_jobs(spec: Spec) -> tuple[list[Callable[[], Any]], Callable[[list[Any]], DesignResult]]:

@@ -52,8 +52,8 @@ from synth.synthesis.screen import SCREEN_ITERATIONS, SCREEN_POINTS, screen_impr
 from synth.synthesis.stabilizing_slices import open_loop_unstable, slices_text, stabilizing_slices
 
 __all__ = ["STRUCTURAL", "STRUCTURAL_REFINEMENTS", "certificate_density", "choose", "conflict_set", "convex_runs",
-           "design_convex", "design_with_integral_action", "exact_forms", "infeasible_verdict", "objective_terms",
-           "polish_redundant"]
+           "design_convex", "design_trial", "design_with_integral_action", "exact_forms", "infeasible_verdict",
+           "objective_terms", "polish_redundant"]
 
 STRUCTURAL = {"PID": "tf", "leadlag": "p"}
 """The structural parameter of each controller type that the convex stage holds at a few fixed values."""
@@ -114,6 +114,26 @@ def design_with_integral_action(spec: Spec) -> DesignResult:
     24.93
     """
     return _design(spec, ConvexSettings(), True)
+
+
+def design_trial(spec: Spec) -> DesignResult:
+    """The convex stage's certified design of ``spec`` alone: no NLP polish, no second design without integral
+    action, and no search for the conflicting requirements when it fails. The certified outer loop's trials
+    under a surrogate bound (:mod:`synth.synthesis.surrogate`) read only whether a design passes and how it
+    scores (an infeasible trial of x4_pi_step spent 1.8 s on the fallback and the conflicts, unread).
+
+    Examples
+    --------
+    >>> from synth.spec import parse_spec
+    >>> spec = parse_spec({"name": "pi", "plant": {"tf": "23*(s+0.43)/((s+9.6)*(s+0.54))", "delay": 0.02},
+    ...                    "controller": {"type": "PI", "bounds": {"kp": [0, 10], "ki": [0, 200]}},
+    ...                    "requirements": [{"type": "peak_sensitivity", "max_db": 6}],
+    ...                    "objective": {"maximize": "integral_gain"}})
+    >>> r = design_trial(spec)
+    >>> r.feasible, r.certificate.passed, "NLP" in r.method
+    (True, True, False)
+    """
+    return _design(spec, ConvexSettings(), False, explain=False)
 
 
 def _may_need_alternative(spec: Spec, main: DesignResult) -> bool:
@@ -296,7 +316,7 @@ def _polished_from(spec: Spec, starts: list[Controller], terms: list[tuple[str, 
     return out
 
 
-def _design(spec: Spec, settings: ConvexSettings, nlp: bool | str) -> DesignResult:
+def _design(spec: Spec, settings: ConvexSettings, nlp: bool | str, explain: bool = True) -> DesignResult:
     terms = objective_terms(spec)
     try:
         runs = convex_runs(spec, settings)
@@ -419,7 +439,8 @@ def _design(spec: Spec, settings: ConvexSettings, nlp: bool | str) -> DesignResu
                           + "): not reported as a solution.") + reference_verdict(spec, ref)
         return result
     worst = min(runs, key=lambda dr: dr[1].diagnosis.total_slack)[1]
-    worst.diagnosis.conflict_set = conflict_set(spec, settings)
+    if explain:
+        worst.diagnosis.conflict_set = conflict_set(spec, settings)
     compromise = check(spec, worst.controller)
     result = DesignResult(spec.name, False, None, None, None, None, None, compromise, method, reference=ref,
                           extras=extras)
