@@ -199,9 +199,10 @@ MAX_STEPS = 4_000_000
 
 
 def discrete_loop(loop: Loop, t_end: float) -> tuple[tuple, float]:
-    """The delayed loop as :func:`step_response` simulates it over ``t_end``: the arguments of
+    """The delayed loop as :func:`step_response` simulates it over ``t_end`` (its finer run): the arguments of
     :func:`synth.delayed_blocks.delayed_loop_in_blocks` (controller and plant held over the step, the delay
-    in steps, the number of steps) and the step.
+    in steps, the number of steps) and the step. A delay of at least one step is an even number of steps (the
+    coarser run takes every other one: :func:`step_response` extrapolates from the two).
 
     Examples
     --------
@@ -216,31 +217,49 @@ def discrete_loop(loop: Loop, t_end: float) -> tuple[tuple, float]:
         dt_target = min(dt_target, STEP_PER_CROSSOVER / float(np.max(crossovers)))
     dt_target = max(dt_target, t_end / MAX_STEPS)
     if loop.delay >= dt_target:
-        m = int(np.ceil(loop.delay / dt_target))
+        m = 2 * int(np.ceil(loop.delay / dt_target / 2))
         dt = loop.delay / m
     else:  # a delay shorter than the step: one step of delay (error of order dt)
         m, dt = 1, dt_target
-    steps = int(np.ceil(t_end / dt))
+    steps = 2 * int(np.ceil(t_end / dt / 2))
+    return _loop_arguments(loop, dt, m, steps), dt
+
+
+def _loop_arguments(loop: Loop, dt: float, m: int, steps: int) -> tuple:
     cn, cd = loop.controller.tf()
     Ac, Bc, Cc, Dc = _zoh(cn, cd, dt)
     Ap, Bp, Cp, Dp = _zoh(loop.plant.num, loop.plant.den, dt)
-    args = (Ac, Bc, np.asarray(Cc, float).ravel(), float(np.ravel(Dc)[0]), Ap, Bp, np.asarray(Cp, float).ravel(),
+    return (Ac, Bc, np.asarray(Cc, float).ravel(), float(np.ravel(Dc)[0]), Ap, Bp, np.asarray(Cp, float).ravel(),
             float(np.ravel(Dp)[0]), m, steps)
-    return args, dt
 
 
-def _delayed_step(loop: Loop, t_end: float, n: int) -> tuple[np.ndarray, np.ndarray, float]:
-    args, dt = discrete_loop(loop, t_end)
+def _simulated(args: tuple) -> np.ndarray:
+    """The kernel's output at steps ``0 .. steps`` (:data:`AUGMENTED_UP_TO`, :data:`BLOCK_STEPS`)."""
     m, steps = args[-2:]
     with np.errstate(over="ignore", invalid="ignore"):
         if m <= AUGMENTED_UP_TO:
-            y_hist = delayed_loop_augmented(*args)
-        elif steps <= BLOCK_STEPS:
-            y_hist = delayed_loop_in_blocks(*args)
-        else:
-            from synth.delayed_step import delayed_loop  # numba: compiled once, cached on disk
+            return delayed_loop_augmented(*args)
+        if steps <= BLOCK_STEPS:
+            return delayed_loop_in_blocks(*args)
+        from synth.delayed_step import delayed_loop  # numba: compiled once, cached on disk
 
-            y_hist = delayed_loop(*args)
+        return delayed_loop(*args)
+
+
+def _delayed_step(loop: Loop, t_end: float, n: int) -> tuple[np.ndarray, np.ndarray, float]:
+    """The held loop at ``dt`` and at ``2 dt`` (the delay an even number of steps, so that both hold it exactly),
+    extrapolated (Richardson): the holds' error is of first order in the step, so ``2 y_dt - y_2dt`` cancels it
+    at the coarse run's steps, and the difference, interpolated, corrects the fine run's steps between them. A
+    PID behind 0.33 s overshot 9.998 % held at 0.66 ms where the method of steps gives 10.123 %; extrapolated,
+    10.12 %. A delay shorter than the step (one step of delay) is not extrapolated."""
+    args, dt = discrete_loop(loop, t_end)
+    m, steps = args[-2:]
+    y_hist = _simulated(args)
+    if m >= 2:
+        coarse = _simulated(_loop_arguments(loop, 2.0 * dt, m // 2, steps // 2))
+        with np.errstate(over="ignore", invalid="ignore"):
+            correction = y_hist[::2] - coarse
+            y_hist = y_hist + np.interp(np.arange(steps + 1), np.arange(0, steps + 1, 2), correction)
     t_sim = np.arange(steps + 1) * dt
     t = np.linspace(0.0, t_end, n)
     return t, np.interp(t, t_sim, y_hist), dt

@@ -4,7 +4,12 @@ including a PI whose slow integral tail makes the horizon long.
 
 Before the simulation step followed the loop's crossover, the step was 1/20000 of the horizon: a PI with
 ``ki = 0.004`` on ``5/(s+1)^2`` behind 50 ms was simulated for 512 s at 25.6 ms steps and overshot 24.9 %
-where the reference gives 24.0 % (a ``max_overshoot: 24.5`` would have been called not met)."""
+where the reference gives 24.0 % (a ``max_overshoot: 24.5`` would have been called not met).
+
+The holds' error is of first order in the step: a PID behind 0.33 s (seed 1's first delayed problem of
+``benchmarks/step_design_verification.py``) overshot 9.998 % held at 0.66 ms where the method of steps gives
+10.123 %, so a design at a 10 % limit was a false "met". The step is now extrapolated from two runs (Richardson):
+within 1e-4 of the reference here, where 2e-3 was the tolerance before."""
 
 import numpy as np
 import pytest
@@ -97,7 +102,7 @@ def _random_case(seed):
     pytest.skip("no stable loop drawn")
 
 
-@pytest.mark.parametrize("case", range(-1, 5))
+@pytest.mark.parametrize("case", range(-1, 8))
 def test_delayed_step_matches_the_method_of_steps(case):
     plant_text, delay, controller = CASES[0] if case < 0 else _random_case(case)
     plant = Plant.from_string(plant_text, delay=delay)
@@ -108,7 +113,19 @@ def test_delayed_step_matches_the_method_of_steps(case):
     t, y, dt = step_response(loop, horizon, 2001)
     c_num, c_den = controller.tf()
     ref = _reference(plant.num, plant.den, delay, c_num, c_den, horizon, t)
-    assert np.max(np.abs(y - ref)) <= 2e-3 * max(1.0, np.max(np.abs(ref))), (plant_text, controller, dt)
+    assert np.max(np.abs(y - ref)) <= 1e-4 * max(1.0, np.max(np.abs(ref))), (plant_text, controller, dt)
     if case < 0:  # the overshoot the requirement reports, over its own (long) horizon, against the reference's
         peak = float(np.max(ref))
-        assert abs(result.details["overshoot"] - 100 * (peak - 1.0)) < 0.15
+        assert abs(result.details["overshoot"] - 100 * (peak - 1.0)) < 0.01
+
+
+def test_a_pid_at_its_overshoot_limit_is_measured_as_the_method_of_steps_does():
+    plant = Plant.from_string("3.83785544493/(s^2 + 8.58985458385*s + 2.89595733607)", delay=0.3291466554043403)
+    controller = Controller("PID", {"kp": 3.89572409167841, "ki": 2.402554696694673, "kd": 0.8413664603555218,
+                                    "tf": 0.028447699154996443})
+    result = StepResponse(max_overshoot=10).evaluate(Loop(plant, controller))
+    t = np.linspace(0.0, 6.0, 6001)
+    ref = _reference(plant.num, plant.den, plant.delay, *controller.tf(), 6.0, t)
+    assert 100 * (float(np.max(ref)) - 1.0) > 10.1  # the design is over the limit
+    assert abs(result.details["overshoot"] - 100 * (float(np.max(ref)) - 1.0)) < 0.01
+    assert not result.met
