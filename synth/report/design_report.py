@@ -108,10 +108,10 @@ def _design_figure_jobs(spec: Spec, result: DesignResult, loops: list[tuple[str,
         if len(spec.plants()) == 1 and size == figures.MAP_GRID:
             jobs.append(("region", job(lambda: figures.feasibility_map(
                 spec, result.controller, out.claim("feasible_region.png"), reference=ref))))
-        elif len(spec.plants()) == 1:  # a requirement simulated point by point: half the columns per job
-            for k, cols in enumerate(((0, size // 2), (size // 2, size))):
-                jobs.append((f"region-columns:{k}", lambda cols=cols: (
-                    figures.feasibility_grid(spec, result.controller, columns=cols), None, [])))
+        elif len(spec.plants()) == 1:  # a requirement simulated point by point: every other column per job
+            for k in range(2):
+                jobs.append((f"region-columns:{k}", lambda k=k: (
+                    figures.feasibility_grid(spec, result.controller, columns=slice(k, None, 2)), None, [])))
         else:  # the plane's grid one plant per job (both cores share them), drawn when all are in
             for k in range(len(spec.plants())):
                 jobs.append((f"region:{k}", lambda k=k: (
