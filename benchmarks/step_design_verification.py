@@ -1,10 +1,11 @@
 """Designs with step-response limits (``step_response``: overshoot, settling time, rise time) against an
 independent reference: a dense grid of controllers whose steps come from the closed loop's poles and residues.
 
-Problems (seeded, reproducible from ``(seed, index)``): plants of order 1-3 without delay (real poles
-0.2-10 rad/s, sometimes a lightly damped pair, sometimes a minimum-phase zero; DC gain 0.5-5), a PI or a PID
-with a fixed derivative filter, maximize the integral gain, under one to three step limits drawn from the
-plant's own time scale, so that some problems are feasible and some are not.
+Problems (seeded, reproducible from ``(seed, index)``): plants of order 1-3 (real poles 0.2-10 rad/s,
+sometimes a lightly damped pair, sometimes a minimum-phase zero; DC gain 0.5-5), a PI or a PID with a fixed
+derivative filter, maximize the integral gain, under one to three step limits drawn from the plant's own time
+scale. With ``--delay-share S`` a strictly proper plant gets a delay of 0.02-0.5 times its slowest time
+constant with probability S (from a random stream of its own: the problems are otherwise the same).
 
 The reference imports nothing from synth: the closed loop ``T = C G / (1 + C G)`` from the polynomials, its
 unit step ``y(t) = T(0) + sum_i r_i e^(p_i t) / p_i`` from numpy's roots and the residues (``y(0+) = T(inf)``
@@ -13,12 +14,18 @@ over ten times the slowest pole's time constant, the metrics by their definition
 value in percent, settling as the last exit from the band, rise from 10 % to 90 %). It calls a grid point
 feasible with 1 % to spare on every limit (0.1 points of overshoot), so that its sampling does not decide.
 
+A delayed loop's step comes from ``benchmarks/delayed_step_reference.py`` (written apart from synth and from
+this file's other reference): the grid by a fixed-step simulation of all its controllers at once (a point counts
+when its last quarter is within 1 % of the final value and it meets the limits with 1 % to spare), the grid's
+best confirmed, and synth's design checked, by the method of steps with ``solve_ivp`` over a horizon doubled
+until the step has settled, stability by the Nyquist count.
+
 For synth's design it reports: its status; whether the reference's step of the design meets the limits (0.05
 points of overshoot and 0.5 % of time to spare for the reference's sampling: "false feasible" otherwise); the
 objective against the grid's best ("within 1 %" counts synth's ki >= 0.99 of the best); "false infeasible"
 where synth found no design and the grid holds feasible points.
 
-Run:  python benchmarks/step_design_verification.py [--seed 0] [--n 40] [--json FILE]
+Run:  python benchmarks/step_design_verification.py [--seed 0] [--n 40] [--json FILE] [--delay-share 0.5]
 """
 
 from __future__ import annotations
@@ -39,8 +46,10 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 # ------------------------------------------------------------------ problems
 
 
-def problem(seed: int, index: int) -> dict[str, Any]:
-    """One design problem as a spec dict, with the plant's polynomials under ``"_plant"``."""
+def problem(seed: int, index: int, delay_share: float = 0.0) -> dict[str, Any]:
+    """One design problem as a spec dict, with the plant's polynomials under ``"_plant"`` and its delay under
+    ``"delay"``. ``delay_share``: the probability that a strictly proper plant gets a delay of 0.02-0.5 times its
+    slowest time constant (drawn from a stream of its own, so the rest of the problem is the same as without)."""
     rng = np.random.default_rng([seed, index])
     order = int(rng.integers(1, 4))
     poles = list(-(10.0 ** rng.uniform(np.log10(0.2), 1.0, order)))
@@ -66,11 +75,15 @@ def problem(seed: int, index: int) -> dict[str, Any]:
             limits["max_settling_time"] = float(rng.uniform(0.5, 6.0) * 4.0 / slow)
         if rng.random() < 0.3:
             limits["max_rise_time"] = float(rng.uniform(0.2, 2.0) / slow)
-    spec = {"name": f"step_{seed}_{index}", "plant": {"tf": _tf_text(num, den)},
+    delay = 0.0
+    delay_rng = np.random.default_rng([seed, index, 7])
+    if delay_rng.random() < delay_share and num.size < den.size:
+        delay = float(10.0 ** delay_rng.uniform(np.log10(0.02), np.log10(0.5)) / slow)
+    spec = {"name": f"step_{seed}_{index}", "plant": {"tf": _tf_text(num, den), "delay": delay},
             "controller": {"type": kind, "bounds": bounds},
             "requirements": [{"type": "step_response", **limits}],
             "objective": {"maximize": "integral_gain"}}
-    return {"spec": spec, "_plant": (num, den), "limits": limits, "kind": kind}
+    return {"spec": spec, "_plant": (num, den), "delay": delay, "limits": limits, "kind": kind, "slow": slow}
 
 
 def _tf_text(num: np.ndarray, den: np.ndarray) -> str:
@@ -136,8 +149,71 @@ def meets(metrics: dict[str, float] | None, limits: dict[str, float], spare_pct:
     return True
 
 
+def delayed_metrics(num: np.ndarray, den: np.ndarray, delay: float, kind: str, p: dict[str, float],
+                    slow: float, band: float = 0.02) -> dict[str, float] | None:
+    """The metrics of a delayed loop's step by the method of steps (``delayed_step_reference.dde_step``), over a
+    horizon doubled (up to four times from 20 slow time constants plus 20 delays) until the last quarter stays
+    within a fifth of the band; None when the loop is not stable or the step never settles there."""
+    from benchmarks.delayed_step_reference import dde_step, stable, step_metrics_from_samples
+
+    if not stable(num, den, delay, kind, p):
+        return None
+    final = _final_value(num, den, kind, p)
+    if abs(final) < 1e-12:
+        return None
+    horizon = 20.0 / slow + 20.0 * delay
+    for _ in range(5):
+        out = dde_step(num, den, delay, kind, p, horizon, 8001)
+        if out is None:
+            return None
+        t, y = out
+        if np.all(np.abs(y[t >= 0.75 * horizon] / final - 1.0) <= band / 5):
+            return step_metrics_from_samples(t, y, final, band)
+        horizon *= 2.0
+    return None
+
+
+def _final_value(num: np.ndarray, den: np.ndarray, kind: str, p: dict[str, float]) -> float:
+    """T(0) of the loop: 1 with integral action, else C(0) G(0) / (1 + C(0) G(0))."""
+    if p["ki"] > 0:
+        return 1.0
+    loop0 = p["kp"] * float(num[-1] / den[-1])
+    return loop0 / (1.0 + loop0)
+
+
+def _delayed_grid_best(prob: dict[str, Any], points: list[dict[str, float]]) -> tuple[dict[str, float] | None, int]:
+    """The best ki among ``points`` whose delayed steps (``grid_steps``, one fixed-step simulation of all of
+    them) are settled over their last quarter and meet the limits with 1 % to spare, confirmed by the method of
+    steps (the next best is tried when it is not: at most ten); and how many met them on the grid."""
+    from benchmarks.delayed_step_reference import grid_steps, step_metrics_from_samples
+
+    num, den = prob["_plant"]
+    delay, slow, kind = prob["delay"], prob["slow"], prob["kind"]
+    horizon = 40.0 / slow + 40.0 * delay
+    passing = []
+    # in chunks of similar speed (the fixed step follows the fastest loop of a chunk): by the high-frequency gain
+    points = sorted(points, key=lambda p: p["kp"] + p.get("kd", 0.0) / p.get("tf", 1.0))
+    for start in range(0, len(points), 500):
+        chunk = points[start:start + 500]
+        ys = grid_steps(num, den, delay, kind, chunk, horizon, 4001)
+        t = np.linspace(0.0, horizon, ys.shape[1])
+        for p, y in zip(chunk, ys):
+            final = _final_value(num, den, kind, p)
+            if not np.all(np.isfinite(y)) or abs(final) < 1e-12 \
+                    or np.any(np.abs(y[t >= 0.75 * horizon] / final - 1.0) > 0.01):
+                continue
+            if meets(step_metrics_from_samples(t, y, final), prob["limits"], 0.1, 0.01):
+                passing.append(p)
+    passing.sort(key=lambda p: -p["ki"])
+    for p in passing[:10]:
+        if meets(delayed_metrics(num, den, delay, kind, p, slow), prob["limits"], 0.05, 0.005):
+            return p, len(passing)
+    return None, len(passing)
+
+
 def reference(prob: dict[str, Any]) -> dict[str, Any]:
-    """Best ki over a dense grid (PI: 60 x 60; PID: 24^3), every point feasible with 1 % to spare."""
+    """Best ki over a dense grid (PI: 60 x 60; PID: 24^3, with a delay 15^3), every point feasible with 1 % to
+    spare; with a delay by :func:`_delayed_grid_best`."""
     num, den = prob["_plant"]
     spec = prob["spec"]
     bounds = spec["controller"]["bounds"]
@@ -146,26 +222,30 @@ def reference(prob: dict[str, Any]) -> dict[str, Any]:
     def axis(lo: float, hi: float, n: int) -> np.ndarray:
         return np.unique(np.r_[np.linspace(lo, hi, n), hi * np.geomspace(1e-3, 1.0, n // 2)])
 
-    n = 40 if len(free) == 2 else 16
+    n = 40 if len(free) == 2 else 16 if prob["delay"] == 0 else 10  # the delayed grid is simulated: 15^3 for a PID
     axes = [axis(*bounds[k], n) for k in free]
+    grid = [{k: float(v) for k, v in zip(free, values)} | {k: lo for k, (lo, hi) in bounds.items() if lo >= hi}
+            for values in np.stack(np.meshgrid(*axes, indexing="ij"), -1).reshape(-1, len(free))]
+    if prob["delay"] > 0:
+        best, feasible = _delayed_grid_best(prob, grid)
+        return {"best": best, "feasible_points": feasible, "grid_points": len(grid)}
     best, feasible = None, 0
-    for values in np.stack(np.meshgrid(*axes, indexing="ij"), -1).reshape(-1, len(free)):
-        p = {k: float(v) for k, v in zip(free, values)} | {k: lo for k, (lo, hi) in bounds.items() if lo >= hi}
+    for p in grid:
         if meets(step_metrics(num, den, prob["kind"], p), prob["limits"], 0.1, 0.01):
             feasible += 1
             if best is None or p["ki"] > best["ki"]:
                 best = p
-    return {"best": best, "feasible_points": feasible, "grid_points": int(np.prod([a.size for a in axes]))}
+    return {"best": best, "feasible_points": feasible, "grid_points": len(grid)}
 
 
 # ------------------------------------------------------------------ run
 
 
-def run_one(seed: int, index: int) -> dict[str, Any]:
+def run_one(seed: int, index: int, delay_share: float = 0.0) -> dict[str, Any]:
     from synth.design import design
     from synth.spec import parse_spec
 
-    prob = problem(seed, index)
+    prob = problem(seed, index, delay_share)
     t = time.perf_counter()
     ref = reference(prob)
     ref_time = time.perf_counter() - t
@@ -173,13 +253,16 @@ def run_one(seed: int, index: int) -> dict[str, Any]:
     t = time.perf_counter()
     result = design(spec)
     synth_time = time.perf_counter() - t
-    row: dict[str, Any] = {"index": index, "kind": prob["kind"], "limits": prob["limits"], "status": result.status,
+    row: dict[str, Any] = {"index": index, "kind": prob["kind"], "delay": prob["delay"], "limits": prob["limits"],
+                           "status": result.status,
                            "synth_time": synth_time, "reference_time": ref_time, "reference": ref}
     num, den = prob["_plant"]
     if result.feasible:
         p = dict(result.controller.parameters)
         row["synth"] = p
-        row["synth_meets"] = meets(step_metrics(num, den, prob["kind"], p), prob["limits"], -0.05, -0.005)
+        metrics = step_metrics(num, den, prob["kind"], p) if prob["delay"] == 0 else \
+            delayed_metrics(num, den, prob["delay"], prob["kind"], p, prob["slow"])
+        row["synth_meets"] = meets(metrics, prob["limits"], -0.05, -0.005)
         if ref["best"] is not None:
             row["gap"] = 1.0 - p["ki"] / ref["best"]["ki"] if ref["best"]["ki"] > 0 else 0.0
     return row
@@ -224,10 +307,12 @@ def main() -> None:
     parser.add_argument("--start", type=int, default=0)
     parser.add_argument("--n", type=int, default=40)
     parser.add_argument("--json", metavar="FILE", help="write one JSON row per problem")
+    parser.add_argument("--delay-share", type=float, default=0.0,
+                        help="probability of a delay (strictly proper plants; 0.02-0.5 slow time constants)")
     args = parser.parse_args()
     rows = []
     for index in range(args.start, args.start + args.n):
-        row = run_one(args.seed, index)
+        row = run_one(args.seed, index, args.delay_share)
         rows.append(row)
         print(f"#{index} {row['kind']} {outcome(row)} gap {100 * row.get('gap', float('nan')):.2f} % "
               f"synth {row['synth_time']:.1f} s, reference {row['reference_time']:.1f} s", flush=True)
