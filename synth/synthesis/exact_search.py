@@ -263,8 +263,9 @@ def exact_search(spec: Spec, near: Controller | None = None, samples: int | None
     finish = pattern_search(spec, best[1], terms, max_checks=FINISH_CHECKS, keeping=keeping)
     counter["checks"] += finish.checks
     final_step = min(final_step, finish.final_step)
-    if finish.improved and scored(finish.controller) > best[0]:
-        best = (scored(finish.controller), finish.controller)
+    finished = scored(finish.controller) if finish.improved else -np.inf
+    if finished > best[0]:
+        best = (finished, finish.controller)
     return ExactSearchResult(best[1], float(best[0]), counter["checks"], len(points), checked, len(chosen),
                              final_step)
 
