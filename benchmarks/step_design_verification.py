@@ -154,11 +154,11 @@ def delayed_metrics(num: np.ndarray, den: np.ndarray, delay: float, kind: str, p
     """The metrics of a delayed loop's step by the method of steps (``delayed_step_reference.dde_step``), over a
     horizon doubled (up to four times from 20 slow time constants plus 20 delays) until the last quarter stays
     within a fifth of the band; None when the loop is not stable or the step never settles there."""
-    from benchmarks.delayed_step_reference import dde_step, stable, step_metrics_from_samples
+    from benchmarks.delayed_step_reference import dde_step, final_value, stable, step_metrics_from_samples
 
     if not stable(num, den, delay, kind, p):
         return None
-    final = _final_value(num, den, kind, p)
+    final = final_value(num, den, kind, p)
     if abs(final) < 1e-12:
         return None
     horizon = 20.0 / slow + 20.0 * delay
@@ -173,19 +173,11 @@ def delayed_metrics(num: np.ndarray, den: np.ndarray, delay: float, kind: str, p
     return None
 
 
-def _final_value(num: np.ndarray, den: np.ndarray, kind: str, p: dict[str, float]) -> float:
-    """T(0) of the loop: 1 with integral action, else C(0) G(0) / (1 + C(0) G(0))."""
-    if p["ki"] > 0:
-        return 1.0
-    loop0 = p["kp"] * float(num[-1] / den[-1])
-    return loop0 / (1.0 + loop0)
-
-
 def _delayed_grid_best(prob: dict[str, Any], points: list[dict[str, float]]) -> tuple[dict[str, float] | None, int]:
     """The best ki among ``points`` whose delayed steps (``grid_steps``, one fixed-step simulation of all of
     them) are settled over their last quarter and meet the limits with 1 % to spare, confirmed by the method of
     steps (the next best is tried when it is not: at most ten); and how many met them on the grid."""
-    from benchmarks.delayed_step_reference import grid_steps, step_metrics_from_samples
+    from benchmarks.delayed_step_reference import final_value, grid_steps, step_metrics_from_samples
 
     num, den = prob["_plant"]
     delay, slow, kind = prob["delay"], prob["slow"], prob["kind"]
@@ -198,7 +190,7 @@ def _delayed_grid_best(prob: dict[str, Any], points: list[dict[str, float]]) -> 
         ys = grid_steps(num, den, delay, kind, chunk, horizon, 4001)
         t = np.linspace(0.0, horizon, ys.shape[1])
         for p, y in zip(chunk, ys):
-            final = _final_value(num, den, kind, p)
+            final = final_value(num, den, kind, p)
             if not np.all(np.isfinite(y)) or abs(final) < 1e-12 \
                     or np.any(np.abs(y[t >= 0.75 * horizon] / final - 1.0) > 0.01):
                 continue

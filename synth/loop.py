@@ -301,16 +301,15 @@ class Loop:
             return roots[np.argsort(-roots.real)]
         pn, pd = _pade(self.delay, pade_order)
         seeds = np.roots(trim(np.polyadd(np.polymul(self.den, pd), np.polymul(self.num, pn))))
+        from synth.loop_batch import horner  # np.polyval's arithmetic, one polynomial per row
+
         polys = [self.den, self.num, np.polyder(self.den), np.polyder(self.num)]
         width = max(p.size for p in polys)
         rows = np.array([np.concatenate([np.zeros(width - p.size), p]) for p in polys])
 
         def values(z: np.ndarray) -> np.ndarray:
-            """den, num, den', num' at ``z`` (rows): Horner's rule as ``np.polyval``, the four at once."""
-            y = np.zeros((4, z.size), dtype=complex)
-            for j in range(width):
-                y = y * z + rows[:, j:j + 1]
-            return y
+            """den, num, den', num' at ``z`` (rows), the four at once."""
+            return horner(rows, z[None, :])
 
         s = seeds.astype(complex)
         active = np.ones(s.size, dtype=bool)  # Newton's method on every seed at once; each stops on its own

@@ -222,8 +222,8 @@ def discrete_loop(loop: Loop, t_end: float) -> tuple[tuple, float]:
     dt_target = t_end / 20000
     if crossovers.size:
         dt_target = min(dt_target, STEP_PER_CROSSOVER / float(np.max(crossovers)))
-    fastest = max((float(np.max(np.abs(np.roots(trim(d))), initial=0.0))
-                   for d in (loop.controller.tf()[1], loop.plant.den)), default=0.0)
+    fastest = max(float(np.max(np.abs(p), initial=0.0))
+                  for p in (np.roots(trim(loop.controller.tf()[1])), loop.plant.poles()))
     if fastest > 0:
         dt_target = min(dt_target, STEP_PER_POLE / fastest)
     dt_target = max(dt_target, t_end / MAX_STEPS)
