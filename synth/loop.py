@@ -16,7 +16,7 @@ import numpy as np
 from synth.controllers import Controller, as_controller
 from synth.freqgrid import characteristic_range, first_fall, log_grid
 from synth.plant import Plant, as_plant
-from synth.polynomials import dc_value, format_factored, magnitude_squared_in_w2, trim
+from synth.polynomials import dc_value, format_factored, horner, magnitude_squared_in_w2, trim
 from synth.stability import StabilityResult, closed_loop_stability, stability_floor
 from synth.stability_sets import gain_margin_factors
 
@@ -301,8 +301,6 @@ class Loop:
             return roots[np.argsort(-roots.real)]
         pn, pd = _pade(self.delay, pade_order)
         seeds = np.roots(trim(np.polyadd(np.polymul(self.den, pd), np.polymul(self.num, pn))))
-        from synth.loop_batch import horner  # np.polyval's arithmetic, one polynomial per row
-
         polys = [self.den, self.num, np.polyder(self.den), np.polyder(self.num)]
         width = max(p.size for p in polys)
         rows = np.array([np.concatenate([np.zeros(width - p.size), p]) for p in polys])

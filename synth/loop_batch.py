@@ -20,28 +20,10 @@ from synth.polynomial_rows import (
     row_product,
     row_roots,
 )
-from synth.polynomials import dc_value
+from synth.polynomials import dc_value, horner
 from synth.rootfind import bisect_roots
 
 __all__ = ["LoopBatch", "horner"]
-
-
-def horner(coeffs: np.ndarray, x: np.ndarray) -> np.ndarray:
-    """Evaluate one polynomial per row: ``coeffs`` is ``(n, k)`` (descending powers, zero-padded on the
-    left), ``x`` is ``(n, m)`` or broadcastable to it; the same arithmetic as ``np.polyval`` row by row.
-
-    Examples
-    --------
-    >>> horner(np.array([[1.0, 2.0], [0.0, 3.0]]), np.array([[1.0, 2.0], [1.0, 2.0]]))
-    array([[3., 4.],
-           [3., 3.]])
-    """
-    coeffs = np.asarray(coeffs)
-    x = np.asarray(x)
-    y = np.zeros(np.broadcast_shapes(x.shape, coeffs.shape[:1] + (1,) * (x.ndim - 1)), dtype=np.result_type(x, coeffs))
-    for j in range(coeffs.shape[1]):
-        y = y * x + coeffs[:, j].reshape((-1,) + (1,) * (x.ndim - 1))
-    return y
 
 
 def _rows(polys: list[np.ndarray]) -> np.ndarray:

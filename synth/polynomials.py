@@ -6,8 +6,8 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["dc_value", "format_factored", "largest_crossing", "magnitude_squared_in_w2", "mirror", "shifted", "trim",
-           "value_at_infinity"]
+__all__ = ["dc_value", "format_factored", "horner", "largest_crossing", "magnitude_squared_in_w2", "mirror", "shifted",
+           "trim", "value_at_infinity"]
 
 
 def trim(p: np.ndarray) -> np.ndarray:
@@ -196,3 +196,21 @@ def format_factored(num: np.ndarray, den: np.ndarray, digits: int = 4) -> str:
     if len(fd) == 1 and not fd[0].startswith("("):
         bottom = fd[0]
     return f"{top}/{bottom}"
+
+
+def horner(coeffs: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """Evaluate one polynomial per row: ``coeffs`` is ``(n, k)`` (descending powers, zero-padded on the
+    left), ``x`` is ``(n, m)`` or broadcastable to it; the same arithmetic as ``np.polyval`` row by row.
+
+    Examples
+    --------
+    >>> horner(np.array([[1.0, 2.0], [0.0, 3.0]]), np.array([[1.0, 2.0], [1.0, 2.0]]))
+    array([[3., 4.],
+           [3., 3.]])
+    """
+    coeffs = np.asarray(coeffs)
+    x = np.asarray(x)
+    y = np.zeros(np.broadcast_shapes(x.shape, coeffs.shape[:1] + (1,) * (x.ndim - 1)), dtype=np.result_type(x, coeffs))
+    for j in range(coeffs.shape[1]):
+        y = y * x + coeffs[:, j].reshape((-1,) + (1,) * (x.ndim - 1))
+    return y
