@@ -42,10 +42,12 @@ class StepResponse(Requirement):
 
     ``max_overshoot`` (percent of the final value ``T(0)``), ``max_settling_time`` (last exit from a
     band of ``settle_band`` times the final value, s) and ``max_rise_time`` (10 % to 90 %, s); give at
-    least one. The response comes from :func:`synth.timeresp.step_response` (exact without a delay, a
-    fine zero-order-hold simulation with one); the horizon follows the dynamics and is extended until
-    the response has settled, else the verdict is "undetermined" (not met). The horizon, the number of
-    samples and the time resolution are in ``details``. On a closed loop that is not stable the
+    least one. The response comes from :func:`synth.timeresp.linear_step` (exact without a delay, a
+    fine zero-order-hold simulation with one, extrapolated and refined until its estimated error is within
+    :data:`synth.timeresp.STEP_TOLERANCE`; the metrics are the worst that error allows); the horizon follows
+    the dynamics and is extended until the response has settled, else the verdict is "undetermined" (not
+    met). The horizon, the number of samples, the time resolution, the simulation step and its error
+    estimate (``simulation_error``, relative to the final value) are in ``details``. On a closed loop that is not stable the
     requirement is not met.
 
     ``under: simulation`` judges the limits on the spec's sampled nonlinear loop instead (its
@@ -165,7 +167,7 @@ class StepResponse(Requirement):
         return linear if self.under == "linear" else self._simulated(loop, linear)
 
     def _linear(self, loop: Loop) -> RequirementResult:
-        from synth.timeresp import default_horizon, step_metrics, step_response, step_tail
+        from synth.timeresp import default_horizon, linear_step, step_metrics, step_tail
 
         final = loop.T0()
         poles = loop.closed_loop_poles()  # once: the horizon and the tail's residues both start from them
@@ -186,7 +188,8 @@ class StepResponse(Requirement):
         points = min(2**start * (_POINTS - 1) + 1, _MAX_POINTS)
         settled = False
         for _ in range(start, MAX_DOUBLINGS + 1):
-            t, y, dt = step_response(loop, horizon, points)
+            run = linear_step(loop, horizon, points)
+            t, y = run.t, run.y
             tail = t >= 0.75 * horizon
             settled = bool(np.all(np.abs(y[tail] - final) <= band)) and after(horizon) <= TAIL_SHARE * band
             if settled:
@@ -196,13 +199,14 @@ class StepResponse(Requirement):
         else:
             horizon /= 2.0  # the last one simulated
         tail_bound = after(horizon)
-        m = step_metrics(t, y, 0.0, final, self.settle_band)
+        m = step_metrics(t, y, 0.0, final, self.settle_band, run.error)
+        error = float(np.max(run.error)) / abs(final) if final else float("nan")
         measured = {"max_overshoot": m.overshoot, "max_settling_time": m.settling_time,
                     "max_rise_time": m.rise_time}
         resolution = float(t[1] - t[0])
         evidence = dict(horizon=float(horizon), samples=int(t.size), resolution=resolution,
-                        simulation_step=dt, settled=settled, tail_bound=tail_bound, poles_counted=int(poles.size),
-                        **m.to_dict())
+                        simulation_step=run.dt, simulation_error=error, settled=settled, tail_bound=tail_bound,
+                        poles_counted=int(poles.size), **m.to_dict())
         parts = self._limits(measured)
         slack, name, value, bound, unit = min(parts, key=lambda p: p[0])
         if not settled:
@@ -212,8 +216,10 @@ class StepResponse(Requirement):
                                binding_frequency=None, message=f"step response {texts}: NOT met", binding=name,
                                determined=False, **evidence)
         texts = "; ".join(f"{n} {fmt(v)} {u} (max {fmt(b)})" for _, n, v, b, u in parts)
+        held = "" if run.dt == 0.0 else (f"; held at {fmt(run.dt)} s, estimated error up to {fmt(error)} of the "
+                                         f"final value, counted against the limits")
         msg = (f"step response: {texts}: {'met' if slack >= 0 else 'NOT met'}, tightest: {name} "
-               f"({t.size} samples over {fmt(horizon)} s, resolution {fmt(resolution)} s; after it the "
+               f"({t.size} samples over {fmt(horizon)} s, resolution {fmt(resolution)} s{held}; after it the "
                f"{poles.size} closed-loop poles can move it by at most {fmt(tail_bound)})")
         return self.result(value=value, bound=bound, unit=unit, slack=slack, margin=bound - value,
                            binding_frequency=None, message=msg, binding=name, determined=True, **evidence)
