@@ -2,7 +2,10 @@
 
 The command line runs them on two cores beside the design (:func:`synth.forked.run_beside`) and hands their
 results to :func:`synth.report.design_report.write_design_report`; without them the report computes them
-itself. This module imports nothing heavy: the jobs import what they need when they run.
+itself. Their results are kept on disk (:mod:`synth.disk_cache`, keyed by the parts of the spec they read and
+the code), so that the usual loop, a requirement edited and the design run again, does not redo them
+(``SYNTH_RESULT_CACHE=off`` turns that off). This module imports nothing heavy: the jobs import what they
+need when they run.
 """
 
 from __future__ import annotations
@@ -10,6 +13,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Any
 
+from synth.disk_cache import cached, enabled
 from synth.results import reference_controller
 from synth.spec import Spec
 
@@ -49,4 +53,16 @@ def spec_studies(spec: Spec) -> list[tuple[str, Callable[[], Any]]]:
             return x4_gap_case(spec, objects=objects), objects
 
         jobs.append(("gap_case", gap_case))
-    return jobs
+    if not enabled():
+        return jobs
+    key = _inputs(spec)
+    return [(name, lambda name=name, job=job: cached("studies", [name, *key], job)) for name, job in jobs]
+
+
+def _inputs(spec: Spec) -> list[bytes | str]:
+    """What the studies read of ``spec``: the nominal plant (coefficients, delay, signals), the ``simulation:``
+    block and the ``reference:`` block (the key of their results on disk, :mod:`synth.disk_cache`)."""
+    plant = spec.nominal_plant()
+    return [plant.num.astype(float).tobytes(), plant.den.astype(float).tobytes(), repr(float(plant.delay)),
+            repr((plant.input, plant.output)), spec.simulation.model_dump_json() if spec.simulation else "",
+            spec.reference.model_dump_json() if spec.reference else ""]
