@@ -3,7 +3,7 @@
 A result is stored under the SHA-256 of the caller's key (the inputs' bytes and settings) and a fingerprint
 of the code and libraries that compute it (every ``synth`` source file, numpy, scipy, casadi): any change to one
 of them is a miss, never a stale result. A file that cannot be read back is a miss too. Entries live in
-:func:`synth.ident.x4_record.cache_dir` ``/<kind>`` (the :data:`KEEP` newest of each kind are kept);
+:func:`cache_dir` ``/<kind>`` (the :data:`KEEP` newest of each kind are kept);
 ``SYNTH_RESULT_CACHE=off`` turns every kind off. Users: the identification of a spec's record
 (:mod:`synth.ident.result_cache`) and the design report's studies that depend on the spec alone
 (:mod:`synth.report.studies`).
@@ -20,7 +20,7 @@ from functools import cache
 from pathlib import Path
 from typing import TypeVar
 
-__all__ = ["KEEP", "cached", "code_fingerprint", "enabled"]
+__all__ = ["KEEP", "cache_dir", "cached", "code_fingerprint", "enabled"]
 
 T = TypeVar("T")
 
@@ -28,6 +28,27 @@ KEEP = 8
 """Entries kept per kind; older ones are removed when a new one is written."""
 
 _OFF = ("off", "0", "no", "false")
+
+
+def cache_dir() -> Path:
+    """Folder for generated data and kept results: ``$SYNTH_CACHE``, else ``~/.cache/synth``, else the system temp folder.
+
+    Examples
+    --------
+    >>> cache_dir().name in ("synth", "synth-cache") or "SYNTH_CACHE" in os.environ
+    True
+    """
+    if os.environ.get("SYNTH_CACHE"):
+        return Path(os.environ["SYNTH_CACHE"])
+    home = Path(os.environ.get("XDG_CACHE_HOME", Path.home() / ".cache")) / "synth"
+    try:
+        home.mkdir(parents=True, exist_ok=True)
+        probe = home / ".write-test"
+        probe.write_text("")
+        probe.unlink()
+        return home
+    except OSError:
+        return Path(tempfile.gettempdir()) / "synth-cache"
 
 
 def enabled(variable: str = "SYNTH_RESULT_CACHE") -> bool:
@@ -77,8 +98,6 @@ def cached(kind: str, key: Iterable[bytes | str], compute: Callable[[], T]) -> T
     >>> cached("example", ["k/(s+p)"], work) == cached("example", ["k/(s+p)"], work), len(calls) <= 1
     (True, True)
     """
-    from synth.ident.x4_record import cache_dir
-
     digest = hashlib.sha256()
     for part in key:
         data = part.encode() if isinstance(part, str) else part

@@ -6,7 +6,7 @@ identification instead of fitting the record again. The key is the SHA-256 of th
 record file's bytes, the identify settings and units, and a fingerprint of the code
 and libraries that compute the fit (:func:`synth.disk_cache.code_fingerprint`): any
 change to one of them is a miss, never a stale result. Entries live in
-:func:`synth.ident.x4_record.cache_dir` ``/identify`` (the 8 newest are kept);
+:func:`synth.disk_cache.cache_dir` ``/identify`` (the 8 newest are kept);
 ``SYNTH_IDENTIFY_CACHE=off`` (or ``SYNTH_RESULT_CACHE=off``) turns the cache off.
 """
 

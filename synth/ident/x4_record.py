@@ -31,12 +31,12 @@ import hashlib
 import json
 import os
 import sys
-import tempfile
 from pathlib import Path
 
 import numpy as np
 
 from synth.data.record import Record, record_from_arrays
+from synth.disk_cache import cache_dir
 from synth.ident.simulate import simulate_plant
 from synth.plant import Plant, Signal
 
@@ -113,27 +113,6 @@ def write_x4_csv(path: str | Path, seed: int = SEED, periods: int = PERIODS) -> 
     lines += [f"{a:.3f},{b:.0f},{c:.4f}" for a, b, c in zip(r.t, r.u, r.y)]
     path.write_text("\n".join(lines) + "\n", encoding="utf-8")
     return path
-
-
-def cache_dir() -> Path:
-    """Folder for generated data: ``$SYNTH_CACHE``, else ``~/.cache/synth``, else the system temp folder.
-
-    Examples
-    --------
-    >>> cache_dir().name in ("synth", "synth-cache") or "SYNTH_CACHE" in os.environ
-    True
-    """
-    if os.environ.get("SYNTH_CACHE"):
-        return Path(os.environ["SYNTH_CACHE"])
-    home = Path(os.environ.get("XDG_CACHE_HOME", Path.home() / ".cache")) / "synth"
-    try:
-        home.mkdir(parents=True, exist_ok=True)
-        probe = home / ".write-test"
-        probe.write_text("")
-        probe.unlink()
-        return home
-    except OSError:
-        return Path(tempfile.gettempdir()) / "synth-cache"
 
 
 _HASHED: dict[tuple[str, int, int], str] = {}
