@@ -71,11 +71,9 @@ def code_fingerprint() -> str:
     >>> len(code_fingerprint())
     64
     """
-    import casadi
-    import numpy
-    import scipy
+    from importlib.metadata import version  # the installed versions, without importing casadi (0.1 s)
 
-    digest = hashlib.sha256(f"{numpy.__version__} {scipy.__version__} {casadi.__version__}".encode())
+    digest = hashlib.sha256(" ".join(version(name) for name in ("numpy", "scipy", "casadi")).encode())
     root = Path(__file__).resolve().parent
     for path in sorted(root.rglob("*.py")):
         digest.update(path.relative_to(root).as_posix().encode())

@@ -24,6 +24,7 @@ from functools import lru_cache
 from pathlib import Path
 from typing import Any
 
+from synth.disk_cache import cached, enabled
 from synth.ident.disturbance_requirements import DisturbanceRequirements, requirements_from_records
 from synth.ident.disturbance_requirements_figure import disturbance_requirements_plot
 from synth.ident.disturbance_synthetic import X4_SYNTHETIC_SHAPE, synthetic_disturbance_record, synthetic_noise_record
@@ -141,7 +142,8 @@ def x4_paper_section(resolution: float = X4_RESOLUTION, rho: float = RHO_SEA_LEV
     Returns
     -------
     PaperSection
-        Cached: the same arguments return the same (frozen) section.
+        Cached: the same arguments return the same (frozen) section; also kept on disk between runs
+        (:mod:`synth.disk_cache`, ``SYNTH_RESULT_CACHE=off`` turns that off).
 
     Examples
     --------
@@ -151,6 +153,13 @@ def x4_paper_section(resolution: float = X4_RESOLUTION, rho: float = RHO_SEA_LEV
     >>> [r.quantity for r in s.disagreements() if r.quantity.startswith("eq. 15 slow")]
     ['eq. 15 slow pole (measured)']
     """
+    if enabled():  # it depends on its arguments and the code alone: kept on disk between runs
+        return cached("paper_section", ["x4", repr((resolution, rho, gain, duration))],
+                      lambda: _x4_section(resolution, rho, gain, duration))
+    return _x4_section(resolution, rho, gain, duration)
+
+
+def _x4_section(resolution: float, rho: float, gain: float, duration: float) -> PaperSection:
     record = synthetic_disturbance_record(duration=duration)
     analysis, req = requirements_from_records([record], [synthetic_noise_record(duration=duration)],
                                               resolution=resolution)
