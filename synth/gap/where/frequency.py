@@ -19,7 +19,6 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-from scipy.integrate import cumulative_trapezoid
 
 from synth.gap.where.coherence import Coherence, input_residual_coherence
 from synth.gap.where.error_model import ErrorModel, fit_error_model
@@ -52,7 +51,7 @@ class FrequencyBand:
 
 
 def _power_share(w: np.ndarray, psd: np.ndarray, w0: float, w1: float) -> float:
-    cum = np.r_[0.0, cumulative_trapezoid(psd, w)]
+    cum = np.r_[0.0, np.cumsum(np.diff(w) * (psd[1:] + psd[:-1]) / 2.0)]  # scipy's cumulative_trapezoid, not imported
     if cum[-1] <= 0:
         return 0.0
     return float((np.interp(w1, w, cum) - np.interp(w0, w, cum)) / cum[-1])
