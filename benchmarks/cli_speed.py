@@ -4,9 +4,10 @@ The baseline is another checkout of synth (by default a ``git worktree`` of ``--
 temporary folder); each command runs with ``PYTHONPATH`` pointing at one checkout and its working directory
 there, alternately baseline and current, and the best of ``--repeat`` runs is kept (the machine is shared:
 the minimum is the least disturbed run). Every command is run once untimed first on each side, so
-first-use work (the synthetic X-4 record, numba's compile cache, the identification kept on disk by
-:mod:`synth.ident.result_cache`) is excluded ("warm"); one row runs the main job with that cache off, so the
-identification is timed too. Python's bytecode cache counts as first-use work too: the commands run without
+first-use work (the synthetic X-4 record, numba's compile cache, the results kept on disk by
+:mod:`synth.disk_cache`: the identification, the report's spec-only studies, the X-4 paper section) is excluded
+("warm"); two rows run with those caches off (the main job, ``specs/x4_rotor.yaml``), so that what they keep is
+timed too. Python's bytecode cache counts as first-use work too: the commands run without
 ``PYTHONDONTWRITEBYTECODE`` (which some shells and containers set), so the warm-up writes ``__pycache__`` on
 both sides as an installed copy's first run does, and no timed run recompiles synth's modules. CPU time
 (user + system of the command) is printed beside the wall time: on a loaded machine it moves far less than
@@ -121,9 +122,12 @@ def cases(tmp: Path) -> dict[str, list[str]]:
     return {
         "synth design specs/x4_rotor_from_data.yaml (README main job)":
             ["design", "specs/x4_rotor_from_data.yaml", "--out", "{out}"],
-        "main job, identification not reused (SYNTH_IDENTIFY_CACHE=off)":
-            ["SYNTH_IDENTIFY_CACHE=off", "design", "specs/x4_rotor_from_data.yaml", "--out", "{out}"],
+        "main job, nothing reused (SYNTH_IDENTIFY_CACHE=off SYNTH_RESULT_CACHE=off)":
+            ["SYNTH_IDENTIFY_CACHE=off", "SYNTH_RESULT_CACHE=off", "design", "specs/x4_rotor_from_data.yaml", "--out",
+             "{out}"],
         "synth design specs/x4_rotor.yaml": ["design", "specs/x4_rotor.yaml", "--out", "{out}"],
+        "x4_rotor, studies not reused (SYNTH_RESULT_CACHE=off)":
+            ["SYNTH_RESULT_CACHE=off", "design", "specs/x4_rotor.yaml", "--out", "{out}"],
         "synth design x4_pi_delay.yaml (PI, 20 ms delay, with report)": ["design", str(pi), "--out", "{out}"],
         "synth design specs/x4_rotor_pi.yaml (PI, nonlinear step, with report)":
             ["design", "specs/x4_rotor_pi.yaml", "--out", "{out}"],
