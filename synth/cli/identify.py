@@ -191,6 +191,8 @@ def _print(result: Any, args: argparse.Namespace, json_path: Path, figures: list
         print(w.text() + ": the record cannot pin it down; do not use it as a confident number")
     for t in tied:
         print(t.text())
+    if fit.solver.get("covariance_note"):
+        print(f"note on the std column: {fit.solver['covariance_note']}")
     print(f"fit {fit.fit_percent:.2f} %, residual std {fit.residual_std:.3g}, "
           f"IPOPT {fit.solver.get('status')} ({fit.solver.get('iterations')} iterations)")
     print(f"plant: {fit.plant.to_string()}")

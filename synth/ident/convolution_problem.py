@@ -231,7 +231,8 @@ class ConvolutionProblem:
     # --------------------------------------------------------------- solving
 
     def solve(self, x0: np.ndarray, par: _Inputs, nonnegative_f: bool = False,
-              lower: np.ndarray | None = None, rtol: float = 0.0) -> tuple[np.ndarray, float, dict[str, Any]]:
+              lower: np.ndarray | None = None, rtol: float = 0.0,
+              within_sample: bool = False) -> tuple[np.ndarray, float, dict[str, Any]]:
         """Levenberg-Marquardt from ``x0``: the decision variables, the sum of squared residuals and a status.
 
         Converged when the Gauss-Newton decrease of the SSR still available is below ``1e-8`` of the noise
@@ -239,10 +240,12 @@ class ConvolutionProblem:
         of its own). The status strings are IPOPT's (``Solve_Succeeded``, ``Maximum_Iterations_Exceeded``,
         ``Diverging_Iterates``), so :func:`synth.ident.fit_failure.fit_failure` reads them alike.
         """
-        lb = -np.inf * np.ones(x0.size)
+        lb, ub = -np.inf * np.ones(x0.size), np.inf * np.ones(x0.size)
         if lower is not None:
             lb[:lower.size] = lower / self.scale
-        x = np.maximum(np.asarray(x0, float).copy(), lb)
+        if self.fit_delay and within_sample:  # the fractional delay kept in [0, dt]
+            lb[self.p], ub[self.p] = 0.0, self.dt
+        x = np.clip(np.asarray(x0, float).copy(), lb, ub)
         if self.fit_delay and nonnegative_f:
             lb[self.p] = 0.0
             x[self.p] = max(x[self.p], 0.1 * self.dt)
@@ -267,7 +270,7 @@ class ConvolutionProblem:
             accepted = False
             while lam < 1e12:
                 step = np.linalg.solve(H + lam * np.diag(d), g)
-                trial = np.maximum(x + step, lb)
+                trial = np.clip(x + step, lb, ub)
                 r_new = self._residual(trial, par, False)[0]
                 with np.errstate(all="ignore"):
                     ssr_new = float(r_new @ r_new)

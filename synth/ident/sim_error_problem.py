@@ -209,9 +209,15 @@ class SimulationErrorProblem:
         return vec if fixed_f is None else np.r_[vec, fixed_f]
 
     def solve(self, x0: np.ndarray, par: np.ndarray, nonnegative_f: bool = False,
-              lower: np.ndarray | None = None) -> tuple[np.ndarray, float, dict[str, Any]]:
-        """Solve from ``x0``: the decision variables, the sum of squared residuals and IPOPT's status."""
+              lower: np.ndarray | None = None, within_sample: bool = False) -> tuple[np.ndarray, float, dict[str, Any]]:
+        """Solve from ``x0``: the decision variables, the sum of squared residuals and IPOPT's status.
+        ``within_sample``: the fractional delay kept in ``[0, dt]`` (the integer part as ``par`` holds it)."""
         lbx = -np.inf * np.ones(x0.size)
+        ubx = np.inf * np.ones(x0.size)
+        if self.fit_delay and within_sample:
+            lbx[self.p], ubx[self.p] = 0.0, self.dt
+            x0 = x0.copy()
+            x0[self.p] = min(max(x0[self.p], 0.0), self.dt)
         if lower is not None:  # bounds on the structure's parameters (scaled like them)
             p = lower.size
             lbx[:p] = lower / self.scale
@@ -221,7 +227,7 @@ class SimulationErrorProblem:
             lbx[self.p] = 0.0
             x0 = x0.copy()
             x0[self.p] = max(x0[self.p], 0.1 * self.dt)
-        sol = self.solver(x0=x0, p=par, lbx=lbx)
+        sol = self.solver(x0=x0, p=par, lbx=lbx, ubx=ubx)
         stats = self.solver.stats()
         return (np.asarray(sol["x"]).ravel(), float(sol["f"]) * 2 * self.obj_scale,
                 {"status": stats.get("return_status"), "iterations": int(stats.get("iter_count", 0)),
