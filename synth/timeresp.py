@@ -197,6 +197,17 @@ class LinearStep:
     dt: float
     error: np.ndarray
 
+    def to_dict(self) -> dict:
+        """JSON-ready dict (NaN errors as None).
+
+        Examples
+        --------
+        >>> LinearStep(np.zeros(2), np.ones(2), 0.0, np.zeros(2)).to_dict()["y"]
+        [1.0, 1.0]
+        """
+        return {"t": self.t.tolist(), "y": self.y.tolist(), "dt": self.dt,
+                "error": [None if not np.isfinite(e) else float(e) for e in self.error]}
+
 
 def linear_step(loop: Loop, t_end: float | None = None, n: int = 2001,
                 decided: Callable[[LinearStep], bool] | None = None) -> LinearStep:

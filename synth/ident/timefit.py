@@ -40,6 +40,7 @@ from synth.distributions import t_ppf
 from synth.errors import DataError, FitError, ModelError
 from synth.ident.convolution_problem import ConvolutionProblem
 from synth.ident.covariance import fit_covariance
+from synth.ident.delay_samples import best_sample
 from synth.ident.fit_failure import LIMIT_STATUSES, fit_failure
 from synth.ident.identifiability import TiedParameter, WeakParameter, tied_to_weak, weak_parameters
 from synth.ident.sim_error_problem import SimulationErrorProblem
@@ -225,30 +226,6 @@ def _as_sensor(sensor: Plant | str | None) -> Plant | None:
         return Plant.from_string(sensor)
     except ModelError as exc:
         raise exc.located("sensor") from None
-
-
-def _best_sample(run: Any, xs: np.ndarray, ssr: float, m: int, st_info: dict[str, Any], shifts: int,
-                 scale: np.ndarray, dt: float, info: dict[str, Any]) -> tuple:
-    """A biproper model's fit moved to the delay's best sample interval: its feedthrough jumps with the held
-    input, so the cost is discontinuous where the delay crosses a sample and a fit started in one interval
-    stays there (``2(s+0.5)/(s+2) e^(-0.1 s)``, 5 ms samples: 4 of 20 noise seeds ended 1-5 samples off with
-    p 6 % low). The neighbouring intervals are refitted from the middle of each, the delay kept inside it; the
-    walk goes on while one of them is better."""
-    p = scale.size
-    for _ in range(20):
-        best = None
-        for step in (-1, 1):
-            if m + step < 0:
-                continue
-            cand = run(xs[:p] * scale, (m + step + 0.5) * dt, within_sample=True)
-            info["starts"] = info.get("starts", 1) + 1
-            if cand[3]["success"] and np.isfinite(cand[1]) and cand[1] < ssr * (1.0 - 1e-9) \
-                    and (best is None or cand[1] < best[1]):
-                best = cand
-        if best is None:
-            break
-        xs, ssr, m, st_info, shifts = best
-    return xs, ssr, m, st_info, shifts
 
 
 def _remaining_improvement(prob: SimulationErrorProblem, xs: np.ndarray, par: np.ndarray, J: np.ndarray,
@@ -450,7 +427,7 @@ def fit_structure(record: Record, structure: Structure | str, delay: str | float
                 if st_info["success"] and ssr <= init_ssr:
                     break
     if fit_delay and st.num_degree >= st.den_degree:  # a jump at the delay: each sample interval its own valley
-        xs, ssr, m, st_info, shifts = _best_sample(run, xs, ssr, m, st_info, shifts, prob.scale, dt, info)
+        xs, ssr, m, st_info, shifts = best_sample(run, xs, ssr, m, st_info, shifts, prob.scale, dt, info)
     info.update(st_info)
     info["delay_shifts"] = shifts
     p = len(st.parameters)

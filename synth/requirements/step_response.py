@@ -223,9 +223,13 @@ class StepResponse(Requirement):
                                binding_frequency=None, message=f"step response {texts}: NOT met", binding=name,
                                determined=False, **evidence)
         texts = "; ".join(f"{n} {fmt(v)} {u} (max {fmt(b)})" for _, n, v, b, u in parts)
-        held = "" if run.dt == 0.0 else (f"; held at {fmt(run.dt)} s, estimated error up to {fmt(error)} of the "
-                                         f"final value" + ("" if decided else ", a limit within it: judged on the "
-                                                           "worst case it allows"))
+        if run.dt == 0.0:
+            held = ""
+        elif not np.isfinite(error):
+            held = f"; held at {fmt(run.dt)} s, the delay one step of it: error not estimated"
+        else:
+            held = (f"; held at {fmt(run.dt)} s, estimated error up to {fmt(error)} of the final value"
+                    + ("" if decided else ", a limit within it: judged on the worst case it allows"))
         msg = (f"step response: {texts}: {'met' if slack >= 0 else 'NOT met'}, tightest: {name} "
                f"({t.size} samples over {fmt(horizon)} s, resolution {fmt(resolution)} s{held}; after it the "
                f"{poles.size} closed-loop poles can move it by at most {fmt(tail_bound)})")
