@@ -44,12 +44,12 @@ class StepResponse(Requirement):
     ``max_overshoot`` (percent of the final value ``T(0)``), ``max_settling_time`` (last exit from a
     band of ``settle_band`` times the final value, s) and ``max_rise_time`` (10 % to 90 %, s); give at
     least one. The response comes from :func:`synth.timeresp.linear_step` (exact without a delay, a
-    fine zero-order-hold simulation with one, extrapolated and refined until its estimated error is within
-    :data:`synth.timeresp.STEP_TOLERANCE`; the metrics are the worst that error allows); the horizon follows
-    the dynamics and is extended until the response has settled, else the verdict is "undetermined" (not
-    met). The horizon, the number of samples, the time resolution, the simulation step and its error
-    estimate (``simulation_error``, relative to the final value) are in ``details``. On a closed loop that is not stable the
-    requirement is not met.
+    fine zero-order-hold simulation with one, extrapolated with an error estimate and refined until that
+    error cannot change a limit's verdict, or to :data:`synth.timeresp.STEP_TOLERANCE`, where a limit still
+    within it is judged on the worst case it allows); the horizon follows the dynamics and is extended until
+    the response has settled, else the verdict is "undetermined" (not met). The horizon, the number of
+    samples, the time resolution, the simulation step and its error estimate (``simulation_error``, relative
+    to the final value) are in ``details``. On a closed loop that is not stable the requirement is not met.
 
     ``under: simulation`` judges the limits on the spec's sampled nonlinear loop instead (its
     ``simulation:`` block: actuator and sensor blocks, operating point, ``dt``, the step
@@ -187,6 +187,7 @@ class StepResponse(Requirement):
         start = 0 if longest <= horizon else int(min(MAX_DOUBLINGS, np.ceil(np.log2(longest / horizon))))
         horizon *= 2.0**start
         points = min(2**start * (_POINTS - 1) + 1, _MAX_POINTS)
+
         def bounds_agree(run: LinearStep) -> bool:  # the run's error cannot change any limit's verdict
             tail = run.t >= 0.75 * run.t[-1]
             if not np.all(np.abs(run.y[tail] - final) <= band):
