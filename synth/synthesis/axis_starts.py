@@ -18,7 +18,7 @@ from synth.plant import Plant
 from synth.synthesis.gainset import ScalarFamily, stability_set
 from synth.synthesis.parametrization import Parametrization
 
-__all__ = ["LEADLAG_SLICES", "axis_starts", "interval_middle", "leadlag_slices"]
+__all__ = ["LEADLAG_SLICES", "axis_starts", "interval_middle", "leadlag_slices", "scan_note"]
 
 SCANNED_TYPES = ("P", "PI", "PID")
 """Controller types whose convex parameters are their own gains (a lead-lag's are ``k`` and ``k z``)."""
@@ -63,6 +63,21 @@ def leadlag_slices(par: Parametrization, plants: list[Plant], draws: int = LEADL
         for a, b in intervals:
             k = interval_middle(a, b)
             yield np.array([k, k * z])
+
+
+def scan_note(ctype: str) -> str:
+    """What :func:`axis_starts` searched for a controller type, for the message of a search that found nothing.
+
+    Examples
+    --------
+    >>> scan_note("leadlag")
+    ' and the exact stabilizing set of k for 40 zeros drawn in the bounds'
+    """
+    if ctype in SCANNED_TYPES:
+        return " and the exact stabilizing set of each gain alone (the others at their values nearest 0)"
+    if ctype == "leadlag":
+        return f" and the exact stabilizing set of k for {LEADLAG_SLICES} zeros drawn in the bounds"
+    return ""
 
 
 def interval_middle(lo: float, hi: float) -> float:

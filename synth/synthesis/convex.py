@@ -34,7 +34,7 @@ from synth.errors import NoStabilizingStartError, SynthError
 from synth.plant import Plant
 from synth.requirements.base import Requirement, magnitude
 from synth.stability import closed_loop_stability, stability_floor
-from synth.synthesis.axis_starts import LEADLAG_SLICES, SCANNED_TYPES, axis_starts
+from synth.synthesis.axis_starts import axis_starts, scan_note
 from synth.synthesis.convex_forms import (
     T0,
     Form,
@@ -280,11 +280,7 @@ class ConvexDesigner:
                 any_found = True
                 yield np.asarray(c, float)
         if not any_found:
-            scanned = " and the exact stabilizing set of each gain alone (the others at their values nearest 0)" \
-                if self.par.ctype in SCANNED_TYPES else (
-                    f" and the exact stabilizing set of k for {LEADLAG_SLICES} zeros drawn in the bounds"
-                    if self.par.ctype == "leadlag" else "")
-            searched = (f"{2 * RANDOM_STARTS} random controllers in the bounds{scanned} gave none; give "
+            searched = (f"{2 * RANDOM_STARTS} random controllers in the bounds{scan_note(self.par.ctype)} gave none; give "
                         "controller.initial or widen the bounds")
             raise NoStabilizingStartError(f"found no stabilizing controller to start from: {searched}",
                                           where="controller", searched=searched)
