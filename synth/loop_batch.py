@@ -23,7 +23,7 @@ from synth.polynomial_rows import (
 from synth.polynomials import dc_value, horner
 from synth.rootfind import bisect_roots
 
-__all__ = ["LoopBatch", "horner"]
+__all__ = ["LoopBatch"]
 
 
 def _rows(polys: list[np.ndarray]) -> np.ndarray:

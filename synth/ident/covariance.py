@@ -23,10 +23,10 @@ SINGULAR = 1e-10
 """Smallest eigenvalue of the column-scaled ``J^T J`` (relative to its largest) still inverted as it is."""
 
 
-def fit_covariance(J: np.ndarray, s2: float, delay_column: int | None = None,
+def fit_covariance(JtJ: np.ndarray, s2: float, delay_column: int | None = None,
                    dt: float = 0.0) -> tuple[np.ndarray, str]:
-    """``(covariance, note)`` of least-squares estimates with output Jacobian ``J`` (samples x parameters) and
-    residual variance ``s2``. ``delay_column``: the column of a fitted delay, ``dt`` the sampling interval:
+    """``(covariance, note)`` of least-squares estimates with ``J^T J`` of the output Jacobian ``J`` (samples x
+    parameters) and residual variance ``s2``. ``delay_column``: the column of a fitted delay, ``dt`` the sampling interval:
     when ``J^T J`` is singular along a direction the delay is part of, the delay's variance is ``dt^2 / 12`` and
     the note says why (see the module's text); a singular direction without the delay keeps infinite variances
     along it. ``note`` is empty when the usual inverse applies.
@@ -37,12 +37,11 @@ def fit_covariance(J: np.ndarray, s2: float, delay_column: int | None = None,
     off with it one for one (no noise here, so nothing else):
 
     >>> J = np.ones((10, 2))
-    >>> cov, note = fit_covariance(J, 0.0, delay_column=1, dt=0.01)
+    >>> cov, note = fit_covariance(J.T @ J, 0.0, delay_column=1, dt=0.01)
     >>> (cov / (0.01**2 / 12)).round(6).tolist(), note[:27]
     ([[1.0, -1.0], [-1.0, 1.0]], 'the delay within one sample')
     """
-    J = np.asarray(J, float)
-    JtJ = J.T @ J
+    JtJ = np.asarray(JtJ, float)
     with np.errstate(all="ignore"):
         scale = np.sqrt(np.diag(JtJ))
         scale = np.where(scale > 0, scale, 1.0)
@@ -58,8 +57,8 @@ def fit_covariance(J: np.ndarray, s2: float, delay_column: int | None = None,
     if d is not None and dt > 0 and np.sum(null) == 1:
         v = vectors[:, 0] / scale  # the null direction in the parameters' own units
         if abs(v[d]) * scale[d] > 0.1:  # the delay takes part in it
-            keep = [i for i in range(J.shape[1]) if i != d]
-            fixed, note = fit_covariance(J[:, keep], s2)
+            keep = [i for i in range(JtJ.shape[0]) if i != d]
+            fixed, note = fit_covariance(JtJ[np.ix_(keep, keep)], s2)
             if not note:
                 slope = np.delete(v, d) / v[d]  # the other parameters per unit of delay along the null direction
                 var = dt**2 / 12.0

@@ -16,10 +16,10 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-from synth.disk_cache import KEEP, cached, code_fingerprint
+from synth.disk_cache import cached
 from synth.disk_cache import enabled as _enabled
 
-__all__ = ["KEEP", "cached_result", "code_fingerprint", "enabled"]
+__all__ = ["cached_result", "enabled"]
 
 
 def enabled() -> bool:

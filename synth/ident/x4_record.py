@@ -42,7 +42,7 @@ from synth.plant import Plant, Signal
 
 __all__ = [
     "COLUMNS", "DELAY", "FILENAME", "FS", "NOISE_STD", "PERIOD", "PERIODS", "PLANT", "SEED", "SENSOR",
-    "SPEED_AT_LOW", "STRUCTURE", "TRUTH", "VERSION", "cache_dir", "main", "write_x4_csv", "x4_step_train",
+    "SPEED_AT_LOW", "STRUCTURE", "TRUTH", "VERSION", "main", "write_x4_csv", "x4_step_train",
     "x4_step_train_path",
 ]
 

@@ -188,11 +188,16 @@ class StepResponse(Requirement):
         horizon *= 2.0**start
         points = min(2**start * (_POINTS - 1) + 1, _MAX_POINTS)
 
+        agreed: list[LinearStep] = []  # the runs whose verdicts were found decided (not judged twice)
+
         def bounds_agree(run: LinearStep) -> bool:  # the run's error cannot change any limit's verdict
             tail = run.t >= 0.75 * run.t[-1]
             if not np.all(np.abs(run.y[tail] - final) <= band):
                 return True  # not settled here: the horizon doubles, this run is not judged
-            return self._decided(run, final)
+            if self._decided(run, final):
+                agreed.append(run)
+                return True
+            return False
 
         settled = False
         for _ in range(start, MAX_DOUBLINGS + 1):
@@ -207,7 +212,8 @@ class StepResponse(Requirement):
         else:
             horizon /= 2.0  # the last one simulated
         tail_bound = after(horizon)
-        decided = run.dt == 0.0 or self._decided(run, final)  # else judged on the worst case the error allows
+        # else judged on the worst case the error allows
+        decided = run.dt == 0.0 or any(r is run for r in agreed) or self._decided(run, final)
         m = step_metrics(t, y, 0.0, final, self.settle_band, None if decided else run.error)
         error = float(np.max(run.error)) / abs(final) if final else float("nan")
         measured = _measured(m)
