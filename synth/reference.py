@@ -76,7 +76,7 @@ def published_summary(label: str, tf: str) -> dict[str, Any]:
     dc = T.dc_gain()
     lo, hi = characteristic_range(T.num, T.den)
     cross = crossings(lambda w: np.abs(T.freqresp(w)), abs(dc) * BANDWIDTH_LEVEL, log_grid(lo, hi * 10))
-    from synth.timeresp import exact_step
+    from synth.exact_steps import exact_step
 
     fastest = max(abs(np.roots(T.den).real).max(), 1e-6)
     t = np.linspace(0, 12.0 / fastest, 4001)

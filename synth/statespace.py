@@ -13,43 +13,78 @@ import numpy as np
 from scipy.linalg import expm
 from scipy.linalg.lapack import dtbtrs
 
-__all__ = ["STEP_BLOCK", "generalized_bilinear", "lfilter", "ss_to_tf", "step_from_rest", "tf_to_ss", "zoh"]
+__all__ = ["POWERS_UP_TO", "STEP_BLOCK", "generalized_bilinear", "lfilter", "ss_to_tf", "step_from_rest", "tf_to_ss", "zoh"]
 
 
 STEP_BLOCK = 64
 """Fewest samples of :func:`step_from_rest` computed by one matrix product from the state at the block's start
 (a longer response takes longer blocks: about the square root of its length)."""
 
+POWERS_UP_TO = 8
+"""Most states for which :func:`step_from_rest` forms the powers of its block step (``n^3`` work per block, cheaper
+than a Python step per block for a controller and plant of a few states; a delay line of a hundred states is
+stepped block by block)."""
 
-def step_from_rest(F: np.ndarray, g: np.ndarray, h: np.ndarray, d: float, size: int) -> np.ndarray:
+
+def step_from_rest(F: np.ndarray, g: np.ndarray, h: np.ndarray, d: float | np.ndarray, size: int,
+                   z0: np.ndarray | None = None) -> np.ndarray:
     """Output ``y[k] = h z[k] + d`` of ``z[k+1] = F z[k] + g`` from ``z[0] = 0``, for ``k < size`` (a discrete
-    system's response to a held unit step).
+    system's response to a held unit step); from ``z[0] = z0`` when given (the step held on from that state).
+    Stacked systems (``F`` of shape ``(b, n, n)``, ``g``, ``h`` and ``z0`` ``(b, n)``, ``d`` ``(b,)``) give
+    ``(b, size)``, all at once.
 
     The samples come a block of ``m`` at a time: ``z[b + j] = F^j z[b] + (F^0 + ... + F^(j-1)) g``, so
     ``y[b + j] = (h F^j) z[b] + h (F^0 + ... + F^(j-1)) g + d``. The rows ``h F^j`` and the sums come by
-    doubling (``log2 m`` matrix products), the block starts by one step of ``F^m`` each, and every sample by
-    one matrix product of the block starts and the rows: about ``2 sqrt(size)`` small products instead of a
-    Python step per sample (the same values to rounding). ``m`` is the power of two of at least
-    :data:`STEP_BLOCK` nearest above ``sqrt(size)``.
+    doubling (``log2 m`` matrix products), the block starts by one step of ``F^m`` each (up to
+    :data:`POWERS_UP_TO` states, from the powers of ``F^m``, doubling again, and a cumulative sum: no Python step
+    at all), and every sample by one matrix product of the block starts and the rows: about ``2 sqrt(size)``
+    small products instead of a Python step per sample (the same values as the recursion to rounding). ``m`` is
+    the power of two of at least :data:`STEP_BLOCK` nearest above ``sqrt(size)``.
 
     Examples
     --------
     >>> step_from_rest(np.array([[0.5]]), np.array([1.0]), np.array([1.0]), 0.0, 4).tolist()  # 0, 1, 1.5, 1.75
     [0.0, 1.0, 1.5, 1.75]
+    >>> step_from_rest(np.array([[0.5]]), np.array([1.0]), np.array([1.0]), 0.0, 3, z0=np.array([1.5])).tolist()
+    [1.5, 1.75, 1.875]
+    >>> step_from_rest(np.array([[[0.5]], [[0.0]]]), np.ones((2, 1)), np.ones((2, 1)), np.zeros(2), 3).tolist()
+    [[0.0, 1.0, 1.5], [0.0, 1.0, 1.0]]
     """
-    n = F.shape[0]
+    single = np.ndim(F) == 2
+    F = np.asarray(F, float).reshape(-1, *np.shape(F)[-2:])
+    b, n = F.shape[0], F.shape[-1]
     m = max(STEP_BLOCK, 1 << int(np.ceil(np.log2(max(np.sqrt(size), 1.0)))))
-    rows = np.reshape(h, (1, n)).astype(float)  # h F^j, j < len(rows)
-    power, forced = F, np.reshape(g, n).astype(float)  # F^len(rows), (F^0 + ... + F^(len(rows)-1)) g
-    while rows.shape[0] < m:
-        rows = np.vstack([rows, rows @ power])
+    g = np.reshape(np.asarray(g, float), (b, n, 1))
+    rows = np.reshape(np.asarray(h, float), (b, 1, n))  # h F^j, j < rows.shape[1]
+    power, forced = F, g  # F^j and (F^0 + ... + F^(j-1)) g for j = rows.shape[1]
+    while rows.shape[1] < m:
+        rows = np.concatenate([rows, rows @ power], axis=1)
         forced = forced + power @ forced
         power = power @ power
-    offsets = d + np.concatenate([[0.0], np.cumsum(rows[:-1] @ g)])  # h (F^0 + ... + F^(j-1)) g + d
-    starts = np.zeros((-(-size // m), n))  # z at each block's start
-    for b in range(1, starts.shape[0]):
-        starts[b] = power @ starts[b - 1] + forced
-    return (starts @ rows.T + offsets).ravel()[:size]
+    # h (F^0 + ... + F^(j-1)) g + d
+    offsets = np.reshape(d, (b, 1)) + np.concatenate([np.zeros((b, 1)), np.cumsum((rows[:, :-1] @ g)[..., 0], axis=1)],
+                                                     axis=1)
+    blocks = -(-size // m)
+    starts = np.zeros((b, blocks, n))  # z at each block's start
+    start = None if z0 is None else np.reshape(np.asarray(z0, float), (b, n))
+    if n <= POWERS_UP_TO:  # P^k z0 + (P^0 + ... + P^(k-1)) forced with P = F^m, the powers P^k by doubling
+        powers, step = np.broadcast_to(np.eye(n), (b, 1, n, n)), power
+        while powers.shape[1] < blocks:
+            powers = np.concatenate([powers, powers @ step[:, None]], axis=1)
+            step = step @ step
+        powers = powers[:, :blocks]
+        starts[:, 1:] = np.cumsum((powers[:, :-1] @ forced[:, None])[..., 0], axis=1)
+        if start is not None:
+            starts += (powers @ start[:, None, :, None])[..., 0]
+    else:
+        if start is not None:
+            starts[:, 0] = start
+        for k in range(1, blocks):
+            starts[:, k] = (power @ starts[:, k - 1, :, None] + forced)[..., 0]
+    y = np.empty((b, blocks * m))
+    for i in range(b):  # one BLAS product per system (stacked products of such thin matrices are far slower)
+        y[i] = (starts[i] @ rows[i].T + offsets[i]).ravel()
+    return y[0, :size] if single else y[:, :size]
 
 
 def tf_to_ss(num: np.ndarray, den: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:

@@ -18,11 +18,12 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from synth.delayed_blocks import delayed_loop_augmented, delayed_loop_in_blocks
+from synth.exact_steps import exact_step
 from synth.loop import Loop
 from synth.polynomials import trim
-from synth.statespace import step_from_rest, tf_to_ss, zoh
+from synth.statespace import tf_to_ss, zoh
 
-__all__ = ["LinearStep", "StepMetrics", "default_horizon", "discrete_loop", "exact_step", "linear_step",
+__all__ = ["LinearStep", "StepMetrics", "default_horizon", "discrete_loop", "linear_step", "metric_rows",
            "step_metrics", "step_response", "step_tail"]
 
 
@@ -88,28 +89,43 @@ def step_metrics(t: np.ndarray, y: np.ndarray, y0: float = 0.0, y_final: float |
         return StepMetrics(float("nan"), float("nan"), float("nan"), yf, float(y.max()))
     frac = (y - y0) / change
     slack = np.zeros(frac.size) if error is None else np.nan_to_num(np.asarray(error, float) / abs(change))
+    rise, peak_frac, settling = (float(v[0]) for v in metric_rows(t, frac[None], slack[None], settle_band))
+    return StepMetrics(rise, max(0.0, (peak_frac - 1.0) * 100.0), settling, yf, float(y0 + peak_frac * change))
 
-    def first_cross(f: np.ndarray, level: float) -> float:
-        idx = np.flatnonzero(f >= level)
-        if idx.size == 0:
-            return float("nan")
-        i = int(idx[0])
-        if i == 0:
-            return float(t[0])
-        f0, f1 = f[i - 1], f[i]
-        return float(t[i - 1] + (level - f0) / (f1 - f0) * (t[i] - t[i - 1]))
+
+def metric_rows(t: np.ndarray, frac: np.ndarray, slack: np.ndarray, settle_band: float,
+                ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The metrics of :func:`step_metrics` for many responses at once: rows of ``frac`` (the response as a fraction
+    of its change, ``(k, m)``) at the times ``t`` (``(m,)``, or ``(k, m)``: each row's own), ``slack`` a bound on each
+    sample's error as a fraction (0: none). Returns the rise times (10-90 %, worst case), the peak fractions and the
+    settling times (``nan`` where the last sample is outside the band), each ``(k,)``.
+
+    Examples
+    --------
+    >>> t = np.linspace(0.0, 10.0, 10001)
+    >>> rise, peak, settle = metric_rows(t, 1.0 - np.exp(-t)[None], np.zeros((1, t.size)), 0.02)
+    >>> round(float(rise[0]), 3), round(float(peak[0]), 4), round(float(settle[0]), 2)
+    (2.197, 1.0, 3.91)
+    """
+    t = np.broadcast_to(np.asarray(t, float), frac.shape)
+    rows = np.arange(frac.shape[0])
+
+    def first_cross(f: np.ndarray, level: float) -> np.ndarray:
+        hit = f >= level
+        i = np.argmax(hit, axis=1)
+        before = np.maximum(i - 1, 0)
+        f0, f1, t0, t1 = f[rows, before], f[rows, i], t[rows, before], t[rows, i]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            at = np.where(i == 0, t[:, 0], t0 + (level - f0) / (f1 - f0) * (t1 - t0))
+        return np.where(hit[rows, i], at, np.nan)
 
     rise = first_cross(frac - slack, 0.9) - first_cross(frac + slack, 0.1)
-    peak_frac = float(np.max(frac + slack))
-    overshoot = max(0.0, (peak_frac - 1.0) * 100.0)
-    outside = np.flatnonzero(np.abs(frac - 1.0) + slack > settle_band)
-    if outside.size == 0:
-        settling = float(t[0])
-    elif outside[-1] == t.size - 1:
-        settling = float("nan")
-    else:
-        settling = float(t[outside[-1] + 1])
-    return StepMetrics(rise, overshoot, settling, yf, float(y0 + peak_frac * change))
+    peak = np.max(frac + slack, axis=1)
+    outside = np.abs(frac - 1.0) + slack > settle_band
+    last = frac.shape[1] - 1 - np.argmax(outside[:, ::-1], axis=1)  # the last sample outside the band
+    after = t[rows, np.minimum(last + 1, frac.shape[1] - 1)]
+    settling = np.where(~outside.any(axis=1), t[:, 0], np.where(last == frac.shape[1] - 1, np.nan, after))
+    return rise, peak, settling
 
 
 def default_horizon(loop: Loop, poles: np.ndarray | None = None) -> float:
@@ -211,12 +227,14 @@ class LinearStep:
 
 
 def linear_step(loop: Loop, t_end: float | None = None, n: int = 2001,
-                decided: Callable[[LinearStep], bool] | None = None) -> LinearStep:
+                decided: Callable[[LinearStep], bool] | None = None, times: np.ndarray | None = None) -> LinearStep:
     """The closed loop's unit step with an estimate of its error: exact without a delay; with one, held at a
     step refined until the estimated error is at most :data:`STEP_TOLERANCE` of the response's largest value
     (or until :data:`MAX_STEPS`). ``decided(run)``: the caller's test that a run is accurate enough for what it
     judges (a step limit whose verdict its error cannot change); refinement then stops as soon as it is true
-    and the error is within :data:`DECIDED_TOLERANCE`.
+    and the error is within :data:`DECIDED_TOLERANCE`. The response is given at ``n`` even times over
+    ``[0, t_end]``, or at ``times`` (from 0, increasing; runs of even spacing such as
+    :func:`synth.exact_steps.doubling_grid`'s).
 
     Examples
     --------
@@ -226,10 +244,12 @@ def linear_step(loop: Loop, t_end: float | None = None, n: int = 2001,
     >>> bool(0.0 < float(run.error.max()) <= 1e-4 * float(np.abs(run.y).max()))
     True
     """
-    t_end = default_horizon(loop) if t_end is None else float(t_end)
-    t = np.linspace(0.0, t_end, n)
+    if times is None:
+        t = np.linspace(0.0, default_horizon(loop) if t_end is None else float(t_end), n)
+    else:
+        t = np.asarray(times, float)
     if loop.delay == 0.0:
-        return LinearStep(t, exact_step(loop.num, trim(np.polyadd(loop.den, loop.num)), t), 0.0, np.zeros(n))
+        return LinearStep(t, exact_step(loop.num, trim(np.polyadd(loop.den, loop.num)), t), 0.0, np.zeros(t.size))
     return _delayed_step(loop, t, decided)
 
 
@@ -395,20 +415,3 @@ def _zoh(num: np.ndarray, den: np.ndarray, dt: float):
     A, B, C, D = tf_to_ss(num, den)
     Ad, Bd = zoh(A, B, dt)
     return Ad, Bd[:, 0], C, D
-
-
-def exact_step(num: np.ndarray, den: np.ndarray, t: np.ndarray) -> np.ndarray:
-    """Unit step response of ``num/den`` (proper, no delay) at the evenly spaced times ``t`` (from 0), exact:
-    a step is held constant, so its zero-order-hold discretization at the spacing of ``t`` has no error.
-
-    Examples
-    --------
-    >>> exact_step(np.array([1.0]), np.array([1.0, 1.0]), np.array([0.0, np.log(2.0)])).round(12).tolist()
-    [0.0, 0.5]
-    """
-    t = np.asarray(t, float)
-    A, B, C, D = tf_to_ss(num, den)
-    if A.size == 0 or t.size < 2:  # a static gain, or only t = 0 (the state starts at rest)
-        return np.full(t.size, D)
-    Ad, Bd = zoh(A, B, float(t[1] - t[0]))
-    return step_from_rest(Ad, Bd[:, 0], np.asarray(C, float), float(D), t.size)

@@ -1,9 +1,11 @@
-"""The report's feasibility map with a requirement that has no vectorized form (a step-response limit): a
-coarser grid, the requirement simulated only where the loop is stable, and there the same slack as the check."""
+"""The report's feasibility map with a requirement that has no vectorized form (a step-response limit behind a
+delay): a coarser grid, the requirement simulated only where the loop is stable, and there the same slack as the
+check. Without the delay the step limit is vectorized (:mod:`synth.exact_steps`): the full grid, the same slacks."""
 
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
 from synth.check import check
 from synth.controllers import Controller
@@ -12,7 +14,7 @@ from synth.report.figures import MAP_GRID, MAP_GRID_SCALAR, feasibility_grid, ma
 from synth.requirements.margins import UNSTABLE_SLACK
 from synth.spec import parse_spec
 
-SPEC = {"name": "pi_step", "plant": {"tf": "6/((s+1)*(s+2)*(s+3))"},
+SPEC = {"name": "pi_step", "plant": {"tf": "6/((s+1)*(s+2)*(s+3))", "delay": 0.05},
         "controller": {"type": "PI", "bounds": {"kp": [0, 12], "ki": [0, 8]}},
         "requirements": [{"type": "step_response", "max_overshoot": 15, "max_settling_time": 8},
                          {"type": "peak_sensitivity", "max_db": 8}],
@@ -23,6 +25,7 @@ def test_the_map_of_a_step_limit_is_coarser_and_simulates_only_stable_loops() ->
     spec = parse_spec(SPEC)
     assert map_grid_size(spec) == MAP_GRID_SCALAR < MAP_GRID
     assert map_grid_size(parse_spec({**SPEC, "requirements": SPEC["requirements"][1:]})) == MAP_GRID
+    assert map_grid_size(parse_spec({**SPEC, "plant": {"tf": SPEC["plant"]["tf"]}})) == MAP_GRID
     design = Controller("PI", {"kp": 3.0, "ki": 2.0})
     xa, xb, A, B, slack = feasibility_grid(spec, design)
     assert (xa, xb) == ("kp", "ki") and slack.shape == (3, MAP_GRID_SCALAR, MAP_GRID_SCALAR)
@@ -40,3 +43,19 @@ def test_the_map_of_a_step_limit_is_coarser_and_simulates_only_stable_loops() ->
     assert met.any() and not met.all()
     j, i = np.argwhere(met)[0]
     assert check(spec, Controller("PI", {"kp": float(A[i]), "ki": float(B[j])})).feasible
+
+
+def test_without_a_delay_the_map_of_a_step_limit_is_the_full_grid_with_the_checks_slacks() -> None:
+    spec = parse_spec({**SPEC, "plant": {"tf": SPEC["plant"]["tf"]}})
+    _, _, A, B, slack = feasibility_grid(spec, Controller("PI", {"kp": 3.0, "ki": 2.0}))
+    assert slack.shape == (3, MAP_GRID, MAP_GRID)
+    stable = slack[0] > 0
+    assert 0 < stable.sum() < stable.size and np.all(slack[1][~stable] <= UNSTABLE_SLACK)
+    step = spec.requirements[0]
+    rng = np.random.default_rng(1)
+    for j, i in zip(*np.nonzero(stable)):
+        if rng.random() < 0.03:
+            c = Controller("PI", {"kp": float(A[i]), "ki": float(B[j])})
+            assert slack[1, j, i] == pytest.approx(step.slack(Loop(spec.nominal_plant(), c), 20), rel=1e-9, abs=1e-12)
+    met = np.all(slack >= 0, axis=0)
+    assert met.any() and not met.all()

@@ -7,9 +7,9 @@ import numpy as np
 import pytest
 from scipy import signal
 
+from synth.exact_steps import exact_step
 from synth.sim.discretize import DISCRETIZATIONS, discretize_controller
 from synth.statespace import tf_to_ss
-from synth.timeresp import exact_step
 
 SCIPY_METHOD = {"tustin": "bilinear", "zoh": "zoh", "backward_euler": "backward_diff", "forward_euler": "euler"}
 

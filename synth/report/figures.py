@@ -169,7 +169,7 @@ def step_plot(loops: list[tuple[str, Loop]], path: Path, scale: float = 1.0, uni
         extra = f" (sampled, dt = {dt:.2g} s)" if dt else ""
         ax.plot(t, scale * y, color=COLORS[i % len(COLORS)], lw=1.8, label=f"closed loop, {name}{extra}")
     if open_loop:
-        from synth.timeresp import exact_step
+        from synth.exact_steps import exact_step
 
         plant = loops[0][1].plant
         t = np.linspace(0, horizon, 2001)
@@ -272,7 +272,7 @@ def map_grid_size(spec: Any) -> int:
     >>> map_grid_size(load_spec("specs/x4_rotor_pi.yaml"))
     45
     """
-    return MAP_GRID if all(type(r).has_batch_form() for r in spec.requirements) else MAP_GRID_SCALAR
+    return MAP_GRID if all(r.vectorized_on(spec.plants()) for r in spec.requirements) else MAP_GRID_SCALAR
 
 
 def feasibility_grid(spec: Any, design_controller: Any, n: int | None = None, plants: list[int] | None = None,
@@ -342,7 +342,7 @@ def feasibility_grid(spec: Any, design_controller: Any, n: int | None = None, pl
 def _grid_slack(req: Any, batch: Any, counts: np.ndarray) -> np.ndarray:
     """``req``'s slack on every loop of ``batch``; one loop at a time only where it is stable (``counts == 0``)
     when the type has no vectorized form."""
-    if type(req).has_batch_form():
+    if req.vectorized_on([batch.plant]):
         return req.batch_slack(batch, 20)
     out = UNSTABLE_SLACK * np.maximum(counts, 1).astype(float)  # as the check says of an unstable loop
     for i in np.flatnonzero(counts == 0):

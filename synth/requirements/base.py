@@ -264,6 +264,18 @@ class Requirement(BaseModel):
         """
         return cls.batch_slack is not Requirement.batch_slack
 
+    def vectorized_on(self, plants: list[Any]) -> bool:
+        """Whether :meth:`batch_slack` is vectorized on these plants (the type's form, :meth:`has_batch_form`; a
+        type whose form covers only some plants or settings says so here).
+
+        Examples
+        --------
+        >>> from synth.plant import Plant; from synth.requirements import Bandwidth
+        >>> Bandwidth(min=1).vectorized_on([Plant.from_string("1/(s+1)")])
+        True
+        """
+        return type(self).has_batch_form()
+
     def name(self) -> str:
         """Label given in the spec, or the type name."""
         return self.label or self.type

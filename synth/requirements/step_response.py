@@ -3,21 +3,24 @@ time, rise time."""
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, ClassVar, Literal
 
 import numpy as np
 from pydantic import NonNegativeFloat, PositiveFloat, model_validator
 
 from synth.requirements.base import Bound, Requirement, RequirementResult, fmt, register
-from synth.requirements.margins import closed_loop_unstable, unstable_result
+from synth.requirements.margins import UNSTABLE_SLACK, closed_loop_unstable, unstable_result
 from synth.requirements.simulated import SimulatedStep, simulated_step
 from synth.sim.spec import SimulationSpec
+from synth.timeresp import StepMetrics
 
 if TYPE_CHECKING:
     from synth.loop import Loop
-    from synth.timeresp import LinearStep, StepMetrics
+    from synth.loop_batch import LoopBatch
+    from synth.timeresp import LinearStep
 
-__all__ = ["MAX_DOUBLINGS", "StepResponse"]
+__all__ = ["INTERVALS", "MAX_DOUBLINGS", "StepResponse"]
 
 MAX_DOUBLINGS = 8
 """The horizon starts at :func:`synth.timeresp.default_horizon` and doubles until the response has
@@ -31,8 +34,13 @@ final value): the bound ``sum |c_i| e^(Re p_i t)`` of :func:`synth.timeresp.step
 nearly cancels creeps back out of the band, and up to a higher overshoot, long after the fast part has settled
 (a PID whose step was within 2 % at 0.37 s overshot 5.5 % at 1.1 s)."""
 
-_POINTS = 4001
-_MAX_POINTS = 64001  # the samples grow with the horizon up to this: the fast part keeps its resolution
+INTERVALS = 2000
+"""Samples of the step over its first horizon (:func:`synth.timeresp.default_horizon`), and over each doubling of it
+(:func:`synth.exact_steps.doubling_grid`): the step grows with the time, so every sample is within 1/2000 of its time
+of the next, and a long horizon costs samples in proportion to its doublings, not its length. An even grid of up
+to 64,001 samples ran before: a PID whose slow tail took eight doublings had 64,001 samples 1/250 of its first
+horizon apart, where 18,001 now start 1/2000 apart."""
+_CHUNK = 2_000_000  # samples of the loops' steps computed together (16 MB per array)
 _LABELS = {"max_overshoot": ("overshoot", "%"), "max_settling_time": ("settling time", "s"),
            "max_rise_time": ("rise time", "s")}
 
@@ -167,27 +175,119 @@ class StepResponse(Requirement):
         linear = self._linear(loop)
         return linear if self.under == "linear" else self._simulated(loop, linear)
 
-    def _linear(self, loop: Loop) -> RequirementResult:
-        from synth.timeresp import default_horizon, linear_step, step_metrics, step_tail
+    def batch_slack(self, batch: LoopBatch, per_decade: int = 80) -> np.ndarray:
+        """The slack of every loop of ``batch`` (:class:`~synth.loop_batch.LoopBatch`), as :meth:`slack` gives it:
+        without a delay the steps of all stable loops at once (:func:`synth.exact_steps.exact_steps`, the same
+        arithmetic as one loop's); with a delay, or ``under`` a simulation, one loop at a time.
+
+        Examples
+        --------
+        >>> from synth.loop_batch import LoopBatch; from synth.plant import Plant
+        >>> from synth.controllers import Controller; from synth.loop import Loop
+        >>> G, req = Plant.from_string("1/(s*(s+1))"), StepResponse(max_overshoot=20, max_settling_time=10)
+        >>> batch = LoopBatch(G, [Controller("P", {"kp": k}) for k in (0.5, 1.0, 4.0)])
+        >>> bool(np.allclose(req.batch_slack(batch), [req.slack(Loop(G, c)) for c in batch.controllers]))
+        True
+        """
+        if not self.vectorized_on([batch.plant]):
+            return super().batch_slack(batch, per_decade)
+        counts = batch.unstable_root_counts()
+        out = UNSTABLE_SLACK * np.maximum(counts, 1).astype(float)
+        stable = np.flatnonzero(counts == 0)
+        loops = batch.loops()
+        out[stable] = [self._slack_of(o) for o in self._exact_outcomes([loops[i] for i in stable])]
+        return out
+
+    def vectorized_on(self, plants: list[Any]) -> bool:
+        """Whether :meth:`batch_slack` is vectorized for these plants: the linear loop's step without a delay.
+
+        Examples
+        --------
+        >>> from synth.plant import Plant
+        >>> req = StepResponse(max_overshoot=20)
+        >>> req.vectorized_on([Plant.from_string("1/(s+1)")]), req.vectorized_on([Plant.from_string("1/(s+1)", delay=0.1)])
+        (True, False)
+        """
+        return self.under == "linear" and all(p.delay == 0.0 for p in plants)
+
+    def _plan(self, loop: Loop) -> _Plan:
+        """The step's final value, the closed loop's poles and tail weights, the band, the first horizon and the
+        doublings the tail needs at least."""
+        from synth.timeresp import default_horizon, step_tail
 
         final = loop.T0()
         poles = loop.closed_loop_poles()  # once: the horizon and the tail's residues both start from them
-        horizon = default_horizon(loop, poles)
+        first = default_horizon(loop, poles)
         poles, weights = step_tail(loop, poles)
         band = self.settle_band * abs(final)
-
-        def after(h: float) -> float:
-            return float(np.sum(weights * np.exp(poles.real * h))) if poles.size else 0.0
-
         # the doublings the poles' tail needs at least, skipped (each pole's term within its share of the bound;
         # past the last doubling the response is simulated once there, for the evidence)
         with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
             needed = np.log(np.maximum(weights * poles.size / (TAIL_SHARE * band), 1.0)) / -poles.real
         longest = float(np.max(needed, initial=0.0))
-        start = 0 if longest <= horizon else int(min(MAX_DOUBLINGS, np.ceil(np.log2(longest / horizon))))
-        horizon *= 2.0**start
-        points = min(2**start * (_POINTS - 1) + 1, _MAX_POINTS)
+        start = 0 if longest <= first else int(min(MAX_DOUBLINGS, np.ceil(np.log2(longest / first))))
+        return _Plan(final, poles, weights, band, first, start)
 
+    def _exact_outcomes(self, loops: list[Loop]) -> list[_Outcome]:
+        """The step of each loop (stable, without a delay), all at once: the loops needing the same doublings
+        together (:func:`synth.exact_steps.exact_steps`), each doubled until settled or
+        :data:`MAX_DOUBLINGS`, as :meth:`_linear` does one loop with a delay."""
+        from synth.exact_steps import doubling_grid, exact_steps
+        from synth.polynomials import trim
+        from synth.timeresp import metric_rows
+
+        plans = [self._plan(loop) for loop in loops]
+        out: list[_Outcome | None] = [None] * len(loops)
+        todo = {i: plan.start for i, plan in enumerate(plans)}
+        while todo:
+            doublings = min(todo.values())
+            unit = doubling_grid(1.0, doublings, INTERVALS)
+            tail = unit >= 0.75 * unit[-1]
+            every = [i for i, d in todo.items() if d == doublings]
+            chunk = max(1, _CHUNK // unit.size)
+            for rows in (every[k:k + chunk] for k in range(0, len(every), chunk)):
+                group = [plans[i] for i in rows]
+                firsts = np.array([g.first for g in group])
+                y = exact_steps([loops[i].num for i in rows], [trim(np.polyadd(loops[i].den, loops[i].num))
+                                                              for i in rows], firsts, unit)
+                finals = np.array([g.final for g in group])
+                horizons = firsts * unit[-1]
+                with np.errstate(invalid="ignore", over="ignore", divide="ignore"):
+                    inside = np.all(np.abs(y[:, tail] - finals[:, None]) <= np.array([g.band for g in group])[:, None],
+                                    axis=1)
+                    settled = inside & np.array([g.after(h) <= TAIL_SHARE * g.band for g, h in zip(group, horizons)])
+                    frac = y / finals[:, None]
+                    rise, peak, settling = metric_rows(firsts[:, None] * unit, frac, np.zeros_like(frac),
+                                                       self.settle_band)
+                for j, i in enumerate(rows):
+                    if not settled[j] and doublings < MAX_DOUBLINGS:
+                        todo[i] = doublings + 1
+                        continue
+                    del todo[i]
+                    final = finals[j]
+                    if final == 0 or not np.isfinite(final):
+                        m = StepMetrics(float("nan"), float("nan"), float("nan"), float(final), float(np.max(y[j])))
+                    else:
+                        m = StepMetrics(float(rise[j]), max(0.0, (float(peak[j]) - 1.0) * 100.0), float(settling[j]),
+                                        float(final), float(peak[j] * final))
+                    out[i] = _Outcome(m, float(horizons[j]), unit.size, float(firsts[j] * (unit[-1] - unit[-2])),
+                                      float(firsts[j] * unit[1]), bool(settled[j]), group[j].after(horizons[j]),
+                                      group[j].poles.size, 0.0, 0.0 if final else float("nan"), True)
+        return [o for o in out if o is not None]
+
+    def _linear(self, loop: Loop) -> RequirementResult:
+        outcome = self._exact_outcomes([loop])[0] if loop.delay == 0.0 else self._delayed_outcome(loop)
+        return self._result_of(outcome)
+
+    def _delayed_outcome(self, loop: Loop) -> _Outcome:
+        """The step of a loop with a delay: simulated (:func:`synth.timeresp.linear_step`, its error estimate
+        refined until no limit's verdict depends on it), the horizon doubled until settled."""
+        from synth.exact_steps import doubling_grid
+        from synth.timeresp import linear_step, step_metrics
+
+        plan = self._plan(loop)
+        final, band = plan.final, plan.band
+        horizon = plan.first * 2.0**plan.start
         agreed: list[LinearStep] = []  # the runs whose verdicts were found decided (not judged twice)
 
         def bounds_agree(run: LinearStep) -> bool:  # the run's error cannot change any limit's verdict
@@ -200,46 +300,52 @@ class StepResponse(Requirement):
             return False
 
         settled = False
-        for _ in range(start, MAX_DOUBLINGS + 1):
-            run = linear_step(loop, horizon, points, decided=bounds_agree)
+        for doublings in range(plan.start, MAX_DOUBLINGS + 1):
+            run = linear_step(loop, decided=bounds_agree, times=doubling_grid(plan.first, doublings, INTERVALS))
             t, y = run.t, run.y
             tail = t >= 0.75 * horizon
-            settled = bool(np.all(np.abs(y[tail] - final) <= band)) and after(horizon) <= TAIL_SHARE * band
+            settled = bool(np.all(np.abs(y[tail] - final) <= band)) and plan.after(horizon) <= TAIL_SHARE * band
             if settled:
                 break
             horizon *= 2.0
-            points = min(2 * points - 1, _MAX_POINTS)
         else:
             horizon /= 2.0  # the last one simulated
-        tail_bound = after(horizon)
         # else judged on the worst case the error allows
-        decided = run.dt == 0.0 or any(r is run for r in agreed) or self._decided(run, final)
+        decided = any(r is run for r in agreed) or self._decided(run, final)
         m = step_metrics(t, y, 0.0, final, self.settle_band, None if decided else run.error)
         error = float(np.max(run.error)) / abs(final) if final else float("nan")
-        measured = _measured(m)
-        resolution = float(t[1] - t[0])
-        evidence = dict(horizon=float(horizon), samples=int(t.size), resolution=resolution,
-                        simulation_step=run.dt, simulation_error=error, settled=settled, tail_bound=tail_bound,
-                        poles_counted=int(poles.size), **m.to_dict())
-        parts = self._limits(measured)
+        return _Outcome(m, float(horizon), int(t.size), float(np.max(np.diff(t))), float(t[1] - t[0]), settled,
+                        plan.after(horizon), plan.poles.size, run.dt, error, decided)
+
+    def _slack_of(self, o: _Outcome) -> float:
+        slack = min(p[0] for p in self._limits(_measured(o.metrics)))
+        return slack if o.settled else min(slack, -1e-3)
+
+    def _result_of(self, o: _Outcome) -> RequirementResult:
+        """The requirement's result on a step :meth:`_exact_outcomes` or :meth:`_delayed_outcome` made."""
+        evidence = dict(horizon=o.horizon, samples=o.samples, resolution=o.resolution, simulation_step=o.dt,
+                        simulation_error=o.error, settled=o.settled, tail_bound=o.tail_bound,
+                        poles_counted=o.poles, **o.metrics.to_dict())
+        parts = self._limits(_measured(o.metrics))
         slack, name, value, bound, unit = min(parts, key=lambda p: p[0])
-        if not settled:
-            texts = (f"undetermined: not settled within {fmt(horizon)} s (the closed-loop poles can still move it by "
-                     f"{fmt(tail_bound)})")
+        if not o.settled:
+            texts = (f"undetermined: not settled within {fmt(o.horizon)} s (the closed-loop poles can still move it "
+                     f"by {fmt(o.tail_bound)})")
             return self.result(value=float("nan"), bound=bound, unit=unit, slack=min(slack, -1e-3), margin=float("nan"),
                                binding_frequency=None, message=f"step response {texts}: NOT met", binding=name,
                                determined=False, **evidence)
         texts = "; ".join(f"{n} {fmt(v)} {u} (max {fmt(b)})" for _, n, v, b, u in parts)
-        if run.dt == 0.0:
+        if o.dt == 0.0:
             held = ""
-        elif not np.isfinite(error):
-            held = f"; held at {fmt(run.dt)} s, the delay one step of it: error not estimated"
+        elif not np.isfinite(o.error):
+            held = f"; held at {fmt(o.dt)} s, the delay one step of it: error not estimated"
         else:
-            held = (f"; held at {fmt(run.dt)} s, estimated error up to {fmt(error)} of the final value"
-                    + ("" if decided else ", a limit within it: judged on the worst case it allows"))
+            held = (f"; held at {fmt(o.dt)} s, estimated error up to {fmt(o.error)} of the final value"
+                    + ("" if o.decided else ", a limit within it: judged on the worst case it allows"))
+        coarsest = "" if o.resolution <= 1.01 * o.finest else f" to {fmt(o.resolution)} s"
         msg = (f"step response: {texts}: {'met' if slack >= 0 else 'NOT met'}, tightest: {name} "
-               f"({t.size} samples over {fmt(horizon)} s, resolution {fmt(resolution)} s{held}; after it the "
-               f"{poles.size} closed-loop poles can move it by at most {fmt(tail_bound)})")
+               f"({o.samples} samples over {fmt(o.horizon)} s, resolution {fmt(o.finest)} s{coarsest}{held}; after it "
+               f"the {o.poles} closed-loop poles can move it by at most {fmt(o.tail_bound)})")
         return self.result(value=value, bound=bound, unit=unit, slack=slack, margin=bound - value,
                            binding_frequency=None, message=msg, binding=name, determined=True, **evidence)
 
@@ -252,6 +358,39 @@ class StepResponse(Requirement):
                        for sign in (1.0, -1.0))
         return all((a[0] >= 0) == (b[0] >= 0) for a, b in zip(self._limits(_measured(worst)),
                                                                self._limits(_measured(best))))
+
+
+@dataclass(frozen=True)
+class _Plan:
+    """What a loop's step starts from (:meth:`StepResponse._plan`)."""
+
+    final: float
+    poles: np.ndarray
+    weights: np.ndarray
+    band: float
+    first: float
+    start: int
+
+    def after(self, horizon: float) -> float:
+        """What the closed-loop poles can still move the step after ``horizon`` (:func:`synth.timeresp.step_tail`)."""
+        return float(np.sum(self.weights * np.exp(self.poles.real * horizon))) if self.poles.size else 0.0
+
+
+@dataclass(frozen=True)
+class _Outcome:
+    """A loop's step as the requirement judges it: the metrics and what they rest on."""
+
+    metrics: StepMetrics
+    horizon: float
+    samples: int
+    resolution: float  # the coarsest spacing of the samples (the doublings' last span)
+    finest: float
+    settled: bool
+    tail_bound: float
+    poles: int
+    dt: float  # the simulation step with a delay, 0 when exact
+    error: float  # the simulation's estimated error, relative to the final value
+    decided: bool  # the error cannot change a limit's verdict (else the metrics are the worst it allows)
 
 
 def _measured(s: SimulatedStep | StepMetrics) -> dict[str, float]:

@@ -240,13 +240,16 @@ def exact_search(spec: Spec, near: Controller | None = None, samples: int | None
     spacing = 2.0 / size ** (1.0 / n)
     chosen: list[tuple[float, np.ndarray]] = []
     checked = 0
-    for s, u, c in candidates:
+    screen = _BatchScreen(spec, [c for _, _, c in candidates])
+    for k, (s, u, c) in enumerate(candidates):
         if len(chosen) == starts:
             break
         if any(np.max(np.abs(u - v)) <= spacing for _, v in chosen):
             continue
         checked += 1
-        if passes(c):
+        if not screen.may_pass(k):  # failed the same exact evaluation, made for many samples at once
+            counter["checks"] += 1
+        elif passes(c):
             chosen.append((s, u))
     if not chosen:
         return ExactSearchResult(None, None, counter["checks"], len(points), checked, 0, 1.0)
@@ -269,4 +272,37 @@ def exact_search(spec: Spec, near: Controller | None = None, samples: int | None
     return ExactSearchResult(best[1], float(best[0]), counter["checks"], len(points), checked, len(chosen),
                              final_step)
 
+
+class _BatchScreen:
+    """The costly requirements that have a vectorized form on every plant (a step limit without a delay:
+    :meth:`~synth.requirements.base.Requirement.vectorized_on`), with the closed-loop root counts, evaluated for
+    the samples in order, :attr:`CHUNK` at a time as they are asked for (the search stops after a few passing
+    samples): a sample they fail fails :func:`synth.check.quick_check` too (the same evaluations), so only the
+    others are checked one by one."""
+
+    CHUNK = 64
+
+    def __init__(self, spec: Spec, controllers: list[Controller]) -> None:
+        plants = spec.plants()
+        self._requirements = [r for r in spec.requirements if r.costly and r.vectorized_on(plants)]
+        self._plants, self._controllers = plants, controllers
+        self._fails = np.zeros(len(controllers), dtype=bool)
+        self._done = 0 if self._requirements else len(controllers)
+
+    def may_pass(self, k: int) -> bool:
+        """Whether sample ``k`` may pass the exact check (False: it fails it)."""
+        from synth.loop_batch import LoopBatch
+
+        while self._done <= k:
+            rows = slice(self._done, self._done + self.CHUNK)
+            fails = np.zeros(len(self._controllers[rows]), dtype=bool)
+            for plant in self._plants:
+                batch = LoopBatch(plant, self._controllers[rows])
+                with np.errstate(all="ignore"):
+                    fails |= batch.unstable_root_counts() > 0
+                    for req in self._requirements:
+                        fails |= ~(np.asarray(req.batch_slack(batch), float) >= 0)
+            self._fails[rows] = fails
+            self._done += self.CHUNK
+        return not self._fails[k]
 

@@ -1,0 +1,117 @@
+"""Step limits on many loops at once (issue 18): the batched steps, metrics and root counts give what the one-loop
+forms give, and the steps themselves what an independent matrix exponential gives at each time."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from scipy.linalg import expm
+
+from synth.controllers import Controller
+from synth.exact_steps import doubling_grid, exact_steps
+from synth.loop import Loop
+from synth.loop_batch import LoopBatch
+from synth.plant import Plant
+from synth.requirements import StepResponse
+from synth.statespace import tf_to_ss
+
+
+def _plant(rng: np.random.Generator) -> Plant:
+    """A random plant: 1-4 poles (some unstable, some at the origin), maybe a zero (maybe in the right
+    half-plane), maybe biproper."""
+    poles = [float(v) for v in rng.normal(size=rng.integers(1, 5)) * rng.choice([0.3, 1.0, 5.0])]
+    if rng.random() < 0.2:
+        poles[0] = 0.0
+    den = np.poly(poles)
+    num = np.array([1.0])
+    if rng.random() < 0.4:
+        num = np.poly([float(rng.normal() * 2.0)])
+    if rng.random() < 0.15 and len(poles) >= 1:
+        num = np.poly([float(-abs(rng.normal()) - 0.1)] * len(poles))  # biproper
+    gain = float(rng.uniform(0.5, 20.0))
+    return Plant(gain * num, den)
+
+
+def _controllers(rng: np.random.Generator, count: int) -> list[Controller]:
+    kind = str(rng.choice(["P", "PI", "PID", "leadlag"]))
+    out = []
+    for _ in range(count):
+        if kind == "P":
+            out.append(Controller("P", {"kp": float(rng.uniform(0.01, 20.0))}))
+        elif kind == "PI":
+            out.append(Controller("PI", {"kp": float(rng.uniform(0.0, 10.0)), "ki": float(rng.uniform(0.0, 10.0))}))
+        elif kind == "PID":
+            out.append(Controller("PID", {"kp": float(rng.uniform(0.0, 10.0)), "ki": float(rng.uniform(0.0, 5.0)),
+                                          "kd": float(rng.uniform(0.0, 2.0)), "tf": 0.02}))
+        else:
+            out.append(Controller("leadlag", {"k": float(rng.uniform(0.1, 10.0)), "z": float(rng.uniform(0.1, 5.0)),
+                                              "p": float(rng.uniform(1.0, 50.0))}))
+    return out
+
+
+@pytest.mark.parametrize("seed", range(12))
+def test_batch_slack_is_the_one_loop_slack(seed):
+    """On random plants and controllers (unstable loops included), the batched slack equals the slack of each
+    loop on its own: same verdict, same number to rounding."""
+    rng = np.random.default_rng(4000 + seed)
+    plant = _plant(rng)
+    controllers = _controllers(rng, 24)
+    req = StepResponse(max_overshoot=float(rng.uniform(1.0, 40.0)), max_settling_time=float(rng.uniform(0.5, 30.0)),
+                       max_rise_time=float(rng.uniform(0.1, 10.0)) if rng.random() < 0.5 else None)
+    batched = req.batch_slack(LoopBatch(plant, controllers))
+    alone = np.array([req.slack(Loop(plant, c)) for c in controllers])
+    assert np.array_equal(batched >= 0, alone >= 0)
+    assert np.allclose(batched, alone, rtol=1e-9, atol=1e-12, equal_nan=True)
+
+
+@pytest.mark.parametrize("seed", range(12))
+def test_root_counts_in_bulk_are_the_one_loop_counts(seed):
+    """The right-half-plane root counts of undelayed loops from batched roots equal what each loop's own stability
+    count says, gains on the stability boundary included."""
+    rng = np.random.default_rng(5000 + seed)
+    plant = _plant(rng)
+    controllers = _controllers(rng, 40)
+    if controllers[0].type == "P":  # a gain on the boundary of 10/((s - 1)(s + 5))'s set: kp = 0.5 puts a root at 0
+        plant = Plant.from_string("10/((s-1)*(s+5))")
+        controllers[:3] = [Controller("P", {"kp": k}) for k in (0.5, 0.5 + 1e-12, 0.4)]
+    counts = LoopBatch(plant, controllers).unstable_root_counts()
+    assert counts.tolist() == [Loop(plant, c).stability().unstable_poles for c in controllers]
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_exact_steps_match_the_matrix_exponential_at_each_time(seed):
+    """Each sample of the batched steps on a doubling grid is the state from rest at that time (one matrix
+    exponential of the augmented system, computed here independently) to 1e-9 of the step's size."""
+    rng = np.random.default_rng(6000 + seed)
+    nums, dens = [], []
+    for _ in range(5):
+        poles = -np.abs(rng.normal(size=3)) * rng.choice([0.5, 2.0, 20.0]) - 0.05
+        dens.append(np.poly(poles))
+        nums.append(np.poly([float(rng.normal())]) * float(rng.uniform(0.5, 5.0)))
+    scales = rng.uniform(0.05, 2.0, 5)
+    unit = doubling_grid(1.0, int(rng.integers(0, 6)), intervals=200)
+    y = exact_steps(nums, dens, scales, unit)
+    for i in range(5):
+        A, B, C, D = tf_to_ss(nums[i], dens[i])
+        n = A.shape[0]
+        for k in rng.integers(0, unit.size, 12):
+            M = np.zeros((n + 1, n + 1))
+            M[:n, :n], M[:n, n] = A * scales[i] * unit[k], B * scales[i] * unit[k]
+            expected = float(C @ expm(M)[:n, n] + D)
+            assert abs(y[i, k] - expected) <= 1e-9 * max(1.0, float(np.max(np.abs(y[i]))))
+
+
+def test_a_slow_tail_is_resolved_at_the_start_with_fewer_samples():
+    """A PID whose slow pole needs the horizon doubled eight times: the samples start at 1/2000 of the first
+    horizon and number 2000 per doubling (18,001), where the even grid used 64,001 samples 1/250 apart; the
+    settling time agrees with python-control's on a dense even grid within the coarsest spacing."""
+    control = pytest.importorskip("control")
+    loop = Loop(Plant.from_string("5/((s+1)*(s+2)*(s+3))"),
+                Controller("PID", {"kp": 5.05, "ki": 1.0, "kd": 3.75, "tf": 0.01}))
+    r = StepResponse(max_overshoot=50, max_settling_time=100).evaluate(loop)
+    assert r.details["settled"] and r.details["samples"] == 18_001  # eight doublings
+    T = control.feedback(control.tf(*loop.controller.tf()) * control.tf(loop.plant.num, loop.plant.den))
+    t = np.linspace(0.0, r.details["horizon"], 400_001)
+    info = control.step_info(T, T=t, SettlingTimeThreshold=0.02)
+    assert r.details["settling_time"] == pytest.approx(info["SettlingTime"], abs=r.details["resolution"] + t[1])
+    assert r.details["overshoot"] == pytest.approx(info["Overshoot"], abs=1e-3)
