@@ -177,8 +177,11 @@ class Loop:
 
     def T0(self) -> float:
         """``|T(0)|``: 1 with integral action, ``L(0)/(1 + L(0))`` otherwise."""
-        cn, cd = self.controller.tf()
-        l0 = dc_value(np.polymul(cn, self.plant.num), np.polymul(cd, self.plant.den))  # exact: s cancels first
+        return self._t0
+
+    @cached_property
+    def _t0(self) -> float:
+        l0 = dc_value(self.num, self.den)  # exact: s cancels first
         if np.isinf(l0):
             return 1.0
         if 1.0 + l0 == 0.0:  # a closed-loop pole at s = 0: |T(0)| is unbounded

@@ -88,22 +88,22 @@ def step_metrics(t: np.ndarray, y: np.ndarray, y0: float = 0.0, y_final: float |
     if change == 0 or not np.isfinite(change):
         return StepMetrics(float("nan"), float("nan"), float("nan"), yf, float(y.max()))
     frac = (y - y0) / change
-    slack = np.zeros(frac.size) if error is None else np.nan_to_num(np.asarray(error, float) / abs(change))
-    rise, peak_frac, settling = (float(v[0]) for v in metric_rows(t, frac[None], slack[None], settle_band))
+    slack = None if error is None else np.nan_to_num(np.asarray(error, float) / abs(change))[None]
+    rise, peak_frac, settling = (float(v[0]) for v in metric_rows(t, frac[None], slack, settle_band))
     return StepMetrics(rise, max(0.0, (peak_frac - 1.0) * 100.0), settling, yf, float(y0 + peak_frac * change))
 
 
-def metric_rows(t: np.ndarray, frac: np.ndarray, slack: np.ndarray, settle_band: float,
+def metric_rows(t: np.ndarray, frac: np.ndarray, slack: np.ndarray | None, settle_band: float,
                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The metrics of :func:`step_metrics` for many responses at once: rows of ``frac`` (the response as a fraction
     of its change, ``(k, m)``) at the times ``t`` (``(m,)``, or ``(k, m)``: each row's own), ``slack`` a bound on each
-    sample's error as a fraction (0: none). Returns the rise times (10-90 %, worst case), the peak fractions and the
+    sample's error as a fraction (None: exact). Returns the rise times (10-90 %, worst case), the peak fractions and the
     settling times (``nan`` where the last sample is outside the band), each ``(k,)``.
 
     Examples
     --------
     >>> t = np.linspace(0.0, 10.0, 10001)
-    >>> rise, peak, settle = metric_rows(t, 1.0 - np.exp(-t)[None], np.zeros((1, t.size)), 0.02)
+    >>> rise, peak, settle = metric_rows(t, 1.0 - np.exp(-t)[None], None, 0.02)
     >>> round(float(rise[0]), 3), round(float(peak[0]), 4), round(float(settle[0]), 2)
     (2.197, 1.0, 3.91)
     """
@@ -119,9 +119,11 @@ def metric_rows(t: np.ndarray, frac: np.ndarray, slack: np.ndarray, settle_band:
             at = np.where(i == 0, t[:, 0], t0 + (level - f0) / (f1 - f0) * (t1 - t0))
         return np.where(hit[rows, i], at, np.nan)
 
-    rise = first_cross(frac - slack, 0.9) - first_cross(frac + slack, 0.1)
-    peak = np.max(frac + slack, axis=1)
-    outside = np.abs(frac - 1.0) + slack > settle_band
+    exact = slack is None  # no error bound: the arrays with it added or taken off are ``frac`` itself
+    low, high = (frac, frac) if exact else (frac - slack, frac + slack)
+    rise = first_cross(low, 0.9) - first_cross(high, 0.1)
+    peak = np.max(high, axis=1)
+    outside = np.abs(frac - 1.0) > settle_band if exact else np.abs(frac - 1.0) + slack > settle_band
     last = frac.shape[1] - 1 - np.argmax(outside[:, ::-1], axis=1)  # the last sample outside the band
     after = t[rows, np.minimum(last + 1, frac.shape[1] - 1)]
     settling = np.where(~outside.any(axis=1), t[:, 0], np.where(last == frac.shape[1] - 1, np.nan, after))

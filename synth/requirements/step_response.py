@@ -257,8 +257,7 @@ class StepResponse(Requirement):
                                     axis=1)
                     settled = inside & np.array([g.after(h) <= TAIL_SHARE * g.band for g, h in zip(group, horizons)])
                     frac = y / finals[:, None]
-                    rise, peak, settling = metric_rows(firsts[:, None] * unit, frac, np.zeros_like(frac),
-                                                       self.settle_band)
+                    rise, peak, settling = metric_rows(firsts[:, None] * unit, frac, None, self.settle_band)
                 for j, i in enumerate(rows):
                     if not settled[j] and doublings < MAX_DOUBLINGS:
                         todo[i] = doublings + 1
