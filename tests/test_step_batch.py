@@ -115,3 +115,23 @@ def test_a_slow_tail_is_resolved_at_the_start_with_fewer_samples():
     info = control.step_info(T, T=t, SettlingTimeThreshold=0.02)
     assert r.details["settling_time"] == pytest.approx(info["SettlingTime"], abs=r.details["resolution"] + t[1])
     assert r.details["overshoot"] == pytest.approx(info["Overshoot"], abs=1e-3)
+
+
+def test_the_search_of_the_bounds_screens_its_samples_in_bulk_without_changing_its_answer(monkeypatch):
+    """The exact search checks its samples in order of score; those a batched step evaluation already fails are
+    not checked one by one. Its answer, and what it says it rests on, are those of checking every one."""
+    from synth.spec import parse_spec
+    from synth.synthesis import exact_search as module
+
+    spec = parse_spec({"name": "pid_step", "plant": {"tf": "5/((s+1)*(s+2)*(s+3))"},
+                       "controller": {"type": "PID", "bounds": {"kp": [0, 20], "ki": [0, 20], "kd": [0, 10],
+                                                                "tf": [0.01, 0.01]}},
+                       "requirements": [{"type": "step_response", "max_overshoot": 5, "max_settling_time": 4}],
+                       "objective": {"maximize": "integral_gain"}})
+    screened = module.exact_search(spec)
+    monkeypatch.setattr(module._BatchScreen, "may_pass", lambda self, k: True)
+    every = module.exact_search(spec)
+    assert screened.controller.parameters == every.controller.parameters
+    assert (screened.checks, screened.checked_samples, screened.starts) == (every.checks, every.checked_samples,
+                                                                            every.starts)
+    assert screened.checked_samples > 100 * screened.starts  # most of the best-scoring samples fail the limits
