@@ -18,6 +18,7 @@ from synth.polynomial_rows import (
     row_magnitude_squared,
     row_poly_product,
     row_product,
+    row_rhp_counts,
     row_roots,
 )
 from synth.polynomials import dc_value, horner
@@ -132,28 +133,12 @@ class LoopBatch:
         return self._counts
 
     def _counts_by_roots(self) -> np.ndarray:
-        """Without a delay, each loop's right-half-plane root count from the roots of ``den + num`` (all loops'
-        roots in batched eigenvalue problems): the count :meth:`synth.loop.Loop.stability` makes, where every root
-        is clear of the band from ``-2 * floor`` (the stability floor) to the axis by ``1e-6`` of its magnitude;
-        ``-1`` (to be counted one by one) for a loop with a root in that band, an improper loop, or one whose
-        ``1 + L`` loses its leading power."""
+        """Without a delay, the counts from the roots of ``den + num`` in bulk (:func:`row_rhp_counts`; -1 where a
+        loop is to be counted one by one)."""
         from synth.stability import stability_floor
 
         p = self.plant
-        floor = stability_floor(p.num, p.den, p.delay)
-        width = max(self.num.shape[1], self.den.shape[1])
-        num = np.pad(self.num, ((0, 0), (width - self.num.shape[1], 0)))
-        den = np.pad(self.den, ((0, 0), (width - self.den.shape[1], 0)))
-        counts = np.full(len(self), -1)
-        lead_num, lead_den = np.argmax(num != 0, axis=1), np.argmax(den != 0, axis=1)
-        char = den + num
-        proper = np.any(den != 0, axis=1) & (~np.any(num != 0, axis=1) | (lead_num >= lead_den))
-        keeps = proper & (char[np.arange(len(self)), lead_den] != 0.0)
-        for i, r in zip(np.flatnonzero(keeps), row_roots(char[keeps])):
-            scale = 1e-6 * np.maximum(1.0, np.abs(r))
-            if not np.any((r.real >= -2.0 * floor - scale) & (r.real <= scale)):
-                counts[i] = int(np.sum(r.real > 0.0))
-        return counts
+        return row_rhp_counts(self.num, self.den, stability_floor(p.num, p.den, p.delay))
 
     def loops(self) -> list[Any]:
         """``Loop(plant, c)`` for every controller, made once per plant: what they compute is kept (a count of

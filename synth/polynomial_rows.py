@@ -5,7 +5,8 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["pad_sub", "row_axis_parts", "row_magnitude_squared", "row_poly_product", "row_product", "row_roots"]
+__all__ = ["pad_sub", "row_axis_parts", "row_magnitude_squared", "row_poly_product", "row_product", "row_rhp_counts",
+           "row_roots"]
 
 
 def row_magnitude_squared(rows: np.ndarray) -> np.ndarray:
@@ -104,3 +105,33 @@ def row_product(rows: np.ndarray, poly: np.ndarray) -> np.ndarray:
     for j, c in enumerate(poly):
         out[:, j:j + rows.shape[1]] += rows * c
     return out
+
+
+def row_rhp_counts(num: np.ndarray, den: np.ndarray, floor: float) -> np.ndarray:
+    """Right-half-plane roots of ``den + num`` for each pair of rows (the closed loop of ``num/den`` without a
+    delay), counted as :func:`synth.stability.closed_loop_stability` counts them with the stability ``floor``,
+    from the roots of all rows in batched eigenvalue problems: where every root is clear of the band from
+    ``-2 floor`` to the axis by ``1e-6`` of its magnitude. ``-1`` (to be counted one by one) for a row with a
+    root in that band, an improper ``num/den``, or a ``den + num`` that loses the leading power of ``den``.
+
+    Examples
+    --------
+    ``1/(s - 1)`` with gains 0.5, 2 and 1 (a root at 0: counted one by one):
+
+    >>> row_rhp_counts(np.array([[0.5], [2.0], [1.0]]), np.array([[1.0, -1.0]] * 3), 1e-6).tolist()
+    [1, 0, -1]
+    """
+    width = max(num.shape[1], den.shape[1])
+    num = np.pad(num, ((0, 0), (width - num.shape[1], 0)))
+    den = np.pad(den, ((0, 0), (width - den.shape[1], 0)))
+    counts = np.full(num.shape[0], -1)
+    lead_num, lead_den = np.argmax(num != 0, axis=1), np.argmax(den != 0, axis=1)
+    char = den + num
+    proper = np.any(den != 0, axis=1) & (~np.any(num != 0, axis=1) | (lead_num >= lead_den))
+    keeps = proper & (char[np.arange(num.shape[0]), lead_den] != 0.0)
+    for i, r in zip(np.flatnonzero(keeps), row_roots(char[keeps])):
+        scale = 1e-6 * np.maximum(1.0, np.abs(r))
+        if not np.any((r.real >= -2.0 * floor - scale) & (r.real <= scale)):
+            counts[i] = int(np.sum(r.real > 0.0))
+    return counts
+
