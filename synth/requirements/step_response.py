@@ -231,7 +231,7 @@ class StepResponse(Requirement):
     def _exact_outcomes(self, loops: list[Loop]) -> list[_Outcome]:
         """The step of each loop (stable, without a delay), all at once: the loops needing the same doublings
         together (:func:`synth.exact_steps.exact_steps`), each doubled until settled or
-        :data:`MAX_DOUBLINGS`, as :meth:`_linear` does one loop with a delay."""
+        :data:`MAX_DOUBLINGS`, as :meth:`_delayed_outcome` does one loop with a delay."""
         from synth.exact_steps import doubling_grid, exact_steps
         from synth.polynomials import trim
         from synth.timeresp import metric_rows
