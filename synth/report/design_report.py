@@ -109,10 +109,11 @@ def _design_figure_jobs(spec: Spec, result: DesignResult, loops: list[tuple[str,
     if result.gain_set is None and result.controller is not None \
             and len(spec.controller.free_parameters()) == 2:
         size = figures.map_grid_size(spec)
-        if len(spec.plants()) == 1 and size == figures.MAP_GRID:
+        if len(spec.plants()) == 1 and size == figures.MAP_GRID and not any(r.costly for r in spec.requirements):
             jobs.append(("region", job(lambda: figures.feasibility_map(
                 spec, result.controller, out.claim("feasible_region.png"), reference=ref))))
-        elif len(spec.plants()) == 1:  # a requirement simulated point by point: every other column per job
+        elif len(spec.plants()) == 1:  # a requirement that simulates (vectorized or point by point): every other
+            # column per job
             for k in range(2):
                 jobs.append((f"region-columns:{k}", lambda k=k: (
                     figures.feasibility_grid(spec, result.controller, columns=slice(k, None, 2)), None, [])))
