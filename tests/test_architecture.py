@@ -250,3 +250,16 @@ def test_import_synth_loads_no_solver_or_plotting_library():
     code = f"import sys, synth; print([m for m in {heavy!r} if m in sys.modules])"
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT, check=True)
     assert out.stdout.strip() == "[]"
+
+
+def test_the_check_and_its_requirements_load_no_matrix_exponential():
+    """``synth check`` on a spec without time responses stays light: the requirement types load the step's
+    modules (scipy.linalg among them, 0.1 s) only when a step is computed (a module-level import of
+    ``synth.timeresp`` in the step limit's module once cost every check that)."""
+    import subprocess
+    import sys
+
+    heavy = ("scipy.linalg", "synth.timeresp", "synth.exact_steps", "synth.statespace")
+    code = f"import sys, synth.check, synth.requirements; print([m for m in {heavy!r} if m in sys.modules])"
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT, check=True)
+    assert out.stdout.strip() == "[]"

@@ -13,12 +13,11 @@ from synth.requirements.base import Bound, Requirement, RequirementResult, fmt, 
 from synth.requirements.margins import UNSTABLE_SLACK, closed_loop_unstable, unstable_result
 from synth.requirements.simulated import SimulatedStep, simulated_step
 from synth.sim.spec import SimulationSpec
-from synth.timeresp import StepMetrics
 
 if TYPE_CHECKING:
     from synth.loop import Loop
     from synth.loop_batch import LoopBatch
-    from synth.timeresp import LinearStep
+    from synth.timeresp import LinearStep, StepMetrics
 
 __all__ = ["INTERVALS", "MAX_DOUBLINGS", "StepResponse"]
 
@@ -234,7 +233,7 @@ class StepResponse(Requirement):
         :data:`MAX_DOUBLINGS`, as :meth:`_delayed_outcome` does one loop with a delay."""
         from synth.exact_steps import doubling_grid, exact_steps
         from synth.polynomials import trim
-        from synth.timeresp import metric_rows
+        from synth.timeresp import StepMetrics, metric_rows
 
         plans = [self._plan(loop) for loop in loops]
         out: list[_Outcome | None] = [None] * len(loops)
