@@ -19,7 +19,7 @@ from synth.statespace import step_from_rest, tf_to_ss
 __all__ = ["doubling_grid", "exact_step", "exact_steps"]
 
 
-def doubling_grid(first: float, doublings: int, intervals: int = 2000) -> np.ndarray:
+def doubling_grid(first: float, doublings: int, intervals: int = 4000) -> np.ndarray:
     """Sample times of a step over ``first * 2**doublings`` seconds that keep the start's resolution: ``intervals``
     even steps over ``[0, first]`` and over each doubling ``[first 2^(k-1), first 2^k]``, the step growing with the
     time (the first two spans share ``first / intervals``, each later one doubles it): ``intervals (doublings + 1)

@@ -33,12 +33,14 @@ final value): the bound ``sum |c_i| e^(Re p_i t)`` of :func:`synth.timeresp.step
 nearly cancels creeps back out of the band, and up to a higher overshoot, long after the fast part has settled
 (a PID whose step was within 2 % at 0.37 s overshot 5.5 % at 1.1 s)."""
 
-INTERVALS = 2000
+INTERVALS = 4000
 """Samples of the step over its first horizon (:func:`synth.timeresp.default_horizon`), and over each doubling of it
-(:func:`synth.exact_steps.doubling_grid`): the step grows with the time, so every sample is within 1/2000 of its time
+(:func:`synth.exact_steps.doubling_grid`): the step grows with the time, so every sample is within 1/4000 of its time
 of the next, and a long horizon costs samples in proportion to its doublings, not its length. An even grid of up
 to 64,001 samples ran before: a PID whose slow tail took eight doublings had 64,001 samples 1/250 of its first
-horizon apart, where 18,001 now start 1/2000 apart."""
+horizon apart, where 36,001 now start 1/4000 apart. On 91 random PI and PID loops against a 400,001-sample even
+grid: overshoot within 0.0011 points and settling times within 0.08 % (the even grid: 0.0025 points, 0.08 %); at
+2000 per span, 0.0053 points and 0.18 %, and pid_step's design 0.8 s faster."""
 _CHUNK = 2_000_000  # samples of the loops' steps computed together (16 MB per array)
 _LABELS = {"max_overshoot": ("overshoot", "%"), "max_settling_time": ("settling time", "s"),
            "max_rise_time": ("rise time", "s")}
