@@ -12,9 +12,8 @@ from collections.abc import Sequence
 from itertools import pairwise
 
 import numpy as np
-from scipy.linalg import expm
 
-from synth.statespace import step_from_rest, tf_to_ss
+from synth.statespace import step_from_rest, tf_to_ss, zoh
 
 __all__ = ["doubling_grid", "exact_step", "exact_steps"]
 
@@ -60,9 +59,9 @@ def exact_steps(nums: Sequence[np.ndarray], dens: Sequence[np.ndarray], scales: 
 
     ``unit`` is taken as runs of even spacing (as :func:`doubling_grid` makes), cut into pieces of the shortest
     run's length. Each piece starts from the exact state at its first time (the step from rest over that time:
-    the zero-order hold's own matrix exponential), so no error is carried from one piece to the next; the pieces
-    of every loop of one order are stepped together (:func:`synth.statespace.step_from_rest` on stacked systems),
-    their matrix exponentials in one call.
+    the zero-order hold's own matrix exponential, :func:`synth.statespace.zoh`), so no error is carried from one
+    piece to the next; the pieces of every loop of one order are stepped together
+    (:func:`synth.statespace.step_from_rest` on stacked systems), their matrix exponentials in one call.
 
     Examples
     --------
@@ -91,8 +90,8 @@ def exact_steps(nums: Sequence[np.ndarray], dens: Sequence[np.ndarray], scales: 
             group = [(a, b) for a, b in pieces if b - a + 1 == size]
             first = np.array([a for a, _ in group])
             span = scales[rows, None]
-            F, G = _held(A, B, span * (unit[first + 1] - unit[first]))  # (loops, pieces, ...)
-            start = _held(A, B, span * unit[first])[1]  # the state at each piece's first time, from rest
+            F, G = zoh(A[:, None], B[:, None, :, None], span * (unit[first + 1] - unit[first]))  # (loops, pieces, ...)
+            start = zoh(A[:, None], B[:, None, :, None], span * unit[first])[1]  # each piece's first state, from rest
             k, m = len(rows), len(group)
             runs = step_from_rest(F.reshape(k * m, order, order), G.reshape(k * m, order),
                                   np.repeat(C, m, axis=0), np.repeat(D, m), size,
@@ -100,17 +99,6 @@ def exact_steps(nums: Sequence[np.ndarray], dens: Sequence[np.ndarray], scales: 
             for j, (a, b) in enumerate(group):
                 out[rows, a:b + 1] = runs[:, j]
     return out
-
-
-def _held(A: np.ndarray, B: np.ndarray, h: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """``(e^{A_i h_ij}, int_0^h_ij e^{A_i s} ds B_i)`` for loops ``i`` (``A`` ``(k, n, n)``, ``B`` ``(k, n)``) and
-    steps ``h`` ``(k, p)``: ``(k, p, n, n)`` and ``(k, p, n)``, from one matrix exponential call."""
-    n = A.shape[-1]
-    M = np.zeros((*h.shape, n + 1, n + 1))
-    M[..., :n, :n] = A[:, None] * h[..., None, None]
-    M[..., :n, n] = B[:, None] * h[..., None]
-    E = expm(M)
-    return E[..., :n, :n], E[..., :n, n]
 
 
 def _even_pieces(t: np.ndarray) -> list[tuple[int, int]]:

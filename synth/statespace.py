@@ -125,26 +125,35 @@ def tf_to_ss(num: np.ndarray, den: np.ndarray) -> tuple[np.ndarray, np.ndarray, 
     return A, B, rest.copy(), D
 
 
-def zoh(A: np.ndarray, B: np.ndarray, h: float) -> tuple[np.ndarray, np.ndarray]:
-    """``(e^{A h}, int_0^h e^{A s} ds B)`` for ``B`` with one column per input.
+def zoh(A: np.ndarray, B: np.ndarray, h: float | np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``(e^{A h}, int_0^h e^{A s} ds B)`` for ``B`` with one column per input. Stacked systems and steps
+    (``A`` of shape ``(..., n, n)``, ``B`` ``(..., n, k)``, ``h`` broadcasting with ``A``'s leading axes) give
+    both stacked, from one matrix exponential call.
 
     Examples
     --------
     >>> Ad, Gd = zoh(np.array([[-1.0]]), np.array([[1.0]]), np.log(2.0))
     >>> float(Ad[0, 0]), round(float(Gd[0, 0]), 12)
     (0.5, 0.5)
+    >>> Ad, Gd = zoh(np.array([[[-1.0]]]), np.array([[[1.0]]]), np.log([[1.0, 2.0, 4.0]]))  # one system, 3 steps
+    >>> Ad.shape, Gd[0, :, 0, 0].round(12).tolist()
+    ((1, 3, 1, 1), [0.0, 0.5, 0.75])
     """
-    n = A.shape[0]
-    B = np.asarray(B, float).reshape(n, -1)
+    A = np.asarray(A, float)
+    n = A.shape[-1]
+    B = np.asarray(B, float).reshape(*A.shape[:-2], n, -1)
+    h = np.asarray(h, float)
+    k = B.shape[-1]
+    lead = np.broadcast_shapes(A.shape[:-2], h.shape)
     if n == 0:
-        return np.zeros((0, 0)), np.zeros((0, B.shape[1]))
-    if h == 0.0:
+        return np.zeros((*lead, 0, 0)), np.zeros((*lead, 0, k))
+    if h.ndim == 0 and A.ndim == 2 and h == 0.0:
         return np.eye(n), np.zeros_like(B)
-    M = np.zeros((n + B.shape[1], n + B.shape[1]))
-    M[:n, :n] = A * h
-    M[:n, n:] = B * h
+    M = np.zeros((*lead, n + k, n + k))
+    M[..., :n, :n] = A * h[..., None, None]
+    M[..., :n, n:] = B * h[..., None, None]
     E = expm(M)
-    return E[:n, :n], E[:n, n:]
+    return E[..., :n, :n], E[..., :n, n:]
 
 
 def generalized_bilinear(A: np.ndarray, B: np.ndarray, C: np.ndarray, D: float, h: float, alpha: float,

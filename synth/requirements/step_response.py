@@ -257,10 +257,12 @@ class StepResponse(Requirement):
                     inside = np.all(np.abs(y[:, tail] - finals[:, None]) <= np.array([g.band for g in group])[:, None],
                                     axis=1)
                     settled = inside & np.array([g.after(h) <= TAIL_SHARE * g.band for g, h in zip(group, horizons)])
-                    frac = y / finals[:, None]
-                    rise, peak, settling = metric_rows(firsts[:, None] * unit, frac, None, self.settle_band)
+                    done = settled | (doublings == MAX_DOUBLINGS)  # the others double and are measured then
+                    rise, peak, settling = np.full((3, len(rows)), np.nan)
+                    rise[done], peak[done], settling[done] = metric_rows(
+                        firsts[done, None] * unit, y[done] / finals[done, None], None, self.settle_band)
                 for j, i in enumerate(rows):
-                    if not settled[j] and doublings < MAX_DOUBLINGS:
+                    if not done[j]:
                         todo[i] = doublings + 1
                         continue
                     del todo[i]
