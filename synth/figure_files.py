@@ -30,6 +30,9 @@ def save_figure(fig: plt.Figure, path: str | Path, dpi: int = DPI) -> Path:
     path = Path(path)
     fig.set_dpi(dpi)  # lay out at the dpi written: the text extents measured here are reused by savefig
     fig.tight_layout()
+    # tight_layout leaves a placeholder layout engine behind, and savefig draws a figure with any engine once
+    # more before the draw it writes (all of the layout work again, without the pixels): none is needed now
+    fig.set_layout_engine(None)
     path.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(path, dpi=dpi, metadata=METADATA)
     plt.close(fig)

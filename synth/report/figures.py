@@ -470,5 +470,6 @@ def warm_up() -> None:
     ax.legend()
     fig.set_dpi(DPI)
     fig.tight_layout()
+    fig.set_layout_engine(None)  # as figure_files.save_figure: one draw, not two
     fig.savefig(io.BytesIO(), format="png", dpi=DPI)
     plt.close(fig)
