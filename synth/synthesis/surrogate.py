@@ -18,6 +18,7 @@ requirements themselves bind (the surrogate's level bounds the whole loop, not t
 from __future__ import annotations
 
 from collections.abc import Callable
+from dataclasses import replace
 from typing import Any
 
 import numpy as np
@@ -182,10 +183,13 @@ def design_certified(spec: Spec, design_fn: Callable[[Spec], DesignResult],
             found = _searched(spec, found, lambda c, n: _certified(spec, best[0], best[1], tried, c, moved, n))
     if found is not None and integral_only:  # the plain design can only do better by dropping integral action
         return found
+    if best is None and integral_only and len(hard) == len(spec.requirements):
+        # nothing but certified-only requirements: the plain design's stages see none of them (it is the free
+        # design again, then a screen and polishes that only its certificate judges), so the search of the
+        # bounds on the exact check goes first and the plain design is made only if that search finds nothing
+        return _last_resort(spec, None, free, tried, lambda: design_fn(spec))
     plain = design_fn(spec)
     if best is None:
-        plain.method += (f"; certified-only requirements ({', '.join(r.type for r in hard)}): no design under "
-                         f"peak |S|, |T| <= {fmt(_FLOOR_DB)} dB passes them either")
         return _last_resort(spec, plain, free, tried)
     assert found is not None
     if plain.feasible and _better(plain, found):
@@ -214,24 +218,40 @@ def _toward(spec: Spec, inside: Controller, outside: Controller) -> tuple[Contro
     return found, LINE_STEPS
 
 
-def _last_resort(spec: Spec, plain: DesignResult, free: DesignResult, tried: int) -> DesignResult:
+def _last_resort(spec: Spec, plain: DesignResult | None, free: DesignResult, tried: int,
+                 make_plain: Callable[[], DesignResult] | None = None) -> DesignResult:
     """No design under the surrogate passed: the plain design (which meets the requirements, when it does, often
     only without integral action) improved by a pattern search on the exact check, or what a search of the
     whole box on the exact check finds (:func:`synth.synthesis.exact_search.exact_search`), whichever scores
-    better and passes the certificate."""
+    better and passes the certificate. With ``plain`` None the search starts near the free design and what it
+    finds is returned; ``make_plain()`` makes the plain design only when the search finds nothing."""
+    hard = ", ".join(r.type for r in certified_only(spec))
+    none_passes = f"; certified-only requirements ({hard}): no design under peak |S|, |T| <= {fmt(_FLOOR_DB)} dB " \
+                  "passes them either"
     opening = f"designed with them ({tried} designs under the surrogate found none that passes)"
-    out = _searched(spec, plain, lambda c, n: _certified(spec, plain, None, tried, c, 0, n, opening))
     with within("search of the bounds on the exact check"):
-        found = exact_search(spec, (plain if plain.controller is not None else free).controller)
-    if found.controller is None:
-        out.method += (f"; a search of the bounds on the exact check found no controller that passes "
-                       f"({found.samples} sampled, {found.checks} checks)")
-        return out
-    opening = (f"found by a search of the bounds on the exact check ({found.samples} controllers sampled, "
+        near = plain.controller if plain is not None and plain.controller is not None else free.controller
+        found = exact_search(spec, near)
+    searched = None
+    if found.controller is not None:
+        how = (f"found by a search of the bounds on the exact check ({found.samples} controllers sampled, "
                f"{found.checked_samples} checked in order of score; pattern search from the best {found.starts} "
                f"that passed, a few sample spacings apart; {found.checks} "
                f"checks), as {tried} designs under the surrogate found none that passes")
-    searched = _certified(spec, plain, None, tried, found.controller, 0, 0, opening)
+        base = plain if plain is not None else free
+        searched = _certified(spec, replace(base, method=base.method + none_passes), None, tried,
+                              found.controller, 0, 0, how)
+        if plain is None and searched.feasible:
+            return searched
+    if plain is None:
+        assert make_plain is not None
+        plain = make_plain()
+    plain = replace(plain, method=plain.method + none_passes)
+    out = _searched(spec, plain, lambda c, n: _certified(spec, plain, None, tried, c, 0, n, opening))
+    if searched is None:
+        out.method += (f"; a search of the bounds on the exact check found no controller that passes "
+                       f"({found.samples} sampled, {found.checks} checks)")
+        return out
     if searched.feasible and (not out.feasible or _better(searched, out)):
         return searched
     return out
