@@ -173,3 +173,45 @@ def test_step_metrics_on_the_doubling_grid_against_a_dense_even_grid(seed):
         settling = t[outside[-1] + 1] if outside.size else 0.0
         assert d["overshoot"] == pytest.approx(max(0.0, (frac.max() - 1.0) * 100.0), abs=5e-3)
         assert d["settling_time"] == pytest.approx(settling, abs=d["resolution"] + t[1])
+
+
+@pytest.mark.parametrize("seed", range(10))
+def test_a_coarse_proof_of_failure_is_never_wrong_and_catches_clear_failures(seed):
+    """``fails_surely`` (the step on a tenth of the samples, all among the full evaluation's) says True only where
+    the full evaluation's slack is negative, on random plants and controllers; and it catches every stable loop
+    whose overshoot is over its limit by more than a point or whose step leaves the band a second after its
+    settling limit."""
+    rng = np.random.default_rng(5000 + seed)
+    plant = _plant(rng)
+    loops = [Loop(plant, c) for c in _controllers(rng, 30)]
+    stable = [lp for lp in loops if lp.stability().stable]
+    req = StepResponse(max_overshoot=float(rng.uniform(1.0, 40.0)), max_settling_time=float(rng.uniform(0.5, 30.0)),
+                       settle_band=float(rng.choice([0.02, 0.05])))
+    proved = req.fails_surely(stable)
+    for lp, sure in zip(stable, proved):
+        r = req.evaluate(lp)
+        if sure:
+            assert r.slack < 0, (lp.controller, r.message)
+        elif r.details.get("settled"):
+            overshoot, settling = r.details["overshoot"], r.details["settling_time"]
+            assert not (overshoot > req.max_overshoot + 1.0 or settling > req.max_settling_time + 1.0), r.message
+
+
+def test_the_quick_check_with_the_coarse_proof_gives_the_checks_verdict():
+    """quick_check asks the coarse proof first: its verdict is still check's on random PID loops of one plant,
+    around its best design under these limits (ki 5.14), where the two verdicts mix."""
+    from synth.check import check, quick_check
+    from synth.spec import parse_spec
+
+    spec = parse_spec({"name": "q", "plant": {"tf": "5/((s+1)*(s+2)*(s+3))"},
+                       "controller": {"type": "PID", "bounds": {"kp": [0, 20], "ki": [0, 20], "kd": [0, 10],
+                                                                "tf": [0.01, 0.01]}},
+                       "requirements": [{"type": "step_response", "max_overshoot": 5, "max_settling_time": 4}]})
+    rng = np.random.default_rng(7)
+    verdicts = []
+    for _ in range(40):
+        c = Controller("PID", {"kp": 5.05 * float(rng.uniform(0.8, 1.2)), "ki": float(rng.uniform(0, 5.5)),
+                               "kd": 3.75 * float(rng.uniform(0.8, 1.2)), "tf": 0.01})  # around the best design
+        verdicts.append(check(spec, c).feasible)
+        assert quick_check(spec, c).feasible == verdicts[-1], c
+    assert 5 <= sum(verdicts) <= len(verdicts) - 5, sum(verdicts)  # both verdicts occur

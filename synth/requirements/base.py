@@ -252,6 +252,20 @@ class Requirement(BaseModel):
         """
         return np.array([self.slack(loop, per_decade) for loop in batch.loops()], dtype=float)
 
+    def fails_surely(self, loops: list[Any]) -> np.ndarray:
+        """For each loop (closed-loop stable), True where a cheaper evaluation than :meth:`slack`'s proves the
+        requirement fails (its slack would be negative); False says nothing. Searches on the exact check ask
+        this first and evaluate the requirement only where it says nothing. The base form proves nothing.
+
+        Examples
+        --------
+        >>> from synth.plant import Plant; from synth.controllers import Controller; from synth.loop import Loop
+        >>> from synth.requirements import Bandwidth
+        >>> Bandwidth(min=100).fails_surely([Loop(Plant.from_string("1/(s+1)"), Controller("P", {"kp": 1.0}))])
+        array([False])
+        """
+        return np.zeros(len(loops), dtype=bool)
+
     @classmethod
     def has_batch_form(cls) -> bool:
         """Whether the type has a vectorized :meth:`batch_slack` (else the scalar fallback runs).

@@ -300,8 +300,15 @@ class _BatchScreen:
                 batch = LoopBatch(plant, self._controllers[rows])
                 with np.errstate(all="ignore"):
                     fails |= batch.unstable_root_counts() > 0
-                    for req in self._requirements:
-                        fails |= ~(np.asarray(req.batch_slack(batch), float) >= 0)
+                    loops = batch.loops()
+                    for req in self._requirements:  # a cheap proof of failure first, the full slack on the rest
+                        left = np.flatnonzero(~fails)
+                        fails[left] |= req.fails_surely([loops[i] for i in left])
+                        left = np.flatnonzero(~fails)
+                        if left.size:
+                            rest = LoopBatch(plant, [self._controllers[rows][i] for i in left]).with_root_counts(
+                                np.zeros(left.size, dtype=int))  # stable: counted above
+                            fails[left] |= ~(np.asarray(req.batch_slack(rest), float) >= 0)
             self._fails[rows] = fails
             self._done += self.CHUNK
         return not self._fails[k]
