@@ -8,13 +8,19 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
+from matplotlib.ticker import LogLocator
 
-__all__ = ["DPI", "METADATA", "save_figure"]
+__all__ = ["DPI", "LOG_MINOR_SUBS", "METADATA", "save_figure"]
 
 METADATA = {"Software": "synth"}
 
 DPI = 110
 """Resolution of every report figure (dots per inch)."""
+
+LOG_MINOR_SUBS = (2.0, 5.0)
+"""Minor ticks (and minor grid lines) of a log axis spanning two decades or more: at 2 and 5 times each power of
+ten, instead of matplotlib's eight per decade. Easier to read, and each tick is an object matplotlib lays out
+and draws (a Bode figure: 0.17 -> 0.13 s)."""
 
 
 def save_figure(fig: plt.Figure, path: str | Path, dpi: int = DPI) -> Path:
@@ -28,6 +34,7 @@ def save_figure(fig: plt.Figure, path: str | Path, dpi: int = DPI) -> Path:
     'line.png'
     """
     path = Path(path)
+    _lighter_log_minor_ticks(fig)
     fig.set_dpi(dpi)  # lay out at the dpi written: the text extents measured here are reused by savefig
     fig.tight_layout()
     # tight_layout leaves a placeholder layout engine behind, and savefig draws a figure with any engine once
@@ -37,3 +44,16 @@ def save_figure(fig: plt.Figure, path: str | Path, dpi: int = DPI) -> Path:
     fig.savefig(path, dpi=dpi, metadata=METADATA)
     plt.close(fig)
     return path
+
+
+def _lighter_log_minor_ticks(fig: plt.Figure) -> None:
+    """Put the minor ticks of each log axis with matplotlib's default minor locator that spans two decades or
+    more (where they carry no labels) at :data:`LOG_MINOR_SUBS`."""
+    for ax in fig.axes:
+        for axis in (ax.xaxis, ax.yaxis):
+            locator = axis.get_minor_locator()
+            if axis.get_scale() != "log" or type(locator) is not LogLocator or getattr(locator, "_subs", None) != "auto":
+                continue
+            lo, hi = sorted(axis.get_view_interval())
+            if lo > 0 and hi >= 100.0 * lo:
+                axis.set_minor_locator(LogLocator(subs=LOG_MINOR_SUBS))
