@@ -2,7 +2,10 @@
 this process goes on with its own work; the jobs' results come back pickled through a pipe.
 
 Forking is off unless :func:`allow_fork` turned it on (the command line does; a library caller's threads or
-event loop are its own business), and ``SYNTH_JOBS=1`` turns it off again.
+event loop are its own business), and ``SYNTH_JOBS=1`` turns it off again. A forked child runs its jobs' own
+``run_beside`` calls serially, except a call that passes ``nested=True``: a long job whose parts are independent
+(the pattern searches of a search of the bounds) forks once more there, for the core that the command's own
+process leaves idle once its part is done (at most one level: a grandchild never forks).
 
 Correctness never depends on the child: off Linux (macOS's system libraries are not safe to use in a forked
 child) or when it is off, the jobs run here, in order; an exception a job raised in the child is raised
@@ -27,6 +30,7 @@ __all__ = ["allow_fork", "run_beside"]
 T = TypeVar("T")
 
 _ALLOWED = [False]
+_DEPTH = [0]  # 0 in the process that allowed forking, 1 in its child, 2 in a nested call's child
 
 
 def allow_fork(allowed: bool = True) -> None:
@@ -40,7 +44,8 @@ def allow_fork(allowed: bool = True) -> None:
     _ALLOWED[0] = allowed
 
 
-def run_beside(jobs: Sequence[Callable[[], Any]], own_work: Callable[[], T]) -> tuple[list[Any], T]:
+def run_beside(jobs: Sequence[Callable[[], Any]], own_work: Callable[[], T], nested: bool = False,
+               ) -> tuple[list[Any], T]:
     """Run ``jobs`` in a forked child while ``own_work()`` runs here; return both results.
 
     The child takes the jobs in order; when ``own_work`` is done this process takes the ones the child has
@@ -54,6 +59,8 @@ def run_beside(jobs: Sequence[Callable[[], Any]], own_work: Callable[[], T]) -> 
         process's objects are lost: only return values come back, so they must pickle).
     own_work : callable without arguments
         What this process does meanwhile.
+    nested : bool
+        Fork even in a forked child (one level down, not further): for independent parts of one long job.
 
     Returns
     -------
@@ -65,7 +72,8 @@ def run_beside(jobs: Sequence[Callable[[], Any]], own_work: Callable[[], T]) -> 
     >>> allow_fork(); run_beside([lambda: 2 + 2, lambda: "x" * 3], lambda: 10)
     ([4, 'xxx'], 10)
     """
-    if len(jobs) == 0 or len(jobs) > 255 or not _ALLOWED[0] or not sys.platform.startswith("linux") \
+    depth_ok = _DEPTH[0] == 0 or (nested and _DEPTH[0] == 1)
+    if len(jobs) == 0 or len(jobs) > 255 or not _ALLOWED[0] or not depth_ok or not sys.platform.startswith("linux") \
             or os.environ.get("SYNTH_JOBS", "") == "1":  # fork is safe with these libraries on Linux only
         mine = own_work()
         return [job() for job in jobs], mine
@@ -79,7 +87,7 @@ def run_beside(jobs: Sequence[Callable[[], Any]], own_work: Callable[[], T]) -> 
         try:
             os.close(read_end)
             _die_with_parent()
-            _ALLOWED[0] = False  # two cores: a job's own run_beside calls run serially in the child
+            _DEPTH[0] += 1  # two cores: a job's own run_beside calls run serially in the child, unless nested
             use_child_slot()  # the stages this child announces show beside the parent's
             payload = pickle.dumps(_run_tickets(jobs, tickets_read), protocol=pickle.HIGHEST_PROTOCOL)
             clear()  # the progress line stops showing this child's last stage

@@ -70,6 +70,45 @@ def test_a_child_that_dies_leaves_its_jobs_to_this_process():
     assert value == "done here"
 
 
+def _in_a_child(job):
+    """``job()`` as run by a forked child (this process sleeps meanwhile, so the child takes it)."""
+    import time
+
+    (value,), _ = run_beside([job], lambda: time.sleep(0.4))
+    return value
+
+
+def _call(nested: bool):
+    """A job whose own run_beside call reports which process ran its one job, and which process it was."""
+    import time
+
+    def job():
+        (ran_in,), _ = run_beside([os.getpid], lambda: time.sleep(0.2), nested=nested)
+        return ran_in, os.getpid()
+
+    return job
+
+
+def test_a_child_forks_again_only_for_a_nested_call_and_only_one_level_down():
+    ran_in, child = _in_a_child(_call(nested=False))
+    assert child != os.getpid() and ran_in == child  # a child's own calls run serially
+    ran_in, child = _in_a_child(_call(nested=True))
+    assert len({os.getpid(), child, ran_in}) == 3  # a nested call forks once more
+    (ran_in, grandchild), child = _in_a_child(_grandchild_runs(_call(nested=True)))
+    assert len({os.getpid(), child, grandchild}) == 3 and ran_in == grandchild  # no third level
+
+
+def _grandchild_runs(job):
+    """A job that has ``job`` run by a grandchild (a nested call from the child); ``(job(), child's pid)``."""
+    import time
+
+    def run():
+        (value,), _ = run_beside([job], lambda: time.sleep(0.4), nested=True)
+        return value, os.getpid()
+
+    return run
+
+
 def test_off_means_serial_in_this_process():
     allow_fork(False)
     (pid,), _ = run_beside([os.getpid], lambda: None)

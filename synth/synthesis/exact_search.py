@@ -28,6 +28,7 @@ import numpy as np
 from synth.check import quick_check
 from synth.controllers import Controller
 from synth.errors import SynthError
+from synth.forked import run_beside
 from synth.loop import Loop
 from synth.objectives import score
 from synth.spec import Spec
@@ -255,8 +256,10 @@ def exact_search(spec: Spec, near: Controller | None = None, samples: int | None
         return ExactSearchResult(None, None, counter["checks"], len(points), checked, 0, 1.0)
     best: tuple[float, Controller] | None = None
     final_step = 1.0
-    for _, u in chosen:
-        found = pattern_search(spec, box.controller(u), terms, max_checks=PATTERN_CHECKS, keeping=keeping)
+    searches = [lambda u=u: pattern_search(spec, box.controller(u), terms, max_checks=PATTERN_CHECKS,
+                                           keeping=keeping) for _, u in chosen]
+    rest, first = run_beside(searches[1:], searches[0], nested=True)  # independent: on both cores when free
+    for found in [first, *rest]:
         counter["checks"] += found.checks
         final_step = min(final_step, found.final_step)
         s = scored(found.controller)
