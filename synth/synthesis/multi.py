@@ -48,7 +48,7 @@ from synth.synthesis.parametrization import parametrize
 from synth.synthesis.pattern import pattern_search
 from synth.synthesis.polish_skip import exact_forms, polish_redundant
 from synth.synthesis.scalar import design_scalar
-from synth.synthesis.screen import SCREEN_ITERATIONS, SCREEN_POINTS, screen_improving, screen_starts
+from synth.synthesis.screen import SCREEN_ITERATIONS, screen_improving, screen_size, screen_starts
 from synth.synthesis.stabilizing_slices import open_loop_unstable, slices_text, stabilizing_slices
 
 __all__ = ["STRUCTURAL", "STRUCTURAL_REFINEMENTS", "certificate_density", "choose", "conflict_set", "convex_runs",
@@ -362,21 +362,21 @@ def _design(spec: Spec, settings: ConvexSettings, nlp: bool | str, explain: bool
     candidates, passed = _certify_best(spec, found, terms, per_decade, cache)
     if passed is not None and nlp and spec.objective is not None:  # a local optimum? better points elsewhere
         value = score(Loop(nominal, passed[1]), terms)
-        announce(f"screen of {SCREEN_POINTS} controllers for better starts")
+        announce(f"screen of {screen_size(spec)} controllers for better starts")
         starts = screen_improving(spec, terms, value + IMPROVEMENT * max(abs(value), 1e-12))
         found.extend(_polished_from(spec, starts, terms, runs[0][0].grid, settings, unconverged))
-        stages.append(f"random screen of the bounds ({SCREEN_POINTS} controllers): {len(starts)} scored more "
+        stages.append(f"random screen of the bounds ({screen_size(spec)} controllers): {len(starts)} scored more "
                       "than 1 % better on its grid" + (", NLP polish from each" if starts else ""))
-        screened = (f"a random screen of {SCREEN_POINTS} controllers over the bounds found "
+        screened = (f"a random screen of {screen_size(spec)} controllers over the bounds found "
                     + (f"{len(starts)} scoring more than 1 % better on its grid, polished" if starts
                        else "none scoring more than 1 % better on its grid"))
         if starts:
             candidates, passed = _certify_best(spec, found, terms, per_decade, cache)
     if passed is None and nlp:  # the local stages found nothing that certifies: starts from the whole box
-        announce(f"nothing certified: screen of {SCREEN_POINTS} controllers")
+        announce(f"nothing certified: screen of {screen_size(spec)} controllers")
         starts = screen_starts(spec)
         found.extend(_polished_from(spec, starts, terms, runs[0][0].grid, settings, unconverged))
-        stages.append(f"random screen of the bounds ({SCREEN_POINTS} controllers, every requirement and plant): "
+        stages.append(f"random screen of the bounds ({screen_size(spec)} controllers, every requirement and plant): "
                       f"NLP polish from the {len(starts)} least violating (at most 3 rounds of {SCREEN_ITERATIONS} "
                       "iterations each)")
         candidates, passed = _certify_best(spec, found, terms, per_decade, cache)
