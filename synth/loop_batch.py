@@ -94,7 +94,11 @@ class LoopBatch:
             p_lo, p_hi = min(p_lo, 1.0 / plant.delay), max(p_hi, 1.0 / plant.delay)
         lo, hi = np.fmin(self._corner_lo, p_lo), np.fmax(self._corner_hi, p_hi)
         none = np.isnan(lo)
-        self.frequency_ranges = np.column_stack([np.where(none, 1e-2, lo / 100.0), np.where(none, 1e2, hi * 100.0)])
+        lo, hi = np.where(none, 1e-2, lo / 100.0), np.where(none, 1e2, hi * 100.0)
+        crossovers = self.gain_crossovers()  # as Loop.frequency_range: two decades beyond them too
+        lo = np.fmin(lo, np.array([w[0] / 100.0 if w.size else np.inf for w in crossovers]))
+        hi = np.fmax(hi, np.array([w[-1] * 100.0 if w.size else 0.0 for w in crossovers]))
+        self.frequency_ranges = np.column_stack([lo, hi])
         """Each loop's :attr:`Loop.frequency_range`, ``(n, 2)``."""
 
     def closed_loop_unstable(self) -> np.ndarray:
