@@ -9,7 +9,7 @@ from typing import TYPE_CHECKING, Any, ClassVar, Literal
 import numpy as np
 from pydantic import Field, NonNegativeFloat, field_validator, model_validator
 
-from synth.freqgrid import log_grid
+from synth.freqgrid import characteristic_range, log_grid
 from synth.requirements.base import NEPER_PER_DB, Bound, Requirement, RequirementResult, db, fmt, register
 from synth.requirements.margins import closed_loop_unstable, unstable_result, with_unstable_rows
 from synth.requirements.simulated import confirm_prediction
@@ -212,9 +212,11 @@ class NoLimitCycle(Requirement):
         """The critical factor of ``loop``. ``k L`` meets a locus at ``1/k`` times the factor of ``L``, so
         the factor of the loop with its controller's gain divided out is kept (:data:`_UNIT_GAIN_FACTORS`)
         and scaled: a gain swept over one plant costs one evaluation."""
-        lo, hi = loop.frequency_range
-        w = log_grid(lo, hi * 10, per_decade)
         cnum, cden = loop.controller.tf()
+        # the corners' range, not the loop's (which reaches beyond its crossovers, and so moves with the gain):
+        # the factor kept for one gain is computed on the grid every gain of the sweep would use
+        lo, hi = characteristic_range(cnum, cden, loop.plant.num, loop.plant.den, delay=loop.delay)
+        w = log_grid(lo, hi * 10, per_decade)
         gain = float(cnum[np.flatnonzero(cnum)[0]] / cden[np.flatnonzero(cden)[0]]) if np.any(cnum) else 0.0
         if not gain > 0:
             return w, critical_gain_factor(loop.L, w, self.delay, self.kinds())
