@@ -52,8 +52,10 @@ def _lighter_log_minor_ticks(fig: plt.Figure) -> None:
     for ax in fig.axes:
         for axis in (ax.xaxis, ax.yaxis):
             locator = axis.get_minor_locator()
-            if axis.get_scale() != "log" or type(locator) is not LogLocator or getattr(locator, "_subs", None) != "auto":
-                continue
+            subs = getattr(locator, "_subs", None)
+            if axis.get_scale() != "log" or type(locator) is not LogLocator or not (isinstance(subs, str)
+                                                                                   and subs == "auto"):
+                continue  # a locator a figure chose itself (an array of subs, say) is left alone
             lo, hi = sorted(axis.get_view_interval())
             if lo > 0 and hi >= 100.0 * lo:
                 axis.set_minor_locator(LogLocator(subs=LOG_MINOR_SUBS))
