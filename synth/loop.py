@@ -206,7 +206,10 @@ class Loop:
         """
         cn, cd = self.controller.tf()
         lo, hi = characteristic_range(cn, cd, self.plant.num, self.plant.den, delay=self.delay)
-        crossovers = self.gain_crossovers()
+        with np.errstate(over="ignore", invalid="ignore"):  # gains near 1e300 overflow |L|^2: corners alone
+            finite = bool(np.all(np.isfinite(magnitude_squared_in_w2(self.num)))
+                          and np.all(np.isfinite(magnitude_squared_in_w2(self.den))))
+        crossovers = self.gain_crossovers() if finite else np.array([])
         if crossovers.size:
             lo, hi = min(lo, float(crossovers[0]) / 100.0), max(hi, float(crossovers[-1]) * 100.0)
         return lo, hi

@@ -95,7 +95,10 @@ class LoopBatch:
         lo, hi = np.fmin(self._corner_lo, p_lo), np.fmax(self._corner_hi, p_hi)
         none = np.isnan(lo)
         lo, hi = np.where(none, 1e-2, lo / 100.0), np.where(none, 1e2, hi * 100.0)
-        crossovers = self.gain_crossovers()  # as Loop.frequency_range: two decades beyond them too
+        with np.errstate(over="ignore", invalid="ignore"):
+            q = pad_sub(row_magnitude_squared(self.num), row_magnitude_squared(self.den))
+        finite = np.all(np.isfinite(q), axis=1)  # gains near 1e300 overflow |L|^2: their corners alone
+        crossovers = self._crossovers_of(np.where(finite[:, None], q, 0.0))  # as Loop.frequency_range
         lo = np.fmin(lo, np.array([w[0] / 100.0 if w.size else np.inf for w in crossovers]))
         hi = np.fmax(hi, np.array([w[-1] * 100.0 if w.size else 0.0 for w in crossovers]))
         self.frequency_ranges = np.column_stack([lo, hi])
@@ -285,7 +288,11 @@ class LoopBatch:
         >>> [w.round(4) for w in b.gain_crossovers()]
         [array([9.9499]), array([], dtype=float64)]
         """
-        q = pad_sub(row_magnitude_squared(self.num), row_magnitude_squared(self.den))
+        return self._crossovers_of(pad_sub(row_magnitude_squared(self.num), row_magnitude_squared(self.den)))
+
+    @staticmethod
+    def _crossovers_of(q: np.ndarray) -> list[np.ndarray]:
+        """The positive real ``w`` of each row's ``|N|^2 - |D|^2`` (a polynomial in ``w^2``)."""
         out = []
         for r in row_roots(q):
             keep = (np.abs(r.imag) <= 1e-9 * (1 + np.abs(r.real))) & (r.real > 0)

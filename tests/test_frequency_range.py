@@ -64,3 +64,13 @@ def test_peaks_of_integrating_loops_with_low_crossovers_match_a_dense_grid(seed)
         assert value == pytest.approx(_dense_peak_db(G.num, G.den, cnum, cden), abs=0.05), c
         assert s_batch[k] == pytest.approx(PeakSensitivity(max_db=0.0).slack(loop), rel=1e-6, abs=1e-9)
         assert t_batch[k] == pytest.approx(PeakComplementary(max_db=0.0).slack(loop), rel=1e-6, abs=1e-9)
+
+
+def test_a_gain_that_overflows_the_magnitude_keeps_the_corners_range():
+    """|L|^2's coefficients overflow for a gain of 1e300: the range is the corners' (no crossovers), one loop and
+    batched, without an error."""
+    G = Plant.from_string("1/(s+1)")
+    huge, usual = Controller("PI", {"kp": 1e300, "ki": 1.0}), Controller("PI", {"kp": 0.037, "ki": 115.0})
+    assert Loop(G, huge).frequency_range == (0.01, 100.0)
+    ranges = LoopBatch(G, [huge, usual]).frequency_ranges
+    assert ranges[0].tolist() == [0.01, 100.0] and ranges[1].tolist() == list(Loop(G, usual).frequency_range)
