@@ -20,6 +20,7 @@ from synth.polynomial_rows import (
     row_product,
     row_rhp_counts,
     row_roots,
+    row_unit_crossings,
 )
 from synth.polynomials import dc_value, horner
 from synth.rootfind import bisect_roots
@@ -98,7 +99,7 @@ class LoopBatch:
         with np.errstate(over="ignore", invalid="ignore"):
             q = pad_sub(row_magnitude_squared(self.num), row_magnitude_squared(self.den))
         finite = np.all(np.isfinite(q), axis=1)  # gains near 1e300 overflow |L|^2: their corners alone
-        crossovers = self._crossovers_of(np.where(finite[:, None], q, 0.0))  # as Loop.frequency_range
+        crossovers = row_unit_crossings(np.where(finite[:, None], q, 0.0))  # as Loop.frequency_range
         lo = np.fmin(lo, np.array([w[0] / 100.0 if w.size else np.inf for w in crossovers]))
         hi = np.fmax(hi, np.array([w[-1] * 100.0 if w.size else 0.0 for w in crossovers]))
         self.frequency_ranges = np.column_stack([lo, hi])
@@ -288,16 +289,7 @@ class LoopBatch:
         >>> [w.round(4) for w in b.gain_crossovers()]
         [array([9.9499]), array([], dtype=float64)]
         """
-        return self._crossovers_of(pad_sub(row_magnitude_squared(self.num), row_magnitude_squared(self.den)))
-
-    @staticmethod
-    def _crossovers_of(q: np.ndarray) -> list[np.ndarray]:
-        """The positive real ``w`` of each row's ``|N|^2 - |D|^2`` (a polynomial in ``w^2``)."""
-        out = []
-        for r in row_roots(q):
-            keep = (np.abs(r.imag) <= 1e-9 * (1 + np.abs(r.real))) & (r.real > 0)
-            out.append(np.sort(np.sqrt(r[keep].real)))
-        return out
+        return row_unit_crossings(pad_sub(row_magnitude_squared(self.num), row_magnitude_squared(self.den)))
 
     def phase_and_delay_margins(self) -> tuple[np.ndarray, np.ndarray]:
         """Each loop's phase margin (deg) and delay margin (s) as :meth:`Loop.margins` gives them.

@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 
 __all__ = ["pad_sub", "row_axis_parts", "row_magnitude_squared", "row_poly_product", "row_product", "row_rhp_counts",
-           "row_roots"]
+           "row_roots", "row_unit_crossings"]
 
 
 def row_magnitude_squared(rows: np.ndarray) -> np.ndarray:
@@ -89,6 +89,22 @@ def row_roots(rows: np.ndarray) -> list[np.ndarray]:
         roots = np.linalg.eigvals(comp)
         for j, i in enumerate(sel):
             out[i] = roots[j]
+    return out
+
+
+def row_unit_crossings(q: np.ndarray) -> list[np.ndarray]:
+    """The positive real ``w`` (sorted) where each row's ``|N|^2 - |D|^2``, a polynomial in ``w^2``, is zero: the
+    gain crossovers of ``N/D``.
+
+    Examples
+    --------
+    >>> [w.round(4).tolist() for w in row_unit_crossings(np.array([[-1.0, 99.0], [-1.0, -1.0]]))]  # 10/(s+1); none
+    [[9.9499], []]
+    """
+    out = []
+    for r in row_roots(q):
+        keep = (np.abs(r.imag) <= 1e-9 * (1 + np.abs(r.real))) & (r.real > 0)
+        out.append(np.sort(np.sqrt(r[keep].real)))
     return out
 
 
