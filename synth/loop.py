@@ -207,9 +207,8 @@ class Loop:
         cn, cd = self.controller.tf()
         lo, hi = characteristic_range(cn, cd, self.plant.num, self.plant.den, delay=self.delay)
         with np.errstate(over="ignore", invalid="ignore"):  # gains near 1e300 overflow |L|^2: corners alone
-            finite = bool(np.all(np.isfinite(magnitude_squared_in_w2(self.num)))
-                          and np.all(np.isfinite(magnitude_squared_in_w2(self.den))))
-        crossovers = self.gain_crossovers() if finite else np.array([])
+            q = trim(np.polysub(magnitude_squared_in_w2(self.num), magnitude_squared_in_w2(self.den)))
+        crossovers = _unit_crossings(q) if np.all(np.isfinite(q)) else np.array([])
         if crossovers.size:
             lo, hi = min(lo, float(crossovers[0]) / 100.0), max(hi, float(crossovers[-1]) * 100.0)
         return lo, hi
@@ -227,12 +226,7 @@ class Loop:
         >>> loop.gain_crossovers().round(4)
         array([9.9499])
         """
-        q = trim(np.polysub(magnitude_squared_in_w2(self.num), magnitude_squared_in_w2(self.den)))
-        if q.size < 2:
-            return np.array([])
-        r = np.roots(q)
-        keep = (np.abs(r.imag) <= 1e-9 * (1 + np.abs(r.real))) & (r.real > 0)
-        return np.sort(np.sqrt(r[keep].real))
+        return _unit_crossings(trim(np.polysub(magnitude_squared_in_w2(self.num), magnitude_squared_in_w2(self.den))))
 
     def crossover(self) -> float | None:
         """Lowest gain-crossover frequency (rad/s), or None if ``|L|`` never crosses 1."""
@@ -383,3 +377,12 @@ def _pade(delay: float, order: int) -> tuple[np.ndarray, np.ndarray]:
     den = np.array([c * delay**k for k, c in enumerate(coeffs)])[::-1]
     num = np.array([c * (-delay) ** k for k, c in enumerate(coeffs)])[::-1]
     return num / den[0], den / den[0]
+
+
+def _unit_crossings(q: np.ndarray) -> np.ndarray:
+    """The positive real ``w`` (sorted) where ``|N|^2 - |D|^2``, the polynomial ``q`` in ``w^2``, is zero."""
+    if q.size < 2:
+        return np.array([])
+    r = np.roots(q)
+    keep = (np.abs(r.imag) <= 1e-9 * (1 + np.abs(r.real))) & (r.real > 0)
+    return np.sort(np.sqrt(r[keep].real))

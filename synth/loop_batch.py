@@ -100,6 +100,7 @@ class LoopBatch:
             q = pad_sub(row_magnitude_squared(self.num), row_magnitude_squared(self.den))
         finite = np.all(np.isfinite(q), axis=1)  # gains near 1e300 overflow |L|^2: their corners alone
         crossovers = row_unit_crossings(np.where(finite[:, None], q, 0.0))  # as Loop.frequency_range
+        self._crossovers = crossovers if bool(np.all(finite)) else None  # gain_crossovers' answer, when exact
         lo = np.fmin(lo, np.array([w[0] / 100.0 if w.size else np.inf for w in crossovers]))
         hi = np.fmax(hi, np.array([w[-1] * 100.0 if w.size else 0.0 for w in crossovers]))
         self.frequency_ranges = np.column_stack([lo, hi])
@@ -289,6 +290,8 @@ class LoopBatch:
         >>> [w.round(4) for w in b.gain_crossovers()]
         [array([9.9499]), array([], dtype=float64)]
         """
+        if self._crossovers is not None:  # found for the frequency ranges (every row finite)
+            return list(self._crossovers)
         return row_unit_crossings(pad_sub(row_magnitude_squared(self.num), row_magnitude_squared(self.den)))
 
     def phase_and_delay_margins(self) -> tuple[np.ndarray, np.ndarray]:
