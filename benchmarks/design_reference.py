@@ -7,7 +7,9 @@ nothing from synth. For a problem of ``benchmarks/design_problems.py``:
 - closed-loop stability by the argument principle on ``1 + L(s)`` along ``s = -eps + jw`` (a contour just
   left of the imaginary axis, so integrators count as open-loop poles inside it): the number of closed-loop
   poles with ``Re > -eps`` is ``P - (change of arg(1 + L))/(2 pi)`` over ``w`` from -inf to inf, with ``P``
-  the open-loop poles with ``Re > -eps`` from ``numpy.roots`` of each factor's denominator;
+  the open-loop poles with ``Re > -eps`` from ``numpy.roots`` of each factor's denominator without a delay, the
+  closed-loop poles with ``Re > -eps`` are counted directly from ``numpy.roots`` of ``den cd + num cn`` (the
+  contour passes within ``eps`` of a controller's poles on the imaginary axis and cannot follow ``1 + L`` there);
 - every requirement from its definition on a log grid of ``DENSE_PER_DECADE`` points per decade (20x the
   80 per decade synth designs on), peaks refined by bounded Brent search, crossings by ``brentq``;
 - the search: for one free parameter a grid of 400 values (linear and logarithmic) then bisection to the
@@ -175,6 +177,11 @@ class LoopModel:
         g = self.grids[DENSE_PER_DECADE if dense else COARSE_PER_DECADE]
         if cd[0] == 0 or not np.all(np.isfinite(cn)):
             return Evaluation(p, False, 99, dense=dense)
+        if self.delay == 0.0:  # a polynomial: its roots, counted directly
+            unstable = self._polynomial_count(cn, cd)
+            if unstable:
+                return Evaluation(p, False, unstable, dense=dense)
+            return self._requirements(p, cn, cd, g, dense)
         # stability: argument principle on the shifted contour
         ss = -self.eps + 1j * g["ws"]
         Ls = g["Gs"] * np.polyval(cn, ss) / np.polyval(cd, ss)
@@ -199,6 +206,23 @@ class LoopModel:
             rational_end = Ls[-1] * np.exp(self.delay * ss[-1])
             if Z != 0 or abs(rational_end - c_inf) > 0.1 * abs(c_inf):  # the grid's end must lie beyond the corners
                 return Evaluation(p, False, max(Z, 1), dense=dense)
+        return self._requirements(p, cn, cd, g, dense)
+
+    def _polynomial_count(self, cn: np.ndarray, cd: np.ndarray) -> int:
+        """Closed-loop poles with ``Re > -eps`` of a loop without delay: roots of ``den cd + num cn`` (``numpy.roots``).
+        The contour count cannot follow ``1 + L`` past open-loop poles on the imaginary axis (a controller
+        ``b0/(s^2 + a0)``): its path passes within ``eps`` of them. An improper closed loop counts as one pole."""
+        char = np.polyadd(np.polymul(self.den, cd), np.polymul(self.num, cn))
+        char = np.trim_zeros(char, "f")
+        if char.size == 0 or not np.all(np.isfinite(char)):
+            return 99
+        if char.size < max(self.den.size + cd.size, self.num.size + cn.size) - 1:  # the leading terms cancel
+            return 97
+        return int(np.sum(np.roots(char).real > -self.eps))
+
+    def _requirements(self, p: dict[str, float], cn: np.ndarray, cd: np.ndarray, g: dict[str, np.ndarray],
+                      dense: bool) -> Evaluation:
+        """Every requirement of a stable loop, on the grid ``g``."""
         ev = Evaluation(p, True, 0, dense=dense)
         w = g["w"]
         C = np.polyval(cn, 1j * w) / np.polyval(cd, 1j * w)
