@@ -495,7 +495,7 @@ def feasibility_map(spec: Any, design_controller: Any, path: Path, n: int | None
     if simulated:  # column_refined_slack
         title += (f"\n{', '.join(simulated)}: simulated at every other {xb}, and between them near its "
                   "boundary or an unstable point")
-    ax.set_title(title, fontsize=10 if simulated else None)
+    ax.set_title(title, **({"fontsize": 10} if simulated else {}))
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize=8, loc="best")
     return save_figure(fig, path)
