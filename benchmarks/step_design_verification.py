@@ -233,14 +233,20 @@ def reference(prob: dict[str, Any]) -> dict[str, Any]:
 # ------------------------------------------------------------------ run
 
 
-def run_one(seed: int, index: int, delay_share: float = 0.0) -> dict[str, Any]:
+def run_one(seed: int, index: int, delay_share: float = 0.0, stored: dict[str, Any] | None = None) -> dict[str, Any]:
+    """One problem: the reference's grid (or ``stored``, a row of :func:`reference_row`: its ``reference`` and
+    ``reference_time``) and synth's design, judged by the reference's own step."""
     from synth.design import design
     from synth.spec import parse_spec
 
     prob = problem(seed, index, delay_share)
-    t = time.perf_counter()
-    ref = reference(prob)
-    ref_time = time.perf_counter() - t
+    if stored is not None:
+        assert (stored["seed"], stored["index"], stored["delay_share"]) == (seed, index, delay_share), stored
+        ref, ref_time = stored["reference"], stored["reference_time"]
+    else:
+        t = time.perf_counter()
+        ref = reference(prob)
+        ref_time = time.perf_counter() - t
     spec = parse_spec(prob["spec"])
     t = time.perf_counter()
     result = design(spec)
@@ -258,6 +264,14 @@ def run_one(seed: int, index: int, delay_share: float = 0.0) -> dict[str, Any]:
         if ref["best"] is not None:
             row["gap"] = 1.0 - p["ki"] / ref["best"]["ki"] if ref["best"]["ki"] > 0 else 0.0
     return row
+
+
+def reference_row(seed: int, index: int, delay_share: float = 0.0) -> dict[str, Any]:
+    """The reference's grid result for one problem, to store (``--references-only``) and pass to :func:`run_one`."""
+    t = time.perf_counter()
+    ref = reference(problem(seed, index, delay_share))
+    return {"seed": seed, "index": index, "delay_share": delay_share, "reference": ref,
+            "reference_time": time.perf_counter() - t}
 
 
 def outcome(row: dict[str, Any]) -> str:
@@ -301,9 +315,20 @@ def main() -> None:
     parser.add_argument("--json", metavar="FILE", help="write one JSON row per problem")
     parser.add_argument("--delay-share", type=float, default=0.0,
                         help="probability of a delay (strictly proper plants; 0.02-0.5 slow time constants)")
+    parser.add_argument("--indices", type=int, nargs="+", help="these problems instead of --start/--n")
+    parser.add_argument("--references-only", action="store_true",
+                        help="write only the reference's rows (reference_row) to --json, for tests to reuse")
     args = parser.parse_args()
+    indices = args.indices or range(args.start, args.start + args.n)
+    if args.references_only:
+        for index in indices:
+            stored = reference_row(args.seed, index, args.delay_share)
+            if args.json:
+                with open(args.json, "a", encoding="utf-8") as fh:
+                    fh.write(json.dumps(stored, default=float) + "\n")
+        return
     rows = []
-    for index in range(args.start, args.start + args.n):
+    for index in indices:
         row = run_one(args.seed, index, args.delay_share)
         rows.append(row)
         print(f"#{index} {row['kind']} {outcome(row)} gap {100 * row.get('gap', float('nan')):.2f} % "

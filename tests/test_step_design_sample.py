@@ -15,14 +15,47 @@ keeps that loop.
 
 from __future__ import annotations
 
+import json
+from pathlib import Path
+
 import pytest
 
-from benchmarks.step_design_verification import outcome, problem, run_one, step_metrics
+from benchmarks.step_design_verification import (
+    delayed_metrics,
+    meets,
+    outcome,
+    problem,
+    reference_row,
+    run_one,
+    step_metrics,
+)
+
+STORED = Path(__file__).resolve().parents[1] / "reports" / "design_verification" / "step_sample_references.jsonl"
+"""The reference's grids for these problems (7-25 s of CPU together), made by
+``python benchmarks/step_design_verification.py --seed 1 --indices 2 5 7 9 10 --references-only --json FILE`` and
+the same with ``--indices 5 10 23 29 --delay-share 1.0``; synth's designs run live against them."""
+
+
+def _stored(index: int, delay_share: float) -> dict:
+    rows = [json.loads(line) for line in STORED.read_text(encoding="utf-8").splitlines()]
+    return next(r for r in rows if (r["seed"], r["index"], r["delay_share"]) == (1, index, delay_share))
+
+
+def test_the_stored_references_are_what_the_reference_computes_and_their_best_points_meet_the_limits() -> None:
+    assert reference_row(1, 2)["reference"] == _stored(2, 0.0)["reference"]  # the cheapest grid, recomputed
+    for line in STORED.read_text(encoding="utf-8").splitlines():
+        row = json.loads(line)
+        prob = problem(row["seed"], row["index"], row["delay_share"])
+        num, den = prob["_plant"]
+        best = row["reference"]["best"]
+        metrics = step_metrics(num, den, prob["kind"], best) if prob["delay"] == 0 else \
+            delayed_metrics(num, den, prob["delay"], prob["kind"], best, prob["slow"])
+        assert meets(metrics, prob["limits"], 0.0, 0.0), row
 
 
 @pytest.mark.parametrize("index", [2, 5, 7, 9, 10])
 def test_step_limited_design_meets_its_limits_and_beats_the_grid(index: int) -> None:
-    row = run_one(1, index)
+    row = run_one(1, index, stored=_stored(index, 0.0))
     assert outcome(row) == "agree feasible", row
     assert row["reference"]["feasible_points"] > 0
     assert row["gap"] <= 0.01, row  # synth's ki at least 99 % of the grid's best
@@ -30,7 +63,7 @@ def test_step_limited_design_meets_its_limits_and_beats_the_grid(index: int) -> 
 
 @pytest.mark.parametrize("index", [5, 10, 23, 29])
 def test_delayed_step_limited_design_meets_its_limits_and_beats_the_grid(index: int) -> None:
-    row = run_one(1, index, delay_share=1.0)
+    row = run_one(1, index, delay_share=1.0, stored=_stored(index, 1.0))
     assert row["delay"] > 0
     assert outcome(row) == "agree feasible", row
     assert row["reference"]["feasible_points"] > 0
