@@ -51,3 +51,21 @@ def test_the_intervals_agree_with_a_direct_count_at_many_gains(seed: int) -> Non
             continue
         stable = closed_loop_stability(np.polymul(k * c1[0], num), np.polymul(c1[1], den), tau).stable
         assert stable == inside, (seed, k, intervals)
+
+
+def test_many_pieces_keep_stability_exact_and_bound_the_counts_below(monkeypatch: pytest.MonkeyPatch) -> None:
+    from synth.stability_sets import COUNTED_PIECES, affine_root_counts
+
+    num, den, tau = np.array([1.0]), np.array([1.0, 1.0]), 20.0
+    gains = np.concatenate([np.linspace(0.01, 3.0, 60), np.geomspace(3.0, 900.0, 120)])
+    counted = []
+    original = stability_sets.closed_loop_stability
+    monkeypatch.setattr(stability_sets, "closed_loop_stability",
+                        lambda *a, **k: counted.append(1) or original(*a, **k))
+    counts = affine_root_counts(None, P, num, den, tau, gains)
+    monkeypatch.undo()
+    assert len(counted) < COUNTED_PIECES  # about 180 pieces hold a gain
+    direct = np.array([closed_loop_stability(k * num, den, tau).unstable_poles for k in gains])
+    assert np.array_equal(counts > 0, direct > 0)  # stable and unstable exact
+    assert np.all(counts <= direct) and np.all(counts[direct > 0] >= 1)  # a lower bound where not counted
+    assert np.array_equal(counts[gains < 1.0], direct[gains < 1.0])
