@@ -19,8 +19,8 @@ from synth.polynomials import largest_crossing, shifted, trim, value_at_infinity
 from synth.rootfind import bisect_roots
 from synth.stability import PHASE_STEP, Rational, characteristic_scale, closed_loop_stability
 
-__all__ = ["COUNTED_PIECES", "GAIN_SEARCH_LIMIT", "ROOTS_PER_CROSSING", "StabilityInterval", "affine_root_counts",
-           "affine_stability_intervals", "gain_margin_factors", "stability_boundaries"]
+__all__ = ["COUNTED_PIECES", "GAIN_SEARCH_LIMIT", "MAX_PHASE_POINTS", "ROOTS_PER_CROSSING", "StabilityInterval",
+           "affine_root_counts", "affine_stability_intervals", "gain_margin_factors", "stability_boundaries"]
 
 
 @dataclass(frozen=True)
@@ -66,6 +66,11 @@ def _boundary_function(c0: Rational | None, c1: Rational, num: np.ndarray, den: 
     return h, rho
 
 
+MAX_PHASE_POINTS = 4_000_000
+"""Most samples of a delay's phase (one per pi/8) that :func:`stability_boundaries` takes: a delay of 1e6 s behind
+``1/(s+1)`` with gains up to 1000 asked for 6e9 (45 GiB); 1/(s+1) e^(-100 s) needs 1e6 (a P design in 5 s)."""
+
+
 def stability_boundaries(
     c0: Rational | None,
     c1: Rational,
@@ -107,7 +112,13 @@ def stability_boundaries(
     w_min = 1e-4 * lo_scale
     grid = [np.geomspace(w_min, w_max, int(100 * np.log10(w_max / w_min)) + 2)]
     if delay > 0:  # the delay's phase, sampled finely up to the last frequency where |L0 + rho L1| can be 1
-        grid.append(np.linspace(0.0, w_lin, int(np.ceil(w_lin * delay / PHASE_STEP)) + 2)[1:])
+        points = int(np.ceil(w_lin * delay / PHASE_STEP)) + 2
+        if points > MAX_PHASE_POINTS:
+            raise ModelError(f"the delay of {delay:g} s turns the loop's phase {w_lin * delay / (2 * np.pi):.3g} times "
+                             f"below {w_lin:.3g} rad/s, where the loop gain can still reach 1: more than synth "
+                             f"resolves ({MAX_PHASE_POINTS * PHASE_STEP / (2 * np.pi):.3g} turns); check that the "
+                             "delay is in seconds, or narrow the controller's bounds", where="plant.delay")
+        grid.append(np.linspace(0.0, w_lin, points)[1:])
     w = np.unique(np.concatenate(grid))
     hv = h(w)
     scale = np.max(np.abs(hv)) if hv.size else 1.0

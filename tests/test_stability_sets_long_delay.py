@@ -69,3 +69,18 @@ def test_many_pieces_keep_stability_exact_and_bound_the_counts_below(monkeypatch
     assert np.array_equal(counts > 0, direct > 0)  # stable and unstable exact
     assert np.all(counts <= direct) and np.all(counts[direct > 0] >= 1)  # a lower bound where not counted
     assert np.array_equal(counts[gains < 1.0], direct[gains < 1.0])
+
+
+def test_a_delay_beyond_resolution_is_one_line_naming_the_delay(run_cli, tmp_path) -> None:
+    from synth.errors import ModelError
+    from synth.stability_sets import stability_boundaries
+
+    with pytest.raises(ModelError, match="check that the delay is in seconds") as info:
+        stability_boundaries(None, P, np.array([1.0]), np.array([1.0, 1.0]), 1e6, 1000.0)
+    assert info.value.where == "plant.delay"
+    spec = tmp_path / "slow.yaml"
+    spec.write_text('name: slow\nplant: {tf: "1/(s+1)", delay: 1000000}\ncontroller: {type: P}\n'
+                    "requirements: [{type: bandwidth, min: 0.001}]\n")
+    res = run_cli("design", str(spec), "--out", str(tmp_path / "out"))
+    assert res.code == 2 and "Traceback" not in res.err
+    assert len(res.err.strip().splitlines()) == 1 and "plant.delay" in res.err
