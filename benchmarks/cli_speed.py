@@ -13,7 +13,7 @@ both sides as an installed copy's first run does, and no timed run recompiles sy
 (user + system of the command) is printed beside the wall time: on a loaded machine it moves far less than
 the wall time.
 
-Run:  python benchmarks/cli_speed.py [--repeat 3] [--baseline-ref main | --baseline DIR] [--quick]
+Run:  python benchmarks/cli_speed.py [--repeat 3] [--baseline-ref main | --baseline DIR] [--quick] [--long-delay]
 """
 
 from __future__ import annotations
@@ -108,6 +108,32 @@ objective: {maximize: integral_gain}
 """
 
 
+LONG_DELAY_SPEC = """\
+name: dead_time_{delay}
+description: "A dead-time process: 1/(s+1) behind {delay} s, P control, bandwidth floor"
+plant:
+  tf: "1/(s+1)"
+  delay: {delay}
+controller:
+  type: P
+  bounds: {{kp: [0, 1000]}}
+requirements:
+  - {{type: bandwidth, min: 0.001}}
+"""
+
+
+def long_delay_cases(tmp: Path) -> dict[str, list[str]]:
+    """``--long-delay``: P designs behind delays long against the plant (the stabilizing set's boundaries, one
+    per turn of the delay's phase beyond the critical gain, number in the thousands)."""
+    out = {}
+    for delay in (5, 20):
+        spec = tmp / f"dead_time_{delay}.yaml"
+        spec.write_text(LONG_DELAY_SPEC.format(delay=delay), encoding="utf-8")
+        out[f"synth design dead_time_{delay}.yaml (1/(s+1) behind {delay} s, P up to 1000, with report)"] = \
+            ["design", str(spec), "--out", "{out}"]
+    return out
+
+
 def cases(tmp: Path) -> dict[str, list[str]]:
     """Label -> command arguments after ``python -m synth`` (``{out}`` is replaced by a fresh folder; a leading
     ``ENV=value`` item is set in the command's environment)."""
@@ -182,13 +208,15 @@ def main() -> None:
     parser.add_argument("--baseline-ref", default="main", help="git ref of the baseline (default main)")
     parser.add_argument("--baseline", type=Path, help="an existing checkout to use as the baseline instead")
     parser.add_argument("--quick", action="store_true", help="one timed run, and only the check command")
+    parser.add_argument("--long-delay", action="store_true",
+                        help="instead of the README's commands, P designs behind long delays (long_delay_cases)")
     args = parser.parse_args()
     repeat = 1 if args.quick else args.repeat
     with tempfile.TemporaryDirectory(prefix="synth-cli-speed-") as tmp_name:
         tmp = Path(tmp_name)
         base = args.baseline.resolve() if args.baseline else baseline_checkout(args.baseline_ref, tmp)
         try:
-            todo = cases(tmp)
+            todo = long_delay_cases(tmp) if args.long_delay else cases(tmp)
             if args.quick:
                 todo = {k: v for k, v in todo.items() if v[0] == "check"}
             sides = {"baseline": base, "current": ROOT}
