@@ -280,7 +280,7 @@ def test_margins_batch_matches_the_scalar_slack_on_unstable_and_conditionally_st
 def test_root_counts_of_a_parameter_grid_match_each_loop():
     """The feasibility map reads the stability of a PI/PID/lead-lag plane column by column off a
     D-decomposition (affine_root_counts); every count must be each loop's own."""
-    from synth.report.figures import column_root_counts
+    from synth.report.feasibility_map import column_root_counts
 
     rng = np.random.default_rng(5)
     for _ in range(6):

@@ -10,7 +10,7 @@ import pytest
 from synth.check import check
 from synth.controllers import Controller
 from synth.loop import Loop
-from synth.report.figures import MAP_GRID, MAP_GRID_SCALAR, column_refined_slack, feasibility_grid, map_grid_size
+from synth.report.feasibility_map import MAP_GRID, MAP_GRID_SCALAR, column_refined_slack, feasibility_grid, map_grid_size
 from synth.requirements import StepResponse
 from synth.requirements.margins import UNSTABLE_SLACK
 from synth.spec import parse_spec

@@ -13,7 +13,7 @@ from synth.forked import run_beside
 from synth.loop import Loop
 from synth.outputs import GENERATOR, OutputDir, dump_json, to_jsonable
 from synth.reference import compare
-from synth.report import figures
+from synth.report import feasibility_map, figures
 from synth.report.templating import render, reproducible, unit_text
 from synth.requirements import SlewRate
 from synth.requirements.base import Requirement, fmt, unique_names
@@ -108,19 +108,19 @@ def _design_figure_jobs(spec: Spec, result: DesignResult, loops: list[tuple[str,
     jobs: list[tuple[str, Any]] = []
     if result.gain_set is None and result.controller is not None \
             and len(spec.controller.free_parameters()) == 2:
-        size = figures.map_grid_size(spec)
-        if len(spec.plants()) == 1 and size == figures.MAP_GRID and not any(r.costly for r in spec.requirements):
-            jobs.append(("region", job(lambda: figures.feasibility_map(
+        size = feasibility_map.map_grid_size(spec)
+        if len(spec.plants()) == 1 and size == feasibility_map.MAP_GRID and not any(r.costly for r in spec.requirements):
+            jobs.append(("region", job(lambda: feasibility_map.feasibility_map(
                 spec, result.controller, out.claim("feasible_region.png"), reference=ref))))
         elif len(spec.plants()) == 1:  # a requirement that simulates (vectorized or point by point): every other
             # column per job
             for k in range(2):
                 jobs.append((f"region-columns:{k}", lambda k=k: (
-                    figures.feasibility_grid(spec, result.controller, columns=slice(k, None, 2)), None, [])))
+                    feasibility_map.feasibility_grid(spec, result.controller, columns=slice(k, None, 2)), None, [])))
         else:  # the plane's grid one plant per job (both cores share them), drawn when all are in
             for k in range(len(spec.plants())):
                 jobs.append((f"region:{k}", lambda k=k: (
-                    figures.feasibility_grid(spec, result.controller, plants=[k]), None, [])))
+                    feasibility_map.feasibility_grid(spec, result.controller, plants=[k]), None, [])))
     gain = result_data.get("gain_set_detail")
     if gain is not None:  # the heavier jobs first: the worker starts on them
         jobs.append(("gain_set", job(lambda: figures.gain_set_plot(
@@ -319,8 +319,8 @@ def write_design_report(spec: Spec, result: DesignResult, out_dir: str | Path, *
         if drawn is not None:
             bounds[key] = drawn
     if plane or halves:
-        grid = figures.combine_grids(plane) if plane else figures.join_columns(halves)
-        figs["region"] = figures.feasibility_map(spec, result.controller, out.claim("feasible_region.png"),
+        grid = feasibility_map.combine_grids(plane) if plane else feasibility_map.join_columns(halves)
+        figs["region"] = feasibility_map.feasibility_map(spec, result.controller, out.claim("feasible_region.png"),
                                                  reference=ref, grid=grid)
     figs = {key: figs[key] for key in _FIGURE_ORDER if key in figs} | figs
     gain = data.get("gain_set_detail")
