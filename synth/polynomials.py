@@ -6,6 +6,8 @@ from typing import Any
 
 import numpy as np
 
+from synth.errors import ModelError
+
 __all__ = ["dc_value", "format_factored", "horner", "largest_crossing", "magnitude_squared_in_w2", "mirror", "shifted",
            "trim", "value_at_infinity"]
 
@@ -128,7 +130,12 @@ def largest_crossing(num: np.ndarray, den: np.ndarray, level: float) -> float:
     >>> round(largest_crossing(np.array([10.0]), np.array([1.0, 1.0]), 1.0), 4)  # |10/(jw+1)| = 1
     9.9499
     """
-    q = np.polysub(magnitude_squared_in_w2(num), level**2 * magnitude_squared_in_w2(den))
+    with np.errstate(over="ignore", invalid="ignore"):
+        q = np.polysub(magnitude_squared_in_w2(num), level**2 * magnitude_squared_in_w2(den))
+    if not np.all(np.isfinite(q)):
+        largest = max(float(np.max(np.abs(num))), float(np.max(np.abs(den))))
+        raise ModelError(f"a loop's magnitude overflows double precision (coefficients up to {largest:.3g}): "
+                         "rescale the plant's or the controller's units")
     q = trim(q)
     if q.size < 2:
         return 0.0

@@ -25,6 +25,7 @@ from synth.errors import ModelError
 from synth.polynomials import largest_crossing, shifted, trim, value_at_infinity
 
 __all__ = [
+    "MAX_PHASE_POINTS",
     "PHASE_STEP",
     "STABILITY_FLOOR",
     "Rational",
@@ -35,6 +36,13 @@ __all__ = [
 ]
 
 PHASE_STEP = np.pi / 8.0
+
+MAX_PHASE_POINTS = 4_000_000
+"""Most samples of a delay's phase (one per :data:`PHASE_STEP`) that a Nyquist count or a D-decomposition takes:
+a P gain of 1e9 behind 20 s of delay asked the count for 1e11 (797 GiB), a delay of 1e6 s behind ``1/(s+1)``
+with gains up to 1000 the D-decomposition for 6e9; 1/(s+1) e^(-100 s) needs 1e6 (a P design in 5 s). Beyond it
+a count is not made (the loop is not certified stable) and a D-decomposition is refused
+(:class:`synth.errors.ModelError`: check the delay's units)."""
 
 
 @dataclass(frozen=True)
@@ -88,7 +96,7 @@ class StabilityResult:
             where = "in the right half-plane" if self.neutral_gain > 1.0 else "accumulating at the imaginary axis"
             return (f"closed loop UNSTABLE: |L(j inf)| = {self.neutral_gain:.4g} >= 1 with a delay (neutral type), "
                     f"infinitely many roots {where}")
-        if self.near_axis is not None and self.unstable_poles == 0:
+        if (self.near_axis is not None and self.unstable_poles == 0) or self.method.startswith("not counted"):
             return f"closed loop not certified stable ({self.method})"
         if self.near_axis is not None:
             return (f"closed loop not stable in practice: {self.unstable_poles} root(s) within {self.near_axis:.3g} "
@@ -304,6 +312,11 @@ def _count(num: np.ndarray, den: np.ndarray, delay: float) -> StabilityResult:
     w_top = largest_crossing(num, den, level)
     axis_max = max((w for w, _ in axis), default=0.0)
     w_top = max(w_top * 1.05, 2.0 * axis_max, 1e-3 * w_lo_scale)
+    if w_top * delay / PHASE_STEP > MAX_PHASE_POINTS:  # not counted: not certified stable (at least one root)
+        return StabilityResult(False, 1, n_rhp, f"not counted: the delay of {delay:g} s turns the loop's phase "
+                               f"{w_top * delay / (2 * np.pi):.3g} times below {w_top:.3g} rad/s, where its gain "
+                               f"falls to {level:g}, more than synth resolves "
+                               f"({MAX_PHASE_POINTS * PHASE_STEP / (2 * np.pi):.3g} turns): not certified stable")
 
     F = _ReturnDifference(num, den, delay)
     eps0 = 1e-6 * w_lo_scale

@@ -17,9 +17,9 @@ import numpy as np
 from synth.errors import ModelError
 from synth.polynomials import largest_crossing, shifted, trim, value_at_infinity
 from synth.rootfind import bisect_roots
-from synth.stability import PHASE_STEP, Rational, characteristic_scale, closed_loop_stability
+from synth.stability import MAX_PHASE_POINTS, PHASE_STEP, Rational, characteristic_scale, closed_loop_stability
 
-__all__ = ["COUNTED_PIECES", "GAIN_SEARCH_LIMIT", "MAX_PHASE_POINTS", "ROOTS_PER_CROSSING", "StabilityInterval",
+__all__ = ["COUNTED_PIECES", "GAIN_SEARCH_LIMIT", "ROOTS_PER_CROSSING", "StabilityInterval",
            "affine_root_counts", "affine_stability_intervals", "gain_margin_factors", "stability_boundaries"]
 
 
@@ -64,11 +64,6 @@ def _boundary_function(c0: Rational | None, c1: Rational, num: np.ndarray, den: 
             return np.where(np.abs(bottom) < 1e-300, np.inf, np.real(-top / bottom))
 
     return h, rho
-
-
-MAX_PHASE_POINTS = 4_000_000
-"""Most samples of a delay's phase (one per pi/8) that :func:`stability_boundaries` takes: a delay of 1e6 s behind
-``1/(s+1)`` with gains up to 1000 asked for 6e9 (45 GiB); 1/(s+1) e^(-100 s) needs 1e6 (a P design in 5 s)."""
 
 
 def stability_boundaries(

@@ -84,3 +84,20 @@ def test_a_delay_beyond_resolution_is_one_line_naming_the_delay(run_cli, tmp_pat
     res = run_cli("design", str(spec), "--out", str(tmp_path / "out"))
     assert res.code == 2 and "Traceback" not in res.err
     assert len(res.err.strip().splitlines()) == 1 and "plant.delay" in res.err
+
+
+def test_a_count_beyond_resolution_is_not_certified_and_an_overflow_is_one_line(run_cli, tmp_path) -> None:
+    from synth.errors import ModelError
+    from synth.polynomials import largest_crossing
+
+    result = closed_loop_stability(np.array([1e9]), np.array([1.0, 1.0]), 20.0)  # 797 GiB of phase samples before
+    assert not result.stable and result.unstable_poles >= 1
+    assert result.describe().startswith("closed loop not certified stable (not counted")
+    assert closed_loop_stability(np.array([1e3]), np.array([1.0, 1.0]), 20.0).unstable_poles > 1  # still counted
+    with pytest.raises(ModelError, match="overflows double precision"):
+        largest_crossing(np.array([1e300]), np.array([1.0, 1.0]), 0.5)
+    spec = tmp_path / "x4.yaml"
+    spec.write_text('name: x4\nplant: {tf: "23*(s+0.43)/((s+9.6)*(s+0.54))"}\ncontroller: {type: P}\n'
+                    "requirements: [{type: bandwidth, min: 1}]\n")
+    res = run_cli("check", str(spec), "--controller", "P(1e300)")
+    assert res.code == 2 and "Traceback" not in res.err and "overflows double precision" in res.err
