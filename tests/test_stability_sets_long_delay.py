@@ -101,3 +101,9 @@ def test_a_count_beyond_resolution_is_not_certified_and_an_overflow_is_one_line(
                     "requirements: [{type: bandwidth, min: 1}]\n")
     res = run_cli("check", str(spec), "--controller", "P(1e300)")
     assert res.code == 2 and "Traceback" not in res.err and "overflows double precision" in res.err
+    delayed = tmp_path / "delayed.yaml"
+    delayed.write_text('name: d\nplant: {tf: "1/(s+1)", delay: 20}\ncontroller: {type: P}\n'
+                       "requirements: [{type: bandwidth, min: 0.001}]\n")
+    res = run_cli("check", str(delayed), "--controller", "P(1e9)")
+    assert res.code == 1 and "Traceback" not in res.err
+    assert "not certified" in res.out and "unstable root" not in res.out.split("\n - ")[0]

@@ -43,7 +43,9 @@ def requirement_rows(results: list[RequirementResult], requirements: list[Requir
     reqs = iter(requirements)
     for r in results:
         if r.type == "stability":
-            value, bound = ("stable" if r.met else f"{int(r.value)} unstable root(s)"), "stable"
+            value = "stable" if r.met else "not certified" if "not certified stable" in r.message else \
+                f"{int(r.value)} unstable root(s)"
+            bound = "stable"
         else:
             value, bound = f"{fmt(r.value)} {r.unit}", next(reqs).report_row(r).bound_text()
         plant = f" [{r.plant}]" if r.plant and r.plant != "nominal" else ""
