@@ -294,7 +294,10 @@ def _ipopt(structure: Any, w: np.ndarray, H: np.ndarray, coh: np.ndarray, theta0
     x0 = list(theta0) + ([min(max(delay0, 0.0), delay_max)] if fit_delay else [])
     sol = solver(x0=x0, lbx=lbx, ubx=ubx)
     xs = np.asarray(sol["x"]).ravel()
-    return xs[:npar], float(xs[npar]) if fit_delay else delay0, str(solver.stats()["return_status"])
+    # IPOPT relaxes its bounds by a relative 1e-8 (bound_relax_factor): a delay at its bound of 0 comes back as
+    # -1e-8, which no plant accepts (a delay-free sweep's fit failed on it)
+    tau = float(np.clip(xs[npar], 0.0, delay_max)) if fit_delay else delay0
+    return xs[:npar], tau, str(solver.stats()["return_status"])
 
 
 def _data(resp: FrequencyResponse | tuple[Any, Any, Any]) -> tuple[np.ndarray, np.ndarray, np.ndarray, tuple | None]:

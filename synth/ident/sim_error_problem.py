@@ -229,6 +229,8 @@ class SimulationErrorProblem:
             x0[self.p] = max(x0[self.p], 0.1 * self.dt)
         sol = self.solver(x0=x0, p=par, lbx=lbx, ubx=ubx)
         stats = self.solver.stats()
-        return (np.asarray(sol["x"]).ravel(), float(sol["f"]) * 2 * self.obj_scale,
+        # IPOPT relaxes its bounds by a relative 1e-8 (bound_relax_factor): a delay at its bound of 0 would come back
+        # as -1e-8, which no plant accepts
+        return (np.clip(np.asarray(sol["x"]).ravel(), lbx, ubx), float(sol["f"]) * 2 * self.obj_scale,
                 {"status": stats.get("return_status"), "iterations": int(stats.get("iter_count", 0)),
                  "success": bool(stats.get("success"))})
