@@ -23,3 +23,13 @@ def test_a_delay_free_sweep_fits_with_delay_zero_not_a_failure(run_cli, tmp_path
     assert res.code == 0, res.out + res.err
     fit = json.loads((tmp_path / "out" / "result.json").read_text())["fit"]
     assert fit["parameters"]["delay"] == 0.0
+
+
+def test_a_record_too_short_for_the_default_band_says_so(run_cli, tmp_path) -> None:
+    t = np.arange(20) / 100.0
+    data = tmp_path / "short.csv"
+    data.write_text("t,u,y\n" + "".join(f"{a},{np.sin(9 * a)},{np.cos(9 * a)}\n" for a in t))
+    res = run_cli("freqresp", "--data", str(data), "--time", "t", "--input", "u", "--output", "y",
+                  "--out", str(tmp_path / "out"))
+    assert res.code == 2 and "Traceback" not in res.err and len(res.err.strip().splitlines()) == 1
+    assert "too short for a frequency response: its 20 samples" in res.err and "w_min < w_max" not in res.err

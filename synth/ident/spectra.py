@@ -181,8 +181,15 @@ def frequency_response(
     if detrend not in ("linear", "constant", "none"):
         raise DataError(f"detrend must be 'linear', 'constant' or 'none', got {detrend!r}")
     nyquist = np.pi * fs
+    given_min, given_max = w_min is not None, w_max is not None
     w_min = lowest_frequency(runs, overlap) if w_min is None else float(w_min)
     w_max = 0.2 * nyquist if w_max is None else float(w_max)
+    if not (0 < w_min < w_max) and not (given_min and given_max):
+        samples = max(r.t.size for r in runs)
+        raise DataError(f"the record is too short for a frequency response: its {samples} samples "
+                        f"({samples / fs:.3g} s) reach down to {w_min:.4g} rad/s only, above the default top of "
+                        f"{w_max:.4g} rad/s (a fifth of the Nyquist frequency {nyquist:.4g} rad/s); record longer, "
+                        "or give both --wmin and --wmax")
     if not (0 < w_min < w_max):
         raise DataError(f"need 0 < w_min < w_max, got w_min = {w_min:g}, w_max = {w_max:g} rad/s")
     if w_max > nyquist:
