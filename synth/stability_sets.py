@@ -148,6 +148,19 @@ count of a piece that must hold right-half-plane roots by this bound; a boundary
 biproper loop's) can take any number."""
 
 
+def roots_crossing(boundaries: list[tuple[float, float]]) -> np.ndarray:
+    """The most closed-loop roots that can cross the imaginary axis at each boundary ``(rho, w)`` of
+    :func:`stability_boundaries`: :data:`ROOTS_PER_CROSSING` at a finite frequency, any number (``inf``) at an
+    infinite one.
+
+    Examples
+    --------
+    >>> roots_crossing([(8.0, 1.7), (2.0, float("inf"))]).tolist()
+    [4.0, inf]
+    """
+    return np.array([float(ROOTS_PER_CROSSING) if np.isfinite(w) else np.inf for _, w in boundaries])
+
+
 def affine_stability_intervals(
     c0: Rational | None,
     c1: Rational,
@@ -206,8 +219,8 @@ def affine_stability_intervals(
     freq = {r: w for r, w in bounds}
     pieces: list[StabilityInterval] = []
     leaving: dict[float, float] = {}  # most roots that can cross the axis at each boundary value
-    for r, w in bounds:
-        leaving[r] = leaving.get(r, 0.0) + (np.inf if not np.isfinite(w) else ROOTS_PER_CROSSING)
+    for (r, _), most in zip(bounds, roots_crossing(bounds)):
+        leaving[r] = leaving.get(r, 0.0) + most
 
     def unstable_at(r: float) -> int:
         cn, cd = _combine(c0, c1, r)
@@ -276,8 +289,7 @@ def affine_root_counts(
     rho_max = float(np.max(np.abs(values))) * 1.0001 + 1e-12
     boundaries = sorted(stability_boundaries(b_c0, b_c1, b_num, b_den, delay, rho_max))
     edges = np.array([r for r, _ in boundaries])
-    # the most roots that can cross the axis at each boundary (one pair, doubled; any number at infinity)
-    crossing = np.array([ROOTS_PER_CROSSING if np.isfinite(w) else np.inf for _, w in boundaries])
+    crossing = roots_crossing(boundaries)
 
     def count_at(r: float) -> int:
         cn, cd = _combine(c0, c1, r)
