@@ -188,6 +188,9 @@ def run(args: argparse.Namespace) -> int:
               + (f"{b.w_min:.4g}-{b.w_max:.4g} rad/s" if b.found else "none"))
         for note in resp.corrections:
             print(f"correction: {note}")
+        if len(quality) == 1 and not args.off_axis and "warning" in quality[0].reason:
+            print(f"run quality: {quality[0].reason} (input spread {quality[0].input_db_spread:.1f} dB; an "
+                  "under-excited frequency's response may be leakage from the others, coherence or not)")
         if len(quality) > 1 or args.off_axis:
             print("runs, best first (" + ("keep " + ", ".join(q.source for q in quality if q.keep)) + "):")
             for q in quality:
