@@ -32,7 +32,9 @@ def test_x4_record_within_3_percent_and_2_ms(x4_result):
     for name in ("k", "z", "p1", "p2"):
         assert p[name] == pytest.approx(TRUTH[name], rel=0.03), name
     assert abs(p["delay"] - TRUTH["delay"]) < 0.002
-    assert x4_result.average.count == 69
+    # 70 periods: the first holds the first step, the second starts 3 s into the train, within the step
+    # response's settling time of the fitted F*H (3.3 s), so it holds some of the start-up transient
+    assert x4_result.average.count == 68 and "dropped 1 more period" in x4_result.whole_record_note
     assert x4_result.fit.solver["success"]
 
 
@@ -42,8 +44,8 @@ def test_x4_confidence_intervals_cover_truth_and_std_is_plausible(x4_result):
     # the 95 % intervals are about +-2 std; the truth lies within 4 std for every parameter
     for name in ("k", "z", "delay"):
         assert abs(p[name] - TRUTH[name]) < 4 * fit.std[name], name
-    # residual std of the average equals the averaged noise (white Gaussian 1.25 / sqrt(69))
-    assert fit.residual_std == pytest.approx(1.25 / np.sqrt(69), rel=0.1)
+    # residual std of the average equals the averaged noise (white Gaussian 1.25 / sqrt(68))
+    assert fit.residual_std == pytest.approx(1.25 / np.sqrt(68), rel=0.1)
     assert fit.fit_percent > 99.5
 
 

@@ -163,6 +163,8 @@ class StepAverage:
         ``True`` in ``"cycle"`` mode: fit the average with a periodic initial state.
     steps : Steps
         The steps found in the record.
+    first_window : int
+        Sample of the record where the first averaged window starts (``"cycle"`` mode; 0 otherwise).
     """
 
     mode: str
@@ -184,6 +186,7 @@ class StepAverage:
     output: Signal = field(default_factory=lambda: Signal("y", ""))
     source: str = "arrays"
     up_index: int = 0
+    first_window: int = 0
 
     def record(self) -> Record:
         """The averaged window as a :class:`~synth.data.Record` (time starting at the window's start).
@@ -249,7 +252,7 @@ def _snr(step: float, sigma: float) -> float:
 
 
 def average_steps(record: Record, steps: Steps | None = None, mode: str = "auto", pre: float | None = None,
-                  direction: int = 0) -> StepAverage:
+                  direction: int = 0, settle: float = 0.0) -> StepAverage:
     """Cut, align and average the step responses of a record.
 
     Parameters
@@ -282,6 +285,8 @@ def average_steps(record: Record, steps: Steps | None = None, mode: str = "auto"
     >>> avg = average_steps(x4_step_train())
     >>> avg.mode, avg.count, avg.dropped, round(avg.snr_before_db), round(avg.snr_after_db)
     ('cycle', 69, 1, 39, 57)
+    >>> average_steps(x4_step_train(), settle=10.0).count          # periods from 10 s after the first step
+    67
     >>> down = average_steps(x4_step_train(), direction=-1)
     >>> down.mode, down.count, (down.up, down.down), down.step_size > 0
     ('edge', 69, (0, 69), True)
@@ -302,16 +307,17 @@ def average_steps(record: Record, steps: Steps | None = None, mode: str = "auto"
         raise DataError("the input is not a periodic square wave (steps must alternate at a constant period); "
                         "use mode='edge'", where=record.source)
     if mode == "cycle" or (mode == "auto" and periodic is not None):
-        return _average_cycles(record, steps, *periodic)  # type: ignore[misc]
+        return _average_cycles(record, steps, *periodic, settle)  # type: ignore[misc]
     return _average_edges(record, steps, pre)
 
 
-def _average_cycles(record: Record, steps: Steps, period: int, high: int) -> StepAverage:
+def _average_cycles(record: Record, steps: Steps, period: int, high: int, settle: float = 0.0) -> StepAverage:
     low_time = period - high
     ups = steps.index[steps.direction > 0]
     starts = ups - low_time
     keep = (starts >= 0) & (starts + period <= record.n)
     first = int(np.argmax(keep)) if np.any(keep) else 0
+    keep &= starts - steps.index[0] >= settle / record.dt - 1e-9
     use = [s for j, s in enumerate(starts) if keep[j] and j > first]  # drop the period holding the first step
     if not use and np.count_nonzero(keep) == 1:
         raise DataError("only one complete period in the record; a periodic average needs two", where=record.source)
@@ -327,7 +333,7 @@ def _average_cycles(record: Record, steps: Steps, period: int, high: int) -> Ste
     t = (np.arange(period) - low_time) * record.dt
     return StepAverage("cycle", t, u, y, len(use), len(use), len(use), int(ups.size) - len(use), step, before, after,
                        _snr(step, before), _snr(step, after), True, steps, record.input, record.output, record.source,
-                       low_time)
+                       low_time, int(use[0]))
 
 
 def _average_edges(record: Record, steps: Steps, pre: float | None, direction: int = 0) -> StepAverage:
