@@ -70,6 +70,8 @@ def test_dt_without_time_column(run_cli, tmp_path):
      "time is not strictly increasing at sample 7"),
     (lambda p: _write(p, _signal(1, 5000)), ["--w-min", "0.5"], "the lowest frequency 0.5 rad/s needs segments of 25.13 s"),
     (lambda p: _write(p, _signal(1)), ["--share", "1.5"], "share must lie strictly between 0 and 1"),
+    (lambda p: p.write_text("t,speed\n" + "".join(f"{k / 1000},{(k % 7) * 1e300}\n" for k in range(200))), [],
+     "column 'speed': values up to 6e+300 overflow its power spectrum"),   # was a matplotlib traceback
 ])
 def test_bad_input_one_line_exit_2(run_cli, tmp_path, make, extra, match):
     p = tmp_path / "d.csv"

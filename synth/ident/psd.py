@@ -247,6 +247,9 @@ def analyze_records(records: Sequence[DisturbanceRecord], noise: Sequence[Distur
     >>> analyze_records([a, b])
     Traceback (most recent call last):
     synth.errors.DataError: arrays: sample interval 0.002 s differs from the 0.001 s of arrays; resample first
+    >>> analyze_records([disturbance_from_arrays(t, 1e300 * np.sin(50 * t))])
+    Traceback (most recent call last):
+    synth.errors.DataError: arrays: column 'y': values up to 1e+300 overflow its power spectrum; rescale the signal
     """
     if not records:
         raise DataError("give at least one record", where="psd")
@@ -256,6 +259,12 @@ def analyze_records(records: Sequence[DisturbanceRecord], noise: Sequence[Distur
         if abs(r.dt - dt0) > 1e-6 * dt0:
             raise DataError(f"sample interval {r.dt:g} s differs from the {dt0:g} s of {everything[0].source}; "
                             "resample first", where=r.source)
+    for r in everything:
+        with np.errstate(over="ignore", invalid="ignore"):
+            power = float(np.sum((r.x - np.mean(r.x)) ** 2))
+        if not np.isfinite(power):
+            raise DataError(f"column '{r.name}': values up to {float(np.max(np.abs(r.x))):.3g} overflow its power "
+                            "spectrum; rescale the signal", where=r.source)
     unit = options.pop("unit", records[0].unit)
     result = analyze_psd([r.x for r in records], dt0, noise=[r.x for r in noise] or None, unit=unit, **options)
     notes = tuple(f"{r.source}: {n}" for r in everything for n in r.notes)
