@@ -118,7 +118,8 @@ def _runs(at: np.ndarray) -> tuple[int, int]:
 
 
 def find_clipping(x: np.ndarray, column: str = "output", name: str = "", unit: str = "", *, record: str = "record",
-                  min_samples: int = 3, ratio: float = 2.0, min_distinct: float = 0.5) -> list[Clipping]:
+                  min_samples: int = 3, ratio: float = 2.0, min_distinct: float = 0.5,
+                  resting: np.ndarray | None = None) -> list[Clipping]:
     """Ends of ``x`` where the signal rests on its extreme value (see the module text).
 
     Parameters
@@ -137,6 +138,9 @@ def find_clipping(x: np.ndarray, column: str = "output", name: str = "", unit: s
         The extreme's count must exceed ``ratio`` times any other value's count.
     min_distinct : float
         Share of distinct values among the other samples for the signal to be continuous-valued.
+    resting : ndarray of bool, optional
+        Samples left out of the count: where the plant rests (its command at its initial level), an output
+        that holds one value is at rest, not clipped (an encoder reads exactly 0 while the motor stands).
 
     Returns
     -------
@@ -151,8 +155,13 @@ def find_clipping(x: np.ndarray, column: str = "output", name: str = "", unit: s
     [('upper', 0.8, 4)]
     >>> find_clipping(np.repeat([5.0, 15.0], 100), "input")  # a step command rests on its levels by design
     []
+    >>> y = np.r_[np.zeros(200), 1 - np.exp(-np.linspace(0.01, 5, 500))]   # at rest, then a step response
+    >>> len(find_clipping(y)), find_clipping(y, resting=np.r_[np.ones(200, bool), np.zeros(500, bool)])
+    (1, [])
     """
     x = np.asarray(x, float).ravel()
+    if resting is not None:
+        x = x[~np.asarray(resting, bool).ravel()]
     if column not in ("input", "output"):
         raise ValueError(f"column must be 'input' or 'output', got {column!r}")
     if x.size < 2 * min_samples or not np.all(np.isfinite(x)):
@@ -175,7 +184,8 @@ def find_clipping(x: np.ndarray, column: str = "output", name: str = "", unit: s
 
 
 def record_clipping(record: Record, which: str = "record") -> list[Clipping]:
-    """Clipping of a record's command and output (:func:`find_clipping` on each).
+    """Clipping of a record's command and output (:func:`find_clipping` on each; the output's samples where the
+    command sits at its initial level are the plant at rest and left out).
 
     Parameters
     ----------
@@ -197,4 +207,5 @@ def record_clipping(record: Record, which: str = "record") -> list[Clipping]:
     ['saturation(output)']
     """
     return [*find_clipping(record.u, "input", record.input.name, record.input.unit, record=which),
-            *find_clipping(record.y, "output", record.output.name, record.output.unit, record=which)]
+            *find_clipping(record.y, "output", record.output.name, record.output.unit, record=which,
+                           resting=record.u == record.u[0])]
