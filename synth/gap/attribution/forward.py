@@ -115,9 +115,10 @@ class ForwardSelection:
         ci = self.ratio_ci(s, s_a)
         share = share_of_excess(j_a, j, self.floor)
         significant = bool(ci[0] > self.threshold)
-        accepted = bool(significant and share >= self.min_share)
         second = nested.second
         params = {k: float(fit.params[k]) for k in second.parameter_names}
+        unphysical = second.outside_bounds(params, self.t_tr, self.u_tr, self.plant)
+        accepted = bool(significant and share >= self.min_share and not unphysical)
         res = EffectResult(nested.label, params, dict(fit.parameter_ci), 1.0 - j / j_a if j_a > 0 else 0.0, ci,
-                           significant, float(share), accepted, j, dict(fit.nominal), "joint")
+                           significant, float(share), accepted, j, dict(fit.nominal), "joint", unphysical)
         return nested, fit, res, yhat, s

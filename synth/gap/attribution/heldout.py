@@ -370,12 +370,13 @@ def diagnose_effects(plant: Plant, record: Record, validate: Record | Sequence[R
         share_ref = share_of_excess(j_ref, j, floor)
         significant = bool(gap_present and ci[0] > threshold)
         joint = isinstance(fit, AugmentedFit)
-        relevant = bool(significant and share_ref >= min_share and joint)
         params = {k: float(fit.params[k]) for k in eff.parameter_names}
+        unphysical = eff.outside_bounds(params, sp.train.t, sp.train.u, plant)
+        relevant = bool(significant and share_ref >= min_share and joint and not unphysical)
         p_ci = fit.parameter_ci if joint else {}
         nominal = dict(fit.nominal) if joint else screened_coefficients(fit.plant)
         res = EffectResult(eff.label, params, p_ci, shrink, ci, significant, float(share), relevant, j, nominal,
-                           "joint" if joint else "screened")
+                           "joint" if joint else "screened", unphysical)
         results.append((res, yhat, s))
     segments = HeldoutSegments({"nominal": s_nom, "refit": s_ref, **{r.effect: s for r, _, s in results}}, counts,
                                np.arange(n_blocks) // blocks,

@@ -69,6 +69,9 @@ class EffectResult:
     fit : str
         ``"joint"`` (casadi re-fit with the nominal coefficients) or ``"screened"``
         (denominator fixed, see :mod:`synth.gap.attribution.screen`; never accepted).
+    unphysical : str
+        Why the fitted parameters leave the effect's physical range for this record
+        (:func:`outside_physical_range`); such a candidate is never accepted. Empty: inside it.
     """
 
     effect: str
@@ -82,6 +85,7 @@ class EffectResult:
     j_heldout: float
     nominal: dict[str, float]
     fit: str = "joint"
+    unphysical: str = ""
 
     def to_dict(self) -> dict[str, Any]:
         """JSON entry of ``"effects"``.
@@ -97,7 +101,8 @@ class EffectResult:
                 "parameter_ci": {k: [float(a), float(b)] for k, (a, b) in self.parameter_ci.items()},
                 "shrinkage": self.shrinkage, "shrinkage_ci": [float(x) for x in self.shrinkage_ci],
                 "significant": self.significant, "share_of_gap": self.share_of_gap, "accepted": self.accepted,
-                "j_heldout": self.j_heldout, "nominal": dict(self.nominal), "fit": self.fit}
+                "j_heldout": self.j_heldout, "nominal": dict(self.nominal), "fit": self.fit,
+                **({"unphysical": self.unphysical} if self.unphysical else {})}
 
 
 @dataclass(frozen=True, eq=False)
@@ -270,8 +275,8 @@ def not_carried(diagnosis: EffectDiagnosis, confirm: int | None, min_share: floa
 
     A candidate the screen ranked below the ``confirm`` best (by screened training error) is never
     re-fitted jointly, and a screened fit cannot be the verdict; a joint fit may fall short of the
-    calibrated threshold, of ``min_share`` of the re-fit's excess over noise, or be grouped with or
-    displaced by the leader.
+    calibrated threshold, of ``min_share`` of the re-fit's excess over noise, leave the effect's physical
+    range, or be grouped with or displaced by the leader.
 
     Parameters
     ----------
@@ -322,6 +327,9 @@ def not_carried(diagnosis: EffectDiagnosis, confirm: int | None, min_share: floa
             reason = (f"screened only: not among the {confirm} best by screened training error, which were "
                       f"re-fitted jointly ({', '.join(joint) or 'none'}), or its joint re-fit failed; a screened fit "
                       "(denominator held) cannot be the verdict: name it alone with --candidates to fit it jointly")
+        elif r.unphysical:
+            reason = (f"fitted jointly, but not a physical {label.replace('_', ' ')}: {r.unphysical} (the data "
+                      "fit better with it, but through a mechanism no such effect has)")
         elif not r.significant:
             reason = (f"fitted jointly; its held-out shrinkage interval [{lo:.2f}, {hi:.2f}] does not clear the "
                       f"calibrated threshold {diagnosis.threshold:.3f}")
