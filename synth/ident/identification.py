@@ -232,7 +232,7 @@ def step_settling_time(plant: Plant, fraction: float = np.exp(-5.0)) -> float:
     """Time after which the step response of ``plant`` stays within ``fraction`` of its final value [s].
 
     What a transient leaves in the output: a slow pole that a near zero cancels settles sooner here than in
-    :func:`settling_time` (which this never exceeds); that one when the static gain is 0 or infinite.
+    :func:`settling_time`, which this never exceeds (and returns when the static gain is 0 or infinite).
 
     Examples
     --------
@@ -299,9 +299,7 @@ def _refit_from_rest(record: Record, avg: StepAverage, fit: TimeFitResult, struc
     the rest it assumes holds for the model it gives. Otherwise the periodic fit stays."""
     settle = settling_time(fit.measured)
     first = float(record.t[avg.steps.index[0]] - record.t[0])
-    if not np.isfinite(settle) or first <= 0:
-        return fit, ""
-    if first < settle and not fit.weak:
+    if not np.isfinite(settle) or first <= 0 or (first < settle and not fit.weak):
         return fit, ""
     skip = min(settle, first)
     weights = ((record.t - record.t[0]) >= skip).astype(float)
@@ -330,30 +328,31 @@ def _drop_transient_periods(record: Record, avg: StepAverage, fit: TimeFitResult
     the train began: within the model's settling time (:func:`step_settling_time`), the average holds part of the
     start-up transient (a step every time constant, 0.5 s periods after a 1 s rest: k and tau 13 standard errors
     off over 20 noise seeds).
+
     Unless the constant start is long enough for the whole-record fit (:func:`_refit_from_rest`), the periods
     that start within the settling time are dropped and the rest refitted, until the model's settling time
-    agrees (at most three rounds); with no period left, the whole record is fitted, its first settling time
-    weighted 0. Returns the fit, its average and a note (empty: nothing changed)."""
-    if fit.weak:
-        return fit, avg, ""   # its model's settling time is not known: _refit_from_rest decides on the whole record
+    agrees (at most three rounds); with no period left, or when their fit fails, the whole record is fitted,
+    its first settling time weighted 0. Returns the fit, its average and a note (empty: nothing changed)."""
     train = float(record.t[avg.steps.index[0]])
     first = train - float(record.t[0])
+    if fit.weak or first >= settling_time(fit.measured):
+        return fit, avg, ""   # _refit_from_rest fits the whole record, the start-up transient from rest included
     dropped, settle = 0, step_settling_time(fit.measured)
     for _ in range(3):
         lead = float(record.t[avg.first_window]) - train
-        if not np.isfinite(settle) or lead >= settle or first >= settle:
+        if not np.isfinite(settle) or lead >= settle:
             break
         try:
             later = average_steps(record, avg.steps, "cycle", settle=settle)
         except DataError:
-            whole, note = _refit_transient(record, fit, structure, delay, sensor, settle, lead)
-            return whole, avg, note
+            return _with_average(_refit_transient(record, fit, structure, delay, sensor, settle, lead,
+                                                  "no later period is left"), avg)
         try:
             fit = fit_structure(later.record(), structure, delay, sensor, True, initial={**fit.parameters},
                                 check=True)
         except FitError as exc:
-            whole, note = _refit_transient(record, fit, structure, delay, sensor, settle, lead)
-            return whole, avg, note if whole is not fit else f"{note}; the later periods' fit failed too ({exc})"
+            return _with_average(_refit_transient(record, fit, structure, delay, sensor, settle, lead,
+                                                  f"the fit of the later periods failed ({exc})"), avg)
         dropped += later.dropped - avg.dropped
         avg, settle = later, step_settling_time(fit.measured)
     if not dropped:
@@ -362,14 +361,18 @@ def _drop_transient_periods(record: Record, avg: StepAverage, fit: TimeFitResult
                       f"time ({settle:.3g} s) after the train began, so they hold part of the start-up transient")
 
 
+def _with_average(fitted: tuple[TimeFitResult, str], avg: StepAverage) -> tuple[TimeFitResult, StepAverage, str]:
+    return fitted[0], avg, fitted[1]
+
+
 def _refit_transient(record: Record, fit: TimeFitResult, structure: Structure, delay: str | float | None,
-                     sensor: Plant | str | None, settle: float, lead: float) -> tuple[TimeFitResult, str]:
-    """No averaged period is free of the start-up transient: the whole record, its first settling time (at most a
-    quarter of the record) weighted 0, from the periodic fit."""
+                     sensor: Plant | str | None, settle: float, lead: float, reason: str) -> tuple[TimeFitResult, str]:
+    """No averaged period free of the start-up transient can be fitted (``reason``): the whole record, its first
+    settling time (at most a quarter of the record) weighted 0, from the periodic fit."""
     skip = min(settle, 0.25 * record.duration)
     weights = ((record.t - record.t[0]) >= skip).astype(float)
     why = (f"the averaged periods begin {lead:.3g} s into the train, within the model's settling time "
-           f"({settle:.3g} s), and no later period is left, so the average holds part of the start-up transient")
+           f"({settle:.3g} s), so the average holds part of the start-up transient, and {reason}")
     try:
         whole = fit_structure(record, structure, delay, sensor, False, initial={**fit.parameters}, weights=weights,
                               check=True)
