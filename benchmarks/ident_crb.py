@@ -9,7 +9,8 @@ design and a noise level, all from the case's seed:
 - ``aperiodic``: two levels, dwell times drawn from 0.3-1.5 settling times (edge averaging, whole-record refit);
 - ``amplitudes``: levels drawn from five amplitudes, dwell times as above (no averaging: the whole record).
 
-Every train starts at rest and holds its first level for 1.5 settling times. The record is
+Every train starts at rest and holds its first level for 1.5 settling times (``--rest``: another number; a short
+rest leaves a periodic train's first averaged periods in the start-up transient). The record is
 ``--samples`` samples at 200 Hz (default 16,000, 80 s) with white Gaussian output noise of 1, 3 or
 10 % of the output's peak, lowered where needed so that every structure parameter's bound stays
 below 10 % of its value (50 % for a near cancellation): the bound is a local statement, and
@@ -148,9 +149,9 @@ def sensor_text(sensor: str | None) -> str | None:
     return f"{a * b}/((s+{a})*(s+{b}))"
 
 
-def _input(rng: np.random.Generator, design: str, n: int, settle: float) -> np.ndarray:
+def _input(rng: np.random.Generator, design: str, n: int, settle: float, rest_settles: float = 1.5) -> np.ndarray:
     t = np.arange(n) * DT
-    rest = 1.5 * settle
+    rest = rest_settles * settle
     if design.startswith("periodic"):
         half = settle if design == "periodic-settling" else settle / 3.0
         half = round(half / DT) * DT
@@ -225,8 +226,8 @@ def crb(case: Case) -> dict[str, float]:
     return {"names": names, "std": np.sqrt(np.diag(cov))[:-1], "cov": cov[:-1, :-1], "P": P}  # type: ignore[dict-item]
 
 
-def make_case(index: int, samples: int) -> Case:
-    """The case drawn from seed ``index``."""
+def make_case(index: int, samples: int, rest: float = 1.5) -> Case:
+    """The case drawn from seed ``index``; the train starts after ``rest`` settling times of constant input."""
     rng = np.random.default_rng(7000 + index)
     kind = KINDS[index % len(KINDS)]
     design = DESIGNS[(index // len(KINDS) + index) % len(DESIGNS)]
@@ -238,7 +239,7 @@ def make_case(index: int, samples: int) -> Case:
     slow = min(v for k, v in truth.items() if k.startswith("p"))
     settle = 5.0 / slow + delay
     case = Case(index, kind, structure, truth, delay, fit_delay, sensor, design, noise_rel, samples)
-    case.u = _input(rng, design, samples, min(settle, 0.15 * samples * DT))
+    case.u = _input(rng, design, samples, min(settle, 0.15 * samples * DT), rest)
     case.y0 = simulate(*_tf(truth, sensor), delay, case.u)
     case.sigma = noise_rel * float(np.max(np.abs(case.y0)))
     # the bound is a local (asymptotic) statement: keep the noise where it is one, i.e. every structure parameter's
@@ -368,6 +369,9 @@ def main() -> None:
     ap.add_argument("--samples", type=int, default=16000, help="samples per record (200 Hz)")
     ap.add_argument("--first", type=int, default=0, help="first case (to split the run over processes)")
     ap.add_argument("--only", type=int, nargs="+", metavar="CASE", help="only these cases (instead of --first/--cases)")
+    ap.add_argument("--rest", type=float, default=1.5,
+                    help="settling times of constant input before the train (default 1.5; below 1 the plant has "
+                         "not settled when a periodic train's averaged periods begin)")
     ap.add_argument("--json", help="write the per-case results here")
     ap.add_argument("--merge", nargs="+", metavar="JSON", help="only print the table of these result files")
     args = ap.parse_args()
@@ -379,7 +383,7 @@ def main() -> None:
     t0 = time.perf_counter()
     chosen = args.only if args.only else range(args.first, args.first + args.cases)
     for i in chosen:
-        case = make_case(i, args.samples)
+        case = make_case(i, args.samples, args.rest)
         results.append(run_case(case, args.seeds))
         print(f"case {i}: {case.label()} done ({time.perf_counter() - t0:.0f} s)", file=sys.stderr, flush=True)
         if args.json:

@@ -19,6 +19,7 @@ from synth.data.coerce import RecordLike, as_record
 from synth.data.record import Record
 from synth.errors import DataError, FitError, ModelError
 from synth.ident.directions import DirectionComparison, fit_by_direction
+from synth.ident.periodic_start import refit_periodic_start
 from synth.ident.steps import StepAverage, average_steps, find_steps
 from synth.ident.structure import Structure, parse_structure
 from synth.ident.timefit import TimeFitResult, fit_structure
@@ -196,9 +197,9 @@ def identify(record: RecordLike, structure: Structure | str, delay: str | float 
     if avg is not None and avg.mode == "edge" and average == "auto":
         fit, whole = _refit_unsettled(record, avg, fit, structure, delay, sensor)
     elif avg is not None and avg.mode == "cycle" and average == "auto":
-        fit, avg, whole = _drop_transient_periods(record, avg, fit, structure, delay, sensor)
+        fit, whole = _refit_from_rest(record, avg, fit, structure, delay, sensor)
         if not whole:
-            fit, whole = _refit_from_rest(record, avg, fit, structure, delay, sensor)
+            fit, avg, whole = refit_periodic_start(record, avg, fit, structure, delay, sensor)
     directions, note = None, ""
     if two_ways and (compare_directions or by_direction):
         try:
@@ -226,32 +227,6 @@ def settling_time(plant: Plant, fraction: float = np.exp(-5.0)) -> float:
     5.1
     """
     return plant.settling_time(float(np.log(1.0 / fraction)))
-
-
-def step_settling_time(plant: Plant, fraction: float = np.exp(-5.0)) -> float:
-    """Time after which the step response of ``plant`` stays within ``fraction`` of its final value [s].
-
-    What a transient leaves in the output: a slow pole that a near zero cancels settles sooner here than in
-    :func:`settling_time`, which this never exceeds (and returns when the static gain is 0 or infinite).
-
-    Examples
-    --------
-    >>> round(step_settling_time(Plant.from_string("1/(s+1)")), 2)                  # 5 time constants
-    5.0
-    >>> p = Plant.from_string("(s+0.5)/((s+0.45)*(s+10))")                          # the slow pole nearly cancelled
-    >>> round(settling_time(p), 1), round(step_settling_time(p), 1)
-    (11.1, 6.1)
-    """
-    from synth.ident.simulate import simulate_plant
-
-    bound = settling_time(plant, fraction)
-    final = plant.dc_gain()
-    if not np.isfinite(bound) or not np.isfinite(final) or final == 0.0 or bound <= 0:
-        return bound
-    grid = np.linspace(0.0, bound, 4001)
-    error = np.abs(simulate_plant(plant, grid, np.ones(grid.size), initial="zero") - final)
-    outside = np.flatnonzero(error > fraction * abs(final))
-    return float(grid[min(outside[-1] + 1, grid.size - 1)]) if outside.size else 0.0
 
 
 def _refit_unsettled(record: Record, avg: StepAverage, fit: TimeFitResult, structure: Structure,
@@ -319,63 +294,3 @@ def _refit_from_rest(record: Record, avg: StepAverage, fit: TimeFitResult, struc
     return whole, (f"the periodic fit's model settles in {settle:.3g} s, longer than the {first:.3g} s of constant "
                    f"input before the train, but the whole record's fit (the constant start weighted 0) settles in "
                    f"{settle_whole:.3g} s, within it: that fit is kept, the start-up transient from rest included")
-
-
-def _drop_transient_periods(record: Record, avg: StepAverage, fit: TimeFitResult, structure: Structure,
-                            delay: str | float | None, sensor: Plant | str | None
-                            ) -> tuple[TimeFitResult, StepAverage, str]:
-    """The periodic average stands for the periodic steady state, but its first period starts one period after
-    the train began: within the model's settling time (:func:`step_settling_time`), the average holds part of the
-    start-up transient (a step every time constant, 0.5 s periods after a 1 s rest: k and tau 13 standard errors
-    off over 20 noise seeds).
-
-    Unless the constant start is long enough for the whole-record fit (:func:`_refit_from_rest`), the periods
-    that start within the settling time are dropped and the rest refitted, until the model's settling time
-    agrees (at most three rounds); with no period left, or when their fit fails, the whole record is fitted,
-    its first settling time weighted 0. Returns the fit, its average and a note (empty: nothing changed)."""
-    train = float(record.t[avg.steps.index[0]])
-    first = train - float(record.t[0])
-    if fit.weak or first >= settling_time(fit.measured):
-        return fit, avg, ""   # _refit_from_rest fits the whole record, the start-up transient from rest included
-    dropped, settle = 0, step_settling_time(fit.measured)
-    for _ in range(3):
-        lead = float(record.t[avg.first_window]) - train
-        if not np.isfinite(settle) or lead >= settle:
-            break
-        try:
-            later = average_steps(record, avg.steps, "cycle", settle=settle)
-        except DataError:
-            return _with_average(_refit_transient(record, fit, structure, delay, sensor, settle, lead,
-                                                  "no later period is left"), avg)
-        try:
-            fit = fit_structure(later.record(), structure, delay, sensor, True, initial={**fit.parameters},
-                                check=True)
-        except FitError as exc:
-            return _with_average(_refit_transient(record, fit, structure, delay, sensor, settle, lead,
-                                                  f"the fit of the later periods failed ({exc})"), avg)
-        dropped += later.dropped - avg.dropped
-        avg, settle = later, step_settling_time(fit.measured)
-    if not dropped:
-        return fit, avg, ""
-    return fit, avg, (f"dropped {dropped} more period(s) from the average: they start within the model's settling "
-                      f"time ({settle:.3g} s) after the train began, so they hold part of the start-up transient")
-
-
-def _with_average(fitted: tuple[TimeFitResult, str], avg: StepAverage) -> tuple[TimeFitResult, StepAverage, str]:
-    return fitted[0], avg, fitted[1]
-
-
-def _refit_transient(record: Record, fit: TimeFitResult, structure: Structure, delay: str | float | None,
-                     sensor: Plant | str | None, settle: float, lead: float, reason: str) -> tuple[TimeFitResult, str]:
-    """No averaged period free of the start-up transient can be fitted (``reason``): the whole record, its first
-    settling time (at most a quarter of the record) weighted 0, from the periodic fit."""
-    skip = min(settle, 0.25 * record.duration)
-    weights = ((record.t - record.t[0]) >= skip).astype(float)
-    why = (f"the averaged periods begin {lead:.3g} s into the train, within the model's settling time "
-           f"({settle:.3g} s), so the average holds part of the start-up transient, and {reason}")
-    try:
-        whole = fit_structure(record, structure, delay, sensor, False, initial={**fit.parameters}, weights=weights,
-                              check=True)
-    except (DataError, FitError) as exc:
-        return fit, f"{why}; the whole-record fit failed ({exc}), so the periodic fit is kept (biased)"
-    return whole, f"{why}: fitted the whole record instead, the first {skip:.3g} s weighted 0"

@@ -1,0 +1,204 @@
+"""A periodic step train that starts before the plant has settled, or soon after a short rest.
+
+The cycle average (:func:`synth.ident.steps.average_steps`) stands for the periodic steady state, and its fit
+removes the output's mean. Two things go wrong when the train's modes do not settle within the first period
+or the constant start before the train is short:
+
+- *Bias.* The first averaged period starts one period after the train began; within the model's settling
+  time the average still holds part of the start-up transient (``2/(0.5 s + 1)`` stepped every 0.5 s after a
+  1 s rest: k and tau 13 standard errors off over 20 noise seeds).
+- *Lost information.* The transition from the constant start into the train carries the static gain, which
+  the average's removed mean does not: on such records the periodic average's standard errors were 2-7
+  times the Cramer-Rao bound (``benchmarks/ident_crb.py --rest 0.3``).
+
+:func:`refit_periodic_start` handles both when the constant start is shorter than the model's settling time
+(a longer one goes to the whole-record fit from rest in :mod:`synth.ident.identification`). It predicts the
+standard errors a whole-record fit would have, from the periodic fit's model (finite-difference sensitivities
+of a simulation over the record, the first settling time weighted 0 because the state before the record is
+not known); when they are :data:`WHOLE_RECORD_GAIN` times smaller or more for some parameter, it fits the
+whole record. Otherwise it drops the periods that start within the settling time and refits the rest.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from synth.data.record import Record
+from synth.errors import DataError, FitError, ModelError
+from synth.ident.simulate import simulate_plant
+from synth.ident.steps import StepAverage, average_steps
+from synth.ident.structure import Structure
+from synth.ident.timefit import TimeFitResult, fit_structure
+from synth.plant import Plant
+
+__all__ = ["WHOLE_RECORD_GAIN", "predicted_whole_record_std", "refit_periodic_start", "step_settling_time"]
+
+#: fit the whole record when it is predicted to shrink some parameter's standard error by this factor or more
+WHOLE_RECORD_GAIN = 1.5
+#: e^-5: the share of a step that counts as settled
+SETTLED = float(np.exp(-5.0))
+
+
+def step_settling_time(plant: Plant, fraction: float = SETTLED) -> float:
+    """Time after which the step response of ``plant`` stays within ``fraction`` of its final value [s].
+
+    What a transient leaves in the output: a slow pole that a near zero cancels settles sooner here than by its
+    time constant alone (:meth:`synth.plant.Plant.settling_time`), which this never exceeds (and returns when the
+    static gain is 0 or infinite).
+
+    Examples
+    --------
+    >>> round(step_settling_time(Plant.from_string("1/(s+1)")), 2)                  # 5 time constants
+    5.0
+    >>> p = Plant.from_string("(s+0.5)/((s+0.45)*(s+10))")                          # the slow pole nearly cancelled
+    >>> round(p.settling_time(5.0), 1), round(step_settling_time(p), 1)
+    (11.1, 6.1)
+    """
+    bound = plant.settling_time(float(np.log(1.0 / fraction)))
+    final = plant.dc_gain()
+    if not np.isfinite(bound) or not np.isfinite(final) or final == 0.0 or bound <= 0:
+        return bound
+    grid = np.linspace(0.0, bound, 4001)
+    error = np.abs(simulate_plant(plant, grid, np.ones(grid.size), initial="zero") - final)
+    outside = np.flatnonzero(error > fraction * abs(final))
+    return float(grid[min(outside[-1] + 1, grid.size - 1)]) if outside.size else 0.0
+
+
+def predicted_whole_record_std(record: Record, fit: TimeFitResult, structure: Structure, noise_std: float,
+                               weights: np.ndarray) -> dict[str, float]:
+    """Standard errors a whole-record fit of ``structure`` would have at ``fit``'s parameters [their units].
+
+    ``sigma sqrt(diag((J^T W J)^-1))`` with ``J`` the central-difference sensitivities of the model's output
+    (sensor included, simulated from rest at the record's first sample) to each fitted parameter and to an
+    output offset (a nuisance parameter), ``W`` the 0/1 ``weights``, ``sigma`` the per-sample ``noise_std``.
+
+    Examples
+    --------
+    >>> from synth.data import record_from_arrays
+    >>> from synth.ident.timefit import fit_structure
+    >>> t = np.arange(0, 20, 0.01); u = np.where(t > 1, 1.0, 0.0)
+    >>> y = simulate_plant(Plant.from_string("2/(s+1)"), t, u) + 0.01 * np.random.default_rng(0).normal(size=t.size)
+    >>> rec = record_from_arrays(t, u, y); fit = fit_structure(rec, "k/(s+p)")
+    >>> std = predicted_whole_record_std(rec, fit, fit.structure, 0.01, np.ones(t.size))
+    >>> bool(abs(std["k"] / fit.std["k"] - 1) < 0.1)                             # the fit's own, on the same record
+    True
+    """
+    names = [k for k in fit.parameters if fit.std.get(k, 0.0) > 0.0]
+    base = dict(fit.parameters)
+    delay_name = "delay" if "delay" in base else structure.delay_parameter
+
+    def output(params: dict[str, float]) -> np.ndarray:
+        plant = structure.plant(params, delay=params.get(delay_name) if delay_name else None)
+        if fit.sensor is not None:
+            plant = plant.series(fit.sensor).with_delay(plant.delay)
+        return simulate_plant(plant, record.t, record.u)
+
+    keep = np.asarray(weights, float) > 0
+    columns = []
+    for name in names:
+        h = 1e-5 * max(abs(base[name]), 1e-3)
+        up, down = {**base, name: base[name] + h}, {**base, name: base[name] - h}
+        columns.append(((output(up) - output(down)) / (2.0 * h))[keep])
+    J = np.column_stack([*columns, np.ones(int(keep.sum()))])
+    try:
+        cov = np.linalg.inv(J.T @ J) * noise_std ** 2
+    except np.linalg.LinAlgError:
+        return {name: float("inf") for name in names}
+    return {name: float(np.sqrt(max(cov[i, i], 0.0))) for i, name in enumerate(names)}
+
+
+def refit_periodic_start(record: Record, avg: StepAverage, fit: TimeFitResult, structure: Structure,
+                         delay: str | float | None, sensor: Plant | str | None
+                         ) -> tuple[TimeFitResult, StepAverage, str]:
+    """The whole record, or the periods free of the start-up transient, instead of the plain periodic fit.
+
+    Only for a constant start shorter than the model's settling time (module text), after the whole-record
+    fit from rest of :mod:`synth.ident.identification` has declined. Returns the fit, its average and a note
+    (empty: nothing changed).
+
+    Examples
+    --------
+    >>> from synth.ident.identification import identify
+    >>> t = np.arange(0, 12, 0.01); u = np.where(t < 1, 0.0, (((t - 1) // 0.5) % 2 == 0).astype(float))
+    >>> y = simulate_plant(Plant.from_string("2/(0.5*s+1)"), t, u) + 0.01 * np.random.default_rng(0).normal(size=t.size)
+    >>> identify((t, u, y), "k/(tau*s+1)").whole_record_note[:45]
+    'dropped 2 more period(s) from the average: th'
+    """
+    train = float(record.t[avg.steps.index[0]])
+    first = train - float(record.t[0])
+    if first >= fit.measured.settling_time(5.0):
+        return fit, avg, ""   # the whole-record fit from rest in synth.ident.identification had its chance
+    settle = step_settling_time(fit.measured)
+    if not np.isfinite(settle):
+        return fit, avg, ""
+    skip = min(fit.measured.settling_time(5.0), 0.25 * record.duration)
+    weights = ((record.t - record.t[0]) >= skip).astype(float)
+    try:
+        predicted = predicted_whole_record_std(record, fit, structure, avg.noise_std_before, weights)
+    except (ModelError, ValueError):
+        predicted = {}
+    gains = {k: fit.std[k] / v for k, v in predicted.items() if v > 0}
+    best = max(gains, key=lambda k: gains[k]) if gains else None
+    if best is not None and gains[best] >= WHOLE_RECORD_GAIN:
+        try:
+            whole = fit_structure(record, structure, delay, sensor, False, initial={**fit.parameters},
+                                  weights=weights, check=True)
+        except (DataError, FitError) as exc:
+            note = f"the whole-record fit, predicted {gains[best]:.3g} times as precise in {best}, failed ({exc})"
+            trimmed, avg, why = _drop_transient_periods(record, avg, fit, structure, delay, sensor, settle, train)
+            return trimmed, avg, f"{note}; {why}" if why else note
+        return whole, avg, (f"the whole record (its first {skip:.3g} s weighted 0: the state before it is not "
+                            f"known) is predicted {gains[best]:.3g} times as precise in {best} as the periodic "
+                            f"average, whose mean is removed, because the {first:.3g} s of constant input before "
+                            "the train and the transition into it carry the static gain: fitted it instead")
+    return _drop_transient_periods(record, avg, fit, structure, delay, sensor, settle, train)
+
+
+def _drop_transient_periods(record: Record, avg: StepAverage, fit: TimeFitResult, structure: Structure,
+                            delay: str | float | None, sensor: Plant | str | None, settle: float, train: float
+                            ) -> tuple[TimeFitResult, StepAverage, str]:
+    """Drop the periods that start within the settling time after the train began and refit the rest, until the
+    model's settling time agrees (at most three rounds); with no period left, or when their fit fails, the whole
+    record, its first settling time weighted 0."""
+    dropped = 0
+    for _ in range(3):
+        lead = float(record.t[avg.first_window]) - train
+        if not np.isfinite(settle) or lead >= settle:
+            break
+        try:
+            later = average_steps(record, avg.steps, "cycle", settle=settle)
+        except DataError:
+            return _with_average(_refit_transient(record, fit, structure, delay, sensor, settle, lead,
+                                                  "no later period is left"), avg)
+        try:
+            fit = fit_structure(later.record(), structure, delay, sensor, True, initial={**fit.parameters},
+                                check=True)
+        except FitError as exc:
+            return _with_average(_refit_transient(record, fit, structure, delay, sensor, settle, lead,
+                                                  f"the fit of the later periods failed ({exc})"), avg)
+        dropped += later.dropped - avg.dropped
+        avg, settle = later, step_settling_time(fit.measured)
+    if not dropped:
+        return fit, avg, ""
+    return fit, avg, (f"dropped {dropped} more period(s) from the average: they start within the model's settling "
+                      f"time ({settle:.3g} s) after the train began, so they hold part of the start-up transient")
+
+
+def _with_average(fitted: tuple[TimeFitResult, str], avg: StepAverage) -> tuple[TimeFitResult, StepAverage, str]:
+    return fitted[0], avg, fitted[1]
+
+
+def _refit_transient(record: Record, fit: TimeFitResult, structure: Structure, delay: str | float | None,
+                     sensor: Plant | str | None, settle: float, lead: float, reason: str) -> tuple[TimeFitResult, str]:
+    """No averaged period free of the start-up transient can be fitted (``reason``): the whole record, its first
+    settling time (at most a quarter of the record) weighted 0, from the periodic fit."""
+    skip = min(settle, 0.25 * record.duration)
+    weights = ((record.t - record.t[0]) >= skip).astype(float)
+    why = (f"the averaged periods begin {lead:.3g} s into the train, within the model's settling time "
+           f"({settle:.3g} s), so the average holds part of the start-up transient, and {reason}")
+    try:
+        whole = fit_structure(record, structure, delay, sensor, False, initial={**fit.parameters}, weights=weights,
+                              check=True)
+    except (DataError, FitError) as exc:
+        return fit, f"{why}; the whole-record fit failed ({exc}), so the periodic fit is kept (biased)"
+    return whole, f"{why}: fitted the whole record instead, the first {skip:.3g} s weighted 0"
