@@ -31,7 +31,8 @@ from synth.ident.structure import Structure
 from synth.ident.timefit import TimeFitResult, fit_structure
 from synth.plant import Plant
 
-__all__ = ["WHOLE_RECORD_GAIN", "predicted_whole_record_std", "refit_periodic_start", "step_settling_time"]
+__all__ = ["WHOLE_RECORD_GAIN", "predicted_whole_record_std", "refit_periodic_start", "starts_at_rest",
+           "step_settling_time"]
 
 #: fit the whole record when it is predicted to shrink some parameter's standard error by this factor or more
 WHOLE_RECORD_GAIN = 1.5
@@ -62,6 +63,28 @@ def step_settling_time(plant: Plant, fraction: float = SETTLED) -> float:
     error = np.abs(simulate_plant(plant, grid, np.ones(grid.size), initial="zero") - final)
     outside = np.flatnonzero(error > fraction * abs(final))
     return float(grid[min(outside[-1] + 1, grid.size - 1)]) if outside.size else 0.0
+
+
+def starts_at_rest(record: Record, first: float, sigmas: float = 3.0) -> bool:
+    """Whether the output is flat over the constant input before the train (the first ``first`` seconds): the
+    means of its first and last thirds agree within ``sigmas`` standard errors (noise from the differences of
+    consecutive samples). Then the plant was at rest when the record began, and a fit may start from rest.
+
+    Examples
+    --------
+    >>> from synth.data import record_from_arrays
+    >>> t = np.arange(0, 10, 0.01); u = np.where(t > 2, 1.0, 0.0); noise = np.random.default_rng(0).normal(size=t.size)
+    >>> starts_at_rest(record_from_arrays(t, u, 0.01 * noise), 2.0)
+    True
+    >>> starts_at_rest(record_from_arrays(t, u, np.exp(-t) + 0.01 * noise), 2.0)     # still decaying
+    False
+    """
+    y = record.y[(record.t - record.t[0]) < first]
+    third = y.size // 3
+    if third < 5:
+        return False
+    sigma = float(np.std(np.diff(y)) / np.sqrt(2.0))
+    return bool(abs(np.mean(y[:third]) - np.mean(y[-third:])) <= sigmas * sigma * np.sqrt(2.0 / third))
 
 
 def predicted_whole_record_std(record: Record, fit: TimeFitResult, structure: Structure, noise_std: float,
@@ -121,8 +144,8 @@ def refit_periodic_start(record: Record, avg: StepAverage, fit: TimeFitResult, s
     >>> from synth.ident.identification import identify
     >>> t = np.arange(0, 12, 0.01); u = np.where(t < 1, 0.0, (((t - 1) // 0.5) % 2 == 0).astype(float))
     >>> y = simulate_plant(Plant.from_string("2/(0.5*s+1)"), t, u) + 0.01 * np.random.default_rng(0).normal(size=t.size)
-    >>> identify((t, u, y), "k/(tau*s+1)").whole_record_note[:45]
-    'dropped 2 more period(s) from the average: th'
+    >>> identify((t, u, y), "k/(tau*s+1)").whole_record_note[:58]
+    'the whole record, from rest (the output is flat over the c'
     """
     train = float(record.t[avg.steps.index[0]])
     first = train - float(record.t[0])
@@ -131,7 +154,8 @@ def refit_periodic_start(record: Record, avg: StepAverage, fit: TimeFitResult, s
     settle = step_settling_time(fit.measured)
     if not np.isfinite(settle):
         return fit, avg, ""
-    skip = min(fit.measured.settling_time(5.0), 0.25 * record.duration)
+    at_rest = starts_at_rest(record, first)
+    skip = 0.0 if at_rest else min(fit.measured.settling_time(5.0), 0.25 * record.duration)
     weights = ((record.t - record.t[0]) >= skip).astype(float)
     try:
         predicted = predicted_whole_record_std(record, fit, structure, avg.noise_std_before, weights)
@@ -147,10 +171,13 @@ def refit_periodic_start(record: Record, avg: StepAverage, fit: TimeFitResult, s
             note = f"the whole-record fit, predicted {gains[best]:.3g} times as precise in {best}, failed ({exc})"
             trimmed, avg, why = _drop_transient_periods(record, avg, fit, structure, delay, sensor, settle, train)
             return trimmed, avg, f"{note}; {why}" if why else note
-        return whole, avg, (f"the whole record (its first {skip:.3g} s weighted 0: the state before it is not "
-                            f"known) is predicted {gains[best]:.3g} times as precise in {best} as the periodic "
-                            f"average, whose mean is removed, because the {first:.3g} s of constant input before "
-                            "the train and the transition into it carry the static gain: fitted it instead")
+        start = ("from rest (the output is flat over the constant start)" if at_rest else
+                 f"its first {skip:.3g} s weighted 0 (the output drifts over the constant start: the state before "
+                 "the record is not known)")
+        return whole, avg, (f"the whole record, {start}, is predicted {gains[best]:.3g} times as precise in {best} "
+                            f"as the periodic average, whose mean is removed, because the {first:.3g} s of constant "
+                            "input before the train and the transition into it carry the static gain: fitted it "
+                            "instead")
     return _drop_transient_periods(record, avg, fit, structure, delay, sensor, settle, train)
 
 
@@ -191,8 +218,8 @@ def _with_average(fitted: tuple[TimeFitResult, str], avg: StepAverage) -> tuple[
 def _refit_transient(record: Record, fit: TimeFitResult, structure: Structure, delay: str | float | None,
                      sensor: Plant | str | None, settle: float, lead: float, reason: str) -> tuple[TimeFitResult, str]:
     """No averaged period free of the start-up transient can be fitted (``reason``): the whole record, its first
-    settling time (at most a quarter of the record) weighted 0, from the periodic fit."""
-    skip = min(settle, 0.25 * record.duration)
+    settling time (at most half the record) weighted 0, from the periodic fit."""
+    skip = min(settle, 0.5 * record.duration)
     weights = ((record.t - record.t[0]) >= skip).astype(float)
     why = (f"the averaged periods begin {lead:.3g} s into the train, within the model's settling time "
            f"({settle:.3g} s), so the average holds part of the start-up transient, and {reason}")
@@ -201,4 +228,6 @@ def _refit_transient(record: Record, fit: TimeFitResult, structure: Structure, d
                               check=True)
     except (DataError, FitError) as exc:
         return fit, f"{why}; the whole-record fit failed ({exc}), so the periodic fit is kept (biased)"
-    return whole, f"{why}: fitted the whole record instead, the first {skip:.3g} s weighted 0"
+    short = (f"; the record is too short for the state at its start to settle before the fitted part ({skip:.3g} "
+             f"of the {settle:.3g} s it needs): the estimates may be biased" if skip < settle else "")
+    return whole, f"{why}: fitted the whole record instead, the first {skip:.3g} s weighted 0{short}"
