@@ -58,7 +58,8 @@ def report_data(spec: Spec, result: DesignResult, keep: dict[str, Any] | None = 
         fit = ident.to_dict()
         data["identification"] = {
             key: fit[key] for key in ("structure", "parameters", "std", "ci95", "fit_percent", "tf", "delay",
-                                      "delay_fitted", "offset", "residual_std", "samples", "record", "averaging")
+                                      "delay_fitted", "offset", "residual_std", "samples", "record", "averaging",
+                                      "whole_record")
         } | {"in_loop_delay": spec.plant.identify.in_loop_delay, "confidence": spec.plant.identify.confidence,
              "uncertainty_plants": [p.label for p in spec.plants()[1:] if p.label.startswith("identified")],
              "sensor": spec.plant.identify.sensor}
