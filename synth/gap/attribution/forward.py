@@ -18,6 +18,7 @@ from synth.data.record import Record
 from synth.errors import ModelError
 from synth.gap.attribution.candidates import joint_fit, map_jobs, seeded_grid
 from synth.gap.attribution.parsimony import share_of_excess
+from synth.gap.attribution.physical import wrong_sign
 from synth.gap.attribution.refit import AugmentedFit
 from synth.gap.attribution.screen import ScreenedFit, screen_effect
 from synth.gap.attribution.verdict import EffectResult
@@ -117,7 +118,7 @@ class ForwardSelection:
         significant = bool(ci[0] > self.threshold)
         second = nested.second
         params = {k: float(fit.params[k]) for k in second.parameter_names}
-        unphysical = second.outside_bounds(params, self.t_tr, self.u_tr, self.plant)
+        unphysical = wrong_sign(second, params, self.t_tr, self.u_tr, self.plant)
         accepted = bool(significant and share >= self.min_share and not unphysical)
         res = EffectResult(nested.label, params, dict(fit.parameter_ci), 1.0 - j / j_a if j_a > 0 else 0.0, ci,
                            significant, float(share), accepted, j, dict(fit.nominal), "joint", unphysical)

@@ -87,6 +87,7 @@ from synth.gap.attribution.calibration import demean, linearized_null, noise_sig
 from synth.gap.attribution.candidates import advance, candidate_fits, screened_coefficients
 from synth.gap.attribution.forward import ForwardSelection
 from synth.gap.attribution.parsimony import free_parameters, parsimonious_lead, share_of_excess
+from synth.gap.attribution.physical import wrong_sign
 from synth.gap.attribution.refit import AugmentedFit, fit_augmented
 from synth.gap.attribution.split import block_ids, split_heldout
 from synth.gap.attribution.verdict import (
@@ -371,7 +372,7 @@ def diagnose_effects(plant: Plant, record: Record, validate: Record | Sequence[R
         significant = bool(gap_present and ci[0] > threshold)
         joint = isinstance(fit, AugmentedFit)
         params = {k: float(fit.params[k]) for k in eff.parameter_names}
-        unphysical = eff.outside_bounds(params, sp.train.t, sp.train.u, plant)
+        unphysical = wrong_sign(eff, params, sp.train.t, sp.train.u, plant)
         relevant = bool(significant and share_ref >= min_share and joint and not unphysical)
         p_ci = fit.parameter_ci if joint else {}
         nominal = dict(fit.nominal) if joint else screened_coefficients(fit.plant)

@@ -71,7 +71,7 @@ class EffectResult:
         (denominator fixed, see :mod:`synth.gap.attribution.screen`; never accepted).
     unphysical : str
         Why the fitted parameters leave the effect's physical range for this record
-        (:func:`outside_physical_range`); such a candidate is never accepted. Empty: inside it.
+        (:func:`synth.gap.attribution.physical.wrong_sign`); such a candidate is never accepted. Empty: inside it.
     """
 
     effect: str

@@ -37,11 +37,7 @@ from synth.errors import ModelError
 from synth.ident.simulate import simulate_plant
 from synth.plant import Plant
 
-#: how far past zero a basis parameter with a one-signed physical range may lie, as a share of that range: a fit a
-#: little past zero is still that effect (switched almost off)
-BOUND_SLACK = 0.05
-
-__all__ = ["BOUND_SLACK", "Effect", "Params", "command_span", "fastest_pole", "log_grid", "slowest_pole", "unit_numerators"]
+__all__ = ["Effect", "Params", "command_span", "fastest_pole", "log_grid", "slowest_pole", "unit_numerators"]
 
 Params = dict[str, float]
 """An effect's parameter values by name."""
@@ -194,35 +190,6 @@ class Effect:
     def bounds(self, t: np.ndarray, u: np.ndarray, plant: Plant) -> dict[str, tuple[float, float]]:
         """Physical bounds of each parameter for this record (the grid lies inside them)."""
         return {}
-
-    def outside_bounds(self, params: Params, t: np.ndarray, u: np.ndarray, plant: Plant) -> str:
-        """Why a basis parameter of ``params`` has a sign its :meth:`bounds` exclude, in words ('' when none has).
-
-        A basis parameter is solved by unconstrained least squares and can come out with a sign no such
-        effect has (a supply that rises when the command steps up). Only the sign is checked, with
-        :data:`BOUND_SLACK` of the range: the magnitudes of the bounds are search ranges, not physics (a
-        benchmark's strong cubic spring lies beyond them), and the grid and factor parameters are searched
-        inside their ranges anyway.
-
-        Examples
-        --------
-        >>> from synth.gap.effects.supply import SupplySagEffect
-        >>> t = np.arange(0, 1, 0.01); u = np.where(t > 0.5, 1.0, 0.0); G = Plant.from_string("1/(s+1)")
-        >>> SupplySagEffect().outside_bounds({"sag": -0.5, "tau": 0.1}, t, u, G)
-        'sag = -0.5 has the wrong sign: its physical range is [0, 1] for this record'
-        >>> SupplySagEffect().outside_bounds({"sag": 3.0, "tau": 0.1}, t, u, G)   # strong, not unphysical
-        ''
-        """
-        for name, (lo, hi) in self.bounds(t, u, plant).items():
-            if name not in params or name not in self.basis_names:
-                continue
-            x = float(params[name])
-            if not np.isfinite(x):
-                continue
-            slack = BOUND_SLACK * (hi - lo) if np.isfinite(hi - lo) else 0.0
-            if (lo >= 0.0 and x < lo - slack) or (hi <= 0.0 and x > hi + slack):
-                return f"{name} = {x:.4g} has the wrong sign: its physical range is [{lo:.4g}, {hi:.4g}] for this record"
-        return ""
 
     def grid(self, t: np.ndarray, u: np.ndarray, plant: Plant) -> list[Params]:
         """Deterministic grid (or starting values) of the non-basis parameters, built from the record."""
