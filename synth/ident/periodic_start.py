@@ -25,7 +25,7 @@ import numpy as np
 
 from synth.data.record import Record
 from synth.errors import DataError, FitError, ModelError
-from synth.ident.identifiability import weak_parameters
+from synth.ident.identifiability import WEAK_RELATIVE_STD
 from synth.ident.simulate import simulate_plant
 from synth.ident.steps import StepAverage, average_steps
 from synth.ident.structure import Structure
@@ -161,7 +161,8 @@ def refit_periodic_start(record: Record, avg: StepAverage, fit: TimeFitResult, s
 
     Only for a constant start shorter than the model's settling time (module text), after the whole-record
     fit from rest of :mod:`synth.ident.identification` has declined; a periodic fit with a weakly identifiable
-    parameter is replaced only when the whole record is predicted to pin every parameter down. Returns the fit,
+    parameter is replaced only when the whole record is predicted to know every parameter to a quarter of its
+    value. Returns the fit,
     its average and a note (empty: nothing changed).
 
     Examples
@@ -188,7 +189,7 @@ def refit_periodic_start(record: Record, avg: StepAverage, fit: TimeFitResult, s
         names, cov = [], np.zeros((0, 0))
     predicted = {name: float(np.sqrt(max(cov[i, i], 0.0))) for i, name in enumerate(names)}
     if fit.weak and (not names or _weak(names, fit, cov, record.dt)):
-        # the whole record would not pin the model down either (a near cancellation): both covariances are
+        # the whole record would leave a parameter loose too (a near cancellation): both covariances are
         # linearizations at a point the record does not fix (CRB case 5's slow pole came out 125 bounds wide,
         # reported at 0.01 of that); the periodic fit stays, flagged weak
         return fit, avg, ""
@@ -213,12 +214,15 @@ def refit_periodic_start(record: Record, avg: StepAverage, fit: TimeFitResult, s
 
 
 def _weak(names: list[str], fit: TimeFitResult, cov: np.ndarray, dt: float) -> bool:
-    """Whether the predicted whole-record covariance leaves a parameter weakly identifiable."""
+    """Whether the predicted whole-record covariance leaves some parameter's standard error above
+    :data:`~synth.ident.identifiability.WEAK_RELATIVE_STD` of its value (the delay against ``max(|delay|, dt)``).
+    Strong correlations alone do not count: a train whose average lost the static gain has k and the slow pole
+    tied, and the whole record then reaches the bound (CRB case 1)."""
     if not np.all(np.isfinite(cov)):
         return True
     sd = np.sqrt(np.maximum(np.diag(cov), 0.0))
-    intervals = {n: (fit.parameters[n] - 1.96 * s, fit.parameters[n] + 1.96 * s) for n, s in zip(names, sd)}
-    return bool(weak_parameters(names, dict(fit.parameters), cov, intervals, "delay", dt))
+    scale = [max(abs(fit.parameters[n]), dt) if n == "delay" else abs(fit.parameters[n]) for n in names]
+    return bool(np.any(sd > WEAK_RELATIVE_STD * np.asarray(scale)))
 
 
 def _drop_transient_periods(record: Record, avg: StepAverage, fit: TimeFitResult, structure: Structure,
