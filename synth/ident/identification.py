@@ -19,7 +19,7 @@ from synth.data.coerce import RecordLike, as_record
 from synth.data.record import Record
 from synth.errors import DataError, FitError, ModelError
 from synth.ident.directions import DirectionComparison, fit_by_direction
-from synth.ident.periodic_start import refit_periodic_start
+from synth.ident.periodic_start import fit_whole_record, refit_periodic_start
 from synth.ident.steps import StepAverage, average_steps, find_steps
 from synth.ident.structure import Structure, parse_structure
 from synth.ident.timefit import TimeFitResult, fit_structure
@@ -279,8 +279,7 @@ def _refit_from_rest(record: Record, avg: StepAverage, fit: TimeFitResult, struc
     skip = min(settle, first)
     weights = ((record.t - record.t[0]) >= skip).astype(float)
     try:
-        whole = fit_structure(record, structure, delay, sensor, False, initial={**fit.parameters}, weights=weights,
-                              check=True)
+        whole = fit_whole_record(record, structure, delay, sensor, {**fit.parameters}, weights)
     except (DataError, FitError) as exc:
         return fit, (f"the whole-record fit from rest failed ({exc}), so the periodic fit is kept" if first >= settle
                      else "")
