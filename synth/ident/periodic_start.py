@@ -201,8 +201,7 @@ def refit_periodic_start(record: Record, avg: StepAverage, fit: TimeFitResult, s
     Only for a constant start shorter than the model's settling time (module text), after the whole-record
     fit from rest of :mod:`synth.ident.identification` has declined; a periodic fit with a weakly identifiable
     parameter is replaced only when the whole record is predicted to know every parameter to a quarter of its
-    value. Returns the fit,
-    its average and a note (empty: nothing changed).
+    value. Returns the fit, its average and a note (empty: nothing changed).
 
     Examples
     --------
@@ -229,8 +228,8 @@ def refit_periodic_start(record: Record, avg: StepAverage, fit: TimeFitResult, s
     predicted = {name: float(np.sqrt(max(cov[i, i], 0.0))) for i, name in enumerate(names)}
     if fit.weak and (not names or _weak(names, fit, cov, record.dt)):
         # the whole record would leave a parameter loose too (a near cancellation): both covariances are
-        # linearizations at a point the record does not fix (CRB case 5's slow pole came out 125 bounds wide,
-        # reported at 0.01 of that); the periodic fit stays, flagged weak
+        # linearizations at a point the record does not fix, and their ratio says nothing; the periodic fit
+        # stays, flagged weak
         return fit, avg, ""
     gains = {k: fit.std[k] / v for k, v in predicted.items() if v > 0}
     best = max(gains, key=lambda k: gains[k]) if gains else None
