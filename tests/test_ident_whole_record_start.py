@@ -38,8 +38,8 @@ def _fake(results: list) -> tuple[list, object]:
     return calls, fit_structure
 
 
-def _fit(tf: str, residual: float) -> SimpleNamespace:
-    return SimpleNamespace(plant=Plant.from_string(tf), residual_std=residual)
+def _fit(tf: str, residual: float, std: float = 0.1) -> SimpleNamespace:
+    return SimpleNamespace(plant=Plant.from_string(tf), residual_std=residual, std={"k": std, "p1": 0.01})
 
 
 @pytest.mark.parametrize(("first", "second", "expected", "tries"), [
@@ -47,6 +47,8 @@ def _fit(tf: str, residual: float) -> SimpleNamespace:
     (_fit("1.5*(s+5e4)/((s+1.58)*(s+3.7e4))", 0.010), _fit("1.6*(s+17)/((s+1.03)*(s+16))", 0.016), 0, 2),
     (_fit("1.6*(s+17)/((s+1.03)*(s+16))", 0.016), None, 0, 1),
     (FitError("max iterations"), _fit("1.6*(s+17)/((s+1.03)*(s+16))", 0.016), 1, 2),
+    # a smaller residual at a singular covariance does not replace a fit whose errors are known
+    (_fit("1.5*(s+5e4)/((s+1.58)*(s+3.7e4))", 0.065), _fit("1.6*(s+17)/((s+1.03)*(s+16))", 0.016, np.inf), 0, 2),
 ])
 def test_the_own_start_is_tried_when_the_first_fit_fails_or_leaves_nyquist(monkeypatch, first, second, expected,
                                                                          tries) -> None:
@@ -57,8 +59,11 @@ def test_the_own_start_is_tried_when_the_first_fit_fails_or_leaves_nyquist(monke
     assert calls[0] == {"k": 1.0} and (tries == 1 or calls[1] is None)   # then the record's own start
 
 
-def test_both_failing_raise_the_first_error(monkeypatch) -> None:
-    _, fake = _fake([FitError("first"), FitError("second")])
+@pytest.mark.parametrize("second", [FitError("second"), _fit("1.6*(s+17)/((s+1.03)*(s+16))", 0.016, np.inf)])
+def test_a_failed_first_fit_raises_unless_the_own_start_gives_known_errors(monkeypatch, second) -> None:
+    """CRB case 4: where the first fit failed, the own start ended at a singular covariance (every error
+    infinite); the caller's average fit, with calibrated errors, is the better answer."""
+    _, fake = _fake([FitError("first"), second])
     monkeypatch.setattr(periodic_start, "fit_structure", fake)
     with pytest.raises(FitError, match="first"):
         periodic_start.fit_whole_record(RECORD, STRUCTURE, "fit", None, {"k": 1.0}, None)

@@ -70,7 +70,9 @@ def fit_whole_record(record: Record, structure: Structure, delay: str | float | 
                      initial: dict[str, float], weights: np.ndarray | None = None) -> TimeFitResult:
     """The whole record fitted from ``initial`` (an average's fit); when that fails, or ends with a pole or zero
     beyond the record's Nyquist frequency, which no sampled record resolves, also from the record's own
-    deterministic start, keeping the smaller residual. (CRB case 5, seed 4: the average's fit carried its nearly
+    deterministic start, keeping the smaller residual unless its standard errors are not all finite (CRB case 4:
+    where the first fit failed, the own start ended at a singular covariance, which is no better founded than the
+    average's fit the caller then keeps). (CRB case 5, seed 4: the average's fit carried its nearly
     cancelling pair to 5e4 rad/s, and the whole record, started there, stayed: a slow pole 1.58 +- 0.007 against
     1.026, residual std 0.065 where its own start reaches the noise, 0.016.)
 
@@ -92,9 +94,12 @@ def fit_whole_record(record: Record, structure: Structure, delay: str | float | 
         fit = fit_structure(record, structure, delay, sensor, False, initial=initial, weights=weights, check=True)
     except (DataError, FitError) as exc:
         try:
-            return fit_structure(record, structure, delay, sensor, False, weights=weights, check=True)
+            other = fit_structure(record, structure, delay, sensor, False, weights=weights, check=True)
         except (DataError, FitError):
             raise exc from None
+        if not _finite_errors(other):   # no better founded than the average's fit the caller keeps
+            raise exc from None
+        return other
     roots = np.concatenate([fit.plant.poles(), fit.plant.zeros()])
     if not np.any(np.abs(roots) > np.pi / record.dt):
         return fit
@@ -102,7 +107,13 @@ def fit_whole_record(record: Record, structure: Structure, delay: str | float | 
         other = fit_structure(record, structure, delay, sensor, False, weights=weights, check=True)
     except (DataError, FitError):
         return fit
-    return other if other.residual_std < fit.residual_std else fit
+    better = other.residual_std < fit.residual_std and (_finite_errors(other) or not _finite_errors(fit))
+    return other if better else fit
+
+
+def _finite_errors(fit: TimeFitResult) -> bool:
+    """Every standard error finite (a singular covariance leaves some infinite)."""
+    return bool(np.all(np.isfinite(list(fit.std.values()))))
 
 
 def starts_at_rest(record: Record, first: float, sigmas: float = 3.0) -> bool:
