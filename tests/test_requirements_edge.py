@@ -56,7 +56,9 @@ def test_x4_from_data_states_the_delay_question_and_keeps_k3_feasible():
     assert k3.feasible
     byname = {r.type: r for r in k3.requirements}
     assert byname["delay_margin"].value == pytest.approx(0.02501, abs=2e-5)
-    assert byname["no_limit_cycle"].value == pytest.approx(1.724, abs=2e-3)
+    # the ratio on the plant identified from the SYNTHETIC record (whole record from rest since session 28:
+    # 1.7296; on the periodic average's plant it was 1.724)
+    assert byname["no_limit_cycle"].value == pytest.approx(1.7296, abs=2e-3)
     quiet = spec.model_copy(update={"requirements": [r.model_copy(update={"confirm": False}) if r.type == "no_limit_cycle"
                                                      else r for r in spec.requirements]})
     assert not check(quiet, "P(20)").feasible  # the old headline: 3.5 ms of delay margin
