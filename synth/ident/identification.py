@@ -19,7 +19,7 @@ from synth.data.coerce import RecordLike, as_record
 from synth.data.record import Record
 from synth.errors import DataError, FitError, ModelError
 from synth.ident.directions import DirectionComparison, fit_by_direction
-from synth.ident.periodic_start import fit_whole_record, refit_periodic_start
+from synth.ident.periodic_start import beyond_nyquist, fit_whole_record, refit_periodic_start, settling_time
 from synth.ident.steps import StepAverage, average_steps, find_steps
 from synth.ident.structure import Structure, parse_structure
 from synth.ident.timefit import TimeFitResult, fit_structure
@@ -218,17 +218,6 @@ def _unstable(plant: Plant) -> bool:
     return bool(np.any(roots.real > 1e-9 * np.maximum(np.abs(roots), 1e-12)))
 
 
-def settling_time(plant: Plant, fraction: float = np.exp(-5.0)) -> float:
-    """Time for the slowest mode of ``plant`` to decay to ``fraction`` of its start, plus the delay (inf if not stable).
-
-    Examples
-    --------
-    >>> round(settling_time(Plant.from_string("1/((s+1)*(s+10))", delay=0.1)), 3)
-    5.1
-    """
-    return plant.settling_time(float(np.log(1.0 / fraction)))
-
-
 def _refit_unsettled(record: Record, avg: StepAverage, fit: TimeFitResult, structure: Structure,
                      delay: str | float | None, sensor: Plant | str | None) -> tuple[TimeFitResult, str]:
     """Edge windows assume the plant at rest before each step; if the fitted model does not settle within
@@ -241,8 +230,7 @@ def _refit_unsettled(record: Record, avg: StepAverage, fit: TimeFitResult, struc
     weights = ((record.t - record.t[0]) >= skip).astype(float)
     # the edge fit is the natural start, unless the average pulled a pole or zero beyond the record's Nyquist
     # frequency, which no sampled record resolves: then the whole record's own deterministic start comes first
-    roots = np.concatenate([fit.plant.poles(), fit.plant.zeros()])
-    beyond = bool(np.any(np.abs(roots) > np.pi / record.dt))
+    beyond = beyond_nyquist(fit.plant, record.dt)
     starts = [("its own start", None), ("the edge fit", {**fit.parameters})]
     failures = []
     for name, initial in starts if beyond else starts[::-1]:

@@ -32,8 +32,8 @@ from synth.ident.structure import Structure
 from synth.ident.timefit import TimeFitResult, fit_structure
 from synth.plant import Plant
 
-__all__ = ["WHOLE_RECORD_GAIN", "fit_whole_record", "predicted_whole_record_covariance", "refit_periodic_start",
-           "starts_at_rest", "step_settling_time"]
+__all__ = ["WHOLE_RECORD_GAIN", "beyond_nyquist", "fit_whole_record", "predicted_whole_record_covariance",
+           "refit_periodic_start", "settling_time", "starts_at_rest", "step_settling_time"]
 
 #: fit the whole record when it is predicted to shrink some parameter's standard error by this factor or more
 WHOLE_RECORD_GAIN = 1.5
@@ -41,22 +41,47 @@ WHOLE_RECORD_GAIN = 1.5
 SETTLED = float(np.exp(-5.0))
 
 
+def settling_time(plant: Plant, fraction: float = SETTLED) -> float:
+    """Time for the slowest mode of ``plant`` to decay to ``fraction`` of its start, plus the delay (inf if not stable).
+
+    Examples
+    --------
+    >>> round(settling_time(Plant.from_string("1/((s+1)*(s+10))", delay=0.1)), 3)
+    5.1
+    """
+    return plant.settling_time(float(np.log(1.0 / fraction)))
+
+
+def beyond_nyquist(plant: Plant, dt: float) -> bool:
+    """Whether ``plant`` has a pole or zero beyond the Nyquist frequency of samples ``dt`` apart, which no such
+    record resolves.
+
+    Examples
+    --------
+    >>> G = Plant.from_string("(s+5e4)/((s+1)*(s+3.7e4))")                     # Nyquist of 5 ms: 628 rad/s
+    >>> beyond_nyquist(G, 0.005), beyond_nyquist(Plant.from_string("1/(s+1)"), 0.005)
+    (True, False)
+    """
+    roots = np.concatenate([plant.poles(), plant.zeros()])
+    return bool(np.any(np.abs(roots) > np.pi / dt))
+
+
 def step_settling_time(plant: Plant, fraction: float = SETTLED) -> float:
     """Time after which the step response of ``plant`` stays within ``fraction`` of its final value [s].
 
     What a transient leaves in the output: a slow pole that a near zero cancels settles sooner here than by its
-    time constant alone (:meth:`synth.plant.Plant.settling_time`), which this never exceeds (and returns when the
-    static gain is 0 or infinite).
+    time constant alone (:func:`settling_time`), which this never exceeds (and returns when the static gain is 0
+    or infinite).
 
     Examples
     --------
     >>> round(step_settling_time(Plant.from_string("1/(s+1)")), 2)                  # 5 time constants
     5.0
     >>> p = Plant.from_string("(s+0.5)/((s+0.45)*(s+10))")                          # the slow pole nearly cancelled
-    >>> round(p.settling_time(5.0), 1), round(step_settling_time(p), 1)
+    >>> round(settling_time(p), 1), round(step_settling_time(p), 1)
     (11.1, 6.1)
     """
-    bound = plant.settling_time(float(np.log(1.0 / fraction)))
+    bound = settling_time(plant, fraction)
     final = plant.dc_gain()
     if not np.isfinite(bound) or not np.isfinite(final) or final == 0.0 or bound <= 0:
         return bound
@@ -100,8 +125,7 @@ def fit_whole_record(record: Record, structure: Structure, delay: str | float | 
         if not _finite_errors(other):   # no better founded than the average's fit the caller keeps
             raise exc from None
         return other
-    roots = np.concatenate([fit.plant.poles(), fit.plant.zeros()])
-    if not np.any(np.abs(roots) > np.pi / record.dt):
+    if not beyond_nyquist(fit.plant, record.dt):
         return fit
     try:
         other = fit_structure(record, structure, delay, sensor, False, weights=weights, check=True)
@@ -202,13 +226,14 @@ def refit_periodic_start(record: Record, avg: StepAverage, fit: TimeFitResult, s
     """
     train = float(record.t[avg.steps.index[0]])
     first = train - float(record.t[0])
-    if first >= fit.measured.settling_time(5.0):
+    slowest = settling_time(fit.measured)
+    if first >= slowest:
         return fit, avg, ""   # the whole-record fit from rest in synth.ident.identification had its chance
     settle = step_settling_time(fit.measured)
     if not np.isfinite(settle):
         return fit, avg, ""
     at_rest = starts_at_rest(record, first)
-    skip = 0.0 if at_rest else min(fit.measured.settling_time(5.0), 0.25 * record.duration)
+    skip = 0.0 if at_rest else min(slowest, 0.25 * record.duration)
     weights = ((record.t - record.t[0]) >= skip).astype(float)
     try:
         names, cov = predicted_whole_record_covariance(record, fit, structure, avg.noise_std_before, weights)
@@ -265,14 +290,14 @@ def _drop_transient_periods(record: Record, avg: StepAverage, fit: TimeFitResult
         try:
             later = average_steps(record, avg.steps, "cycle", settle=settle)
         except DataError:
-            return _with_average(_refit_transient(record, fit, structure, delay, sensor, settle, lead,
-                                                  "no later period is left"), avg)
+            return _refit_transient(record, avg, fit, structure, delay, sensor, settle, lead,
+                                    "no later period is left")
         try:
             fit = fit_structure(later.record(), structure, delay, sensor, True, initial={**fit.parameters},
                                 check=True)
         except FitError as exc:
-            return _with_average(_refit_transient(record, fit, structure, delay, sensor, settle, lead,
-                                                  f"the fit of the later periods failed ({exc})"), avg)
+            return _refit_transient(record, avg, fit, structure, delay, sensor, settle, lead,
+                                    f"the fit of the later periods failed ({exc})")
         dropped += later.dropped - avg.dropped
         avg, settle = later, step_settling_time(fit.measured)
     if not dropped:
@@ -281,12 +306,9 @@ def _drop_transient_periods(record: Record, avg: StepAverage, fit: TimeFitResult
                       f"time ({settle:.3g} s) after the train began, so they hold part of the start-up transient")
 
 
-def _with_average(fitted: tuple[TimeFitResult, str], avg: StepAverage) -> tuple[TimeFitResult, StepAverage, str]:
-    return fitted[0], avg, fitted[1]
-
-
-def _refit_transient(record: Record, fit: TimeFitResult, structure: Structure, delay: str | float | None,
-                     sensor: Plant | str | None, settle: float, lead: float, reason: str) -> tuple[TimeFitResult, str]:
+def _refit_transient(record: Record, avg: StepAverage, fit: TimeFitResult, structure: Structure,
+                     delay: str | float | None, sensor: Plant | str | None, settle: float, lead: float,
+                     reason: str) -> tuple[TimeFitResult, StepAverage, str]:
     """No averaged period free of the start-up transient can be fitted (``reason``): the whole record, its first
     settling time (at most half the record) weighted 0, from the periodic fit."""
     skip = min(settle, 0.5 * record.duration)
@@ -296,7 +318,7 @@ def _refit_transient(record: Record, fit: TimeFitResult, structure: Structure, d
     try:
         whole = fit_whole_record(record, structure, delay, sensor, {**fit.parameters}, weights)
     except (DataError, FitError) as exc:
-        return fit, f"{why}; the whole-record fit failed ({exc}), so the periodic fit is kept (biased)"
+        return fit, avg, f"{why}; the whole-record fit failed ({exc}), so the periodic fit is kept (biased)"
     short = (f"; the record is too short for the state at its start to settle before the fitted part ({skip:.3g} "
              f"of the {settle:.3g} s it needs): the estimates may be biased" if skip < settle else "")
-    return whole, f"{why}: fitted the whole record instead, the first {skip:.3g} s weighted 0{short}"
+    return whole, avg, f"{why}: fitted the whole record instead, the first {skip:.3g} s weighted 0{short}"
