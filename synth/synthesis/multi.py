@@ -48,7 +48,7 @@ from synth.synthesis.parametrization import parametrize
 from synth.synthesis.pattern import pattern_search
 from synth.synthesis.polish_skip import exact_forms, polish_redundant
 from synth.synthesis.scalar import design_scalar
-from synth.synthesis.screen import SCREEN_ITERATIONS, screen_improving, screen_size, screen_starts
+from synth.synthesis.screen import SCREEN_ITERATIONS, screen_improving, screen_near_improving, screen_size, screen_starts
 from synth.synthesis.stabilizing_slices import open_loop_unstable, slices_text, stabilizing_slices
 
 __all__ = ["STRUCTURAL", "STRUCTURAL_REFINEMENTS", "certificate_density", "choose", "conflict_set", "convex_runs",
@@ -363,14 +363,19 @@ def _design(spec: Spec, settings: ConvexSettings, nlp: bool | str, explain: bool
     if passed is not None and nlp and spec.objective is not None:  # a local optimum? better points elsewhere
         value = score(Loop(nominal, passed[1]), terms)
         announce(f"screen of {screen_size(spec)} controllers for better starts")
-        starts = screen_improving(spec, terms, value + IMPROVEMENT * max(abs(value), 1e-12))
-        found.extend(_polished_from(spec, starts, terms, runs[0][0].grid, settings, unconverged))
+        above = value + IMPROVEMENT * max(abs(value), 1e-12)
+        starts = screen_improving(spec, terms, above)
+        near = [] if starts else screen_near_improving(spec, terms, above)
+        found.extend(_polished_from(spec, starts + near, terms, runs[0][0].grid, settings, unconverged))
         stages.append(f"random screen of the bounds ({screen_size(spec)} controllers): {len(starts)} scored more "
-                      "than 1 % better on its grid" + (", NLP polish from each" if starts else ""))
+                      "than 1 % better on its grid" + (", NLP polish from each" if starts else "")
+                      + (", NLP polish from the least violating of those that score better" if near else ""))
         screened = (f"a random screen of {screen_size(spec)} controllers over the bounds found "
                     + (f"{len(starts)} scoring more than 1 % better on its grid, polished" if starts
-                       else "none scoring more than 1 % better on its grid"))
-        if starts:
+                       else "none scoring more than 1 % better on its grid"
+                       + (", and an NLP polish from the least violating one that scores better "
+                          "(a near miss) was made" if near else "")))
+        if starts or near:
             candidates, passed = _certify_best(spec, found, terms, per_decade, cache)
     if passed is None and nlp:  # the local stages found nothing that certifies: starts from the whole box
         announce(f"nothing certified: screen of {screen_size(spec)} controllers")

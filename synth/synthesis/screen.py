@@ -20,8 +20,9 @@ from synth.controllers import Controller
 from synth.loop_batch import LoopBatch
 from synth.spec import Spec
 
-__all__ = ["PARAMETER_MEASURES", "SCREEN_ITERATIONS", "SCREEN_POINTS", "SCREEN_POINTS_MANY", "screen_improving",
-           "screen_points", "screen_size", "screen_starts"]
+__all__ = ["NEAR_POOL", "PARAMETER_MEASURES", "SCREEN_ITERATIONS", "SCREEN_POINTS", "SCREEN_POINTS_MANY",
+           "screen_improving", "screen_near_improving", "screen_points", "screen_scores", "screen_size",
+           "screen_starts"]
 
 SCREEN_POINTS = 384
 """Controllers drawn by the screen for up to three free parameters (:func:`screen_size`)."""
@@ -238,6 +239,140 @@ def screen_improving(spec: Spec, terms: list[tuple[str, str, float]], above: flo
     meets_heavy = _InScoreOrder(order, n, lambda chunk: _meeting(controllers, chunk, heavy, plants))
     return [controllers[i] for i in _pick(order, n, keep, lambda i: meets_heavy(i) and all(
         Loop(p, controllers[i]).stability().stable for p in plants), _parameters(controllers))]
+
+
+NEAR_POOL = 192
+"""Controllers scoring better whose closed-loop roots :func:`screen_near_improving` counts, at most."""
+
+
+def screen_near_improving(spec: Spec, terms: list[tuple[str, str, float]], above: float, keep: int = 1,
+                          n: int | None = None) -> list[Controller]:
+    """Up to ``keep`` controllers of :func:`screen_points` that keep every closed loop stable and score above
+    ``above`` but miss a requirement, least violating first (their worst slack over every requirement and
+    plant): starts for the NLP where no screened point both meets the requirements and scores better, and
+    the better designs lie in a thin feasible region that a polish reaches from just outside it.
+
+    Every point is scored at once (:func:`screen_scores`); those that score better are taken in the order of
+    their worst slack on the requirements that count no closed-loop roots (every loop taken as stable); the
+    first :data:`NEAR_POOL` of them have their closed-loop roots counted, and the stable ones are ranked on
+    every requirement: the root counts stay bounded.
+
+    Examples
+    --------
+    >>> from synth.spec import parse_spec
+    >>> from synth.check import check
+    >>> spec = parse_spec({"name": "pi", "plant": {"tf": "1/(s+1)^3"}, "requirements": [{"type":
+    ...                    "peak_sensitivity", "max_db": 3}], "controller": {"type": "PI", "bounds": {"kp": [0, 5],
+    ...                    "ki": [0, 5]}}, "objective": {"maximize": "integral_gain"}})
+    >>> terms = [("integral_gain", "maximize", 1.0)]
+    >>> screen_improving(spec, terms, 0.3)  # no screened point meets |S| <= 3 dB with ki > 0.3
+    []
+    >>> [(c.parameters["ki"] > 0.3, check(spec, c).feasible) for c in screen_near_improving(spec, terms, 0.3)]
+    [(True, False)]
+    """
+    n = screen_size(spec) if n is None else n
+    controllers = screen_points(spec, n)
+    plants = spec.plants()
+    light = [r for r in spec.requirements if r.type not in STABILITY_BASED]
+    heavy = [r for r in spec.requirements if r.type in STABILITY_BASED]
+    idx = np.arange(len(controllers))
+    light_worst = _worst_slack(controllers, idx, light, plants, assume_stable=True)
+    better = idx[(screen_scores(spec, controllers, terms) > above) & (light_worst > -np.inf)]
+    better = better[np.argsort(-light_worst[better], kind="stable")][:NEAR_POOL]
+    if better.size == 0:
+        return []
+    worst = light_worst[better]
+    for plant in plants:
+        worst = np.where(LoopBatch(plant, [controllers[i] for i in better]).closed_loop_unstable(), -np.inf, worst)
+    alive = better[worst > -np.inf]
+    if alive.size == 0:
+        return []
+    worst = np.fmin(worst[worst > -np.inf], _worst_slack(controllers, alive, heavy, plants))
+    near = [(float(v), int(i)) for v, i in zip(worst, alive) if -np.inf < v < 0]
+    order = [i for _, i in sorted(near, key=lambda vi: -vi[0])]
+    return [controllers[i] for i in _pick(order, n, keep, lambda i: True, _parameters(controllers))][:keep]
+
+
+def screen_scores(spec: Spec, controllers: list[Controller], terms: list[tuple[str, str, float]]) -> np.ndarray:
+    """Every controller's objective (:func:`synth.objectives.score` on the nominal plant, every loop taken as
+    stable), the bandwidth read off one grid for all at once (:func:`_grid_bandwidths`), the other
+    measures loop by loop (the parameter measures cost nothing); ``-inf`` where it is not a number. For
+    ranking starts only: the polish and the certificate judge the designs.
+
+    Examples
+    --------
+    >>> from synth.spec import parse_spec
+    >>> spec = parse_spec({"name": "p", "plant": {"tf": "1/(s+1)"}, "requirements": [{"type": "bandwidth",
+    ...                    "min": 1.0}], "controller": {"type": "P", "bounds": {"kp": [0, 10]}}})
+    >>> scores = screen_scores(spec, [Controller("P", {"kp": 3.0})], [("bandwidth", "maximize", 1.0)])
+    >>> bool(abs(scores[0] - 4.0) < 0.05)  # T = 3/(s+4): -3 dB at 4 rad/s
+    True
+    """
+    from synth.loop import Loop
+    from synth.objectives import measure
+
+    nominal = spec.nominal_plant()
+    total = np.zeros(len(controllers))
+    for name, sense, weight in terms:
+        if name == "bandwidth":
+            value = _grid_bandwidths(LoopBatch(nominal, controllers))
+        else:
+            with np.errstate(all="ignore"):
+                value = np.array([measure(name).evaluate(Loop(nominal, c)) for c in controllers], float)
+        total += weight * (value if sense == "maximize" else -value)
+    return np.where(np.isnan(total), -np.inf, total)
+
+
+def _grid_bandwidths(batch: LoopBatch, per_decade: int = 20) -> np.ndarray:
+    """Every loop's first fall of ``|T|`` 3 dB below ``|T(0)|`` on one log grid (``per_decade`` points, two
+    decades below to one above the batch's frequency ranges), interpolated in log frequency between the grid
+    points around it: ``inf`` where it does not fall, ``nan`` where ``T(0) = 0``. No dip between grid points
+    counts, unlike ``Loop.bandwidth``: a ranking, not a measurement.
+
+    Examples
+    --------
+    >>> from synth.plant import Plant
+    >>> batch = LoopBatch(Plant.from_string("1/(s+1)"), [Controller("P", {"kp": k}) for k in (1.0, 3.0)])
+    >>> [round(float(w), 1) for w in _grid_bandwidths(batch)]  # T = k/(s + 1 + k): -3 dB at 1 + k
+    [2.0, 4.0]
+    """
+    from synth.loop import BANDWIDTH_LEVEL
+
+    lo, hi = float(np.min(batch.frequency_ranges[:, 0])) / 100.0, float(np.max(batch.frequency_ranges[:, 1])) * 10
+    grid = np.geomspace(lo, hi, max(int(np.ceil(np.log10(hi / lo) * per_decade)), 2))
+    level = batch.T0() * BANDWIDTH_LEVEL
+    with np.errstate(all="ignore"):
+        mag = np.abs(batch.T(grid))
+    below = mag < level[:, None]
+    first = np.argmax(below, axis=1)
+    prev = np.maximum(first - 1, 0)
+    rows = np.arange(len(batch))
+    a, b = mag[rows, prev], mag[rows, first]
+    with np.errstate(all="ignore"):
+        share = np.clip(np.where(a > b, (a - level) / (a - b), 0.0), 0.0, 1.0)
+        w = np.exp(np.log(grid[prev]) + share * (np.log(grid[first]) - np.log(grid[prev])))
+    w = np.where(below.any(axis=1), w, np.inf)
+    return np.where(level > 0, w, np.nan)
+
+
+def _worst_slack(controllers: list[Controller], idx: np.ndarray, requirements: list, plants: list,
+                 assume_stable: bool = False) -> np.ndarray:
+    """Each controller of ``idx``'s smallest slack over ``requirements`` and ``plants`` on the screen's grid
+    (``-inf`` where one is not a number; ``+inf`` without requirements); ``assume_stable`` as in
+    :func:`_meeting`."""
+    worst = np.full(idx.size, np.inf)
+    if not requirements or idx.size == 0:
+        return worst
+    first = LoopBatch(plants[0], [controllers[i] for i in idx])
+    for k, plant in enumerate(plants):
+        batch = first if k == 0 else first.with_plant(plant)
+        if assume_stable:
+            batch = batch.with_root_counts(np.zeros(idx.size, int))
+        for req in requirements:
+            with np.errstate(all="ignore"):
+                slack = np.asarray(req.batch_slack(batch, 20), float)
+            worst = np.fmin(worst, np.where(np.isnan(slack), -np.inf, slack))
+    return worst
 
 
 class _InScoreOrder:
