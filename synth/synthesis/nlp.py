@@ -199,6 +199,7 @@ def polish(requirements: list[Requirement], plants: list[Plant], start: Controll
     exact_from_now = False
     hold_sides_now = HOLD_SIDES == "always"
     shrinks = 0
+    settled = False  # the last answer needed no further round
     for rnd in range(rounds + MAX_SHRINKS):
         if rnd - shrinks >= rounds:
             break
@@ -270,11 +271,19 @@ def polish(requirements: list[Requirement], plants: list[Plant], start: Controll
         if trust_edge:  # the trust region held the step back: the next one may go further
             radius *= 4
         if _crossovers_changed(current, candidate, plants) or _at_helper_box(b, x, len(ctrl.free)) or trust_edge:
-            current = candidate
+            current, settled = candidate, False
         elif not between.size:
+            settled = True
             break
         # else violated only between grid points: the same start again with those frequencies added (an interior
         # point method restarted at an optimum, its constraints active, wanders; cf. the servo PID in benchmarks)
+    if not settled and solved:
+        # the rounds ran out while the last answer asked for another (on its trust region's edge, a helper on its
+        # box, crossovers that moved; or the round after it left the stabilizing set): a KKT point of that
+        # round's NLP, not shown to be one of the problem's
+        last = next(h for h in reversed(history) if h["controller"] == str(solved[0]) and not h.get("unstable"))
+        if not last.get("offered"):
+            last.update(offered=True, rounds_exhausted=True)
     value = None
     if solved:
         from synth.objectives import score

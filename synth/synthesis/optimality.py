@@ -58,7 +58,8 @@ def optimality_of(stage: str, controller: str, unconverged: set[str], screened: 
         ``str(controller)`` of the chosen design.
     unconverged : set of str
         The designs (as text) that a stage returned without converging: where IPOPT stopped at its iteration
-        limit, or a convex-concave run that ended before its tolerance.
+        limit or the polish's rounds ran out while its answer still asked for another round, or a
+        convex-concave run that ended before its tolerance.
     screened : str
         What the pattern search and the random screen of the bounds found beyond the local stages (clauses), if
         they ran.
@@ -73,6 +74,9 @@ def optimality_of(stage: str, controller: str, unconverged: set[str], screened: 
     >>> o = optimality_of("nlp", "PI(kp=1, ki=2)", {"PI(kp=1, ki=2)"})
     >>> o.local, o.basis[:76]
     (False, 'not shown to be a local optimum (the NLP polish (IPOPT) stopped at its itera')
+    >>> o.basis[76:160]
+    'tion limit, or its rounds ran out while the answer still moved); the design is certi'
+
     """
     method = _METHODS.get(stage, stage)
     if stage == "pattern search":
@@ -83,7 +87,8 @@ def optimality_of(stage: str, controller: str, unconverged: set[str], screened: 
         return Optimality(False, stage, "not optimized: a point of the random screen of the bounds, certified"
                           + (f"; {screened}" if screened else ""))
     if controller in unconverged:
-        why = f"{method} stopped at its iteration limit" if stage.startswith("nlp") else \
+        why = f"{method} stopped at its iteration limit, or its rounds ran out while the answer still moved" \
+            if stage.startswith("nlp") else \
             f"{method} ended without a KKT point (a bisection on the objective, or its iteration limit)"
         return Optimality(False, stage, f"not shown to be a local optimum ({why}); the design is "
                           "certified feasible, a better one may exist" + (f"; {screened}" if screened else ""))
