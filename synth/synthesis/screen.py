@@ -183,16 +183,8 @@ def screen_starts(spec: Spec, keep: int = 3, n: int | None = None) -> list[Contr
     """
     n = screen_size(spec) if n is None else n
     controllers = screen_points(spec, n)
-    worst = np.full(len(controllers), np.inf)
-    first = LoopBatch(spec.plants()[0], controllers)
-    for k, plant in enumerate(spec.plants()):
-        batch = first if k == 0 else first.with_plant(plant)
-        unstable = batch.closed_loop_unstable()
-        worst = np.where(unstable, -np.inf, worst)
-        for req in spec.requirements:
-            with np.errstate(all="ignore"):
-                slack = np.asarray(req.batch_slack(batch, 20), float)
-            worst = np.fmin(worst, np.where(np.isnan(slack), -np.inf, slack))
+    worst = _worst_slack(controllers, np.arange(len(controllers)), list(spec.requirements), spec.plants(),
+                         stable_only=True)
     order = [int(i) for i in np.argsort(-worst, kind="stable")]
     return [controllers[i] for i in _pick(order, n, keep, lambda i: bool(np.isfinite(worst[i]) or worst[i] > 0),
                                           _parameters(controllers))]
@@ -281,14 +273,8 @@ def screen_near_improving(spec: Spec, terms: list[tuple[str, str, float]], above
     better = better[np.argsort(-light_worst[better], kind="stable")][:NEAR_POOL]
     if better.size == 0:
         return []
-    worst = light_worst[better]
-    for plant in plants:
-        worst = np.where(LoopBatch(plant, [controllers[i] for i in better]).closed_loop_unstable(), -np.inf, worst)
-    alive = better[worst > -np.inf]
-    if alive.size == 0:
-        return []
-    worst = np.fmin(worst[worst > -np.inf], _worst_slack(controllers, alive, heavy, plants))
-    near = [(float(v), int(i)) for v, i in zip(worst, alive) if -np.inf < v < 0]
+    worst = np.fmin(light_worst[better], _worst_slack(controllers, better, heavy, plants, stable_only=True))
+    near = [(float(v), int(i)) for v, i in zip(worst, better) if -np.inf < v < 0]
     order = [i for _, i in sorted(near, key=lambda vi: -vi[0])]
     return [controllers[i] for i in _pick(order, n, keep, lambda i: True, _parameters(controllers))][:keep]
 
@@ -356,16 +342,18 @@ def _grid_bandwidths(batch: LoopBatch, per_decade: int = 20) -> np.ndarray:
 
 
 def _worst_slack(controllers: list[Controller], idx: np.ndarray, requirements: list, plants: list,
-                 assume_stable: bool = False) -> np.ndarray:
+                 assume_stable: bool = False, stable_only: bool = False) -> np.ndarray:
     """Each controller of ``idx``'s smallest slack over ``requirements`` and ``plants`` on the screen's grid
     (``-inf`` where one is not a number; ``+inf`` without requirements); ``assume_stable`` as in
-    :func:`_meeting`."""
+    :func:`_meeting`; ``stable_only``: ``-inf`` where a closed loop is unstable (exact count)."""
     worst = np.full(idx.size, np.inf)
-    if not requirements or idx.size == 0:
+    if not (requirements or stable_only) or idx.size == 0:
         return worst
     first = LoopBatch(plants[0], [controllers[i] for i in idx])
     for k, plant in enumerate(plants):
         batch = first if k == 0 else first.with_plant(plant)
+        if stable_only:
+            worst = np.where(batch.closed_loop_unstable(), -np.inf, worst)
         if assume_stable:
             batch = batch.with_root_counts(np.zeros(idx.size, int))
         for req in requirements:
