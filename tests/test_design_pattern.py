@@ -13,7 +13,7 @@ import pytest
 from synth.controllers import Controller
 from synth.spec import parse_spec
 from synth.synthesis.integral_action import objective_terms
-from synth.synthesis.pattern import pattern_search
+from synth.synthesis.pattern import PATTERN_CHECKS, pattern_search
 
 SPEC = {"name": "rand_1_4", "plant": {"tf": "20.7413*(1-s/3.49742)/((s+14.6471)*(s+0.155887))", "delay": 0.168246},
         "controller": {"type": "leadlag", "bounds": {"k": [0.0, 15.0583], "z": [0.076462, 30.5848],
@@ -30,7 +30,7 @@ def test_pattern_search_takes_a_screened_point_to_the_reference_optimum():
 
     spec = parse_spec(SPEC)
     result = pattern_search(spec, Controller("leadlag", SCREENED), objective_terms(spec))
-    assert result.improved and result.checks <= 160
+    assert result.improved and result.checks <= PATTERN_CHECKS
     plant = Plant.from_string(SPEC["plant"]["tf"])
     before = reference.check_point(plant.num, plant.den, SPEC["plant"]["delay"], SPEC, SCREENED)
     after = reference.check_point(plant.num, plant.den, SPEC["plant"]["delay"], SPEC,
@@ -113,3 +113,29 @@ def test_a_start_closer_to_minus_one_than_the_keeping_level_is_searched_not_retu
     plant = spec.nominal_plant()
     assert score(Loop(plant, result.controller), terms) > score(Loop(plant, start), terms)
     assert closest(result.controller) >= 0.9 * closest(start)
+
+
+@pytest.mark.parametrize(("index", "start", "reference_best", "reached"), [
+    (20, {"kp": 1.707171861208554, "ki": 0.06718624210324364}, 3.990492521051015, 0.98),
+    (69, {"b0": 46.6384, "b1": 25.372, "a0": 1646.26}, 45.18344251006973, 0.93),
+])
+def test_moves_along_the_active_boundary_where_coordinate_moves_stall(index, start, reference_best, reached):
+    """Seed 16 #20 (a PI on an integrating plant behind a delay: margins, static sensitivity, bandwidth floor)
+    and #69 (a rational controller, peak |S| and |KS| bounds), both maximizing bandwidth: the design's answer
+    sits on a requirement's boundary where moving any one parameter either breaks the bound or lowers the
+    bandwidth, while moving two together along the boundary raises it (#20: 3.28 % below the reference's best,
+    #69: 9.77 %), and the coordinate search found no better point. With the boundary moves it reaches within 2 %
+    (#20) and 7 % (#69, within its check budget; the design's polish from there ends 1.6 % below), judged by
+    the reference's own dense check."""
+    reference = pytest.importorskip("benchmarks.design_reference")
+    from benchmarks.design_problems import problem
+
+    p = problem(16, index)
+    spec = parse_spec(p.spec)
+    result = pattern_search(spec, Controller(p.spec["controller"]["type"], start), objective_terms(spec),
+                            keeping=0.05)
+    before = reference.check_point(p.num, p.den, p.delay, p.spec, start)
+    after = reference.check_point(p.num, p.den, p.delay, p.spec, dict(result.controller.parameters))
+    assert before.feasible(0.0) and after.feasible(1e-3)
+    assert before.objective < 0.975 * reference_best
+    assert result.improved and after.objective >= reached * reference_best
