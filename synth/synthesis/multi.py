@@ -464,13 +464,16 @@ def _design(spec: Spec, settings: ConvexSettings, nlp: bool | str, explain: bool
     return result
 
 
-def conflict_set(spec: Spec, settings: ConvexSettings) -> list[str]:
+def conflict_set(spec: Spec, settings: ConvexSettings) -> list[str] | None:
     """A minimal set of requirements that cannot be met together (deletion filter).
 
     Each requirement is dropped in turn; if the others are still infeasible it
     is left out for good, else it is kept. Feasibility is tested by the convex
     phase 1 from several stabilizing starts (a local method: a kept requirement
-    is one whose removal let it find a design).
+    is one whose removal let it find a design). None when no stabilizing start
+    is found for the filter's fixed structure (a lead-lag's pole held at the
+    middle of its range: seed 12 #184 of the design benchmark ended in a
+    traceback): the diagnosis then names the requirements by their elastic prices.
     """
     requirements = list(spec.requirements)
     names = unique_names(requirements)
@@ -487,8 +490,11 @@ def conflict_set(spec: Spec, settings: ConvexSettings) -> list[str]:
             continue
         designer = ConvexDesigner([requirements[k] for k in trial], [names[k] for k in trial], spec.plants(),
                                   par, None, settings)
-        if not designer.is_feasible():
-            keep = trial
+        try:
+            if not designer.is_feasible():
+                keep = trial
+        except NoStabilizingStartError:
+            return None
     return [names[k] for k in keep]
 
 
