@@ -126,6 +126,7 @@ def test_a_pid_on_an_unstable_plant_reaches_the_basin_only_a_near_miss_leads_to(
     rec = run_problem(generate(119, 16)[118], time_limit=120.0, stored=stored)
     assert rec["outcome"] == "agree feasible" and rec["synth_passes_reference"], rec["outcome"]
     assert rec["objective_gap"] <= 0.01, rec["objective_gap"]  # was 0.128
+    assert "misses them by the least led to this design" in rec["synth_verdict"]
 
 
 def test_near_misses_score_better_stay_stable_and_miss_a_requirement() -> None:

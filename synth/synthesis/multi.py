@@ -372,11 +372,14 @@ def _design(spec: Spec, settings: ConvexSettings, nlp: bool | str, explain: bool
                       + (", NLP polish from the least violating of those that score better" if near else ""))
         screened = (f"a random screen of {screen_size(spec)} controllers over the bounds found "
                     + (f"{len(starts)} scoring more than 1 % better on its grid, polished" if starts
-                       else "none scoring more than 1 % better on its grid"
-                       + (", and an NLP polish from the least violating one that scores better "
-                          "(a near miss) was made" if near else "")))
+                       else "none scoring more than 1 % better on its grid"))
         if starts or near:
             candidates, passed = _certify_best(spec, found, terms, per_decade, cache)
+            if near:  # (the screen's starts were none: a design polished from the screen came from the near miss)
+                screened += (", and of those that score better but miss the requirements, an NLP polish from the "
+                             "one that misses them by the least " + (
+                                 "led to this design" if passed is not None and passed[0] == "nlp from screen"
+                                 else "ended at no better design"))
     if passed is None and nlp:  # the local stages found nothing that certifies: starts from the whole box
         announce(f"nothing certified: screen of {screen_size(spec)} controllers")
         starts = screen_starts(spec)
