@@ -14,7 +14,7 @@ import pytest
 import synth
 from benchmarks.design_problems import problem
 from synth.synthesis.convex_settings import ConvexSettings
-from synth.synthesis.multi import conflict_set
+from synth.synthesis.conflict_set import conflict_set
 
 SPEC = problem(12, 184).spec
 

@@ -37,6 +37,7 @@ from synth.results import (
     reference_verdict,
 )
 from synth.spec import Spec
+from synth.synthesis.conflict_set import conflict_set
 from synth.synthesis.convex import ConvexDesigner
 from synth.synthesis.convex_results import ConvexResult, infeasible_verdict
 from synth.synthesis.convex_settings import ConvexSettings
@@ -44,7 +45,7 @@ from synth.synthesis.integral_action import integral_only, objective_terms, with
 from synth.synthesis.nlp import polish
 from synth.synthesis.no_start import no_start_result
 from synth.synthesis.optimality import optimality_of
-from synth.synthesis.parametrization import parametrize
+from synth.synthesis.parametrization import STRUCTURAL, parametrize, reference_frequency
 from synth.synthesis.pattern import pattern_search
 from synth.synthesis.polish_skip import exact_forms, polish_redundant
 from synth.synthesis.scalar import design_scalar
@@ -54,9 +55,6 @@ from synth.synthesis.stabilizing_slices import open_loop_unstable, slices_text, 
 __all__ = ["STRUCTURAL", "STRUCTURAL_REFINEMENTS", "certificate_density", "choose", "conflict_set", "convex_runs",
            "design_convex", "design_trial", "design_with_integral_action", "exact_forms", "infeasible_verdict",
            "objective_terms", "polish_redundant"]
-
-STRUCTURAL = {"PID": "tf", "leadlag": "p"}
-"""The structural parameter of each controller type that the convex stage holds at a few fixed values."""
 
 IMPROVEMENT = 0.01
 """A screened controller is a start for another NLP polish when it scores this much (relative) better than the
@@ -197,7 +195,7 @@ def convex_runs(spec: Spec, settings: ConvexSettings) -> list[tuple[ConvexDesign
     names = unique_names(requirements)
     name, sense, _ = objective_terms(spec)[0]
     runs = []
-    w0 = _reference_frequency(spec)
+    w0 = reference_frequency(spec)
     start = spec.controller.initial_controller()
     tried: dict[float, tuple[ConvexDesigner, ConvexResult]] = {}
 
@@ -246,15 +244,6 @@ def convex_runs(spec: Spec, settings: ConvexSettings) -> list[tuple[ConvexDesign
                     a, b = sorted((grid[i], grid[j]))
                     run(float(np.sqrt(a * b)) if a > 0 else 0.5 * (a + b))
     return runs
-
-
-def _reference_frequency(spec: Spec) -> float:
-    """Geometric mean of the nominal plant's corner frequencies (scales rational coefficients)."""
-    from synth.freqgrid import characteristic_range
-
-    p = spec.nominal_plant()
-    lo, hi = characteristic_range(p.num, p.den, delay=p.delay)
-    return float(np.sqrt(lo * hi))
 
 
 def certificate_density(settings: ConvexSettings, grids: list[np.ndarray]) -> int:
@@ -465,40 +454,6 @@ def _design(spec: Spec, settings: ConvexSettings, nlp: bool | str, explain: bool
                      "them fail it too.")
     result.verdict = infeasible_verdict(worst, compromise) + nlp_note + reference_verdict(spec, ref)
     return result
-
-
-def conflict_set(spec: Spec, settings: ConvexSettings) -> list[str] | None:
-    """A minimal set of requirements that cannot be met together (deletion filter).
-
-    Each requirement is dropped in turn; if the others are still infeasible it
-    is left out for good, else it is kept. Feasibility is tested by the convex
-    phase 1 from several stabilizing starts (a local method: a kept requirement
-    is one whose removal let it find a design). None when no stabilizing start
-    is found for the filter's fixed structure (a lead-lag's pole held at the
-    middle of its range: seed 12 #184 of the design benchmark ended in a
-    traceback): the diagnosis then names the requirements by their elastic prices.
-    """
-    requirements = list(spec.requirements)
-    names = unique_names(requirements)
-    keep = list(range(len(requirements)))
-    key = STRUCTURAL.get(spec.controller.type)
-    bounds = spec.controller.all_bounds()
-    if key and bounds[key][0] < bounds[key][1]:
-        lo, hi = bounds[key]
-        bounds = {**bounds, key: (float(np.sqrt(lo * hi)) if lo > 0 else 0.5 * (lo + hi),) * 2}
-    par = parametrize(spec.controller.type, bounds, spec.controller.order, _reference_frequency(spec))
-    for i in list(keep):
-        trial = [k for k in keep if k != i]
-        if not trial:
-            continue
-        designer = ConvexDesigner([requirements[k] for k in trial], [names[k] for k in trial], spec.plants(),
-                                  par, None, settings)
-        try:
-            if not designer.is_feasible():
-                keep = trial
-        except NoStabilizingStartError:
-            return None
-    return [names[k] for k in keep]
 
 
 def _describe(spec: Spec, label: dict) -> str:

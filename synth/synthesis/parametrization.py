@@ -26,13 +26,22 @@ stay of order one; :meth:`RationalParametrization.controller` converts back.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from synth.controllers import RATIONAL, Controller
 from synth.errors import SynthError
+from synth.freqgrid import characteristic_range
 
-__all__ = ["Affine", "LinearParametrization", "Parametrization", "RationalParametrization", "parametrize"]
+if TYPE_CHECKING:
+    from synth.spec import Spec
+
+__all__ = ["STRUCTURAL", "Affine", "LinearParametrization", "Parametrization", "RationalParametrization", "parametrize",
+           "reference_frequency"]
+
+STRUCTURAL = {"PID": "tf", "leadlag": "p"}
+"""The structural parameter of each controller type that the convex stage holds at a few fixed values."""
 
 
 @dataclass
@@ -387,3 +396,19 @@ def parametrize(ctype: str, bounds: dict[str, tuple[float, float]], order: tuple
             raise SynthError("a rational controller needs its order", where="controller.order")
         return RationalParametrization(order[0], order[1], bounds, w0)
     raise SynthError(f"no parametrization for controller type {ctype}", where="controller.type")
+
+
+def reference_frequency(spec: Spec) -> float:
+    """Geometric mean of the nominal plant's corner frequencies (scales rational coefficients).
+
+    Examples
+    --------
+    >>> from synth.spec import parse_spec
+    >>> spec = parse_spec({"name": "x", "plant": {"tf": "1/((s+1)*(s+100))"}, "controller": {"type": "P"},
+    ...                    "requirements": [{"type": "bandwidth", "min": 1.0}]})
+    >>> 1.0 < reference_frequency(spec) < 100.0
+    True
+    """
+    p = spec.nominal_plant()
+    lo, hi = characteristic_range(p.num, p.den, delay=p.delay)
+    return float(np.sqrt(lo * hi))
