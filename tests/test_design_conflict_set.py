@@ -13,8 +13,8 @@ import pytest
 
 import synth
 from benchmarks.design_problems import problem
-from synth.synthesis.convex_settings import ConvexSettings
 from synth.synthesis.conflict_set import conflict_set
+from synth.synthesis.convex_settings import ConvexSettings
 
 SPEC = problem(12, 184).spec
 

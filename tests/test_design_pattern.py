@@ -13,7 +13,7 @@ import pytest
 from synth.controllers import Controller
 from synth.spec import parse_spec
 from synth.synthesis.integral_action import objective_terms
-from synth.synthesis.pattern import PATTERN_CHECKS, pattern_search
+from synth.synthesis.pattern import BOUNDARY_CHECKS, PATTERN_CHECKS, pattern_search
 
 SPEC = {"name": "rand_1_4", "plant": {"tf": "20.7413*(1-s/3.49742)/((s+14.6471)*(s+0.155887))", "delay": 0.168246},
         "controller": {"type": "leadlag", "bounds": {"k": [0.0, 15.0583], "z": [0.076462, 30.5848],
@@ -133,7 +133,7 @@ def test_moves_along_the_active_boundary_where_coordinate_moves_stall(index, sta
     p = problem(16, index)
     spec = parse_spec(p.spec)
     result = pattern_search(spec, Controller(p.spec["controller"]["type"], start), objective_terms(spec),
-                            keeping=0.05)
+                            max_checks=BOUNDARY_CHECKS, keeping=0.05, boundary_moves=True)
     before = reference.check_point(p.num, p.den, p.delay, p.spec, start)
     after = reference.check_point(p.num, p.den, p.delay, p.spec, dict(result.controller.parameters))
     assert before.feasible(0.0) and after.feasible(1e-3)

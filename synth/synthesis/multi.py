@@ -46,7 +46,7 @@ from synth.synthesis.nlp import polish
 from synth.synthesis.no_start import no_start_result
 from synth.synthesis.optimality import optimality_of
 from synth.synthesis.parametrization import STRUCTURAL, parametrize, reference_frequency
-from synth.synthesis.pattern import pattern_search
+from synth.synthesis.pattern import BOUNDARY_CHECKS, pattern_search
 from synth.synthesis.polish_skip import exact_forms, polish_redundant
 from synth.synthesis.scalar import design_scalar
 from synth.synthesis.screen import SCREEN_ITERATIONS, screen_improving, screen_near_improving, screen_size, screen_starts
@@ -383,7 +383,8 @@ def _design(spec: Spec, settings: ConvexSettings, nlp: bool | str, explain: bool
         # the best certified design is not a converged stage's answer (a raw screened point, an IPOPT round
         # stopped at its limit, a convex bisection): pattern search on the exact check from it
         announce("pattern search")
-        search = pattern_search(spec, passed[1], terms, keeping=settings.stability_level)
+        search = pattern_search(spec, passed[1], terms, max_checks=BOUNDARY_CHECKS, keeping=settings.stability_level,
+                                boundary_moves=True)
         stages.append(f"pattern search on the exact check from the {passed[0]} design ({search.checks} checks, "
                       f"{'improved' if search.improved else 'no improvement'})")
         if search.improved:

@@ -30,10 +30,14 @@ from synth.synthesis.convex_settings import ConvexSettings, design_grid
 from synth.synthesis.delay_grid import controller_gain_bound
 from synth.synthesis.parametrization import parametrize
 
-__all__ = ["PATTERN_CHECKS", "PatternResult", "pattern_search"]
+__all__ = ["BOUNDARY_CHECKS", "PATTERN_CHECKS", "PatternResult", "pattern_search"]
 
-PATTERN_CHECKS = 400
-"""Most checks a pattern search makes."""
+PATTERN_CHECKS = 160
+"""Most checks a pattern search makes (by default)."""
+
+BOUNDARY_CHECKS = 400
+"""Most checks of the search from a design no converged stage produced, which also moves along the active
+boundary (:func:`_boundary_move`): such moves cost a few checks each."""
 
 
 @dataclass(frozen=True)
@@ -60,7 +64,8 @@ class PatternResult:
 
 def pattern_search(spec: Spec, start: Controller, terms: list[tuple[str, str, float]],
                    max_checks: int = PATTERN_CHECKS, first_step: float = 0.1, min_step: float = 1e-4,
-                   per_decade: int = SEARCH_PER_DECADE, keeping: float = 0.0) -> PatternResult:
+                   per_decade: int = SEARCH_PER_DECADE, keeping: float = 0.0, boundary_moves: bool = False,
+                   ) -> PatternResult:
     """Improve ``start`` (which should pass the check) by pattern search over the spec's free parameters.
 
     Parameters
@@ -81,6 +86,9 @@ def pattern_search(spec: Spec, start: Controller, terms: list[tuple[str, str, fl
         ``stability_level``), so that the search does not walk a design to the edge of stability. A start that
         comes closer to -1 on this grid (the stages keep ``|1 + L|`` only on their own grid) sets the floor
         instead: no move comes closer than the start.
+    boundary_moves : bool
+        Where the coordinate and pattern moves stall, also try moves along the active boundary
+        (:func:`_boundary_move`) and restart from a point they find.
 
     Returns
     -------
@@ -155,7 +163,7 @@ def pattern_search(spec: Spec, start: Controller, terms: list[tuple[str, str, fl
         found = hooke_jeeves(lambda z: value(at(z)), z, lo, hi, better, step, min_step,
                              max_checks - checks - 1, start_value=vz)
         z, vz = found.z, found.value
-        if len(free) < 2 or checks >= max_checks:
+        if not boundary_moves or len(free) < 2 or checks >= max_checks:
             break
         traded = _boundary_move(lambda z: value(at(z)), z, vz, lo, hi, better, step, min_step,
                                 lambda: max_checks - checks)
