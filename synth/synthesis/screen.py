@@ -267,13 +267,14 @@ def screen_near_improving(spec: Spec, terms: list[tuple[str, str, float]], above
     plants = spec.plants()
     light = [r for r in spec.requirements if r.type not in STABILITY_BASED]
     heavy = [r for r in spec.requirements if r.type in STABILITY_BASED]
-    idx = np.arange(len(controllers))
-    light_worst = _worst_slack(controllers, idx, light, plants, assume_stable=True)
-    better = idx[(screen_scores(spec, controllers, terms) > above) & (light_worst > -np.inf)]
-    better = better[np.argsort(-light_worst[better], kind="stable")][:NEAR_POOL]
+    better = np.flatnonzero(screen_scores(spec, controllers, terms) > above)
+    light_worst = _worst_slack(controllers, better, light, plants, assume_stable=True)
+    top = np.argsort(-light_worst, kind="stable")[:NEAR_POOL]
+    better, light_worst = better[top], light_worst[top]
+    better, light_worst = better[light_worst > -np.inf], light_worst[light_worst > -np.inf]
     if better.size == 0:
         return []
-    worst = np.fmin(light_worst[better], _worst_slack(controllers, better, heavy, plants, stable_only=True))
+    worst = np.fmin(light_worst, _worst_slack(controllers, better, heavy, plants, stable_only=True))
     near = [(float(v), int(i)) for v, i in zip(worst, better) if -np.inf < v < 0]
     order = [i for _, i in sorted(near, key=lambda vi: -vi[0])]
     return [controllers[i] for i in _pick(order, n, keep, lambda i: True, _parameters(controllers))][:keep]
