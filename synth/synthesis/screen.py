@@ -242,7 +242,9 @@ def screen_near_improving(spec: Spec, terms: list[tuple[str, str, float]], above
     """Up to ``keep`` controllers of :func:`screen_points` that keep every closed loop stable and score above
     ``above`` but miss a requirement, least violating first (their worst slack over every requirement and
     plant): starts for the NLP where no screened point both meets the requirements and scores better, and
-    the better designs lie in a thin feasible region that a polish reaches from just outside it.
+    the better designs lie in a thin feasible region that a polish reaches from just outside it. As for the
+    screen's other starts (:func:`_pick`), the drawn points come first and the copies with parameters pinned at
+    a bound only after them, so a pinned copy is a start only when fewer than ``keep`` drawn points qualify.
 
     Every point is scored at once (:func:`screen_scores`); those that score better are taken in the order of
     their worst slack on the requirements that count no closed-loop roots (every loop taken as stable); the
