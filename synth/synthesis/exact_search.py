@@ -189,7 +189,7 @@ def exact_search(spec: Spec, near: Controller | None = None, samples: int | None
     >>> check(spec, found.controller).feasible, round(found.controller.parameters["ki"], 2)
     (True, 1.76)
     """
-    from scipy.stats import qmc
+    from synth.stats_stand_in import sobol_points
 
     box = _Box(spec)
     n = len(box.free)
@@ -217,14 +217,14 @@ def exact_search(spec: Spec, near: Controller | None = None, samples: int | None
         return value if np.isfinite(value) else -np.inf
 
     size = samples or min(512, 64 * 2**n)
-    points = [u for u in qmc.Sobol(n, scramble=True, seed=seed).random(size)]
+    points = list(sobol_points(n, size, seed))
     # as many again spread evenly over the plain box: a feasible set in the middle of a long range (kp 0.3-0.4
     # of [0, 2]) is thin on the scales that resolve small values
     points += [np.array([box.coordinate(p, box.bounds[p][0] + (box.bounds[p][1] - box.bounds[p][0]) * x)
-                         for p, x in zip(box.free, u)]) for u in qmc.Sobol(n, scramble=True, seed=seed + 2).random(size)]
+                         for p, x in zip(box.free, u)]) for u in sobol_points(n, size, seed + 2)]
     if near is not None and all(p in near.parameters for p in box.free):
         centre = box.point(near)
-        around = qmc.Sobol(n, scramble=True, seed=seed + 1).random(max(16, size // 4))
+        around = sobol_points(n, max(16, size // 4), seed + 1)
         points += [np.clip(centre + 0.5 * (u - 0.5), 0.0, 1.0) for u in around]
         for k in range(8):  # the design scaled down towards zero gain
             points.append(box.point(near.with_parameters(**{p: near.parameters[p] * 2.0**-k for p in box.free
