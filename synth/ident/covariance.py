@@ -19,8 +19,13 @@ import numpy as np
 
 __all__ = ["SINGULAR", "fit_covariance"]
 
-SINGULAR = 1e-10
-"""Smallest eigenvalue of the column-scaled ``J^T J`` (relative to its largest) still inverted as it is."""
+SINGULAR = 1e-13
+"""Smallest eigenvalue of the column-scaled ``J^T J`` (relative to its largest) still inverted as it is. A truly
+singular direction (the biproper delay within a sample) shows as round-off, 1e-18 to 3e-16 (8 noise seeds of
+tests/test_ident_biproper_delay.py); an ill-conditioned but regular fit lies well above: two zeros and three poles
+behind a sensor at 0.03 % noise (the Cramer-Rao benchmark's case 4) gives 8e-11 to 1.1e-10, and at the earlier
+threshold of 1e-10 seven of its 20 seeds reported every standard error as infinite, the estimates within 1.5
+bounds of the truth. Inverted at 1e-10, ``J^T J`` keeps about six significant digits."""
 
 
 def fit_covariance(JtJ: np.ndarray, s2: float, delay_column: int | None = None,
