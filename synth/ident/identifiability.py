@@ -121,6 +121,10 @@ def weak_parameters(names: list[str], values: dict[str, float], covariance: np.n
     [('z', 'p', 0.998), ('p', 'z', 0.998)]
     >>> weak_parameters(["k", "p"], {"k": 2.0, "p": 3.0}, np.diag([1e-4, 1e-4]), {"k": (1.98, 2.02), "p": (2.98, 3.02)})
     []
+    >>> inf = float("inf")  # two zeros that met at the estimate: the Jacobian cannot tell them apart
+    >>> weak = weak_parameters(["z1", "z2"], {"z1": 0.706, "z2": 0.706}, np.diag([inf, inf]), {})
+    >>> weak[0].reason[:38]
+    'it equals z2 at the estimate, where th'
     """
     cov = np.asarray(covariance, float)
     idx = [i for i, n in enumerate(names) if n != "offset"]
@@ -136,7 +140,13 @@ def weak_parameters(names: list[str], values: dict[str, float], covariance: np.n
         others = [j for j in idx if j != i and np.isfinite(corr[i, j])]
         j = max(others, key=lambda k: abs(corr[i, k])) if others else None
         rho = float(corr[i, j]) if j is not None else 0.0
-        if not np.isfinite(sd[i]):
+        twin = next((names[k] for k in idx if k != i and not np.isfinite(sd[k])
+                     and abs(float(values[names[k]]) - value) <= 1e-6 * max(abs(value), 1e-12)), None)
+        if not np.isfinite(sd[i]) and twin is not None:
+            reason = (f"it equals {twin} at the estimate, where the model cannot tell them apart (two roots "
+                      "that coincide: the record may call for a complex pair, which a quadratic factor such as "
+                      "(s^2+a*s+b) can fit)")
+        elif not np.isfinite(sd[i]):
             reason = "its standard error is not finite"
         elif rel > WEAK_RELATIVE_STD:
             reason = f"std {100 * rel:.3g} % of the value"
