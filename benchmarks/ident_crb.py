@@ -316,15 +316,33 @@ def verdicts(p: dict[str, float], failed: bool) -> dict[str, bool]:
             "reported": not failed and 0.7 <= p["reported_over_emp"] <= 1.4}
 
 
+def paired(p: dict[str, float]) -> bool:
+    """One (case, parameter) judged beside the efficient estimator on the same noise realizations (the "ideal"
+    columns): empirical std at most 1.5 times that estimator's, and mean within 0.5 empirical std of its mean. What
+    20 seeds' shared noise does to both cancels, so a failure here is the fit's own, not chance's.
+
+    Examples
+    --------
+    >>> paired({"std_over_crb": 1.6, "bias_over_std": 0.6, "ideal_std_over_crb": 1.4, "ideal_bias_over_std": 0.6})
+    True
+    >>> paired({"std_over_crb": 2.2, "bias_over_std": 0.1, "ideal_std_over_crb": 1.0, "ideal_bias_over_std": 0.1})
+    False
+    """
+    std, ideal_std = p["std_over_crb"], p["ideal_std_over_crb"]  # both in units of the bound
+    bias, ideal_bias = p["bias_over_std"] * std, p["ideal_bias_over_std"] * ideal_std
+    return std <= 1.5 * ideal_std and abs(bias - ideal_bias) <= 0.5 * std
+
+
 def summary(results: list[dict[str, Any]]) -> str:
     lines = [f"{'case':<5}{'plant, design, sensor, delay, noise':<58}{'param':<7}{'std/CRB':>8}{'bias/std':>9}"
              f"{'rep/emp':>8}{'ideal':>14}{'weak':>6}{'s/fit':>7}"]
-    pairs, passed, ideal, case_ok = 0, {"efficient": 0, "unbiased": 0, "reported": 0, "all": 0}, [], 0
+    pairs, passed, ideal, case_ok, paired_ok = 0, {"efficient": 0, "unbiased": 0, "reported": 0, "all": 0}, [], 0, 0
     ideal_reported: list[bool] = []
     ideal_ratio: list[float] = []
     for r in results:
         failed = bool(r["failed"]) or not r["params"]
         ok_case = True
+        ok_paired = not failed
         for i, name in enumerate(r["crb"]):
             p = r["params"].get(name)
             v = verdicts(p, failed) if p else {"efficient": False, "unbiased": False, "reported": False}
@@ -333,6 +351,7 @@ def summary(results: list[dict[str, Any]]) -> str:
                 passed[key] += val
             passed["all"] += all(v.values())
             ok_case &= v["efficient"] and v["unbiased"]
+            ok_paired = ok_paired and bool(p) and paired(p)
             if p:
                 ideal.append(p["ideal_std_over_crb"] <= 1.5 and abs(p["ideal_bias_over_std"]) <= 0.5)
                 ratio = p["reported_std"] / (p["ideal_std_over_crb"] * r["crb"][name])
@@ -348,6 +367,7 @@ def summary(results: list[dict[str, Any]]) -> str:
             else:
                 lines.append(f"{r['case']:<5}{r['label']:<58}{name:<7} no result ({len(r['failed'])} failed fits)")
         case_ok += ok_case
+        paired_ok += ok_paired
     lines.append("")
     lines.append(f"(case, parameter) pairs: {pairs}; std <= 1.5 CRB: {100 * passed['efficient'] / pairs:.1f} %, "
                  f"|bias| <= 0.5 std: {100 * passed['unbiased'] / pairs:.1f} %, reported std within 0.7-1.4 of the "
@@ -359,6 +379,9 @@ def summary(results: list[dict[str, Any]]) -> str:
                  f"{np.median(ideal_ratio):.2f}, "
                  f"5-95 % {np.percentile(ideal_ratio, 5):.2f}-{np.percentile(ideal_ratio, 95):.2f}")
     lines.append(f"cases with every parameter efficient and unbiased: {case_ok} of {len(results)}")
+    lines.append(f"cases with every parameter efficient and unbiased beside the efficient estimator on the same noise "
+                 f"(std <= 1.5 times its std, |mean - its mean| <= 0.5 std: the noise the two share cancels): "
+                 f"{paired_ok} of {len(results)}")
     return "\n".join(lines)
 
 
