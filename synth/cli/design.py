@@ -77,7 +77,7 @@ def _design_and_report(args: argparse.Namespace, spec: Any) -> tuple[Any, dict[s
 
     out_dir = Path(args.out) if args.out else Path("reports") / spec.name
     jobs, combine = design_jobs(spec)  # a PI/PID with and without integral action: two jobs
-    if args.no_report:  # the jobs on both cores all the same (servo_pid: 3.4 -> 2.0 s)
+    if args.no_report:  # the jobs on both cores all the same (servo_pid: 3.4 -> 1.9 s)
         rest, first = run_beside(jobs[1:], jobs[0])
         return combine([first, *rest]), None, out_dir
     studies = spec_studies(spec)  # and the report's studies that need the spec alone

@@ -309,7 +309,7 @@ def _best_bounded(order: np.ndarray, bound: np.ndarray, value: Callable[[np.ndar
 
     Examples
     --------
-    >>> values = {0: -0.5, 1: -0.2, 2: -0.9, 3: -0.1}
+    >>> values = {0: -0.5, 1: -0.2, 2: -0.9, 3: -0.45}
     >>> asked = []
     >>> def value(idx):
     ...     asked.extend(idx.tolist()); return np.array([values[int(i)] for i in idx])
@@ -318,7 +318,7 @@ def _best_bounded(order: np.ndarray, bound: np.ndarray, value: Callable[[np.ndar
     >>> asked  # 1's -0.2 beats any value bounded by -0.3: 2 and 3 were never evaluated
     [0, 1]
     >>> _best_bounded(np.arange(4), np.array([-0.1, -0.15, -0.3, -0.4]), value, 2, lambda i: False, chunk=1)
-    [1, 0]
+    [1, 3]
     """
     found: list[tuple[float, int, int]] = []  # (-value, position, index)
     start = 0
