@@ -143,9 +143,9 @@ def weak_parameters(names: list[str], values: dict[str, float], covariance: np.n
         twin = next((names[k] for k in idx if k != i and not np.isfinite(sd[k])
                      and abs(float(values[names[k]]) - value) <= 1e-6 * max(abs(value), 1e-12)), None)
         if not np.isfinite(sd[i]) and twin is not None:
-            reason = (f"it equals {twin} at the estimate, where the model cannot tell them apart (two roots "
-                      "that coincide: the record may call for a complex pair, which a quadratic factor such as "
-                      "(s^2+a*s+b) can fit)")
+            reason = (f"it equals {twin} at the estimate, where the model cannot tell them apart: two roots that "
+                      "coincide (the record may call for a complex pair, which a quadratic factor such as "
+                      "(s^2+a*s+b) can fit) or a pole that cancels a zero (a lower order fits)")
         elif not np.isfinite(sd[i]):
             reason = "its standard error is not finite"
         elif rel > WEAK_RELATIVE_STD:
