@@ -21,8 +21,8 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["TIED_CORRELATION", "TIED_RELATIVE_STD", "TIED_TO_WEAK", "WEAK_RELATIVE_STD", "TiedParameter",
-           "WeakParameter", "tied_to_weak", "weak_parameters"]
+__all__ = ["COINCIDE", "TIED_CORRELATION", "TIED_RELATIVE_STD", "TIED_TO_WEAK", "WEAK_RELATIVE_STD", "TiedParameter",
+           "WeakParameter", "coinciding", "tied_to_weak", "weak_parameters"]
 
 #: a parameter whose standard error exceeds this share of its value is weakly identifiable
 WEAK_RELATIVE_STD = 0.25
@@ -32,6 +32,40 @@ TIED_CORRELATION = 0.995
 TIED_RELATIVE_STD = 0.05
 #: a pinned-down parameter correlated at least this much with a weak one has an interval no better founded
 TIED_TO_WEAK = 0.9
+#: parameters whose values agree to this share of their size have met (:func:`coinciding`)
+COINCIDE = 1e-4
+
+_MET = ("the model cannot tell them apart there: two roots that coincide (the record may call for a complex "
+        "pair, which a quadratic factor such as (s^2+a*s+b) can fit) or a pole that cancels a zero (a lower "
+        "order fits)")
+
+
+def coinciding(values: dict[str, float]) -> str:
+    """A sentence naming the groups of parameters whose values agree to :data:`COINCIDE` of their size and
+    what that says about the structure (empty when none do): a fit that ends or stalls there sits where two of
+    its roots meet. A structure of real first-order factors fitted to a record with a complex pair of zeros
+    stops with them equal.
+
+    Examples
+    --------
+    >>> coinciding({"k": 30.7, "z1": 1.32449475, "z2": 1.32449465, "p1": 4.02, "p2": 3.0})[:60]
+    'z1 and z2 met at 1.324: the model cannot tell them apart the'
+    >>> coinciding({"k": 2.0, "p": 3.0})
+    ''
+    """
+    names = [k for k, v in values.items() if np.isfinite(v) and v != 0.0]
+    groups: list[list[str]] = []
+    for name in names:
+        group = next((g for g in groups if abs(values[g[0]] - values[name]) <= COINCIDE * abs(values[g[0]])), None)
+        if group is None:
+            groups.append([name])
+        else:
+            group.append(name)
+    met = [g for g in groups if len(g) > 1]
+    if not met:
+        return ""
+    listed = "; ".join(f"{', '.join(g[:-1])} and {g[-1]} met at {values[g[0]]:.4g}" for g in met)
+    return f"{listed}: {_MET}"
 
 
 @dataclass(frozen=True)
@@ -123,8 +157,8 @@ def weak_parameters(names: list[str], values: dict[str, float], covariance: np.n
     []
     >>> inf = float("inf")  # two zeros that met at the estimate: the Jacobian cannot tell them apart
     >>> weak = weak_parameters(["z1", "z2"], {"z1": 0.706, "z2": 0.706}, np.diag([inf, inf]), {})
-    >>> weak[0].reason[:38]
-    'it equals z2 at the estimate, where th'
+    >>> weak[0].reason[:58]
+    'it equals z2 at the estimate, and the model cannot tell th'
     """
     cov = np.asarray(covariance, float)
     idx = [i for i, n in enumerate(names) if n != "offset"]
@@ -143,9 +177,7 @@ def weak_parameters(names: list[str], values: dict[str, float], covariance: np.n
         twin = next((names[k] for k in idx if k != i and not np.isfinite(sd[k])
                      and abs(float(values[names[k]]) - value) <= 1e-6 * max(abs(value), 1e-12)), None)
         if not np.isfinite(sd[i]) and twin is not None:
-            reason = (f"it equals {twin} at the estimate, where the model cannot tell them apart: two roots that "
-                      "coincide (the record may call for a complex pair, which a quadratic factor such as "
-                      "(s^2+a*s+b) can fit) or a pole that cancels a zero (a lower order fits)")
+            reason = f"it equals {twin} at the estimate, and {_MET}"
         elif not np.isfinite(sd[i]):
             reason = "its standard error is not finite"
         elif rel > WEAK_RELATIVE_STD:

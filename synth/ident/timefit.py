@@ -42,7 +42,7 @@ from synth.ident.convolution_problem import ConvolutionProblem
 from synth.ident.covariance import fit_covariance
 from synth.ident.delay_samples import best_sample
 from synth.ident.fit_failure import LIMIT_STATUSES, fit_failure
-from synth.ident.identifiability import TiedParameter, WeakParameter, tied_to_weak, weak_parameters
+from synth.ident.identifiability import TiedParameter, WeakParameter, coinciding, tied_to_weak, weak_parameters
 from synth.ident.sim_error_problem import SimulationErrorProblem
 from synth.ident.srivc import linear_initial_model, map_to_structure
 from synth.ident.structure import Structure, parse_structure
@@ -466,8 +466,10 @@ def fit_structure(record: Record, structure: Structure | str, delay: str | float
                           int(y_fit.size), p_total, remaining)
     info["failure"] = failure
     if failure and check:
-        raise FitError(f"fit of {st.formula!r} failed: {failure}; try another structure, a fixed delay or a shorter "
-                       f"part of the record", where=record.source, status=st_info.get("status"),
+        met = coinciding(dict(zip(st.parameters, theta.tolist())))  # stalled where two roots meet: say so
+        raise FitError(f"fit of {st.formula!r} failed: {failure}; {met + '; ' if met else ''}try another "
+                       f"structure, a fixed delay or a shorter part of the record", where=record.source,
+                       status=st_info.get("status"),
                        parameters={**dict(zip(st.parameters, theta.tolist())), delay_name: float(d_hat)})
     if -1e-7 <= d_hat < 0.0:  # IPOPT relaxes the bound f >= 0 by 1e-8
         d_hat = 0.0
