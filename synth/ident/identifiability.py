@@ -40,6 +40,11 @@ _MET = ("the model cannot tell them apart there: two roots that coincide (the re
         "order fits)")
 
 
+def _meet(a: float, b: float, share: float = COINCIDE) -> bool:
+    """Whether ``a`` and ``b`` agree to ``share`` of ``a``'s size."""
+    return abs(a - b) <= share * max(abs(a), 1e-12)
+
+
 def coinciding(values: dict[str, float]) -> str:
     """A sentence naming the groups of parameters whose values agree to :data:`COINCIDE` of their size and
     what that says about the structure (empty when none do): a fit that ends or stalls there sits where two of
@@ -56,7 +61,7 @@ def coinciding(values: dict[str, float]) -> str:
     names = [k for k, v in values.items() if np.isfinite(v) and v != 0.0]
     groups: list[list[str]] = []
     for name in names:
-        group = next((g for g in groups if abs(values[g[0]] - values[name]) <= COINCIDE * abs(values[g[0]])), None)
+        group = next((g for g in groups if _meet(values[g[0]], values[name])), None)
         if group is None:
             groups.append([name])
         else:
@@ -175,7 +180,7 @@ def weak_parameters(names: list[str], values: dict[str, float], covariance: np.n
         j = max(others, key=lambda k: abs(corr[i, k])) if others else None
         rho = float(corr[i, j]) if j is not None else 0.0
         twin = next((names[k] for k in idx if k != i and not np.isfinite(sd[k])
-                     and abs(float(values[names[k]]) - value) <= 1e-6 * max(abs(value), 1e-12)), None)
+                     and _meet(value, float(values[names[k]]), 1e-6)), None)
         if not np.isfinite(sd[i]) and twin is not None:
             reason = f"it equals {twin} at the estimate, and {_MET}"
         elif not np.isfinite(sd[i]):

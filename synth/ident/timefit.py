@@ -461,16 +461,17 @@ def fit_structure(record: Record, structure: Structure | str, delay: str | float
     if st_info.get("status") in LIMIT_STATUSES and s2 > 0 and np.all(np.isfinite(JtJ)):
         remaining = _remaining_improvement(prob, xs, par, J, resid, JtJ, scale_vec, s2, mask, y, lb, fit_delay, dt)
         info["remaining_improvement_std"] = remaining
-    failure = fit_failure(dict(zip(st.parameters, theta.tolist())), theta0, st_info.get("status"),
+    fitted = dict(zip(st.parameters, theta.tolist()))
+    failure = fit_failure(fitted, theta0, st_info.get("status"),
                           bool(st_info.get("success")), fit_pct, d_hat if fit_delay else None, n * dt,
                           int(y_fit.size), p_total, remaining)
     info["failure"] = failure
     if failure and check:
-        met = coinciding(dict(zip(st.parameters, theta.tolist())))  # stalled where two roots meet: say so
+        met = coinciding(fitted)  # stalled where two roots meet: say so
         raise FitError(f"fit of {st.formula!r} failed: {failure}; {met + '; ' if met else ''}try another "
                        f"structure, a fixed delay or a shorter part of the record", where=record.source,
                        status=st_info.get("status"),
-                       parameters={**dict(zip(st.parameters, theta.tolist())), delay_name: float(d_hat)})
+                       parameters={**fitted, delay_name: float(d_hat)})
     if -1e-7 <= d_hat < 0.0:  # IPOPT relaxes the bound f >= 0 by 1e-8
         d_hat = 0.0
     tq = float(t_ppf(0.975, dof))

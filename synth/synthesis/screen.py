@@ -279,11 +279,9 @@ def screen_near_improving(spec: Spec, terms: list[tuple[str, str, float]], above
     better, light_worst = better[light_worst > -np.inf], light_worst[light_worst > -np.inf]
     stable = _worst_slack(controllers, better, [], plants, stable_only=True) > -np.inf  # in one batch
     better, light_worst = better[stable], light_worst[stable]
-    bound_of = dict(zip(better.tolist(), light_worst.tolist()))
 
-    def worst(chunk: np.ndarray) -> np.ndarray:  # every loop of these is stable: their roots are not counted again
-        bound = np.array([bound_of[int(i)] for i in chunk])
-        return np.fmin(bound, _worst_slack(controllers, chunk, heavy, plants, assume_stable=True))
+    def heavy_slack(chunk: np.ndarray) -> np.ndarray:  # every loop of these is stable: roots not counted again
+        return _worst_slack(controllers, chunk, heavy, plants, assume_stable=True)
 
     key = _parameters(controllers)
     extra = max(n // 3, 1)
@@ -292,7 +290,7 @@ def screen_near_improving(spec: Spec, terms: list[tuple[str, str, float]], above
     out: list[int] = []
     for g, members in enumerate(groups):
         need = keep if g == 0 else 1
-        for i in _best_bounded(better[members], light_worst[members], worst, need,
+        for i in _best_bounded(better[members], light_worst[members], heavy_slack, need,
                                lambda i: key(i) in picked):
             picked.add(key(i))
             out.append(i)
@@ -301,9 +299,9 @@ def screen_near_improving(spec: Spec, terms: list[tuple[str, str, float]], above
 
 def _best_bounded(order: np.ndarray, bound: np.ndarray, value: Callable[[np.ndarray], np.ndarray], need: int,
                   skip: Callable[[int], bool], chunk: int = 8) -> list[int]:
-    """The first ``need`` indices of ``order`` (not ``skip``-ped) with ``-inf < value < 0``, the largest value
-    first (ties: the earlier in ``order``), where ``bound`` (non-increasing along ``order``) bounds each one's
-    value from above: ``value`` (of an array of indices) is asked ``chunk`` at a time along ``order``, only until
+    """The first ``need`` indices of ``order`` (not ``skip``-ped) whose worth, the smaller of ``bound``
+    (non-increasing along ``order``) and ``value``, lies in ``(-inf, 0)``, the largest first (ties: the earlier
+    in ``order``): ``value`` (of an array of indices) is asked ``chunk`` at a time along ``order``, only until
     the ``need``-th best so far is at least the next bound, so no later index could displace it (the chunks
     double: a batch's cost has a fixed part).
 
@@ -326,7 +324,8 @@ def _best_bounded(order: np.ndarray, bound: np.ndarray, value: Callable[[np.ndar
         if len(found) >= need and -found[need - 1][0] >= bound[start]:
             break
         idx = order[start:start + chunk]
-        for pos, (i, v) in enumerate(zip(idx, value(idx)), start):
+        worth = np.fmin(bound[start:start + idx.size], value(idx))
+        for pos, (i, v) in enumerate(zip(idx, worth), start):
             if -np.inf < v < 0 and not skip(int(i)):
                 found.append((-float(v), pos, int(i)))
         found.sort()
