@@ -7,6 +7,11 @@ event loop are its own business), and ``SYNTH_JOBS=1`` turns it off again. A for
 (the pattern searches of a search of the bounds) forks once more there, for the core that the command's own
 process leaves idle once its part is done (at most one level: a grandchild never forks).
 
+A process that knows the other core is idle may also keep a helper there (:func:`spare_core`, used by
+:class:`synth.speculation.Speculator`): the command's own process while nothing else of the command runs, and a
+child whose parent lent it the core (``run_beside(..., lend_core=True)``: the parent's own work is short and
+no job is left for it).
+
 Correctness never depends on the child: off Linux (macOS's system libraries are not safe to use in a forked
 child) or when it is off, the jobs run here, in order; an exception a job raised in the child is raised
 here; a job whose result or exception does not survive pickling, or every job of a child that died, runs
@@ -25,12 +30,14 @@ from typing import Any, TypeVar
 
 from synth.progress import clear, use_child_slot
 
-__all__ = ["allow_fork", "run_beside"]
+__all__ = ["allow_fork", "become_helper", "fork_allowed", "occupy_spare_core", "restore_spare_core", "run_beside",
+           "spare_core"]
 
 T = TypeVar("T")
 
 _ALLOWED = [False]
 _DEPTH = [0]  # 0 in the process that allowed forking, 1 in its child, 2 in a nested call's child
+_SPARE = [True]  # whether the other core is idle while this process works (see spare_core)
 
 
 def allow_fork(allowed: bool = True) -> None:
@@ -44,8 +51,59 @@ def allow_fork(allowed: bool = True) -> None:
     _ALLOWED[0] = allowed
 
 
+def fork_allowed() -> bool:
+    """Whether this process may fork at all: :func:`allow_fork` called, on Linux, ``SYNTH_JOBS`` not 1.
+
+    Examples
+    --------
+    >>> allow_fork(False); fork_allowed()
+    False
+    """
+    return _ALLOWED[0] and sys.platform.startswith("linux") and os.environ.get("SYNTH_JOBS", "") != "1"
+
+
+def spare_core() -> bool:
+    """Whether a helper process may use the other core now: forking is allowed, and no forked job of this command
+    is running beside this process (in the command's process outside :func:`run_beside`; in a child only when
+    its parent lent it the core, and not while the child's own nested call runs).
+
+    Examples
+    --------
+    >>> allow_fork(False); spare_core()
+    False
+    """
+    return fork_allowed() and _SPARE[0] and _DEPTH[0] <= 1
+
+
+def occupy_spare_core() -> bool:
+    """Mark the other core as taken (a helper was started there); returns what :func:`restore_spare_core` needs.
+
+    Examples
+    --------
+    >>> allow_fork(); before = occupy_spare_core(); spare_core()
+    False
+    >>> restore_spare_core(before); spare_core() == before
+    True
+    """
+    before, _SPARE[0] = _SPARE[0], False
+    return before
+
+
+def restore_spare_core(before: bool) -> None:
+    """Undo :func:`occupy_spare_core` (the helper has stopped)."""
+    _SPARE[0] = before
+
+
+def become_helper() -> None:
+    """In a freshly forked helper process (:class:`synth.speculation.Speculator`): die with the parent, fork
+    nothing further, use no spare core."""
+    _die_with_parent()
+    _DEPTH[0] = 2
+    _SPARE[0] = False
+
+
 def run_beside(jobs: Sequence[Callable[[], Any]], own_work: Callable[[], T], nested: bool = False,
-               ) -> tuple[list[Any], T]:
+               lend_core: bool = False) -> tuple[list[Any], T]:
     """Run ``jobs`` in a forked child while ``own_work()`` runs here; return both results.
 
     The child takes the jobs in order; when ``own_work`` is done this process takes the ones the child has
@@ -61,6 +119,9 @@ def run_beside(jobs: Sequence[Callable[[], Any]], own_work: Callable[[], T], nes
         What this process does meanwhile.
     nested : bool
         Fork even in a forked child (one level down, not further): for independent parts of one long job.
+    lend_core : bool
+        ``own_work`` is short and no job will be left for this process: the child may keep a helper on this
+        process's core once it is idle (:func:`spare_core`).
 
     Returns
     -------
@@ -73,8 +134,7 @@ def run_beside(jobs: Sequence[Callable[[], Any]], own_work: Callable[[], T], nes
     ([4, 'xxx'], 10)
     """
     depth_ok = _DEPTH[0] == 0 or (nested and _DEPTH[0] == 1)
-    if len(jobs) == 0 or len(jobs) > 255 or not _ALLOWED[0] or not depth_ok or not sys.platform.startswith("linux") \
-            or os.environ.get("SYNTH_JOBS", "") == "1":  # fork is safe with these libraries on Linux only
+    if len(jobs) == 0 or len(jobs) > 255 or not depth_ok or not fork_allowed():  # fork is safe on Linux only
         mine = own_work()
         return [job() for job in jobs], mine
     tickets_read, tickets_write = os.pipe()
@@ -88,6 +148,7 @@ def run_beside(jobs: Sequence[Callable[[], Any]], own_work: Callable[[], T], nes
             os.close(read_end)
             _die_with_parent()
             _DEPTH[0] += 1  # two cores: a job's own run_beside calls run serially in the child, unless nested
+            _SPARE[0] = lend_core
             use_child_slot()  # the stages this child announces show beside the parent's
             payload = pickle.dumps(_run_tickets(jobs, tickets_read), protocol=pickle.HIGHEST_PROTOCOL)
             clear()  # the progress line stops showing this child's last stage
@@ -98,6 +159,7 @@ def run_beside(jobs: Sequence[Callable[[], Any]], own_work: Callable[[], T], nes
             os._exit(status)
     os.close(write_end)
     here: dict[int, Any] = {}
+    spare, _SPARE[0] = _SPARE[0], False  # the child works on the other core
     try:
         mine = own_work()
         while ticket := os.read(tickets_read, 1):  # the jobs the child has not started yet
@@ -110,6 +172,7 @@ def run_beside(jobs: Sequence[Callable[[], Any]], own_work: Callable[[], T], nes
         raise
     finally:
         os.close(tickets_read)
+        _SPARE[0] = spare
     _, status = os.waitpid(pid, 0)
     there = (_unpickle(payload) if status == 0 else None) or {}
     out = []

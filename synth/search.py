@@ -33,7 +33,8 @@ class SearchResult(Generic[V]):
 
 def hooke_jeeves(f: Callable[[np.ndarray], V], z0: np.ndarray, lo: np.ndarray, hi: np.ndarray,
                  better: Callable[[V, V], bool], step: float, min_step: float, budget: int,
-                 start_value: V | None = None) -> SearchResult[V]:
+                 start_value: V | None = None, ahead: Callable[[np.ndarray], None] | None = None,
+                 ) -> SearchResult[V]:
     """Search ``f`` from ``z0`` within ``[lo, hi]`` for a point ``better`` than the others found.
 
     Parameters
@@ -53,6 +54,10 @@ def hooke_jeeves(f: Callable[[np.ndarray], V], z0: np.ndarray, lo: np.ndarray, h
         Most evaluations of ``f``.
     start_value : optional
         ``f(z0)`` when the caller has it already (``z0`` inside the box): not evaluated again.
+    ahead : callable, optional
+        Told the point the search will likely evaluate after the one it evaluates now (the move down when it
+        tries a move up, which fails more often than not; the first move around a pattern move's point), so
+        that it can be computed meanwhile (:class:`synth.speculation.Speculator`). It changes nothing else.
 
     Returns
     -------
@@ -74,16 +79,24 @@ def hooke_jeeves(f: Callable[[np.ndarray], V], z0: np.ndarray, lo: np.ndarray, h
         used += 1
         return f(z)
 
+    def moved(z: np.ndarray, i: int, s: float) -> np.ndarray:
+        y = z.copy()
+        y[i] = min(max(y[i] + s, lo[i]), hi[i])
+        return y
+
     def explore(base: np.ndarray, v_base: V, h: float) -> tuple[np.ndarray, V]:
         z, vz = base.copy(), v_base
         for i in range(z.size):
             for s in (h, -h):
                 if used >= budget:
                     return z, vz
-                y = z.copy()
-                y[i] = min(max(y[i] + s, lo[i]), hi[i])
+                y = moved(z, i, s)
                 if y[i] == z[i]:
                     continue
+                if ahead is not None and s > 0 and used + 1 < budget:
+                    down = moved(z, i, -h)
+                    if down[i] != z[i]:
+                        ahead(down)
                 vy = value(y)
                 if better(vy, vz):
                     z, vz = y, vy
@@ -101,6 +114,8 @@ def hooke_jeeves(f: Callable[[np.ndarray], V], z0: np.ndarray, lo: np.ndarray, h
         while used < budget:  # pattern moves: on along the net move while exploring around it helps
             zp = np.minimum(np.maximum(zn + (zn - z), lo), hi)
             z, vz = zn, vn
+            if ahead is not None and zp.size and used + 1 < budget:
+                ahead(moved(zp, 0, h))  # explore's first move from zp
             zq, vq = explore(zp, value(zp), h)
             if not better(vq, vz):
                 break

@@ -81,8 +81,10 @@ def _design_and_report(args: argparse.Namespace, spec: Any) -> tuple[Any, dict[s
         rest, first = run_beside(jobs[1:], jobs[0])
         return combine([first, *rest]), None, out_dir
     studies = spec_studies(spec)  # and the report's studies that need the spec alone
-    # the design on the other core while this one loads the report's modules (synth.forked)
-    results, curves = run_beside([*jobs, *(job for _, job in studies)], lambda: _prepare_report(spec))
+    # the design on the other core while this one loads the report's modules (synth.forked); with nothing else
+    # to do here afterwards, this core is lent to the design's guesses (synth.speculation)
+    beside = [*jobs, *(job for _, job in studies)]
+    results, curves = run_beside(beside, lambda: _prepare_report(spec), lend_core=len(beside) == 1)
     result = combine(results[:len(jobs)])
     studied = {name: value for (name, _), value in zip(studies, results[len(jobs):])}
     from synth.report.design_report import write_design_report

@@ -26,6 +26,7 @@ from synth.objectives import score
 from synth.results import SEARCH_PER_DECADE
 from synth.search import hooke_jeeves
 from synth.spec import Spec
+from synth.speculation import Speculator
 from synth.synthesis.convex_settings import ConvexSettings, design_grid
 from synth.synthesis.delay_grid import controller_gain_bound
 from synth.synthesis.parametrization import parametrize
@@ -127,10 +128,13 @@ def pattern_search(spec: Spec, start: Controller, terms: list[tuple[str, str, fl
         keeping = min(keeping, closest(start))
 
     def value(params: dict[str, float]) -> tuple[float, float]:
-        """(objective score, smallest requirement slack); (-inf, -inf) when the check fails or cannot be made
-        (e.g. a Nyquist count that does not converge)."""
         nonlocal checks
         checks += 1
+        return evaluated(params)
+
+    def evaluated(params: dict[str, float]) -> tuple[float, float]:
+        """(objective score, smallest requirement slack); (-inf, -inf) when the check fails or cannot be made
+        (e.g. a Nyquist count that does not converge)."""
         c = Controller(start.type, params)
         try:
             with np.errstate(all="ignore"):
@@ -159,18 +163,25 @@ def pattern_search(spec: Spec, start: Controller, terms: list[tuple[str, str, fl
 
     z, vz = np.array([x[k] for k in free]) / scale, first
     step = first_step
-    while True:  # coordinate and pattern moves; where they stall, a move along the active boundary restarts them
-        found = hooke_jeeves(lambda z: value(at(z)), z, lo, hi, better, step, min_step,
-                             max_checks - checks - 1, start_value=vz)
-        z, vz = found.z, found.value
-        if not boundary_moves or len(free) < 2 or checks >= max_checks:
-            break
-        traded = _boundary_move(lambda z: value(at(z)), z, vz, lo, hi, better, step, min_step,
-                                lambda: max_checks - checks)
-        if traded is None:
-            break
-        z, vz, moved_by = traded
-        step = min(2 * moved_by, first_step)  # the next moves start near the scale that worked
+    with Speculator(lambda key: evaluated(at(np.array(key)))) as guesses:  # the likely next check on the idle core
+
+        def searched(z: np.ndarray) -> tuple[float, float]:
+            nonlocal checks
+            checks += 1
+            return guesses.value(tuple(z))
+
+        while True:  # coordinate and pattern moves; where they stall, a move along the active boundary restarts
+            found = hooke_jeeves(searched, z, lo, hi, better, step, min_step, max_checks - checks - 1,
+                                 start_value=vz, ahead=lambda z: guesses.ahead(tuple(z)))
+            z, vz = found.z, found.value
+            if not boundary_moves or len(free) < 2 or checks >= max_checks:
+                break
+            traded = _boundary_move(lambda z: value(at(z)), z, vz, lo, hi, better, step, min_step,
+                                    lambda: max_checks - checks)
+            if traded is None:
+                break
+            z, vz, moved_by = traded
+            step = min(2 * moved_by, first_step)  # the next moves start near the scale that worked
     improved = vz[0] > first[0] and better(vz, first)
     return PatternResult(Controller(start.type, at(z)) if improved else start, improved, checks, found.step)
 

@@ -33,6 +33,7 @@ from synth.requirements import NoLimitCycle, PeakComplementary, PeakSensitivity,
 from synth.requirements.base import Requirement, db, fmt
 from synth.results import CERTIFICATE_PER_DECADE, Certificate, DesignResult, objective_label, objective_note
 from synth.spec import Spec
+from synth.speculation import Speculator
 from synth.synthesis.convex_settings import ConvexSettings
 from synth.synthesis.exact_search import exact_search
 from synth.synthesis.integral_action import objective_terms
@@ -144,29 +145,32 @@ def design_certified(spec: Spec, design_fn: Callable[[Spec], DesignResult],
         return no_start_result(spec, NoStabilizingStartError(no_start["searched"], searched=no_start["searched"]))
     if not free.feasible:  # the other requirements already fail: nothing for the surrogate to add
         return design_fn(spec)
-    if quick_check(spec, free.controller).feasible:
-        return _certified(spec, free, None, 1)
     loose = _peaks_db(spec, free)  # the free design's level: too loose (it fails the exact check)
     tight = _FLOOR_DB  # no design below this level
     best, tried, over = None, 1, free.controller
     level = float(np.clip(_start_level(hard), tight + 0.2, max(loose - 0.2, tight + 0.2)))
-    for _ in range(BISECTIONS + 2):
-        with within(f"outer loop {tried + 1}/{BISECTIONS + 3} (surrogate bound {level:.2f} dB)"):
-            trial = (trial_fn or design_fn)(surrogate_spec(spec, level))
-        tried += 1
-        designed = trial.feasible and "alternatives" not in trial.extras  # not the structure's fallback
-        if designed and quick_check(spec, trial.controller).feasible:  # the certificate re-checks the chosen one
-            if best is None or _better(trial, best[0]):
-                best = (trial, level)
-            tight = level  # passes: a looser level may do better
-        elif designed or best is not None:
-            loose = level  # fails the exact check (or, above a level that passed, no design: stay below)
-            over = trial.controller if designed else over
-        else:
-            tight = level  # no design and nothing passed yet: the surrogate is too strict
-        if loose - tight < RESOLUTION_DB:
-            break
-        level = float(np.sqrt(tight * loose))  # geometric: the free level can be tens of dB
+    with Speculator(lambda level: _trial(spec, trial_fn or design_fn, level)) as guesses:  # the idle core
+        guesses.ahead(level)  # while the free design is checked
+        if quick_check(spec, free.controller).feasible:
+            return _certified(spec, free, None, 1)
+        for _ in range(BISECTIONS + 2):
+            if level - tight >= RESOLUTION_DB and not guesses.expects(level):  # the next level should this fail
+                guesses.ahead(float(np.sqrt(tight * level)))
+            with within(f"outer loop {tried + 1}/{BISECTIONS + 3} (surrogate bound {level:.2f} dB)"):
+                trial, designed, passes = guesses.value(level)
+            tried += 1
+            if passes:  # the certificate re-checks the chosen one
+                if best is None or _better(trial, best[0]):
+                    best = (trial, level)
+                tight = level  # passes: a looser level may do better
+            elif designed or best is not None:
+                loose = level  # fails the exact check (or, above a level that passed, no design: stay below)
+                over = trial.controller if designed else over
+            else:
+                tight = level  # no design and nothing passed yet: the surrogate is too strict
+            if loose - tight < RESOLUTION_DB:
+                break
+            level = float(np.sqrt(tight * loose))  # geometric: the free level can be tens of dB
     integral_only = all(n in ("integral_gain", "low_frequency_gain") and sense == "maximize"
                         for n, sense, _ in objective_terms(spec))
     found = None
@@ -195,6 +199,14 @@ def design_certified(spec: Spec, design_fn: Callable[[Spec], DesignResult],
     if plain.feasible and _better(plain, found):
         return plain
     return found
+
+
+def _trial(spec: Spec, make: Callable[[Spec], DesignResult], level: float) -> tuple[DesignResult, bool, bool]:
+    """The design under the surrogate at ``level`` dB, whether it is a design (not the structure's fallback),
+    and whether it passes the exact check."""
+    trial = make(surrogate_spec(spec, level))
+    designed = trial.feasible and "alternatives" not in trial.extras
+    return trial, designed, designed and quick_check(spec, trial.controller).feasible
 
 
 def _toward(spec: Spec, inside: Controller, outside: Controller) -> tuple[Controller | None, int]:
