@@ -66,6 +66,7 @@ class Speculator(Generic[K, V]):
         self._requests = -1
         self._answers = -1
         self._spare = False
+        self._finished = False  # a helper stopped or failed: no new one
         self.guesses = 0
         """Keys sent to the helper."""
         self.hits = 0
@@ -79,11 +80,11 @@ class Speculator(Generic[K, V]):
 
     def ahead(self, key: K) -> None:
         """Let the helper compute ``fn(key)`` if it is idle (starting it on the first call when the other core is
-        idle); otherwise nothing."""
+        idle; never again once it stopped or failed); otherwise nothing."""
         if key in self._known or key == self._pending:
             return
         if self._pid == 0:
-            if self._requests == -2 or not forked.spare_core():
+            if self._finished or not forked.spare_core():
                 return
             self._start()
             if self._pid == 0:
@@ -121,9 +122,8 @@ class Speculator(Generic[K, V]):
         return self._fn(key)
 
     def close(self) -> None:
-        """Stop the helper (if any)."""
+        """Stop the helper (if any); no new one starts."""
         self._stop()
-        self._requests = -2  # no new helper after close
 
     # ------------------------------------------------------------------ the helper
     def _start(self) -> None:
@@ -174,7 +174,7 @@ class Speculator(Generic[K, V]):
             except (ChildProcessError, ProcessLookupError):
                 pass
             forked.restore_spare_core(self._spare)
-        self._pid, self._pending = 0, None
+        self._pid, self._pending, self._finished = 0, None, True
 
 
 def _serve(fn: Callable[[Any], Any], requests: int, answers: int) -> None:

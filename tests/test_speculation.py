@@ -160,3 +160,15 @@ def test_a_pattern_search_and_a_certified_design_are_the_same_with_the_helper():
     assert guessing.controller.parameters == serial.controller.parameters
     assert guessing.method == serial.method and guessing.extras["surrogate"] == serial.extras["surrogate"]
     assert guessing.feasible and len(hits) == 2 and min(hits) > 0  # the bisection's guesses, the search's
+
+
+def test_a_helper_that_dies_costs_only_its_guess():
+    import signal
+
+    with Speculator(_square_and_pid) as guesses:
+        guesses.ahead(3)
+        assert guesses.expects(3)
+        os.kill(guesses._pid, signal.SIGKILL)  # the helper process
+        assert guesses.value(3) == (9, os.getpid())  # computed here
+        guesses.ahead(4)  # no helper any more: nothing is sent
+        assert not guesses.expects(4) and guesses.value(4) == (16, os.getpid())
