@@ -46,11 +46,13 @@ class Speculator(Generic[K, V]):
 
     Examples
     --------
+    >>> from synth.forked import allow_fork
+    >>> allow_fork(False)  # a library call: nothing is forked
     >>> calls = []
     >>> def square(x):
     ...     calls.append(x)
     ...     return x * x
-    >>> with Speculator(square) as spec:  # no fork allowed here (a library call): every value computed here
+    >>> with Speculator(square) as spec:  # every value computed here
     ...     spec.ahead(3)
     ...     [spec.value(2), spec.value(3)]
     [4, 9]
@@ -106,6 +108,8 @@ class Speculator(Generic[K, V]):
 
         Examples
         --------
+        >>> from synth.forked import allow_fork
+        >>> allow_fork(False)
         >>> with Speculator(abs) as spec:
         ...     spec.ahead(-1); spec.expects(-1)  # no helper in a library call
         False
