@@ -45,7 +45,7 @@ from synth.synthesis.convex_forms import (
     without_implied,
 )
 from synth.synthesis.convex_results import ConvexResult, Diagnosis, RequirementConflict
-from synth.synthesis.convex_settings import ConvexSettings, design_grid
+from synth.synthesis.convex_settings import ConvexSettings, design_grid, resonance_points
 from synth.synthesis.cvxpy_loader import cp
 from synth.synthesis.delay_grid import controller_gain_bound
 from synth.synthesis.objective_forms import CoefficientRatioFloor, Level, ReturnDifferenceFloor
@@ -491,7 +491,9 @@ class ConvexDesigner:
             if not extra or round_ == refinements:
                 break
             w = np.asarray(extra)
-            self.grid = np.unique(np.concatenate([self.grid, w, w * (1 - 1e-3), w * (1 + 1e-3)]))
+            self.grid = np.unique(np.concatenate([self.grid, w, w * (1 - 1e-3), w * (1 + 1e-3),
+                                                  resonance_points(self.plants, self.par.controller(rho),
+                                                                   self.grid)]))
             history.append({"phase": 0, "iteration": round_, "refined_points": float(w.size)})
             self._build()
         return ConvexResult("optimal", self.par.controller(rho), rho, value, len(history), self.solves,

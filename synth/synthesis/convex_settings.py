@@ -7,12 +7,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from synth.controllers import Controller
 from synth.freqgrid import characteristic_range, log_grid
 from synth.plant import Plant
 from synth.requirements.base import Requirement
 from synth.synthesis.delay_grid import delay_points
 
-__all__ = ["ConvexSettings", "design_grid"]
+__all__ = ["ConvexSettings", "design_grid", "resonance_points"]
 
 
 @dataclass
@@ -79,3 +80,42 @@ def design_grid(plants: list[Plant], requirements: list[Requirement], settings: 
                 lo, hi = min(lo, v / 100), max(hi, v * 100)
     grid = np.geomspace(lo, hi, settings.n_points) if settings.n_points else log_grid(lo, hi, settings.per_decade)
     return np.union1d(grid, delay_points(plants, grid, gain_bound))
+
+
+def resonance_points(plants: list[Plant], c: Controller, grid: np.ndarray, damping: float = 0.3,
+                      half_width: int = 6) -> np.ndarray:
+    """Frequencies that resolve every lightly damped root of the loop at ``c`` (plant and controller poles and
+    zeros, closed-loop poles with the delay left out): ``|r| exp(k zeta / 2)`` for ``|k| <= half_width``. A
+    peak of ``|S|`` or ``|T|`` is about ``2 zeta`` wide in relative frequency, narrower than the design grid's
+    spacing for ``zeta`` under about 0.03, and it moves with the design between grid points. The NLP polish adds
+them to every round's grid; the convex stage to each refinement's: a rational controller whose poles at
+0.53 rad/s (damping 0.04) put the gain crossover, at a phase margin of -95 deg, between two grid points passed
+every grid constraint; each refinement added the crossover and the next design moved the resonance on (seed
+12 #284 of the design benchmark, tests/test_design_resonance_grid.py).
+
+    Examples
+    --------
+    >>> from synth.plant import Plant; from synth.controllers import Controller
+    >>> w = resonance_points([Plant.from_string("1/(s^2+0.02*s+1)")], Controller("P", {"kp": 0.0}),
+    ...                      np.geomspace(0.01, 100, 41))
+    >>> w.size, round(float(w[6]), 6)  # 13 points around the pole pair at 1 rad/s
+    (13, 1.0)
+    """
+    cn, cd = c.tf()
+    roots = []
+    for p in plants:
+        num, den = np.polymul(cn, p.num), np.polymul(cd, p.den)
+        closed = np.polyadd(den, num)
+        for poly in (num, den, closed):
+            poly = np.trim_zeros(np.asarray(poly, float), "f")
+            if poly.size > 1 and np.all(np.isfinite(poly)):
+                roots.extend(np.roots(poly))
+    out = []
+    for r in roots:
+        size = abs(r)
+        if size <= 0 or not grid[0] <= size <= grid[-1] or abs(r.imag) < 1e-9 * size:
+            continue
+        zeta = abs(r.real) / size
+        if zeta < damping:
+            out.append(size * np.exp(np.arange(-half_width, half_width + 1) * max(zeta, 1e-3) / 2))
+    return np.unique(np.concatenate(out)) if out else np.array([])

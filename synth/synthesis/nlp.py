@@ -62,8 +62,8 @@ from synth.controllers import Controller
 from synth.loop import BANDWIDTH_LEVEL, Loop
 from synth.plant import Plant
 from synth.requirements.base import Requirement
+from synth.synthesis.convex_settings import resonance_points
 from synth.synthesis.nlp_forms import NLP_FORMS, NLPContext
-from synth.synthesis.nlp_peaks import resonance_points
 from synth.synthesis.nlp_problem import NLPBuilder, SymbolicController, loop_response, phase_crossovers, t0_squared
 from synth.synthesis.nlp_sides import hold_sides
 

@@ -20,7 +20,7 @@ from synth.plant import Plant
 from synth.synthesis.delay_grid import delay_resolving_step
 from synth.synthesis.nlp_problem import NLPBuilder, loop_response
 
-__all__ = ["NEAR_DB", "PEAK_TIGHT", "peak_brackets", "peak_frequencies", "resonance_points", "track_peaks"]
+__all__ = ["NEAR_DB", "PEAK_TIGHT", "peak_brackets", "peak_frequencies", "track_peaks"]
 
 NEAR_DB = 3.0
 """Local maxima of the start design within this many dB of the bound (or above it) are tracked."""
@@ -99,37 +99,3 @@ def track_peaks(b: NLPBuilder, plant: Plant, designs: list[Controller], curve: s
         else:
             b.geq((1.0 + L).abs2() - top.abs2() / (bound**2 * tight))
 
-
-def resonance_points(plants: list[Plant], c: Controller, grid: np.ndarray, damping: float = 0.3,
-                      half_width: int = 6) -> np.ndarray:
-    """Frequencies that resolve every lightly damped root of the loop at ``c`` (plant and controller poles and
-    zeros, closed-loop poles with the delay left out): ``|r| exp(k zeta / 2)`` for ``|k| <= half_width``. A
-    peak of ``|S|`` or ``|T|`` is about ``2 zeta`` wide in relative frequency, narrower than the design grid's
-    spacing for ``zeta`` under about 0.03, and it moves with the design between grid points.
-
-    Examples
-    --------
-    >>> from synth.plant import Plant; from synth.controllers import Controller
-    >>> w = resonance_points([Plant.from_string("1/(s^2+0.02*s+1)")], Controller("P", {"kp": 0.0}),
-    ...                      np.geomspace(0.01, 100, 41))
-    >>> w.size, round(float(w[6]), 6)  # 13 points around the pole pair at 1 rad/s
-    (13, 1.0)
-    """
-    cn, cd = c.tf()
-    roots = []
-    for p in plants:
-        num, den = np.polymul(cn, p.num), np.polymul(cd, p.den)
-        closed = np.polyadd(den, num)
-        for poly in (num, den, closed):
-            poly = np.trim_zeros(np.asarray(poly, float), "f")
-            if poly.size > 1 and np.all(np.isfinite(poly)):
-                roots.extend(np.roots(poly))
-    out = []
-    for r in roots:
-        size = abs(r)
-        if size <= 0 or not grid[0] <= size <= grid[-1] or abs(r.imag) < 1e-9 * size:
-            continue
-        zeta = abs(r.real) / size
-        if zeta < damping:
-            out.append(size * np.exp(np.arange(-half_width, half_width + 1) * max(zeta, 1e-3) / 2))
-    return np.unique(np.concatenate(out)) if out else np.array([])
