@@ -1,4 +1,5 @@
-"""The convex stage's refined grid follows lightly damped roots (synth.synthesis.convex_settings.resonance_points, which the NLP polish already used).
+"""The convex stage's refined grid follows the loop's lightly damped roots (synth.synthesis.convex_settings.
+resonance_points, which the NLP polish already used).
 
 A design can put a controller resonance between two design-grid points: every grid constraint holds, the dense
 check fails. Seed 12 #284 of the design benchmark (a rational controller of order (0, 3) on a first-order plant,
@@ -13,9 +14,9 @@ import numpy as np
 
 import synth
 from synth.check import check
-from synth.spec import parse_spec
 from synth.controllers import Controller
 from synth.plant import Plant
+from synth.spec import parse_spec
 from synth.synthesis.convex_settings import resonance_points
 
 REFERENCE_BANDWIDTH = 0.3854119173974279
