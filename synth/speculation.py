@@ -133,7 +133,13 @@ class Speculator(Generic[K, V]):
     def _start(self) -> None:
         request_read, request_write = os.pipe()
         answer_read, answer_write = os.pipe()
-        pid = os.fork()
+        try:
+            pid = os.fork()
+        except OSError:  # no process to spare (a limit reached): every value computed here
+            for fd in (request_read, request_write, answer_read, answer_write):
+                os.close(fd)
+            self._finished = True
+            return
         if pid == 0:  # the helper: answer requests until the pipe closes, never return into the caller
             try:
                 os.close(request_write)

@@ -172,3 +172,15 @@ def test_a_helper_that_dies_costs_only_its_guess():
         assert guesses.value(3) == (9, os.getpid())  # computed here
         guesses.ahead(4)  # no helper any more: nothing is sent
         assert not guesses.expects(4) and guesses.value(4) == (16, os.getpid())
+
+
+def test_a_fork_that_fails_leaves_every_value_to_this_process(monkeypatch):
+    import synth.speculation as speculation
+
+    def no_fork() -> int:
+        raise OSError("Resource temporarily unavailable")
+
+    monkeypatch.setattr(speculation.os, "fork", no_fork)
+    with Speculator(_square_and_pid) as guesses:
+        guesses.ahead(2)
+        assert not guesses.expects(2) and guesses.value(2) == (4, os.getpid()) and guesses.guesses == 0
