@@ -83,15 +83,17 @@ def design_grid(plants: list[Plant], requirements: list[Requirement], settings: 
 
 
 def resonance_points(plants: list[Plant], c: Controller, grid: np.ndarray, damping: float = 0.3,
-                      half_width: int = 6) -> np.ndarray:
+                     half_width: int = 6, moving_only: bool = False) -> np.ndarray:
     """Frequencies that resolve every lightly damped root of the loop at ``c`` (plant and controller poles and
-    zeros, closed-loop poles with the delay left out): ``|r| exp(k zeta / 2)`` for ``|k| <= half_width``. A
-    peak of ``|S|`` or ``|T|`` is about ``2 zeta`` wide in relative frequency, narrower than the design grid's
-    spacing for ``zeta`` under about 0.03, and it moves with the design between grid points. The NLP polish adds
-them to every round's grid; the convex stage to each refinement's: a rational controller whose poles at
-0.53 rad/s (damping 0.04) put the gain crossover, at a phase margin of -95 deg, between two grid points passed
-every grid constraint; each refinement added the crossover and the next design moved the resonance on (seed
-12 #284 of the design benchmark, tests/test_design_resonance_grid.py).
+    zeros, closed-loop poles with the delay left out; with ``moving_only`` those that move with the design: the
+    controller's and the closed loop's): ``|r| exp(k zeta / 2)`` for ``|k| <= half_width``. A peak of ``|S|`` or
+    ``|T|`` is about ``2 zeta`` wide in relative frequency, narrower than the design grid's spacing for ``zeta``
+    under about 0.03, and it moves with the design between grid points. The NLP polish adds them to every
+    round's grid. The convex stage adds the moving ones to each refinement's grid (a fixed plant resonance it
+    resolves by refining at the violations it causes): a rational controller whose poles at 0.53 rad/s (damping
+    0.04) put the gain crossover, at a phase margin of -95 deg, between two grid points passed every grid
+    constraint, and each refinement added the crossover while the next design moved the resonance on (seed 12
+    #284 of the design benchmark, tests/test_design_resonance_grid.py).
 
     Examples
     --------
@@ -106,7 +108,7 @@ every grid constraint; each refinement added the crossover and the next design m
     for p in plants:
         num, den = np.polymul(cn, p.num), np.polymul(cd, p.den)
         closed = np.polyadd(den, num)
-        for poly in (num, den, closed):
+        for poly in (cn, cd, closed) if moving_only else (num, den, closed):
             poly = np.trim_zeros(np.asarray(poly, float), "f")
             if poly.size > 1 and np.all(np.isfinite(poly)):
                 roots.extend(np.roots(poly))
