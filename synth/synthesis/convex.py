@@ -45,19 +45,13 @@ from synth.synthesis.convex_forms import (
     without_implied,
 )
 from synth.synthesis.convex_results import ConvexResult, Diagnosis, RequirementConflict
-from synth.synthesis.convex_settings import ConvexSettings, design_grid, resonance_points
+from synth.synthesis.convex_settings import RESONANCE_REFINED, ConvexSettings, design_grid, resonance_points
 from synth.synthesis.cvxpy_loader import cp
 from synth.synthesis.delay_grid import controller_gain_bound
 from synth.synthesis.objective_forms import CoefficientRatioFloor, Level, ReturnDifferenceFloor
 from synth.synthesis.parametrization import Parametrization
 
-__all__ = ["GRID_TOLERANCE", "RESONANCE_REFINED", "SOLVER", "ConvexDesigner"]
-
-RESONANCE_REFINED = 0.05
-"""Damping below which a refinement of the convex stage's grid also resolves a root of the controller or of the
-closed loop (:func:`~synth.synthesis.convex_settings.resonance_points`): its peak is then narrower than the
-40-per-decade grid's spacing (2 zeta < 0.13 in log frequency). At 0.3, as the NLP polish uses, servo_pid's two
-designs took 12 % more CPU for the same answers."""
+__all__ = ["GRID_TOLERANCE", "SOLVER", "ConvexDesigner"]
 
 SOLVER = cp.CLARABEL
 _OK = {cp.OPTIMAL, cp.OPTIMAL_INACCURATE}
