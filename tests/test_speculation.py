@@ -37,7 +37,6 @@ def test_a_guess_is_computed_by_the_helper_and_a_wrong_one_changes_nothing():
         ahead = guesses.value(3)
         guesses.ahead(10)  # a wrong guess: the search asks for 4
         wrong = guesses.value(4)
-        assert guesses.expects(10) or guesses.value(10)[0] == 100
     assert (here[0], ahead[0], wrong[0]) == (4, 9, 16)
     assert here[1] == os.getpid() and wrong[1] == os.getpid()
     assert ahead[1] != os.getpid()  # the helper's
