@@ -191,8 +191,10 @@ def test_a_ringing_pi_at_its_settling_limit_is_refined_until_the_band_decides():
     assert 1.74 < ref_settling < 1.76
     assert not result.met
     assert abs(result.details["settling_time"] - ref_settling) < 2e-3
-    # refined until its error cannot change the verdict (it started at 5e-4 of T(0), on the wrong side of the band)
-    assert 0.0 < result.details["simulation_error"] < 3e-4
+    # refined until its error cannot change the verdict: below the 4e-4 of T(0) that put the peak on the wrong
+    # side of the band, and decided (not judged on the worst case the error allows)
+    assert 0.0 < result.details["simulation_error"] < 4e-4
+    assert "judged on the worst case" not in result.message
     run = linear_step(loop, 2.5, 25001)  # the estimate bounds what the method of steps finds
     assert np.max(np.abs(run.y - ref)) <= np.max(run.error)
 
