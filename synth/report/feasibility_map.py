@@ -120,7 +120,8 @@ def _grid_slack(req: Any, batch: Any, counts: np.ndarray) -> np.ndarray:
         return req.batch_slack(batch, 20).reshape(counts.shape)
     loops = batch.loops()
     columns = counts.shape[1]
-    return column_refined_slack(lambda j, i: req.slack(loops[j * columns + i], 20), counts)[0]
+    # called only where the loop is stable (counts == 0, from the D-decomposition): not counted again
+    return column_refined_slack(lambda j, i: req.stable_slack(loops[j * columns + i], 20), counts)[0]
 
 
 NEAR_BOUNDARY = 0.1

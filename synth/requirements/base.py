@@ -234,6 +234,21 @@ class Requirement(BaseModel):
         """
         return self.evaluate(loop, per_decade).slack
 
+    def stable_slack(self, loop: Loop, per_decade: int = 80) -> float:
+        """:meth:`slack` on a loop the caller has already counted closed-loop stable (as
+        :meth:`synth.loop.Loop.stability` counts, e.g. by a D-decomposition over a grid): a type that would count
+        the loop's roots again before its own work skips that count. The base form is :meth:`slack`.
+
+        Examples
+        --------
+        >>> from synth.loop import Loop; from synth.plant import Plant; from synth.controllers import Controller
+        >>> from synth.requirements import Bandwidth
+        >>> loop = Loop(Plant.from_string("1/(s+1)"), Controller("P", {"kp": 9.0}))
+        >>> Bandwidth(min=100).stable_slack(loop) == Bandwidth(min=100).slack(loop)
+        True
+        """
+        return self.slack(loop, per_decade)
+
     def batch_slack(self, batch: LoopBatch, per_decade: int = 80) -> np.ndarray:
         """Slack on every loop of ``batch`` (one plant, many controllers), as an array.
 
