@@ -37,6 +37,7 @@ Run:  nice -n 10 python benchmarks/ident_crb.py [--cases 50] [--seeds 20] [--sam
 from __future__ import annotations
 
 import argparse
+import itertools
 import json
 import sys
 import time
@@ -254,12 +255,30 @@ def make_case(index: int, samples: int, rest: float = 1.5) -> Case:
     return case
 
 
-def matched(names: list[str], params: dict[str, float], std: dict[str, float]) -> tuple[np.ndarray, np.ndarray]:
-    """Values and stds in ``names`` order, poles and zeros sorted (their labels are interchangeable)."""
+def matched(names: list[str], params: dict[str, float], std: dict[str, float],
+            truth: dict[str, float] | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Values and stds in ``names`` order; the poles' and the zeros' labels are interchangeable, so each group is
+    matched to ``truth``'s by the assignment with the least sum of squared relative differences (without
+    ``truth``: both sorted). Sorting is that assignment while the estimates keep the truth's order; a weakly
+    identified pole of a near cancellation can pass another pole, and sorting then charged its error to the
+    well-identified pole it passed (case 20: p1, whose bound is 0.3 % of its value, at 1473 bounds of spread).
+
+    Examples
+    --------
+    Truth p1 = 1 (well identified), p2 = 10 (weakly), estimated 1.01 and 0.5:
+
+    >>> est, std, truth = {"p1": 0.5, "p2": 1.01}, {"p1": 4.0, "p2": 0.01}, {"p1": 1.0, "p2": 10.0}
+    >>> matched(["p1", "p2"], est, std, truth)[0].tolist(), matched(["p1", "p2"], est, std)[0].tolist()
+    ([1.01, 0.5], [0.5, 1.01])
+    """
     vals, sds = dict(params), dict(std)
     for prefix in ("p", "z"):
         group = [n for n in names if n.startswith(prefix) and n[1:].isdigit()]
-        order = sorted(group, key=lambda n: params[n])
+        if truth is None:
+            order = sorted(group, key=lambda n: params[n])
+        else:
+            order = list(min(itertools.permutations(group), key=lambda perm: sum(
+                ((params[old] - truth[new]) / truth[new]) ** 2 for new, old in zip(group, perm))))
         for new, old in zip(group, order):
             vals[new], sds[new] = params[old], std[old]
     return np.array([vals[n] for n in names]), np.array([sds[n] for n in names])
@@ -283,7 +302,7 @@ def run_case(case: Case, seeds: int) -> dict[str, Any]:
         except Exception as exc:  # a failed fit counts against the case
             failed.append(f"seed {seed}: {type(exc).__name__}: {exc}"[:200])
             continue
-        v, s = matched(names, res.fit.parameters, res.fit.std)
+        v, s = matched(names, res.fit.parameters, res.fit.std, dict(zip(names, truth)))
         est.append(v)
         rep.append(s)
         weak += bool(res.fit.weak)

@@ -21,7 +21,7 @@ def test_benchmark_sample_fits_near_the_independent_cramer_rao_bound(index):
     res = identify((t, case.u, y), case.structure, "fit" if case.fit_delay else case.delay, sensor_text(case.sensor),
                    compare_directions=False)
     names = bound["names"]
-    value, std = matched(names, res.fit.parameters, res.fit.std)
     truth = np.array([case.truth.get(n, case.delay) for n in names])
+    value, std = matched(names, res.fit.parameters, res.fit.std, dict(zip(names, truth)))
     assert np.all(np.abs(value - truth) < 4.5 * bound["std"]), dict(zip(names, (value - truth) / bound["std"]))
     assert np.all((std > 0.75 * bound["std"]) & (std < 1.4 * bound["std"])), dict(zip(names, std / bound["std"]))
