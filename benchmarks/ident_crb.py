@@ -261,7 +261,7 @@ def matched(names: list[str], params: dict[str, float], std: dict[str, float],
     matched to ``truth``'s by the assignment with the least sum of squared relative differences (without
     ``truth``: both sorted). Sorting is that assignment while the estimates keep the truth's order; a weakly
     identified pole of a near cancellation can pass another pole, and sorting then charged its error to the
-    well-identified pole it passed (case 20: p1, whose bound is 0.3 % of its value, at 1473 bounds of spread).
+    well-identified pole it passed (case 20: p1, whose bound is 0.02 % of its value, at 1473 bounds of spread).
 
     Examples
     --------
