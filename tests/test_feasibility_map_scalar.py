@@ -28,11 +28,15 @@ def test_the_map_of_a_step_limit_is_coarser_and_simulates_only_stable_loops(monk
     assert map_grid_size(parse_spec({**SPEC, "requirements": SPEC["requirements"][1:]})) == MAP_GRID
     assert map_grid_size(parse_spec({**SPEC, "plant": {"tf": SPEC["plant"]["tf"]}})) == MAP_GRID
     design = Controller("PI", {"kp": 3.0, "ki": 2.0})
-    simulated = []
-    original = StepResponse.slack
-    monkeypatch.setattr(StepResponse, "slack", lambda self, loop, *a: simulated.append(1) or original(self, loop, *a))
+    simulated, counted = [], []
+    original = StepResponse._linear
+    monkeypatch.setattr(StepResponse, "_linear", lambda self, loop: simulated.append(1) or original(self, loop))
+    import synth.requirements.step_response as step_module
+    unstable = step_module.closed_loop_unstable
+    monkeypatch.setattr(step_module, "closed_loop_unstable", lambda loop: counted.append(1) or unstable(loop))
     xa, xb, A, B, slack = feasibility_grid(spec, design)
     monkeypatch.undo()
+    assert not counted  # the D-decomposition's counts stand: no loop's roots counted again before its step
     assert (xa, xb) == ("kp", "ki") and slack.shape == (3, MAP_GRID_SCALAR, MAP_GRID_SCALAR)
     stable = slack[0] > 0
     assert 0 < stable.sum() < stable.size  # high gains destabilize this third-order plant
