@@ -201,7 +201,9 @@ class StepResponse(Requirement):
     def batch_slack(self, batch: LoopBatch, per_decade: int = 80) -> np.ndarray:
         """The slack of every loop of ``batch`` (:class:`~synth.loop_batch.LoopBatch`), as :meth:`slack` gives it:
         without a delay the steps of all stable loops at once (:func:`synth.exact_steps.exact_steps`, the same
-        arithmetic as one loop's); with a delay, or ``under`` a simulation, one loop at a time.
+        arithmetic as one loop's); with a delay, one loop at a time where the batch's root counts
+        (:meth:`~synth.loop_batch.LoopBatch.unstable_root_counts`: by D-decomposition when the loops differ by a
+        gain) say the loop is stable; ``under`` a simulation, one loop at a time.
 
         Examples
         --------
@@ -212,13 +214,16 @@ class StepResponse(Requirement):
         >>> bool(np.allclose(req.batch_slack(batch), [req.slack(Loop(G, c)) for c in batch.controllers]))
         True
         """
-        if not self.vectorized_on([batch.plant]):
+        if self.under != "linear":
             return super().batch_slack(batch, per_decade)
         counts = batch.unstable_root_counts()
         out = UNSTABLE_SLACK * np.maximum(counts, 1).astype(float)
         stable = np.flatnonzero(counts == 0)
         loops = batch.loops()
-        out[stable] = [self._slack_of(o) for o in self._exact_outcomes([loops[i] for i in stable])]
+        if batch.plant.delay > 0.0:  # simulated one by one, the count already made
+            out[stable] = [self.stable_slack(loops[i], per_decade) for i in stable]
+        else:
+            out[stable] = [self._slack_of(o) for o in self._exact_outcomes([loops[i] for i in stable])]
         return out
 
     def vectorized_on(self, plants: list[Any]) -> bool:
