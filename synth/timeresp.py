@@ -264,8 +264,8 @@ simulated for 512 s, ran at 25.6 ms steps and overshot 24.9 % where a fine simul
 extrapolation). The rule was ``w_c dt <= 0.002`` until the error was estimated and controlled; starting ten times
 coarser, a PI behind 20 ms simulated 20,000-80,000 steps instead of 100,000-400,000 (the report's feasibility map of
 such a PI: 3.7 -> 2.2 s). On 300 random delayed loops the largest difference from a run started at
-``w_c dt = 0.0005`` was within the estimate on 299 with either start (at most 0.31 of it); the other is a biproper
-plant, whose step jumps at each multiple of the delay, with either start."""
+``w_c dt = 0.0005`` was within the estimate on 299 with either start (at most 0.41 of it, 0.44 before); the other
+is a biproper plant, whose step jumps at each multiple of the delay, with either start."""
 
 STEP_PER_POLE = 0.01
 """Largest simulation step of a delayed loop times the largest magnitude of the controller's and the plant's
