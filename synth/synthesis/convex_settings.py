@@ -110,14 +110,15 @@ def resonance_points(plants: list[Plant], c: Controller, grid: np.ndarray, dampi
     (13, 1.0)
     """
     cn, cd = c.tf()
-    roots = []
+    polys = [cn, cd] if moving_only else []  # the controller's own roots: the same for every plant
     for p in plants:
         num, den = np.polymul(cn, p.num), np.polymul(cd, p.den)
-        closed = np.polyadd(den, num)
-        for poly in (cn, cd, closed) if moving_only else (num, den, closed):
-            poly = np.trim_zeros(np.asarray(poly, float), "f")
-            if poly.size > 1 and np.all(np.isfinite(poly)):
-                roots.extend(np.roots(poly))
+        polys += [np.polyadd(den, num)] if moving_only else [num, den, np.polyadd(den, num)]
+    roots = []
+    for poly in polys:
+        poly = np.trim_zeros(np.asarray(poly, float), "f")
+        if poly.size > 1 and np.all(np.isfinite(poly)):
+            roots.extend(np.roots(poly))
     out = []
     for r in roots:
         size = abs(r)
