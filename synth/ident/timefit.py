@@ -93,6 +93,8 @@ class TimeFitResult:
     t, y, yhat : numpy.ndarray
         The fitted data and the model output (for figures; not in ``to_dict``).
     periodic : bool
+    weights : numpy.ndarray or None
+        The 0/1 sample weights of the cost, if any (not in ``to_dict``).
     """
 
     structure: Structure
@@ -117,6 +119,7 @@ class TimeFitResult:
     yhat: np.ndarray = field(repr=False)
     u0: float = 0.0
     periodic: bool = False
+    weights: np.ndarray | None = field(default=None, repr=False)
 
     @property
     def residuals(self) -> np.ndarray:
@@ -488,4 +491,4 @@ def fit_structure(record: Record, structure: Structure | str, delay: str | float
         measured = Plant(measured.num, measured.den, d_hat, record.input, record.output, "identified with sensor")
     return TimeFitResult(st, params, std, ci, names, cov, float(d_hat), fit_delay, b_hat, float(sd[-1]),
                          fit_pct, float(np.sqrt(s2)), plant, sensor, measured, initial_out, info, t.copy(), y.copy(),
-                         yhat, u0, periodic)
+                         yhat, u0, periodic, weights)
