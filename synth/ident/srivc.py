@@ -25,7 +25,7 @@ from synth.errors import ModelError
 from synth.ident.structure import Structure
 from synth.plant import Plant
 
-__all__ = ["linear_initial_model", "map_to_structure"]
+__all__ = ["filter_bank", "linear_initial_model", "map_to_structure", "srivc_with_root"]
 
 
 def _expm_np(M: np.ndarray) -> np.ndarray:
@@ -68,11 +68,20 @@ def _delayed_zoh(A: np.ndarray, B: np.ndarray, dt: float, delay: float) -> Any:
     return DelayedZOH(Ad, A_rest @ G_f, G_late, steps, fraction)
 
 
-def _filter_bank(den: np.ndarray, dt: float, x: np.ndarray, count: int, delay: float = 0.0) -> list[np.ndarray]:
+def filter_bank(den: np.ndarray, dt: float, x: np.ndarray, count: int, delay: float = 0.0) -> list[np.ndarray]:
     """``s^k / den(s)`` applied to the held samples ``x`` (delayed), ``k = 0 .. count - 1``, zero initial state.
 
     One exact ZOH discretization of the companion form of ``1/den`` serves every ``k``
     (its states are ``s^k/den x``); ``k = deg(den)`` follows from ``den`` itself.
+
+    Examples
+    --------
+    ``1/(s+2)`` and ``s/(s+2)`` of a unit step held from the first sample, 0.5 s later: ``(1 - e^-1)/2`` and
+    ``e^-1``:
+
+    >>> x = np.ones(51)
+    >>> [round(float(v[-1]), 6) for v in filter_bank(np.array([1.0, 2.0]), 0.01, x, 2)]
+    [0.31606, 0.367879]
     """
     from scipy.signal import lfilter, ss2tf
 
@@ -112,13 +121,13 @@ def _bank(den: np.ndarray, t: np.ndarray, x: np.ndarray, count: int, delay: floa
           reps: int) -> list[np.ndarray]:
     dt = float(t[1] - t[0])
     if not periodic:
-        return _filter_bank(den, dt, x, count, delay)
+        return filter_bank(den, dt, x, count, delay)
     n = x.size
-    return [v[-n:] for v in _filter_bank(den, dt, np.tile(x, reps), count, delay)]
+    return [v[-n:] for v in filter_bank(den, dt, np.tile(x, reps), count, delay)]
 
 
 def _tile_filter(plant: Plant, t: np.ndarray, x: np.ndarray, periodic: bool, reps: int) -> np.ndarray:
-    """``plant`` applied to ``x`` from zero state (or its periodic response), through :func:`_filter_bank`."""
+    """``plant`` applied to ``x`` from zero state (or its periodic response), through :func:`filter_bank`."""
     num = plant.num[::-1]
     bank = _bank(plant.den, t, x, num.size, plant.delay, periodic, reps)
     return sum(c * b for c, b in zip(num, bank))
@@ -190,6 +199,57 @@ def _srivc_step(t: np.ndarray, v: np.ndarray, y: np.ndarray, na: int, nb: int, d
         est = np.linalg.lstsq(phi, yf[na], rcond=None)[0]
     a = est[:na][::-1]
     return est[na:][::-1], (_stable(np.r_[1.0, a]) if na else np.array([1.0]))
+
+
+def srivc_with_root(t: np.ndarray, v: np.ndarray, y: np.ndarray, den: np.ndarray, nb: int, delay: float, root: float,
+                    iterations: int = 8) -> tuple[np.ndarray, np.ndarray]:
+    """SRIVC estimate of ``B(s)/A(s) exp(-delay s)`` from ``v`` to ``y`` with ``A(s)`` holding the factor ``s + root``.
+
+    The other factor ``A'(s)`` (monic) and ``B(s)`` (degree ``nb``) are estimated: ``(s + root) A'(s) y_f =
+    B(s) v_f`` is linear in both, with the prefilter ``1/A(s)`` of the previous iterate; ``den`` (which holds
+    ``s + root``) is the first prefilter. Non-periodic records from rest. What
+    :mod:`synth.ident.pair_relocation` profiles a nearly cancelling pair's location with.
+
+    Returns
+    -------
+    num, den : numpy.ndarray
+        ``B`` and ``A`` (highest power first; ``A`` monic, its other factor made stable).
+
+    Examples
+    --------
+    >>> from synth.ident.simulate import simulate_plant
+    >>> t = np.arange(0, 6, 0.01); u = np.where((t % 2) >= 1, 1.0, 0.0)
+    >>> y = simulate_plant(Plant.from_string("6/((s+2)*(s+3))"), t, u)
+    >>> num, den = srivc_with_root(t, u, y, np.poly([-3.0, -1.0]), 0, 0.0, 3.0)
+    >>> num.round(4).tolist(), (-np.roots(den)).round(4).tolist()
+    ([6.0], [3.0, 2.0])
+    """
+    na = np.asarray(den).size - 1
+    m = na - 1
+    den = np.asarray(den, float) / den[0]
+    num: np.ndarray | None = None
+    for _ in range(iterations):
+        with np.errstate(over="ignore", invalid="ignore"):
+            yf = _bank(den, t, y, na + 1, 0.0, False, 1)
+            vf = _bank(den, t, v, nb + 1, delay, False, 1)
+            source = yf if num is None else _bank(den, t, _tile_filter(Plant(num, den, delay), t, v, False, 1),
+                                                  na + 1, 0.0, False, 1)
+        phi = np.column_stack([-(yf[i + 1] + root * yf[i]) for i in range(m)] + vf)
+        zeta = np.column_stack([-(source[i + 1] + root * source[i]) for i in range(m)] + vf)
+        try:
+            est = np.linalg.solve(zeta.T @ phi, zeta.T @ (yf[m + 1] + root * yf[m]))
+        except np.linalg.LinAlgError:
+            break
+        if not np.all(np.isfinite(est)):
+            break
+        new_num, new_den = est[m:][::-1], np.polymul(_stable(np.r_[1.0, est[:m][::-1]]), [1.0, root])
+        done = num is not None and np.allclose(new_den, den, rtol=1e-7) and np.allclose(new_num, num, rtol=1e-7)
+        num, den = new_num, new_den
+        if done:
+            break
+    if num is None:
+        raise ModelError(f"SRIVC with a root at {-root:g} found no estimate")
+    return num, den
 
 
 def _first_response(t: np.ndarray, w: np.ndarray, y: np.ndarray) -> float:
