@@ -191,6 +191,9 @@ def _print(result: Any, args: argparse.Namespace, json_path: Path, figures: list
         print(w.text() + ": the record cannot pin it down; do not use it as a confident number")
     for t in tied:
         print(t.text())
+    for step in fit.solver.get("pair_profile", []):
+        if step.get("note"):
+            print(f"note: {step['note']}")
     if fit.solver.get("covariance_note"):
         print(f"note on the std column: {fit.solver['covariance_note']}")
     print(f"fit {fit.fit_percent:.2f} %, residual std {fit.residual_std:.3g}, "

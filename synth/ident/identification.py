@@ -19,6 +19,7 @@ from synth.data.coerce import RecordLike, as_record
 from synth.data.record import Record
 from synth.errors import DataError, FitError, ModelError
 from synth.ident.directions import DirectionComparison, fit_by_direction
+from synth.ident.pair_relocation import relocate_pair
 from synth.ident.periodic_start import beyond_nyquist, fit_whole_record, refit_periodic_start, settling_time
 from synth.ident.steps import StepAverage, average_steps, find_steps
 from synth.ident.structure import Structure, parse_structure
@@ -186,6 +187,7 @@ def identify(record: RecordLike, structure: Structure | str, delay: str | float 
                            f"whole record's fit failed too ({whole_error}); try another structure, a fixed delay "
                            "or a shorter part of the record", where=record.source) from None
         if not _unstable(whole_fit.measured):
+            whole_fit = _other_pair_minima(record, whole_fit, structure, delay, sensor)
             return IdentifyResult(record, whole_fit, avg, None, "", False,
                                   f"the fit of the {avg.mode} average failed ({failed}); fitted the whole record "
                                   "instead, from rest")
@@ -200,6 +202,7 @@ def identify(record: RecordLike, structure: Structure | str, delay: str | float 
         fit, whole = _refit_from_rest(record, avg, fit, structure, delay, sensor)
         if not whole:
             fit, avg, whole = refit_periodic_start(record, avg, fit, structure, delay, sensor)
+    fit = _other_pair_minima(record, fit, structure, delay, sensor)
     directions, note = None, ""
     if two_ways and (compare_directions or by_direction):
         try:
@@ -209,6 +212,16 @@ def identify(record: RecordLike, structure: Structure | str, delay: str | float 
                 raise
             note = f"up and down steps not compared: {exc}"
     return IdentifyResult(record, fit, avg, directions, note, by_direction, whole)
+
+
+def _other_pair_minima(record: Record, fit: TimeFitResult, structure: Structure, delay: str | float | None,
+                       sensor: Plant | str | None) -> TimeFitResult:
+    """A fit of the whole record from rest, moved out of a nearly cancelling pair's other minima
+    (:func:`synth.ident.pair_relocation.relocate_pair`) when it has a weakly identifiable parameter: a pair the
+    record pins down is not profiled (the X-4 record's, 26 s on its 420,000 samples). An average's fit as it is."""
+    if fit.periodic or fit.t.size != record.t.size or not fit.weak:
+        return fit
+    return relocate_pair(record, fit, structure, delay, sensor, fit.weights)
 
 
 def _unstable(plant: Plant) -> bool:
