@@ -40,7 +40,7 @@ from synth.ident.structure import Structure
 from synth.ident.timefit import TimeFitResult, fit_structure
 from synth.plant import Plant
 
-__all__ = ["LOCATIONS", "NEAR_CANCELLATION", "POLISHED", "REFIT_DROP", "PairProfile", "pair_profile", "relocate_pair"]
+__all__ = ["LOCATIONS", "NEAR_CANCELLATION", "REFIT_DROP", "PairProfile", "pair_profile", "relocate_pair"]
 
 #: a zero within this factor of a pole is a near cancellation whose location is profiled
 NEAR_CANCELLATION = 2.0
@@ -48,8 +48,6 @@ NEAR_CANCELLATION = 2.0
 LOCATIONS = 24
 #: a profile point this many noise variances of SSR below the fit starts a refit
 REFIT_DROP = 1.0
-#: profile points polished by Gauss-Newton on the other poles
-POLISHED = 24
 #: Gauss-Newton evaluations per other-pole coefficient in a polish
 _EVALUATIONS = 12
 
@@ -195,8 +193,8 @@ def pair_profile(record: Record, fit: TimeFitResult, weights: np.ndarray | None 
     """The residual along each nearly cancelling pair's location of ``fit`` (a fit of ``record`` from rest).
 
     At each of :data:`LOCATIONS` points the pair's pole is held and the other poles estimated by SRIVC with
-    that root (:func:`synth.ident.srivc.srivc_with_root`), the numerator and offset by linear least squares;
-    the :data:`POLISHED` lowest points are then polished by Gauss-Newton on the other poles.
+    that root (:func:`synth.ident.srivc.srivc_with_root`), the numerator and offset by linear least squares,
+    then the other poles (and a fitted delay) polished by Gauss-Newton.
 
     Parameters
     ----------
@@ -260,11 +258,9 @@ def pair_profile(record: Record, fit: TimeFitResult, weights: np.ndarray | None 
                 continue
             r, num = proj.solve(den)
             ssr[i], models[i] = float(r @ r), (num, den)
-        for i in np.argsort(ssr)[:POLISHED]:
-            if np.isfinite(ssr[i]):
-                value, num, den, d = _polish(proj, models[i][1], grid[i], fit.delay_fitted)
-                if value < ssr[i]:
-                    ssr[i], models[i], delays[i] = value, (num, den), d
+            value, num, den, d = _polish(proj, den, q, fit.delay_fitted)
+            if value < ssr[i]:
+                ssr[i], models[i], delays[i] = value, (num, den), d
         k = int(np.argmin(ssr))
         out.append(PairProfile(zero, pole, grid, (ssr_fit - ssr) / s2, models[k], float(delays[k])))
     return out
