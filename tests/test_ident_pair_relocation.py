@@ -80,3 +80,26 @@ def test_identify_relocates_a_caught_whole_record_fit(monkeypatch: pytest.Monkey
     res = identify((p["t"], p["u"], p["y"]), st, p["delay_option"], p["sensor"], average="none")
     assert res.fit.solver["pair_profile"][-1]["refit"] == "kept: a lower residual"
     assert abs(res.fit.parameters["z"] / p["truth"]["z"] - 1) < 0.2
+
+
+def test_synth_identify_says_the_fit_moved(run_cli, tmp_path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """The CLI prints the relocation's note and writes its evidence to the JSON."""
+    import synth.ident.identification as identification
+
+    p = problem(14)
+    path = tmp_path / "rec.csv"
+    path.write_text("t,u,y\n" + "\n".join(f"{a:.4f},{b:.6g},{c:.10g}" for a, b, c in zip(p["t"], p["u"], p["y"])))
+    real = identification.fit_structure
+
+    def caught(*args, **kwargs):
+        kwargs.setdefault("initial", {**wrong_start(p["truth"], 0), "delay": p["delay"]})
+        return real(*args, **{"solver": "convolution", **kwargs})
+
+    monkeypatch.setattr(identification, "fit_structure", caught)
+    res = run_cli("identify", "--data", str(path), "--time", "t", "--input", "u", "--output", "y",
+                  "--structure", p["structure"], "--delay", "fit", "--average", "none", "--out",
+                  str(tmp_path / "out"), "--json", str(tmp_path / "r.json"))
+    assert res.code == 0, res.err
+    assert "note: the fit ended with a zero at" in res.out and "noise variances of SSR lower, kept" in res.out
+    assert json.loads((tmp_path / "r.json").read_text())["solver"]["pair_profile"][-1]["refit"] == \
+        "kept: a lower residual"
