@@ -118,8 +118,11 @@ def run(seed: int) -> list[dict[str, Any]]:
         return fit_structure(rec, st, p["delay_option"], p["sensor"], initial={**initial, "delay": p["delay"]},
                              solver="convolution")
 
-    reference = ssr(fitted(p["truth"]))
-    rows = []
+    rows: list[dict[str, Any]] = []
+    truth_fit = fitted(p["truth"])
+    if truth_fit.solver.get("failure"):  # no reference to judge against (problem 193: a delay below 0)
+        return [{"seed": seed, "start": "truth", "error": f"reference: {truth_fit.solver['failure']}"[:200]}]
+    reference = ssr(truth_fit)
     for kind, name in enumerate(STARTS):
         row: dict[str, Any] = {"seed": seed, "start": name, "structure": p["structure"], "samples": int(p["t"].size),
                                "sensor": p["sensor"] is not None, "delay": p["delay_option"]}
