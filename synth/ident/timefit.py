@@ -485,13 +485,10 @@ def fit_structure(record: Record, structure: Structure | str, delay: str | float
     if not fit_delay:
         params[delay_name], std[delay_name] = float(d_hat), 0.0
     ci = {k: (params[k] - tq * std[k], params[k] + tq * std[k]) for k in params}
-    # a failed fit without ``check`` is returned with its reason in solver["failure"]; a delay that ended below 0
-    # (Levenberg-Marquardt from a given start, benchmarks/pair_relocation.py problem 193) has no plant: held at 0
-    plant = st.plant(theta, delay=max(d_hat, 0.0), input=record.input, output=record.output, label="identified")
+    plant = st.plant(theta, delay=d_hat, input=record.input, output=record.output, label="identified")
     measured = plant.series(sensor) if sensor is not None else plant
     if sensor is not None:
-        measured = Plant(measured.num, measured.den, plant.delay, record.input, record.output,
-                         "identified with sensor")
+        measured = Plant(measured.num, measured.den, d_hat, record.input, record.output, "identified with sensor")
     return TimeFitResult(st, params, std, ci, names, cov, float(d_hat), fit_delay, b_hat, float(sd[-1]),
                          fit_pct, float(np.sqrt(s2)), plant, sensor, measured, initial_out, info, t.copy(), y.copy(),
                          yhat, u0, periodic, weights)
