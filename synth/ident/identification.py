@@ -221,7 +221,7 @@ def _other_pair_minima(record: Record, fit: TimeFitResult, structure: Structure,
     record pins down is not profiled (the X-4 record's, 26 s on its 420,000 samples). An average's fit as it is."""
     if fit.periodic or fit.t.size != record.t.size or not fit.weak:
         return fit
-    return relocate_pair(record, fit, structure, delay, sensor, fit.weights)
+    return relocate_pair(record, fit, structure, delay, sensor)
 
 
 def _unstable(plant: Plant) -> bool:

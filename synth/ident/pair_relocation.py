@@ -190,7 +190,7 @@ def _polish(proj: _Projection, den: np.ndarray, root: float,
     return float(r @ r), num, full(x), delay_of(x)
 
 
-def pair_profile(record: Record, fit: TimeFitResult, weights: np.ndarray | None = None) -> list[PairProfile]:
+def pair_profile(record: Record, fit: TimeFitResult) -> list[PairProfile]:
     """The residual along each nearly cancelling pair's location of ``fit`` (a fit of ``record`` from rest).
 
     At each of :data:`LOCATIONS` points the pair's pole is held and the other poles estimated by SRIVC with
@@ -200,10 +200,9 @@ def pair_profile(record: Record, fit: TimeFitResult, weights: np.ndarray | None 
     Parameters
     ----------
     record : Record
-        The record the fit was made on (not periodic: the plant at rest at the first input sample).
+        The record the fit was made on (not periodic: the plant at rest at the first input sample); the samples
+        the fit weighted 0 (``fit.weights``) are left out here too.
     fit : TimeFitResult
-    weights : numpy.ndarray, optional
-        The fit's 0/1 sample weights.
 
     Returns
     -------
@@ -229,10 +228,10 @@ def pair_profile(record: Record, fit: TimeFitResult, weights: np.ndarray | None 
     (1.56, 1.75, 20.7)
     """
     w = record.u - record.u[0]
-    mask = np.ones(w.size, bool) if weights is None else np.asarray(weights) > 0
+    mask = np.ones(w.size, bool) if fit.weights is None else fit.weights > 0  # the samples the fit's cost used
     residual = (record.y - fit.yhat)[mask]
     ssr_fit = float(residual @ residual)
-    s2 = ssr_fit / max(residual.size - len(fit.names), 1)
+    s2 = ssr_fit / max(_dof(fit), 1)
     plant, sensor = fit.plant, fit.sensor
     if not s2 > 0 or fit.periodic:
         return []
@@ -274,7 +273,7 @@ def _dof(fit: TimeFitResult) -> int:
 
 
 def relocate_pair(record: Record, fit: TimeFitResult, structure: Structure, delay: str | float | None,
-                  sensor: Plant | str | None, weights: np.ndarray | None = None) -> TimeFitResult:
+                  sensor: Plant | str | None) -> TimeFitResult:
     """``fit``, or the structure fitted again from a better point on a nearly cancelling pair's profile.
 
     The refit replaces ``fit`` when its residual is lower; the profile's evidence is added to the kept fit's
@@ -296,7 +295,7 @@ def relocate_pair(record: Record, fit: TimeFitResult, structure: Structure, dela
     >>> moved.plant.to_string(3), moved.solver["pair_profile"][-1]["refit"]
     ('8.04*(s+21.2)/((s+19.4)*(s+2))', 'kept: a lower residual')
     """
-    profiles = pair_profile(record, fit, weights)
+    profiles = pair_profile(record, fit)
     if not profiles:
         return fit
     evidence: list[dict[str, Any]] = [p.to_dict() for p in profiles]
@@ -313,7 +312,7 @@ def relocate_pair(record: Record, fit: TimeFitResult, structure: Structure, dela
             initial = {**dict(zip(structure.parameters, theta.tolist())), "delay": best.delay}
             # Levenberg-Marquardt: IPOPT's simulation-error problem stepped a pole into the right half-plane
             # from such a start and diverged (a 3rd-order plant, 8,000 samples), where LM converged in 0.4 s
-            other = fit_structure(record, structure, delay, sensor, False, initial=initial, weights=weights,
+            other = fit_structure(record, structure, delay, sensor, False, initial=initial, weights=fit.weights,
                                   check=True, solver="convolution")
         except (DataError, FitError, ModelError) as exc:
             evidence.append({"refit": f"failed: {exc}", "note": f"{where}, but the refit from there failed ({exc}): "
