@@ -6,11 +6,14 @@ reason :func:`fit_failure` gives; ``synth identify`` prints it as one line and e
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 
 from synth.distributions import f_sf
 
-__all__ = ["ABSURD_FACTOR", "CONVERGED_WITHIN", "FAILED_STATUSES", "LIMIT_STATUSES", "SIGNIFICANCE", "fit_failure"]
+__all__ = ["ABSURD_FACTOR", "CONVERGED_WITHIN", "FAILED_STATUSES", "LIMIT_STATUSES", "SIGNIFICANCE", "fit_failure",
+           "start_ssr"]
 
 #: IPOPT return statuses that end a fit without a usable optimum
 FAILED_STATUSES = ("Diverging_Iterates", "Maximum_Iterations_Exceeded", "Maximum_CpuTime_Exceeded",
@@ -34,14 +37,15 @@ ABSURD_FACTOR = 1e8
 
 def fit_failure(parameters: dict[str, float], start: np.ndarray, status: str | None, success: bool,
                 fit_percent: float, delay: float | None, duration: float, samples: int = 0, free: int = 0,
-                remaining_step: float = float("inf")) -> str:
+                remaining_step: float = float("inf"), start_fit_percent: float = float("nan")) -> str:
     """Why a finished fit is not a result, or ``""`` if it is one.
 
     A fit fails when the solver diverged or stopped at a limit (:data:`FAILED_STATUSES`), a
     parameter is not finite or ``ABSURD_FACTOR`` times larger than both its start and 1, the fit is
     no better than the output's mean (``fit_percent <= 0``) or than noise would be (given ``samples``
     and ``free``: the F-test of the explained variance against the residual one has a p-value above
-    ``SIGNIFICANCE``), or a fitted delay lies outside ``[0, duration)``.
+    ``SIGNIFICANCE``), a fitted delay lies outside ``[0, duration)``, or the fit ended with a larger residual
+    than its own start had (``start_fit_percent``): a local solver that moved uphill did not converge.
 
     Parameters
     ----------
@@ -66,6 +70,10 @@ def fit_failure(parameters: dict[str, float], start: np.ndarray, status: str | N
         time limit (:data:`LIMIT_STATUSES`) with less than ``CONVERGED_WITHIN`` to go has converged as
         far as the data can tell (e.g. crawling along a fold such as ``T1 = T2``) and is not a failure;
         diverging is always one.
+    start_fit_percent : float
+        The fit (same measure as ``fit_percent``) of the starting values, NaN when unknown. The residual norm
+        is ``1 - fit/100`` of the output's spread, so the fit is worse than its start when
+        ``100 - fit_percent`` exceeds ``100 - start_fit_percent`` by more than a relative ``1e-6``.
 
     Returns
     -------
@@ -85,20 +93,26 @@ def fit_failure(parameters: dict[str, float], start: np.ndarray, status: str | N
     >>> fit_failure({"k": 2.0, "p": 3.0}, np.array([2.1, 2.9]), "Maximum_Iterations_Exceeded", False, 98.6, 0.02,
     ...             60.0, remaining_step=0.004)  # stopped at the limit, but converged within its uncertainty
     ''
+    >>> fit_failure({"k": 2e-12, "p": -3.2}, np.array([2.1, 2.9]), "Solved_To_Acceptable_Level", True, 1.74, 9.36,
+    ...             60.0, start_fit_percent=96.1)
+    'the fit ended worse than its start (fit 1.74 % against 96.10 % at the start): the solver moved away'
     """
     bad = {k: v for (k, v), v0 in zip(parameters.items(), np.asarray(start, float))
            if not np.isfinite(v) or abs(v) > ABSURD_FACTOR * max(1.0, abs(float(v0)) if np.isfinite(v0) else 1.0)}
     shown = ", ".join(f"{k} = {v:.3g}" for k, v in bad.items())
     limited = status in LIMIT_STATUSES and remaining_step < CONVERGED_WITHIN
     if not success and status in FAILED_STATUSES and not limited:
-        detail = ", ".join(x for x in (shown, f"fit {fit_percent:.2f} %" if np.isfinite(fit_percent) else "") if x)
+        detail = ", ".join(x for x in (shown, f"fit {_percent(fit_percent)} %" if np.isfinite(fit_percent) else "") if x)
         return f"IPOPT stopped with {status}" + (f" ({detail})" if detail else "")
     if bad:
         return f"parameters at absurd magnitudes ({shown})"
     if delay is not None and not (np.isfinite(delay) and -1e-7 <= delay < duration):  # IPOPT relaxes bounds by 1e-8
         return f"the fitted delay is {delay:.5g} s, outside [0, {duration:.5g}) s"
+    if np.isfinite(start_fit_percent) and 100.0 - fit_percent > (100.0 - start_fit_percent) * (1.0 + 1e-6):
+        return (f"the fit ended worse than its start (fit {_percent(fit_percent)} % against "
+                f"{_percent(start_fit_percent)} % at the start): the solver moved away")
     if not np.isfinite(fit_percent) or fit_percent <= 0.0:
-        return f"fit {fit_percent:.2f} %: the model explains the output no better than its mean"
+        return f"fit {_percent(fit_percent)} %: the model explains the output no better than its mean"
     if samples > free > 1:
         explained = 1.0 - (1.0 - fit_percent / 100.0) ** 2  # share of the variance about the mean
         dof = samples - free
@@ -108,3 +122,56 @@ def fit_failure(parameters: dict[str, float], start: np.ndarray, status: str | N
             return (f"fit {fit_percent:.2f} %: the model explains no more of the output than noise would "
                     f"(F-test p = {p_value:.2g})")
     return ""
+
+
+def _percent(value: float) -> str:
+    """A fit in percent for a message: two decimals, or three digits where a diverged fit is astronomically bad."""
+    return f"{value:.2f}" if abs(value) < 1e6 else f"{value:.3g}"
+
+
+def start_ssr(prob: Any, theta0: np.ndarray, d0: float, b0: float, w: np.ndarray, y: np.ndarray,
+               mask: np.ndarray | None, fit_delay: bool, dt: float) -> float:
+    """Sum of squared (weighted) residuals of the starting values, ``inf`` where their simulation is not finite
+    (a start whose fit the solver must not end above: see :func:`fit_failure`).
+
+    Parameters
+    ----------
+    prob : SimulationErrorProblem or ConvolutionProblem
+        The fit's problem (its ``scale``, ``inputs`` and ``yhat_fn``).
+    theta0 : numpy.ndarray
+        Starting structure parameters.
+    d0, b0 : float
+        Starting delay [s] and output offset.
+    w, y : numpy.ndarray
+        The input relative to its first sample, and the measured output.
+    mask : numpy.ndarray or None
+        The fitted samples (None: all).
+    fit_delay : bool
+        Whether the delay is a decision variable.
+    dt : float
+        Sample interval [s].
+
+    Returns
+    -------
+    float
+
+    Examples
+    --------
+    >>> from synth.ident.convolution_problem import ConvolutionProblem
+    >>> from synth.ident.structure import parse_structure
+    >>> st, t = parse_structure("k/(s+p)"), np.arange(400) * 0.01
+    >>> w = (t >= 0.5).astype(float); y = 2.0 * (1 - np.exp(-(t - 0.5).clip(0)))
+    >>> prob = ConvolutionProblem(st, None, t.size, 0.01, False, np.array([2.0, 1.0]), False, y, False, None)
+    >>> start_ssr(prob, np.array([2.0, 1.0]), 0.0, 0.0, w, y, None, False, 0.01) < 1e-3
+    True
+    """
+    m = int(np.floor(d0 / dt + 1e-9))
+    f = d0 - m * dt
+    x0 = np.r_[theta0 / prob.scale, f, b0] if fit_delay else np.r_[theta0 / prob.scale, b0]
+    par = prob.inputs(w, m) if fit_delay else prob.inputs(w, m, f)
+    with np.errstate(all="ignore"):
+        r = y - np.asarray(prob.yhat_fn(x0, par)).ravel()
+        if mask is not None:
+            r = r[mask]
+        value = float(r @ r)
+    return value if np.isfinite(value) else float("inf")

@@ -41,7 +41,7 @@ from synth.errors import DataError, FitError, ModelError
 from synth.ident.convolution_problem import ConvolutionProblem
 from synth.ident.covariance import fit_covariance
 from synth.ident.delay_samples import best_sample
-from synth.ident.fit_failure import LIMIT_STATUSES, fit_failure
+from synth.ident.fit_failure import LIMIT_STATUSES, fit_failure, start_ssr
 from synth.ident.identifiability import TiedParameter, WeakParameter, coinciding, tied_to_weak, weak_parameters
 from synth.ident.sim_error_problem import SimulationErrorProblem
 from synth.ident.srivc import linear_initial_model, map_to_structure
@@ -421,13 +421,15 @@ def fit_structure(record: Record, structure: Structure | str, delay: str | float
     info["starts"] = 1
     yd_fit = yd if mask is None else yd[mask]
     init_ssr = float(np.sum((yd_fit - np.mean(yd_fit)) ** 2))
-    if not st_info["success"] or not np.isfinite(ssr) or ssr > init_ssr:
+    y_fit = y if mask is None else y[mask]
+    ssr_start = start_ssr(prob, theta0, d0, b0, w, y, mask, fit_delay, dt)
+    if not st_info["success"] or not np.isfinite(ssr) or ssr > min(init_ssr, ssr_start):
         for factor in (0.5, 2.0, 0.2, 5.0):
             cand = run(theta0 * factor, d0)
             info["starts"] += 1
             if cand[3]["success"] and cand[1] < ssr:
                 xs, ssr, m, st_info, shifts = cand
-                if st_info["success"] and ssr <= init_ssr:
+                if st_info["success"] and ssr <= min(init_ssr, ssr_start):
                     break
     if fit_delay and st.num_degree >= st.den_degree:  # a jump at the delay: each sample interval its own valley
         xs, ssr, m, st_info, shifts = best_sample(run, xs, ssr, m, st_info, shifts, prob.scale, dt, info)
@@ -443,7 +445,6 @@ def fit_structure(record: Record, structure: Structure | str, delay: str | float
         par = prob.inputs(w, m, f_hat)
     d_hat = m * dt + f_hat
     yhat = np.asarray(prob.yhat_fn(xs, par)).ravel()
-    y_fit = y if mask is None else y[mask]
     resid_fit = (y - yhat) if mask is None else (y - yhat)[mask]
     fit_pct = float(100.0 * (1.0 - np.linalg.norm(resid_fit) / np.linalg.norm(y_fit - np.mean(y_fit))))
     J = np.asarray(prob.jac_fn(xs, par))
@@ -467,7 +468,8 @@ def fit_structure(record: Record, structure: Structure | str, delay: str | float
     fitted = dict(zip(st.parameters, theta.tolist()))
     failure = fit_failure(fitted, theta0, st_info.get("status"),
                           bool(st_info.get("success")), fit_pct, d_hat if fit_delay else None, n * dt,
-                          int(y_fit.size), p_total, remaining)
+                          int(y_fit.size), p_total, remaining,
+                          float(100.0 * (1.0 - np.sqrt(ssr_start) / np.linalg.norm(y_fit - np.mean(y_fit)))))
     info["failure"] = failure
     if failure and check:
         met = coinciding(fitted)  # stalled where two roots meet: say so
@@ -492,3 +494,4 @@ def fit_structure(record: Record, structure: Structure | str, delay: str | float
     return TimeFitResult(st, params, std, ci, names, cov, float(d_hat), fit_delay, b_hat, float(sd[-1]),
                          fit_pct, float(np.sqrt(s2)), plant, sensor, measured, initial_out, info, t.copy(), y.copy(),
                          yhat, u0, periodic, weights)
+
