@@ -230,7 +230,12 @@ class Controller:
             values[p] = float(v)
         object.__setattr__(self, "type", ctype.name)
         object.__setattr__(self, "parameters", values)
-        ctype.tf(values)  # validates positivity constraints
+        num, den = ctype.tf(values)  # validates positivity constraints
+        while num.size > 1 and den.size > 1 and num[-1] == 0.0 and den[-1] == 0.0:  # common factors s cancel
+            num, den = num[:-1], den[:-1]
+        num.setflags(write=False)  # shared by every caller of tf(): an in-place change is an error, not a stale copy
+        den.setflags(write=False)
+        object.__setattr__(self, "_tf", (num, den))  # searches and maps ask for a controller's polynomials often
 
     @property
     def kind(self) -> ControllerType:
@@ -296,10 +301,7 @@ class Controller:
         >>> Controller("PI", {"kp": 2, "ki": 0}).tf()
         (array([2.]), array([1.]))
         """
-        num, den = self.kind.tf(self.parameters)
-        while num.size > 1 and den.size > 1 and num[-1] == 0.0 and den[-1] == 0.0:
-            num, den = num[:-1], den[:-1]
-        return num, den
+        return self._tf  # type: ignore[attr-defined]  # made once, by __post_init__
 
     def freqresp(self, w: Any) -> np.ndarray:
         """Complex response ``C(j w)``.

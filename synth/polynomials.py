@@ -21,6 +21,8 @@ def trim(p: np.ndarray) -> np.ndarray:
     array([1., 2.])
     """
     p = np.atleast_1d(np.asarray(p, dtype=float))
+    if p.ndim == 1 and p.size and p[0] != 0.0:  # nothing to drop (most calls)
+        return p
     nonzero = np.flatnonzero(p != 0.0)
     return p[nonzero[0]:] if nonzero.size else np.array([0.0])
 
