@@ -9,6 +9,7 @@ from typing import TYPE_CHECKING, Any, ClassVar, Literal
 import numpy as np
 from pydantic import NonNegativeFloat, PositiveFloat, model_validator
 
+from synth.loop_memo import LoopMemo
 from synth.requirements.base import Bound, Requirement, RequirementResult, fmt, register
 from synth.requirements.margins import UNSTABLE_SLACK, closed_loop_unstable, unstable_result
 from synth.requirements.simulated import SimulatedStep, simulated_step
@@ -45,6 +46,7 @@ SCREEN_INTERVALS = 400
 """Samples per span of :meth:`StepResponse.fails_surely`'s coarse step: a divisor of :data:`INTERVALS`, so that its
 samples are among the ones the full evaluation takes (over the same first horizon and the doublings it starts
 with), and what they prove the full evaluation finds too."""
+_DELAYED_OUTCOMES: LoopMemo[_Outcome] = LoopMemo()  # the delayed loops' steps, by loop and requirement
 _CHUNK = 2_000_000  # samples of the loops' steps computed together (16 MB per array)
 _LABELS = {"max_overshoot": ("overshoot", "%"), "max_settling_time": ("settling time", "s"),
            "max_rise_time": ("rise time", "s")}
@@ -345,7 +347,8 @@ class StepResponse(Requirement):
         return [o for o in out if o is not None]
 
     def _linear(self, loop: Loop) -> RequirementResult:
-        outcome = self._exact_outcomes([loop])[0] if loop.delay == 0.0 else self._delayed_outcome(loop)
+        outcome = self._exact_outcomes([loop])[0] if loop.delay == 0.0 else \
+            _DELAYED_OUTCOMES.get(loop, self._delayed_outcome, self)  # a search asks again: not simulated twice
         return self._result_of(outcome)
 
     def _delayed_outcome(self, loop: Loop) -> _Outcome:

@@ -163,16 +163,25 @@ def pattern_search(spec: Spec, start: Controller, terms: list[tuple[str, str, fl
 
     z, vz = np.array([x[k] for k in free]) / scale, first
     step = first_step
+    # exploratory moves come back to points they tried (the start too), by another rounding of z at times
+    seen = {tuple(at(z).values()): first}
     with Speculator(lambda key: evaluated(at(np.array(key)))) as guesses:  # the likely next check on the idle core
 
         def searched(z: np.ndarray) -> tuple[float, float]:
             nonlocal checks
-            checks += 1
-            return guesses.value(tuple(z))
+            checks += 1  # counted as a check all the same: the search's path and budget do not change
+            point = tuple(at(z).values())
+            if point not in seen:
+                seen[point] = guesses.value(tuple(z))
+            return seen[point]
+
+        def guess(z: np.ndarray) -> None:  # a point already checked needs no helper
+            if tuple(at(z).values()) not in seen:
+                guesses.ahead(tuple(z))
 
         while True:  # coordinate and pattern moves; where they stall, a move along the active boundary restarts
             found = hooke_jeeves(searched, z, lo, hi, better, step, min_step, max_checks - checks - 1,
-                                 start_value=vz, ahead=lambda z: guesses.ahead(tuple(z)))
+                                 start_value=vz, ahead=guess)
             z, vz = found.z, found.value
             if not boundary_moves or len(free) < 2 or checks >= max_checks:
                 break
