@@ -12,6 +12,7 @@ from collections.abc import Callable
 
 import numpy as np
 
+from synth.errors import ModelError
 from synth.rootfind import bisect_roots
 
 __all__ = ["DEFAULT_PER_DECADE", "Curve", "band_grid", "band_grids", "batch_first_crossing", "batch_peak",
@@ -63,8 +64,16 @@ def log_grid(w_lo: float, w_hi: float, per_decade: int = DEFAULT_PER_DECADE) -> 
     --------
     >>> log_grid(1.0, 100.0, 2)
     array([  1.        ,   3.16227766,  10.        ,  31.6227766 , 100.        ])
+    >>> log_grid(1e-310, 1e3)  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    synth.errors.ModelError: cannot grid the frequencies from 1e-310 to 1000 rad/s (a delay, pole or zero at an ...
     """
-    n = max(2, int(np.ceil(per_decade * np.log10(w_hi / w_lo))) + 1)
+    decades = np.log10(w_hi / w_lo) if w_lo > 0 else np.inf
+    if not np.isfinite(decades):  # e.g. 1 / delay underflowed: a plant delay of 1e308 s
+        raise ModelError(f"cannot grid the frequencies from {w_lo:g} to {w_hi:g} rad/s (a delay, pole or zero at an "
+                         "extreme scale?)")
+    n = max(2, int(np.ceil(per_decade * decades)) + 1)
     return np.geomspace(w_lo, w_hi, n)
 
 

@@ -41,6 +41,7 @@ __all__ = [
     "fmt",
     "magnitude",
     "register",
+    "tagged_type",
     "unique_names",
 ]
 
@@ -195,6 +196,21 @@ def register(cls: type[Requirement]) -> type[Requirement]:
     name = cls.model_fields["type"].default
     REQUIREMENT_TYPES[name] = cls
     return cls
+
+
+def tagged_type(table: dict[str, Any], entry: Any) -> Any:
+    """The entry of ``table`` named by a spec entry's ``type`` (None when the entry is no mapping, or its type is
+    not a string or not in the table): a user's ``type: [1]`` is an unknown type, not a lookup that fails.
+
+    Examples
+    --------
+    >>> tagged_type(REQUIREMENT_TYPES, {"type": "peak_sensitivity"}).__name__
+    'PeakSensitivity'
+    >>> tagged_type(REQUIREMENT_TYPES, {"type": [1]}), tagged_type(REQUIREMENT_TYPES, "bandwidth")
+    (None, None)
+    """
+    kind = entry.get("type") if isinstance(entry, dict) else None
+    return table.get(kind) if isinstance(kind, str) else None
 
 
 class Requirement(BaseModel):

@@ -135,13 +135,13 @@ def bind_simulation(entries: Any, simulation: Any) -> Any:
     >>> [("simulation" in e) for e in bind_simulation(entries, {"dt": 0.001})]
     [True, False]
     """
-    from synth.requirements.base import REQUIREMENT_TYPES
+    from synth.requirements.base import REQUIREMENT_TYPES, tagged_type
 
     if not isinstance(entries, list) or simulation is None:
         return entries
     out = []
     for e in entries:
-        cls = REQUIREMENT_TYPES.get(e.get("type")) if isinstance(e, dict) else None
+        cls = tagged_type(REQUIREMENT_TYPES, e)
         wants = getattr(cls, "wants_simulation", None)
         if wants is not None and e.get("simulation") is None and wants(e):
             e = {**e, "simulation": simulation}

@@ -14,6 +14,7 @@ from pydantic import BaseModel, ValidationError
 
 from synth.errors import SpecError
 from synth.requirements import REQUIREMENT_TYPES
+from synth.requirements.base import tagged_type
 from synth.sim.spec import BLOCK_TAGS, DISTURBANCE_TAGS, SIMULATION_TAGS
 from synth.spec.document import Spec
 
@@ -102,9 +103,9 @@ def _allowed_keys(loc: tuple[Any, ...], data: Any) -> list[str]:
         if isinstance(part, int):
             node = node[part] if isinstance(node, list) and part < len(node) else None
             if model == "requirements":
-                model = REQUIREMENT_TYPES.get(node.get("type")) if isinstance(node, dict) else None
+                model = tagged_type(REQUIREMENT_TYPES, node)
             elif isinstance(model, dict):  # a list of tagged models (simulation blocks, disturbances)
-                model = model.get(node.get("type")) if isinstance(node, dict) else None
+                model = tagged_type(model, node)
             continue
         node = node.get(part) if isinstance(node, dict) else None
         if model is Spec and part == "requirements":

@@ -142,13 +142,14 @@ def stricter_when(data: dict[str, Any], path: str) -> int:
     (1, -1)
     """
     from synth.requirements import REQUIREMENT_TYPES
+    from synth.requirements.base import tagged_type
 
     parts = path.split(".")
     where = f"--sweep {path}"
     if parts[0] == "requirements" and len(parts) >= 3:
         items = data.get("requirements", [])
         item = items[_index(items, parts[1], ".".join(parts[:2]), "requirements")]
-        cls = REQUIREMENT_TYPES.get(item.get("type")) if isinstance(item, dict) else None
+        cls = tagged_type(REQUIREMENT_TYPES, item)
         if cls is None:
             raise SpecError(f"requirement {parts[1]!r} has no known type", where=where)
         index = int(parts[3]) if len(parts) == 4 and parts[3].isdigit() else None
