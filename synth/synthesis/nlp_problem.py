@@ -35,8 +35,10 @@ milliseconds instead of a tenth of a second for a few thousand constraints."""
 
 IPOPT_OPTIONS = {"ipopt.print_level": 0, "print_time": False, "ipopt.sb": "yes", "ipopt.max_iter": 1500,
                  "ipopt.hessian_approximation": "limited-memory",
-                 "ipopt.tol": 1e-9, "ipopt.constr_viol_tol": 1e-9, "ipopt.mu_max": 1e-3}
-"""IPOPT's options for the polish. ``mu_max`` caps the barrier parameter of the adaptive strategy (IPOPT's
+                 "ipopt.tol": 1e-9, "ipopt.constr_viol_tol": 1e-9, "ipopt.mu_max": 1e-3, "show_eval_warnings": False}
+"""IPOPT's options for the polish. A trial point where a constraint is NaN is rejected by IPOPT's line search;
+casadi's warning about it went to the terminal of ``synth design --quiet`` (``show_eval_warnings``).
+``mu_max`` caps the barrier parameter of the adaptive strategy (IPOPT's
 choice under the limited-memory Hessian). A polish starts from a design that already meets the requirements,
 usually near an optimum; with hundreds of grid constraints, the barrier terms of a large ``mu`` outweigh the
 objective and pulled the iterates far from that start, which then took hundreds of small steps to come back
