@@ -54,3 +54,18 @@ def test_the_pattern_search_checks_each_point_once(monkeypatch):
     assert result.improved and result.controller.parameters["ki"] > 5.0
     assert len(seen) == len(set(seen))  # no point checked twice
     assert result.checks > len(seen)  # the search did come back to points it had tried
+
+
+def test_a_requirement_that_also_simulates_keeps_its_linear_step():
+    """``under: both`` carries the spec's simulation block, whose lists do not hash: the kept step is keyed by the
+    limits and the band alone (a TypeError before)."""
+    from synth.sim.spec import SimulationSpec
+
+    sim = SimulationSpec.model_validate({"dt": 0.001, "actuator": [{"type": "saturation", "min": -1, "max": 1}]})
+    loop = Loop(Plant.from_string("1/(s+1)", delay=0.1), Controller("PI", {"kp": 1.0, "ki": 2.0}))
+    both = StepResponse(max_overshoot=15, under="both", simulation=sim).evaluate(loop)
+    tighter = StepResponse(max_overshoot=8, under="both", simulation=sim).evaluate(Loop(loop.plant, loop.controller))
+    linear = StepResponse(max_overshoot=15).evaluate(Loop(loop.plant, loop.controller))
+    assert 9.0 < linear.value < 10.0 and linear.met  # the linear step overshoots 9.5 %
+    assert both.met and both.value == linear.value and "simulated step" in both.message
+    assert not tighter.met and tighter.value == linear.value  # the linear step breaks 8 %, judged on its own limit

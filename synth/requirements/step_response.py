@@ -348,8 +348,13 @@ class StepResponse(Requirement):
 
     def _linear(self, loop: Loop) -> RequirementResult:
         outcome = self._exact_outcomes([loop])[0] if loop.delay == 0.0 else \
-            _DELAYED_OUTCOMES.get(loop, self._delayed_outcome, self)  # a search asks again: not simulated twice
+            _DELAYED_OUTCOMES.get(loop, self._delayed_outcome, *self._linear_key())  # asked again: not simulated twice
         return self._result_of(outcome)
+
+    def _linear_key(self) -> tuple[float | None, ...]:
+        """What the linear step's outcome depends on besides the loop: the limits and the settling band (not the
+        ``simulation`` block, whose lists do not hash, nor the label)."""
+        return self.max_overshoot, self.max_settling_time, self.max_rise_time, self.settle_band
 
     def _delayed_outcome(self, loop: Loop) -> _Outcome:
         """The step of a loop with a delay: simulated (:func:`synth.timeresp.linear_step`, its error estimate
