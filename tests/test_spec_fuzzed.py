@@ -1,7 +1,7 @@
 """Specs mutated at random (the way a typo or a wrong paste mutates them): one line and exit 2, never a traceback.
 
 The cases are ones a seeded fuzz of the repository's specs found (``type`` given as a list, a plant delay of
-1e308 s); the fuzz itself mutated 1,800 specs for ``synth check`` with no other escape."""
+1e308 s); the fuzz itself mutated 2,000 specs for ``synth check`` (seeds 0-4 and 11) with no other escape."""
 
 from __future__ import annotations
 
