@@ -5,8 +5,8 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["pad_sub", "row_axis_parts", "row_magnitude_squared", "row_poly_product", "row_product", "row_rhp_counts",
-           "row_roots", "row_unit_crossings"]
+__all__ = ["pad_sub", "ragged_rows", "row_axis_parts", "row_corners", "row_magnitude_squared", "row_poly_product",
+           "row_product", "row_rhp_counts", "row_roots", "row_unit_crossings"]
 
 
 def row_magnitude_squared(rows: np.ndarray) -> np.ndarray:
@@ -151,3 +151,40 @@ def row_rhp_counts(num: np.ndarray, den: np.ndarray, floor: float) -> np.ndarray
             counts[i] = int(np.sum(r.real > 0.0))
     return counts
 
+
+def row_corners(*rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The smallest and largest root magnitude (above 1e-12) over the same row of every array (each row one
+    polynomial): :func:`synth.freqgrid.corner_frequencies` of every row at once; NaN where a row has none.
+
+    Examples
+    --------
+    >>> lo, hi = row_corners(np.array([[1.0, 2.0], [0.0, 1.0]]), np.array([[1.0, 10.0], [1.0, 0.0]]))
+    >>> lo.tolist(), hi.tolist()
+    ([2.0, nan], [10.0, nan])
+    """
+    n = rows[0].shape[0]
+    lo, hi = np.full(n, np.inf), np.full(n, -np.inf)
+    for r in rows:
+        for i, roots in enumerate(row_roots(r)):
+            mags = np.abs(roots)
+            mags = mags[mags > 1e-12]
+            if mags.size:
+                lo[i], hi[i] = min(lo[i], mags.min()), max(hi[i], mags.max())
+    none = ~np.isfinite(lo)
+    return np.where(none, np.nan, lo), np.where(none, np.nan, hi)
+
+
+def ragged_rows(rows: np.ndarray, values: np.ndarray, n: int) -> np.ndarray:
+    """``values`` grouped by their row (``rows`` sorted or not) into an ``(n, k)`` array padded with NaN.
+
+    Examples
+    --------
+    >>> ragged_rows(np.array([1, 0, 1]), np.array([5.0, 6.0, 7.0]), 3).tolist()
+    [[6.0, nan], [5.0, 7.0], [nan, nan]]
+    """
+    out = np.full((n, max(1, int(np.bincount(rows, minlength=n).max()) if rows.size else 1)), np.nan)
+    order = np.argsort(rows, kind="stable")
+    rows, values = rows[order], values[order]
+    start = np.searchsorted(rows, np.arange(n))
+    out[rows, np.arange(rows.size) - start[rows]] = values
+    return out
