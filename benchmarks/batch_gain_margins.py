@@ -29,8 +29,8 @@ from synth.loop_batch import LoopBatch
 from synth.plant import Plant
 
 
-def batch(rng: np.random.Generator) -> tuple[Plant, list[Controller]]:
-    """One random plant behind a delay and a batch of controllers of one type."""
+def batch(rng: np.random.Generator, max_loops: int = 60) -> tuple[Plant, list[Controller]]:
+    """One random plant behind a delay and a batch of 5 to ``max_loops - 1`` controllers of one type."""
     poles = -np.exp(rng.uniform(np.log(0.05), np.log(50), rng.integers(1, 4)))
     den, k = np.poly(poles), np.exp(rng.uniform(np.log(0.1), np.log(100)))
     if rng.random() < 0.3:  # a lightly damped pair
@@ -40,7 +40,7 @@ def batch(rng: np.random.Generator) -> tuple[Plant, list[Controller]]:
     plant = Plant(np.array([k * abs(np.prod(poles))]), den, delay)
     kind = str(rng.choice(["P", "PI", "PID"]))
     controllers = []
-    for _ in range(int(rng.integers(5, 60))):
+    for _ in range(int(rng.integers(5, max_loops))):
         gains = {"kp": float(np.exp(rng.uniform(np.log(1e-3), np.log(50))))}
         if kind != "P":
             gains["ki"] = float(np.exp(rng.uniform(np.log(1e-3), np.log(500 if kind == "PI" else 50))))
