@@ -8,7 +8,8 @@ wrong, so the command line can print it as-is and exit with code 2.
 
 from __future__ import annotations
 
-__all__ = ["DataError", "FitError", "ModelError", "NoStabilizingStartError", "OutputExistsError", "SpecError", "SynthError"]
+__all__ = ["DataError", "FitError", "ModelError", "NoStabilizingControllerError", "NoStabilizingStartError",
+           "OutputExistsError", "SpecError", "SynthError"]
 
 
 class SynthError(Exception):
@@ -86,6 +87,28 @@ class NoStabilizingStartError(SynthError):
         """Return a copy with ``where`` prefixed, keeping what was searched."""
         inner = f"{where}: {self.where}" if self.where else where
         return NoStabilizingStartError(self.message, where=inner, searched=self.searched)
+
+
+class NoStabilizingControllerError(NoStabilizingStartError):
+    """The controller's bounds hold no controller that stabilizes the loop, and ``proof`` says what shows it (an
+    exact decomposition of the bounds, not a search): :func:`synth.design.design` answers "infeasible".
+
+    Examples
+    --------
+    >>> err = NoStabilizingControllerError("no PI in the bounds stabilizes the loop", proof="the D-decomposition")
+    >>> isinstance(err, NoStabilizingStartError), err.located("controller").proof
+    (True, 'the D-decomposition')
+    """
+
+    def __init__(self, message: str, where: str | None = None, searched: str | None = None,
+                 proof: str = "") -> None:
+        super().__init__(message, where, searched)
+        self.proof = proof
+
+    def located(self, where: str) -> NoStabilizingControllerError:
+        """Return a copy with ``where`` prefixed, keeping what was searched and the proof."""
+        inner = f"{where}: {self.where}" if self.where else where
+        return NoStabilizingControllerError(self.message, where=inner, searched=self.searched, proof=self.proof)
 
 
 class FitError(SynthError, RuntimeError):

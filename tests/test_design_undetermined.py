@@ -1,4 +1,5 @@
-"""A design whose search finds no stabilizing controller answers "undetermined", with its evidence.
+"""A design whose search finds no stabilizing controller answers "undetermined", with its evidence; where the
+bounds are shown to hold none (a PI's plane, synth.synthesis.stabilizing_plane), "infeasible", with the proof.
 
 Before, such a spec ended in a one-line error and exit 2 ("bad input"), although the spec is valid. The
 plants here are ``k e^(-theta s)/(s - p)`` with ``theta p > 1``: a known result for a first-order unstable
@@ -43,23 +44,56 @@ def _p_stabilizable(k: float, p: float, theta: float) -> bool:
 
 
 @pytest.mark.parametrize("seed", range(3))
-def test_a_plant_no_controller_in_the_bounds_stabilizes_gets_an_undetermined_design(seed):
+def test_a_plant_no_pi_in_the_bounds_stabilizes_gets_an_infeasible_design_with_the_proof(seed):
     rng = np.random.default_rng(40 + seed)
     p, k = float(rng.uniform(0.3, 3.0)), float(rng.uniform(0.5, 5.0))
     theta = float(rng.uniform(1.2, 3.0)) / p
     assert not _p_stabilizable(k, p, theta)
     assert _p_stabilizable(k, p, 0.5 / p)  # the reference can say yes
     result = design(parse_spec(_spec(k, p, theta)))
+    assert result.status == "infeasible" and not result.feasible and result.controller is None
+    assert "No controller in the bounds stabilizes the loop" in result.verdict and "D-decomposition" in result.verdict
+    data = result.to_dict()
+    assert data["status"] == "infeasible" and data["infeasible"]["reason"] == "no stabilizing controller"
+
+
+@pytest.mark.parametrize("seed", [0, 2])
+def test_a_structure_the_plane_does_not_decide_stays_undetermined(seed):
+    """A lead-lag (not affine in its gain and zero together) on the same plants, whose search finds no stabilizing
+    one (seed 1's shorter delay, ``theta p = 1.43``, leaves room for a lead's phase: a lead-lag is found there):
+    only searched, so "undetermined"."""
+    rng = np.random.default_rng(40 + seed)
+    p, k = float(rng.uniform(0.3, 3.0)), float(rng.uniform(0.5, 5.0))
+    theta = float(rng.uniform(1.2, 3.0)) / p
+    spec = {**_spec(k, p, theta), "controller": {"type": "leadlag", "bounds": {"k": [0.0, 10.0 * p / k],
+                                                                              "z": [0.1, 10.0], "p": [1.0, 50.0]}}}
+    result = design(parse_spec(spec))
     assert result.status == "undetermined" and not result.feasible and result.controller is None
     assert "600 random controllers" in result.verdict and "does not prove" in result.verdict
     data = result.to_dict()
     assert data["status"] == "undetermined" and data["undetermined"]["reason"] == "no stabilizing start"
 
 
-def test_cli_exit_3_and_a_report_that_lists_the_requirements_as_not_evaluated(tmp_path, capsys):
+def test_cli_exit_1_and_a_report_with_the_proof(tmp_path, capsys):
     spec = tmp_path / "u.yaml"
     spec.write_text("name: u\nplant: {tf: \"1/(s-1)\", delay: 2.0}\ncontroller: {type: PI, bounds: "
                     "{kp: [0, 5], ki: [0.1, 5]}}\nrequirements:\n  - {type: margins, phase_margin_deg: 30}\n"
+                    "objective: {maximize: bandwidth}\n", encoding="utf-8")
+    code = main(["design", str(spec), "--out", str(tmp_path / "out")])
+    out = capsys.readouterr().out
+    assert code == 1, out
+    assert "u: INFEASIBLE" in out and "D-decomposition" in out
+    data = json.loads((tmp_path / "out" / "result.json").read_text(encoding="utf-8"))
+    assert data["status"] == "infeasible" and data["infeasible"]["reason"] == "no stabilizing controller"
+    html = (tmp_path / "out" / "report.html").read_text(encoding="utf-8")
+    assert "<strong>Infeasible.</strong>" in html
+    assert "not evaluated: no controller in the bounds stabilizes the loop" in html
+
+
+def test_cli_exit_3_and_a_report_that_lists_the_requirements_as_not_evaluated(tmp_path, capsys):
+    spec = tmp_path / "u.yaml"
+    spec.write_text("name: u\nplant: {tf: \"1/(s-1)\", delay: 2.0}\ncontroller: {type: leadlag, bounds: "
+                    "{k: [0, 5], z: [0.1, 10], p: [1, 50]}}\nrequirements:\n  - {type: margins, phase_margin_deg: 30}\n"
                     "objective: {maximize: bandwidth}\n", encoding="utf-8")
     code = main(["design", str(spec), "--out", str(tmp_path / "out")])
     out = capsys.readouterr().out

@@ -50,6 +50,7 @@ from synth.synthesis.cvxpy_loader import cp
 from synth.synthesis.delay_grid import controller_gain_bound
 from synth.synthesis.objective_forms import CoefficientRatioFloor, Level, ReturnDifferenceFloor
 from synth.synthesis.parametrization import Parametrization
+from synth.synthesis.stabilizing_plane import plane_starts
 
 __all__ = ["GRID_TOLERANCE", "SOLVER", "ConvexDesigner"]
 
@@ -273,7 +274,8 @@ class ConvexDesigner:
         candidates = itertools.chain([np.clip(initial, lo, hi)] if initial is not None else [], [self.par.start()],
                                      (self.par.random(rng) for _ in range(RANDOM_STARTS)),
                                      (self._pinned(self.par.random(rng), lo, rng) for _ in range(RANDOM_STARTS)),
-                                     axis_starts(self.par, self.plants))  # a thin stabilizing slab
+                                     axis_starts(self.par, self.plants),  # a thin stabilizing slab
+                                     plane_starts(self.par, self.plants, lambda: any_found))  # or a proof of none
         any_found = False
         for c in candidates:
             if c is not None and self._stable(np.asarray(c, float)):
@@ -299,11 +301,8 @@ class ConvexDesigner:
         return self.starts(initial, 1)[0]
 
     def feasible(self, rho0: np.ndarray, history: list) -> tuple[np.ndarray, float]:
-        """Phase 1: minimize the total elastic slack from ``rho0``.
-
-        Returns ``(rho, violation)`` where ``violation`` is 0 when the exact
-        check finds every requirement met at ``rho``, else the elastic total.
-        """
+        """Phase 1: minimize the total elastic slack from ``rho0``: ``(rho, violation)``, ``violation`` 0 when the
+        exact check finds every requirement met at ``rho``, else the elastic total."""
         problem = self._elastic_problem()
         rho_c, total = rho0, np.inf
         for it in range(self.settings.max_iterations):

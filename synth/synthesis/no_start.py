@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from synth.errors import NoStabilizingStartError
+from synth.errors import NoStabilizingControllerError, NoStabilizingStartError
 from synth.results import DesignResult, reference_check, reference_verdict
 from synth.spec import Spec
 
@@ -13,7 +13,9 @@ def no_start_result(spec: Spec, error: NoStabilizingStartError) -> DesignResult:
     """The "undetermined" answer of a design whose search found no stabilizing controller in the bounds.
 
     Random controllers that all destabilize the loop show that the stabilizing set is small or empty, not
-    that it is empty: the verdict says what was searched and is neither feasible nor infeasible.
+    that it is empty: the verdict says what was searched and is neither feasible nor infeasible. When the
+    error is a :class:`~synth.errors.NoStabilizingControllerError` (the bounds were shown to hold no stabilizing
+    controller), the answer is "infeasible" and says what shows it.
 
     Examples
     --------
@@ -29,6 +31,14 @@ def no_start_result(spec: Spec, error: NoStabilizingStartError) -> DesignResult:
     searched = error.searched
     n = len(spec.plants())
     on = "the plant" if n == 1 else f"all {n} plants"
+    if isinstance(error, NoStabilizingControllerError):  # shown, not only searched: the design is infeasible
+        verdict = (f"No controller in the bounds stabilizes the loop on {on}, so no requirement can be met "
+                   f"(exact: {error.proof}). Widen the bounds (negative gains included where the plant needs "
+                   "them) or choose another controller structure." + reference_verdict(spec, ref))
+        return DesignResult(spec.name, False, None, None, None, None, None, None,
+                            f"stabilizing set: {error.proof}", verdict, reference=ref,
+                            extras={"infeasible": {"reason": "no stabilizing controller", "proof": error.proof}},
+                            status="infeasible")
     verdict = (f"No controller in the bounds was found that stabilizes the loop on {on}, so no "
                f"requirement could be evaluated ({searched}). The bounds may hold no stabilizing controller; a "
                "search that found none does not prove it."
