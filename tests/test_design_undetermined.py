@@ -74,33 +74,29 @@ def test_a_structure_the_plane_does_not_decide_stays_undetermined(seed):
     assert data["status"] == "undetermined" and data["undetermined"]["reason"] == "no stabilizing start"
 
 
-def test_cli_exit_1_and_a_report_with_the_proof(tmp_path, capsys):
+def _designed(tmp_path, capsys, controller: str) -> tuple[int, str, dict, str]:
+    """``synth design`` on ``1/(s-1)`` behind 2 s with ``controller`` (YAML): exit code, output, result.json, HTML."""
     spec = tmp_path / "u.yaml"
-    spec.write_text("name: u\nplant: {tf: \"1/(s-1)\", delay: 2.0}\ncontroller: {type: PI, bounds: "
-                    "{kp: [0, 5], ki: [0.1, 5]}}\nrequirements:\n  - {type: margins, phase_margin_deg: 30}\n"
-                    "objective: {maximize: bandwidth}\n", encoding="utf-8")
+    spec.write_text("name: u\nplant: {tf: \"1/(s-1)\", delay: 2.0}\ncontroller: " + controller + "\nrequirements:\n"
+                    "  - {type: margins, phase_margin_deg: 30}\nobjective: {maximize: bandwidth}\n", encoding="utf-8")
     code = main(["design", str(spec), "--out", str(tmp_path / "out")])
-    out = capsys.readouterr().out
+    data = json.loads((tmp_path / "out" / "result.json").read_text(encoding="utf-8"))
+    return code, capsys.readouterr().out, data, (tmp_path / "out" / "report.html").read_text(encoding="utf-8")
+
+
+def test_cli_exit_1_and_a_report_with_the_proof(tmp_path, capsys):
+    code, out, data, html = _designed(tmp_path, capsys, "{type: PI, bounds: {kp: [0, 5], ki: [0.1, 5]}}")
     assert code == 1, out
     assert "u: INFEASIBLE" in out and "D-decomposition" in out
-    data = json.loads((tmp_path / "out" / "result.json").read_text(encoding="utf-8"))
     assert data["status"] == "infeasible" and data["infeasible"]["reason"] == "no stabilizing controller"
-    html = (tmp_path / "out" / "report.html").read_text(encoding="utf-8")
     assert "<strong>Infeasible.</strong>" in html
     assert "not evaluated: no controller in the bounds stabilizes the loop" in html
 
 
 def test_cli_exit_3_and_a_report_that_lists_the_requirements_as_not_evaluated(tmp_path, capsys):
-    spec = tmp_path / "u.yaml"
-    spec.write_text("name: u\nplant: {tf: \"1/(s-1)\", delay: 2.0}\ncontroller: {type: leadlag, bounds: "
-                    "{k: [0, 5], z: [0.1, 10], p: [1, 50]}}\nrequirements:\n  - {type: margins, phase_margin_deg: 30}\n"
-                    "objective: {maximize: bandwidth}\n", encoding="utf-8")
-    code = main(["design", str(spec), "--out", str(tmp_path / "out")])
-    out = capsys.readouterr().out
+    code, out, data, html = _designed(tmp_path, capsys, "{type: leadlag, bounds: {k: [0, 5], z: [0.1, 10], p: [1, 50]}}")
     assert code == 3, out  # before: exit 2, "found no stabilizing controller"
     assert "u: UNDETERMINED" in out
-    data = json.loads((tmp_path / "out" / "result.json").read_text(encoding="utf-8"))
     assert data["status"] == "undetermined" and data["feasible"] is False
-    html = (tmp_path / "out" / "report.html").read_text(encoding="utf-8")
     assert "<strong>Undetermined.</strong>" in html and 'class="verdict warn"' in html
     assert "not evaluated: no controller in the bounds was found" in html
