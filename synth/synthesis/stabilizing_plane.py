@@ -103,8 +103,8 @@ def plane_search(ctype: str, names: tuple[str, str], fixed: dict[str, float], pl
     if cuts.size - 1 > MAX_STRIPS:
         return None
     on_zero = _zero_lines(ctype, names, fixed, plants, boxes)
-    if on_zero is not None:
-        return on_zero
+    if on_zero is not None:  # a start, or a line the check could not settle: no proof either way
+        return on_zero if on_zero.start is not None else None
     middles = x_lo + (x_hi - x_lo) * 0.5 * (cuts[:-1] + cuts[1:])
     widths = np.diff(cuts)
     for k in np.argsort(-widths):  # the widest strips first: a stabilizing region is found soonest there
@@ -116,6 +116,8 @@ def plane_search(ctype: str, names: tuple[str, str], fixed: dict[str, float], pl
         start = _stable_point(ctype, fixed, plants, {xn: x}, yn, intervals)
         if start is not None:
             return PlaneSearch(start, int(widths.size), f"found in strip {k + 1} of {widths.size}")
+        if intervals:  # stabilizing values the loop's own count did not confirm: no proof either way
+            return None
     strips = f"{widths.size} strips" if widths.size > 1 else "one strip"
     return PlaneSearch(None, int(widths.size),
                        f"the D-decomposition of the {xn}-{yn} box: the boundaries' turning points and crossings cut it "
@@ -124,20 +126,24 @@ def plane_search(ctype: str, names: tuple[str, str], fixed: dict[str, float], pl
 
 def _zero_lines(ctype: str, names: tuple[str, str], fixed: dict[str, float], plants: list[Plant],
                 boxes: tuple[tuple[float, float], tuple[float, float]]) -> PlaneSearch | None:
-    """A stabilizing controller on a line where one gain is 0, when the box holds such a line and one: there the
+    """A stabilizing controller on a line where one gain is 0, when the box holds such a line and one (a search
+    without a start when a line's set could not be computed or confirmed; None when the lines hold none): there the
     controller's form changes (a PI with ``ki = 0`` is ``kp``, its pole at 0 cancelled; a PID with ``kd = 0`` loses
     its filter's pole), so the loop is not the plane's affine family and its one-parameter set is computed apart."""
     for k, (lo, hi) in enumerate(boxes):
         if not lo <= 0.0 <= hi:
             continue
         other, (o_lo, o_hi) = names[1 - k], boxes[1 - k]
+        undecided = PlaneSearch(None, 0, f"the line {names[k]} = 0 not decided")
         try:
             intervals = stability_set(ScalarFamily(ctype, other, {**fixed, names[k]: 0.0}), plants, o_lo, o_hi)
         except (ArithmeticError, ValueError, RuntimeError):
-            continue
+            return undecided
         start = _stable_point(ctype, fixed, plants, {names[k]: 0.0}, other, intervals)
         if start is not None:
             return PlaneSearch(start, 0, f"found on the line {names[k]} = 0")
+        if intervals:
+            return undecided
     return None
 
 
