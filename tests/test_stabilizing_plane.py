@@ -145,3 +145,19 @@ def test_random_plane_against_the_brute_force_grid(index):
     else:
         point_stable, point_marginal = reference_point(case, found.start[names[0]], found.start[names[1]])
         assert point_stable or point_marginal, f"the start {found.start} is unstable for the reference"
+
+
+@pytest.mark.parametrize("plant, box, point", [
+    # a lightly damped zero swings the boundary curve out and back within 2 zeta w, between two samples of the
+    # log grid that both lie far from the box (a review found these four called empty)
+    ("(s^2+0.002*s+1)/((s+1)^3)", ((1.0, 300.0), (480.0, 520.0)), {"kp": 250.0, "ki": 500.0}),
+    ("(s^2+0.002*s+1)/((s+1)^3)", ((150.0, 206.0), (400.0, 600.0)), {"kp": 205.5, "ki": 500.0}),
+    ("(s^2+0.01*s+1)/((s+1)^3)", ((20.0, 41.0), (95.0, 105.0)), {"kp": 40.5, "ki": 100.0}),
+    # a box a thousandth of its width high, which the curve's peak in ki enters between two samples below it
+    ("1/((s+1)^3)", ((1.0, 100.0), (2.2499, 2.2509)), {"kp": 3.5, "ki": 2.24991}),
+])
+def test_boxes_a_review_found_called_empty(plant, box, point):
+    G = Plant.from_string(plant)
+    assert _stable("PI", {}, ("kp", "ki"), point, [G])  # the box holds this stabilizing controller
+    found = plane_search("PI", ("kp", "ki"), {}, [G], box)
+    assert found is not None and found.start is not None and _stable("PI", {}, ("kp", "ki"), found.start, [G])

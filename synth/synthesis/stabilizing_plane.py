@@ -307,6 +307,16 @@ def _frequencies(curve: _Curve, plant: Plant) -> np.ndarray | None:
     w_max = 1.2 * max([*tops, hi_scale])
     w_min = 1e-4 * lo_scale
     grid = [np.geomspace(w_min, w_max, int(100 * np.log10(w_max / w_min)) + 2)]
+    # around every lightly damped root of the loop's polynomials: there the curve can swing out and back within a
+    # span of 2 zeta w, narrower than the log grid's steps, with both neighbours far from the box
+    for poly in (curve.N, curve.D, curve.d, *curve.n):
+        poly = trim(poly)
+        if poly.size < 3 or not np.all(np.isfinite(poly)):
+            continue
+        for r in np.roots(poly):
+            w0, spread = abs(r.imag), abs(r.real)
+            if w0 > 0 and spread < 0.2 * w0:
+                grid.append(np.clip(w0 + max(spread, 1e-9 * w0) * np.linspace(-40.0, 40.0, 401), w_min, None))
     if curve.delay > 0:
         points = int(np.ceil(w_max * curve.delay / PHASE_STEP)) + 2
         if points > min(MAX_PHASE_POINTS, MAX_POINTS // 2):
@@ -317,21 +327,59 @@ def _frequencies(curve: _Curve, plant: Plant) -> np.ndarray | None:
 
 def _refined(curve: _Curve, w: np.ndarray, u: np.ndarray, v: np.ndarray, det: np.ndarray,
              ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray] | None:
-    """The samples with midpoints added wherever a chord near the box is longer than :data:`CHORD` (None when
-    that takes more than :data:`MAX_POINTS`)."""
-    for _ in range(40):
-        with np.errstate(invalid="ignore"):
-            long = _near_segments(u, v) & (np.hypot(np.diff(u), np.diff(v)) > CHORD) \
-                & (np.sign(det[:-1]) == np.sign(det[1:]))
-        if not np.any(long):
-            break
-        if w.size + np.count_nonzero(long) > MAX_POINTS:
-            return None
-        i = np.flatnonzero(long)
-        mid = 0.5 * (w[i] + w[i + 1])
+    """The samples with each chord's middle sample added wherever the chord's ends and that sample come near the box
+    and the chord is longer than :data:`CHORD` or the middle strays from it by more than that (None when that
+    takes more than :data:`MAX_POINTS`). The middle is looked at for every chord: a curve can leave the chord far
+    from the box and swing into it between two samples."""
+    extra = _extrema(curve, w, u, v)  # where the curve turns in u or in v: an arc that enters the box between two
+    if extra.size:  # samples far from it turns there
+        w = np.unique(np.concatenate([w, extra]))
+        u, v, det = curve.at(w)
+    for _ in range(60):
+        mid = 0.5 * (w[:-1] + w[1:])
         mu, mv, mdet = curve.at(mid)
-        w, u, v, det = (np.insert(a, i + 1, b) for a, b in ((w, mid), (u, mu), (v, mv), (det, mdet)))
+        with np.errstate(invalid="ignore"):
+            su, sv = np.stack([u[:-1], u[1:], mu]), np.stack([v[:-1], v[1:], mv])
+            near = (su.min(0) <= 1 + _NEAR) & (su.max(0) >= -_NEAR) & (sv.min(0) <= 1 + _NEAR) & (sv.max(0) >= -_NEAR)
+            stray = np.hypot(mu - 0.5 * (u[:-1] + u[1:]), mv - 0.5 * (v[:-1] + v[1:]))
+            split = near & ((np.hypot(np.diff(u), np.diff(v)) > CHORD) | (stray > CHORD)) \
+                & (np.sign(det[:-1]) == np.sign(det[1:])) & (np.sign(mdet) == np.sign(det[:-1]))
+        if not np.any(split):
+            break
+        if w.size + np.count_nonzero(split) > MAX_POINTS:
+            return None
+        i = np.flatnonzero(split)
+        w, u, v, det = (np.insert(a, i + 1, b[i]) for a, b in ((w, mid), (u, mu), (v, mv), (det, mdet)))
+    else:
+        return None  # still refining: not resolved
     return w, u, v, det
+
+
+def _extrema(curve: _Curve, w: np.ndarray, u: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """The frequencies of the curve's local extrema in ``u`` and in ``v`` between samples (golden section, all at
+    once)."""
+    out = []
+    for axis, values in ((0, u), (1, v)):
+        dv = np.diff(values)
+        with np.errstate(invalid="ignore"):
+            k = np.flatnonzero(dv[:-1] * dv[1:] < 0) + 1
+        if k.size == 0:
+            continue
+        sign = np.where(dv[k - 1] > 0, 1.0, -1.0)
+        a, b = w[k - 1].astype(float), w[k + 1].astype(float)
+        g = (np.sqrt(5.0) - 1.0) / 2.0
+        c, e = b - g * (b - a), a + g * (b - a)
+        fc, fe = sign * curve.at(c)[axis], sign * curve.at(e)[axis]
+        for _ in range(60):
+            left = fc > fe
+            a, b = np.where(left, a, c), np.where(left, e, b)
+            c, e = np.where(left, b - g * (b - a), e), np.where(left, c, a + g * (b - a))
+            fresh = sign * curve.at(np.where(left, c, e))[axis]
+            fc, fe = np.where(left, fresh, fe), np.where(left, fc, fresh)
+            if np.all(b - a <= 1e-12 * b):
+                break
+        out.append(0.5 * (a + b))
+    return np.concatenate(out) if out else np.zeros(0)
 
 
 def _near_segments(u: np.ndarray, v: np.ndarray) -> np.ndarray:
