@@ -13,9 +13,12 @@ where a gain is 0 are decided apart (there the controller's form changes: a PI w
 
 Stability is counted as everywhere in synth: every root left of the stability floor
 (:func:`synth.stability.stability_floor`), so the curves are those of the loop shifted by that floor. They are
-sampled until every chord near the box is shorter than :data:`CHORD` of it, and the turning points and
-crossings are refined to about ``1e-9`` of the box: a region thinner than that is not resolved. Only strictly
-proper loops are decided here (a biproper loop's roots can also come in from infinity).
+sampled on a log grid, around every lightly damped root of the loop's polynomials and at every extremum of either
+coordinate, then refined until every chord near the box is shorter than :data:`CHORD` of it and its middle sample
+strays from it by less than that; the turning points and crossings are refined on the curve. The proof rests on
+that sampling: an excursion of a curve into the box between two samples that are both far from it, with no
+extremum and no middle sample seen near it, is not resolved. Only strictly proper loops are decided here (a
+biproper loop's roots can also come in from infinity).
 """
 
 from __future__ import annotations
