@@ -33,6 +33,7 @@ from synth.errors import NoStabilizingControllerError
 from synth.loop import Loop
 from synth.plant import Plant
 from synth.polynomials import largest_crossing, shifted, trim
+from synth.rootfind import bisect_roots
 from synth.stability import MAX_PHASE_POINTS, PHASE_STEP, characteristic_scale, stability_floor
 from synth.synthesis.axis_starts import interval_middle
 from synth.synthesis.chord_crossings import CHORD, chord_crossings, line_crossings
@@ -359,30 +360,15 @@ def _refined(curve: _Curve, w: np.ndarray, u: np.ndarray, v: np.ndarray, det: np
 
 
 def _extrema(curve: _Curve, w: np.ndarray, u: np.ndarray, v: np.ndarray) -> np.ndarray:
-    """The frequencies of the curve's local extrema in ``u`` and in ``v`` between samples (golden section, all at
-    once)."""
-    out = []
+    """The frequencies of the curve's local extrema in ``u`` and in ``v`` between samples (:func:`_golden`)."""
+    out = [np.zeros(0)]
     for axis, values in ((0, u), (1, v)):
         dv = np.diff(values)
         with np.errstate(invalid="ignore"):
             k = np.flatnonzero(dv[:-1] * dv[1:] < 0) + 1
-        if k.size == 0:
-            continue
-        sign = np.where(dv[k - 1] > 0, 1.0, -1.0)
-        a, b = w[k - 1].astype(float), w[k + 1].astype(float)
-        g = (np.sqrt(5.0) - 1.0) / 2.0
-        c, e = b - g * (b - a), a + g * (b - a)
-        fc, fe = sign * curve.at(c)[axis], sign * curve.at(e)[axis]
-        for _ in range(60):
-            left = fc > fe
-            a, b = np.where(left, a, c), np.where(left, e, b)
-            c, e = np.where(left, b - g * (b - a), e), np.where(left, c, a + g * (b - a))
-            fresh = sign * curve.at(np.where(left, c, e))[axis]
-            fc, fe = np.where(left, fresh, fe), np.where(left, fc, fresh)
-            if np.all(b - a <= 1e-12 * b):
-                break
-        out.append(0.5 * (a + b))
-    return np.concatenate(out) if out else np.zeros(0)
+        if k.size:
+            out.append(_golden(curve, w[k - 1], w[k + 1], np.where(dv[k - 1] > 0, 1.0, -1.0), axis)[0])
+    return np.concatenate(out)
 
 
 def _near_segments(u: np.ndarray, v: np.ndarray) -> np.ndarray:
@@ -408,41 +394,41 @@ def _turning_points(curve: _Curve, w: np.ndarray, u: np.ndarray, v: np.ndarray) 
     out = u[k[flat]].tolist()
     k = k[~flat]
     sign = np.where(du[k - 1] > 0, 1.0, -1.0)  # a maximum (+1) or a minimum (-1) of u
-    a, b = w[k - 1].astype(float), w[k + 1].astype(float)
+    _, peak = _golden(curve, w[k - 1], w[k + 1], sign, 0)
+    with np.errstate(invalid="ignore"):
+        out += (sign * np.fmax(peak, sign * u[k])).tolist()
+    return out
+
+
+def _golden(curve: _Curve, a: np.ndarray, b: np.ndarray, sign: np.ndarray, axis: int,
+            ) -> tuple[np.ndarray, np.ndarray]:
+    """Golden-section search of ``sign * curve.at(w)[axis]``'s maximum in each ``[a, b]``, all at once: the
+    frequencies and the values there."""
+    a, b = np.asarray(a, float), np.asarray(b, float)
     g = (np.sqrt(5.0) - 1.0) / 2.0
     c, e = b - g * (b - a), a + g * (b - a)
-    fc, fe = sign * curve.at(c)[0], sign * curve.at(e)[0]
-    best = sign * u[k]
+    fc, fe = sign * curve.at(c)[axis], sign * curve.at(e)[axis]
     for _ in range(60):
-        left = fc > fe  # the extremum lies in [a, e]
+        left = fc > fe  # the maximum lies in [a, e]
         a, b = np.where(left, a, c), np.where(left, e, b)
         c, e = np.where(left, b - g * (b - a), e), np.where(left, c, a + g * (b - a))
-        fresh = sign * curve.at(np.where(left, c, e))[0]
+        fresh = sign * curve.at(np.where(left, c, e))[axis]
         fc, fe = np.where(left, fresh, fe), np.where(left, fc, fresh)
         if np.all(b - a <= 1e-13 * b):
             break
     with np.errstate(invalid="ignore"):
-        out += (sign * np.fmax(np.fmax(fc, fe), best)).tolist()
-    return out
+        return 0.5 * (a + b), np.fmax(fc, fe)
 
 
 def _edge_crossings(curve: _Curve, w: np.ndarray, u: np.ndarray, v: np.ndarray, edge: float) -> list[float]:
-    """The scaled ``x`` where the curve crosses the box's edge ``v = edge`` within the box (bisection, all at
-    once)."""
+    """The scaled ``x`` where the curve crosses the box's edge ``v = edge`` within the box
+    (:func:`synth.rootfind.bisect_roots`, all at once)."""
     f = v - edge
     k = np.flatnonzero(f[:-1] * f[1:] < 0)
     k = k[(np.maximum(u[k], u[k + 1]) >= -_NEAR) & (np.minimum(u[k], u[k + 1]) <= 1 + _NEAR)]
     if k.size == 0:
         return []
-    a, b, fa = w[k].astype(float), w[k + 1].astype(float), f[k]
-    for _ in range(100):
-        m = 0.5 * (a + b)
-        fm = curve.at(m)[1] - edge
-        same = (fm < 0) == (fa < 0)
-        a, fa, b = np.where(same, m, a), np.where(same, fm, fa), np.where(same, b, m)
-        if np.all(b - a <= 1e-14 * b):
-            break
-    return curve.at(0.5 * (a + b))[0].tolist()
+    return curve.at(bisect_roots(lambda x: curve.at(x)[1] - edge, w[k], w[k + 1]))[0].tolist()
 
 
 def _zero_line(curve: _Curve) -> np.ndarray | None:
