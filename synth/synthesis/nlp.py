@@ -40,7 +40,9 @@ the answer when its crossovers changed or a helper variable ended on its box; an
 grid points is solved again from the same start with those frequencies (and the answer's sharp peaks) added,
 since an interior-point method restarted at an optimum with its constraints active wanders. A peak objective's
 maximum that the answer has off the grid (searched where the score searches it, which reaches below the grid
-where ``|S|`` rises towards ``|S(0)|``) is bounded in the next round's objective. An answer whose
+where ``|S|`` rises towards ``|S(0)|``) is bounded in the next round's objective. Likewise a bandwidth objective's dip: where
+the answer's ``|T|`` falls below the level between the ratios' samples, short of the bandwidth variable, its least
+value is held at the level in the next round, from the same start. An answer whose
 closed loop is unstable (a step jumped over the thin region where ``|1 + L|`` is small on the grid) is
 discarded and the round repeated in a trust region around its start, which grows again when it held a step
 back; from then on every close approach of the start's Nyquist curve to -1 is held on its side
@@ -65,7 +67,14 @@ from synth.requirements import PeakSensitivity
 from synth.requirements.base import Requirement
 from synth.synthesis.convex_settings import resonance_points
 from synth.synthesis.nlp_forms import NLP_FORMS, NLPContext
-from synth.synthesis.nlp_problem import NLPBuilder, SymbolicController, loop_response, phase_crossovers, t0_squared
+from synth.synthesis.nlp_problem import (
+    TIGHT,
+    NLPBuilder,
+    SymbolicController,
+    loop_response,
+    phase_crossovers,
+    t0_squared,
+)
 from synth.synthesis.nlp_sides import hold_sides
 
 __all__ = ["NLPResult", "polish"]
@@ -95,9 +104,10 @@ class NLPResult:
 
 
 def _term(b: NLPBuilder, name: str, plants: list[Plant], grid: np.ndarray, start: Controller,
-          peaks_at: np.ndarray) -> Any:
+          peaks_at: np.ndarray, dips: np.ndarray) -> Any:
     """The measure ``name`` as a casadi expression in its natural unit (adds helper variables); a peak is
-    bounded on ``grid`` and at ``peaks_at`` (the maxima earlier rounds' answers had off the grid)."""
+    bounded on ``grid`` and at ``peaks_at`` (the maxima earlier rounds' answers had off the grid), a bandwidth
+    also held at ``dips`` (where earlier answers' ``|T|`` fell below the level between the ratios' samples)."""
     ctrl = b.ctrl
     plant = plants[0]
     loop0 = Loop(plant, start)
@@ -113,6 +123,9 @@ def _term(b: NLPBuilder, name: str, plants: list[Plant], grid: np.ndarray, start
         _, L = loop_response(ctrl, plant, v * ca.DM(np.geomspace(1e-3, 1.0, 80)))  # one column: 80 ratios
         if name == "bandwidth":
             b.geq(L.abs2() - BANDWIDTH_LEVEL**2 * t02 * (1.0 + L).abs2())
+            if dips.size:  # with the backoff of magnitude bounds: the dip moves a little with the next answer
+                _, Ld = loop_response(ctrl, plant, dips)
+                b.geq(TIGHT * Ld.abs2() - BANDWIDTH_LEVEL**2 * t02 * (1.0 + Ld).abs2())
         else:
             b.geq(L.abs2() - 1.0)
         return v
@@ -137,13 +150,13 @@ def _term(b: NLPBuilder, name: str, plants: list[Plant], grid: np.ndarray, start
 
 
 def _add_objective(b: NLPBuilder, terms: list[tuple[str, str, float]], plants: list[Plant], grid: np.ndarray,
-                   start: Controller, peaks_at: np.ndarray) -> None:
+                   start: Controller, peaks_at: np.ndarray, dips: np.ndarray) -> None:
     """Minimize ``-sum(w s f)`` scaled by its value at the start (``s`` = +1 maximize, -1 minimize)."""
     from synth.objectives import score
 
     total = 0.0
     for name, sense, weight in terms:
-        total = total + weight * (1.0 if sense == "maximize" else -1.0) * _term(b, name, plants, grid, start, peaks_at)
+        total = total + weight * (1.0 if sense == "maximize" else -1.0) * _term(b, name, plants, grid, start, peaks_at, dips)
     scale = max(abs(score(Loop(plants[0], start), terms)), 1e-6)
     b.f = -total / scale
 
@@ -194,6 +207,7 @@ def polish(requirements: list[Requirement], plants: list[Plant], start: Controll
     grid = np.asarray(grid, float)
     extra = np.array([])
     missed = np.array([])  # maxima of a peak objective that earlier answers had off the grid
+    dips = np.array([])  # minima of |T| below a bandwidth objective that earlier answers had between its samples
     converged = False
     solved: list[Controller] = []
     radius: float | None = None  # a trust region once a step has jumped out of the stabilizing set
@@ -223,7 +237,7 @@ def polish(requirements: list[Requirement], plants: list[Plant], start: Controll
                 b.geq((1.0 + L).abs2() - stability_level**2)
             if hold_sides_now:  # an earlier answer crossed -1: the start's close approaches keep their side
                 held += hold_sides(b, p, current, (float(grid[0]), float(grid[-1])), stability_level)
-        _add_objective(b, objective, plants, grid, current, missed)
+        _add_objective(b, objective, plants, grid, current, missed, dips)
         if exact_from_now:  # an earlier round's quasi-Newton steps crawled: this problem gets the exact Hessian
             x, stats = b.solve(EXACT_HESSIAN, expand=True)
         else:
@@ -266,7 +280,10 @@ def polish(requirements: list[Requirement], plants: list[Plant], start: Controll
         between = _violated_frequencies(requirements, plants, candidate)
         peaks = _missed_peaks(objective, plants, candidate, np.union1d(np.union1d(grid, extra), missed))
         missed = np.union1d(missed, _with_neighbours(peaks))
-        between = np.concatenate([between, peaks])
+        dip = _missed_dip(plants[0], candidate, float(x[b.offsets["bandwidth"]]) if "bandwidth" in b.offsets
+                          and any(t[0] == "bandwidth" for t in objective) else None)
+        dips = np.union1d(dips, _with_neighbours(dip))
+        between = np.concatenate([between, peaks, dip])
         if between.size:  # and the candidate's sharp features, which the next answer moves only a little
             extra = np.unique(np.concatenate([extra, _with_neighbours(between),
                                               resonance_points(plants, candidate, grid)]))
@@ -387,6 +404,25 @@ def _missed_peaks(objective: list[tuple[str, str, float]], plants: list[Plant], 
             if np.isfinite(true) and 20 * np.log10(true / max(seen, 1e-300)) > tol_db:
                 out.append(w)
     return np.array(out, float)
+
+
+def _missed_dip(plant: Plant, c: Controller, wb: float | None) -> np.ndarray:
+    """The frequency (none or one) where ``|T|`` of ``c`` is least between its bandwidth and the NLP's bandwidth
+    variable ``wb``, when the bandwidth falls short of ``wb``: the NLP held ``|T|`` at the level only on its
+    ratios' samples, and a dip between two of them that reaches below the level ends the bandwidth there (seed
+    18 #15 of the design benchmark: a PID's polish ended at 12.8 rad/s, its NLP's bandwidth 87.7 rad/s, the dip's
+    least ``|T|`` 0.15 % under the level)."""
+    from synth.freqgrid import log_grid, peak
+
+    if wb is None:
+        return np.array([])
+    loop = Loop(plant, c)
+    true = loop.bandwidth()
+    if not np.isfinite(true) or true >= wb * (1.0 - 1e-6):
+        return np.array([])
+    with np.errstate(all="ignore"):
+        _, w = peak(lambda v: 1.0 / np.abs(loop.T(v)), log_grid(true, wb, 400))
+    return np.array([w], float) if np.isfinite(w) else np.array([])
 
 
 def _violated_frequencies(requirements: list[Requirement], plants: list[Plant], c: Controller) -> np.ndarray:

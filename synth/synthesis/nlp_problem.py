@@ -147,9 +147,12 @@ class NLPBuilder:
         self.lbg: list[float] = []
         self.ubg: list[float] = []
         self.f: Any = 0.0
+        self.offsets: dict[str, int] = {}
+        """Position in the solution of the first variable of each name."""
 
     def var(self, name: str, x0: float, lo: float, hi: float) -> Any:
         v = SYM.sym(name)
+        self.offsets.setdefault(name, sum(len(a) for a in self.x0))
         self.x.append(v)
         self.x0.append(np.array([x0]))
         self.lbx.append(np.array([lo]))
