@@ -280,3 +280,19 @@ def test_a_periodic_cycles_amplitude_leaves_out_its_centres_drift():
     # the window's half range still holds the drift: what the amplitude would have been
     keep = v.result.t >= v.result.t[-1] - (v.result.t[-1] - case["t_step"]) / 2
     assert 0.5 * np.ptp(v.result.output[keep]) > 1.03 * lc.amplitude
+
+
+def test_a_pattern_of_several_oscillations_says_how_often_it_crosses_its_mean():
+    """Seed 108 loop 51 (P, rate limit and relay): the record repeats every 5.47 s, ten irregular oscillations each
+    time. synth's period is the repeat's; its text also gives the oscillations' mean spacing, which is what the
+    reference's own per-cycle measure reports as its period (0.547 s)."""
+    case = random_cases(100, 108)[51]
+    v = step_verdict(synth_loop(case), 0.0, case["step"], case["t_step"])
+    lc = v.metrics.limit_cycle
+    assert v.verdict == "limit_cycle" and lc.periodic and lc.period == pytest.approx(5.47, rel=0.01)
+    assert "crosses its mean upwards 10 times in each repeat" in lc.reason
+    spacing = float(lc.reason.split("(every ")[1].split(" s")[0])
+    ref = reference_run(case)
+    assert ref["verdict"] == "limit_cycle"
+    assert spacing == pytest.approx(ref["period"], rel=0.02)
+    assert lc.period == pytest.approx(10 * ref["period"], rel=0.02)
