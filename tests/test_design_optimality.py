@@ -22,14 +22,14 @@ SERVO = {"name": "servo_pid", "plant": {"tf": "400/(s*(s^2+4*s+400))", "delay": 
 
 # seed 3, problem 58 of benchmarks/design_problems.py: an unstable plant and a rational controller whose
 # NLP polish does not improve on the convex stage; the convex bisection does not end at a KKT point
-UNSTABLE_RATIONAL = {"name": "rand_3_58", "plant": {"tf": "9.19378*1/((s-4.3995))", "delay": 0.0},
-                     "controller": {"type": "rational", "order": [1, 2], "bounds": {
-                         "b0": [-6582.29, 6582.29], "b1": [-815.368, 815.368], "a0": [0.0, 29326.5],
-                         "a1": [0.0, 3632.76]}},
-                     "requirements": [{"type": "peak_sensitivity", "max_db": 8.51655},
-                                      {"type": "sensitivity_static", "max_db": -11.5947},
-                                      {"type": "peak_complementary", "max_db": 5.88887}],
-                     "objective": {"maximize": "bandwidth"}}
+UNCONVERGED_PID = {"name": "rand_18_51", "plant": {"tf": "0.055714*1/((s+0.0698449)*(s+0.0498698))"},
+                   "controller": {"type": "PID", "bounds": {"kp": [0.0, 3.7741], "ki": [0.0, 0.860993],
+                                                            "kd": [0.0, 16.5435], "tf": [0.438343, 0.438343]}},
+                   "requirements": [{"type": "sensitivity_static", "max_db": -12.7636, "plant_gain": 0.459685}],
+                   "objective": {"maximize": "bandwidth"}}
+"""The design benchmark's seed 18 #51: the best design is the pattern search's, after stages none of which converged
+(until session 37 this test used seed 3 #58, a rational controller on ``9.19/(s - 4.40)``, whose polish converges
+since the polish holds a bandwidth dip between its samples)."""
 
 
 def test_a_design_claimed_locally_optimal_has_no_better_feasible_neighbour():
@@ -59,7 +59,7 @@ def test_a_design_claimed_locally_optimal_has_no_better_feasible_neighbour():
 
 @pytest.mark.slow
 def test_a_design_from_a_stage_that_stopped_early_says_it_is_not_shown_optimal():
-    d = design(parse_spec(UNSTABLE_RATIONAL))
+    d = design(parse_spec(UNCONVERGED_PID))
     optimality = d.extras["optimality"]
     assert d.feasible
     assert optimality["local"] is False
