@@ -8,7 +8,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from synth.controllers import Controller
-from synth.freqgrid import characteristic_range, log_grid
+from synth.freqgrid import characteristic_range, log_grid, unity_gain_frequency
 from synth.plant import Plant
 from synth.requirements.base import Requirement
 from synth.synthesis.delay_grid import delay_points
@@ -74,11 +74,14 @@ def design_grid(plants: list[Plant], requirements: list[Requirement], settings: 
     lo, hi = np.inf, 0.0
     for p in plants:
         a, b = characteristic_range(p.num, p.den, delay=p.delay)
+        unity = unity_gain_frequency(p.num, p.den)  # a plant without corners (k / s): where a loop crosses over
+        if unity is not None:  # (1 / delay alone put 4.59 e^(-0.00023 s) / s's grid at 43-430,000 rad/s)
+            a, b = min(a, unity / 100.0), max(b, unity * 100.0)
         lo, hi = min(lo, a), max(hi, b)
     for r in requirements:
         band = getattr(r, "band", None)
-        if band is not None:
-            lo = min(lo, band[0] / 10 if band[0] > 0 else lo)
+        if band is not None:  # a band from 0 reaches two decades below its top (it had no point in it at all
+            lo = min(lo, band[0] / 10 if band[0] > 0 else band[1] / 100)  # when the plant's range lay above it)
             hi = max(hi, band[1] * 10)
         for key, bound in r.bounds.items():  # frequency bounds (a bandwidth's min and max)
             v = getattr(r, key, None) if bound.unit == "rad/s" else None

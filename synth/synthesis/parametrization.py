@@ -32,7 +32,7 @@ import numpy as np
 
 from synth.controllers import RATIONAL, Controller
 from synth.errors import SynthError
-from synth.freqgrid import characteristic_range
+from synth.freqgrid import characteristic_range, unity_gain_frequency
 
 if TYPE_CHECKING:
     from synth.spec import Spec
@@ -399,7 +399,12 @@ def parametrize(ctype: str, bounds: dict[str, tuple[float, float]], order: tuple
 
 
 def reference_frequency(spec: Spec) -> float:
-    """Geometric mean of the nominal plant's corner frequencies (scales rational coefficients).
+    """Geometric mean of the nominal plant's corner frequencies (scales rational coefficients). A plant without
+    corners, ``k s^r`` (an integrator, a pure gain), has the frequency where its gain is 1 instead, at most
+    ``1 / delay``: where a loop around it crosses over. (``1 / delay`` alone put the scale of ``4.59 e^(-0.00023 s)
+    / s`` at 4,300 rad/s, three decades above any loop the bounds allow; a rational controller's ``b0`` then
+    ranged over +-3e-8 in the convex stage's units, below the solver's tolerance, and the design answered
+    "infeasible" where the design benchmark's reference met every requirement: seed 19 #35.)
 
     Examples
     --------
@@ -408,7 +413,14 @@ def reference_frequency(spec: Spec) -> float:
     ...                    "requirements": [{"type": "bandwidth", "min": 1.0}]})
     >>> 1.0 < reference_frequency(spec) < 100.0
     True
+    >>> spec = parse_spec({"name": "x", "plant": {"tf": "4/s^2", "delay": 0.01}, "controller": {"type": "P"},
+    ...                    "requirements": [{"type": "bandwidth", "min": 1.0}]})
+    >>> round(reference_frequency(spec), 6)
+    2.0
     """
     p = spec.nominal_plant()
+    unity = unity_gain_frequency(p.num, p.den)
+    if unity is not None:
+        return min(unity, 1.0 / p.delay) if p.delay > 0 else unity
     lo, hi = characteristic_range(p.num, p.den, delay=p.delay)
     return float(np.sqrt(lo * hi))
