@@ -17,7 +17,7 @@ from synth.rootfind import bisect_roots
 
 __all__ = ["DEFAULT_PER_DECADE", "Curve", "band_grid", "band_grids", "batch_first_crossing", "batch_peak",
            "bracketed_maxima", "characteristic_range", "corner_frequencies", "crossings", "first_fall", "log_grid",
-           "log_grids", "neighbour_brackets", "peak", "refine_maxima", "resolving_grid", "unity_gain_frequency"]
+           "log_grids", "neighbour_brackets", "peak", "refine_maxima", "resolving_grid"]
 
 Curve = Callable[[np.ndarray], np.ndarray]
 
@@ -38,24 +38,6 @@ def characteristic_range(*polys: np.ndarray, delay: float = 0.0) -> tuple[float,
     if np.isnan(lo):
         return 1e-2, 1e2
     return float(lo) / 100.0, float(hi) * 100.0
-
-
-def unity_gain_frequency(num: np.ndarray, den: np.ndarray) -> float | None:
-    """For ``num/den = k s^r`` with every root at the origin and ``r != 0`` (an integrator, a double integrator, a
-    differentiator: no corner frequency) the frequency where ``|k| w^r = 1``, where a loop around it crosses over;
-    None otherwise.
-
-    Examples
-    --------
-    >>> unity_gain_frequency(np.array([4.0]), np.array([1.0, 0.0, 0.0]))
-    2.0
-    >>> unity_gain_frequency(np.array([1.0]), np.array([1.0, 1.0])) is None
-    True
-    """
-    num, den = np.trim_zeros(np.asarray(num, float), "f"), np.trim_zeros(np.asarray(den, float), "f")
-    if num.size == 0 or den.size == 0 or num.size == den.size or not np.isnan(corner_frequencies(num, den)[0]):
-        return None
-    return float(abs(num[0] / den[0]) ** (-1.0 / (num.size - den.size)))
 
 
 def corner_frequencies(*polys: np.ndarray) -> tuple[float, float]:

@@ -10,12 +10,12 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from synth.freqgrid import unity_gain_frequency
 from synth.plant import Plant
 from synth.requirements import PeakComplementary, Sensitivity
 from synth.spec import parse_spec
 from synth.synthesis.convex_settings import ConvexSettings, design_grid
 from synth.synthesis.parametrization import reference_frequency
+from synth.unity_gain import unity_gain_frequency
 
 PLANT = Plant.from_string("4.59214/s", delay=0.000232547)
 BAND = Sensitivity(max_db=-21.9987, band=(0.0, 0.341965))
@@ -45,3 +45,18 @@ def test_plants_with_corners_or_a_pure_gain_have_no_unity_gain_frequency():
     assert unity_gain_frequency(np.array([1.0]), np.array([1.0, 1.0, 0.0])) is None  # a corner at 1 rad/s
     assert unity_gain_frequency(np.array([3.0]), np.array([1.0])) is None
     assert unity_gain_frequency(np.array([2.0, 0.0]), np.array([1.0])) == pytest.approx(0.5)
+
+
+def test_an_infeasible_rational_design_names_its_active_bounds_in_the_parameters_units():
+    """The convex stage works on coefficients scaled by powers of the reference frequency (100 rad/s here); the
+    diagnosis printed those (``b0 <= 0.005``, ``a0 >= 0.01``, seed 19 #35's ``b0 <= 3.05332e-08``), not the bounds
+    the spec wrote."""
+    from synth.design import design
+
+    spec = parse_spec({"name": "r", "plant": {"tf": "1/(s+100)"}, "controller": {"type": "rational", "order": [0, 1],
+                       "bounds": {"b0": [-0.5, 0.5], "a0": [1, 10]}},
+                       "requirements": [{"type": "sensitivity", "max_db": -20, "band": [0, 1]}]})
+    assert reference_frequency(spec) == pytest.approx(100.0)
+    d = design(spec)
+    assert d.status == "infeasible"
+    assert "Active parameter bounds: b0 <= 0.5, a0 >= 1." in d.verdict

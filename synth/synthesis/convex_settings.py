@@ -8,10 +8,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from synth.controllers import Controller
-from synth.freqgrid import characteristic_range, log_grid, unity_gain_frequency
+from synth.freqgrid import characteristic_range, log_grid
 from synth.plant import Plant
 from synth.requirements.base import Requirement
 from synth.synthesis.delay_grid import delay_points
+from synth.unity_gain import unity_gain_frequency
 
 __all__ = ["RESONANCE_REFINED", "ConvexSettings", "design_grid", "resonance_points"]
 

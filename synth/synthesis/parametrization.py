@@ -32,7 +32,8 @@ import numpy as np
 
 from synth.controllers import RATIONAL, Controller
 from synth.errors import SynthError
-from synth.freqgrid import characteristic_range, unity_gain_frequency
+from synth.freqgrid import characteristic_range
+from synth.unity_gain import unity_gain_frequency
 
 if TYPE_CHECKING:
     from synth.spec import Spec
@@ -198,6 +199,10 @@ class LinearParametrization:
             lo = np.array([k_lo, min(corners)])
             hi = np.array([k_hi, max(corners)])
         return lo, hi
+
+    def scale(self) -> np.ndarray:
+        """True value = rho * scale: ones (``rho`` holds the parameters themselves, a lead-lag's ``k z`` for ``z``)."""
+        return np.ones(self.size)
 
     def linear_constraints(self) -> tuple[np.ndarray, np.ndarray]:
         """``(A, b)`` with ``A rho <= b`` expressing every bound exactly (linear for lead-lag with k >= 0)."""
