@@ -342,11 +342,12 @@ class ConvexDesigner:
         if self.box:
             A, b = self.par.linear_constraints()
             duals = self.box[0].dual_value
+            scale = self.par.scale()  # the bound in the parameter's own units (a rational's rho is scaled by w0^k)
             for row, d, rhs in zip(A, np.atleast_1d(duals) if duals is not None else [], b):
                 if d > 1e-6:
                     i = int(np.argmax(np.abs(row)))
                     rel = "<=" if row[i] > 0 else ">="
-                    active.append(f"{self.par.names[i]} {rel} {rhs * np.sign(row[i]):.6g}")
+                    active.append(f"{self.par.names[i]} {rel} {rhs * np.sign(row[i]) * scale[i]:.6g}")
         return Diagnosis(total, conflicts, active, self.par.controller(rho))
 
     def optimize(self, rho_c: np.ndarray, history: list) -> tuple[np.ndarray, float]:
