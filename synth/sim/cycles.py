@@ -21,7 +21,7 @@ import dataclasses
 
 import numpy as np
 
-from synth.sim.limitcycle import REPEAT, Oscillation, repeats
+from synth.sim.limitcycle import REPEAT, SAMPLED_HYSTERESIS, Oscillation, repeats
 
 __all__ = ["autocorrelation_period", "measure_cycle"]
 
@@ -129,7 +129,7 @@ def measure_cycle(t: np.ndarray, y: np.ndarray, osc: Oscillation, cycles: int,
                  else osc.amplitude_range or (half, half), "period_range": osc.period_range or (period, period)}
     elif pattern is not None:  # a complex waveform (more than two mean crossings a period)
         period, half = pattern, float(_repeat_halves(t, y, pattern)[-1])
-        ups = _upward_crossings(y[t >= t[-1] - period], 0.25)
+        ups = _upward_crossings(y[t >= t[-1] - period], SAMPLED_HYSTERESIS)  # as the cycle detector counts
         how = (f"periodic: the record repeats every {period:.4g} s within {100 * REPEAT:g} % RMS (autocorrelation); "
                + (f"it crosses its mean upwards {ups} times in each repeat (every {period / ups:.4g} s on average); "
                   if ups >= 2 else "") + f"its mean crossings: {osc.reason}")
