@@ -21,7 +21,7 @@ import dataclasses
 
 import numpy as np
 
-from synth.sim.limitcycle import REPEAT, SAMPLED_HYSTERESIS, Oscillation, repeats
+from synth.sim.limitcycle import REPEAT, Oscillation, cycle_table, repeats
 
 __all__ = ["autocorrelation_period", "measure_cycle"]
 
@@ -85,16 +85,6 @@ def _repeat_halves(t: np.ndarray, y: np.ndarray, pattern: float) -> np.ndarray:
     return 0.5 * (top - bottom)
 
 
-def _upward_crossings(y: np.ndarray, hysteresis: float) -> int:
-    """Upward crossings of ``y``'s mean, each counted once ``y`` has been below the mean by ``hysteresis`` of its
-    half range and then above it by as much (the small wiggles of a relay's rate-limited output do not count)."""
-    r = y - np.mean(y)
-    h = hysteresis * 0.5 * float(np.ptp(y))
-    side = np.where(r > h, 1, np.where(r < -h, -1, 0))
-    side = side[side != 0]  # the band between the thresholds keeps the side last seen
-    return int(np.count_nonzero((side[1:] == 1) & (side[:-1] == -1)))
-
-
 def measure_cycle(t: np.ndarray, y: np.ndarray, osc: Oscillation, cycles: int,
                   min_amplitude: float = 0.0) -> Oscillation:
     """The limit cycle of the window ``t, y`` (already judged sustained), measured: ``osc`` is
@@ -129,7 +119,8 @@ def measure_cycle(t: np.ndarray, y: np.ndarray, osc: Oscillation, cycles: int,
                  else osc.amplitude_range or (half, half), "period_range": osc.period_range or (period, period)}
     elif pattern is not None:  # a complex waveform (more than two mean crossings a period)
         period, half = pattern, float(_repeat_halves(t, y, pattern)[-1])
-        ups = _upward_crossings(y[t >= t[-1] - period], SAMPLED_HYSTERESIS)  # as the cycle detector counts
+        starts, _ = cycle_table(t, y)  # the window's whole cycles, delimited as the cycle detector delimits them
+        ups = round(period * (starts.size - 1) / (starts[-1] - starts[0])) if starts.size >= 2 else 0
         how = (f"periodic: the record repeats every {period:.4g} s within {100 * REPEAT:g} % RMS (autocorrelation); "
                + (f"it crosses its mean upwards {ups} times in each repeat (every {period / ups:.4g} s on average); "
                   if ups >= 2 else "") + f"its mean crossings: {osc.reason}")

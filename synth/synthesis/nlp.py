@@ -280,8 +280,8 @@ def polish(requirements: list[Requirement], plants: list[Plant], start: Controll
         between = _violated_frequencies(requirements, plants, candidate)
         peaks = _missed_peaks(objective, plants, candidate, np.union1d(np.union1d(grid, extra), missed))
         missed = np.union1d(missed, _with_neighbours(peaks))
-        dip = _missed_dip(plants[0], candidate, float(x[b.offsets["bandwidth"]]) if "bandwidth" in b.offsets
-                          and any(t[0] == "bandwidth" for t in objective) else None)
+        # (only a bandwidth objective makes a variable of that name)
+        dip = _missed_dip(plants[0], candidate, float(x[b.offsets["bandwidth"]]) if "bandwidth" in b.offsets else None)
         dips = np.union1d(dips, _with_neighbours(dip))
         between = np.concatenate([between, peaks, dip])
         if between.size:  # and the candidate's sharp features, which the next answer moves only a little
