@@ -239,6 +239,43 @@ def test_an_integrator_winding_behind_a_relay_and_backlash_is_not_settled():
     assert v.metrics.limit_cycle.period == pytest.approx(ref["period"], rel=0.02)
 
 
+def test_a_quantizer_stepping_through_its_levels_before_a_relay_holds_nothing():
+    """Seed 109 loop 5 of benchmarks/sim_verdicts.py (PI, a quantizer then a relay in the actuator): the relay sits
+    at its level, the output stands still at 0.249 (short of the step's 0.427) and the integrator winds away from
+    the relay's switching point for ever, crossing the quantizer's levels as it goes. synth blamed the quantizer
+    and answered "undetermined" at its 10,000 s cap; the quantizer's output moves, the relay holds for ever: the
+    output has settled, as the independent reference finds, at the same value and time."""
+    case = random_cases(100, 109)[5]
+    v = step_verdict(synth_loop(case), 0.0, case["step"], case["t_step"])
+    ref = reference_run(case, horizon=120.0)
+    assert (v.verdict, ref["verdict"]) == ("settled", "settled")
+    assert v.metrics.final_value == pytest.approx(ref["final_value"], rel=1e-6)
+    assert abs(v.metrics.settling_time - ref["settling_time"]) <= case["dt"]
+    assert v.evidence.horizons[-1] < 10_000.0
+
+
+def test_a_command_winding_through_a_dead_zone_beyond_the_default_cap_is_followed_there():
+    """PI(0.5, 0.5) on 1/(s+1) stepping to 1 behind a dead zone of half-width 700: the output stands still at 0
+    while the integrator winds through the zone at 0.5 per second, for 1,400 s, beyond the default cap (1,202 s:
+    64 first horizons). Held to that cap the verdict is "undetermined" and says the command leaves the zone within
+    2,800 s at its drift (the zone's whole width, 1,400, at 0.5 per second: an upper bound); left to itself the
+    cap gives way to that wait and the run sees the output reach the reference."""
+    from synth.sim.blocks import DeadZone
+    from synth.sim.horizon import plan_horizon
+    from synth.sim.verdict import default_cap
+
+    loop = NonlinearLoop(Plant.from_string("1/(s+1)"), Controller("PI", {"kp": 0.5, "ki": 0.5}),
+                         actuator=[DeadZone(width=700.0)], dt=0.01)
+    cap = default_cap(loop, plan_horizon(loop, 0.0, None).horizon)
+    assert 1000.0 < cap < 1400.0
+    short = step_verdict(loop, 0.0, 1.0, max_horizon=cap)
+    assert short.verdict == "undetermined" and "winds behind the dead zone" in short.evidence.criterion
+    assert "within 2.8e+03 s" in short.evidence.criterion
+    whole = step_verdict(loop, 0.0, 1.0)
+    assert whole.verdict == "settled" and whole.metrics.final_value == pytest.approx(1.0, abs=1e-4)
+    assert whole.metrics.settling_time > 1400.0 and whole.evidence.cap > cap
+
+
 def test_winding_up_behind_a_saturation_for_ever_is_settled_and_behind_a_dead_zone_it_waits():
     """PI on 1/(s+1) stepping to 1: saturated at 0.5 the output settles at 0.5 while the integrator winds for
     ever (settled); behind a dead zone of half-width 0.3 the command winds through the zone and the output

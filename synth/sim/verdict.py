@@ -271,7 +271,7 @@ def judge(result: SimResult, t_step: float, step: tuple[float, float], metrics: 
                          "small oscillation)", a.cycles)
     held = winding_behind(result, after, span, actuator, SHRINK)
     if held is not None:
-        return Judgement(None, held, a.cycles)
+        return Judgement(None, held.text, a.cycles, wait=held.wait)
     return Judgement("settled", f"within {100 * SETTLED:g} % of the step over the last {span / 4:.2g} s, "
                      f"its motion at most half that of the quarter before and still shrinking", a.cycles)
 
@@ -362,6 +362,10 @@ def step_verdict(loop: NonlinearLoop, start: float, end: float, t_step: float = 
                                          window=window if window is not None else (T - t_step) / 4)
         j = judge(result, t_step, (start, end), metrics, min_amplitude, previous, T >= cap * (1 - 1e-12),
                   loop.actuator)
+        if j.verdict is None and T >= cap * (1 - 1e-12) and max_horizon is None and np.isfinite(j.wait):
+            # the output waits behind a block the winding command leaves within j.wait: the default cap gives way
+            # to a run that sees it let go, as far as the sample cap allows
+            cap = max(cap, min(T + 2.0 * j.wait, MAX_SAMPLES * loop.dt))
         if j.verdict is not None or T >= cap * (1 - 1e-12):
             break
         previous = j

@@ -28,12 +28,16 @@ class Judgement:
         Whole cycles seen in the last half of the run.
     growing : bool
         The run grows (a second growing run confirms divergence).
+    wait : float
+        Seconds after which an actuator block that holds a still output while the command winds lets go at
+        most (:class:`synth.sim.holding.Winding`); ``inf`` otherwise.
     """
 
     verdict: str | None
     criterion: str
     cycles: int
     growing: bool = False
+    wait: float = float("inf")
 
 
 @dataclass(frozen=True)
