@@ -239,6 +239,20 @@ def test_an_integrator_winding_behind_a_relay_and_backlash_is_not_settled():
     assert v.metrics.limit_cycle.period == pytest.approx(ref["period"], rel=0.02)
 
 
+def test_a_slow_tail_is_measured_against_its_limit_not_its_last_mean():
+    """Seed 109 loop 41 (PID on an integrator, actuator saturation): a closed-loop pole about 11 s long still
+    moves the output at synth's 101 s horizon, so the mean of its last 5 % stood 3.7e-6 above the final value and
+    the 2 % settling time came out 6 samples (of 1 ms) early. The tail's window means, extrapolated, give the final
+    value (the step itself: the loop has two integrators) and the settling time of the reference's 480 s run."""
+    case = random_cases(100, 109)[41]
+    v = step_verdict(synth_loop(case), 0.0, case["step"], case["t_step"])
+    ref = reference_run(case, horizon=480.0)
+    assert v.verdict == ref["verdict"] == "settled" and v.evidence.horizons[-1] < 200.0
+    assert v.metrics.final_value == pytest.approx(case["step"], rel=1e-9)
+    assert abs(v.metrics.settling_time - ref["settling_time"]) <= case["dt"]
+    assert abs(v.metrics.rise_time - ref["rise_time"]) <= case["dt"]
+
+
 def test_a_quantizer_stepping_through_its_levels_before_a_relay_holds_nothing():
     """Seed 109 loop 5 of benchmarks/sim_verdicts.py (PI, a quantizer then a relay in the actuator): the relay sits
     at its level, the output stands still at 0.249 (short of the step's 0.427) and the integrator winds away from
