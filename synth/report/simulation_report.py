@@ -28,6 +28,7 @@ from synth.sim.onset import OnsetResult, oscillation_onset
 from synth.sim.results import SimResult
 from synth.sim.simulator import simulate_batch, simulate_open_loop, simulate_step
 from synth.sim.spec import SimulationSpec
+from synth.sim.verdict import step_verdict
 from synth.spec import Spec
 from synth.timeresp import step_metrics, step_response
 
@@ -93,7 +94,7 @@ def simulation_report(spec: Spec, design: Controller | None, reference: Controll
         runs, data = _step_runs(spec, "design", design)
         report = SimulationReport({**part.data, "runs": {"design": data, **part.data["runs"]}},
                                   {"design": runs, **part.runs}, part.onset, part.rise_vs_rate)
-        report.data["verdict"] = _verdict(report.data, y_unit)
+        report.data["verdict"], report.data["design_warning"] = _verdict(report.data, y_unit), _warning(report.data, y_unit)
         _CACHE.clear()
         _CACHE[key] = report
         return report
@@ -109,7 +110,7 @@ def simulation_report(spec: Spec, design: Controller | None, reference: Controll
         if ctrl is None:
             continue
         report.runs[label], report.data["runs"][label] = _step_runs(spec, label, ctrl)
-    report.data["verdict"] = _verdict(report.data, y_unit)
+    report.data["verdict"], report.data["design_warning"] = _verdict(report.data, y_unit), _warning(report.data, y_unit)
     probe = reference or design
     if sim.onset is not None and probe is not None and probe.type == "P":
         loop = sim.build_loop(plant, probe)
@@ -126,6 +127,10 @@ def simulation_report(spec: Spec, design: Controller | None, reference: Controll
     return report
 
 
+_TOWARDS_FINAL = ("rise_time", "overshoot", "settling_time", "final_value")
+"""Step metrics measured against the final value: left out (None) of a run whose step does not settle."""
+
+
 def _step_runs(spec: Spec, label: str, ctrl: Controller) -> tuple[dict[str, SimResult], dict[str, Any]]:
     """The nonlinear and the linear step run of one controller, and their numbers for ``result.json``."""
     sim = spec.simulation
@@ -139,7 +144,13 @@ def _step_runs(spec: Spec, label: str, ctrl: Controller) -> tuple[dict[str, SimR
     }
     metrics = {k: nonlinear_step_metrics(r, sim.step_time, min_amplitude=sim.limit_cycle.min_amplitude,
                                          window=sim.limit_cycle.window).to_dict() for k, r in runs.items()}
-    return runs, {"controller": str(ctrl), "loop": loop.to_dict(), **metrics}
+    # what the step ends in is not read off the shown horizon: the run is extended until it decides
+    verdict = step_verdict(loop, *step, t_step=sim.step_time, horizon=sim.horizon, disturbances=disturbances,
+                           seed=sim.seed, min_amplitude=sim.limit_cycle.min_amplitude)
+    if verdict.verdict != "settled":  # no final value: nothing to rise, overshoot or settle towards
+        metrics["nonlinear"] = {**metrics["nonlinear"], **dict.fromkeys(_TOWARDS_FINAL)}
+    return runs, {"controller": str(ctrl), "loop": loop.to_dict(), **metrics,
+                  "step_verdict": {**verdict.to_dict(), "summary": verdict.summary(loop.plant.output.unit or "")}}
 
 
 def _assumptions(sim: SimulationSpec, plant: Any, u: str, y: str) -> list[str]:
@@ -174,21 +185,48 @@ def _block_text(b: Any, unit: str) -> str:
     return kind + " " + ", ".join(f"{k} {v}" for k, v in d.items() if v is not None)
 
 
+def _warning(data: dict[str, Any], y: str) -> str | None:
+    """For the report's top verdict: what the design's simulated step ends in, unless it settles."""
+    run = data["runs"].get("design")
+    if run is None or run["step_verdict"]["verdict"] == "settled":
+        return None
+    v = run["step_verdict"]
+    if v["verdict"] == "limit_cycle":
+        what = (f"ends in a sustained oscillation of {fmt(v['limit_cycle']['amplitude'])} {y} every "
+                f"{fmt(v['limit_cycle']['period'])} s")
+    else:
+        what = "diverges" if v["verdict"] == "diverging" else f"is undetermined within {fmt(v['evidence']['horizon'])} s"
+    step = " -> ".join(f"{fmt(x)}" for x in data["step"])
+    return (f"Nonlinear step check: the design's simulated step {step} {y} {what} (the spec's simulation block: "
+            "actuator and sensor limits; see below).")
+
+
 def _verdict(data: dict[str, Any], y: str) -> str:
+    """The section's verdict: for each controller what its step ends in (:func:`synth.sim.verdict.step_verdict`,
+    on as long a run as it takes, which may exceed the horizon shown) and its rise time on the run shown."""
     parts = []
+    shown = data["horizon"]
     for label, run in data["runs"].items():
-        nl, lin = run["nonlinear"], run["linear"]
-        lc = nl["limit_cycle"]
-        if lc["present"] or lc["diverging"]:
-            osc = (f"ends in a sustained oscillation of {fmt(lc['amplitude'])} {y} every {fmt(lc['period'])} s"
-                   if lc["present"] else "diverges")
+        nl, lin, v = run["nonlinear"], run["linear"], run["step_verdict"]
+        lc, horizon = v["limit_cycle"], v["evidence"]["horizon"]
+        beyond = f", beyond the {fmt(shown)} s shown" if horizon > shown * (1 + 1e-9) else ""
+        if v["verdict"] == "limit_cycle":
+            osc = (f"ends in a sustained oscillation of {fmt(lc['amplitude'])} {y} every {fmt(lc['period'])} s "
+                   f"(seen on a {fmt(horizon)} s run{beyond})")
+        elif v["verdict"] == "diverging":
+            osc = f"diverges (seen on a {fmt(horizon)} s run{beyond})"
+        elif v["verdict"] == "settled":
+            osc = f"settles without a limit cycle (settled on a {fmt(horizon)} s run)"
         else:
-            osc = "settles without a limit cycle"
-        parts.append(
-            f"The {label} {run['controller']} {osc}; nonlinear rise time {fmt(nl['rise_time'])} s against "
-            f"{fmt(lin['rise_time'])} s with every nonlinear block off "
-            f"(rate-limited {fmt(nl['rate_limited_time'])} s, "
-            f"saturated {fmt(nl['saturated_time'])} s).")
+            osc = f"is undetermined within {fmt(horizon)} s ({v['evidence']['criterion']})"
+        limited = f"rate-limited {fmt(nl['rate_limited_time'])} s, saturated {fmt(nl['saturated_time'])} s"
+        if nl["rise_time"] is not None:
+            rise = (f"nonlinear rise time {fmt(nl['rise_time'])} s against {fmt(lin['rise_time'])} s with every "
+                    f"nonlinear block off ({limited})")
+        else:
+            rise = (f"no nonlinear rise time, having no final value to rise to ({fmt(lin['rise_time'])} s with every "
+                    f"nonlinear block off; {limited} of the {fmt(shown)} s shown)")
+        parts.append(f"The {label} {run['controller']} {osc}; {rise}.")
     return " ".join(parts)
 
 
@@ -433,6 +471,8 @@ def simulation_figures(spec: Spec, design: Controller | None, reference: Control
         rises = [run[k]["rise_time"] for run in rep.data["runs"].values() for k in ("nonlinear", "linear")]
         rises = [r for r in rises if r is not None and np.isfinite(r)]
         t_end = rep.data["step_time"] + max(0.1, 5 * max(rises, default=0.0))
+        if any(run["step_verdict"]["verdict"] != "settled" for run in rep.data["runs"].values()):
+            t_end = np.inf  # a step that does not settle: the whole run shown
         figs["sim_step"] = figures.step_comparison(rep.runs, out.claim("nonlinear_step.png"), rep.data["units"],
                                                    min(t_end, rep.data["step_time"] + rep.data["horizon"]))
     if rep.onset is not None:
