@@ -292,6 +292,26 @@ def _certify_best(spec: Spec, found: list[tuple[str, Controller]], terms: list[t
     return [(*found[k], certified[k]) for k in range(len(found))], None
 
 
+def initial_in_bounds(spec: Spec) -> Controller | None:
+    """The spec's ``controller.initial``, when every parameter of it lies within the spec's bounds (the design
+    without integral action fixes ``ki`` at 0, outside a start that has one).
+
+    Examples
+    --------
+    >>> from synth.spec import parse_spec
+    >>> spec = parse_spec({"name": "pi", "plant": {"tf": "1/(s+1)"}, "requirements": [{"type": "bandwidth",
+    ...                    "min": 1.0}], "controller": {"type": "PI", "bounds": {"kp": [0, 5], "ki": [0, 5]},
+    ...                    "initial": {"kp": 1.0, "ki": 2.0}}})
+    >>> str(initial_in_bounds(spec)), initial_in_bounds(without_integral_action(spec))
+    ('PI(kp=1, ki=2)', None)
+    """
+    start = spec.controller.initial_controller()
+    if start is None:
+        return None
+    bounds = spec.controller.all_bounds()
+    return start if all(lo <= start.parameters[p] <= hi for p, (lo, hi) in bounds.items()) else None
+
+
 def _polished_from(spec: Spec, starts: list[Controller], terms: list[tuple[str, str, float]], grid: np.ndarray,
                    settings: ConvexSettings, unconverged: set[str]) -> list[tuple[str, Controller]]:
     """Screened starts and what a short NLP polish (3 rounds of :data:`SCREEN_ITERATIONS`) made of each, as
@@ -315,6 +335,9 @@ def _design(spec: Spec, settings: ConvexSettings, nlp: bool | str, explain: bool
     nominal = spec.nominal_plant()
     found: list[tuple[str, Controller]] = [("convex", conv.controller) for _, conv in runs
                                            if conv.status == "optimal"]
+    initial = initial_in_bounds(spec)
+    if initial is not None:  # the spec's own start is a candidate: no design scores below it if it certifies
+        found.append(("initial", initial))
     feasible_runs = [(d, r) for d, r in runs if r.status == "optimal"]
     extras: dict[str, Any] = {"synthesis": {"convex": [r.to_dict() for _, r in runs]}}
     unconverged = {str(r.controller) for _, r in runs if r.status == "optimal" and not r.converged}
@@ -348,6 +371,14 @@ def _design(spec: Spec, settings: ConvexSettings, nlp: bool | str, explain: bool
         stages.append(f"NLP polish (casadi + IPOPT{exact}, {res.iterations} iterations, {res.status})")
         found.extend(("nlp", c) for c in reversed(res.candidates))
         unconverged.update(h["controller"] for h in res.history if h.get("offered"))
+        if initial is not None:  # the convex runs fix a structural parameter on their own grid: its basin is lost
+            announce("NLP polish from the spec's initial controller")
+            res = polish(list(spec.requirements), spec.plants(), initial, spec.controller.all_bounds(), terms,
+                         runs[0][0].grid, settings.per_decade, settings.stability_level)
+            found.extend(("nlp from initial", c) for c in reversed(res.candidates))
+            unconverged.update(h["controller"] for h in res.history if h.get("offered"))
+            stages.append(f"NLP polish from the spec's initial controller ({res.iterations} iterations, "
+                          f"{res.status})")
     candidates, passed = _certify_best(spec, found, terms, per_decade, cache)
     if passed is not None and nlp and spec.objective is not None:  # a local optimum? better points elsewhere
         value = score(Loop(nominal, passed[1]), terms)

@@ -14,7 +14,8 @@ __all__ = ["Optimality", "optimality_of"]
 
 _METHODS = {"convex": "the convex-concave iteration", "nlp": "the NLP polish (IPOPT)",
             "nlp from screen": "the NLP polish (IPOPT) from a screened start",
-            "nlp from pattern search": "the NLP polish (IPOPT) from the pattern search's design"}
+            "nlp from pattern search": "the NLP polish (IPOPT) from the pattern search's design",
+            "nlp from initial": "the NLP polish (IPOPT) from the spec's initial controller"}
 
 
 @dataclass(frozen=True)
@@ -26,7 +27,8 @@ class Optimality:
     local : bool
         The stage that produced the design converged (a KKT point of its problem on the design grid).
     stage : str
-        That stage (``"convex"``, ``"nlp"``, ``"nlp from screen"``, ``"screen"`` or ``"pattern search"``).
+        That stage (``"convex"``, ``"nlp"``, ``"nlp from screen"``, ``"screen"``, ``"pattern search"``,
+        ``"initial"`` or ``"nlp from initial"``).
     basis : str
         One sentence, for the verdict.
     """
@@ -83,6 +85,9 @@ def optimality_of(stage: str, controller: str, unconverged: set[str], screened: 
         return Optimality(False, stage, "not shown to be a local optimum (a pattern search on the exact check "
                           "improved the best design of the stages before, none of which converged); the design is "
                           "certified feasible, a better one may exist" + (f"; {screened}" if screened else ""))
+    if stage == "initial":
+        return Optimality(False, stage, "not optimized: the spec's initial controller, certified; no stage found a "
+                          "better design" + (f"; {screened}" if screened else ""))
     if stage == "screen":
         return Optimality(False, stage, "not optimized: a point of the random screen of the bounds, certified"
                           + (f"; {screened}" if screened else ""))
