@@ -29,7 +29,8 @@ objective: {{maximize: integral_gain}}
     by_name = {r["name"]: r for r in diag["requirements"]}
     assert by_name["sensitivity"]["price"] > 0 and by_name["peak_sensitivity"]["price"] > 0
     assert diag["total_elastic_slack"] > 0
-    assert "cannot be met together): sensitivity, peak_sensitivity" in result.verdict
+    assert "could not meet together): sensitivity, peak_sensitivity" in result.verdict
+    assert "do not prove that none exists" in result.verdict  # a search, not a proof
     assert result.compromise is not None and not result.compromise.feasible
 
 

@@ -100,14 +100,15 @@ def infeasible_verdict(convex: ConvexResult, compromise: Any = None) -> str:
     --------
     >>> c = Controller("P", {"kp": 1.0})
     >>> why = Diagnosis(0.3, [RequirementConflict("bandwidth", 0.3, 2.0, True, -0.3, "bandwidth 1 < 2 rad/s")], [], c)
-    >>> infeasible_verdict(ConvexResult("infeasible", c, np.ones(1), None, 3, 3, 0.1, diagnosis=why))[-80:]
-    'Conflicting requirements (a minimal set that cannot be met together): bandwidth.'
+    >>> infeasible_verdict(ConvexResult("infeasible", c, np.ones(1), None, 3, 3, 0.1, diagnosis=why))[-94:]
+    'Conflicting requirements (a minimal set the same searches could not meet together): bandwidth.'
     """
     diag = convex.diagnosis
     if diag is None:
         raise SynthError("no diagnosis for a design that was not found infeasible")
-    parts = [f"The requirements cannot all be met within the controller bounds (convex-concave from "
-             f"{convex.starts_tried} stabilizing start(s), then NLP from the closest design, found none)."]
+    parts = [f"No design found that meets every requirement within the controller bounds (convex-concave from "
+             f"{convex.starts_tried} stabilizing start(s), then NLP from the closest design: local searches, which "
+             "do not prove that none exists)."]
     violated = [c for c in diag.conflicts if c.violated]
     pushing = [c for c in diag.conflicts if not c.violated and c.name in diag.conflicting()]
     if violated:
@@ -119,6 +120,6 @@ def infeasible_verdict(convex: ConvexResult, compromise: Any = None) -> str:
                      + ", ".join(f"{c.name} (price {c.price:.3g})" for c in pushing) + ".")
     if diag.bounds_active:
         parts.append("Active parameter bounds: " + ", ".join(diag.bounds_active) + ".")
-    parts.append("Conflicting requirements (a minimal set that cannot be met together): "
+    parts.append("Conflicting requirements (a minimal set the same searches could not meet together): "
                  + ", ".join(diag.conflicting()) + ".")
     return " ".join(parts)
