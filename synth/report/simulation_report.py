@@ -185,20 +185,24 @@ def _block_text(b: Any, unit: str) -> str:
     return kind + " " + ", ".join(f"{k} {v}" for k, v in d.items() if v is not None)
 
 
+def _ending(v: dict[str, Any], y: str) -> str:
+    """What a step verdict (``step_verdict``'s dict) says the step ends in, as a verb phrase."""
+    if v["verdict"] == "limit_cycle":
+        lc = v["limit_cycle"]
+        return f"ends in a sustained oscillation of {fmt(lc['amplitude'])} {y} every {fmt(lc['period'])} s"
+    if v["verdict"] == "settled":
+        return "settles without a limit cycle"
+    return "diverges" if v["verdict"] == "diverging" else f"is undetermined within {fmt(v['evidence']['horizon'])} s"
+
+
 def _warning(data: dict[str, Any], y: str) -> str | None:
     """For the report's top verdict: what the design's simulated step ends in, unless it settles."""
     run = data["runs"].get("design")
     if run is None or run["step_verdict"]["verdict"] == "settled":
         return None
-    v = run["step_verdict"]
-    if v["verdict"] == "limit_cycle":
-        what = (f"ends in a sustained oscillation of {fmt(v['limit_cycle']['amplitude'])} {y} every "
-                f"{fmt(v['limit_cycle']['period'])} s")
-    else:
-        what = "diverges" if v["verdict"] == "diverging" else f"is undetermined within {fmt(v['evidence']['horizon'])} s"
     step = " -> ".join(f"{fmt(x)}" for x in data["step"])
-    return (f"Nonlinear step check: the design's simulated step {step} {y} {what} (the spec's simulation block: "
-            "actuator and sensor limits; see below).")
+    return (f"Nonlinear step check: the design's simulated step {step} {y} {_ending(run['step_verdict'], y)} (the "
+            "spec's simulation block: actuator and sensor limits; see below).")
 
 
 def _verdict(data: dict[str, Any], y: str) -> str:
@@ -208,17 +212,13 @@ def _verdict(data: dict[str, Any], y: str) -> str:
     shown = data["horizon"]
     for label, run in data["runs"].items():
         nl, lin, v = run["nonlinear"], run["linear"], run["step_verdict"]
-        lc, horizon = v["limit_cycle"], v["evidence"]["horizon"]
+        horizon = v["evidence"]["horizon"]
         beyond = f", beyond the {fmt(shown)} s shown" if horizon > shown * (1 + 1e-9) else ""
-        if v["verdict"] == "limit_cycle":
-            osc = (f"ends in a sustained oscillation of {fmt(lc['amplitude'])} {y} every {fmt(lc['period'])} s "
-                   f"(seen on a {fmt(horizon)} s run{beyond})")
-        elif v["verdict"] == "diverging":
-            osc = f"diverges (seen on a {fmt(horizon)} s run{beyond})"
-        elif v["verdict"] == "settled":
-            osc = f"settles without a limit cycle (settled on a {fmt(horizon)} s run)"
+        if v["verdict"] == "undetermined":
+            osc = f"{_ending(v, y)} ({v['evidence']['criterion']})"
         else:
-            osc = f"is undetermined within {fmt(horizon)} s ({v['evidence']['criterion']})"
+            seen = "settled" if v["verdict"] == "settled" else "seen"
+            osc = f"{_ending(v, y)} ({seen} on a {fmt(horizon)} s run{beyond if seen == 'seen' else ''})"
         limited = f"rate-limited {fmt(nl['rate_limited_time'])} s, saturated {fmt(nl['saturated_time'])} s"
         if nl["rise_time"] is not None:
             rise = (f"nonlinear rise time {fmt(nl['rise_time'])} s against {fmt(lin['rise_time'])} s with every "

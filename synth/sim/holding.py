@@ -29,7 +29,8 @@ away from where its output changes: winding up there, the output is settled."""
 
 def first_block_holds_for_a_while(block: Any, u: float, du: float) -> bool | None:
     """Whether the first actuator block, seeing the command ``u`` drifting by ``du``, holds its output only
-    until the command reaches a point where it changes (True), for ever (False), or does not hold (None).
+    until the command reaches a point where it changes (True: :func:`held_range` is finite), for ever (False), or
+    does not hold (None).
 
     Examples
     --------
@@ -41,28 +42,28 @@ def first_block_holds_for_a_while(block: Any, u: float, du: float) -> bool | Non
     >>> first_block_holds_for_a_while(sat, 2.0, 0.1), first_block_holds_for_a_while(sat, 2.0, -0.1)
     (False, True)
     """
-    if block.kind == "saturation":
-        if u > block.max:
-            return du < 0
-        if u < block.min:
-            return du > 0
-        return None
+    if block.kind == "saturation" and block.min <= u <= block.max:
+        return None  # within its limits: the output follows the command
     if block.kind == "static":
-        xs = np.array([a for a, _ in block.table])
-        ys = np.array([b for _, b in block.table])
+        xs, ys = _table(block)
         k = int(np.clip(np.searchsorted(xs, u) - 1, 0, xs.size - 2))
         if ys[k + 1] != ys[k]:  # on a sloped piece (or its extension): the output follows the command
             return None
-        # the flat piece ends where a value in the drift's way differs, or where the table's end piece, which
-        # extends for ever, slopes
-        ahead, end_slopes = (ys[xs > u], ys[-1] != ys[-2]) if du > 0 else (ys[xs < u], ys[0] != ys[1])
-        return bool(np.any(ahead != ys[k]) or end_slopes)
-    return True if block.kind in HOLDING_BLOCKS else None
+    elif block.kind not in (*HOLDING_BLOCKS, "saturation"):
+        return None
+    return bool(np.isfinite(held_range(block, u, du)))
+
+
+def _table(block: Any) -> tuple[np.ndarray, np.ndarray]:
+    """A static block's table as its ``x`` and ``y`` columns."""
+    return np.array([a for a, _ in block.table]), np.array([b for _, b in block.table])
 
 
 def memoryless_output(block: Any, x: np.ndarray) -> np.ndarray | None:
     """A memoryless actuator block's output for the input samples ``x`` (a quantizer, a saturation, a dead zone, a
-    table); None for a block with a state (a backlash, a rate limit, dynamics).
+    table); None for a block with a state (a backlash, a rate limit, dynamics). The block equations in numpy, for
+    the whole window at once: the simulator's own are compiled per sample, and loading them for ``Block.apply``
+    costs a process about half a second.
 
     Examples
     --------
@@ -83,8 +84,7 @@ def memoryless_output(block: Any, x: np.ndarray) -> np.ndarray | None:
         c, w = block.center, block.width
         return np.where(x > c + w, x - w, np.where(x < c - w, x + w, c))
     if block.kind == "static":
-        xs = np.array([a for a, _ in block.table])
-        ys = np.array([b for _, b in block.table])
+        xs, ys = _table(block)
         inside = np.interp(x, xs, ys)
         low = ys[0] + (x - xs[0]) * (ys[1] - ys[0]) / (xs[1] - xs[0])  # the end pieces extend for ever
         high = ys[-1] + (x - xs[-1]) * (ys[-1] - ys[-2]) / (xs[-1] - xs[-2])
@@ -115,8 +115,7 @@ def held_range(block: Any, u: float, du: float) -> float:
         edge = block.max if u > block.max else block.min
         return abs(u - edge) if (u - edge) * du < 0 else np.inf
     if block.kind == "static":
-        xs = np.array([a for a, _ in block.table])
-        ys = np.array([b for _, b in block.table])
+        xs, ys = _table(block)
         now = memoryless_output(block, np.array([u]))[0]
         ahead = np.flatnonzero((xs > u) & (ys != now)) if du > 0 else np.flatnonzero((xs < u) & (ys != now))
         if ahead.size:

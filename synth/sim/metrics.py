@@ -96,12 +96,13 @@ beyond anything it reached, 0.8 % of its range); so can one that drifts away for
 simulation benchmark's seed 105, 56 %). The slow tails this is for are 1e-5 of their range from the limit."""
 
 
-def tail_limit(y: np.ndarray) -> float:
+def tail_limit(y: np.ndarray, extrapolate: bool = True) -> float:
     """The final value of a record that still converges: the means ``m1, m2, m3`` of three consecutive windows
     at its end (:data:`TAIL_SHARE` of the record each) extrapolated as a geometric sequence (Aitken's delta
     squared: exact for a tail ``a + b exp(-t / tau)``, whose window means change by a constant ratio), when the
     changes have one sign and shrink by a ratio below :data:`MAX_TAIL_RATIO` and the extrapolation is within
-    :data:`MAX_TAIL_CORRECTION` of the record's range; otherwise the last window's mean.
+    :data:`MAX_TAIL_CORRECTION` of the record's range; otherwise, or with ``extrapolate`` False (a run that ends
+    oscillating or diverging), the last window's mean.
     A loop with a slow pole 11 s long, stopped at 99 s, is 4.6e-5 short of its final value on the last
     window's mean, which moved its 2 % settling time by 6 samples of 1 ms; extrapolated, it is 1.3e-8 short.
 
@@ -119,7 +120,7 @@ def tail_limit(y: np.ndarray) -> float:
     """
     w = max(1, round(TAIL_SHARE * y.size))
     last = float(np.mean(y[-w:]))
-    if y.size < 3 * w:
+    if y.size < 3 * w or not extrapolate:
         return last
     m1, m2 = float(np.mean(y[-3 * w:-2 * w])), float(np.mean(y[-2 * w:-w]))
     d1, d2 = m2 - m1, last - m2
@@ -179,7 +180,7 @@ def nonlinear_step_metrics(result: SimResult, t_step: float = 0.0, final_value: 
     if final_value is not None:
         yf = float(final_value)
     else:
-        yf = tail_limit(ya) if not (osc.present or osc.diverging) else float(np.mean(ya[-max(1, round(0.05 * ya.size)):]))
+        yf = tail_limit(ya, extrapolate=not (osc.present or osc.diverging))
     y0 = float(y[i0])
     base: StepMetrics = step_metrics(ta - ta[0], ya, y0=y0, y_final=yf, settle_band=settle_band)
     settling = None if (osc.present or osc.diverging or not np.isfinite(base.settling_time)) \
