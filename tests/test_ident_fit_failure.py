@@ -41,13 +41,16 @@ def test_a_delay_fitted_below_zero_names_the_fit_not_the_option():
 
 @pytest.mark.slow
 def test_iteration_limit_on_noise_fails_with_the_solver_status():
-    """IPOPT crawls on the flat cost of noise: stopped at the limit (the status is kept) and not above noise.
-    The same square wave sampled at 20 ms (300 samples, noise seed 2): each iteration costs half as much."""
+    """IPOPT crawls on the flat cost of noise: not above noise, and the error carries the status of the fit it
+    judged. The same square wave sampled at 20 ms (300 samples, noise seed 2): each iteration costs half as
+    much. (Until the delay's moves between sample intervals had to lower the cost, the fit kept was one that
+    stopped at the iteration limit; now it is the converged fit before a move that did not pay.)"""
     t = T[::2]
     noise = np.random.default_rng(2).normal(size=t.size)
     with pytest.raises(FitError, match="no more of the output than noise") as info:
         identify((t, U[::2], noise), "K/(T*s+1)", delay="fit")
-    assert info.value.status == "Maximum_Iterations_Exceeded"
+    assert info.value.status in ("Solve_Succeeded", *LIMIT_STATUSES)
+    assert "F-test p = " in str(info.value) and "IPOPT stopped" not in str(info.value)
 
 
 def test_failure_rules():
@@ -140,7 +143,9 @@ def test_ipopt_from_a_far_start_does_not_return_a_fit_worse_than_the_start():
     start_fit = 100.0 * (1.0 - np.linalg.norm(p["y"] - y0) / np.linalg.norm(p["y"] - p["y"].mean()))
     try:
         res = fit_structure(rec, st, "fit", None, initial=start, solver="ipopt", check=True)
-    except FitError as error:  # this machine: IPOPT ends at fit 1.12 %, the start had 70.55 %
-        assert "worse than its start (fit " in str(error) and f"against {start_fit:.2f} % at the start" in str(error)
+    except FitError as error:  # a failure, not a result (this machine: IPOPT stops on an invalid number)
+        assert error.status is not None and "failed: " in str(error)
+        if "worse than its start" in str(error):
+            assert f"against {start_fit:.2f} % at the start" in str(error)
     else:  # where IPOPT's path differs, the fit returned must at least hold the start's
         assert res.fit_percent >= start_fit - 1e-3, (res.fit_percent, start_fit)

@@ -11,12 +11,13 @@ from synth.ident import identify
 @pytest.mark.slow
 def test_whole_record_refit_ignores_an_edge_fit_beyond_nyquist():
     # the Cramer-Rao benchmark's case 44 (k (s+z)/((s+p1)(s+p2)), delay fitted, behind a known sensor, an
-    # aperiodic train whose edges do not settle), noise seed 2: the 0.36 s edge average fitted
-    # p2 = 148,370 rad/s (Nyquist: 628 rad/s) with k = 21,463; the refit from there stopped at IPOPT's
-    # iteration limit and that edge fit was the result
+    # aperiodic train whose edges do not settle). Noise seed 2 once had the 0.36 s edge average fit
+    # p2 = 148,370 rad/s (Nyquist: 628 rad/s) with k = 21,463, and the refit from there stopped at IPOPT's
+    # iteration limit with that edge fit as the result; since a delay move between sample intervals must lower
+    # the cost its edge fit stays below Nyquist. Seed 4's edge fit puts a pair at 4,528 and 4,600 rad/s.
     case = make_case(44, 16000)
     t = np.arange(case.samples) * DT
-    y = 3.0 + case.y0 + case.sigma * np.random.default_rng(2).normal(size=case.samples)
+    y = 3.0 + case.y0 + case.sigma * np.random.default_rng(4).normal(size=case.samples)
     res = identify((t, case.u, y), case.structure, "fit", sensor_text(case.sensor), compare_directions=False)
     fit = res.fit
     assert fit.t.size == case.samples  # the whole record, not the 79-sample average

@@ -12,7 +12,7 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["best_sample"]
+__all__ = ["best_sample", "walk_intervals"]
 
 
 def best_sample(run: Callable[..., tuple], xs: np.ndarray, ssr: float, m: int, st_info: dict[str, Any], shifts: int,
@@ -67,3 +67,81 @@ def best_sample(run: Callable[..., tuple], xs: np.ndarray, ssr: float, m: int, s
             break
         xs, ssr, m, st_info, shifts = best
     return xs, ssr, m, st_info, shifts
+
+
+def walk_intervals(solve: Callable[..., tuple], xi: np.ndarray, d_start: float, offset: float, dt: float,
+                   noise_dof: int, within_sample: bool = False) -> tuple:
+    """A fit with a fitted delay, its whole samples moved while the fraction leaves its sample interval and the
+    move lowers the cost.
+
+    The delay is ``m dt + f``: ``m`` whole samples of the held input and a fraction ``f`` that interpolates
+    between two of them. When the solver carries ``f`` out of ``[0, dt)``, the fit moves to that interval and
+    solves again (at most 20 moves, none to an interval already solved or below 0). A move is kept when it
+    converges to a cost within one noise variance (``SSR / noise_dof``) of the best so far, or converges where
+    the best failed: a biproper model's fraction within the sample trades off with its gain and zero, along a
+    direction the cost hardly sees, and a fraction carried out along it points nowhere. Where a move does not
+    pay, the best fit is refitted with the fraction kept inside its interval and kept if as good.
+
+    Parameters
+    ----------
+    solve : callable
+        ``solve(x0, m, bounded, inside) -> (xs, ssr, status)`` with ``x0 = [parameters, f, offset]`` (the
+        parameters scaled as the solver's), ``m`` the whole samples, ``bounded`` the fraction kept ``>= 0``
+        (``m == 0``), ``inside`` the fraction kept within ``[0, dt]``; ``status["success"]``, ``["iterations"]``.
+    xi : ndarray
+        Starting parameters (scaled).
+    d_start, offset : float
+        Starting delay [s] and output offset.
+    dt : float
+        Sampling interval [s].
+    noise_dof : int
+        Fitted samples less parameters (the noise variance is ``SSR / noise_dof``).
+    within_sample : bool
+        Keep the fraction within the starting interval (no moves).
+
+    Returns
+    -------
+    tuple
+        ``(xs, ssr, m, status, moves)``, ``status["iterations"]`` summed over the solves.
+
+    Examples
+    --------
+    A cost whose fraction drifts out of the first interval along a flat valley, every other interval worse:
+
+    >>> def solve(x0, m, bounded, inside):
+    ...     f = min(x0[1], 0.01) if inside else 0.013
+    ...     return np.array([x0[0], f, x0[2]]), 1.0 + m, {"success": True, "iterations": 3}
+    >>> xs, ssr, m, status, moves = walk_intervals(solve, np.ones(1), 0.004, 0.0, 0.01, 100)
+    >>> m, float(xs[1]), ssr, moves, status["iterations"]
+    (0, 0.005, 1.0, 0, 9)
+    """
+    m = int(np.floor(d_start / dt + 1e-9))
+    f = d_start - m * dt
+    moves, seen, iters, best = 0, set(), 0, None
+    p = xi.size
+    while True:
+        xs, ssr, status = solve(np.r_[xi, f, offset], m, m == 0, within_sample)
+        iters += status["iterations"]
+        ok = bool(status["success"])
+        as_good = best is not None and (ok > best[3]["success"] or (
+            ok == best[3]["success"] and ssr <= best[1] * (1.0 + 1.0 / noise_dof)))
+        if within_sample and best is not None:  # the refit inside the interval, below
+            if not as_good:
+                xs, ssr, m, status = best
+            break
+        if best is not None and not as_good:  # the move did not pay: refit where it left, f inside its interval
+            xs, ssr, m, status = best
+            moves -= 1
+            f, xi, offset, within_sample = 0.5 * dt, xs[:p], xs[-1], True
+            continue
+        if best is None or ok > best[3]["success"] or (ok == best[3]["success"] and ssr < best[1]):
+            best = (xs, ssr, m, status)
+        fx = float(xs[p])
+        seen.add(m)
+        move = int(np.floor(fx / dt))  # f left [0, dt): the delay is in another sample interval
+        if move and not within_sample and (m + move) not in seen and m + move >= 0 and moves < 20:
+            m, f, xi, offset = m + move, fx - move * dt, xs[:p], xs[-1]
+            moves += 1
+            continue
+        break
+    return xs, ssr, m, {**status, "iterations": iters}, moves

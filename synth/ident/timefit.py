@@ -40,7 +40,7 @@ from synth.distributions import t_ppf
 from synth.errors import DataError, FitError, ModelError
 from synth.ident.convolution_problem import ConvolutionProblem
 from synth.ident.covariance import fit_covariance
-from synth.ident.delay_samples import best_sample
+from synth.ident.delay_samples import best_sample, walk_intervals
 from synth.ident.fit_failure import LIMIT_STATUSES, fit_failure, start_ssr
 from synth.ident.identifiability import TiedParameter, WeakParameter, coinciding, tied_to_weak, weak_parameters
 from synth.ident.sim_error_problem import SimulationErrorProblem
@@ -390,32 +390,18 @@ def fit_structure(record: Record, structure: Structure | str, delay: str | float
 
     solve_options = {"rtol": rtol} if isinstance(prob, ConvolutionProblem) else {}
 
+    noise_dof = max(1, (n if mask is None else int(mask.sum())) - p_total)
+
     def run(theta_start: np.ndarray, d_start: float,
             within_sample: bool = False) -> tuple[np.ndarray, float, int, dict[str, Any], int]:
-        m = int(np.floor(d_start / dt + 1e-9))
-        f = d_start - m * dt
-        xi = theta_start / prob.scale
-        shifts, seen, b_start, iters = 0, set(), b0, 0
-        while True:
-            if fit_delay:
-                x0 = np.r_[xi, f, b_start]
-                xs, ssr, st_info = prob.solve(x0, prob.inputs(w, m), nonnegative_f=(m == 0), lower=lb,
-                                              within_sample=within_sample, **solve_options)
-                iters += st_info["iterations"]
-                fx = float(xs[len(xi)])
-                seen.add(m)
-                move = int(np.floor(fx / dt))  # f left [0, dt): the delay is in another sample interval
-                if move and not within_sample and (m + move) not in seen and m + move >= 0 and shifts < 20:
-                    m, f, xi, b_start = m + move, fx - move * dt, xs[:len(xi)], xs[-1]
-                    shifts += 1
-                    continue
-            else:
-                fixed_f = d_start - m * dt
-                xs, ssr, st_info = prob.solve(np.r_[xi, b_start], prob.inputs(w, m, fixed_f), lower=lb,
-                                              **solve_options)
-                iters += st_info["iterations"]
-            st_info["iterations"] = iters
-            return xs, ssr, m, st_info, shifts
+        if not fit_delay:
+            m = int(np.floor(d_start / dt + 1e-9))
+            xs, ssr, st_info = prob.solve(np.r_[theta_start / prob.scale, b0], prob.inputs(w, m, d_start - m * dt),
+                                          lower=lb, **solve_options)
+            return xs, ssr, m, st_info, 0
+        return walk_intervals(lambda x0, m, bounded, inside: prob.solve(
+            x0, prob.inputs(w, m), nonnegative_f=bounded, lower=lb, within_sample=inside, **solve_options),
+            theta_start / prob.scale, d_start, b0, dt, noise_dof, within_sample)
 
     xs, ssr, m, st_info, shifts = run(theta0, d0)
     info["starts"] = 1
