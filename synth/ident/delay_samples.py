@@ -76,11 +76,13 @@ def walk_intervals(solve: Callable[..., tuple], xi: np.ndarray, d_start: float, 
 
     The delay is ``m dt + f``: ``m`` whole samples of the held input and a fraction ``f`` that interpolates
     between two of them. When the solver carries ``f`` out of ``[0, dt)``, the fit moves to that interval and
-    solves again (at most 20 moves, none to an interval already solved or below 0). A move is kept when it
+    solves again (at most 20 moves, none to an interval already solved; a whole delay below 0 goes to the first
+    interval, where the fraction is bounded ``>= 0``). A move is kept when it
     converges to a cost within one noise variance (``SSR / noise_dof``) of the best so far, or converges where
     the best failed: a biproper model's fraction within the sample trades off with its gain and zero, along a
-    direction the cost hardly sees, and a fraction carried out along it points nowhere. Where a move does not
-    pay, the best fit is refitted with the fraction kept inside its interval and kept if as good.
+    direction the cost hardly sees, and a fraction carried out along it points nowhere. A fit whose whole delay
+    is below 0 counts as failed. Where a move does not pay, or the delay stays below 0, the best fit is refitted
+    with the fraction kept inside its interval and kept if as good.
 
     Parameters
     ----------
@@ -122,26 +124,30 @@ def walk_intervals(solve: Callable[..., tuple], xi: np.ndarray, d_start: float, 
     while True:
         xs, ssr, status = solve(np.r_[xi, f, offset], m, m == 0, within_sample)
         iters += status["iterations"]
-        ok = bool(status["success"])
-        as_good = best is not None and (ok > best[3]["success"] or (
-            ok == best[3]["success"] and ssr <= best[1] * (1.0 + 1.0 / noise_dof)))
+        fx = float(xs[p])
+        ok = bool(status["success"]) and m * dt + fx >= 0.0  # a whole delay below 0 is no plant's
+        as_good = best is not None and (ok > best[4] or (ok == best[4] and ssr <= best[1] * (1.0 + 1.0 / noise_dof)))
         if within_sample and best is not None:  # the refit inside the interval, below
             if not as_good:
-                xs, ssr, m, status = best
+                xs, ssr, m, status = best[:4]
             break
         if best is not None and not as_good:  # the move did not pay: refit where it left, f inside its interval
-            xs, ssr, m, status = best
+            xs, ssr, m, status = best[:4]
             moves -= 1
             f, xi, offset, within_sample = 0.5 * dt, xs[:p], xs[-1], True
             continue
-        if best is None or ok > best[3]["success"] or (ok == best[3]["success"] and ssr < best[1]):
-            best = (xs, ssr, m, status)
-        fx = float(xs[p])
+        if best is None or ok > best[4] or (ok == best[4] and ssr < best[1]):
+            best = (xs, ssr, m, status, ok)
         seen.add(m)
         move = int(np.floor(fx / dt))  # f left [0, dt): the delay is in another sample interval
-        if move and not within_sample and (m + move) not in seen and m + move >= 0 and moves < 20:
-            m, f, xi, offset = m + move, fx - move * dt, xs[:p], xs[-1]
+        target = max(m + move, 0)  # below 0 samples: the first interval, its fraction bounded >= 0
+        if move and not within_sample and target not in seen and moves < 20:
+            m, f, xi, offset = target, fx - (target - m) * dt, xs[:p], xs[-1]
             moves += 1
+            continue
+        if m * dt + fx < 0.0 and not within_sample:  # still below 0: refit with the fraction inside the interval
+            f, xi, offset, within_sample = 0.5 * dt, xs[:p], xs[-1], True
             continue
         break
     return xs, ssr, m, {**status, "iterations": iters}, moves
+
