@@ -77,12 +77,12 @@ def walk_intervals(solve: Callable[..., tuple], xi: np.ndarray, d_start: float, 
     The delay is ``m dt + f``: ``m`` whole samples of the held input and a fraction ``f`` that interpolates
     between two of them. When the solver carries ``f`` out of ``[0, dt)``, the fit moves to that interval and
     solves again (at most 20 moves, none to an interval already solved; a whole delay below 0 goes to the first
-    interval, where the fraction is bounded ``>= 0``). A move is kept when it
-    converges to a cost within one noise variance (``SSR / noise_dof``) of the best so far, or converges where
-    the best failed: a biproper model's fraction within the sample trades off with its gain and zero, along a
-    direction the cost hardly sees, and a fraction carried out along it points nowhere. A fit whose whole delay
-    is below 0 counts as failed. Where a move does not pay, or the delay stays below 0, the best fit is refitted
-    with the fraction kept inside its interval and kept if as good.
+    interval, where the fraction is bounded ``>= 0``). A move is kept when it converges to a cost within one
+    noise variance (``SSR / noise_dof``) of the best so far, or converges where the best failed: a biproper
+    model's fraction within the sample trades off with its gain and zero, along a direction the cost hardly
+    sees, and a fraction carried out along it points nowhere. A fit whose whole delay is below 0 counts as
+    failed. Where a move does not pay, or the delay stays below 0, the best fit is refitted with the fraction
+    kept inside its interval, and that refit is kept if as good.
 
     Parameters
     ----------
@@ -150,4 +150,3 @@ def walk_intervals(solve: Callable[..., tuple], xi: np.ndarray, d_start: float, 
             continue
         break
     return xs, ssr, m, {**status, "iterations": iters}, moves
-
