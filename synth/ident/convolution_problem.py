@@ -160,13 +160,14 @@ class ConvolutionProblem:
         in double precision (below ``1e-17`` of its largest value, over a whole block)."""
         s = A.shape[0]
         blk = min(_BLOCK, length)
-        U = np.empty((s, blk, 2))
-        v, P = B, np.eye(s)
-        for j in range(blk):
-            U[:, j] = v
-            v = A @ v
-            P = A @ P
-        U = U.reshape(s, 2 * blk)
+        # [B, A B, ..., A^(blk-1) B] by doubling: [U, A^k U] doubles a block of k columns (log2(blk) products
+        # instead of blk, each of which also advanced A^k one step)
+        U, P = B[:, None, :], A  # (s, k, 2) and A^k
+        while U.shape[1] < blk:
+            U = np.concatenate([U, np.einsum("ij,jkl->ikl", P, U)], axis=1)
+            P = P @ P
+        P = np.linalg.matrix_power(A, blk) if U.shape[1] != blk else P
+        U = U[:, :blk].reshape(s, 2 * blk)
         blocks, peak, g = [], np.zeros(C.shape[0]), C
         for _ in range(-(-length // blk)):
             R = g @ U  # rows x (blk * 2)
