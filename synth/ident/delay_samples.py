@@ -126,27 +126,27 @@ def walk_intervals(solve: Callable[..., tuple], xi: np.ndarray, d_start: float, 
         iters += status["iterations"]
         fx = float(xs[p])
         ok = bool(status["success"]) and m * dt + fx >= 0.0  # a whole delay below 0 is no plant's
+        # converged before failed, then the cost: within one noise variance of the best is as good
         as_good = best is not None and (ok > best[4] or (ok == best[4] and ssr <= best[1] * (1.0 + 1.0 / noise_dof)))
         if within_sample and best is not None:  # the refit inside the interval, below
             if not as_good:
                 xs, ssr, m, status = best[:4]
             break
-        if best is not None and not as_good:  # the move did not pay: refit where it left, f inside its interval
+        if best is not None and not as_good:  # the move did not pay: back to the fit it left
             xs, ssr, m, status = best[:4]
             moves -= 1
-            f, xi, offset, within_sample = 0.5 * dt, xs[:p], xs[-1], True
-            continue
-        if best is None or ok > best[4] or (ok == best[4] and ssr < best[1]):
-            best = (xs, ssr, m, status, ok)
-        seen.add(m)
-        move = int(np.floor(fx / dt))  # f left [0, dt): the delay is in another sample interval
-        target = max(m + move, 0)  # below 0 samples: the first interval, its fraction bounded >= 0
-        if move and not within_sample and target not in seen and moves < 20:
-            m, f, xi, offset = target, fx - (target - m) * dt, xs[:p], xs[-1]
-            moves += 1
-            continue
-        if m * dt + fx < 0.0 and not within_sample:  # still below 0: refit with the fraction inside the interval
-            f, xi, offset, within_sample = 0.5 * dt, xs[:p], xs[-1], True
-            continue
-        break
+        else:
+            if best is None or ok > best[4] or (ok == best[4] and ssr < best[1]):
+                best = (xs, ssr, m, status, ok)
+            seen.add(m)
+            move = int(np.floor(fx / dt))  # f left [0, dt): the delay is in another sample interval
+            target = max(m + move, 0)  # below 0 samples: the first interval, its fraction bounded >= 0
+            if move and not within_sample and target not in seen and moves < 20:
+                m, f, xi, offset = target, fx - (target - m) * dt, xs[:p], xs[-1]
+                moves += 1
+                continue
+            if within_sample or m * dt + fx >= 0.0:
+                break
+        # a move that did not pay, or a whole delay still below 0: refit with the fraction inside the interval
+        f, xi, offset, within_sample = 0.5 * dt, xs[:p], xs[-1], True
     return xs, ssr, m, {**status, "iterations": iters}, moves
