@@ -15,6 +15,7 @@ import numpy as np
 
 from synth.controllers import Controller, as_controller
 from synth.freqgrid import characteristic_range, first_fall, log_grid
+from synth.narrow_peaks import LIGHT_DAMPING, narrow_peak_frequencies
 from synth.plant import Plant, as_plant
 from synth.polynomials import dc_value, format_factored, horner, magnitude_squared_in_w2, trim
 from synth.stability import StabilityResult, closed_loop_stability, stability_floor
@@ -217,6 +218,28 @@ class Loop:
         """Log frequency grid over :attr:`frequency_range`."""
         return log_grid(*self.frequency_range, per_decade)
 
+    @cached_property
+    def narrow_peaks(self) -> np.ndarray:
+        """Frequencies around lightly damped closed-loop poles, whose peaks a log grid can step over
+        (:func:`synth.narrow_peaks.narrow_peak_frequencies`).
+
+        Examples
+        --------
+        >>> loop = Loop(Plant.from_string("1/(s^2 + 0.001*s + 1)"), Controller("P", {"kp": 0.1}))
+        >>> bool(np.any(np.abs(loop.narrow_peaks - np.sqrt(1.1)) < 1e-6))
+        True
+        """
+        try:
+            if self.delay == 0.0:
+                return narrow_peak_frequencies(self.closed_loop_poles())
+            # with a delay, only a closed-loop pole next to a lightly damped open-loop pole or zero (that nearly
+            # cancels it in |S| or |T|) hides its peak from the grid: Newton's method from those alone
+            seeds = np.concatenate([np.roots(self.den), np.roots(self.num)]) if self.num.size > 1 else np.roots(self.den)
+            seeds = seeds[(seeds.imag > 0) & (np.abs(seeds.real) < LIGHT_DAMPING * np.abs(seeds))]
+            return narrow_peak_frequencies(self.quasi_roots(seeds)) if seeds.size else np.zeros(0)
+        except (ArithmeticError, ValueError, np.linalg.LinAlgError):  # no poles found: the grid alone
+            return np.zeros(0)
+
     def gain_crossovers(self) -> np.ndarray:
         """All frequencies where ``|L(jw)| = 1`` (exact polynomial roots; the delay has |.| = 1).
 
@@ -316,7 +339,19 @@ class Loop:
             roots = np.roots(trim(np.polyadd(self.den, self.num)))
             return roots[np.argsort(-roots.real)]
         pn, pd = _pade(self.delay, pade_order)
-        seeds = np.roots(trim(np.polyadd(np.polymul(self.den, pd), np.polymul(self.num, pn))))
+        return self.quasi_roots(np.roots(trim(np.polyadd(np.polymul(self.den, pd), np.polymul(self.num, pn)))))
+
+    def quasi_roots(self, seeds: np.ndarray) -> np.ndarray:
+        """Roots of ``den(s) + num(s) exp(-delay s)`` by Newton's method from ``seeds`` (the converged ones,
+        without repeats, sorted by decreasing real part).
+
+        Examples
+        --------
+        >>> loop = Loop(Plant.from_string("1/(s+1)", delay=0.1), Controller("P", {"kp": 2.0}))
+        >>> r = loop.quasi_roots(np.array([-3.0 + 0j]))
+        >>> float(abs(r[0] + 1 + 2 * np.exp(-0.1 * r[0])))
+        0.0
+        """
         polys = [self.den, self.num, np.polyder(self.den), np.polyder(self.num)]
         width = max(p.size for p in polys)
         rows = np.array([np.concatenate([np.zeros(width - p.size), p]) for p in polys])

@@ -27,10 +27,26 @@ if TYPE_CHECKING:
     from synth.loop_batch import LoopBatch
 
 __all__ = ["FAR", "MAX_DB", "PeakComplementary", "PeakRequirement", "PeakSensitivity", "Sensitivity", "StaticSensitivity",
-           "band_text"]
+           "band_text", "with_narrow_peaks"]
 
 MAX_DB = {"max_db": Bound("upper", "dB")}
 """The bound of every requirement here: a magnitude at most ``max_db``."""
+
+
+def with_narrow_peaks(grid: np.ndarray, loop: Loop, band: tuple[float, float]) -> np.ndarray:
+    """``grid`` with the loop's :attr:`~synth.loop.Loop.narrow_peaks` inside ``band`` added (sorted, unique).
+
+    Examples
+    --------
+    >>> from synth.loop import Loop; from synth.plant import Plant; from synth.controllers import Controller
+    >>> loop = Loop(Plant.from_string("1/(s^2 + 0.001*s + 1)"), Controller("P", {"kp": 0.1}))
+    >>> grid = with_narrow_peaks(np.geomspace(0.1, 10.0, 9), loop, (0.0, 10.0))
+    >>> grid.size > 9, bool(np.all(np.diff(grid) > 0))
+    (True, True)
+    """
+    extra = loop.narrow_peaks
+    extra = extra[(extra >= band[0]) & (extra <= band[1])]
+    return np.union1d(grid, extra) if extra.size else grid
 
 
 def band_text(band: tuple[float, float]) -> str:
@@ -65,7 +81,7 @@ class Sensitivity(BandMixin, Requirement):
     example: ClassVar[dict[str, Any]] = {"type": "sensitivity", "max_db": -15.0, "band": (0.0, 30.0)}
 
     def evaluate(self, loop: Loop, per_decade: int = 80) -> RequirementResult:
-        grid = band_grid(self.band, loop.frequency_range, per_decade)
+        grid = with_narrow_peaks(band_grid(self.band, loop.frequency_range, per_decade), loop, self.band)
         value, w_peak = peak(lambda w: np.abs(loop.S(w)), grid)
         value_db = db(value)
         margin = self.max_db - value_db
@@ -204,11 +220,12 @@ class PeakRequirement(Requirement):
     def evaluate(self, loop: Loop, per_decade: int = 80) -> RequirementResult:
         if self.band is not None:
             check_band(self.band)
-            grid = band_grid(self.band, loop.frequency_range, per_decade)
+            grid = with_narrow_peaks(band_grid(self.band, loop.frequency_range, per_decade), loop, self.band)
             where = band_text(self.band)
         else:
             lo, hi = loop.frequency_range
             grid = np.append(log_grid(lo, hi * 10, per_decade), hi * FAR)  # the limit w -> inf (|KS| -> |C(inf)|)
+            grid = with_narrow_peaks(grid, loop, (0.0, np.inf))
             where = "over all frequencies"
         value, w_peak = peak(self.curve(loop), grid)
         value_db = db(value)
