@@ -14,11 +14,14 @@ from collections.abc import Iterator
 
 import numpy as np
 
+from synth.controllers import RATIONAL
 from synth.plant import Plant
 from synth.synthesis.gainset import ScalarFamily, stability_set
-from synth.synthesis.parametrization import Parametrization
+from synth.synthesis.intervals import interval_middle
+from synth.synthesis.parametrization import Parametrization, RationalParametrization
+from synth.synthesis.rational_slices import RATIONAL_SLICES, rational_slices
 
-__all__ = ["LEADLAG_SLICES", "axis_starts", "interval_middle", "leadlag_slices", "scan_note"]
+__all__ = ["LEADLAG_SLICES", "axis_starts", "leadlag_slices", "scan_note"]
 
 SCANNED_TYPES = ("P", "PI", "PID")
 """Controller types whose convex parameters are their own gains (a lead-lag's are ``k`` and ``k z``)."""
@@ -77,21 +80,9 @@ def scan_note(ctype: str) -> str:
         return " and the exact stabilizing set of each gain alone (the others at their values nearest 0)"
     if ctype == "leadlag":
         return f" and the exact stabilizing set of k for {LEADLAG_SLICES} zeros drawn in the bounds"
+    if ctype == RATIONAL:
+        return f" and the exact stabilizing set of the numerator's gain for {RATIONAL_SLICES} pole/zero patterns"
     return ""
-
-
-def interval_middle(lo: float, hi: float) -> float:
-    """A point well inside ``[lo, hi]``: the geometric middle of an interval of one sign spanning more than a
-    factor 10, else the arithmetic middle.
-
-    Examples
-    --------
-    >>> interval_middle(-2.0, -1.5), interval_middle(1e-4, 1.0)
-    (-1.75, 0.01)
-    """
-    if lo * hi > 0 and max(abs(lo), abs(hi)) > 10 * min(abs(lo), abs(hi)):
-        return float(np.sign(lo) * np.sqrt(lo * hi))
-    return 0.5 * (lo + hi)
 
 
 def axis_starts(par: Parametrization, plants: list[Plant]) -> Iterator[np.ndarray]:
@@ -108,6 +99,9 @@ def axis_starts(par: Parametrization, plants: list[Plant]) -> Iterator[np.ndarra
     """
     if par.ctype == "leadlag":
         yield from leadlag_slices(par, plants)
+        return
+    if isinstance(par, RationalParametrization):
+        yield from rational_slices(par, plants)
         return
     if par.ctype not in SCANNED_TYPES:
         return

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["intersect", "remove", "union"]
+__all__ = ["intersect", "interval_middle", "remove", "union"]
 
 Intervals = list[tuple[float, float]]
 
@@ -66,3 +66,17 @@ def remove(a: Intervals, lo: float, hi: float) -> Intervals:
         if a_hi >= above:
             out.append((above, a_hi))
     return out
+
+
+def interval_middle(lo: float, hi: float) -> float:
+    """A point well inside ``[lo, hi]``: the geometric middle of an interval of one sign spanning more than a
+    factor 10, else the arithmetic middle.
+
+    Examples
+    --------
+    >>> interval_middle(-2.0, -1.5), interval_middle(1e-4, 1.0)
+    (-1.75, 0.01)
+    """
+    if lo * hi > 0 and max(abs(lo), abs(hi)) > 10 * min(abs(lo), abs(hi)):
+        return float(np.sign(lo) * np.sqrt(lo * hi))
+    return 0.5 * (lo + hi)

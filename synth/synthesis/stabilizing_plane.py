@@ -35,9 +35,9 @@ from synth.plant import Plant
 from synth.polynomials import largest_crossing, shifted, trim
 from synth.rootfind import bisect_roots
 from synth.stability import MAX_PHASE_POINTS, PHASE_STEP, characteristic_scale, stability_floor
-from synth.synthesis.axis_starts import interval_middle
 from synth.synthesis.chord_crossings import CHORD, chord_crossings, line_crossings
 from synth.synthesis.gainset import ScalarFamily, stability_set
+from synth.synthesis.intervals import interval_middle
 from synth.synthesis.parametrization import Parametrization
 
 __all__ = ["CHORD", "MAX_POINTS", "MAX_STRIPS", "PlaneSearch", "plane_search", "plane_starts"]
