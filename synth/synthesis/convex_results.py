@@ -75,6 +75,8 @@ class ConvexResult:
     grid_points: int = 0
     starts_tried: int = 1
     converged: bool = False
+    note: str = ""
+    """What was run beyond the usual (a rescaled second run: :mod:`synth.synthesis.rational_rescale`)."""
 
     def to_dict(self) -> dict[str, Any]:
         return {
@@ -89,7 +91,7 @@ class ConvexResult:
             "starts_tried": self.starts_tried,
             "history": self.history,
             "diagnosis": self.diagnosis.to_dict() if self.diagnosis else None,
-        }
+        } | ({"note": self.note} if self.note else {})
 
 
 def infeasible_verdict(convex: ConvexResult, compromise: Any = None) -> str:

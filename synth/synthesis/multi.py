@@ -48,6 +48,7 @@ from synth.synthesis.optimality import optimality_of
 from synth.synthesis.parametrization import STRUCTURAL, parametrize, reference_frequency
 from synth.synthesis.pattern import BOUNDARY_CHECKS, pattern_search
 from synth.synthesis.polish_skip import exact_forms, polish_redundant
+from synth.synthesis.rational_rescale import rescaled_run
 from synth.synthesis.scalar import design_scalar
 from synth.synthesis.screen import SCREEN_ITERATIONS, screen_improving, screen_near_improving, screen_size, screen_starts
 from synth.synthesis.stabilizing_slices import open_loop_unstable, slices_text, stabilizing_slices
@@ -223,6 +224,8 @@ def convex_runs(spec: Spec, settings: ConvexSettings) -> list[tuple[ConvexDesign
         run(v)
     if not runs:
         raise no_start[0]
+    if key is None and runs[0][1].status != "optimal":  # a rational loop far above the plant's corners
+        runs.extend([rescaled] if (rescaled := rescaled_run(spec, settings, names, (name, sense))) else [])
     if key is not None and len(values) > 1:
         terms, nominal = objective_terms(spec), spec.nominal_plant()
 
@@ -345,9 +348,9 @@ def _design(spec: Spec, settings: ConvexSettings, nlp: bool | str, explain: bool
     ref = reference_check(spec)
     stages = [f"convex-concave (cvxpy + Clarabel) on {runs[0][1].grid_points} frequency points x "
               f"{len(spec.plants())} plant(s), {sum(r.solves for _, r in runs)} convex solves"]
-    if len(runs) > 1:
-        key = STRUCTURAL[spec.controller.type]
-        stages[0] += f", {len(runs)} fixed values of {key}"
+    if len(runs) > 1 and spec.controller.type in STRUCTURAL:
+        stages[0] += f", {len(runs)} fixed values of {STRUCTURAL[spec.controller.type]}"
+    stages[0] += "".join(f"; {r.note}" for _, r in runs if r.note)
     cache: dict[int, Certificate] = {}
     redundant = polish_redundant(spec, [r for _, r in runs]) if nlp is True else None
     if redundant is not None:
@@ -484,6 +487,7 @@ def _design(spec: Spec, settings: ConvexSettings, nlp: bool | str, explain: bool
     if screened:
         nlp_note += (f" {screened} more candidate(s) from the random screen of the bounds and NLP polishes from "
                      "them fail it too.")
+    nlp_note += "".join(f" Also tried: {r.note}." for _, r in runs if r.note)
     result.verdict = infeasible_verdict(worst, compromise) + nlp_note + reference_verdict(spec, ref)
     return result
 
