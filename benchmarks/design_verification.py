@@ -349,7 +349,11 @@ def main() -> None:
                             biproper=float(stored[0].get("biproper", 0.0)) if stored else 0.0)
         fh = args.json.open("w") if args.json else None
         for old in tqdm(sorted(stored, key=lambda r: r["index"]), desc="synth re-run"):
-            rec = run_problem(problems[old["index"]], time_limit=args.time_limit, stored=old)
+            problem = problems[old["index"]]
+            if problem.spec != old["spec"]:  # a record of an older generator, or one that did not store its biproper
+                # share (seed 21's: regenerated at 0, its problems were other plants): the record's own problem
+                problem = Problem(old["index"], old["spec"], old["num"], old["den"], old["delay"], old["features"])
+            rec = run_problem(problem, time_limit=args.time_limit, stored=old)
             records.append(rec)
             if fh:
                 fh.write(json.dumps(rec, default=float) + "\n")
