@@ -139,6 +139,29 @@ class LoopModel:
         return {"w": w, "G": self.G(w), "ws": ws, "Gs": np.polyval(self.num, s) / np.polyval(self.den, s)
                 * np.exp(-self.delay * s)}
 
+    def _near_axis(self, g: dict[str, np.ndarray], cn: np.ndarray, cd: np.ndarray) -> dict[str, np.ndarray]:
+        """``g`` with points added around every open-loop pole and zero (plant and controller) within 2 % of its
+        modulus of the contour: ``Im r + k d`` for ``|k|`` from 0.01 to 200 (geometric), ``d`` its distance from
+        the contour. Near such a root ``1 + L`` can turn through a whole circle, and ``|S|`` or ``|T|`` peak,
+        between two points of a log grid (seed 8 #88: controller poles at ``0.0018 +- 26.41j``, closed-loop
+        poles at ``-0.0071 +- 26.405j``, a peak 0.01 rad/s wide)."""
+        polys = [q for q in (self.den, self.num, cd, cn) if np.asarray(q).size > 1]
+        roots = np.concatenate([np.roots(q) for q in polys]) if polys else np.zeros(0, complex)
+        roots = roots[np.isfinite(roots) & (roots.imag > 0)]
+        near = roots[np.abs(roots.real + self.eps) < 0.02 * np.abs(roots)]
+        if near.size == 0:
+            return g
+        dist = np.maximum(np.abs(near.real + self.eps), 1e-12 * np.abs(near))
+        k = np.geomspace(0.01, 200.0, 60)
+        k = np.concatenate([-k[::-1], [0.0], k])
+        extra = (near.imag[:, None] + dist[:, None] * k[None, :]).ravel()
+        extra = extra[extra > 0]
+        ws = np.union1d(g["ws"], extra)
+        w = np.union1d(g["w"], extra[(extra >= self.w_lo) & (extra <= self.w_hi)])
+        s = -self.eps + 1j * ws
+        return {"w": w, "G": self.G(w), "ws": ws,
+                "Gs": np.polyval(self.num, s) / np.polyval(self.den, s) * np.exp(-self.delay * s)}
+
     def F_shifted(self, ws: np.ndarray, cn: np.ndarray, cd: np.ndarray) -> np.ndarray:
         """``1 + L(s)`` on ``s = -eps + j ws``."""
         s = -self.eps + 1j * ws
@@ -177,6 +200,7 @@ class LoopModel:
         g = self.grids[DENSE_PER_DECADE if dense else COARSE_PER_DECADE]
         if cd[0] == 0 or not np.all(np.isfinite(cn)):
             return Evaluation(p, False, 99, dense=dense)
+        g = self._near_axis(g, cn, cd)
         if self.delay == 0.0:  # a polynomial: its roots, counted directly
             unstable = self._polynomial_count(cn, cd)
             if unstable:
