@@ -87,7 +87,9 @@ def scan_note(ctype: str) -> str:
 
 def axis_starts(par: Parametrization, plants: list[Plant]) -> Iterator[np.ndarray]:
     """``rho`` at the middle of every exact stabilizing interval of each gain alone (see the module
-    docstring), gain by gain, for P, PI and PID controllers (nothing for other types).
+    docstring), gain by gain, for P, PI and PID controllers; of the gain ``k`` for drawn zeros of a lead-lag
+    (:func:`leadlag_slices`) and of the numerator's gain for drawn pole/zero patterns of a rational controller
+    (:func:`synth.synthesis.rational_slices.rational_slices`).
 
     Examples
     --------
