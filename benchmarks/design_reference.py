@@ -39,6 +39,15 @@ LN10_20 = np.log(10) / 20
 DB3 = 10 ** (-3 / 20)
 
 
+def _distinct(w: np.ndarray) -> np.ndarray:
+    """Sorted ``w`` without points within 1e-9 (relative) of the one before: brackets between such neighbours
+    are empty in floating point (a sign change seen on the grid that ``brentq`` cannot find again)."""
+    if w.size < 2:
+        return w
+    keep = np.concatenate([[True], np.diff(w) > 1e-9 * np.abs(w[1:])])
+    return w[keep]
+
+
 def controller_polys(ctype: str, order: list[int] | None, p: dict[str, float]) -> tuple[np.ndarray, np.ndarray]:
     """Controller numerator and denominator from the spec-format table."""
     t = ctype.lower()
@@ -151,13 +160,13 @@ class LoopModel:
         near = roots[np.abs(roots.real + self.eps) < 0.02 * np.abs(roots)]
         if near.size == 0:
             return g
-        dist = np.maximum(np.abs(near.real + self.eps), 1e-12 * np.abs(near))
+        dist = np.maximum(np.abs(near.real + self.eps), 1e-7 * np.abs(near))  # a root on the axis: 1e-7 of it
         k = np.geomspace(0.01, 200.0, 60)
         k = np.concatenate([-k[::-1], [0.0], k])
         extra = (near.imag[:, None] + dist[:, None] * k[None, :]).ravel()
         extra = extra[extra > 0]
-        ws = np.union1d(g["ws"], extra)
-        w = np.union1d(g["w"], extra[(extra >= self.w_lo) & (extra <= self.w_hi)])
+        ws = _distinct(np.union1d(g["ws"], extra))
+        w = _distinct(np.union1d(g["w"], extra[(extra >= self.w_lo) & (extra <= self.w_hi)]))
         s = -self.eps + 1j * ws
         return {"w": w, "G": self.G(w), "ws": ws,
                 "Gs": np.polyval(self.num, s) / np.polyval(self.den, s) * np.exp(-self.delay * s)}
