@@ -1,7 +1,8 @@
 """Stabilizing starts of a rational controller from exact one-parameter scans of its gain.
 
 A rational controller ``C = X/D`` is affine in a common factor ``k`` of its numerator. For a denominator and
-numerator shape drawn in the bounds (real poles and zeros, log-uniform over the frequencies the bounds allow),
+numerator shape drawn in the bounds (real poles, complex pairs and real zeros, log-uniform over the frequencies
+the bounds allow),
 the exact stabilizing set of ``k`` (D-decomposition, :func:`synth.synthesis.gainset.stability_set`) gives
 starts that random draws of every coefficient miss: on an open-loop unstable plant a loop needs both a gain in
 a narrow range and controller poles well above the crossover it forces, a corner of a box of several decades
@@ -28,14 +29,14 @@ RATIONAL_SLICES = 40
 its gain."""
 
 SPAN_BELOW = 10.0
-"""Poles and zeros are drawn from ``w0 / SPAN_BELOW`` up to the fastest the bounds allow."""
+"""Poles and zeros are drawn from ``w0 / SPAN_BELOW`` up to the fastest the bounds allow ..."""
+
+SPAN_ABOVE = 1e4
+"""... and at most ``w0 * SPAN_ABOVE`` where the bounds allow any."""
 
 DAMPING_MIN = 0.05
 """Complex pole pairs are drawn with damping log-uniform in ``[DAMPING_MIN, 1]``: a lightly damped pair above the
 crossover adds little phase lag below it while its gain still rolls off (seed 23 #5's feasible set needs one)."""
-
-SPAN_ABOVE = 1e4
-"""... and at most ``w0 * SPAN_ABOVE`` where the bounds allow any."""
 
 
 class ShapedGain(ScalarFamily):
@@ -57,10 +58,10 @@ class ShapedGain(ScalarFamily):
         return Controller(RATIONAL, {**{n: float(value) * c for n, c in self.shape.items()}, **self.fixed})
 
 
-def _fastest(names: list[str], hi: np.ndarray, count: int, cap: float) -> float:
-    """The largest ``p <= cap`` with every coefficient of ``(s + p)^count`` inside its upper bound."""
-    coeffs = np.poly1d([1.0, 1.0]) ** count
-    binom = coeffs.coeffs[::-1][: len(names)]  # binom[i]: the coefficient of s^i, times p^(count - i)
+def _fastest(hi: np.ndarray, count: int, cap: float) -> float:
+    """The largest ``p <= cap`` with every coefficient of ``(s + p)^count`` below ``s^count`` inside its upper
+    bound ``hi`` (``hi[i]`` bounds the coefficient of ``s^i``)."""
+    binom = (np.poly1d([1.0, 1.0]) ** count).coeffs[::-1]  # binom[i]: the coefficient of s^i, times p^(count - i)
     p = cap
     for i, h in enumerate(hi):
         if np.isfinite(h) and binom[i] > 0:
@@ -105,7 +106,7 @@ def rational_slices(par: RationalParametrization, plants: list[Plant], draws: in
     if integrator:  # D = s * D1: the bounds on a_i hold D1's coefficient of s^(i-1)
         a_hi = a_hi[1:]
     p_min = par.w0 / SPAN_BELOW
-    p_max = _fastest(a_names, a_hi, free_poles, par.w0 * SPAN_ABOVE) if free_poles > 0 else p_min
+    p_max = _fastest(a_hi, free_poles, par.w0 * SPAN_ABOVE) if free_poles > 0 else p_min
     z_max = par.w0 * SPAN_ABOVE
     if not (np.all(np.isfinite(lo[: par.m + 1])) or np.all(np.isfinite(hi[: par.m + 1]))) or p_max <= p_min:
         return
