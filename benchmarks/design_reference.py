@@ -48,6 +48,17 @@ def _distinct(w: np.ndarray) -> np.ndarray:
     return w[keep]
 
 
+def _log_crossing(f: Any, w_a: float, w_b: float, xtol: float) -> float:
+    """The frequency in ``[w_a, w_b]`` where ``f`` changes sign, found by ``brentq`` in ``log w``. The grid saw a
+    sign change between the two points; when ``f`` at ``exp(log w)`` (a rounded copy of the grid point) no longer
+    shows it, the crossing is at an end within rounding, and the end where ``|f|`` is smaller is returned."""
+    a, b = np.log(w_a), np.log(w_b)
+    fa, fb = f(np.exp(a)), f(np.exp(b))
+    if fa == 0 or fb == 0 or np.sign(fa) == np.sign(fb):
+        return float(w_a if abs(fa) <= abs(fb) else w_b)
+    return float(np.exp(brentq(lambda lx: f(np.exp(lx)), a, b, xtol=xtol)))
+
+
 def controller_polys(ctype: str, order: list[int] | None, p: dict[str, float]) -> tuple[np.ndarray, np.ndarray]:
     """Controller numerator and denominator from the spec-format table."""
     t = ctype.lower()
@@ -301,8 +312,7 @@ class LoopModel:
             i = int(below[0])
             if i == 0:
                 return float(w[0])
-            return float(np.exp(brentq(lambda lx: funcs["T"](np.exp(lx)) - thr, np.log(w[i - 1]), np.log(w[i]),
-                                       xtol=1e-12)))
+            return _log_crossing(lambda x: funcs["T"](x) - thr, w[i - 1], w[i], 1e-12)
 
         for k, r in enumerate(self.requirements):
             t = r["type"]
@@ -377,7 +387,7 @@ class LoopModel:
         im = L.imag
         for i in np.nonzero(np.sign(im[:-1]) * np.sign(im[1:]) < 0)[0]:
             if L[i].real < 0 or L[i + 1].real < 0:
-                x = np.exp(brentq(lambda lx: Lf(np.exp(lx)).imag, np.log(w[i]), np.log(w[i + 1]), xtol=1e-13))
+                x = _log_crossing(lambda x: Lf(x).imag, w[i], w[i + 1], 1e-13)
                 lv = Lf(x)
                 if lv.real < 0:
                     ks.append(1 / abs(lv))
@@ -387,7 +397,7 @@ class LoopModel:
                  -20 * np.log10(max(down)) if down else np.inf)
         pm, dm = np.inf, np.inf
         for i in np.nonzero(np.sign(mag[:-1]) * np.sign(mag[1:]) < 0)[0]:
-            x = np.exp(brentq(lambda lx: np.log(abs(Lf(np.exp(lx)))), np.log(w[i]), np.log(w[i + 1]), xtol=1e-13))
+            x = _log_crossing(lambda x: np.log(abs(Lf(x))), w[i], w[i + 1], 1e-13)
             ph = np.degrees(np.angle(Lf(x)))
             this = (ph + 360.0) % 360.0 - 180.0
             pm = min(pm, this)
