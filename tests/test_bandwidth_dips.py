@@ -54,3 +54,51 @@ def test_a_notch_narrower_than_the_grid_in_every_row_of_a_batch():
         assert first_fall(lambda x, i=i: f(np.broadcast_to(x, (3, *np.shape(x))))[i], 0.5, grid) == pytest.approx(
             truth, rel=1e-5)
     assert not below.any()
+
+
+def _dip_loops(seed: int, count: int):
+    """Random stable P loops on ``K (s^2 + 2 zeta wz s + wz^2) / ((s + p1)(s + p2)(s + p3)) e^(-s delay)``: zeros
+    damped 1e-5 to 1e-2, the gain set so that ``|L| > 1`` except within a relative ``r`` (1e-5 to 0.05) of
+    ``wz``, half of them with a delay. Yields ``(loop, num, den, delay, kp, wz, width)``."""
+    rng = np.random.default_rng(seed)
+    made = 0
+    while made < count:
+        wz, zeta = 10 ** rng.uniform(-0.5, 1.5), 10 ** rng.uniform(-5, -2)
+        poles = 10 ** rng.uniform(-1, 2.5, size=3)
+        gain = 10 ** rng.uniform(-1, 2)
+        delay = 0.0 if rng.random() < 0.5 else 10 ** rng.uniform(-3, -1.5)
+        num, den = gain * np.array([1.0, 2 * zeta * wz, wz * wz]), np.poly(-poles)
+        r = 10 ** rng.uniform(-5, -1.3)
+        kp = abs(np.polyval(den, 1j * wz)) / (2 * gain * wz * wz * r)
+        loop = Loop(Plant(num, den, delay=delay), Controller("P", {"kp": float(kp)}))
+        if not loop.stability().stable or not np.isfinite(loop.bandwidth()):
+            continue
+        made += 1
+        yield loop, num, den, delay, kp, wz, max(r, zeta)
+
+
+def _brute_T(num, den, delay, kp, w):
+    s = 1j * w
+    L = kp * np.polyval(num, s) / np.polyval(den, s) * np.exp(-delay * s)
+    return np.abs(L / (1 + L))
+
+
+def test_narrow_dips_set_the_bandwidth():
+    """The bandwidth (80 points per decade, one loop and in a batch) lies between the brute force's last point above
+    the level and its first below, on every loop; about half the loops have their bandwidth in the dip. (A first
+    crossing taken from the grid alone, without refining its local minima, put the bandwidth past the dip on 49 of
+    136 such loops, up to five decades too high.)"""
+    in_dip = 0
+    for loop, num, den, delay, kp, wz, width in _dip_loops(11, 60):
+        bw = loop.bandwidth()
+        level = loop.T0() * 10 ** (-3 / 20)
+        w = np.union1d(np.geomspace(1e-4, bw * (1 + 1e-3), 100_000),
+                       np.linspace(wz * (1 - 4 * width), wz * (1 + 4 * width), 100_001))
+        below = np.nonzero(_brute_T(num, den, delay, kp, w) < level)[0]
+        assert below.size, (wz, kp, delay)  # the brute force sees |T| fall by bw (1 + 1e-3)
+        first = int(below[0])
+        assert w[first - 1] <= bw * (1 + 1e-9) and bw <= w[first] * (1 + 1e-9), (bw, w[first - 1], w[first], wz)
+        slack = Bandwidth(type="bandwidth", min=1.0).batch_slack(LoopBatch(loop.plant, [loop.controller]))
+        assert abs(float(slack[0]) - np.log(bw)) < 1e-6
+        in_dip += abs(bw - wz) < 0.05 * wz
+    assert in_dip >= 20
