@@ -155,3 +155,12 @@ def test_record_disturbance_from_csv(tmp_path):
 def test_block_validation(make, message):
     with pytest.raises(ModelError, match=message):
         make()
+
+
+def test_a_symmetric_table_is_exactly_zero_at_its_middle():
+    eps, level = 1.7303501862000147e-06, 0.48608418533100345  # a relay as a steep table (seed 111 loop 84)
+    relay = Static(((-2 * eps, -level), (-eps, -level), (eps, level), (2 * eps, level)))
+    y = relay.apply(np.array([0.0, eps / 2, -eps / 2, eps, 3 * eps]), DT)
+    assert y[0] == 0.0
+    assert y[1] == pytest.approx(level / 2, rel=1e-12) and y[2] == pytest.approx(-level / 2, rel=1e-12)
+    assert y[3] == level and y[4] == level

@@ -366,3 +366,19 @@ def test_a_pattern_of_several_oscillations_says_how_often_it_crosses_its_mean():
     assert ref["verdict"] == "limit_cycle"
     assert spacing == pytest.approx(ref["period"], rel=0.02)
     assert lc.period == pytest.approx(10 * ref["period"], rel=0.02)
+
+
+def test_a_relay_loop_at_rest_stays_at_rest_until_its_step():
+    """Seed 111 loop 84: a PI behind a steep relay table (gain 2.8e5 between -eps and eps), the step at t = 1 s. The
+    table's interpolation gave 5.6e-17 at 0, which the relay amplified into full chatter before the step (0.95 s)
+    and put the settling time 7 samples before the reference's."""
+    case = random_cases(100, seed=111)[84]
+    relay = case["actuator"][0]
+    assert relay[0] == "relay"
+    v = step_verdict(synth_loop(case), 0.0, case["step"], case["t_step"])
+    t, u = np.asarray(v.result.t), np.asarray(v.result.actuator)
+    assert np.all(u[t < case["t_step"] - 1e-9] == 0.0)
+    ref = reference_run(case)
+    assert ref["verdict"] == v.verdict == "settled"
+    assert abs(v.metrics.settling_time - ref["settling_time"]) <= case["dt"] + 1e-9
+    assert abs(v.metrics.rise_time - ref["rise_time"]) <= case["dt"]

@@ -98,8 +98,9 @@ def static_step(p, x):
     i = 0
     while i < n - 2 and x > xs[i + 1]:
         i += 1
-    slope = (ys[i + 1] - ys[i]) / (xs[i + 1] - xs[i])
-    return ys[i] + slope * (x - xs[i]), False
+    # the fraction of the segment, then the rise: exact at a symmetric segment's middle (a relay's table gives 0
+    # at 0, where the slope form gave 5.6e-17, which a steep relay amplified into chatter while the loop was at rest)
+    return ys[i] + (x - xs[i]) / (xs[i + 1] - xs[i]) * (ys[i + 1] - ys[i]), False
 
 
 @jit
