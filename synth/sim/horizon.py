@@ -102,7 +102,9 @@ def _linear_settling(loop: Any) -> tuple[bool, float | None, float | None]:
         return False, None, None
     dden = np.polyder(den)
     dc = np.polyval(num, 0.0) / np.polyval(den, 0.0)
-    res = np.abs(np.polyval(num, poles) / (np.polyval(dden, poles) * poles)) / max(abs(dc), 1e-12)
+    with np.errstate(divide="ignore", invalid="ignore"):  # a repeated pole has no simple residue
+        res = np.abs(np.polyval(num, poles) / (np.polyval(dden, poles) * poles)) / max(abs(dc), 1e-12)
+    res = np.where(np.isfinite(res), res, 1.0)  # counted as a visible mode of the step's size
     visible = res > _ENVELOPE / max(len(poles), 1)
     taus = -1.0 / poles.real
     slowest = float(np.max(taus[visible])) if np.any(visible) else float(np.max(taus))
