@@ -177,7 +177,19 @@ class Loop:
             return np.where(self._infinite(C) | np.isnan(C), 1.0 / G, KS)
 
     def T0(self) -> float:
-        """``|T(0)|``: 1 with integral action, ``L(0)/(1 + L(0))`` otherwise."""
+        """``|T(0)|``: 1 with integral action, ``|L(0)/(1 + L(0))|`` otherwise (the bandwidth's reference level;
+        a step's final value is :meth:`dc_gain`, with its sign)."""
+        return abs(self._t0)
+
+    def dc_gain(self) -> float:
+        """``T(0)`` with its sign, a unit reference step's final value: 1 with integral action, ``L(0)/(1 + L(0))``
+        otherwise (negative where ``-1 < L(0) < 0``).
+
+        Examples
+        --------
+        >>> Loop(Plant.from_string("-2/(s+1)"), Controller("P", {"kp": 0.3})).dc_gain()
+        -1.4999999999999998
+        """
         return self._t0
 
     @cached_property
@@ -185,9 +197,9 @@ class Loop:
         l0 = dc_value(self.num, self.den)  # exact: s cancels first
         if np.isinf(l0):
             return 1.0
-        if 1.0 + l0 == 0.0:  # a closed-loop pole at s = 0: |T(0)| is unbounded
+        if 1.0 + l0 == 0.0:  # a closed-loop pole at s = 0: T(0) is unbounded
             return float("inf")
-        return float(abs(l0 / (1.0 + l0)))
+        return float(l0 / (1.0 + l0))
 
     # --------------------------------------------------------------- frequencies
     @cached_property

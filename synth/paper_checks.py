@@ -84,7 +84,7 @@ def _real_poles(poles: np.ndarray) -> list[float]:
 
 def _rise_time(loop: Loop) -> float:
     t, y, _ = step_response(loop)
-    return step_metrics(t, y, y_final=loop.T0()).rise_time
+    return step_metrics(t, y, y_final=loop.dc_gain()).rise_time
 
 
 def _tf_rise_time(tf: str, horizon: float = 20.0) -> float:

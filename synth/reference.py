@@ -45,7 +45,7 @@ def loop_summary(loop: Loop) -> dict[str, Any]:
     """
     poles = loop.closed_loop_poles()
     t, y, dt = step_response(loop)
-    metrics = step_metrics(t, y, y_final=loop.T0())
+    metrics = step_metrics(t, y, y_final=loop.dc_gain())
     margins = loop.margins()
     return {
         "controller": str(loop.controller),

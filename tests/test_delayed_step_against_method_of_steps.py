@@ -214,3 +214,44 @@ def test_a_peak_within_the_simulations_error_of_the_band_is_judged_on_the_worst_
     assert result.details["settling_time"] > 1.74
     assert "judged on the worst case" in result.message
     assert result.details["simulation_error"] <= 1e-4 * 2.1  # refined to the tolerance (|y| peaks at 2.02 T(0))
+
+
+def _negative_dc_case(seed):
+    """A stable P loop with ``-1 < L(0) < 0`` (a negative plant gain, or a right-half-plane zero), half of them
+    delayed: its step settles at ``T(0) < 0``."""
+    rng = np.random.default_rng(seed)
+    for _ in range(200):
+        poles = -rng.uniform(0.3, 5.0, int(rng.integers(1, 4)))
+        zero = [float(rng.uniform(0.5, 5.0))] if rng.random() < 0.5 else []  # (s - z): a right-half-plane zero
+        num = np.poly(zero) if zero else np.array([-1.0])
+        l0 = -float(rng.uniform(0.2, 0.8))
+        num = num * l0 / (np.polyval(num, 0.0) / np.prod(-poles))
+        delay = float(rng.uniform(0.02, 0.3)) if seed % 2 else 0.0
+        loop = Loop(Plant(num, np.poly(poles), delay=delay), Controller("P", {"kp": 1.0}))
+        if loop.stability().stable:
+            return loop, num, np.poly(poles), delay
+    pytest.skip("no stable loop drawn")
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_a_step_that_settles_below_zero_is_measured(seed):
+    """``T(0) < 0``: the step requirement took ``|T(0)|`` for the final value, so the response never entered its band
+    and every such loop was "undetermined: not settled" (found by a black-box test of ``synth check``)."""
+    from scipy import signal
+
+    loop, num, den, delay = _negative_dc_case(seed)
+    final = loop.dc_gain()
+    assert final < 0 and loop.T0() == -final
+    result = StepResponse(max_settling_time=1e4, max_overshoot=1e3).evaluate(loop)
+    assert result.met and result.details["settled"], result.message
+    t_end = max(20.0, 1.5 * result.details["settling_time"])
+    t = np.linspace(0.0, t_end, 60001)
+    if delay:
+        ref = _reference(num, den, delay, [1.0], [1.0], t_end, t)
+    else:
+        _, ref = signal.step(signal.lti(num, np.polyadd(den, num)), T=t)
+    assert abs(ref[-1] / final - 1.0) < 0.02  # inside the band at the end
+    outside = np.flatnonzero(np.abs(ref / final - 1.0) > 0.02)
+    ref_settling = float(t[outside[-1] + 1]) if outside.size else 0.0
+    assert abs(result.details["settling_time"] - ref_settling) < 5e-3 * max(1.0, ref_settling)
+    assert abs(result.details["overshoot"] - max(0.0, 100 * (float(np.max(ref / final)) - 1.0))) < 0.05

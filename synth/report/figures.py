@@ -172,7 +172,7 @@ def step_plot(loops: list[tuple[str, Loop]], path: Path, scale: float = 1.0, uni
         y = np.interp(shift, t, y) * (t >= plant.delay)
         ax.plot(t, scale * y / max(plant.dc_gain(), 1e-300), color="grey", ls=":", lw=1.5,
                 label="open-loop plant, normalized to its DC gain")
-    found = _step_limits(ax, limits, scale * loops[0][1].T0(), horizon, first) if limits and first else []
+    found = _step_limits(ax, limits, scale * loops[0][1].dc_gain(), horizon, first) if limits and first else []
     if drawn is not None:
         drawn.extend(bound_drawn(artist, name, what) for artist, name, what in found)
     ax.set_xlabel("time [s]")

@@ -303,7 +303,7 @@ def _published(spec: Spec, sim: SimulationSpec, report: SimulationReport,
         rises = {name: _rise(batch[i], sim.step_time) for i, name in enumerate(variants)}
         linear_loop = Loop(plant, Controller("P", {"kp": gain}))
         t, y, _ = step_response(linear_loop)
-        rises["continuous linear model"] = step_metrics(t, y, y_final=linear_loop.T0()).rise_time
+        rises["continuous linear model"] = step_metrics(t, y, y_final=linear_loop.dc_gain()).rise_time
         out["rise_time"] = {"gain": gain, "published": pub.closed_loop_rise_time, "simulated": rises}
         rates = np.geomspace(500.0, 2e5, 31)
         sweep = [loop.replace(actuator=tuple(RateLimit(r) if isinstance(b, RateLimit) else b

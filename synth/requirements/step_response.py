@@ -285,7 +285,7 @@ class StepResponse(Requirement):
         doublings the tail needs at least."""
         from synth.timeresp import default_horizon, step_tail
 
-        final = loop.T0()
+        final = loop.dc_gain()  # with its sign: a step to T(0) < 0 settles below 0
         poles = loop.closed_loop_poles()  # once: the horizon and the tail's residues both start from them
         first = default_horizon(loop, poles)
         poles, weights = step_tail(loop, poles)
