@@ -5,6 +5,8 @@ The cases are ones a seeded fuzz of the repository's specs found (``type`` given
 
 from __future__ import annotations
 
+import json
+
 import pytest
 import yaml
 
@@ -48,3 +50,41 @@ def test_a_long_delay_within_range_is_still_checked(run_cli, tmp_path):
                  requirements=[{"type": "margins", "gain_margin_db": 6, "phase_margin_deg": 45}])
     r = run_cli("check", spec, "--controller", "P(0.5)")
     assert r.code == 0, r.err
+
+
+@pytest.mark.parametrize("requirement, key", [
+    ({"type": "peak_sensitivity", "max_db": 6, "band": [5, 0.1]}, "band"),
+    ({"type": "peak_complementary", "max_db": 3, "band": [1, 1]}, "band"),
+    ({"type": "peak_sensitivity", "max_db": 6, "band": [-1, 1]}, "band"),
+    ({"type": "peak_control_sensitivity", "max_db": 20, "band": [0, float("inf")]}, "band"),
+    ({"type": "peak_sensitivity", "max_db": float("nan")}, "max_db"),
+    ({"type": "sensitivity", "max_db": float("nan"), "band": [0, 5]}, "max_db"),
+    ({"type": "sensitivity_static", "max_db": -10, "plant_gain": 0}, "plant_gain"),
+    ({"type": "sensitivity_static", "max_db": -10, "plant_gain": float("nan")}, "plant_gain"),
+])
+def test_a_peak_band_or_bound_that_cannot_be_checked_is_one_line(run_cli, tmp_path, requirement, key):
+    """Found by a black-box test of ``synth check``: a peak requirement's band was checked only when evaluated (a
+    ValueError traceback, exit 1), ``plant_gain: 0`` divided by zero, and a NaN bound was accepted and printed as
+    "+nan NOT MET" beside a message that said "met"."""
+    r = run_cli("check", _spec(tmp_path, requirements=[requirement]), "--controller", "PI(1, 1)")
+    assert r.code == 2 and "Traceback" not in r.err, r.err
+    lines = r.err.strip().splitlines()
+    assert len(lines) == 1 and f"requirements[0].{key}" in lines[0], lines
+
+
+@pytest.mark.parametrize("plant, controller, expected_db", [
+    ("s/(s+1)^2", "P(1)", 0.0),  # the plant's DC gain is 0: S(0) = 1 whatever the controller
+    ("1/(s*(s+1))", "leadlag(k=1, z=0, p=1)", -6.0206),  # C(0) = 0 meets the plant's pole at 0: L(0) = 1
+])
+def test_static_sensitivity_on_a_plant_without_a_finite_dc_gain(run_cli, tmp_path, plant, controller, expected_db):
+    """``plant_gain`` left to the model, whose DC gain is 0 or infinite: S(0) from the loop's exact L(0) (a
+    ZeroDivisionError traceback before, and NaN dB for the limit ``0 * inf``)."""
+    spec = _spec(tmp_path, plant={"tf": plant}, controller={"type": "leadlag" if "leadlag" in controller else "P"},
+                 requirements=[{"type": "sensitivity_static", "max_db": -3}])
+    json_path = tmp_path / "out.json"
+    r = run_cli("check", spec, "--controller", controller, "--json", str(json_path))
+    assert r.code in (0, 1) and "Traceback" not in r.err, r.err
+    data = json.loads(json_path.read_text(encoding="utf-8"))
+    static = next(q for q in data["requirements"] if q["type"] == "sensitivity_static")
+    assert static["value"] == pytest.approx(expected_db, abs=1e-3)
+    assert static["met"] == (expected_db <= -3)

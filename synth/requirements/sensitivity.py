@@ -6,9 +6,10 @@ from collections.abc import Callable
 from typing import TYPE_CHECKING, Any, ClassVar, Literal
 
 import numpy as np
-from pydantic import Field
+from pydantic import Field, FiniteFloat, field_validator
 
 from synth.freqgrid import band_grid, band_grids, batch_peak, crossings, log_grid, log_grids, peak
+from synth.polynomials import dc_value
 from synth.requirements.base import (
     NEPER_PER_DB,
     BandMixin,
@@ -75,7 +76,7 @@ class Sensitivity(BandMixin, Requirement):
     """
 
     type: Literal["sensitivity"] = "sensitivity"
-    max_db: float
+    max_db: FiniteFloat
     title: ClassVar[str] = "sensitivity over a band"
     bounds: ClassVar[dict[str, Bound]] = MAX_DB
     example: ClassVar[dict[str, Any]] = {"type": "sensitivity", "max_db": -15.0, "band": (0.0, 30.0)}
@@ -129,12 +130,20 @@ class StaticSensitivity(Requirement):
     """
 
     type: Literal["sensitivity_static"] = "sensitivity_static"
-    max_db: float
-    plant_gain: float | None = Field(default=None, description="low-frequency plant gain")
+    max_db: FiniteFloat
+    plant_gain: FiniteFloat | None = Field(default=None, description="low-frequency plant gain")
     title: ClassVar[str] = "static sensitivity"
     bounds: ClassVar[dict[str, Bound]] = MAX_DB
     stricter: ClassVar[dict[str, int]] = {"plant_gain": -1}
     example: ClassVar[dict[str, Any]] = {"type": "sensitivity_static", "max_db": -15.0, "plant_gain": 1.8}
+
+    @field_validator("plant_gain")
+    @classmethod
+    def _nonzero_gain(cls, gain: float | None) -> float | None:
+        if gain == 0.0:
+            raise ValueError("plant_gain must be non-zero (the plant's low-frequency gain; leave it out to use the "
+                             "model's)")
+        return gain
 
     def gain(self, loop: Loop) -> float:
         """Plant gain used: the stated one or the model's DC gain."""
@@ -143,7 +152,8 @@ class StaticSensitivity(Requirement):
     def evaluate(self, loop: Loop, per_decade: int = 80) -> RequirementResult:
         g = self.gain(loop)
         c0 = loop.controller.dc_gain()
-        l0 = c0 * g
+        # the model's L(0) exactly (a zero of C at s = 0 meets an integrating plant's pole: a finite limit)
+        l0 = c0 * g if self.plant_gain is not None else dc_value(loop.num, loop.den)
         value_db = -np.inf if np.isinf(l0) else db(1.0 / (1.0 + l0)) if l0 != -1 else np.inf
         margin = self.max_db - value_db
         source = "stated" if self.plant_gain is not None else "model DC"
@@ -155,11 +165,14 @@ class StaticSensitivity(Requirement):
                    f"{'met' if margin >= 0 else 'NOT met'} ({source} plant gain {fmt(g)}, C(0) = {fmt(c0)})")
         return self.result(value=value_db, bound=self.max_db, unit="dB", slack=margin * NEPER_PER_DB,
                            margin=margin, binding_frequency=0.0, message=msg, plant_gain=g,
-                           controller_dc_gain=c0, minimum_dc_gain=(1.0 / self.linear_bound("max_db") - 1) / g)
+                           controller_dc_gain=c0,
+                           minimum_dc_gain=(1.0 / self.linear_bound("max_db") - 1) / g if g != 0 else float("inf"))
 
     def batch_slack(self, batch: LoopBatch, per_decade: int = 80) -> np.ndarray:
         """Vectorized slack: the same closed form for every controller's DC gain."""
         g = float(self.plant_gain) if self.plant_gain is not None else batch.plant.dc_gain()
+        if not np.isfinite(g) or g == 0.0:  # L(0) is a limit of C(s) G(s): one loop at a time, exactly
+            return Requirement.batch_slack(self, batch, per_decade)
         l0 = batch.controller_dc_gains() * g
         with np.errstate(divide="ignore", invalid="ignore"):
             value_db = np.where(np.isinf(l0), -np.inf, np.where(l0 == -1, np.inf, db_values(1.0 / (1.0 + l0))))
@@ -183,10 +196,15 @@ class PeakRequirement(Requirement):
     True
     """
 
-    max_db: float
+    max_db: FiniteFloat
     band: tuple[float, float] | None = None
     symbol: ClassVar[str] = "|S|"
     bounds: ClassVar[dict[str, Bound]] = MAX_DB
+
+    @field_validator("band")
+    @classmethod
+    def _check_band(cls, band: tuple[float, float] | None) -> tuple[float, float] | None:
+        return None if band is None else check_band(band)
 
     def curve(self, loop: Loop) -> Callable[[np.ndarray], np.ndarray]:  # pragma: no cover - overridden
         """The magnitude whose peak is bounded, as a function of ``w``."""
