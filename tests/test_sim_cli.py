@@ -68,6 +68,18 @@ def test_simulate_cli_writes_series_plot_and_json(run_cli, tmp_path):
     assert "rise time 10-90 %" in res.out
 
 
+def test_a_reference_that_does_not_step_has_no_step_metrics(run_cli, tmp_path):
+    """``--step 900:900`` (the loop held at its operating point): rise time, overshoot and settling are n/a, in the
+    table and as nulls in the JSON. Before, they were measured on the output's rounding-level motion (a black-box
+    test found "rise time 0.635 s, overshoot 27.33 %" on an output that stayed at 1)."""
+    res = run_cli("simulate", "specs/x4_rotor.yaml", "--controller", "P(3)", "--step", "900:900",
+                  "--out", str(tmp_path / "sim"), "--json", str(tmp_path / "m.json"))
+    assert res.code == 0, res.err
+    data = json.loads((tmp_path / "m.json").read_text())
+    assert data["rise_time"] is None and data["overshoot"] is None and data["settling_time"] is None
+    assert res.out.count("n/a: the reference does not step") == 3
+
+
 def test_simulate_cli_reports_a_limit_cycle_with_exit_1(run_cli, tmp_path):
     res = run_cli("simulate", "specs/x4_rotor.yaml", "-c", "P(8)", "--delay", "0.015", "--json", "-",
                   "--out", str(tmp_path))
@@ -131,3 +143,10 @@ def test_committed_x4_report_has_the_nonlinear_reconciliation():
     for text in ["Nonlinear step check", "Onset of oscillation", "Where the source's statements sit",
                  "oscillation_onset.png", "nonlinear_step.png", "K &gt; 5"]:
         assert text in html, text
+
+
+def test_a_step_limit_under_a_simulation_that_does_not_step_is_bad_input(tmp_path):
+    spec = BASE.replace("requirements: [{type: bandwidth, min: 10}]",
+                        "requirements: [{type: step_response, max_overshoot: 10, under: simulation}]")
+    with pytest.raises(SpecError, match=r"simulation.step \[870, 870\] does not step"):
+        parse_spec(spec + "simulation: {dt: 0.001, step: [870, 870]}\n")

@@ -246,10 +246,12 @@ def _print_metrics(say: Any, spec: Any, loop: Any, m: Any, step: tuple[float, fl
     lc = m.limit_cycle
     cycle = {"limit_cycle": f"{fmt(lc.amplitude)} {y} every {fmt(lc.period)} s" if lc.present else "yes",
              "diverging": "diverges", "settled": "none", "undetermined": "undetermined"}[verdict]
+    no_step = "n/a: the reference does not step"
     rows = [
-        ["rise time 10-90 %", f"{fmt(m.rise_time)} s"],
-        ["overshoot", f"{fmt(m.overshoot)} %"],
-        ["settling time (2 %)", f"{fmt(m.settling_time)} s" if m.settling_time is not None else "not settled"],
+        ["rise time 10-90 %", no_step if step[0] == step[1] else f"{fmt(m.rise_time)} s"],
+        ["overshoot", no_step if step[0] == step[1] else f"{fmt(m.overshoot)} %"],
+        ["settling time (2 %)", no_step if step[0] == step[1] else
+         f"{fmt(m.settling_time)} s" if m.settling_time is not None else "not settled"],
         ["final value", f"{fmt(m.final_value)} {y}"],
         ["peak actuator rate", f"{fmt(m.actuator_peak_rate)} {u}/s"],
         ["actuator range", f"{fmt(m.actuator_min)} to {fmt(m.actuator_max)} {u}"],
@@ -308,7 +310,8 @@ def _run_sweep(args: argparse.Namespace, spec: Any, sim: Any, loop: Any, step: t
                                disturbances, sim.seed)
         for i, res in enumerate(batch):
             window = sim.limit_cycle.window or (horizon - t_step) / 4
-            m = nonlinear_step_metrics(res, t_step, min_amplitude=sim.limit_cycle.min_amplitude, window=window)
+            m = nonlinear_step_metrics(res, t_step, min_amplitude=sim.limit_cycle.min_amplitude, window=window,
+                                       step_size=step[1] - step[0])
             j = judge(res, t_step, step, m, sim.limit_cycle.min_amplitude)
             value = values[start + i]
             verdict = j.verdict

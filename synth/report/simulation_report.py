@@ -143,7 +143,8 @@ def _step_runs(spec: Spec, label: str, ctrl: Controller) -> tuple[dict[str, SimR
         "linear": simulate_step(loop.linear(), *step, sim.horizon, sim.step_time, disturbances, sim.seed),
     }
     metrics = {k: nonlinear_step_metrics(r, sim.step_time, min_amplitude=sim.limit_cycle.min_amplitude,
-                                         window=sim.limit_cycle.window).to_dict() for k, r in runs.items()}
+                                         window=sim.limit_cycle.window, step_size=step[1] - step[0]).to_dict()
+               for k, r in runs.items()}
     # what the step ends in is not read off the shown horizon: the run is extended until it decides
     verdict = step_verdict(loop, *step, t_step=sim.step_time, horizon=sim.horizon, disturbances=disturbances,
                            seed=sim.seed, min_amplitude=sim.limit_cycle.min_amplitude)

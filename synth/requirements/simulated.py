@@ -119,7 +119,7 @@ def simulated_step(sim: SimulationSpec, loop: Loop, settle_band: float = 0.02, e
     from synth.sim.metrics import nonlinear_step_metrics
 
     m = nonlinear_step_metrics(v.result, sim.step_time, settle_band=settle_band,
-                               min_amplitude=sim.limit_cycle.min_amplitude)
+                               min_amplitude=sim.limit_cycle.min_amplitude, step_size=end - start)
     settling = nan if m.settling_time is None else float(m.settling_time)
     return SimulatedStep("settled", float(m.overshoot), settling, float(m.rise_time), v.summary(), evidence)
 

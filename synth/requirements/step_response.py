@@ -117,6 +117,11 @@ class StepResponse(Requirement):
         if self.under != "linear" and self.simulation is None:
             raise ValueError(f"under: {self.under} judges the step under the spec's simulation: blocks, "
                              "and the spec has no simulation: block")
+        if self.under != "linear" and self.simulation.step is not None and \
+                self.simulation.step[0] == self.simulation.step[1]:
+            a = self.simulation.step[0]
+            raise ValueError(f"under: {self.under} measures the simulation's step, and simulation.step [{a:g}, {a:g}] "
+                             "does not step")
         return self
 
     @classmethod

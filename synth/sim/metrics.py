@@ -134,7 +134,7 @@ def tail_limit(y: np.ndarray, extrapolate: bool = True) -> float:
 def nonlinear_step_metrics(result: SimResult, t_step: float = 0.0, final_value: float | None = None,
                            settle_band: float = 0.02, min_amplitude: float = 0.0,
                            window: float | None = None, hysteresis: float = 0.5,
-                           whole_cycles: bool = False) -> NonlinearStepMetrics:
+                           whole_cycles: bool = False, step_size: float | None = None) -> NonlinearStepMetrics:
     """Step metrics of a simulated run whose reference steps at ``t_step``.
 
     Parameters
@@ -154,6 +154,9 @@ def nonlinear_step_metrics(result: SimResult, t_step: float = 0.0, final_value: 
     hysteresis, whole_cycles
         As in :func:`~synth.sim.limitcycle.detect_oscillation` (:func:`~synth.sim.verdict.step_verdict`
         passes :data:`~synth.sim.limitcycle.SAMPLED_HYSTERESIS` and True).
+    step_size : float, optional
+        The reference's change at ``t_step``: 0 leaves rise time, overshoot and settling time undefined (NaN; a run
+        held at its operating point, where the output's change is rounding).
 
     Examples
     --------
@@ -182,7 +185,10 @@ def nonlinear_step_metrics(result: SimResult, t_step: float = 0.0, final_value: 
     else:
         yf = tail_limit(ya, extrapolate=not (osc.present or osc.diverging))
     y0 = float(y[i0])
-    base: StepMetrics = step_metrics(ta - ta[0], ya, y0=y0, y_final=yf, settle_band=settle_band)
+    if step_size == 0.0:  # the reference does not step: no rise, overshoot or settling to measure
+        base = StepMetrics(float("nan"), float("nan"), float("nan"), yf, float(np.max(ya)))
+    else:
+        base = step_metrics(ta - ta[0], ya, y0=y0, y_final=yf, settle_band=settle_band)
     settling = None if (osc.present or osc.diverging or not np.isfinite(base.settling_time)) \
         else float(base.settling_time)
     before = float(a[i0 - 1]) if i0 > 0 else result.actuator_rest

@@ -358,7 +358,7 @@ def step_verdict(loop: NonlinearLoop, start: float, end: float, t_step: float = 
         tried.append(T)
         result = simulate_step(loop, start, end, T, t_step, disturbances, seed)
         metrics = nonlinear_step_metrics(result, t_step, min_amplitude=min_amplitude, hysteresis=SAMPLED_HYSTERESIS,
-                                         whole_cycles=True,
+                                         whole_cycles=True, step_size=end - start,
                                          window=window if window is not None else (T - t_step) / 4)
         j = judge(result, t_step, (start, end), metrics, min_amplitude, previous, T >= cap * (1 - 1e-12),
                   loop.actuator)
@@ -372,7 +372,7 @@ def step_verdict(loop: NonlinearLoop, start: float, end: float, t_step: float = 
         T = min(2 * T, cap)
     if j.verdict == "limit_cycle" and window is None:  # steady over the last half: measure it there
         metrics = nonlinear_step_metrics(result, t_step, min_amplitude=min_amplitude, hysteresis=SAMPLED_HYSTERESIS,
-                                         whole_cycles=True, window=(T - t_step) / 2)
+                                         whole_cycles=True, window=(T - t_step) / 2, step_size=end - start)
     if j.verdict == "limit_cycle":  # periodic, or not (with its ranges); a complex waveform by autocorrelation
         span = (T - t_step) / 2 if window is None else window
         keep = result.t >= T - span
