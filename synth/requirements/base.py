@@ -19,9 +19,10 @@ from dataclasses import asdict, dataclass, field
 from typing import TYPE_CHECKING, Any, ClassVar, Literal
 
 import numpy as np
-from pydantic import BaseModel, ConfigDict, field_validator
+from pydantic import BaseModel, ConfigDict
 
 from synth.errors import SpecError
+from synth.requirements.bands import BandMixin, check_band
 
 if TYPE_CHECKING:
     from synth.loop import Loop
@@ -250,6 +251,20 @@ class Requirement(BaseModel):
         """
         return self.evaluate(loop, per_decade).slack
 
+    def part_slacks(self, loop: Loop, per_decade: int = 80) -> list[float]:
+        """The slacks of the requirement's parts (one per limit it sets; :meth:`slack` is their minimum): a
+        search that moves along several active limits at once needs each one's gradient, not the minimum's.
+
+        Examples
+        --------
+        >>> from synth.loop import Loop; from synth.plant import Plant; from synth.controllers import Controller
+        >>> from synth.requirements import Bandwidth
+        >>> loop = Loop(Plant.from_string("1/(s+1)"), Controller("P", {"kp": 9.0}))
+        >>> Bandwidth(min=100).part_slacks(loop) == [Bandwidth(min=100).slack(loop)]
+        True
+        """
+        return [self.slack(loop, per_decade)]
+
     def stable_slack(self, loop: Loop, per_decade: int = 80) -> float:
         """:meth:`slack` on a loop the caller has already counted closed-loop stable (as
         :meth:`synth.loop.Loop.stability` counts, e.g. by a D-decomposition over a grid): a type that would count
@@ -406,35 +421,6 @@ class Requirement(BaseModel):
             binding_frequency=None if binding_frequency is None else float(binding_frequency),
             met=bool(slack >= 0), message=message, details=details,
         )
-
-
-class BandMixin(BaseModel):
-    """A frequency band ``[low, high]`` in rad/s with ``0 <= low < high``."""
-
-    band: tuple[float, float]
-
-    @field_validator("band")
-    @classmethod
-    def _check_band(cls, band: tuple[float, float]) -> tuple[float, float]:
-        return check_band(band)
-
-
-def check_band(band: tuple[float, float]) -> tuple[float, float]:
-    """``band`` if it is ``[low, high]`` with ``0 <= low < high`` finite (rad/s), else ValueError.
-
-    Examples
-    --------
-    >>> check_band((0.0, 30.0))
-    (0.0, 30.0)
-    """
-    lo, hi = band
-    if not (np.isfinite(lo) and np.isfinite(hi)):
-        raise ValueError(f"band must be finite, got [{lo:g}, {hi:g}]")
-    if lo < 0 or hi <= 0:
-        raise ValueError(f"band must be non-negative frequencies in rad/s, got [{lo:g}, {hi:g}]")
-    if hi <= lo:
-        raise ValueError(f"band must be [low, high] with low < high, got [{lo:g}, {hi:g}]")
-    return band
 
 
 def fmt(x: float | None, digits: int = 4) -> str:

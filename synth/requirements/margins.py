@@ -63,24 +63,43 @@ class MarginsRequirement(Requirement):
             given = [f.replace("_db", "").replace("_deg", "").replace("_", " ") for f in self.bounds
                      if getattr(self, f) is not None]
             return unstable_result(self, loop, " and ".join(given), **m.to_dict())
-        parts = []
-        if self.gain_margin_db is not None:
-            two_sided = min(m.gain_margin_db, -m.lower_gain_margin_db)
-            w = m.phase_crossover if m.gain_margin_db <= -m.lower_gain_margin_db else m.lower_phase_crossover
-            slack = (two_sided - self.gain_margin_db) * NEPER_PER_DB
-            parts.append((slack, "gain margin", two_sided, self.gain_margin_db, "dB", w))
-        if self.phase_margin_deg is not None:
-            slack = np.radians(m.phase_margin_deg - self.phase_margin_deg)
-            parts.append((slack, "phase margin", m.phase_margin_deg, self.phase_margin_deg, "deg",
-                          m.gain_crossover))
-        if self.delay_margin is not None:
-            slack = np.log(m.delay_margin / self.delay_margin) if m.delay_margin > 0 else -np.inf
-            parts.append((slack, "delay margin", m.delay_margin, self.delay_margin, "s", m.gain_crossover))
+        parts = self._parts(m)
         slack, name, value, bound, unit, w = min(parts, key=lambda p: p[0])
         texts = [f"{p[1]} {fmt(p[2])} {p[4]} (min {fmt(p[3])})" for p in parts]
         msg = f"{'; '.join(texts)}: {'met' if slack >= 0 else 'NOT met'}, tightest: {name}"
         return self.result(value=value, bound=bound, unit=unit, slack=slack, margin=value - bound,
                            binding_frequency=w, message=msg, binding=name, **m.to_dict())
+
+    def _parts(self, m: Any) -> list[tuple[float, str, float, float, str, float | None]]:
+        """``(slack, name, value, bound, unit, frequency)`` of each margin the requirement bounds, from the loop's
+        margins ``m`` (the gain margin the nearer of the upward and the downward one)."""
+        parts = []
+        if self.gain_margin_db is not None:
+            two_sided = min(m.gain_margin_db, -m.lower_gain_margin_db)
+            w = m.phase_crossover if m.gain_margin_db <= -m.lower_gain_margin_db else m.lower_phase_crossover
+            parts.append(((two_sided - self.gain_margin_db) * NEPER_PER_DB, "gain margin", two_sided,
+                          self.gain_margin_db, "dB", w))
+        if self.phase_margin_deg is not None:
+            parts.append((np.radians(m.phase_margin_deg - self.phase_margin_deg), "phase margin", m.phase_margin_deg,
+                          self.phase_margin_deg, "deg", m.gain_crossover))
+        if self.delay_margin is not None:
+            slack = np.log(m.delay_margin / self.delay_margin) if m.delay_margin > 0 else -np.inf
+            parts.append((slack, "delay margin", m.delay_margin, self.delay_margin, "s", m.gain_crossover))
+        return parts
+
+    def part_slacks(self, loop: Loop, per_decade: int = 80) -> list[float]:
+        """Each bounded margin's slack; an unstable closed loop's slack (:meth:`slack`) for each.
+
+        Examples
+        --------
+        >>> from synth.loop import Loop; from synth.plant import Plant; from synth.controllers import Controller
+        >>> loop = Loop(Plant.from_string("1/(s*(s+1))"), Controller("P", {"kp": 1.0}))
+        >>> [round(s, 3) for s in MarginsRequirement(gain_margin_db=6, phase_margin_deg=45).part_slacks(loop)]
+        [inf, 0.119]
+        """
+        if closed_loop_unstable(loop):
+            return [self.slack(loop, per_decade)] * len(self._parts(loop.margins()))
+        return [float(p[0]) for p in self._parts(loop.margins())]
 
     def batch_slack(self, batch: LoopBatch, per_decade: int = 80) -> np.ndarray:
         """Vectorized slack, the scalar form's numbers: gain crossovers of all loops by batched polynomial

@@ -39,9 +39,25 @@ if TYPE_CHECKING:
     from synth.spec import Spec
 
 __all__ = ["STRUCTURAL", "Affine", "LinearParametrization", "Parametrization", "RationalParametrization", "parametrize",
-           "reference_frequency"]
+           "reference_frequency", "structural_values"]
 
 STRUCTURAL = {"PID": "tf", "leadlag": "p"}
+
+
+def structural_values(lo: float, hi: float) -> list[float]:
+    """The values of a structural parameter (:data:`STRUCTURAL`) the convex stage fixes in turn: the bounds' ends and
+    their middle (geometric for positive bounds), or the one fixed value.
+
+    Examples
+    --------
+    >>> structural_values(0.01, 1.0), structural_values(0.05, 0.05)
+    ([0.01, 0.1, 1.0], [0.05])
+    """
+    if lo == hi:
+        return [lo]
+    if lo > 0:
+        return [float(v) for v in np.geomspace(lo, hi, 3)]
+    return [float(v) for v in np.linspace(lo, hi, 3)]
 """The structural parameter of each controller type that the convex stage holds at a few fixed values."""
 
 
