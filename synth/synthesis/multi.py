@@ -37,6 +37,7 @@ from synth.results import (
     reference_verdict,
 )
 from synth.spec import Spec
+from synth.synthesis.ascent_probe import climb
 from synth.synthesis.conflict_set import conflict_set
 from synth.synthesis.convex import ConvexDesigner
 from synth.synthesis.convex_results import ConvexResult, infeasible_verdict
@@ -45,7 +46,7 @@ from synth.synthesis.integral_action import integral_only, objective_terms, with
 from synth.synthesis.nlp import polish
 from synth.synthesis.no_start import no_start_result
 from synth.synthesis.optimality import optimality_of
-from synth.synthesis.parametrization import STRUCTURAL, parametrize, reference_frequency
+from synth.synthesis.parametrization import STRUCTURAL, parametrize, reference_frequency, structural_values
 from synth.synthesis.pattern import BOUNDARY_CHECKS, pattern_search
 from synth.synthesis.polish_skip import exact_forms, polish_redundant
 from synth.synthesis.rational_rescale import rescaled_run
@@ -168,14 +169,6 @@ def _better(a: DesignResult, b: DesignResult) -> bool:
     return va > vb if a.objective["sense"] == "maximize" else va < vb
 
 
-def _structural_values(lo: float, hi: float) -> list[float]:
-    if lo == hi:
-        return [lo]
-    if lo > 0:
-        return list(np.geomspace(lo, hi, 3))
-    return list(np.linspace(lo, hi, 3))
-
-
 def convex_runs(spec: Spec, settings: ConvexSettings) -> list[tuple[ConvexDesigner, ConvexResult]]:
     """The convex-concave design from each structural start (e.g. three filter constants of a PID).
 
@@ -191,7 +184,7 @@ def convex_runs(spec: Spec, settings: ConvexSettings) -> list[tuple[ConvexDesign
     bounds = spec.controller.all_bounds()
     ctype = spec.controller.type
     key = STRUCTURAL.get(ctype)
-    values = _structural_values(*bounds[key]) if key else [None]
+    values = structural_values(*bounds[key]) if key else [None]
     requirements = list(spec.requirements)
     names = unique_names(requirements)
     name, sense, _ = objective_terms(spec)[0]
@@ -411,6 +404,13 @@ def _design(spec: Spec, settings: ConvexSettings, nlp: bool | str, explain: bool
                       f"NLP polish from the {len(starts)} least violating (at most 3 rounds of {SCREEN_ITERATIONS} "
                       "iterations each)")
         candidates, passed = _certify_best(spec, found, terms, per_decade, cache)
+    if passed is not None and spec.objective is not None and optimality_of(passed[0], str(passed[1]),
+                                                                            unconverged).local:
+        climbed, steps = climb(spec, passed[1], terms, settings.stability_level)  # the claim, on the exact check
+        if steps:
+            found.append(("ascent probe", climbed))
+            stages.append(f"first-order test of the {passed[0]} design on the exact requirements: {steps} steps up")
+            candidates, passed = _certify_best(spec, found, terms, per_decade, cache)
     searched = ""
     if passed is not None and spec.objective is not None \
             and not optimality_of(passed[0], str(passed[1]), unconverged).local:

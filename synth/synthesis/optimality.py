@@ -28,7 +28,7 @@ class Optimality:
         The stage that produced the design converged (a KKT point of its problem on the design grid).
     stage : str
         That stage (``"convex"``, ``"nlp"``, ``"nlp from screen"``, ``"screen"``, ``"pattern search"``,
-        ``"initial"`` or ``"nlp from initial"``).
+        ``"initial"``, ``"nlp from initial"`` or ``"ascent probe"``).
     basis : str
         One sentence, for the verdict.
     """
@@ -83,8 +83,14 @@ def optimality_of(stage: str, controller: str, unconverged: set[str], screened: 
     method = _METHODS.get(stage, stage)
     if stage == "pattern search":
         return Optimality(False, stage, "not shown to be a local optimum (a pattern search on the exact check "
-                          "improved the best design of the stages before, none of which converged); the design is "
+                          "improved the best design of the stages before, none of which was shown to be a local "
+                          "optimum); the design is "
                           "certified feasible, a better one may exist" + (f"; {screened}" if screened else ""))
+    if stage == "ascent probe":
+        return Optimality(False, stage, "not shown to be a local optimum (a converged stage's design failed the "
+                          "first-order test on the exact requirements: steps along directions that raise the objective "
+                          "and every nearly active limit improved it); the design is certified feasible, a better one "
+                          "may exist" + (f"; {screened}" if screened else ""))
     if stage == "initial":
         return Optimality(False, stage, "not optimized: the spec's initial controller, certified; no stage found a "
                           "better design" + (f"; {screened}" if screened else ""))
