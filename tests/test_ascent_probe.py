@@ -13,6 +13,8 @@ import pytest
 
 from synth.controllers import Controller
 from synth.design import design
+from synth.loop import Loop
+from synth.objectives import score
 from synth.spec import parse_spec
 from synth.synthesis.ascent_probe import ascent_probe, climb
 from synth.synthesis.integral_action import objective_terms
@@ -72,3 +74,21 @@ def test_at_a_pi_optimum_the_probe_finds_no_real_way_up(seed):
     result = design(spec)
     assert result.feasible
     assert ascent_probe(spec, result.controller, objective_terms(spec), 0.05) is None
+
+
+def test_a_step_to_an_undefined_objective_is_no_gain():
+    """The design benchmark's seed 22 #57: a PID with ``kp`` 2e-7 and ``ki`` 0 under a bandwidth objective, ``|T(0)|``
+    3.4e-6. A step of the probe made the bandwidth NaN (``T(0)`` at 0), and a NaN compared as no worse."""
+    spec = parse_spec({"name": "rand_22_57", "plant": {"tf": "2422.25*1/((s+3.42322)*(s+18.3444)*(s+9.40345)*"
+                                                          "(s+0.267522))", "delay": 0.888018},
+                       "controller": {"type": "PID", "bounds": {"kp": [0.0, 7.42816], "ki": [0.0, 21.7443],
+                                                                "kd": [0.0, 2.53756], "tf": [0.0341614, 0.0341614]}},
+                       "requirements": [{"type": "peak_sensitivity", "max_db": 1.32784},
+                                        {"type": "slew_rate", "rate_limit": 25.7297, "max_error": 1.79649,
+                                         "band": [0.0292728, 8.93756]}],
+                       "objective": {"maximize": "bandwidth"}})
+    start = Controller("PID", {"kp": 2.2479950309640476e-07, "ki": 0.0, "kd": 0.044147755269378613, "tf": 0.0341614})
+    top, _ = climb(spec, start, objective_terms(spec), 0.05)
+    terms = objective_terms(spec)
+    assert np.isfinite(score(Loop(spec.nominal_plant(), top), terms))
+    assert score(Loop(spec.nominal_plant(), top), terms) >= score(Loop(spec.nominal_plant(), start), terms)

@@ -111,6 +111,8 @@ def ascent_probe(spec: Spec, controller: Controller, terms: list[tuple[str, str,
         return None
     nominal = spec.nominal_plant()
     f0 = score(Loop(nominal, controller), terms)
+    if not np.isfinite(f0):
+        return None
     scales = np.array([_scale(x[k], *bounds[k]) for k in free])
     grad_f = np.zeros(len(free))
     active = base < ACTIVE
@@ -147,7 +149,7 @@ def ascent_probe(spec: Spec, controller: Controller, terms: list[tuple[str, str,
         for j, k in enumerate(free):
             params[k] = float(np.clip(x[k] + t * d[j], *bounds[k]))
         trial = Controller(controller.type, params)
-        if score(Loop(nominal, trial), terms) <= f0 + MIN_GAIN * max(abs(f0), 1e-12):
+        if not score(Loop(nominal, trial), terms) > f0 + MIN_GAIN * max(abs(f0), 1e-12):  # (NaN: no gain)
             continue
         if quick_check(spec, trial).feasible and (floor == 0.0 or _closest(spec, trial) >= floor):
             return trial
