@@ -22,11 +22,11 @@ from scipy.optimize import linprog
 
 from synth.check import quick_check
 from synth.controllers import Controller
-from synth.freqgrid import log_grid, peak
 from synth.loop import Loop
 from synth.objectives import score
 from synth.results import SEARCH_PER_DECADE
 from synth.spec import Spec
+from synth.synthesis.pattern import closest_approach
 
 __all__ = ["ACTIVE", "CLIMB_ROUNDS", "MIN_GAIN", "STEPS", "ascent_probe", "climb"]
 
@@ -62,18 +62,6 @@ def _parts(spec: Spec, c: Controller) -> np.ndarray | None:
         for req in spec.requirements:
             out.extend(req.part_slacks(loop, SEARCH_PER_DECADE))
     return np.array(out, dtype=float)
-
-
-def _closest(spec: Spec, c: Controller) -> float:
-    """Smallest ``|1 + L|`` over the plants on a grid of the loop's range, minima refined."""
-    out = np.inf
-    with np.errstate(all="ignore"):
-        for plant in spec.plants():
-            loop = Loop(plant, c)
-            lo, hi = loop.frequency_range
-            peak_s, _ = peak(lambda w, loop=loop: np.abs(loop.S(w)), log_grid(lo, hi, SEARCH_PER_DECADE))
-            out = min(out, 0.0 if not np.isfinite(peak_s) else 1.0 / peak_s)
-    return out
 
 
 def ascent_probe(spec: Spec, controller: Controller, terms: list[tuple[str, str, float]],
@@ -143,7 +131,7 @@ def ascent_probe(spec: Spec, controller: Controller, terms: list[tuple[str, str,
     if lp.status != 0 or -lp.fun <= 1e-6:
         return None
     d = lp.x[:n] * scales
-    floor = min(keeping, _closest(spec, controller)) if keeping > 0 else 0.0
+    floor = min(keeping, closest_approach(spec.plants(), controller)) if keeping > 0 else 0.0
     for t in STEPS:
         params = dict(x)
         for j, k in enumerate(free):
@@ -151,7 +139,7 @@ def ascent_probe(spec: Spec, controller: Controller, terms: list[tuple[str, str,
         trial = Controller(controller.type, params)
         if not score(Loop(nominal, trial), terms) > f0 + MIN_GAIN * max(abs(f0), 1e-12):  # (NaN: no gain)
             continue
-        if quick_check(spec, trial).feasible and (floor == 0.0 or _closest(spec, trial) >= floor):
+        if quick_check(spec, trial).feasible and (floor == 0.0 or closest_approach(spec.plants(), trial) >= floor):
             return trial
     return None
 

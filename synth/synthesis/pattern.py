@@ -14,13 +14,14 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
 from synth.check import quick_check
 from synth.controllers import Controller
 from synth.errors import SynthError
-from synth.freqgrid import peak
+from synth.freqgrid import log_grid, peak
 from synth.loop import Loop
 from synth.objectives import score
 from synth.results import SEARCH_PER_DECADE
@@ -31,7 +32,7 @@ from synth.synthesis.convex_settings import ConvexSettings, design_grid
 from synth.synthesis.delay_grid import controller_gain_bound
 from synth.synthesis.parametrization import parametrize
 
-__all__ = ["BOUNDARY_CHECKS", "PATTERN_CHECKS", "PatternResult", "pattern_search"]
+__all__ = ["BOUNDARY_CHECKS", "PATTERN_CHECKS", "PatternResult", "closest_approach", "pattern_search"]
 
 PATTERN_CHECKS = 160
 """Most checks a pattern search makes (by default)."""
@@ -61,6 +62,27 @@ class PatternResult:
     improved: bool
     checks: int
     final_step: float
+
+
+def closest_approach(plants: list[Any], c: Controller, grid: np.ndarray | None = None) -> float:
+    """Smallest ``|1 + L|`` over the plants on ``grid`` (default: each loop's frequency range at
+    :data:`~synth.results.SEARCH_PER_DECADE`), its minima refined between grid points (a move along a requirement's
+    boundary can bring the Nyquist curve to -1 where no grid point sees it).
+
+    Examples
+    --------
+    >>> from synth.plant import Plant
+    >>> round(closest_approach([Plant.from_string("1/(s*(s+1))")], Controller("P", {"kp": 1.0})), 3)
+    0.681
+    """
+    out = np.inf
+    with np.errstate(all="ignore"):
+        for p in plants:
+            loop = Loop(p, c)
+            w = grid if grid is not None else log_grid(*loop.frequency_range, SEARCH_PER_DECADE)
+            peak_s, _ = peak(lambda w, loop=loop: np.abs(loop.S(w)), w)
+            out = min(out, 0.0 if not np.isfinite(peak_s) else 1.0 / peak_s)
+    return out
 
 
 def pattern_search(spec: Spec, start: Controller, terms: list[tuple[str, str, float]],
@@ -114,15 +136,7 @@ def pattern_search(spec: Spec, start: Controller, terms: list[tuple[str, str, fl
                        _gain_bound(spec))
 
     def closest(c: Controller) -> float:
-        """Smallest ``|1 + L|`` over the plants on the grid, its minima refined between grid points (a move
-        along a requirement's boundary can bring the Nyquist curve to -1 where no grid point sees it)."""
-        out = np.inf
-        with np.errstate(all="ignore"):
-            for p in spec.plants():
-                loop = Loop(p, c)
-                peak_s, _ = peak(lambda w, loop=loop: np.abs(loop.S(w)), grid)
-                out = min(out, 0.0 if not np.isfinite(peak_s) else 1.0 / peak_s)
-        return out
+        return closest_approach(spec.plants(), c, grid)
 
     if keeping > 0:  # a start closer to -1 than that (between the stage's own grid points): no move comes closer
         keeping = min(keeping, closest(start))
