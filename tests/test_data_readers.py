@@ -286,3 +286,32 @@ def test_hq_frd_with_units_in_the_header(run_cli, tmp_path):
     assert res.code == 0, res.err
     res = run_cli("hq", "--frd", str(p), "--json", "-")
     assert res.code == 2 and "column 'w' not found; found omega (rad/s), mag_db [dB], phase_deg (deg)" in res.err
+
+
+@pytest.mark.parametrize("header, picked, message", [
+    ("t,u,y,z", {}, r"line 3: column 'u': 'abc' is not a number$"),  # by position: never the next numeric column
+    ("t,u,y", {}, r"line 3: column 'u': 'abc' is not a number$"),
+    ("t,u,u", {}, r"column 'u' appears 2 times in the header \(columns 2, 3\)"),
+])
+def test_a_column_picked_by_position_is_the_files(tmp_path, header, picked, message):
+    """Found by a black-box test of ``synth identify``: a text cell dropped its column, and the default columns
+    (time, input, output by position) shifted onto the next ones (y -> z fitted as input -> output, exit 0)."""
+    p = tmp_path / "r.csv"
+    rows = [[0, 0, 0, 1], [1, "abc" if header != "t,u,u" else 1, 1, 6], [2, 1, 2, 11], [3, 1, 3, 16]]
+    width = len(header.split(","))
+    p.write_text(header + "\n" + "".join(",".join(map(str, r[:width])) + "\n" for r in rows))
+    with pytest.raises(DataError, match=message):
+        load_record(p, **picked)
+
+
+@pytest.mark.parametrize("roles, message", [
+    ({"input": "y", "output": "y"}, "column 'y' is given as both the input and the output column"),
+    ({"time": "t", "input": "t", "output": "y"}, "column 't' is given as both the time and the input column"),
+    ({"input": "u", "output": "y", "aux": ["u"]}, "column 'u' is given as both the input and the aux column"),
+])
+def test_one_column_in_two_roles_is_one_line(tmp_path, roles, message):
+    """A KeyError traceback before (the column was taken out of the table twice)."""
+    p = tmp_path / "r.csv"
+    p.write_text("t,u,y\n0,0,0\n1,1,1\n2,1,2\n3,1,3\n")
+    with pytest.raises(DataError, match=message):
+        load_record(p, **roles)

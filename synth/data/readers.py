@@ -83,6 +83,9 @@ class Table:
         Columns that are not numbers -> the first offending cell (raised when the column is asked for).
     notes : tuple of str
         What reading did (comment lines skipped, decimal commas read).
+    order : tuple of str
+        Every header in file order, those that are not numbers included (default: the numeric ones, then the
+        others): a column picked by its position is the file's, never the next numeric one.
 
     Examples
     --------
@@ -96,9 +99,12 @@ class Table:
     source: str = "columns"
     problems: dict[str, str] = field(default_factory=dict)
     notes: tuple[str, ...] = ()
+    order: tuple[str, ...] = ()
 
     def names(self) -> list[str]:
         """All column names: the numeric ones and those that are not numbers, in file order."""
+        if self.order:
+            return list(self.order)
         return list(self.columns) + [k for k in self.problems if k not in self.columns]
 
     def get(self, name: str) -> str | None:
@@ -170,7 +176,7 @@ class Table:
         columns = {new.get(k, k): v for k, v in self.columns.items()}
         units = {new.get(k, k): self.units.get(k, "") or split_unit(new.get(k, k))[1] for k in self.columns}
         problems = {new.get(k, k): v for k, v in self.problems.items()}
-        return Table(columns, units, self.source, problems, self.notes)
+        return Table(columns, units, self.source, problems, self.notes, tuple(new.get(k, k) for k in self.order))
 
 
 def table_from_columns(columns: Mapping[Any, Any], source: str = "columns") -> Table:
@@ -274,6 +280,7 @@ def _read_csv(path: Path) -> Table:
     keep = [i for i, h in enumerate(header) if h]
     twice = {h: [i + 1 for i in keep if header[i] == h] for h in {header[i] for i in keep}}
     twice = {h: at for h, at in twice.items() if len(at) > 1}  # a header written twice: which one is meant?
+    order = tuple(dict.fromkeys(header[i] for i in keep))  # file order, a doubled header once
     keep = [i for i in keep if header[i] not in twice]
     names = [header[i] for i in keep]
     notes = (f"skipped {comments} comment line(s) starting with #",) if comments else ()
@@ -282,7 +289,7 @@ def _read_csv(path: Path) -> Table:
     fast = _numeric_body(lines[1:], delimiter, len(header))
     if fast is not None:
         return Table({h: fast[:, i].copy() for i, h in zip(keep, names)}, {h: split_unit(h)[1] for h in names},
-                     str(path), doubled, notes)
+                     str(path), doubled, notes, order)
     values: dict[str, list[float]] = {h: [] for h in names}
     problems: dict[str, str] = {}
     decimal_comma = 0
@@ -304,7 +311,7 @@ def _read_csv(path: Path) -> Table:
                     values[h].append(x)
     notes += (f"read {decimal_comma} decimal comma(s)",) if decimal_comma else ()
     columns = {h: np.asarray(v, float) for h, v in values.items() if h not in problems}
-    return Table(columns, {h: split_unit(h)[1] for h in names}, str(path), {**problems, **doubled}, notes)
+    return Table(columns, {h: split_unit(h)[1] for h in names}, str(path), {**problems, **doubled}, notes, order)
 
 
 def _numeric_body(rows: list[tuple[int, str]], delimiter: str | None, width: int) -> np.ndarray | None:

@@ -359,12 +359,14 @@ def load_record(
 
 
 def _pick(table: Table, name: str | None, role: str, fallback: int) -> str:
+    """The column ``name`` means, or without a name the file's column at position ``fallback`` (one that is not
+    numbers is then the error it is when named, not skipped for the next one)."""
     if name is None:
-        keys = list(table.columns)
+        keys = table.names()
         if len(keys) <= fallback:
             raise DataError(f"no {role} column given and the file has only {len(keys)} column(s)",
                             where=table.source)
-        return keys[fallback]
+        return table.find(keys[fallback], role)
     return table.find(name, role)
 
 
@@ -405,6 +407,11 @@ def record_from_columns(
     u_name = _pick(table, input, "input", 1 - shift)
     y_name = _pick(table, output, "output", 2 - shift)
     aux_cols = {key: table.columns[key] for key in (_pick(table, a, "aux", 0) for a in aux)}
+    roles = [("time", t_name)] * (not from_dt) + [("input", u_name), ("output", y_name)] + [("aux", k) for k in aux_cols]
+    for i, (role, key) in enumerate(roles):
+        other = next((r for r, k in roles[:i] if k == key), None)
+        if other is not None:
+            raise DataError(f"column '{key}' is given as both the {other} and the {role} column", where=table.source)
     scale = 1.0 if from_dt else TIME_UNITS.get(table.units.get(t_name, ""), 1.0)
     t = np.arange(table.columns[u_name].size) * float(dt or 0) if from_dt else table.columns[t_name] * scale
     scaled = scale != 1.0
