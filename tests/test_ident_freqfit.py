@@ -82,6 +82,8 @@ def test_structure_errors_are_one_line():
         fit_frequency_response(data, "2/3", w_range=(1, 1.3))
     with pytest.raises(ModelError, match="delay must be"):
         fit_frequency_response(data, "0/2", delay=-1.0)
+    with pytest.raises(ModelError, match="'O/2' has no s and no delay"):  # the letter O for a zero, delay held
+        fit_frequency_response(data, "O/2", delay=0.0)
 
 
 def test_step_verification_fit_percent():

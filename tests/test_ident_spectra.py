@@ -139,3 +139,26 @@ def test_sweep_design_seed_numbers_and_signal_content():
     assert np.count_nonzero(np.diff(np.signbit(head).astype(int))) == 3
     with pytest.raises(DataError, match="w_min < w_max"):
         design_sweep(2.0, 1.0)
+
+
+def test_the_phase_is_anchored_in_the_coherent_band():
+    """An integrator behind a delay, whose points below the coherent band are noise (found by a black-box test of
+    ``synth freqresp``: unwrapped from a noisy lowest point, the whole band sat 360 deg high, +254 deg at 1 rad/s).
+    The phase in the band is the truth's, on the branch that puts the band's first point in (-270, 90] deg."""
+    from synth.ident.spectra import FrequencyResponse
+
+    w = np.geomspace(0.1, 20.0, 80)
+    truth = Plant.from_string("5/(s*(s+5))", delay=0.08).freqresp(w)
+    rng = np.random.default_rng(3)
+    H = truth.copy()
+    low = w < 0.22
+    H[low] = np.abs(truth[low]) * np.exp(1j * rng.uniform(-np.pi, np.pi, low.sum()))  # noise below the band
+    coh = np.where(low, 0.3, 0.99)
+    band = coherent_band(w, coh)
+    r = FrequencyResponse(w, H, coh, np.zeros(w.size), np.ones(w.size), np.ones(w.size), np.ones(w.size),
+                          np.ones(w.size, complex), band, (10.0,))
+    inside = (w >= band.w_min) & (w <= band.w_max)
+    expected = np.degrees(np.unwrap(np.angle(truth[inside])))
+    expected -= 360.0 * np.ceil((expected[0] - 90.0) / 360.0)
+    assert -270.0 < expected[0] <= 90.0 and abs(expected[0] + 94.0) < 1.0  # -90 - atan(w/5) - 0.08 w rad
+    np.testing.assert_allclose(r.phase_deg[inside], expected, atol=1e-9)

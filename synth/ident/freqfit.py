@@ -364,6 +364,9 @@ def fit_frequency_response(
     orders = parse_orders(text) if not isinstance(structure, Structure) else None
     st: Any = _Orders(*orders) if orders else (structure if isinstance(structure, Structure) else parse_structure(text))
     own_delay = getattr(st, "delay", None)
+    if st.den_degree == 0 and st.num_degree == 0 and own_delay is None and delay != "fit":
+        raise ModelError(f"structure {text!r} has no s and no delay: a static gain needs no frequency-response fit "
+                         "(give orders like 0/2, or a formula in s)")
     if own_delay is not None and delay != "fit":
         raise ModelError(f"structure {text!r} has its own delay factor; do not also give a delay")
     if isinstance(delay, str) and delay != "fit":

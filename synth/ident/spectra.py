@@ -96,8 +96,13 @@ class FrequencyResponse:
 
     @property
     def phase_deg(self) -> np.ndarray:
-        """Phase [deg], unwrapped from the lowest frequency."""
-        return np.degrees(np.unwrap(np.angle(self.H)))
+        """Phase [deg], unwrapped along ``w`` and shifted by a multiple of 360 deg so that it lies in (-270, 90] deg
+        at the coherent band's lowest frequency (the first point without a band), as ``synth hq`` takes it: the
+        points below the band are noise, and anchoring there put an integrator's phase at +250 deg."""
+        phase = np.degrees(np.unwrap(np.angle(self.H)))
+        at = int(np.searchsorted(self.w, self.band.w_min)) if self.band.found else 0
+        at = min(at, phase.size - 1)
+        return phase - 360.0 * np.ceil((phase[at] - 90.0) / 360.0)
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready: the grid ``w``, ``magnitude_db``, ``phase_deg``, ``coherence``, ``random_error``, band.
