@@ -404,8 +404,8 @@ def _design(spec: Spec, settings: ConvexSettings, nlp: bool | str, explain: bool
                       f"NLP polish from the {len(starts)} least violating (at most 3 rounds of {SCREEN_ITERATIONS} "
                       "iterations each)")
         candidates, passed = _certify_best(spec, found, terms, per_decade, cache)
-    if passed is not None and spec.objective is not None and optimality_of(passed[0], str(passed[1]),
-                                                                            unconverged).local:
+    if nlp and passed is not None and spec.objective is not None and optimality_of(passed[0], str(passed[1]),
+                                                                                   unconverged).local:
         climbed, steps = climb(spec, passed[1], terms, settings.stability_level)  # the claim, on the exact check
         if steps:
             found.append(("ascent probe", climbed))
