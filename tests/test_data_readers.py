@@ -127,7 +127,8 @@ def test_random_csv_loads_to_the_values_written(tmp_path, seed):
     assert r.t[0] == pytest.approx(t[0]) and r.t[-1] == pytest.approx(t[-1])
     assert np.ptp(steps) <= 1e-9 * steps.mean() and steps.mean() <= np.median(np.diff(t)) * (1 + 1e-9)
     tol = 1e-9 * steps.mean()
-    assert r.u.tolist() == [_held(t, u, g, tol) for g in r.t]
+    # each grid interval [g, g + dt) holds the command written for the longer part of it: the one at its middle
+    assert r.u.tolist() == [_held(t, u, g + 0.5 * steps.mean(), tol) for g in r.t]
     np.testing.assert_allclose(r.y, [_linear(t, y, g) for g in r.t], rtol=1e-9, atol=1e-9)
     np.testing.assert_allclose(r.aux[case["header"][3]], [_linear(t, a, g) for g in r.t], rtol=1e-9, atol=1e-9)
     runs = [float(x) for k, x in enumerate(r.u) if k == 0 or x != r.u[k - 1]]
@@ -315,3 +316,23 @@ def test_one_column_in_two_roles_is_one_line(tmp_path, roles, message):
     p.write_text("t,u,y\n0,0,0\n1,1,1\n2,1,2\n3,1,3\n")
     with pytest.raises(DataError, match=message):
         load_record(p, **roles)
+
+
+def test_resampled_command_edges_are_not_late_on_average():
+    """Jittered stamps (4-6 ms), a command that changes only at stamps: after resampling, each edge sits at most half
+    an interval from where it was written, and the edges are not late on average (taking the level at each
+    interval's start moved them 0.5 interval later on average, a lag that biased fitted time constants)."""
+    from synth.data import record_from_arrays
+
+    rng = np.random.default_rng(4)
+    t = np.cumsum(rng.uniform(0.004, 0.006, 20_000))
+    t -= t[0]
+    levels = np.repeat(rng.choice([-1.0, 1.0], 400), 50)  # a level every 50 stamps (about 0.25 s)
+    r = record_from_arrays(t, levels, np.sin(t))
+    dt = r.t[1] - r.t[0]
+    written = t[np.flatnonzero(np.diff(levels)) + 1]
+    moved = r.t[np.flatnonzero(np.diff(r.u)) + 1]
+    assert moved.size == written.size
+    shift = (moved - written) / dt
+    assert np.all(np.abs(shift) <= 0.5 + 1e-9)
+    assert abs(shift.mean()) < 0.05  # the old rule: +0.5

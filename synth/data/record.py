@@ -145,9 +145,11 @@ def uniform_columns(
     Samples sharing a time stamp keep the last of them (at most ``REPEATED_LIMIT`` of
     them: more means a rounded time column). Irregular sampling
     (intervals spread by more than 0.1 %) is resampled onto a uniform grid from
-    the first to the last time stamp: the columns in ``held`` (commands) keep
-    their last value between samples (zero-order hold, so a step stays a step),
-    the others are interpolated linearly. The grid interval is the median
+    the first to the last time stamp: the columns in ``held`` (commands) are
+    held (zero-order hold, so a step stays a step), each grid interval taking the
+    value the command has for the longer part of it (the one at its middle: an
+    edge moves by at most half an interval, either way, not always later), the
+    others are interpolated linearly. The grid interval is the median
     interval, or the shortest time a held column stays at one value if that is
     shorter (down to a quarter of the median), so that no command level is
     skipped; the notes say what was done.
@@ -225,14 +227,18 @@ def _resample(tt: np.ndarray, arrays: dict[str, np.ndarray], held: list[str]
     n = max(1, int(np.ceil(span / target - 1e-9)))
     grid = np.linspace(tt[0], tt[-1], n + 1)
     dt = span / n
-    index = np.clip(np.searchsorted(tt, grid + 1e-9 * dt, side="right") - 1, 0, tt.size - 1)
+    # a held value is the one the input has for the longer part of the interval it holds on the grid,
+    # [g, g + dt): the one at g + dt/2. The value at g itself (the last stamp before it) moved every edge
+    # later by half an interval on average, a lag that biased the fit (K 0.4 % and T 1.2 % low, 30-46 of
+    # their reported std, on a first-order plant with 4-6 ms jittered stamps)
+    index = np.clip(np.searchsorted(tt, grid + 0.5 * dt, side="right") - 1, 0, tt.size - 1)
     out = {k: (v[index] if k in held else np.interp(grid, tt, v)) for k, v in arrays.items()}
     note = f"onto a uniform {dt:.4g} s grid ({tt.size} -> {grid.size} samples)"
     for h in held:
         runs = int(np.count_nonzero(np.diff(arrays[h]))) + 1
         kept = int(np.count_nonzero(np.diff(out[h]))) + 1
         lost = f"; {runs - kept} of its {runs} levels were shorter than the grid and dropped" if kept < runs else ""
-        note += f"; '{h}' held at its last value between samples (zero-order hold){lost}"
+        note += f"; '{h}' held (zero-order hold, each interval at the value of its middle){lost}"
     others = [k for k in out if k not in held]
     if others:
         note += f"; {', '.join(repr(k) for k in others)} linearly interpolated"
