@@ -337,6 +337,9 @@ def _count(num: np.ndarray, den: np.ndarray, delay: float) -> StabilityResult:
     if n_origin:
         total += _indentation_phase(F, 0.0, eps0)
     winding = -total / (2.0 * np.pi)
+    if not np.isfinite(winding):  # e.g. 1/(s+1)^400: (j w)^400 overflows beyond 6 rad/s
+        raise ModelError(f"cannot count the closed loop's poles: its frequency response overflows floating point "
+                         f"(loop polynomials of degree {max(len(num), len(den)) - 1})")
     n_closed = round(winding) + n_rhp
     if abs(winding - round(winding)) > 0.1 or n_closed < 0:
         raise RuntimeError(f"Nyquist count failed to converge (winding {winding:.3f})")

@@ -88,3 +88,13 @@ def test_static_sensitivity_on_a_plant_without_a_finite_dc_gain(run_cli, tmp_pat
     static = next(q for q in data["requirements"] if q["type"] == "sensitivity_static")
     assert static["value"] == pytest.approx(expected_db, abs=1e-3)
     assert static["met"] == (expected_db <= -3)
+
+
+def test_a_loop_whose_response_overflows_is_one_line(run_cli, tmp_path):
+    """Found by a black-box test: ``1/(s+1)^400`` behind 0.1 s; ``(j w)^400`` overflows beyond 6 rad/s and the
+    Nyquist count's winding came out NaN (a ValueError traceback, exit 1)."""
+    spec = _spec(tmp_path, plant={"tf": "1/(s+1)^400", "delay": 0.1}, controller={"type": "PI"},
+                 requirements=[{"type": "disk_margin", "min": 0.5}])
+    r = run_cli("check", spec, "--controller", "PI(kp=0.8, ki=0.6)")
+    assert r.code == 2 and "Traceback" not in r.err
+    assert r.err.strip().splitlines() == [r.err.strip()] and "overflows floating point" in r.err
