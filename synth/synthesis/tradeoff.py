@@ -256,6 +256,23 @@ def design_point(data: dict[str, Any], sweeps: list[Sweep], values: tuple[float,
                          result.verdict, time.perf_counter() - t0, status=result.status)
 
 
+def _validated(data: dict[str, Any], sweeps: list[Sweep], values: tuple[float, ...]) -> None:
+    """Raise the spec's own one-line error (:func:`synth.spec.messages.spec_error`) where the point is not a valid
+    spec, named by its swept values (``plant.delay: must be >= 0.0, got -0.1``)."""
+    from pydantic import ValidationError
+
+    from synth.spec.messages import spec_error
+
+    point = dict(data)
+    for sw, v in zip(sweeps, values):
+        point = set_value(point, sw.path, v)
+    try:
+        Spec.model_validate_json(json.dumps(point), strict=True)
+    except ValidationError as exc:
+        label = ", ".join(f"{sw.path}={v:g}" for sw, v in zip(sweeps, values))
+        raise spec_error(exc, f"--sweep {label}", None, point) from None
+
+
 def design_chunk(data: dict[str, Any], sweeps: list[Sweep], chunk: list[tuple[float, ...]]) -> list[TradeoffPoint]:
     """Design a contiguous run of points, each warm-started from the previous feasible design."""
     out = []
@@ -392,6 +409,8 @@ def tradeoff(spec: Spec, sweeps: list[Sweep], scheduler: str | Any | None = None
         except SpecError:  # a map over any two values still designs; it just has no front
             signs = []
     grid = _grid(sweeps)
+    for values in grid:  # a swept value the spec forbids is bad input, said before any design, not a row
+        _validated(data, sweeps, values)
     t0 = time.perf_counter()
     results: list[TradeoffPoint] = []
     if scheduler is not None:
