@@ -271,7 +271,8 @@ class Diagnosis:
 
 
 def _fmt(x: float) -> str:
-    return f"{x:.4g}" if np.isfinite(x) else ("none" if x > 0 else "-none")
+    """A parameter in the headline, as the effects' table writes it (an absent limit is ``inf`` or ``-inf``)."""
+    return f"{x:.4g}" if np.isfinite(x) else ("inf" if x > 0 else "-inf")
 
 
 def check_candidates(candidates: list[str] | tuple[str, ...]) -> list[str]:
