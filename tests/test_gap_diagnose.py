@@ -144,3 +144,23 @@ def test_diagnose_takes_arrays_columns_and_records_alike():
 def test_diagnose_names_a_form_that_is_not_a_record():
     with pytest.raises(DataError, match="not a record"):
         diagnose(Plant.from_string("2/(0.2*s+1)"), 42, candidates=["delay"])
+
+
+@pytest.mark.parametrize("seed", [0, 1])
+def test_a_symmetric_actuator_saturation_is_named_with_both_limits(seed):
+    """Found by a black-box test: ``4/(s^2 + 2.4 s + 4)`` behind an input clipped at +-0.6 (random command levels in
+    [-1, 1], noise std 0.01). The saturation's grid tried one limit at a time; its one-sided fit lost to a static
+    nonlinearity (a2 = 0.012, a3 = -0.43). The record is simulated here by scipy (the clipped command through the
+    linear plant, zero-order hold), not by synth."""
+    from scipy import signal
+
+    rng = np.random.default_rng(seed)
+    dt, n = 0.01, 20_000
+    t = np.arange(n) * dt
+    u = np.repeat(rng.uniform(-1.0, 1.0, n // 200), 200)
+    num, den, _ = signal.cont2discrete(([4.0], [1.0, 2.4, 4.0]), dt, method="zoh")
+    y = signal.lfilter(np.ravel(num), den, np.clip(u, -0.6, 0.6)) + 0.01 * rng.standard_normal(n)
+    d = diagnose(Plant.from_string("4/(s^2+2.4*s+4)"), (t, u, y))
+    assert d.verdict["effects"][0] == "saturation", d.summary
+    p = next(e for e in d.attribution.effects if e.effect == "saturation").parameters
+    assert abs(p["lower"] + 0.6) < 0.06 and abs(p["upper"] - 0.6) < 0.06

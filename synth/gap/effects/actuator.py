@@ -130,7 +130,11 @@ class SaturationEffect(Effect):
                 uppers.append(up)
             if all(abs(down - x) > 0.01 * span for x in lowers) and lo < down < hi:
                 lowers.append(down)
-        return [{"upper": x} for x in sorted(uppers, reverse=True)] + [{"lower": x} for x in sorted(lowers)]
+        # and both limits at once, each at the same fraction of the span from its end: an actuator's range clips
+        # both ways, which one limit at a time fits only as a one-sided clip plus a bias
+        both = [{"upper": hi - f * span, "lower": lo + f * span} for f in fractions if f < 0.5]
+        return ([{"upper": x} for x in sorted(uppers, reverse=True)] + [{"lower": x} for x in sorted(lowers)]
+                + both)
 
     def data_grid(self, t: np.ndarray, u: np.ndarray, y: np.ndarray, plant: Plant) -> list[Params]:
         if self.placement == "input" or type(self).grid is not SaturationEffect.grid:  # a subclass's own grid wins
@@ -153,6 +157,9 @@ class SaturationEffect(Effect):
         side = "upper" if np.isfinite(point.get("upper", np.inf)) else "lower"
         other = "lower" if side == "upper" else "upper"
         span = float(np.ptp(u_train)) if u_train is not None and np.ptp(u_train) > 0 else abs(point[side]) or 1.0
+        if np.isfinite(point.get("upper", np.inf)) and np.isfinite(point.get("lower", -np.inf)):  # both limits
+            return [{"upper": point["upper"] + a * span, "lower": point["lower"] + b * span}
+                    for a in (-0.03, 0.0, 0.03) for b in (-0.03, 0.0, 0.03)]
         grid = [{side: point[side] + f * span} for f in (-0.05, -0.02, 0.0, 0.02, 0.05)]
         return [{k: v for k, v in g.items() if k != other} for g in grid]
 
