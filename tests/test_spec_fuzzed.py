@@ -98,3 +98,16 @@ def test_a_loop_whose_response_overflows_is_one_line(run_cli, tmp_path):
     r = run_cli("check", spec, "--controller", "PI(kp=0.8, ki=0.6)")
     assert r.code == 2 and "Traceback" not in r.err
     assert r.err.strip().splitlines() == [r.err.strip()] and "overflows floating point" in r.err
+
+
+@pytest.mark.parametrize("changes, message", [
+    ({"plant": {"tf": "2/((s+1)*(0.5*s+1))", "variants": [{"label": "z", "delay": -0.1}]}},
+     "plant.variants[0].delay: must be >= 0.0, got -0.1"),  # 'delay' is also a simulation block's tag
+    ({"requirements": [{"type": "no_limit_cycle", "actuator": []}]},
+     "requirements[0].actuator: needs at least 1 item(s), got []"),  # a list of blocks, not a pair of numbers
+])
+def test_messages_name_the_key_and_the_kind_of_value(run_cli, tmp_path, changes, message):
+    """Found by a black-box test: the variant's key was dropped from the path, and an empty block list was asked
+    for "exactly 2 numbers [low, high]"."""
+    r = run_cli("check", _spec(tmp_path, **changes), "--controller", "P(1)")
+    assert r.code == 2 and message in r.err, r.err

@@ -66,13 +66,15 @@ def line_of(root: yaml.Node | None, loc: tuple[Any, ...]) -> int | None:
 def _clean_loc(loc: tuple[Any, ...]) -> tuple[Any, ...]:
     out: list[Any] = []
     for i, part in enumerate(loc):
+        parent = loc[i - 2] if i > 1 else None
         if (
             isinstance(part, str)
             and i > 0
             and isinstance(loc[i - 1], int)
-            and (part in REQUIREMENT_TYPES or part in SIMULATION_TAGS)
+            and ((parent == "requirements" and part in REQUIREMENT_TYPES)
+                 or (parent in ("actuator", "sensor", "disturbances") and part in SIMULATION_TAGS))
         ):
-            continue  # discriminated-union tag inserted by pydantic
+            continue  # discriminated-union tag inserted by pydantic (not a key of that name: a variant's 'delay')
         if isinstance(part, str) and ("[" in part or part.startswith("function-")):
             continue
         out.append(part)
@@ -176,6 +178,8 @@ def _message(err: dict[str, Any], data: Any, loc: tuple[Any, ...]) -> str:
     if kind in {"too_short", "too_long"}:
         if loc and loc[-1] == "requirements":
             return "the requirement list is empty; give at least one requirement"
+        if str(err.get("ctx", {}).get("field_type", "")).lower() == "list":  # a list of items, not a pair
+            return f"needs at least {err['ctx'].get('min_length', 1)} item(s), got {given!r}"
         return f"expected exactly 2 numbers [low, high], got {given!r}"
     if kind in {"greater_than", "greater_than_equal"}:
         limit = err["ctx"].get("gt", err["ctx"].get("ge"))
