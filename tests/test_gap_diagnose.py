@@ -164,3 +164,22 @@ def test_a_symmetric_actuator_saturation_is_named_with_both_limits(seed):
     assert d.verdict["effects"][0] == "saturation", d.summary
     p = next(e for e in d.attribution.effects if e.effect == "saturation").parameters
     assert abs(p["lower"] + 0.6) < 0.06 and abs(p["upper"] - 0.6) < 0.06
+
+
+def test_a_one_sided_saturation_headline_writes_the_absent_limit_as_the_table_does():
+    """``min(u, 0.5)`` through ``4/(s^2 + 2.4 s + 4)`` (scipy, zero-order hold): the verdict names saturation with its
+    upper limit, and its headline writes the absent lower limit as ``-inf`` (it wrote ``-none``; found by a black-box
+    test)."""
+    from scipy import signal
+
+    rng = np.random.default_rng(3)
+    dt, n = 0.01, 20_000
+    t = np.arange(n) * dt
+    u = np.repeat(rng.uniform(-1.0, 1.0, n // 200), 200)
+    num, den, _ = signal.cont2discrete(([4.0], [1.0, 2.4, 4.0]), dt, method="zoh")
+    y = signal.lfilter(np.ravel(num), den, np.minimum(u, 0.5)) + 0.01 * rng.standard_normal(n)
+    d = diagnose(Plant.from_string("4/(s^2+2.4*s+4)"), (t, u, y))
+    assert d.verdict["effects"][0] == "saturation", d.summary
+    p = next(e for e in d.attribution.effects if e.effect == "saturation").parameters
+    assert abs(p["upper"] - 0.5) < 0.03 and p["lower"] == -np.inf
+    assert "lower = -inf" in d.summary and "none" not in d.summary
