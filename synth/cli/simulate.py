@@ -246,12 +246,13 @@ def _print_metrics(say: Any, spec: Any, loop: Any, m: Any, step: tuple[float, fl
     lc = m.limit_cycle
     cycle = {"limit_cycle": f"{fmt(lc.amplitude)} {y} every {fmt(lc.period)} s" if lc.present else "yes",
              "diverging": "diverges", "settled": "none", "undetermined": "undetermined"}[verdict]
-    no_step = "n/a: the reference does not step"
+    settling = f"{fmt(m.settling_time)} s" if m.settling_time is not None else "not settled"
+    timing = [f"{fmt(m.rise_time)} s", f"{fmt(m.overshoot)} %", settling] if step[0] != step[1] else \
+        ["n/a: the reference does not step"] * 3
     rows = [
-        ["rise time 10-90 %", no_step if step[0] == step[1] else f"{fmt(m.rise_time)} s"],
-        ["overshoot", no_step if step[0] == step[1] else f"{fmt(m.overshoot)} %"],
-        ["settling time (2 %)", no_step if step[0] == step[1] else
-         f"{fmt(m.settling_time)} s" if m.settling_time is not None else "not settled"],
+        ["rise time 10-90 %", timing[0]],
+        ["overshoot", timing[1]],
+        ["settling time (2 %)", timing[2]],
         ["final value", f"{fmt(m.final_value)} {y}"],
         ["peak actuator rate", f"{fmt(m.actuator_peak_rate)} {u}/s"],
         ["actuator range", f"{fmt(m.actuator_min)} to {fmt(m.actuator_max)} {u}"],

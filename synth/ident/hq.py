@@ -28,7 +28,7 @@ from synth.ident.hq_metrics import (
     check_choice,
     crossing_metrics,
 )
-from synth.ident.model_phase import continuous_phase, low_frequency_form, model_grid
+from synth.ident.model_phase import anchored_phase, continuous_phase, low_frequency_form, model_grid
 from synth.plant import Plant
 
 __all__ = ["coherence_random_error", "fit_phase_line", "hq_from_frd", "hq_from_plant"]
@@ -305,8 +305,7 @@ def hq_from_frd(w: Any, H: Any, coherence: Any = None, averages: Any = None,
     check_choice(phase_fit, PHASE_FITS, "phase_fit")
     w, H, g2, nd = _validate_frd(w, H, coherence, averages)
     notes: list[str] = []
-    phase = np.unwrap(np.angle(H)) * DEG
-    phase -= 360.0 * np.ceil((phase[0] - 90.0) / 360.0)
+    phase = anchored_phase(H)
     mag = 20 * np.log10(np.abs(H))
     reason = "given"
     if response_type == "auto":

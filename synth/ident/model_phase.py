@@ -14,7 +14,20 @@ from synth.errors import ModelError
 from synth.ident.hq_metrics import DEG
 from synth.plant import Plant
 
-__all__ = ["continuous_phase", "low_frequency_form", "model_grid"]
+__all__ = ["anchored_phase", "continuous_phase", "low_frequency_form", "model_grid"]
+
+
+def anchored_phase(H: np.ndarray, at: int = 0) -> np.ndarray:
+    """Phase of a measured response ``H`` [deg], unwrapped along its grid and shifted by a multiple of 360 deg so that
+    it lies in (-270, 90] deg at point ``at`` (the branch ``synth hq`` and ``synth freqresp`` read).
+
+    Examples
+    --------
+    >>> anchored_phase(np.exp(1j * np.radians([250.0, 240.0, 230.0]))).round(1)
+    array([-110., -120., -130.])
+    """
+    phase = np.unwrap(np.angle(H)) * DEG
+    return phase - 360.0 * np.ceil((phase[at] - 90.0) / 360.0)
 
 
 def _zeros(plant: Plant) -> np.ndarray:

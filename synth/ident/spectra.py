@@ -17,6 +17,7 @@ import numpy as np
 from synth.data import Record
 from synth.errors import DataError
 from synth.ident.coherence import COHERENCE_THRESHOLD, CoherentBand, coherence_from_spectra, coherent_band, random_error
+from synth.ident.model_phase import anchored_phase
 from synth.ident.spectral_windows import (
     as_runs,
     check_length,
@@ -99,10 +100,8 @@ class FrequencyResponse:
         """Phase [deg], unwrapped along ``w`` and shifted by a multiple of 360 deg so that it lies in (-270, 90] deg
         at the coherent band's lowest frequency (the first point without a band), as ``synth hq`` takes it: the
         points below the band are noise, and anchoring there put an integrator's phase at +250 deg."""
-        phase = np.degrees(np.unwrap(np.angle(self.H)))
         at = int(np.searchsorted(self.w, self.band.w_min)) if self.band.found else 0
-        at = min(at, phase.size - 1)
-        return phase - 360.0 * np.ceil((phase[at] - 90.0) / 360.0)
+        return anchored_phase(self.H, min(at, self.H.size - 1))
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready: the grid ``w``, ``magnitude_db``, ``phase_deg``, ``coherence``, ``random_error``, band.

@@ -26,7 +26,7 @@ from synth.loop import Loop
 from synth.objectives import score
 from synth.results import SEARCH_PER_DECADE
 from synth.spec import Spec
-from synth.synthesis.pattern import closest_approach
+from synth.synthesis.pattern import closest_approach, parameter_scales
 
 __all__ = ["ACTIVE", "CLIMB_ROUNDS", "MIN_GAIN", "STEPS", "ascent_probe", "climb"]
 
@@ -45,11 +45,6 @@ MIN_GAIN = 1e-3
 
 CLIMB_ROUNDS = 20
 """Most probes :func:`climb` makes."""
-
-
-def _scale(value: float, lo: float, hi: float) -> float:
-    """A parameter's scale: its size plus 1 % of its range (as the pattern search's)."""
-    return abs(value) + 0.01 * (hi - lo) if np.isfinite(hi - lo) else max(abs(value), 1e-6)
 
 
 def _parts(spec: Spec, c: Controller) -> np.ndarray | None:
@@ -101,7 +96,7 @@ def ascent_probe(spec: Spec, controller: Controller, terms: list[tuple[str, str,
     f0 = score(Loop(nominal, controller), terms)
     if not np.isfinite(f0):
         return None
-    scales = np.array([_scale(x[k], *bounds[k]) for k in free])
+    scales = parameter_scales(x, bounds, free)
     grad_f = np.zeros(len(free))
     active = base < ACTIVE
     grad_g = np.zeros((int(active.sum()), len(free)))

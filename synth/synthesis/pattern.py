@@ -32,7 +32,7 @@ from synth.synthesis.convex_settings import ConvexSettings, design_grid
 from synth.synthesis.delay_grid import controller_gain_bound
 from synth.synthesis.parametrization import parametrize
 
-__all__ = ["BOUNDARY_CHECKS", "PATTERN_CHECKS", "PatternResult", "closest_approach", "pattern_search"]
+__all__ = ["BOUNDARY_CHECKS", "PATTERN_CHECKS", "PatternResult", "closest_approach", "parameter_scales", "pattern_search"]
 
 PATTERN_CHECKS = 160
 """Most checks a pattern search makes (by default)."""
@@ -62,6 +62,17 @@ class PatternResult:
     improved: bool
     checks: int
     final_step: float
+
+
+def parameter_scales(x: dict[str, float], bounds: dict[str, tuple[float, float]], names: list[str]) -> np.ndarray:
+    """Each parameter's scale, the unit of a search's steps: its size plus 1 % of its range.
+
+    Examples
+    --------
+    >>> parameter_scales({"kp": 2.0, "ki": 0.0}, {"kp": (0.0, 10.0), "ki": (0.0, 200.0)}, ["kp", "ki"]).tolist()
+    [2.1, 2.0]
+    """
+    return np.array([abs(x[k]) + 0.01 * (bounds[k][1] - bounds[k][0]) for k in names])
 
 
 def closest_approach(plants: list[Any], c: Controller, grid: np.ndarray | None = None) -> float:
@@ -168,7 +179,7 @@ def pattern_search(spec: Spec, start: Controller, terms: list[tuple[str, str, fl
     first = value(x)
     if not np.isfinite(first[0]) or not free:
         return PatternResult(start, False, checks, 0.0)
-    scale = np.array([abs(x[k]) + 0.01 * (bounds[k][1] - bounds[k][0]) for k in free])
+    scale = parameter_scales(x, bounds, free)
     lo = np.array([bounds[k][0] for k in free]) / scale
     hi = np.array([bounds[k][1] for k in free]) / scale
 

@@ -233,9 +233,7 @@ def design_point(data: dict[str, Any], sweeps: list[Sweep], values: tuple[float,
     from synth.design import design
 
     t0 = time.perf_counter()
-    point = dict(data)
-    for sw, v in zip(sweeps, values):
-        point = set_value(point, sw.path, v)
+    point = _point(data, sweeps, values)
     if initial is not None:
         point["controller"] = {**point["controller"], "initial": initial}
     labels = {sw.path: v for sw, v in zip(sweeps, values)}
@@ -256,6 +254,14 @@ def design_point(data: dict[str, Any], sweeps: list[Sweep], values: tuple[float,
                          result.verdict, time.perf_counter() - t0, status=result.status)
 
 
+def _point(data: dict[str, Any], sweeps: list[Sweep], values: tuple[float, ...]) -> dict[str, Any]:
+    """The spec's data with each swept value set."""
+    point = dict(data)
+    for sw, v in zip(sweeps, values):
+        point = set_value(point, sw.path, v)
+    return point
+
+
 def _validated(data: dict[str, Any], sweeps: list[Sweep], values: tuple[float, ...]) -> None:
     """Raise the spec's own one-line error (:func:`synth.spec.messages.spec_error`) where the point is not a valid
     spec, named by its swept values (``plant.delay: must be >= 0.0, got -0.1``)."""
@@ -263,9 +269,7 @@ def _validated(data: dict[str, Any], sweeps: list[Sweep], values: tuple[float, .
 
     from synth.spec.messages import spec_error
 
-    point = dict(data)
-    for sw, v in zip(sweeps, values):
-        point = set_value(point, sw.path, v)
+    point = _point(data, sweeps, values)
     try:
         Spec.model_validate_json(json.dumps(point), strict=True)
     except ValidationError as exc:
