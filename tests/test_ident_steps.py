@@ -62,3 +62,21 @@ def test_input_without_step():
     u = np.r_[np.zeros(99), 1.0]
     with pytest.raises(DataError):
         average_steps(record_from_arrays(t, u, t), mode="cycle")
+
+
+def test_a_last_step_near_the_records_end_is_left_out_not_every_window_cut():
+    """Steps 40-80 samples apart, the record ending 5 samples after the last one: the windows are the 40 samples
+    between the closest two steps and the last step is dropped (the old rule cut every window to the 5 samples left
+    after it and refused the record: 'steps are only 5 samples apart')."""
+    rng = np.random.default_rng(3)
+    edges = np.cumsum(rng.integers(40, 81, 12)) + 20
+    n = int(edges[-1]) + 5
+    u = np.zeros(n)
+    for k, e in enumerate(edges):
+        u[e:] = 1.0 if k % 2 == 0 else 0.0
+    t = np.arange(n) * 0.01
+    y = np.convolve(u, 1 - np.exp(-np.arange(200) * 0.01 / 0.05))[:n] * 0.01 / 0.05 * (1 - np.exp(-0.01 / 0.05))
+    avg = average_steps(record_from_arrays(t, u, y), mode="edge")
+    assert avg.dropped == 1 and avg.count == edges.size - 1
+    assert round(avg.t[-1] / 0.01) + 1 == int(np.min(np.diff(edges)))
+    assert avg.u[:-1].max() == pytest.approx(1.0) and avg.u[avg.t >= 0].min() == pytest.approx(1.0)

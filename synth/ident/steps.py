@@ -152,7 +152,8 @@ class StepAverage:
     up, down : int
         Up and down steps inside the averaged windows.
     dropped : int
-        Windows not used (the first period in ``"cycle"`` mode).
+        Windows not used (the first period in ``"cycle"`` mode; in ``"edge"`` mode a last step closer to the
+        record's end than the shortest time between two steps).
     step_size : float
         Output step size of the averaged response (see the module docstring).
     noise_std_before, noise_std_after : float
@@ -337,9 +338,19 @@ def _average_cycles(record: Record, steps: Steps, period: int, high: int, settle
 
 
 def _average_edges(record: Record, steps: Steps, pre: float | None, direction: int = 0) -> StepAverage:
-    gaps = np.diff(np.r_[steps.index, record.n])
-    post = int(np.min(gaps))
+    # the window is the shortest time between two steps; a last step closer to the record's end than that is
+    # left out (its window would run past the end) rather than shortening every window to what is left of it
+    between = np.diff(steps.index)
+    tail = record.n - int(steps.index[-1])
+    post = int(np.min(between)) if between.size else tail
     keep = steps.direction == direction if direction else np.ones(steps.count, bool)
+    cut = 0
+    if tail < post:
+        cut = int(keep[-1])
+        keep[-1] = False
+        if not np.any(keep):
+            post = tail  # the only step of its direction: its window is what the record has
+            keep[-1], cut = True, 0
     idx, dirs = steps.index[keep], steps.direction[keep]
     if pre is None:
         n_pre = min(max(1, post // 10), int(steps.index[0]))
@@ -362,6 +373,6 @@ def _average_edges(record: Record, steps: Steps, pre: float | None, direction: i
     before, after = _noise(yw)
     t = np.arange(-n_pre, post) * record.dt
     ups = int(np.sum(dirs > 0))
-    return StepAverage("edge", t, u, y, int(idx.size), ups, int(idx.size) - ups, 0, step, before, after,
+    return StepAverage("edge", t, u, y, int(idx.size), ups, int(idx.size) - ups, cut, step, before, after,
                        _snr(step, before), _snr(step, after), False, steps, record.input, record.output, record.source,
                        n_pre)
