@@ -80,3 +80,13 @@ def test_a_last_step_near_the_records_end_is_left_out_not_every_window_cut():
     assert avg.dropped == 1 and avg.count == edges.size - 1
     assert round(avg.t[-1] / 0.01) + 1 == int(np.min(np.diff(edges)))
     assert avg.u[:-1].max() == pytest.approx(1.0) and avg.u[avg.t >= 0].min() == pytest.approx(1.0)
+
+
+def test_a_step_whose_edge_falls_inside_a_sample_interval_starts_at_that_sample():
+    """A resampled record holds the interval's mean command where an edge falls inside it (0.2, 0.6, 0.5 here):
+    the step is at that sample, so its window's samples before the step are all at the old level."""
+    t = np.arange(10) * 0.1
+    steps = find_steps(record_from_arrays(t, [0, 0.2, 1, 1, 1, 0.6, 0, 0.5, 1, 1], t ** 2))
+    assert steps.index.tolist() == [1, 5, 7] and steps.direction.tolist() == [1, -1, 1]
+    plain = find_steps(record_from_arrays(t, [0, 0, 1, 1, 1, 0, 0, 1, 1, 1], t ** 2))
+    assert plain.index.tolist() == [2, 5, 7]

@@ -1,7 +1,7 @@
 """Real records as they come (../shared/data): each test checks numbers the folder's README.txt documents.
 
 - esc_thrust_stand_1s: RCbenchmark CSV logs with units in every header, a BOM, trailing commas, a text
-  column, repeated and jittered time stamps; the ESC command is a staircase and must stay one.
+  column, repeated and jittered time stamps; the ESC command is a staircase and must stay one (its integral kept).
 - hsm150_two_motor_steps: MAT files whose record is a 20000 x 7 matrix ``data``.
 - silverbox_duffing: CSV without a time column (fs = 10^7 / 2^14 Hz), quoted headers, trailing commas.
 """
@@ -49,22 +49,21 @@ def test_esc_command_stays_a_staircase_after_resampling(name):
     repeated = int(np.sum(np.diff(native) == 0))  # a level logged at the same instant as the next cannot be kept
     r = load_record(path, "Time (s)", "ESC signal", "Thrust", aux=["Voltage"])
     assert (r.input.label(), r.output.label()) == ("ESC signal [µs]", "Thrust [gf]")
-    levels = np.unique(r.u)
-    # README: first -> last in `step` increments, one level per row; every row's level survives resampling except
-    # the one overwritten at a repeated time stamp and one held for less than half a grid interval (each interval
-    # holds the level the command has for the longer part of it; the notes say so): the 2020 log's first level,
-    # 1300 us, lasts 2 ms before 3.5 s levels
+    # README: first -> last in `step` increments, one level per row, non-decreasing. Each grid interval holds the
+    # logged command's mean over it (each row's level held to the next row's stamp), so the staircase's integral
+    # is kept at every grid point; a level over two grid intervals or more keeps its value exactly on one of them
     dt = float(r.t[1] - r.t[0])
     native_u = read_table(path).columns["ESC signal (µs)"]
-    stamps = np.r_[native[np.r_[True, np.diff(native) > 0]], native[-1] + dt]
-    held = np.diff(stamps)
-    short = int(np.sum(held[:-1] < 0.5 * dt))
-    assert short == (1 if name.startswith("StepsTest_2020") else 0)
-    assert levels.size == rows - repeated - short
-    assert short == 0 or any("shorter than the grid and dropped" in n for n in r.notes)
-    assert np.allclose((levels - first) / step, np.round((levels - first) / step))  # no interpolated (ramp) values
-    changes = np.diff(r.u)[np.diff(r.u) != 0]
-    assert changes.size == rows - repeated - short - 1 and np.allclose(changes, step)
+    keep = np.r_[np.diff(native) > 0, True]  # the last of the rows sharing a stamp
+    stamps, values = native[keep], native_u[keep]
+    assert values.size == rows - repeated  # one level per row, less one per repeated stamp
+    integral = np.r_[0.0, np.cumsum(values[:-1] * np.diff(stamps))]
+    np.testing.assert_allclose(np.cumsum(r.u[:-1]) * dt, np.interp(r.t[1:], stamps, integral), rtol=1e-9)
+    assert np.all(np.diff(r.u) >= -1e-9 * last) and r.u.min() >= first  # still a non-decreasing staircase
+    long = values[:-1][np.diff(stamps) >= 2 * dt * (1 + 1e-9)]
+    assert np.all(np.isin(long, r.u))
+    exact = r.u[np.isin(r.u, values)]
+    assert np.allclose((exact - first) / step, np.round((exact - first) / step))
     assert r.u[-1] == last and r.u.max() == last and native_u[-1] == last
     assert any("zero-order hold" in n for n in r.notes) and any("'Thrust (gf)'" in n for n in r.notes)
     assert (repeated > 0) == any(n.startswith("repeated time stamps") for n in r.notes)
@@ -89,7 +88,11 @@ def test_esc_log_with_the_issue_trailing_comment_loads(tmp_path):
     p.write_text("# RCbenchmark log\n" + "\n".join([*lines[:40], "# a-> Type: Steps, note", *lines[40:]])
                  + "\n# a-> Type: Steps test finished\n", encoding="utf-8")
     r = load_record(p, "Time", "ESC signal (µs)", "Thrust (gf)")
-    assert np.unique(r.u).size == 100 and r.notes[0] == "skipped 3 comment line(s) starting with #"
+    plain = load_record(shared_path("data", ESC, "StepsTest20230624_2023-06-24_190243.csv"), "Time",
+                        "ESC signal (µs)", "Thrust (gf)")
+    assert r.notes[0] == "skipped 3 comment line(s) starting with #"
+    assert r.t.tolist() == plain.t.tolist() and r.u.tolist() == plain.u.tolist() and r.y.tolist() == plain.y.tolist()
+    assert r.u.min() >= 1000.0 and r.u[-1] == 2000.0 and r.u.size >= 100  # README: 101 rows, 1000 -> 2000 us
 
 
 HSM = "hsm150_two_motor_steps"

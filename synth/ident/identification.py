@@ -87,9 +87,13 @@ class IdentifyResult:
 
 
 def _two_level(u: np.ndarray) -> bool:
+    """At least 98 % of the samples near one of the input's two extremes, not counting a lone sample between
+    them at a level change (an edge inside a sample interval of a resampled record holds the interval's mean)."""
     lo, hi = float(np.min(u)), float(np.max(u))
     near = (np.abs(u - lo) <= 0.05 * (hi - lo)) | (np.abs(u - hi) <= 0.05 * (hi - lo))
-    return bool(np.mean(near) >= 0.98)
+    lone = np.zeros(u.size, dtype=bool)
+    lone[1:-1] = ~near[1:-1] & near[:-2] & near[2:]
+    return bool(np.mean(near | lone) >= 0.98)
 
 
 def identify(record: RecordLike, structure: Structure | str, delay: str | float | None = None,

@@ -88,7 +88,10 @@ def find_steps(record: Record, hysteresis: float = 0.2) -> Steps:
     """Find the steps of a two-level input.
 
     The input is compared with a Schmitt trigger at ``low + (0.5 +- hysteresis)
-    (high - low)`` of its range, so noise on the input does not make extra steps.
+    (high - low)`` of its range, so noise on the input does not make extra steps. A step is at the first
+    sample past the trigger, or at the one before when that sample has left the old level (by more than a tenth
+    of the range) and the one before it had not: an edge inside a sample interval (a resampled record holds the
+    interval's mean command there), whose window must not count that sample as before the step.
 
     Parameters
     ----------
@@ -117,6 +120,7 @@ def find_steps(record: Record, hysteresis: float = 0.2) -> Steps:
     state = u[0] > 0.5 * (lo + hi)
     index, direction = [], []
     above, below = u >= upper, u <= lower
+    near_low, near_high = u <= lo + 0.1 * (hi - lo), u >= hi - 0.1 * (hi - lo)
     k = 0
     n = u.size
     while k < n:
@@ -124,8 +128,12 @@ def find_steps(record: Record, hysteresis: float = 0.2) -> Steps:
         if not nxt.size:
             break
         k += int(nxt[0])
+        old_level = near_high if state else near_low
+        edge = k
+        if k >= 2 and not old_level[k - 1] and old_level[k - 2] and (not index or k - 1 > index[-1]):
+            edge = k - 1  # one sample already off the old level: the edge is inside its interval (e.g. resampled)
         state = not state
-        index.append(k)
+        index.append(edge)
         direction.append(1 if state else -1)
     if not index:
         raise DataError(f"column '{record.input.name}': no step found in the input", where=record.source)
