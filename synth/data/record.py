@@ -49,6 +49,10 @@ class Record:
         Where the record came from (a file path, or ``"arrays"``).
     notes : tuple of str
         What loading did to the data (for example resampling); shown in reports.
+    noise_factor : float
+        What a fit's white-noise variance estimate is multiplied by for its parameters' uncertainty: 1, unless
+        the output was interpolated from uneven time stamps (then adjacent samples share logged samples' noise;
+        :func:`synth.data.interpolated_noise.interpolation_noise_factor`).
 
     Examples
     --------
@@ -66,6 +70,7 @@ class Record:
     aux: dict[str, np.ndarray] = field(default_factory=dict)
     source: str = "arrays"
     notes: tuple[str, ...] = ()
+    noise_factor: float = 1.0
 
     @property
     def n(self) -> int:
@@ -100,7 +105,7 @@ class Record:
         if np.count_nonzero(keep) < 2:
             raise DataError(f"segment [{t0}, {t1}] s holds fewer than 2 samples", where=self.source)
         return Record(self.t[keep], self.u[keep], self.y[keep], self.input, self.output,
-                      {k: v[keep] for k, v in self.aux.items()}, self.source, self.notes)
+                      {k: v[keep] for k, v in self.aux.items()}, self.source, self.notes, self.noise_factor)
 
     def require_duration(self, w_min: float) -> None:
         """Raise unless the record is long enough to resolve ``w_min`` [rad/s].
@@ -132,7 +137,8 @@ class Record:
         return {"source": self.source, "samples": self.n, "dt": self.dt, "duration": self.duration,
                 "input": {"name": self.input.name, "unit": self.input.unit},
                 "output": {"name": self.output.name, "unit": self.output.unit},
-                "aux": sorted(self.aux), "notes": list(self.notes)}
+                "aux": sorted(self.aux), "notes": list(self.notes),
+                **({"noise_factor": self.noise_factor} if self.noise_factor != 1.0 else {})}
 
 
 def uniform_columns(
@@ -272,6 +278,7 @@ def record_from_arrays(
     aux: Mapping[str, Sequence[float] | np.ndarray] | None = None,
     source: str = "arrays",
     names: tuple[str, str, str] = ("time", "input", "output"),
+    noise_factor: float | None = None,
 ) -> Record:
     """Validate arrays and build a :class:`Record` (resampling irregular time explicitly).
 
@@ -290,6 +297,9 @@ def record_from_arrays(
         Named in every error message (a file path).
     names : tuple of str
         Column names of ``t``, ``u``, ``y`` as the user wrote them, for error messages.
+    noise_factor : float, optional
+        :attr:`Record.noise_factor`; by default 1, or on irregular time what the output's interpolation implies
+        (:func:`synth.data.interpolated_noise.interpolation_noise_factor`).
 
     Raises
     ------
@@ -316,7 +326,18 @@ def record_from_arrays(
                         where=source)
     if np.ptp(yy) == 0:
         raise DataError(f"column '{names[2]}': the output never responds (constant {yy[0]:g})", where=source)
-    return Record(tt, uu, yy, input, output, arrays, source, notes)
+    if noise_factor is None:
+        noise_factor = 1.0
+        if any(n.startswith("resampled") for n in notes):
+            from synth.data.interpolated_noise import interpolation_noise_factor
+
+            native = np.asarray(t, dtype=float).ravel()
+            native = native[np.r_[np.diff(native) > 0, True]]  # one per stamp, as resampling kept them
+            noise_factor = interpolation_noise_factor(native, tt)
+            notes += (f"the interpolated output shares each logged sample's noise between grid samples: a fit's "
+                      f"noise variance is taken {noise_factor:.3g} times its residuals' for the parameters' "
+                      "uncertainty",)
+    return Record(tt, uu, yy, input, output, arrays, source, notes, float(noise_factor))
 
 
 def read_columns(path: str | Path) -> dict[str, np.ndarray]:

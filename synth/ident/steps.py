@@ -174,6 +174,8 @@ class StepAverage:
         The steps found in the record.
     first_window : int
         Sample of the record where the first averaged window starts (``"cycle"`` mode; 0 otherwise).
+    noise_factor : float
+        The record's :attr:`~synth.data.Record.noise_factor`, carried to :meth:`record`.
     """
 
     mode: str
@@ -196,6 +198,7 @@ class StepAverage:
     source: str = "arrays"
     up_index: int = 0
     first_window: int = 0
+    noise_factor: float = 1.0
 
     def record(self) -> Record:
         """The averaged window as a :class:`~synth.data.Record` (time starting at the window's start).
@@ -208,7 +211,8 @@ class StepAverage:
         6000
         """
         return record_from_arrays(self.t, self.u, self.y, self.input, self.output,
-                                  source=f"{self.source} (average of {self.count} {self.mode}s)")
+                                  source=f"{self.source} (average of {self.count} {self.mode}s)",
+                                  noise_factor=self.noise_factor)
 
     def to_dict(self) -> dict[str, Any]:
         """JSON summary (no samples).
@@ -342,7 +346,7 @@ def _average_cycles(record: Record, steps: Steps, period: int, high: int, settle
     t = (np.arange(period) - low_time) * record.dt
     return StepAverage("cycle", t, u, y, len(use), len(use), len(use), int(ups.size) - len(use), step, before, after,
                        _snr(step, before), _snr(step, after), True, steps, record.input, record.output, record.source,
-                       low_time, int(use[0]))
+                       low_time, int(use[0]), record.noise_factor)
 
 
 def _average_edges(record: Record, steps: Steps, pre: float | None, direction: int = 0) -> StepAverage:
@@ -383,4 +387,4 @@ def _average_edges(record: Record, steps: Steps, pre: float | None, direction: i
     ups = int(np.sum(dirs > 0))
     return StepAverage("edge", t, u, y, int(idx.size), ups, int(idx.size) - ups, cut, step, before, after,
                        _snr(step, before), _snr(step, after), False, steps, record.input, record.output, record.source,
-                       n_pre)
+                       n_pre, 0, record.noise_factor)

@@ -442,7 +442,8 @@ def fit_structure(record: Record, structure: Structure | str, delay: str | float
     dof = resid.size - J.shape[1]
     s2 = float(np.sum(resid**2) / dof)
     JtJ = J.T @ J
-    cov, note = fit_covariance(JtJ, s2, p if fit_delay else None, dt)
+    # an output interpolated from uneven stamps: its residuals understate the noise the estimates carry
+    cov, note = fit_covariance(JtJ, s2 * record.noise_factor, p if fit_delay else None, dt)
     if note:
         info["covariance_note"] = note
     with np.errstate(all="ignore"):

@@ -1,0 +1,40 @@
+"""How much a fit's white-noise uncertainty understates the truth on an output interpolated onto a uniform grid.
+
+A record with uneven time stamps is resampled (:func:`synth.data.record.uniform_columns`): the output at a grid
+time ``g`` between the logged samples ``i`` and ``i + 1`` is ``(1 - f) y_i + f y_(i+1)``. The logged noise (white,
+variance ``sigma^2``) becomes ``e = W n`` on the grid, ``W`` the interpolation weights. A least-squares fit on the
+grid estimates the noise variance from its residuals, about ``kappa sigma^2`` with ``kappa`` the mean over the grid
+of ``(1 - f)^2 + f^2`` (2/3 for positions spread evenly over the intervals), and reports ``s^2 (J^T J)^-1``. The
+estimates' covariance is ``sigma^2 (J^T J)^-1 J^T W W^T J (J^T J)^-1``; where the model's sensitivities ``J`` change
+little over one logged interval, ``J^T W W^T J`` is about ``sum_i c_i^2 J_i J_i^T`` and ``J^T J`` about
+``sum_i c_i J_i J_i^T``, ``c_i`` the total weight logged sample ``i`` carries on the grid. With ``c`` spread evenly
+over the record, the covariance is the reported one times ``(sum c^2 / sum c) / kappa``:
+:func:`interpolation_noise_factor`. Averaging windows of such a record (independent noise) scales both alike.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = ["interpolation_noise_factor"]
+
+
+def interpolation_noise_factor(native: np.ndarray, grid: np.ndarray) -> float:
+    """The factor by which the white-noise variance of a fit on ``grid`` must be multiplied when the output there
+    was linearly interpolated from samples at the (strictly increasing) times ``native``: 1 when every grid time is
+    a logged one, about 1.5 for a grid as dense as the logged samples at random offsets, more where a gap in the
+    log spreads one sample's noise over several grid points.
+
+    Examples
+    --------
+    >>> interpolation_noise_factor(np.arange(5.0), np.arange(5.0))  # the logged times themselves
+    1.0
+    >>> round(interpolation_noise_factor(np.arange(0.0, 1001.0), np.arange(0.0, 1000.0) + 0.5), 3)  # midpoints
+    2.0
+    """
+    native, grid = np.asarray(native, float), np.asarray(grid, float)
+    i = np.clip(np.searchsorted(native, grid, side="right") - 1, 0, native.size - 2)
+    f = np.clip((grid - native[i]) / (native[i + 1] - native[i]), 0.0, 1.0)
+    kappa = float(np.mean((1.0 - f) ** 2 + f**2))
+    carried = np.bincount(i, 1.0 - f, native.size) + np.bincount(i + 1, f, native.size)
+    return float(np.sum(carried**2) / np.sum(carried) / kappa)
