@@ -173,8 +173,7 @@ def identify(record: RecordLike, structure: Structure | str, delay: str | float 
     whole = ""
     try:
         fit = fit_structure(data, structure, delay, sensor, periodic, check=True)
-        failed = "" if avg is None or not _unstable(fit.measured) else \
-            f"its model is unstable ({fit.measured.to_string(4)}) although the steps settle"
+        failed = "" if avg is None else _implausible_average_fit(fit, record.dt)
     except FitError as exc:
         if avg is None or average != "auto" or by_direction:
             raise
@@ -226,6 +225,20 @@ def _other_pair_minima(record: Record, fit: TimeFitResult, structure: Structure,
     if fit.periodic or fit.t.size != record.t.size or not fit.weak:
         return fit
     return relocate_pair(record, fit, structure, delay, sensor)
+
+
+def _implausible_average_fit(fit: TimeFitResult, dt: float) -> str:
+    """Why the fit of a step average is not a model of the record ('' when it may be): unstable although the
+    steps settle, or a pole or zero of the identified plant beyond the record's Nyquist frequency, which no
+    record sampled at ``dt`` resolves (a few short windows can be fitted by a fast pair whose product stands in
+    for a gain: k = -2.2e5 with poles at 669 and 9,511 rad/s for k = 4.1, poles 0.87 and 3.3, on a 0.7 s edge
+    average of a record at 6.7 ms)."""
+    if _unstable(fit.measured):
+        return f"its model is unstable ({fit.measured.to_string(4)}) although the steps settle"
+    if beyond_nyquist(fit.plant, dt):
+        return (f"its model {fit.plant.to_string(4)} has a pole or zero beyond the record's Nyquist frequency "
+                f"({np.pi / dt:.4g} rad/s)")
+    return ""
 
 
 def _unstable(plant: Plant) -> bool:
