@@ -37,7 +37,8 @@ def test_load_cell_like_difference_is_detected_and_both_reported_near_truth():
     assert c.down.parameters["T"] == pytest.approx(0.025, rel=0.05)
     assert c.up.parameters["K"] == pytest.approx(2.0, rel=0.02) and c.down.parameters["K"] == pytest.approx(2.0, rel=0.02)
     assert abs(c.difference["T"] - 0.015) < 3 * c.std["T"]  # the difference with its standard error
-    assert (c.up_average.up, c.up_average.down, c.down_average.up, c.down_average.down) == (8, 0, 0, 7)
+    # 8 up and 7 down steps; the first (up) step is left out of the comparison: its window holds the record's start
+    assert (c.up_average.up, c.up_average.down, c.down_average.up, c.down_average.down) == (7, 0, 0, 7)
     assert c.summary().startswith("up and down steps differ: T 0.039") and "p < 1e-12 over 3 parameters" in c.summary()
     # the average of both directions lies between them: the compromise the report warns about
     assert 0.025 < res.fit.parameters["T"] < 0.040
@@ -93,3 +94,28 @@ def test_hsm150_torque_steps_differ_by_direction_as_the_readme_says(run):
     assert 40 - 2 <= c.down.parameters["K"] * 0.010 <= 46 + 2  # down
     for side in (c.up, c.down):
         assert 1.1 - 0.1 <= side.parameters["T"] <= 1.9 + 0.1
+
+
+def _linear_train_starting_off_rest(seed: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``2/(0.03 s + 1)``, a square wave between 1 and 2 (half period 0.3 s, 20 edges, the first at 0.1 s), the
+    output starting at 1.0 where rest at the first level is 2.0; exact zero-order hold at 1 ms, noise std 0.02."""
+    t = np.arange(0.0, 0.1 + 20 * 0.3, 0.001)
+    u = np.where(t < 0.1 - 1e-9, 1.0, np.where(((t - 0.1 + 1e-9) // 0.3) % 2 == 0, 2.0, 1.0))
+    a = np.exp(-0.001 / 0.03)
+    y = np.empty(t.size)
+    y[0] = 1.0
+    for k in range(1, t.size):
+        y[k] = a * y[k - 1] + (1 - a) * 2.0 * u[k - 1]
+    return t, u, y + 0.02 * np.random.default_rng(seed).normal(size=t.size)
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_a_record_starting_mid_transient_is_not_called_direction_dependent(seed):
+    """Found by a black-box test: the first up step's window held the start-up from an unknown state (1.8 % of a
+    step left), and a linear plant's up and down steps were called different at 3.9-4.9 sigma on 3 of 3 seeds.
+    That step is now left out of the comparison when its direction has others."""
+    res = identify(_linear_train_starting_off_rest(seed), "K/(T*s+1)")
+    c = res.directions
+    assert c is not None and not c.significant, c.z if c is not None else res.direction_note
+    for fit in (c.up, c.down):
+        assert abs(fit.parameters["K"] - 2.0) < 4 * fit.std["K"] and abs(fit.parameters["T"] - 0.03) < 4 * fit.std["T"]

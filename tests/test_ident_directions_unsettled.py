@@ -25,7 +25,9 @@ def test_a_linear_plant_stepped_every_four_time_constants_agrees(noise: float) -
     record = record_from_arrays(T, U, y)
     c = fit_by_direction(record, "k/(tau*s+1)")
     assert c.unsettled == pytest.approx(np.exp(-4.0), rel=0.05)
-    assert abs(c.difference["k"]) > 0.01  # the windows' bias is there
+    # the first step (from rest, the only window without the previous step's remainder) is left out of the
+    # comparison, so both directions' windows carry the same remainder: before, that step made k differ by 0.01-0.02
+    assert abs(c.difference["k"]) < 0.005
     assert not c.significant, c.summary()
     assert "left when the next one came" in c.summary()
 

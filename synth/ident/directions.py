@@ -188,7 +188,8 @@ def compare_fits(up: TimeFitResult, down: TimeFitResult, alpha: float = ALPHA,
 def fit_by_direction(record: Record, structure: Structure | str, delay: str | float | None = None,
                      sensor: Plant | str | None = None, steps: Steps | None = None,
                      alpha: float = ALPHA) -> DirectionComparison:
-    """Fit the up steps and the down steps of a step train apart and compare them.
+    """Fit the up steps and the down steps of a step train apart and compare them (the record's first step left
+    out when its direction has another: its window holds whatever came before the record).
 
     Parameters
     ----------
@@ -229,8 +230,14 @@ def fit_by_direction(record: Record, structure: Structure | str, delay: str | fl
     (True, 0.04, 0.025)
     """
     steps = steps or find_steps(record)
-    up_avg = average_steps(record, steps, "edge", direction=1)
-    down_avg = average_steps(record, steps, "edge", direction=-1)
+    # the record may start before the plant is at rest (mid-transient), which only the first step's window holds:
+    # it is left out when its direction has another step (a periodic average drops the first period alike). With
+    # it, a linear plant's record starting 1.8 % of a step off rest was called direction-dependent at 3.9-4.9 sigma
+    compared = steps
+    if np.count_nonzero(steps.direction == steps.direction[0]) >= 2:
+        compared = Steps(steps.index[1:], steps.direction[1:], steps.low, steps.high)
+    up_avg = average_steps(record, compared, "edge", direction=1)
+    down_avg = average_steps(record, compared, "edge", direction=-1)
     up = fit_structure(up_avg.record(), structure, delay, sensor, check=True)
     down = fit_structure(down_avg.record(), structure, delay, sensor, check=True)
     return compare_fits(up, down, alpha, up_avg, down_avg, unsettled_fraction(record, steps, [up.plant, down.plant]))
