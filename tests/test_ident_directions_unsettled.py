@@ -48,3 +48,37 @@ def test_a_train_that_settles_allows_almost_nothing() -> None:
     record = record_from_arrays(T, U, np.sin(T))
     assert unsettled_fraction(record, find_steps(record), [Plant.from_string("2/(0.05*s+1)")]) < 1e-12
     assert unsettled_fraction(record, find_steps(record), [Plant.from_string("1/(s*(s+1))")]) == 1.0
+
+
+def _square_wave(half: float, seed: int = 0) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``2/(0.03 s + 1)`` (the same both ways), a square wave between 1 and 2 after 0.5 s at rest, 20 edges; exact
+    zero-order hold at 1 ms, noise std 0.01."""
+    t = np.arange(0.0, 0.5 + 20 * half, 0.001)
+    u = np.where(t < 0.5 - 1e-9, 1.0, np.where(((t - 0.5 + 1e-9) // half) % 2 == 0, 2.0, 1.0))
+    a = np.exp(-0.001 / 0.03)
+    y = np.empty(t.size)
+    y[0] = 2.0
+    for k in range(1, t.size):
+        y[k] = a * y[k - 1] + (1 - a) * 2.0 * u[k - 1]
+    return t, u, y + 0.01 * np.random.default_rng(seed).normal(size=t.size)
+
+
+def test_a_direction_dependent_model_from_steps_that_do_not_settle_is_a_failure(tmp_path, run_cli) -> None:
+    """Found by a black-box test: with steps 5 time constants apart (0.7 % of a step left), ``--by-direction``
+    returned gains of 1.985 +- 0.0012 both ways for a truth of 2 (13 std low); at 3.3 time constants 1.93 (40 std).
+    Such a result is now a failure that says how far apart the steps must be; 10 time constants apart it stands."""
+    from synth.errors import FitError
+    from synth.ident import identify
+
+    with pytest.raises(FitError, match=r"do not settle between one another \(0\.68 % of a step left.*use steps at "
+                                       r"least 0\.2\d+ s apart"):
+        identify(_square_wave(0.15), "K/(T*s+1)", by_direction=True)
+    res = identify(_square_wave(0.3), "K/(T*s+1)", by_direction=True)
+    for fit in (res.directions.up, res.directions.down):
+        assert abs(fit.parameters["K"] - 2.0) < 4 * fit.std["K"] and abs(fit.parameters["T"] - 0.03) < 4 * fit.std["T"]
+    t, u, y = _square_wave(0.15)
+    path = tmp_path / "train.csv"
+    path.write_text("t,u,y\n" + "".join(f"{a:.6f},{b:g},{c:.9g}\n" for a, b, c in zip(t, u, y)))
+    r = run_cli("identify", "--data", str(path), "--structure", "K/(T*s+1)", "--by-direction", "--no-figures",
+                "--out", str(tmp_path / "id"))
+    assert r.code == 1 and "do not settle between one another" in r.err and len(r.err.strip().splitlines()) == 1
