@@ -4,7 +4,7 @@ Case 9 of ``benchmarks/ident_crb.py`` (a zero and two poles, an aperiodic two-le
 noise 1.9 % of the peak): the average of its 8 edges is too little for the fit. Before, 12 of 20 noise seeds
 ended in a FitError (IPOPT at its iteration limit) and others returned a diverged model with an unstable pole
 (seed 0: p1 = -2.05, p2 = 1.1e5) as a result. Then the whole record was fitted from its own deterministic start.
-Those edge windows were 1.4 s, cut by the record's end after the last step; that step is now left out of the
+Those edge windows were 0.185 s, cut by the record's end after the last step; that step is now left out of the
 average, the windows are 5.32 s, their fit holds, and the whole record is refitted from it (the windows are shorter
 than the model's settling time). The fallback itself is tested on a fit made to fail.
 """
