@@ -15,6 +15,7 @@ from synth.ident.simulate import simulate_plant
 from synth.ident.timefit import fit_structure
 from synth.plant import Plant
 from tests.conftest import shared_path
+from tests.first_order_reference import first_order_held, square_wave
 
 T = np.arange(0, 4, 0.001)
 U = np.where((T % 0.5) >= 0.25, 1.0, 0.0)  # 8 periods of 0.5 s: 8 up and 7 down steps, settled in 0.25 s
@@ -99,13 +100,8 @@ def test_hsm150_torque_steps_differ_by_direction_as_the_readme_says(run):
 def _linear_train_starting_off_rest(seed: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """``2/(0.03 s + 1)``, a square wave between 1 and 2 (half period 0.3 s, 20 edges, the first at 0.1 s), the
     output starting at 1.0 where rest at the first level is 2.0; exact zero-order hold at 1 ms, noise std 0.02."""
-    t = np.arange(0.0, 0.1 + 20 * 0.3, 0.001)
-    u = np.where(t < 0.1 - 1e-9, 1.0, np.where(((t - 0.1 + 1e-9) // 0.3) % 2 == 0, 2.0, 1.0))
-    a = np.exp(-0.001 / 0.03)
-    y = np.empty(t.size)
-    y[0] = 1.0
-    for k in range(1, t.size):
-        y[k] = a * y[k - 1] + (1 - a) * 2.0 * u[k - 1]
+    t, u = square_wave(0.3, 20, 0.1, 0.001)
+    y = first_order_held(t, u, 2.0, 0.03, y0=1.0)
     return t, u, y + 0.02 * np.random.default_rng(seed).normal(size=t.size)
 
 

@@ -13,6 +13,7 @@ from synth.ident.directions import fit_by_direction, unsettled_fraction
 from synth.ident.simulate import simulate_plant
 from synth.ident.steps import find_steps
 from synth.plant import Plant
+from tests.first_order_reference import first_order_held, square_wave
 
 T = np.arange(0, 10, 0.01)
 U = np.where((T % 4) >= 2, 1.0, 0.0)  # a step every 2 s: four time constants of 2/(0.5 s + 1)
@@ -53,13 +54,8 @@ def test_a_train_that_settles_allows_almost_nothing() -> None:
 def _square_wave(half: float, seed: int = 0) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """``2/(0.03 s + 1)`` (the same both ways), a square wave between 1 and 2 after 0.5 s at rest, 20 edges; exact
     zero-order hold at 1 ms, noise std 0.01."""
-    t = np.arange(0.0, 0.5 + 20 * half, 0.001)
-    u = np.where(t < 0.5 - 1e-9, 1.0, np.where(((t - 0.5 + 1e-9) // half) % 2 == 0, 2.0, 1.0))
-    a = np.exp(-0.001 / 0.03)
-    y = np.empty(t.size)
-    y[0] = 2.0
-    for k in range(1, t.size):
-        y[k] = a * y[k - 1] + (1 - a) * 2.0 * u[k - 1]
+    t, u = square_wave(half, 20, 0.5, 0.001)
+    y = first_order_held(t, u, 2.0, 0.03, y0=2.0)
     return t, u, y + 0.01 * np.random.default_rng(seed).normal(size=t.size)
 
 

@@ -13,6 +13,7 @@ import numpy as np
 import pytest
 
 from synth.ident import identify
+from tests.first_order_reference import first_order_held
 
 TRUTH = {"K": 3.0, "T": 0.3}
 
@@ -28,10 +29,7 @@ def _jittered_record(seed: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         value = 1.0 if value <= 0 else -1.0
         u[k:end] = value
         k = max(end, k + 1)
-    y = np.zeros(t.size)  # exact: each stamp's command held to the next stamp, through K/(T s + 1)
-    for i in range(1, t.size):
-        a = np.exp(-(t[i] - t[i - 1]) / TRUTH["T"])
-        y[i] = a * y[i - 1] + (1 - a) * TRUTH["K"] * u[i - 1]
+    y = first_order_held(t, u, TRUTH["K"], TRUTH["T"])  # exact: each stamp's command held to the next stamp
     return t, u, y + 0.01 * rng.standard_normal(t.size)
 
 
