@@ -21,7 +21,8 @@ __all__ = ["interpolation_noise_factor"]
 
 def interpolation_noise_factor(native: np.ndarray, grid: np.ndarray) -> float:
     """The factor by which the white-noise variance of a fit on ``grid`` must be multiplied when the output there
-    was linearly interpolated from samples at the (strictly increasing) times ``native``: 1 when every grid time is
+    was linearly interpolated from samples at the (increasing) times ``native`` (a repeated time counts once, as
+    resampling keeps one sample per time stamp): exactly 1 when every grid time is
     a logged one, about 1.5 for a grid as dense as the logged samples at random offsets, more where a gap in the
     log spreads one sample's noise over several grid points.
 
@@ -33,6 +34,9 @@ def interpolation_noise_factor(native: np.ndarray, grid: np.ndarray) -> float:
     2.0
     """
     native, grid = np.asarray(native, float), np.asarray(grid, float)
+    native = native[np.r_[np.diff(native) > 0, True]]  # one per time stamp
+    if native.size < 2 or (grid.size == native.size and np.array_equal(grid, native)):  # the logged times
+        return 1.0
     i = np.clip(np.searchsorted(native, grid, side="right") - 1, 0, native.size - 2)
     f = np.clip((grid - native[i]) / (native[i + 1] - native[i]), 0.0, 1.0)
     kappa = float(np.mean((1.0 - f) ** 2 + f**2))

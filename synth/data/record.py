@@ -17,6 +17,7 @@ from typing import Any
 
 import numpy as np
 
+from synth.data.interpolated_noise import interpolation_noise_factor
 from synth.data.readers import TIME_UNITS, Table, read_table, table_from_columns
 from synth.errors import DataError
 from synth.plant import Signal
@@ -326,14 +327,9 @@ def record_from_arrays(
                         where=source)
     if np.ptp(yy) == 0:
         raise DataError(f"column '{names[2]}': the output never responds (constant {yy[0]:g})", where=source)
-    if noise_factor is None:
-        noise_factor = 1.0
-        if any(n.startswith("resampled") for n in notes):
-            from synth.data.interpolated_noise import interpolation_noise_factor
-
-            native = np.asarray(t, dtype=float).ravel()
-            native = native[np.r_[np.diff(native) > 0, True]]  # one per stamp, as resampling kept them
-            noise_factor = interpolation_noise_factor(native, tt)
+    if noise_factor is None:  # exactly 1 unless the grid is not the logged stamps (resampled)
+        noise_factor = interpolation_noise_factor(np.asarray(t, dtype=float).ravel(), tt)
+        if noise_factor != 1.0:
             notes += (f"the interpolated output shares each logged sample's noise between grid samples: a fit's "
                       f"noise variance is taken {noise_factor:.3g} times its residuals' for the parameters' "
                       "uncertainty",)

@@ -225,8 +225,6 @@ def _require_settled_windows(directions: DirectionComparison, source: str) -> No
     next step came, times the parameter (a black-box test: the gain 0.75 % low at 0.68 % left, 13 reported std;
     the comparison of the two allows twice that). As the result, such a fit would be a biased number with a small
     std."""
-    from synth.ident.periodic_start import settling_time
-
     if directions.unsettled <= 0:
         return
     worst = None  # (share of a step that may be left, direction, parameter, allowance, std)
