@@ -22,9 +22,10 @@ ROOT = Path(__file__).resolve().parents[1]
 
 @pytest.fixture(scope="module")
 def big_csv(tmp_path_factory):
-    """100,000 samples with a rate limit: the diagnosis runs about 6 s on 2 quiet cores, 4 s of it after the
-    workers start (20,000 samples left well under a second on a loaded machine: the run could end first)."""
-    t = np.arange(0, 1000, 0.01)
+    """300,000 samples with a rate limit: the diagnosis runs about 10 s on 2 quiet cores, 4 s of it after the
+    workers start (100,000 samples left 1.4 s there, which a loaded CI machine once used up before the
+    signal was sent: the run ended with exit code 0)."""
+    t = np.arange(0, 3000, 0.01)
     u = np.where((t % 2) >= 1, 100.0, 0.0) * (1 + 0.5 * np.sin(0.1 * t))
     y = simulate_plant(Plant.from_string(PLANT), t, RateLimit(400.0).apply(u, 0.01))
     y = y + 0.2 * np.random.default_rng(0).normal(size=t.size)
@@ -79,6 +80,7 @@ def test_sigterm_or_sigint_leaves_no_worker_and_writes_partial_json(big_csv, tmp
     out = tmp_path / "gap.json"
     proc = start(big_csv, out)
     kids = wait_for_workers(proc)
+    assert proc.poll() is None, "the diagnosis ended before the signal could be sent: the record is too short"
     proc.send_signal(sig)
     _, err = proc.communicate(timeout=60)
     assert proc.returncode == 128 + sig

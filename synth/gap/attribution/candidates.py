@@ -256,8 +256,12 @@ def map_jobs(fn: Any, jobs: list[Any], workers: int, done: Any = None) -> list[A
     import multiprocessing
     import os
 
-    pool = multiprocessing.get_context().Pool(min(workers, len(jobs)), initializer=watch_parent,
-                                              initargs=(os.getpid(),))
+    forked = "fork" in multiprocessing.get_all_start_methods()
+    context = multiprocessing.get_context("fork" if forked else None)
+    if forked:  # the workers inherit the jobs: only their indices go through the task pipe (see _inherited_job)
+        _INHERITED[:] = [fn, jobs]
+        fn, jobs = _inherited_job, list(range(len(jobs)))
+    pool = context.Pool(min(workers, len(jobs)), initializer=watch_parent, initargs=(os.getpid(),))
     try:
         out = []
         for i, res in enumerate(pool.imap(fn, jobs, chunksize=1)):
@@ -271,6 +275,29 @@ def map_jobs(fn: Any, jobs: list[Any], workers: int, done: Any = None) -> list[A
         raise
     finally:
         pool.join()
+        _INHERITED.clear()
+
+
+_INHERITED: list[Any] = []  # the function and jobs of the running map_jobs, inherited by its forked workers
+
+
+def _inherited_job(index: int) -> Any:
+    """Run job ``index`` of the :func:`map_jobs` call that forked this worker.
+
+    Sending the jobs themselves (records of hundreds of thousands of samples) through the pool's task pipe
+    filled it: the pool's task thread then blocked on a write that no terminated worker would read, and
+    ``Pool.terminate`` waited for that thread forever (a SIGTERM during the attribution hung ``synth
+    diagnose``). An index never fills the pipe.
+
+    Examples
+    --------
+    >>> _INHERITED[:] = [abs, [-4]]
+    >>> _inherited_job(0)
+    4
+    >>> _INHERITED.clear()
+    """
+    fn, jobs = _INHERITED
+    return fn(jobs[index])
 
 
 def screened_coefficients(plant: Plant) -> dict[str, float]:
