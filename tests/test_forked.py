@@ -17,6 +17,25 @@ from synth.forked import allow_fork, run_beside
 ROOT = Path(__file__).resolve().parents[1]
 
 
+def _child_has_begun():
+    """``(begin, wait)``: a job calls ``begin()`` as it starts; ``wait()`` (this process's own work) returns once
+    a job has begun in another process (a loaded machine may start the child late: a fixed sleep here let this
+    process take every job)."""
+    import select
+
+    read_end, write_end = os.pipe()
+    parent = os.getpid()
+
+    def begin():
+        if os.getpid() != parent:
+            os.write(write_end, b"x")
+
+    def wait(required: bool = True):
+        ready, _, _ = select.select([read_end], [], [], 60.0 if required else 3.0)
+        assert ready or not required, "no job began in the child within 60 s"
+
+    return begin, wait
+
 @pytest.fixture(autouse=True)
 def _fork_allowed():
     allow_fork(True)
@@ -27,13 +46,16 @@ def _fork_allowed():
 def test_results_come_back_in_order_and_both_processes_take_jobs():
     import time
 
+    begin, wait = _child_has_begun()
+
     def job(i: int):
         def run():
+            begin()
             time.sleep(0.05)
             return i * i, os.getpid()
         return run
 
-    results, mine = run_beside([job(i) for i in range(8)], lambda: time.sleep(0.12) or "own")
+    results, mine = run_beside([job(i) for i in range(8)], lambda: wait() or "own")
     assert mine == "own"
     assert [r[0] for r in results] == [i * i for i in range(8)]
     pids = {r[1] for r in results}
@@ -71,10 +93,9 @@ def test_a_child_that_dies_leaves_its_jobs_to_this_process():
 
 
 def _in_a_child(job):
-    """``job()`` as run by a forked child (this process sleeps meanwhile, so the child takes it)."""
-    import time
-
-    (value,), _ = run_beside([job], lambda: time.sleep(0.4))
+    """``job()`` as run by a forked child (this process waits until the child has taken it)."""
+    begin, wait = _child_has_begun()
+    (value,), _ = run_beside([lambda: begin() or job()], wait)
     return value
 
 
@@ -83,7 +104,11 @@ def _call(nested: bool):
     import time
 
     def job():
-        (ran_in,), _ = run_beside([os.getpid], lambda: time.sleep(0.2), nested=nested)
+        if not nested:  # the call runs serially in the child: its one job runs there whatever its own work does
+            (ran_in,), _ = run_beside([os.getpid], lambda: time.sleep(0.2), nested=False)
+            return ran_in, os.getpid()
+        begin, wait = _child_has_begun()  # (a third level runs serially: then no job begins elsewhere)
+        (ran_in,), _ = run_beside([lambda: begin() or os.getpid()], lambda: wait(required=False), nested=True)
         return ran_in, os.getpid()
 
     return job
@@ -100,10 +125,10 @@ def test_a_child_forks_again_only_for_a_nested_call_and_only_one_level_down():
 
 def _grandchild_runs(job):
     """A job that has ``job`` run by a grandchild (a nested call from the child); ``(job(), child's pid)``."""
-    import time
 
     def run():
-        (value,), _ = run_beside([job], lambda: time.sleep(0.4), nested=True)
+        begin, wait = _child_has_begun()
+        (value,), _ = run_beside([lambda: begin() or job()], wait, nested=True)
         return value, os.getpid()
 
     return run

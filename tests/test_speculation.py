@@ -7,6 +7,7 @@ search evaluates: a guess that is not the search's next point makes no hit."""
 from __future__ import annotations
 
 import os
+import select
 import time
 
 import numpy as np
@@ -90,11 +91,14 @@ def test_spare_core_follows_the_jobs_beside():
     assert spare_core()  # the command's process, nothing beside it
     seen = {}
 
+    read_end, write_end = os.pipe()
+
     def own():
         seen["own"] = spare_core()
-        time.sleep(0.05)
+        select.select([read_end], [], [], 60.0)  # until the child has taken the job (not a fixed sleep: a loaded
+        # machine may start the child late, and this process would take the job itself)
 
-    lent, _ = run_beside([lambda: spare_core()], own, lend_core=True)
+    lent, _ = run_beside([lambda: os.write(write_end, b"x") and spare_core()], own, lend_core=True)
     seen["lent"] = lent[0]
     not_lent, _ = run_beside([lambda: spare_core()], lambda: time.sleep(0.05))
     assert seen == {"own": False, "lent": True} and not_lent == [False]
