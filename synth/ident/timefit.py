@@ -43,6 +43,7 @@ from synth.ident.covariance import fit_covariance
 from synth.ident.delay_samples import best_sample, walk_intervals
 from synth.ident.fit_failure import LIMIT_STATUSES, fit_failure, start_ssr
 from synth.ident.identifiability import TiedParameter, WeakParameter, coinciding, tied_to_weak, weak_parameters
+from synth.ident.residual_whiteness import correlated_residuals_note
 from synth.ident.sim_error_problem import SimulationErrorProblem
 from synth.ident.srivc import linear_initial_model, map_to_structure
 from synth.ident.structure import Structure, parse_structure
@@ -444,8 +445,9 @@ def fit_structure(record: Record, structure: Structure | str, delay: str | float
     JtJ = J.T @ J
     # an output interpolated from uneven stamps: its residuals understate the noise the estimates carry
     cov, note = fit_covariance(JtJ, s2 * record.noise_factor, p if fit_delay else None, dt)
-    if note:
-        info["covariance_note"] = note
+    correlated = correlated_residuals_note(resid)
+    if note or correlated:
+        info["covariance_note"] = "; ".join(n for n in (note, correlated) if n)
     with np.errstate(all="ignore"):
         sd = np.sqrt(np.clip(np.diag(cov), 0.0, None))
     remaining = float("inf")
