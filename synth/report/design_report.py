@@ -125,7 +125,8 @@ def _design_figure_jobs(spec: Spec, result: DesignResult, loops: list[tuple[str,
     gain = result_data.get("gain_set_detail")
     if gain is not None:  # the heavier jobs first: the worker starts on them
         jobs.append(("gain_set", job(lambda: figures.gain_set_plot(
-            gain["parameter"], tuple(gain["bounds"]), curves if curves is not None else slack_curves(spec),
+            gain["parameter"], tuple(gain["bounds"]),
+            curves if curves is not None else slack_curves(_gain_set_spec(spec)),
             result_data["gain_set"], marks, out.claim("gain_set.png")))))
     slew = [r for r in spec.requirements if isinstance(r, SlewRate)]
     if slew and loops:
@@ -194,6 +195,16 @@ def _analysis_figures(spec: Spec, data: dict[str, Any], objects: dict[str, Any],
 
         figs.update(paper_section_figures(spec, out))
     return figs
+
+
+def _gain_set_spec(spec: Spec) -> Spec:
+    """The spec a design's gain set is over: the spec itself with one free parameter; a PI or PID whose design
+    without integral action won (its gain set is over the proportional gain) with ``ki`` fixed at 0."""
+    if len(spec.controller.free_parameters()) == 1:
+        return spec
+    from synth.synthesis.integral_action import without_integral_action
+
+    return without_integral_action(spec) or spec
 
 
 def slack_curves(spec: Spec) -> dict[str, tuple[np.ndarray, np.ndarray]]:
