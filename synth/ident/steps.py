@@ -116,6 +116,9 @@ def find_steps(record: Record, hysteresis: float = 0.2) -> Steps:
         raise DataError(f"hysteresis must be in [0, 0.5), got {hysteresis}")
     u = record.u
     lo, hi = float(np.min(u)), float(np.max(u))
+    if not hi > lo:  # both thresholds would be the one level: the search below would never advance
+        raise DataError(f"column '{record.input.name}': the input is constant ({lo:g}): no step in it",
+                        where=record.source)
     upper, lower = lo + (0.5 + hysteresis) * (hi - lo), lo + (0.5 - hysteresis) * (hi - lo)
     state = u[0] > 0.5 * (lo + hi)
     index, direction = [], []
@@ -135,6 +138,7 @@ def find_steps(record: Record, hysteresis: float = 0.2) -> Steps:
         state = not state
         index.append(edge)
         direction.append(1 if state else -1)
+        k += 1  # the next level change comes after this sample (a sample on both thresholds counts once)
     if not index:
         raise DataError(f"column '{record.input.name}': no step found in the input", where=record.source)
     high_mask = u > 0.5 * (lo + hi)
