@@ -20,7 +20,7 @@ ROOT = Path(__file__).resolve().parents[1]
 
 SCRIPT = """
 import os, signal, sys, threading, time
-from synth.gap.attribution.candidates import map_jobs
+from synth.worker_pool import map_jobs
 
 class SlowToPickle:
     def __init__(self, i):

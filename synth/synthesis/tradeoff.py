@@ -20,7 +20,6 @@ import json
 import os
 import time
 from collections.abc import Callable, Sequence
-from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import asdict, dataclass, field
 from typing import Any
 
@@ -289,6 +288,17 @@ def design_chunk(data: dict[str, Any], sweeps: list[Sweep], chunk: list[tuple[fl
     return out
 
 
+@dataclass(frozen=True)
+class _ChunkJob:
+    """:func:`design_chunk` of one spec and its sweeps, called with a chunk (a job of :func:`map_jobs`)."""
+
+    data: dict[str, Any]
+    sweeps: list[Sweep]
+
+    def __call__(self, chunk: list[tuple[float, ...]]) -> list[TradeoffPoint]:
+        return design_chunk(self.data, self.sweeps, chunk)
+
+
 def _grid(sweeps: list[Sweep]) -> list[tuple[float, ...]]:
     if len(sweeps) == 1:
         return [(v,) for v in sweeps[0].values]
@@ -439,12 +449,19 @@ def tradeoff(spec: Spec, sweeps: list[Sweep], scheduler: str | Any | None = None
                 if progress:
                     progress(len(results), len(grid))
         else:
-            with ProcessPoolExecutor(max_workers=min(n, len(chunks))) as pool:
-                futures = [pool.submit(design_chunk, data, sweeps, c) for c in chunks]
-                for fut in as_completed(futures):
-                    results += fut.result()
-                    if progress:
-                        progress(len(results), len(grid))
+            from synth.worker_pool import map_jobs
+
+            # workers that die with this process and stop at once on an interruption (a SIGTERM left the
+            # executor's workers running; a Ctrl-C waited for the chunks being designed)
+            finished = [0]
+
+            def chunk_done(i: int) -> None:
+                finished[0] += len(chunks[i])
+                if progress:
+                    progress(finished[0], len(grid))
+
+            for part in map_jobs(_ChunkJob(data, sweeps), chunks, min(n, len(chunks)), done=chunk_done):
+                results += part
     order = {values: i for i, values in enumerate(grid)}
     results.sort(key=lambda p: order[tuple(p.values[s.path] for s in sweeps)])
     if len(sweeps) == 2:  # back to row-major order for tables
