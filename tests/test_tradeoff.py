@@ -108,3 +108,15 @@ def test_a_swept_value_the_spec_forbids_is_bad_input(run_cli, tmp_path, sweep, m
     res = run_cli("tradeoff", "specs/x4_rotor.yaml", "--sweep", sweep, "--out", str(tmp_path / "r"), "--quiet")
     assert res.code == 2 and res.err.strip().splitlines() == [res.err.strip()] and message in res.err, res.err
     assert not (tmp_path / "r").exists()
+
+
+def test_the_json_file_is_the_same_bytes_on_a_rerun(run_cli, tmp_path):
+    """--json FILE held the run's wall-clock seconds: two runs of the same command differed."""
+    files = []
+    for k in range(2):
+        res = run_cli("tradeoff", "specs/x4_rotor.yaml", "--sweep", "requirements.bandwidth.min=60:70:2",
+                      "--out", str(tmp_path / f"r{k}"), "--quiet", "--workers", "1", "--json", str(tmp_path / f"{k}.json"))
+        assert res.code == 0, res.err
+        files.append((tmp_path / f"{k}.json").read_bytes())
+    assert files[0] == files[1] and b'"seconds"' not in files[0]
+    assert files[0] == (tmp_path / "r0" / "tradeoff.json").read_bytes()

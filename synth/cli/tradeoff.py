@@ -77,10 +77,13 @@ def run(args: argparse.Namespace) -> int:
     out_dir = Path(args.out) if args.out else Path("reports") / spec.name
     command = "synth tradeoff " + shlex.quote(args.spec) + "".join(f" --sweep {shlex.quote(s)}" for s in args.sweep)
     files = write_tradeoff_report(result, out_dir, command=command, force=args.force)
+    from synth.report.templating import reproducible
+
+    saved = reproducible(result.to_dict())  # as tradeoff.json: no wall-clock times, the same bytes on a re-run
     if args.json == "-":
-        sys.stdout.write(dump_json(result.to_dict()))
+        sys.stdout.write(dump_json(saved))
     elif args.json:
-        write_json(args.json, result.to_dict(), force=args.force)
+        write_json(args.json, saved, force=args.force)
     if not args.quiet and args.json != "-":
         rows = [[*(fmt(p.values[s.path]) for s in sweeps), {"feasible": "yes", "infeasible": "no"}.get(p.status, p.status),
                  fmt(p.objective),
