@@ -179,7 +179,9 @@ def run(args: argparse.Namespace) -> int:
         v = step_verdict(loop, step[0], step[1], t_step, given, args.max_horizon, disturbances, sim.seed,
                          sim.limit_cycle.min_amplitude, sim.limit_cycle.window)
     except ModelError as exc:
-        raise exc.located("--max-horizon" if args.max_horizon is not None else "simulation") from None
+        where = "--horizon" if exc.message.startswith("horizon ") and args.horizon is not None else (
+            "--max-horizon" if args.max_horizon is not None else "simulation")
+        raise exc.located(where) from None
     result, metrics = v.result, v.metrics
     payload = {"spec": spec.name, "controller": str(controller), "step": list(step), "step_time": t_step,
                "horizon": v.evidence.horizon, "loop": loop.to_dict(), **v.to_dict()}

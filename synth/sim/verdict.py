@@ -293,6 +293,10 @@ def default_cap(loop: NonlinearLoop, first: float) -> float:
     return float(min(max(64 * first, slow, 60.0), MAX_SAMPLES * loop.dt))
 
 
+#: samples after the step a verdict needs at least (its rules compare quarters of the run after the step)
+MIN_SAMPLES_AFTER_STEP = 8
+
+
 def step_verdict(loop: NonlinearLoop, start: float, end: float, t_step: float = 0.0, horizon: float | None = None,
                  max_horizon: float | None = None, disturbances: Sequence[Any] = (), seed: int = 0,
                  min_amplitude: float = 0.0, window: float | None = None) -> StepVerdict:
@@ -348,6 +352,10 @@ def step_verdict(loop: NonlinearLoop, start: float, end: float, t_step: float = 
     cap = max_horizon if max_horizon is not None else default_cap(loop, first)
     if not (np.isfinite(cap) and cap > t_step):
         raise ModelError(f"max_horizon must be a finite number of seconds after the step, got {max_horizon!r}")
+    for name, value in (("horizon", horizon), ("max_horizon", cap)):
+        if value is not None and (value - t_step) / loop.dt < MIN_SAMPLES_AFTER_STEP:
+            raise ModelError(f"{name} {value:g} s leaves {max(0.0, (value - t_step) / loop.dt):.3g} samples of "
+                             f"{loop.dt:g} s after the step; a verdict needs at least {MIN_SAMPLES_AFTER_STEP}")
     if cap / loop.dt > 50 * MAX_SAMPLES:
         raise ModelError(f"max_horizon {cap:g} s is {cap / loop.dt:.3g} samples of {loop.dt:g} s; "
                          f"at most {50 * MAX_SAMPLES:.3g}")
