@@ -186,6 +186,8 @@ def run(args: argparse.Namespace) -> int:
               f"{resp.w[0]:.4g}-{resp.w[-1]:.4g} rad/s ({resp.kind})")
         print(f"coherent band (gamma^2 >= {b.threshold:g}, not oscillating): "
               + (f"{b.w_min:.4g}-{b.w_max:.4g} rad/s" if b.found else "none"))
+        if b.note:
+            print(f"note: {b.note}")
         for note in resp.corrections:
             print(f"correction: {note}")
         if len(quality) == 1 and not args.off_axis and "warning" in quality[0].reason:

@@ -71,6 +71,7 @@ class CoherentBand:
     span: float
     mask: np.ndarray = field(repr=False)
     ceiling: float = 0.1
+    note: str = ""
 
     @property
     def found(self) -> bool:
@@ -89,9 +90,10 @@ class CoherentBand:
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready summary."""
-        return {"w_min": self.w_min if self.found else None, "w_max": self.w_max if self.found else None,
-                "threshold": self.threshold, "roughness": self.roughness, "span_decades": self.span,
-                "ceiling": self.ceiling}
+        out = {"w_min": self.w_min if self.found else None, "w_max": self.w_max if self.found else None,
+               "threshold": self.threshold, "roughness": self.roughness, "span_decades": self.span,
+               "ceiling": self.ceiling}
+        return out | ({"note": self.note} if self.note else {})
 
 
 def _runs(flags: np.ndarray) -> list[tuple[int, int]]:

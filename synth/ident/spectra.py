@@ -17,6 +17,7 @@ import numpy as np
 from synth.data import Record
 from synth.errors import DataError
 from synth.ident.coherence import COHERENCE_THRESHOLD, CoherentBand, coherence_from_spectra, coherent_band, random_error
+from synth.ident.excitation_edge import trim_to_excitation
 from synth.ident.model_phase import anchored_phase
 from synth.ident.spectral_windows import (
     as_runs,
@@ -220,7 +221,7 @@ def frequency_response(
     with np.errstate(divide="ignore", invalid="ignore"):
         H = gxy / gxx
     err = random_error(coh, n_d)
-    band = coherent_band(grid, coh, coherence_threshold)
+    band = trim_to_excitation(coherent_band(grid, coh, coherence_threshold), grid, gxx)
     return FrequencyResponse(grid, H, coh, err, n_d, gxx, gyy, gxy, band, tuple(float(x) for x in lengths),
                              "measured", runs[0].input.label(), runs[0].output.label(),
                              tuple(r.source for r in runs))
