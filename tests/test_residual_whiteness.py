@@ -68,3 +68,76 @@ def test_a_significant_but_small_correlation_gives_no_note():
     w = rng.normal(size=200_001)
     e = w[1:] + 0.05 * w[:-1]
     assert correlated_residuals_note(e) == ""
+
+
+# ----------------------------------------------------------------------------------------- the split check
+
+
+def drifting(seed: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The 200 s train of ``record`` with white noise plus a random walk: the cycle average hides the drift from
+    the residuals, not from the estimates."""
+    rng = np.random.default_rng(seed)
+    t, u = square_wave(2.0, 100, 1.0, 0.01)
+    y = first_order_held(t, u, 2.0, 0.5, y0=2.0)
+    return t, u, y + 0.05 * rng.normal(size=t.size) + 0.002 * np.cumsum(rng.normal(size=t.size))
+
+
+def test_a_drift_the_residuals_do_not_show_is_caught_by_the_split_check():
+    """Over 6 seeds: the estimates scatter at least twice their reported std (the reference, from the fits
+    alone), the residual test says nothing, and the split check says "stds too small" on every seed with a
+    largest ratio above 1.5."""
+    from synth.data import record_from_arrays
+    from synth.ident.split_check import split_check
+
+    fits, checks = [], []
+    for seed in range(6):
+        t, u, y = drifting(seed)
+        fits.append(identify((t, u, y), "K/(T*s+1)").fit)
+        checks.append(split_check(record_from_arrays(t, u, y), "K/(T*s+1)", parts=5))
+    worst = max(np.std([f.parameters[k] for f in fits], ddof=1) / np.mean([f.std[k] for f in fits])
+                for k in ("K", "T"))
+    assert worst > 2
+    assert all("correlated" not in f.solver.get("covariance_note", "") for f in fits)
+    assert all(c.verdict == "stds too small" and c.fitted == 5 for c in checks)
+    assert all(max(c.ratio.values()) > 1.5 for c in checks)
+    assert set(checks[0].ratio) == {"K", "T"}  # the fixed delay and the offset are not tested
+
+
+def test_white_noise_passes_the_split_check():
+    from synth.data import record_from_arrays
+    from synth.ident.split_check import split_check
+
+    for seed in range(3):
+        check = split_check(record_from_arrays(*record(seed, 0.0)), "K/(T*s+1)", parts=5)
+        assert check.verdict == "consistent", check.text()
+        assert all(p > 1e-3 for p in check.p_value.values())
+
+
+def test_the_split_check_is_undetermined_when_parts_do_not_fit():
+    """Parts of 25 samples of a slow plant hold no step: their fits fail and the verdict says so, with why."""
+    from synth.data import record_from_arrays
+    from synth.ident.split_check import split_check
+
+    t = np.arange(0, 1.5, 0.01)
+    u = np.where(t > 0.2, 1.0, 0.0)
+    y = first_order_held(t, u, 1.0, 5.0) + 1e-4 * np.random.default_rng(0).normal(size=t.size)
+    check = split_check(record_from_arrays(t, u, y), "K/(T*s+1)", parts=6)
+    assert check.verdict == "undetermined" and check.fitted < 3 and check.failures
+    assert "undetermined" in check.text()
+
+
+def test_the_cli_split_check_prints_its_verdict_and_refuses_two_parts(tmp_path, run_cli):
+    t, u, y = drifting(0)
+    path = tmp_path / "drift.csv"
+    np.savetxt(path, np.c_[t, u, y], delimiter=",", header="t,u,y", comments="")
+    common = ["identify", "--data", str(path), "--structure", "K/(T*s+1)", "--no-figures"]
+    res = run_cli(*common, "--out", str(tmp_path / "a"), "--split-check", "5")
+    assert res.code == 0, res.err
+    assert "split check over 5 parts of 40.2 s: the part estimates scatter more than their stds say" in res.out
+    import json
+
+    data = json.loads((tmp_path / "a" / "identify.json").read_text())
+    assert data["split_check"]["verdict"] == "stds too small" and data["split_check"]["fitted"] == 5
+    bad = run_cli(*common, "--out", str(tmp_path / "b"), "--split-check", "2")
+    assert bad.code == 2 and bad.err.strip().endswith("--split-check: needs 3 parts or more, got 2")
+    assert not (tmp_path / "b").exists()

@@ -44,6 +44,11 @@ Up and down steps of a train are also fitted apart and compared parameter by par
 against their standard errors; a difference beyond them is reported (with its size in
 standard errors and its p-value). --by-direction reports both fits as the model.
 
+--split-check PARTS cuts the record into PARTS contiguous parts, identifies each as the whole
+and tests whether the part estimates scatter as their own stds say (chi-square over the parts);
+"stds too small" names the factor by which they scatter more (coloured noise, a drift, dynamics
+that change over the record). Also in the JSON, "split_check".
+
 Records: '#' comment lines anywhere; units in headers ('Time (s)', 'Voltage [V]') become the
 signals' units and columns may be named with or without them; uneven time stamps are resampled
 with the input held between samples (a step stays a step) and the output interpolated.
@@ -80,6 +85,10 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--by-direction", action="store_true",
                    help="direction-dependent model: fit the up steps and the down steps apart and report both "
                         "(a step train is always checked for a difference between them)")
+    p.add_argument("--split-check", type=int, default=0, metavar="PARTS",
+                   help="also cut the record into PARTS (3 or more) contiguous parts, identify each and test whether "
+                        "their estimates scatter as their stds say (coloured noise, drift or changing dynamics make "
+                        "the stds too small); costs PARTS more fits")
     p.add_argument("--x4-demo", action="store_true",
                    help="use the SYNTHETIC X-4 step train (generated on first use) with the paper's structure and sensor")
     p.add_argument("--out", metavar="DIR", help="folder for identify.json and figures "
@@ -118,6 +127,8 @@ def run(args: argparse.Namespace) -> int:
         raise SynthError("give the record, e.g. --data run.csv (or --x4-demo)", where="--data")
     if not args.structure:
         raise SynthError('give the plant structure, e.g. --structure "k/(s+p)"', where="--structure")
+    if args.split_check and args.split_check < 3:
+        raise SynthError(f"needs 3 parts or more, got {args.split_check}", where="--split-check")
     from synth.cli._outputs import check_outputs
 
     check_outputs(Path(args.out) if args.out else Path("reports") / "identify" / Path(args.data).stem,
@@ -137,6 +148,15 @@ def run(args: argparse.Namespace) -> int:
         where = "--delay" if "delay" in exc.message and "structure" not in exc.message else None
         raise (exc.located(where) if where else exc) from None
     payload: dict[str, Any] = {"data": str(args.data), **result.to_dict()}
+    if args.split_check:
+        from synth.errors import DataError
+        from synth.ident.split_check import split_check
+
+        try:
+            check = split_check(record, structure, args.delay, args.sensor, args.average, parts=args.split_check)
+        except DataError as exc:
+            raise SynthError(exc.message, where="--split-check") from None
+        payload["split_check"] = check.to_dict()
     if args.x4_demo:
         payload["synthetic"] = "SYNTHETIC record generated from the seed paper's model (synth.ident.x4_record)"
     out_dir = Path(args.out) if args.out else Path("reports") / "identify" / Path(args.data).stem
@@ -157,6 +177,8 @@ def run(args: argparse.Namespace) -> int:
         write_json(args.json, payload, force=args.force)
     if not args.quiet and args.json != "-":
         _print(result, args, json_path, figures)
+        if "split_check" in payload:
+            print(payload["split_check"]["text"])
     return 0
 
 

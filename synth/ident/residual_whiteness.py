@@ -62,7 +62,8 @@ def correlated_residuals_note(residuals: np.ndarray, lags: int = 20) -> str:
     worst = int(np.argmax(np.abs(rho)))
     if p >= P_VALUE or abs(rho[worst]) < MIN_CORRELATION:
         return ""
+    shown = f"= {p:.1g}" if p > 1e-300 else "< 1e-300"
     return (f"the residuals are correlated (autocorrelation {rho[worst]:.2f} at lag {worst + 1} "
-            f"sample{'s' if worst else ''}, Ljung-Box p {'= ' + format(p, '.1g') if p > 1e-300 else '< 1e-300'} over {m} lags): coloured noise, drift or a model "
-            f"error; the stds assume white residuals and may be several times too small (fits of separate parts "
-            f"of the record show the real scatter)")
+            f"sample{'s' if worst else ''}, Ljung-Box p {shown} over {m} lags): coloured noise, drift or a model "
+            f"error; the stds assume white residuals and may be several times too small (the split check, "
+            f"synth.ident.split_check or --split-check 5, measures the real scatter)")
