@@ -107,10 +107,9 @@ def summary(rows: list[dict[str, Any]]) -> str:
         false = sum(r["verdict"] == "stds too small" for r in right)
         caught = sum(r["verdict"] == "stds too small" for r in small)
         scale = [r["split_worst"] / r["worst_emp_over_rep"] for r in small if r["verdict"] == "stds too small"]
+        shown = f"{np.median(scale):.2f}" if scale else "-"
         lines.append(f"| {kind} | {len(right)} | {false} | {len(small)} | {caught} | {len(between)} | "
-                     f"{len(undetermined)} | {np.median(scale):.2f} |" if scale else
-                     f"| {kind} | {len(right)} | {false} | {len(small)} | {caught} | {len(between)} | "
-                     f"{len(undetermined)} | - |")
+                     f"{len(undetermined)} | {shown} |")
     return "\n".join(lines)
 
 

@@ -63,7 +63,9 @@ def watch_parent(parent: int) -> None:
 def map_jobs(fn: Any, jobs: list[Any], workers: int, done: Any = None) -> list[Any]:
     """``[fn(j) for j in jobs]``, on ``workers`` processes when there are several jobs.
 
-    ``done(i)``, if given, is called in this process as job ``i`` finishes (in order).
+    ``done(i)``, if given, is called in this process as job ``i`` finishes (in order). On Linux the workers
+    are forked and inherit ``fn`` and the jobs (only indices go through the pool's pipe); elsewhere ``fn`` and
+    the jobs must pickle.
 
     The workers die with this process (:func:`watch_parent`: a SIGKILL of the parent leaves none
     behind), and any exception here, a KeyboardInterrupt or the exception a signal handler raises
@@ -83,8 +85,11 @@ def map_jobs(fn: Any, jobs: list[Any], workers: int, done: Any = None) -> list[A
         return out
     import multiprocessing
     import os
+    import sys
 
-    forked = "fork" in multiprocessing.get_all_start_methods()
+    # on Linux the workers are forked and inherit the jobs; elsewhere the platform's default start method
+    # pickles them (macOS's default, spawn: fork is unsafe there with some system libraries)
+    forked = sys.platform.startswith("linux") and "fork" in multiprocessing.get_all_start_methods()
     context = multiprocessing.get_context("fork" if forked else None)
     if forked:  # the workers inherit the jobs: only their indices go through the task pipe (see _inherited_job)
         _INHERITED[:] = [fn, jobs]
