@@ -120,3 +120,13 @@ def test_the_json_file_is_the_same_bytes_on_a_rerun(run_cli, tmp_path):
         files.append((tmp_path / f"{k}.json").read_bytes())
     assert files[0] == files[1] and b'"seconds"' not in files[0]
     assert files[0] == (tmp_path / "r0" / "tradeoff.json").read_bytes()
+
+
+def test_a_bad_sweep_is_one_line_without_a_progress_bar(run_cli, tmp_path):
+    """The bar was drawn before the sweep was validated: its empty line came with the error."""
+    res = run_cli("tradeoff", "specs/x4_rotor.yaml", "--sweep", "controller.bounds.kp.0=0:30:3",
+                  "--out", str(tmp_path / "r"), "--workers", "1")
+    assert res.code == 2
+    assert res.err.strip().splitlines() == [
+        "synth tradeoff: error: --sweep controller.bounds.kp.0=30: controller.bounds: kp: lower bound 30 is above "
+        "upper bound 20"]

@@ -62,12 +62,14 @@ def run(args: argparse.Namespace) -> int:
         raise SpecError("must be at least 1", where="--workers")
     total = len(sweeps[0].values) * (len(sweeps[1].values) if len(sweeps) > 1 else 1)
     bar = None
-    if not args.quiet and args.json != "-":
-        from tqdm import tqdm
-
-        bar = tqdm(total=total, desc=f"{spec.name} trade-off", unit="design", file=sys.stderr)
+    show = not args.quiet and args.json != "-"
 
     def progress(done: int, _total: int) -> None:
+        nonlocal bar
+        if bar is None and show:  # drawn once the sweep is valid: a bad one is one line, without a bar
+            from tqdm import tqdm
+
+            bar = tqdm(total=total, desc=f"{spec.name} trade-off", unit="design", file=sys.stderr)
         if bar is not None:
             bar.update(done - bar.n)
 

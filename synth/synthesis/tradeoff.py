@@ -397,7 +397,8 @@ def tradeoff(spec: Spec, sweeps: list[Sweep], scheduler: str | Any | None = None
     workers : int, optional
         Local processes (default: the number of CPUs); ignored with Dask.
     progress : callable, optional
-        Called as ``progress(done, total)`` after every finished chunk.
+        Called as ``progress(0, total)`` once the sweep is validated, then ``progress(done, total)`` after every
+        finished chunk.
 
     Returns
     -------
@@ -425,6 +426,8 @@ def tradeoff(spec: Spec, sweeps: list[Sweep], scheduler: str | Any | None = None
     grid = _grid(sweeps)
     for values in grid:  # a swept value the spec forbids is bad input, said before any design, not a row
         _validated(data, sweeps, values)
+    if progress:  # the sweep is valid: the designs start
+        progress(0, len(grid))
     t0 = time.perf_counter()
     results: list[TradeoffPoint] = []
     if scheduler is not None:
