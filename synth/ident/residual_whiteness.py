@@ -2,7 +2,7 @@
 
 ``cov = s^2 (J^T J)^-1`` is the covariance of the estimates when the residuals are white. With coloured noise,
 drift or a model error they are correlated and the stds can be several times too small (an AR(1) noise with
-coefficient 0.95 on a first-order step train: the estimates scatter 9 times more than their reported std). The
+coefficient 0.95 on a first-order step train: the estimates scatter 5.6-9.3 times more than their reported std). The
 Ljung-Box statistic over the first lags tests whiteness; a note is given when the correlation is both
 significant and large enough to matter.
 """

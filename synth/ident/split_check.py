@@ -2,7 +2,7 @@
 
 A fit's std column assumes white residuals. Coloured noise, a slow drift or dynamics that change over the
 record make the estimates scatter more, and a cycle average can hide the cause from the residuals (a random
-walk drift: the residuals of the average look white while the estimates scatter 3-4 times more than their
+walk drift: the residuals of the average look white while the estimates scatter 2.7-4.4 times more than their
 stds). The check measures the scatter instead: the record is cut into ``parts`` contiguous parts of equal
 length, each is identified as the whole was, and each parameter's part estimates are compared with their own
 stds,
