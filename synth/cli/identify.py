@@ -153,7 +153,8 @@ def run(args: argparse.Namespace) -> int:
         from synth.ident.split_check import split_check
 
         try:
-            check = split_check(record, structure, args.delay, args.sensor, args.average, parts=args.split_check)
+            check = split_check(record, structure, args.delay, args.sensor, args.average, parts=args.split_check,
+                                reference={**result.fit.parameters})
         except DataError as exc:
             raise SynthError(exc.message, where="--split-check") from None
         payload["split_check"] = check.to_dict()

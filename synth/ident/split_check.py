@@ -25,6 +25,8 @@ import numpy as np
 from synth.data.record import Record
 from synth.distributions import chi2_sf
 from synth.errors import DataError, SynthError
+from synth.ident.exchangeable import align_labels, exchangeable_groups
+from synth.ident.structure import parse_structure
 
 __all__ = ["SplitCheck", "split_check"]
 
@@ -98,7 +100,7 @@ def _p(p: float) -> str:
 
 
 def split_check(record: Record, structure: Any, delay: str | float | None = None, sensor: Any = None,
-                average: str = "auto", parts: int = 5) -> SplitCheck:
+                average: str = "auto", parts: int = 5, reference: dict[str, float] | None = None) -> SplitCheck:
     """Identify ``parts`` contiguous parts of ``record`` as :func:`~synth.ident.identification.identify` would
     the whole, and test whether the part estimates scatter as their stds say.
 
@@ -109,6 +111,11 @@ def split_check(record: Record, structure: Any, delay: str | float | None = None
         As given to :func:`~synth.ident.identification.identify` for the whole record.
     parts : int
         Number of parts, 3 or more.
+    reference : dict, optional
+        The whole record's fitted parameters: parameters that play the same role (the two poles of
+        ``k/((s+p1)*(s+p2))``, :func:`~synth.ident.exchangeable.exchangeable_groups`) are labelled in each part as
+        in this fit (default: as in the first part that fits). Unaligned, a part that returned the slow pole
+        as ``p2`` made a right std look 24 times too small.
 
     Returns
     -------
@@ -140,6 +147,7 @@ def split_check(record: Record, structure: Any, delay: str | float | None = None
         raise DataError(f"{record.t.size} samples cut into {parts} parts leave fewer than 20 per part",
                         where="parts")
     edges = np.linspace(0, record.t.size, parts + 1).astype(int)
+    groups = exchangeable_groups(parse_structure(structure) if isinstance(structure, str) else structure)
     estimates: dict[str, list[float]] = {}
     stds: dict[str, list[float]] = {}
     failures: list[str] = []
@@ -158,9 +166,14 @@ def split_check(record: Record, structure: Any, delay: str | float | None = None
                             f"identifiable in this part, not compared")
             continue
         fitted += 1
+        values = {k: float(fit.parameters.get(k, fit.delay)) for k in names}
+        errors = {k: float(fit.std.get(k, np.nan)) for k in names}
+        if reference is None:
+            reference = values
+        values, errors = align_labels(values, errors, reference, groups)  # p1 the slow pole in every part
         for name in names:
-            estimates.setdefault(name, []).append(float(fit.parameters.get(name, fit.delay)))
-            stds.setdefault(name, []).append(float(fit.std.get(name, np.nan)))
+            estimates.setdefault(name, []).append(values[name])
+            stds.setdefault(name, []).append(errors[name])
     seconds = float(record.t[-1] - record.t[0]) / parts
     if fitted < 3:
         return SplitCheck(parts, seconds, fitted, estimates, stds, {}, {}, "undetermined", failures)
