@@ -24,6 +24,7 @@ LAYERS: dict[str, int] = {
     "synth.distributions": 0, "synth.statespace": 0, "synth.outputs": 0, "synth.figure_files": 0, "synth.forked": 0,
     "synth.search": 0, "synth.jit": 0, "synth.polynomial_rows": 0, "synth.progress": 0, "synth.delayed_blocks": 0,
     "synth.disk_cache": 0, "synth.exact_steps": 0, "synth.stats_stand_in": 0, "synth.speculation": 0,
+    "synth.worker_pool": 0,
     # 1 models: plants, controllers, the loop and its exact stability, records
     "synth.plant": 1, "synth.controllers": 1, "synth.stability": 1, "synth.stability_sets": 1, "synth.freqgrid": 1,
     "synth.unity_gain": 1, "synth.narrow_peaks": 1,
