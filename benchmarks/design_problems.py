@@ -62,6 +62,23 @@ def _g(x: float) -> str:
     return f"{x:.6g}"
 
 
+def _type3_plant(rng: np.random.Generator, wt: float) -> tuple[list[str], np.ndarray, np.ndarray, list[str]]:
+    """``k (s + z) / (s^2 (s + p1) [(s + p2)])``: a double integrator with a zero (the loop is type 3 under integral
+    action), the class where session 41 found a converged polish called a local optimum with a way up left."""
+    z = float(_g(wt * 10 ** rng.uniform(-1.0, 0.0)))
+    poles = [float(_g(wt * 10 ** rng.uniform(-1.5, -0.3)))]
+    if rng.random() < 0.5:
+        poles.append(float(_g(wt * 10 ** rng.uniform(0.2, 1.0))))
+    num = np.array([1.0, z])
+    den = np.array([1.0, 0.0, 0.0])
+    for p in poles:
+        den = np.polymul(den, [1.0, p])
+    s = 1j * wt
+    k = float(_g(1.0 / abs(np.polyval(num, s) / np.polyval(den, s))))
+    tf = f"{_g(k)}*(s+{_g(z)})/(s^2*" + "*".join(f"(s+{_g(p)})" for p in poles) + ")"
+    return [tf], k * num, den, ["integrator", "double_integrator"]
+
+
 def _plant(rng: np.random.Generator, wt: float, simple: bool,
            biproper: np.random.Generator | None = None) -> tuple[list[str], np.ndarray, np.ndarray, list[str]]:
     order = int(rng.integers(1, 3 if simple else 6))
@@ -187,7 +204,7 @@ def _requirements(rng: np.random.Generator, wt: float, kind: str, num: np.ndarra
 
 
 def problem(seed: int, index: int, *, controllers: tuple[str, ...] = CONTROLLERS, simple: bool = False,
-            biproper: float = 0.0) -> Problem:
+            biproper: float = 0.0, type3: float = 0.0) -> Problem:
     """The ``index``-th problem of the sequence ``seed`` (independent of the other indices).
 
     Parameters
@@ -202,6 +219,10 @@ def problem(seed: int, index: int, *, controllers: tuple[str, ...] = CONTROLLERS
         Share of biproper plants (zeros added up to the plant's order). They are decided and drawn from a stream
         of their own, so every other draw, and every problem of a sequence with ``biproper=0`` (all results
         before session 21), stays as it was.
+    type3 : float
+        Share of plants that are a double integrator with a zero (``k (s + z) / (s^2 (s + p1) [(s + p2)])``),
+        drawn from a stream of their own in place of the plant ``rng`` would draw (the draws after the plant
+        stay those of the sequence with ``type3=0``, except that the plant's own draws are skipped).
 
     Examples
     --------
@@ -212,7 +233,11 @@ def problem(seed: int, index: int, *, controllers: tuple[str, ...] = CONTROLLERS
     rng = np.random.default_rng([seed, index])
     wt = float(_g(10 ** rng.uniform(-1, 2)))
     extra = np.random.default_rng([seed, index, 1])
-    (tf,), num, den, feats = _plant(rng, wt, simple, extra if extra.random() < biproper else None)
+    third = np.random.default_rng([seed, index, 3])
+    if not simple and third.random() < type3:
+        (tf,), num, den, feats = _type3_plant(third, wt)
+    else:
+        (tf,), num, den, feats = _plant(rng, wt, simple, extra if extra.random() < biproper else None)
     delay = 0.0
     if rng.random() < 0.6:
         delay = float(_g(rng.uniform(0, 1) ** 2 * 0.5 * 2 * np.pi / wt * (0.2 if simple else 1.0)))
@@ -250,8 +275,9 @@ def main() -> None:
     ap.add_argument("--n", type=int, default=5)
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--biproper", type=float, default=0.0, help="share of biproper plants")
+    ap.add_argument("--type3", type=float, default=0.0, help="share of double integrators with a zero")
     args = ap.parse_args()
-    for p in generate(args.n, args.seed, biproper=args.biproper):
+    for p in generate(args.n, args.seed, biproper=args.biproper, type3=args.type3):
         print(json.dumps(p.to_dict()))
 
 

@@ -325,6 +325,8 @@ def main() -> None:
     ap.add_argument("--quick", action="store_true", help="10 problems")
     ap.add_argument("--biproper", type=float, default=0.0,
                     help="share of biproper plants (their own random stream: 0 keeps every earlier sequence)")
+    ap.add_argument("--type3", type=float, default=0.0,
+                    help="share of double integrators with a zero (their own random stream, as --biproper)")
     ap.add_argument("--summarize", type=Path, nargs="+", help="only re-read (and re-classify) JSON-lines files")
     ap.add_argument("--rerun", type=Path, nargs="+", metavar="JSONL",
                     help="re-run synth only on the problems of these records, against their stored references")
@@ -346,7 +348,8 @@ def main() -> None:
         stored = [r for r in stored if args.controller in (None, r["controller"])]
         seed = int(stored[0]["spec"]["name"].split("_")[1]) if stored else args.seed
         problems = generate(max((r["index"] for r in stored), default=-1) + 1, seed,
-                            biproper=float(stored[0].get("biproper", 0.0)) if stored else 0.0)
+                            biproper=float(stored[0].get("biproper", 0.0)) if stored else 0.0,
+                            type3=float(stored[0].get("type3", 0.0)) if stored else 0.0)
         fh = args.json.open("w") if args.json else None
         for old in tqdm(sorted(stored, key=lambda r: r["index"]), desc="synth re-run"):
             problem = problems[old["index"]]
@@ -360,11 +363,12 @@ def main() -> None:
                 fh.flush()
     else:
         n = 10 if args.quick else args.n
-        problems = generate(args.start + n, args.seed, biproper=args.biproper)[args.start:]
+        problems = generate(args.start + n, args.seed, biproper=args.biproper, type3=args.type3)[args.start:]
         fh = args.json.open("w") if args.json else None
         for p in tqdm(problems, desc="design verification"):
             rec = run_problem(p, time_limit=args.time_limit, budget=args.budget)
             rec["biproper"] = args.biproper
+            rec["type3"] = args.type3
             records.append(rec)
             if fh:
                 fh.write(json.dumps(rec, default=float) + "\n")
