@@ -181,10 +181,13 @@ def run(args: argparse.Namespace) -> int:
     if args.json:
         write_json(args.json, data, force=args.force)
     u = m.uncertainty or {}
+    below = f"below {m.w[0]:.4g} rad/s (the lowest frequency measured)" if m.below_data else ""
     rows = [("w180", _fmt(m.w180, "rad/s", u.get("w180"))),
-            ("bandwidth_phase (-135 deg)", _fmt(m.bandwidth_phase, "rad/s", u.get("bandwidth_phase"))),
-            ("bandwidth_gain (+6 dB)", _fmt(m.bandwidth_gain, "rad/s", u.get("bandwidth_gain"))),
-            ("bandwidth", _fmt(m.bandwidth, "rad/s", u.get("bandwidth"))
+            ("bandwidth_phase (-135 deg)", below if "phase" in m.below_data
+             else _fmt(m.bandwidth_phase, "rad/s", u.get("bandwidth_phase"))),
+            ("bandwidth_gain (+6 dB)", below if "gain" in m.below_data
+             else _fmt(m.bandwidth_gain, "rad/s", u.get("bandwidth_gain"))),
+            ("bandwidth", below if m.bandwidth_limit == "below_data" else _fmt(m.bandwidth, "rad/s", u.get("bandwidth"))
              + (f"  ({m.bandwidth_limit}-limited)" if m.bandwidth else "")),
             ("phase delay tau_p", _fmt(m.phase_delay, "s", u.get("phase_delay"), 3)
              + (f"  (phase at 2 w180: {m.phase_2w180:.1f} deg, {m.phase_method})" if m.phase_2w180 is not None else ""))]

@@ -106,11 +106,34 @@ def hq_from_plant(plant: Plant, response_type: str = "auto") -> HQMetrics:
         tau = -(phase2 + 180.0) / (DEG * 2 * w180)
     bw, limit = bandwidth_by_type(response_type, found["w135"], found["wg"])
     return HQMetrics("model", response_type, reason, w180, found["w135"], found["wg"], bw, limit, tau,
-                     found["g180"], phase2, "exact", None, found["crossings"], None, None, tuple(notes),
+                     found["g180"], phase2, "exact", None, found["crossings"], None, None, tuple(notes), (),
                      w, curve.mag_db, curve.phase, None)
 
 
 # --------------------------------------------------------------------------- measured frequency response
+def phase_roughness(w: np.ndarray, phase: np.ndarray) -> float:
+    """Point-to-point scatter of a measured phase [deg]: the lesser of two estimates of its noise.
+
+    One is the RMS residual about a least-squares parabola, which a smooth curve with more bending than a parabola
+    (a lightly damped mode) also inflates; the other is the RMS second difference over sqrt(6) (exact for white
+    scatter of equal spacing), which smooth curvature inflates only on a coarse grid. Noise inflates both, so the
+    lesser is not fooled by a smooth curve on either kind of grid.
+
+    Examples
+    --------
+    >>> w = np.linspace(1.0, 4.0, 40)
+    >>> smooth = -90 - np.degrees(np.arctan2(0.4 * w, 4 - w**2))   # a mode with damping 0.1 at 2 rad/s
+    >>> noisy = smooth + np.random.default_rng(0).normal(0.0, 8.0, w.size)
+    >>> phase_roughness(w, smooth) < 2.0, phase_roughness(w, noisy) > 5.0
+    (True, True)
+    """
+    parabola = float(np.sqrt(np.mean((phase - np.polyval(np.polyfit(w, phase, 2), w)) ** 2)))
+    if phase.size < 5:
+        return parabola
+    second = np.diff(phase, 2)
+    return min(parabola, float(np.sqrt(np.mean(second**2) / 6.0)))
+
+
 def _validate_frd(w: Any, H: Any, coherence: Any, averages: Any) -> tuple[Any, ...]:
     try:
         w = np.asarray(w, float).ravel()
@@ -176,11 +199,12 @@ def _detect_type(w: np.ndarray, phase: np.ndarray, g2: np.ndarray | None) -> tup
     idx = np.flatnonzero(use)[:5]
     p = float(np.median(phase[idx]))
     where = f"median phase {p:.0f} deg over the {idx.size} lowest frequencies ({w[idx[0]]:.3g}-{w[idx[-1]]:.3g} rad/s)"
-    if abs(p + 90) < 45:
+    if abs(p + 90) < 30:
         return "rate", f"auto: {where}, near -90 deg (an integrator)"
     if abs(p) < 45:
         return "attitude", f"auto: {where}, near 0 deg (finite low-frequency gain)"
-    return "rate", f"auto: {where}, neither near 0 nor -90 deg; the rate rule (lesser) is used"
+    return "rate", (f"auto: {where}, neither near 0 nor -90 deg; the rate rule (lesser) is used; give "
+                    "--response-type if the type is known")
 
 
 def fit_phase_line(w: np.ndarray, phase_deg: np.ndarray, band: tuple[float, float],
@@ -335,8 +359,7 @@ def hq_from_frd(w: Any, H: Any, coherence: Any = None, averages: Any = None,
         elif coh_at and coh_at(w2) < COHERENCE_OK:
             reasons.append(f"the coherence at 2 w180 is {coh_at(w2):.2f} < {COHERENCE_OK}")
         if np.count_nonzero(in_band) >= 4:
-            x, y = w[in_band], phase[in_band]
-            rough = float(np.sqrt(np.mean((y - np.polyval(np.polyfit(x, y, 2), x)) ** 2)))
+            rough = phase_roughness(w[in_band], phase[in_band])
             if rough > rough_deg:
                 reasons.append(f"the phase between {band[0]:.4g} and {band[1]:.4g} rad/s scatters {rough:.2g} deg RMS "
                                f"about a smooth curve (> {rough_deg:g} deg)")
@@ -361,7 +384,7 @@ def hq_from_frd(w: Any, H: Any, coherence: Any = None, averages: Any = None,
             slope2 = _local_slope(w, phase, w2)
         tau = -(phase2 + 180.0) / (DEG * w2)
 
-    bw, limit = bandwidth_by_type(response_type, w135, wg)
+    bw, limit = bandwidth_by_type(response_type, w135, wg, found["below"])
     unc = coh = None
     if g2 is not None:
         unc, coh = _uncertainties(w, mag, phase, g2, n_d, found, tau, phase2, sig_phi2, slope2, limit)
@@ -369,4 +392,5 @@ def hq_from_frd(w: Any, H: Any, coherence: Any = None, averages: Any = None,
         if low:
             notes.append(f"coherence below {COHERENCE_OK} (seed 2's accuracy criterion) at: {', '.join(low)}")
     return HQMetrics("measured", response_type, reason, w180, w135, wg, bw, limit, tau, found["g180"], phase2,
-                     method, line, found["crossings"], unc, coh, tuple(notes), w, mag, phase, g2)
+                     method, line, found["crossings"], unc, coh, tuple(notes), tuple(found["below"]), w, mag, phase,
+                     g2)

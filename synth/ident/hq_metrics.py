@@ -185,7 +185,8 @@ class HQMetrics:
     bandwidth : float or None
         The bandwidth by the response type's rule [rad/s].
     bandwidth_limit : str
-        ``"phase"`` or ``"gain"``: which definition sets ``bandwidth`` (``"none"`` if undefined).
+        ``"phase"`` or ``"gain"``: which definition sets ``bandwidth`` (``"none"`` if undefined,
+        ``"below_data"`` when a crossing the rule needs lies below the lowest measured frequency).
     phase_delay : float or None
         ``tau_p`` [s].
     gain_w180_db : float or None
@@ -204,6 +205,9 @@ class HQMetrics:
         Coherence at each metric's frequency.
     notes : tuple of str
         Choices made (which crossing, why the line was used, assumptions).
+    below_data : tuple of str
+        Bandwidths (``"phase"``, ``"gain"``) whose crossing lies below the lowest measured frequency, so that the
+        data bound them from above only (measured data only).
     w, magnitude_db, phase_deg, coherence : numpy.ndarray or None
         The curve the metrics were read from (for figures; left out of ``to_dict`` by default).
 
@@ -233,6 +237,7 @@ class HQMetrics:
     uncertainty: dict[str, float | None] | None = None
     coherence_at: dict[str, float | None] | None = None
     notes: tuple[str, ...] = ()
+    below_data: tuple[str, ...] = ()
     w: np.ndarray | None = field(default=None, repr=False)
     magnitude_db: np.ndarray | None = field(default=None, repr=False)
     phase_deg: np.ndarray | None = field(default=None, repr=False)
@@ -263,6 +268,8 @@ class HQMetrics:
                       "phase_delay": "s", "gain_w180_db": "dB", "phase_2w180_deg": "deg"},
             "notes": list(self.notes),
         }
+        if self.below_data:
+            out["below_data"] = {"bandwidths": list(self.below_data), "lowest_frequency": float(self.w[0])}
         if curves and self.w is not None:
             out["curves"] = {"w": self.w, "magnitude_db": self.magnitude_db, "phase_deg": self.phase_deg,
                              "coherence": self.coherence}
@@ -358,7 +365,15 @@ def crossing_metrics(curve: ResponseCurve, notes: list[str]) -> dict[str, Any]:
             notes.append(text)
     w180 = x180.w if x180 else None
     out: dict[str, Any] = {"w180": w180, "w135": x135.w if x135 else None, "wg": None, "g180": None,
-                           "crossings": {"phase_-180": c180, "phase_-135": c135}}
+                           "crossings": {"phase_-180": c180, "phase_-135": c135}, "below": []}
+    if not curve.exact and curve.phase[0] < -135.0:
+        # measured data whose phase is already past -135 deg at the lowest frequency: the first downward crossing
+        # lies below the data; a later one inside it is not the phase bandwidth
+        out["w135"] = None
+        out["below"].append("phase")
+        notes.append(f"the phase is {curve.phase[0]:.1f} deg at the lowest measured frequency ({curve.w[0]:.4g} "
+                     f"rad/s), already below -135 deg: the phase bandwidth lies below the data (< {curve.w[0]:.4g} "
+                     "rad/s); measure lower frequencies to find it")
     if w180 is None:
         notes.append("the phase never falls through -180 deg in the frequency range: w180, the gain bandwidth and "
                      "the phase delay are undefined")
@@ -372,23 +387,35 @@ def crossing_metrics(curve: ResponseCurve, notes: list[str]) -> dict[str, Any]:
                      "largest pilot gain that keeps 6 dB of gain margin")
     if text:
         notes.append(text)
-    if xg is None:
+    if xg is None and not curve.exact and curve.mag_db[0] < level:
+        out["below"].append("gain")
+        notes.append(f"the gain is {curve.mag_db[0]:.4g} dB at the lowest measured frequency ({curve.w[0]:.4g} "
+                     f"rad/s), already below {level:.4g} dB (6 dB above the gain at w180): the gain bandwidth "
+                     f"lies below the data (< {curve.w[0]:.4g} rad/s); measure lower frequencies to find it")
+    elif xg is None:
         notes.append(f"the gain never falls through {level:.4g} dB (6 dB above the gain at w180) below w180: "
                      "the gain bandwidth is undefined")
     out.update(wg=xg.w if xg else None, g180=g180, crossings={**out["crossings"], "gain_+6dB": cg})
     return out
 
 
-def bandwidth_by_type(response_type: str, w135: float | None, wg: float | None) -> tuple[float | None, str]:
+def bandwidth_by_type(response_type: str, w135: float | None, wg: float | None,
+                      below: tuple[str, ...] | list[str] = ()) -> tuple[float | None, str]:
     """The bandwidth by the response type's rule and which definition sets it.
 
-    An attitude response type takes the phase bandwidth, a rate type the lesser of the two.
+    An attitude response type takes the phase bandwidth, a rate type the lesser of the two. A bandwidth the rule
+    needs whose crossing lies below the data (``below``) leaves the bandwidth unknown (``"below_data"``): below the
+    lowest measured frequency, so no measured crossing can be the lesser.
 
     Examples
     --------
     >>> bandwidth_by_type("rate", 1.4, 2.3), bandwidth_by_type("attitude", None, 2.3)
     ((1.4, 'phase'), (None, 'none'))
+    >>> bandwidth_by_type("rate", None, 1.7, below=["phase"])
+    (None, 'below_data')
     """
+    if "phase" in below or (response_type != "attitude" and "gain" in below):
+        return None, "below_data"
     if response_type == "attitude":
         return (w135, "phase") if w135 is not None else (None, "none")
     candidates = [(v, k) for v, k in ((w135, "phase"), (wg, "gain")) if v is not None]
