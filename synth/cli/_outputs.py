@@ -12,11 +12,13 @@ from pathlib import Path
 
 
 def check_outputs(folder: str | Path | None, names: Iterable[str] = (), files: Iterable[str | Path | None] = (),
-                  force: bool = False) -> None:
+                  force: bool = False, inputs: Iterable[str | Path | None] = ()) -> None:
     """Refuse now what would be refused after the computation.
 
     ``folder`` is a report folder (``None``: none written) and ``names`` the main files written there;
-    ``files`` are single output files (``None`` and ``"-"``, standard output, are skipped).
+    ``files`` are single output files (``None`` and ``"-"``, standard output, are skipped). An output named twice
+    (a ``--json`` that is the ``--out`` file, or a file of the report folder) or that is one of the command's
+    ``inputs`` is refused too: one would overwrite the other.
 
     Examples
     --------
@@ -29,10 +31,24 @@ def check_outputs(folder: str | Path | None, names: Iterable[str] = (), files: I
     >>> check_outputs(d / "new", ["report.html"], files=["-", None, d / "out.json"])
     >>> sorted(p.name for p in d.iterdir())  # nothing written
     ['report.html']
+    >>> check_outputs(None, files=[d / "a.json"], inputs=[d / "a.json"])
+    Traceback (most recent call last):
+    synth.errors.SpecError: ...a.json: is an input of this command; writing the output there would overwrite it
     """
-    from synth.errors import OutputExistsError
+    from synth.errors import OutputExistsError, SpecError
     from synth.outputs import OutputDir, check_writable
 
+    singles = [Path(f) for f in files if f is not None and str(f) != "-"]
+    outputs = ([Path(folder) / n for n in names] if folder is not None else []) + singles
+    seen: set[Path] = set()
+    for path in outputs:
+        if path.resolve() in seen:
+            raise SpecError("is named as two outputs of this command; give each its own file", where=str(path))
+        seen.add(path.resolve())
+    for given in inputs:
+        if given is not None and str(given) != "-" and Path(given).resolve() in seen:
+            raise SpecError("is an input of this command; writing the output there would overwrite it",
+                            where=str(given))
     if folder is not None:
         OutputDir(folder, force, expect=list(names))
     for file in files:

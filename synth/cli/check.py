@@ -40,7 +40,7 @@ def run(args: argparse.Namespace) -> int:
     from synth.outputs import dump_json, write_json
     from synth.spec import load_spec
 
-    check_outputs(None, files=[args.json], force=args.force)  # before any computation
+    check_outputs(None, files=[args.json], force=args.force, inputs=[args.spec])  # before any computation
     spec = load_spec(args.spec)
     try:
         controller = Controller.from_string(args.controller)

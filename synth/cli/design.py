@@ -108,7 +108,7 @@ def run(args: argparse.Namespace) -> int:
 
     name = args.out or spec_name(args.spec)  # refuse before any computation (the spec's plant may be identified)
     folder = None if args.no_report or not name else (Path(args.out) if args.out else Path("reports") / name)
-    check_outputs(folder, ["result.json", "report.html"], [args.json], args.force)
+    check_outputs(folder, ["result.json", "report.html"], [args.json], args.force, inputs=[args.spec])
     spec = load_spec(args.spec)
     say = (lambda *a: None) if args.quiet or args.json == "-" else print
     with StageLine("design", enabled=False if args.quiet or args.json == "-" else None):

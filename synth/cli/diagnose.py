@@ -133,7 +133,8 @@ def run(args: argparse.Namespace) -> int:
 
     stem = Path(args.data).stem + ("_round_robin" if args.round_robin else "")
     check_outputs(None if args.no_report else Path(args.out or Path("reports") / "diagnose" / stem),
-                  ["result.json", "report.html"], [args.json], args.force)  # refuse before the slow part
+                  ["result.json", "report.html"], [args.json], args.force,
+                  inputs=[args.data])  # refuse before the slow part
     plant = load_model(args.plant, args.delay, where="--plant")
     aux = _split(args.aux)
     kw: dict[str, Any] = {"aux": aux, "input_unit": args.input_unit, "output_unit": args.output_unit,

@@ -111,7 +111,8 @@ def run(args: argparse.Namespace) -> int:
     from synth.outputs import OutputDir, dump_json, write_json
     from synth.plant import Plant
 
-    check_outputs(args.out, ["result.json", "bode.png"], [args.json], args.force)  # before any computation
+    check_outputs(args.out, ["result.json", "bode.png"], [args.json], args.force,
+                  inputs=args.data)  # before any computation
     runs = [_load(p, args, off_axis=True) for p in args.data]
     if not 1 <= args.points_per_decade <= 2000:
         raise SynthError(f"must be between 1 and 2000, got {args.points_per_decade}", where="--points-per-decade")

@@ -142,7 +142,8 @@ def run(args: argparse.Namespace) -> int:
     from synth.outputs import OutputDir, check_writable, dump_json, write_json
     from synth.plant import Plant
 
-    check_outputs(args.out, ["hq.json", "hq_bode.png"], [args.json], args.force)  # before any computation
+    check_outputs(args.out, ["hq.json", "hq_bode.png"], [args.json], args.force,
+                  inputs=[args.frd])  # before any computation
     if args.tf is not None:
         try:
             plant = Plant.from_string(args.tf, delay=args.delay)

@@ -132,7 +132,8 @@ def run(args: argparse.Namespace) -> int:
     from synth.cli._outputs import check_outputs
 
     check_outputs(Path(args.out) if args.out else Path("reports") / "identify" / Path(args.data).stem,
-                  ["identify.json"] + ([] if args.no_figures else ["fit.png", "train.png"]), [args.json], args.force)
+                  ["identify.json"] + ([] if args.no_figures else ["fit.png", "train.png"]), [args.json], args.force,
+                  inputs=[args.data])
     try:
         structure = parse_structure(args.structure)
     except ModelError as exc:

@@ -147,7 +147,8 @@ def run(args: argparse.Namespace) -> int:
                     ["metrics.json"] + ([] if args.csv else ["timeseries.csv"]) + ([] if args.plot else ["step.png"]))
     uses_folder = not args.csv if args.sweep else not (args.csv and args.plot)
     check_outputs((Path(args.out) if args.out else Path("reports") / name / "simulate") if name and uses_folder
-                  else None, folder_names, [args.json, args.csv, None if args.sweep else args.plot], args.force)
+                  else None, folder_names, [args.json, args.csv, None if args.sweep else args.plot], args.force,
+                  inputs=[args.spec])
     spec = load_spec(args.spec)
     sim = spec.simulation or SimulationSpec()
     text = args.controller or (spec.reference.controller if spec.reference else None)

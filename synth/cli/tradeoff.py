@@ -53,7 +53,8 @@ def run(args: argparse.Namespace) -> int:
 
     name = args.out or spec_name(args.spec)  # refuse before any computation
     check_outputs((Path(args.out) if args.out else Path("reports") / name) if name else None,
-                  ["tradeoff.csv", "tradeoff.json", "tradeoff.html", "tradeoff.png"], [args.json], args.force)
+                  ["tradeoff.csv", "tradeoff.json", "tradeoff.html", "tradeoff.png"], [args.json], args.force,
+                  inputs=[args.spec])
     spec = load_spec(args.spec)
     sweeps = [Sweep.parse(s) for s in args.sweep]
     if len(sweeps) > 2:
