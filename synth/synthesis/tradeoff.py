@@ -65,7 +65,10 @@ class Sweep:
                     raise ValueError
                 values = list(np.linspace(float(start), float(stop), n))
             else:
-                values = [float(v) for v in spec.split(",") if v.strip()]
+                items = spec.split(",")
+                if len(items) > 1 and not all(v.strip() for v in items):
+                    raise SpecError(f"sweep {text!r} has an empty item in its list of values", where="--sweep")
+                values = [float(v) for v in items if v.strip()]
         except ValueError:
             raise SpecError(f"sweep {text!r}: values must be start:stop:count (count >= 1) or a list of numbers",
                             where="--sweep") from None
@@ -416,6 +419,11 @@ def tradeoff(spec: Spec, sweeps: list[Sweep], scheduler: str | Any | None = None
     data = spec.model_dump(mode="json", exclude_none=True)
     for sw in sweeps:  # fail early on a bad path
         set_value(data, sw.path, sw.values[0])
+    if len(sweeps) == 2:  # two paths (a label and a type, say) naming one value would overwrite each other
+        both = set_value(set_value(data, sweeps[0].path, -1.5e300), sweeps[1].path, 1.5e300)
+        if set_value(both, sweeps[1].path, -2.5e300) == set_value(both, sweeps[0].path, -2.5e300):
+            raise SpecError(f"the two sweeps {sweeps[0].path!r} and {sweeps[1].path!r} name the same value; "
+                            "sweep it once", where="--sweep")
     if len(sweeps) == 1:  # a one-value sweep needs its direction: fail early
         signs = [stricter_when(data, sweeps[0].path)]
     else:
