@@ -10,6 +10,9 @@ from typing import Any
 
 __all__ = ["COMMAND", "DESCRIPTION", "HELP", "ORDER", "add_arguments", "run", "sweep_csv_text"]
 
+MAX_SAMPLES = 20_000_000
+"""Most samples one run's CSV may hold (about 0.5 GB of text)."""
+
 COMMAND = "sweep-design"
 ORDER = 38
 HELP = "design a frequency-sweep test input (seed 2): range, duration, amplitude, fades; a CSV for the rig"
@@ -44,7 +47,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--reduce-above", type=float, metavar="HZ",
                    help="reduce the amplitude from this input frequency on [Hz] (the report's pilots did above 1.5 Hz "
                         "to spare the rotor pylon mode); the change is smooth over the half octave below it")
-    p.add_argument("--reduce-to", type=float, default=0.5, metavar="FRACTION",
+    p.add_argument("--reduce-to", type=float, default=None, metavar="FRACTION",
                    help="the reduced amplitude as a fraction of --amplitude (default 0.5)")
     p.add_argument("--runs", type=int, default=2, help="runs to concatenate for the analysis (one more is flown)")
     p.add_argument("--name", default="input", help="input column name (default 'input')")
@@ -81,22 +84,30 @@ def _positive(value: float | None, flag: str, allow_zero: bool = False) -> None:
 def run(args: argparse.Namespace) -> int:
     import dataclasses
 
+    from synth.cli._outputs import check_outputs
     from synth.cli._table import name_values
     from synth.errors import DataError, SynthError
     from synth.ident.sweep_design import design_sweep
-    from synth.outputs import GENERATOR, atomic_write_text, check_writable, dump_json, write_json
+    from synth.outputs import GENERATOR, atomic_write_text, dump_json, write_json
 
     for value, flag in ((args.w_min, "--w-min"), (args.w_max, "--w-max"), (args.duration, "--duration"),
                         (args.amplitude, "--amplitude"), (args.sample_rate, "--sample-rate")):
         _positive(value, flag)
     _positive(args.fade, "--fade", allow_zero=True)
     _positive(args.reduce_above, "--reduce-above")
+    if args.reduce_to is not None and args.reduce_above is None:
+        raise SynthError("has no effect without --reduce-above (the frequency above which the amplitude is reduced)",
+                         where="--reduce-to")
+    if args.reduce_to is None:
+        args.reduce_to = 0.5
     if args.reduce_above is not None and not (0 < args.reduce_to <= 1):
         raise SynthError(f"must be a fraction in (0, 1], got {args.reduce_to:g}", where="--reduce-to")
     if args.runs < 1:
         raise SynthError(f"must be at least 1, got {args.runs}", where="--runs")
     if not args.name.strip() or "," in args.name or "\n" in args.name:
         raise SynthError(f"not a usable column name: {args.name!r}", where="--name")
+    if args.name.strip() == "time_s":
+        raise SynthError("'time_s' is the time column's name; give the input another", where="--name")
     try:
         plan = design_sweep(args.w_min, args.w_max, args.runs)
     except DataError as exc:
@@ -119,6 +130,14 @@ def run(args: argparse.Namespace) -> int:
         notes.append(f"the fade ({fade:g} s) is longer than T_max ({plan.t_max:.4g} s): the first low-frequency cycle "
                      "is mostly faded out")
     rate = args.sample_rate or plan.sample_rate
+    samples = plan.run_length * rate + 1
+    if samples > MAX_SAMPLES:
+        raise SynthError(f"the run would hold {samples:,.0f} samples ({plan.run_length:g} s at {rate:.4g} Hz), over "
+                         f"{MAX_SAMPLES:,}: narrow the frequency range (one sweep per part of it) or lower --sample-rate",
+                         where="--sample-rate" if args.sample_rate else "--w-min/--w-max")
+    if args.reduce_above is not None and 2.0 * math.pi * args.reduce_above <= plan.w_min * 2 ** 0.5:
+        notes.append(f"--reduce-above {args.reduce_above:g} Hz is within half an octave of w_min "
+                     f"({plan.w_min / (2 * math.pi):.3g} Hz): the low-frequency cycles are reduced too")
     try:
         reduce_above = None if args.reduce_above is None else 2.0 * math.pi * args.reduce_above
         t, u = plan.signal(amplitude=args.amplitude, sample_rate=rate, fade=fade, reduce_above=reduce_above,
@@ -126,9 +145,7 @@ def run(args: argparse.Namespace) -> int:
     except DataError as exc:
         raise SynthError(exc.message, where="--sample-rate" if "sample rate" in exc.message else "--amplitude") from None
     out = Path(args.out)
-    check_writable(out, args.force)
-    if args.json and args.json != "-":
-        check_writable(Path(args.json), args.force)
+    check_outputs(None, files=[out, args.json], force=args.force)
     header = (f"{GENERATOR}: frequency sweep {plan.w_min:g}-{plan.w_max:g} rad/s, {plan.run_length:g} s, amplitude "
               f"{args.amplitude:g}, fade {fade:.4g} s, {rate:g} Hz")
     if args.reduce_above is not None:

@@ -134,7 +134,7 @@ class SweepDesign:
         """
         fs = float(sample_rate or self.sample_rate)
         if not fs > 2.0 * self.f_max:
-            raise DataError(f"sample rate {fs:g} Hz must exceed twice f_max = {self.f_max:.3g} Hz")
+            raise DataError(f"sample rate {fs:g} Hz must exceed 2 f_max = {2 * self.f_max:.3g} Hz")
         if not amplitude > 0:
             raise DataError(f"amplitude must be positive, got {amplitude:g}")
         t = np.arange(round(self.run_length * fs) + 1) / fs
@@ -145,6 +145,11 @@ class SweepDesign:
         dw = self.w_max - self.w_min
         phase = self.w_min * t + c2 * dw * (sweep / c1 * np.expm1(c1 * tau / sweep) - tau)
         u = np.sin(phase)
+        fade = 0.25 * self.t_max if fade is None else float(fade)
+        if fade > 0:
+            ramp = np.clip(np.minimum(t, t[-1] - t) / fade, 0.0, 1.0)
+            u = u * 0.5 * (1.0 - np.cos(np.pi * ramp))
+        peak = float(np.max(np.abs(u)))  # before any reduction, so that a reduced start is not scaled back up
         if reduce_above is not None:
             if not (np.isfinite(reduce_above) and reduce_above > 0 and 0 < reduce_to <= 1):
                 raise DataError(f"amplitude reduction needs a frequency > 0 and a fraction in (0, 1], got "
@@ -152,12 +157,7 @@ class SweepDesign:
             w_now = self.w_min + c2 * dw * np.expm1(c1 * tau / sweep)   # instantaneous frequency d(phase)/dt
             x = np.clip(np.log2(np.maximum(w_now, 1e-300) / reduce_above) / 0.5 + 1.0, 0.0, 1.0)
             u = u * (1.0 - (1.0 - reduce_to) * 0.5 * (1.0 - np.cos(np.pi * x)))
-        fade = 0.25 * self.t_max if fade is None else float(fade)
-        if fade > 0:
-            ramp = np.clip(np.minimum(t, t[-1] - t) / fade, 0.0, 1.0)
-            u = u * 0.5 * (1.0 - np.cos(np.pi * ramp))
-        peak = np.max(np.abs(u[: max(1, np.searchsorted(t, t_low + 1e-9))])) if reduce_above is not None else 0.0
-        return t, amplitude * u / (peak if peak > 0 else np.max(np.abs(u)))
+        return t, amplitude * u / peak
 
 
 def design_sweep(w_min: float, w_max: float, runs_used: int = 2) -> SweepDesign:
