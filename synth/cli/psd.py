@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import math
 import sys
 from pathlib import Path
 from typing import Any
@@ -17,7 +18,11 @@ DESCRIPTION = """Power spectral density of one or several disturbance records (s
 One-sided Welch PSD in unit^2/(rad/s) on rad/s (records averaged), its log-log trend (dB/decade),
 the noise floor, narrow-band spikes, and the frequency below which --share of the disturbance
 power above the floor lies. The suggested bandwidth requirement is --factor times that frequency:
-feedback attenuates a disturbance only below the loop's bandwidth.
+feedback attenuates a disturbance only below the loop's bandwidth. No requirement is suggested when the
+power above the floor is within the Welch estimate's chi-square scatter (false-alarm rate 0.1 %), and it is
+"undetermined" with fewer than 4 segments averaged. Bands must lie in (0, Nyquist]; uneven time stamps
+that jitter around a grid are used without interpolation (otherwise the note states the interpolation's
+attenuation), and the mean square is the raw samples'.
 
 example:
   synth psd --data env.csv --data env2.csv --time t --signal speed --unit rad/s
@@ -44,7 +49,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    help="rename columns before picking them, e.g. acc[0]=accel_x (a MAT matrix gives acc[0], "
                         "acc[1], ...; a struct s.field); repeatable")
     p.add_argument("--unit", default="", help="unit of the signal (labels; default: the header's)")
-    p.add_argument("--dt", type=float, help="sample interval [s] for files without a time column")
+    p.add_argument("--dt", type=float,
+                   help="sample interval [s] for files without a time column (with --time: must agree within 1 %%)")
     p.add_argument("--noise-data", action="append", default=[], metavar="FILE",
                    help="noise-only record (e.g. motor stopped) whose level is the noise floor")
     p.add_argument("--share", type=float, default=0.9, help="share of disturbance power (default 0.9)")
@@ -73,27 +79,44 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace) -> int:
     from synth.cli._outputs import check_outputs
     from synth.cli._table import name_values
-    from synth.data.disturbance import load_disturbance
     from synth.data.readers import parse_column_map
+    from synth.errors import SynthError
     from synth.ident.bandwidth_suggestion import suggest_bandwidth
-    from synth.ident.psd import analyze_records
+    from synth.ident.psd import MIN_SEGMENTS, analyze_records
+    from synth.ident.psd_stamps import load_psd_record
     from synth.ident.welch import unit_squared
     from synth.outputs import OutputDir, check_writable, dump_json, write_json
 
-    check_outputs(args.out, ["psd.json", "psd.png"], [args.json], args.force)  # before any computation
+    check_outputs(args.out, ["psd.json", "psd.png"], [args.json], args.force,
+                  inputs=args.data)  # before any computation
+    _check_options(args)
     columns = parse_column_map(args.columns)
-    records = [load_disturbance(f, args.time, args.signal, args.unit, args.dt, columns) for f in args.data]
-    noise = [load_disturbance(f, args.time, args.signal, args.unit, args.dt, columns) for f in args.noise_data]
+    loaded = [load_psd_record(f, args.time, args.signal, args.unit, args.dt, columns) for f in args.data]
+    records = [r for r, _ in loaded]
+    noise = [load_psd_record(f, args.time, args.signal, args.unit, args.dt, columns)[0] for f in args.noise_data]
+    _check_against_records(args, [*records, *noise])
+    raw_ms = sum(ms * r.x.size for r, ms in loaded) / sum(r.x.size for r in records)
     a = analyze_records(records, noise, share=args.share, band=tuple(args.band) if args.band else None,
                         segment=args.segment, w_min=args.w_min,
                         floor_band=tuple(args.floor_band) if args.floor_band else None, spike_db=args.spike_db,
                         detrend=args.detrend)
-    suggestion = suggest_bandwidth(a, args.factor) if a.share_frequency is not None else None
-    data = {**a.to_dict(), "records": [r.to_dict() for r in records], "noise_records": [r.to_dict() for r in noise],
-            "bandwidth_suggestion": suggestion.to_dict() if suggestion else None}
-    derived = _derive_requirements(args, a, records[0].dt)
+    suggestion = None
+    if a.share_frequency is not None and a.suggestion_withheld is None:
+        if not math.isfinite(args.factor * a.share_frequency):
+            raise SynthError(f"{args.factor:g} x the share frequency {a.share_frequency:.4g} rad/s is not finite; "
+                             "give a factor of order 1", where="--factor")
+        suggestion = suggest_bandwidth(a, args.factor)
+    withheld = a.suggestion_withheld or "none: no disturbance power above the noise floor"
+    data = {**a.to_dict(), "raw_mean_square": raw_ms, "records": [r.to_dict() for r in records],
+            "noise_records": [r.to_dict() for r in noise],
+            "bandwidth_suggestion": suggestion.to_dict() if suggestion else
+            {"status": withheld.split(":")[0], "reason": withheld}}
+    undetermined = a.suggestion_withheld if a.segments < MIN_SEGMENTS else None
+    derived = _derive_requirements(args, a, records[0].dt) if undetermined is None else None
     if derived is not None:
         data["requirements"] = derived.to_dict()
+    elif undetermined is not None and (args.requirements or args.resolution is not None):
+        data["requirements"] = {"status": "undetermined", "reason": undetermined}
     if args.json and args.json != "-":
         check_writable(Path(args.json), args.force)
     out = OutputDir(args.out, args.force) if args.out else None
@@ -126,11 +149,17 @@ def run(args: argparse.Namespace) -> int:
             (f"{100 * a.share:g} % of disturbance power below",
              f"{a.share_frequency:.4g} rad/s (spikes counted: {a.share_frequency_with_spikes:.4g} rad/s)"
              if a.share_frequency is not None else "undefined"),
-            ("mean square", f"{a.total_power:.4g} {u2} (above the floor: {a.disturbance_power:.4g} {u2})")]
+            ("mean square", f"{raw_ms:.4g} {u2} of the raw samples (the spectrum integrates to {a.total_power:.4g} "
+                            f"{u2}; above the floor: {a.disturbance_power:.4g} {u2}, scatter "
+                            f"{a.disturbance_power_scatter:.2g} {u2})")]
     if suggestion:
         rows.append(("suggested requirement", f"{suggestion.spec_entry()}  (bandwidth >= {suggestion.factor:g} x "
                                               f"{suggestion.share_frequency:.4g} rad/s)"))
+    else:
+        rows.append(("suggested requirement", withheld))
     print(name_values(rows, a.notes))
+    if undetermined is not None and (args.requirements or args.resolution is not None):
+        print(f"\nrequirements from the disturbance: {undetermined}")
     if derived is not None:
         print("\nrequirements from the disturbance:\n" + derived.yaml())
         print(name_values([(e.name, f"{e.value:.4g} {e.unit}  ({e.feature})") for e in derived.evidence],
@@ -159,3 +188,34 @@ def _derive_requirements(args: argparse.Namespace, analysis: Any, dt: float) -> 
     except DataError as exc:
         flag = "--resolution" if "resolution" in exc.message else "--margin-db" if "margin" in exc.message else None
         raise exc.located(flag) if flag else exc from None
+
+
+def _check_options(args: argparse.Namespace) -> None:
+    """Refuse bad option values before any file is read (one line naming the option)."""
+    from synth.errors import SynthError
+
+    for flag, value, what in (("--factor", args.factor, "a finite number > 0"),
+                              ("--spike-db", args.spike_db, "a finite number of dB > 0"),
+                              ("--dt", args.dt, "a finite number > 0 s"),
+                              ("--segment", args.segment, "a finite number > 0 s"),
+                              ("--w-min", args.w_min, "a finite number > 0 rad/s")):
+        if value is not None and not (math.isfinite(value) and value > 0):
+            raise SynthError(f"must be {what}, got {value:g}", where=flag)
+    if not (math.isfinite(args.share) and 0 < args.share < 1):
+        raise SynthError(f"share must lie strictly between 0 and 1, got {args.share:g}", where="--share")
+
+
+def _check_against_records(args: argparse.Namespace, records: list[Any]) -> None:
+    """Check --dt against the time column and the bands against the Nyquist frequency of the records."""
+    from synth.errors import SynthError
+    from synth.ident.psd import check_band
+
+    dt = records[0].dt
+    if args.dt is not None and args.time is not None:
+        for r in records:
+            if abs(args.dt - r.dt) > 0.01 * r.dt:
+                raise SynthError(f"{args.dt:g} s disagrees with the {r.dt:.4g} s of the time column '{args.time}' in "
+                                 f"{r.source} (by more than 1 %); leave out --dt or --time", where="--dt")
+    for flag, band in (("--band", args.band), ("--floor-band", args.floor_band)):
+        if band is not None:
+            check_band(band, dt, flag)

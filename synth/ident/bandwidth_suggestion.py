@@ -40,7 +40,8 @@ class BandwidthSuggestion:
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready form."""
-        return {"share": self.share, "share_frequency": self.share_frequency, "factor": self.factor,
+        return {"status": "suggested", "share": self.share, "share_frequency": self.share_frequency,
+                "factor": self.factor,
                 "min_bandwidth": self.min_bandwidth, "spec_entry": self.spec_entry(),
                 "rule": f"closed-loop bandwidth >= {self.factor:g} x the frequency below which "
                         f"{100 * self.share:g} % of the disturbance power (above the noise floor, spikes left out) lies"}
@@ -48,6 +49,13 @@ class BandwidthSuggestion:
 
 def suggest_bandwidth(analysis: PsdAnalysis, factor: float = 1.0) -> BandwidthSuggestion:
     """Turn the share frequency of a spectrum into a minimum closed-loop bandwidth (rule above).
+
+    Raises
+    ------
+    DataError
+        ``factor`` not a finite number > 0 or the bandwidth not finite; no share frequency; or the
+        analysis withholds a suggestion (``analysis.suggestion_withheld``: too few segments, or the
+        power above the floor within the estimate's scatter), with its reason.
 
     Examples
     --------
@@ -61,7 +69,14 @@ def suggest_bandwidth(analysis: PsdAnalysis, factor: float = 1.0) -> BandwidthSu
     """
     if not (np.isfinite(factor) and factor > 0):
         raise DataError(f"factor must be > 0, got {factor!r}", where="psd: bandwidth factor")
+    withheld = getattr(analysis, "suggestion_withheld", None)
+    if withheld:
+        raise DataError(withheld, where="psd")
     if analysis.share_frequency is None:
         raise DataError("the spectrum has no disturbance power above its noise floor; no bandwidth follows from it",
                         where="psd")
-    return BandwidthSuggestion(analysis.share, analysis.share_frequency, factor, factor * analysis.share_frequency)
+    bandwidth = factor * analysis.share_frequency
+    if not np.isfinite(bandwidth):
+        raise DataError(f"{factor:g} x the share frequency {analysis.share_frequency:.4g} rad/s is not finite",
+                        where="psd: bandwidth factor")
+    return BandwidthSuggestion(analysis.share, analysis.share_frequency, factor, bandwidth)

@@ -307,7 +307,7 @@ def requirements_from_disturbance(analysis: PsdAnalysis, resolution: float | Non
         Evidence("bandwidth floor", minimum, "rad/s", f"fitted disturbance {margin_db:g} dB above the sensor floor"),
         Evidence("ideal bandwidth", ideal, "rad/s", "fitted disturbance meets the sensor floor"),
     ]
-    if analysis.share_frequency is not None:
+    if analysis.share_frequency is not None and analysis.suggestion_withheld is None:
         s = suggest_bandwidth(analysis)
         ev.append(Evidence(f"{100 * s.share:g} % power frequency", s.share_frequency, "rad/s",
                            "synth.ident.psd.suggest_bandwidth, for comparison"))

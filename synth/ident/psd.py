@@ -12,10 +12,23 @@ put together:
   3 dB of the floor.
 - **Share frequency**: the disturbance power density is ``S - floor`` (not clipped, so noise-only
   bins add nothing on average), spikes replaced by the running median.
+- **Evidence for a requirement**: a Welch bin's estimate scatters as ``S chi2(nu)/nu`` (``nu`` the
+  degrees of freedom of the averaged segments), so on a pure floor the power above the floor,
+  ``sum(S - floor) dw``, scatters about zero with the standard deviation
+  :attr:`PsdAnalysis.disturbance_power_scatter` (the bins' own scatter, adjacent Hann bins correlated,
+  plus the floor estimate's, a median over its band). Power above the floor below
+  ``SIGNIFICANCE_Z`` of these (false-alarm rate :data:`FALSE_ALARM_RATE` per record) is what the
+  estimate's scatter explains: no share frequency and no bandwidth requirement follow from it. With
+  fewer than :data:`MIN_SEGMENTS` segments averaged the spectrum is too rough for a requirement at all:
+  the suggestion is "undetermined".
+- **Uneven time stamps** (:func:`synth.ident.psd_stamps.load_psd_record`): stamps jittering around a uniform grid are used as
+  they are on that grid (interpolation would low-pass the spectrum); otherwise the linear interpolation
+  is kept and its attenuation stated; the mean square of the raw samples is reported either way.
 """
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any
@@ -23,7 +36,7 @@ from typing import Any
 import numpy as np
 
 from synth.data.disturbance import DisturbanceRecord
-from synth.distributions import chi2_median
+from synth.distributions import chi2_median, norm_ppf
 from synth.errors import DataError
 from synth.ident.spectrum_features import (
     Spike,
@@ -36,10 +49,21 @@ from synth.ident.spectrum_features import (
 )
 from synth.ident.welch import effective_dof, unit_squared, welch_psd
 
-__all__ = ["KNEE_DB", "PsdAnalysis", "analyze_psd", "analyze_records"]
+__all__ = ["FALSE_ALARM_RATE", "KNEE_DB", "MIN_SEGMENTS", "PsdAnalysis", "analyze_psd", "analyze_records",
+           "check_band"]
 
 #: the trend band ends where the running median comes within this many dB of the floor
 KNEE_DB = 3.0
+#: fewer Welch segments than this (fewer than about 7.7 degrees of freedom, each bin's estimate spread over
+#: a factor of 6 for 90 % of its chi-square distribution) give no requirement: "undetermined"
+MIN_SEGMENTS = 4
+#: probability that a pure noise floor's power above the floor passes as a disturbance (one-sided)
+FALSE_ALARM_RATE = 1e-3
+#: the same as a number of standard deviations of the above-floor power (normal approximation)
+SIGNIFICANCE_Z = float(norm_ppf(1.0 - FALSE_ALARM_RATE))
+#: variance of a sum of Hann-windowed periodogram bins over the sum of their variances: the squared correlation
+#: of adjacent bins' Fourier coefficients is (2/3)^2, of bins two apart (1/6)^2
+_HANN_BIN_VARIANCE_FACTOR = 1.0 + 2.0 * (2.0 / 3.0) ** 2 + 2.0 * (1.0 / 6.0) ** 2
 
 
 # ----------------------------------------------------------------------------------------- result
@@ -74,7 +98,12 @@ class PsdAnalysis:
     share_frequency_with_spikes : float
         The same with the spikes counted [rad/s].
     total_power, disturbance_power : float
-        Mean square of the signals and the part above the floor [unit^2].
+        Mean square of the signals (the spectrum's integral) and the part above the floor [unit^2].
+    disturbance_power_scatter : float
+        Standard deviation of ``disturbance_power`` on a pure noise floor [unit^2] (module text).
+    suggestion_withheld : str or None
+        Why no bandwidth requirement follows from the spectrum (too few segments, or power above the
+        floor within the estimate's scatter); None when one does.
     notes : tuple of str
 
     Examples
@@ -103,6 +132,8 @@ class PsdAnalysis:
     total_power: float
     disturbance_power: float
     notes: tuple[str, ...] = ()
+    disturbance_power_scatter: float = 0.0
+    suggestion_withheld: str | None = None
 
     @property
     def psd_db(self) -> np.ndarray:
@@ -126,6 +157,10 @@ class PsdAnalysis:
             "spikes": [s.to_dict() for s in self.spikes], "share": self.share,
             "share_frequency": self.share_frequency, "share_frequency_with_spikes": self.share_frequency_with_spikes,
             "total_power": self.total_power, "disturbance_power": self.disturbance_power,
+            "disturbance_power_scatter": self.disturbance_power_scatter,
+            "significance": {"false_alarm_rate": FALSE_ALARM_RATE, "z": SIGNIFICANCE_Z,
+                             "min_segments": MIN_SEGMENTS},
+            "suggestion_withheld": self.suggestion_withheld,
             "units": {"w": "rad/s", "psd": u, "psd_db": f"dB re 1 {u}", "segment_length": "s",
                       "resolution": "rad/s", "power": sq, "share_frequency": "rad/s"},
             "notes": list(self.notes),
@@ -181,10 +216,12 @@ def analyze_psd(signals: Sequence[np.ndarray], dt: float, share: float = 0.9, ba
     if not 0 < share < 1:
         raise DataError(f"share must lie strictly between 0 and 1, got {share!r}", where="psd: share")
     for name, b in (("band", band), ("floor band", floor_band)):
-        if b is not None and not (len(b) == 2 and 0 <= b[0] < b[1]):
-            raise DataError(f"expected two increasing frequencies >= 0 rad/s, got {list(b)}", where=f"psd: {name}")
+        if b is not None:
+            check_band(b, dt, f"psd: {name}")
     if w_min is not None and not (np.isfinite(w_min) and w_min > 0):
         raise DataError(f"w_min must be > 0 rad/s, got {w_min!r}", where="psd")
+    if not (math.isfinite(spike_db) and spike_db > 0):
+        raise DataError(f"must be a finite number of dB > 0, got {spike_db!r}", where="psd: spike_db")
     notes: list[str] = []
     w, S, k = welch_psd(signals, dt, segment, w_min, detrend)
     dw = float(w[1] - w[0])
@@ -194,8 +231,10 @@ def analyze_psd(signals: Sequence[np.ndarray], dt: float, share: float = 0.9, ba
         wn, Sn, kn = welch_psd(noise, dt, 2 * np.pi / dw * 1.0, None, detrend)
         floor, fband = noise_floor(wn, Sn, kn, floor_band or (float(wn[0]), float(wn[-1])))
         source = "noise record"
+        floor_bins, floor_segments = int(np.count_nonzero((wn >= fband[0]) & (wn <= fband[1]))), kn
     else:
         floor, fband = noise_floor(w, S, k, floor_band, mask)
+        floor_bins, floor_segments = int(np.count_nonzero((w >= fband[0]) & (w <= fband[1]))), k
         source = "median of the floor band" if floor_band else "median of the upper half"
         sel = (w >= fband[0]) & (w <= fband[1]) & ~mask
         if np.count_nonzero(sel) >= 3:
@@ -218,14 +257,96 @@ def analyze_psd(signals: Sequence[np.ndarray], dt: float, share: float = 0.9, ba
     smooth = np.where(mask, 10 ** (median / 10) / (chi2_median(effective_dof(k)) / effective_dof(k)), S)
     total = float(np.sum(S) * dw)
     disturbance = float(np.sum(smooth - floor) * dw)
-    try:
-        wf = share_frequency(w, smooth - floor, share)
-        wf_spikes = share_frequency(w, S - floor, share)
-    except DataError as exc:
-        wf = wf_spikes = None
-        notes.append(f"no share frequency: {exc.message}")
+    scatter = _above_floor_scatter(floor, dw, w.size, k, floor_bins, floor_segments, source != "noise record")
+    withheld: str | None = None
+    wf = wf_spikes = None
+    sq = unit_squared(unit)
+    if disturbance <= SIGNIFICANCE_Z * scatter:
+        withheld = (f"not significant: the power above the floor, {disturbance:.3g} {sq} "
+                    f"({100 * disturbance / total:.2g} % of the mean square), is within the scatter of the Welch "
+                    f"estimate ({SIGNIFICANCE_Z:.2f} sigma = {SIGNIFICANCE_Z * scatter:.3g} {sq}, chi-square with "
+                    f"{effective_dof(k):.3g} degrees of freedom per bin; false-alarm rate {100 * FALSE_ALARM_RATE:g} %)")
+        notes.append(f"no share frequency and no bandwidth requirement: {withheld}")
+    else:
+        try:
+            wf = share_frequency(w, smooth - floor, share)
+            wf_spikes = share_frequency(w, S - floor, share)
+        except DataError as exc:
+            withheld = f"none: {exc.message}"
+            notes.append(f"no share frequency: {exc.message}")
+    if k < MIN_SEGMENTS:
+        withheld = f"undetermined: {k} segments averaged, need >= {MIN_SEGMENTS}"
+        notes.append(f"{withheld} (each bin's estimate is chi-square with {effective_dof(k):.3g} degrees of freedom: "
+                     "a longer record, or a shorter --segment, gives more)")
     return PsdAnalysis(w, S, unit, len(signals), k, (2 * np.pi / dw), dw, floor, fband, source, trend, tuple(spikes),
-                       share, wf, wf_spikes, total, disturbance, tuple(notes))
+                       share, wf, wf_spikes, total, disturbance, tuple(notes), scatter, withheld)
+
+
+def _chi2_over_nu_pdf(x: float, nu: float) -> float:
+    """Density of ``chi2(nu)/nu`` at ``x > 0``."""
+    y, h = nu * x, nu / 2.0
+    return nu * math.exp((h - 1.0) * math.log(y) - y / 2.0 - h * math.log(2.0) - math.lgamma(h))
+
+
+def _above_floor_scatter(floor: float, dw: float, bins: int, segments: int, floor_bins: int,
+                         floor_segments: int, overlap: bool) -> float:
+    """Standard deviation [unit^2] of ``sum(S - floor) dw`` over ``bins`` bins when ``S`` is the floor alone.
+
+    In units of the floor, each bin's estimate is ``X = chi2(nu)/nu`` (variance ``2/nu``); the floor is the
+    median ``M`` of ``floor_bins`` such bins over the median ``m`` of ``chi2/nu`` (asymptotic variance
+    ``1 / (4 n f(m)^2)``, ``f`` the density). When the floor band lies in the summed bins (``overlap``) the
+    two covary: ``Cov(sum over the band of X, M) = (1/2 - F_{nu+2}(nu m)) / f(m)`` (the asymptotic
+    covariance of a sum and a median, ``E[X 1{X < m}] = F_{nu+2}(nu m)`` for chi-square). Sums over
+    adjacent Hann bins are correlated: every term is scaled by :data:`_HANN_BIN_VARIANCE_FACTOR`.
+
+    Examples
+    --------
+    >>> round(_above_floor_scatter(1.0, 1.0, 100, 40, 50, 40, True) / 100, 3)  # 100 bins, 40 segments
+    0.033
+    """
+    from scipy import special
+
+    from synth.distributions import chi2_ppf
+
+    c = _HANN_BIN_VARIANCE_FACTOR
+    nu, nu_f, n_f = effective_dof(segments), effective_dof(floor_segments), max(floor_bins, 1)
+    m = float(chi2_ppf(0.5, nu_f)) / nu_f
+    f = _chi2_over_nu_pdf(m, nu_f)
+    var = 2.0 * bins / nu + bins**2 / (4.0 * n_f * (f * m) ** 2)
+    if overlap:
+        cov_band_median = (0.5 - float(special.chdtr(nu_f + 2.0, nu_f * m))) / f
+        var -= 2.0 * bins * cov_band_median / m
+    return float(floor * dw * math.sqrt(c * max(var, 2.0 * bins / nu * 0.1)))
+
+
+def check_band(band: Sequence[float], dt: float, where: str) -> tuple[float, float]:
+    """A frequency band [rad/s]: two finite increasing frequencies > 0, the upper at most Nyquist (``pi/dt``).
+
+    Raises
+    ------
+    DataError
+        One line at ``where`` saying what is wrong (the Nyquist frequency named in rad/s).
+
+    Examples
+    --------
+    >>> check_band((10.0, 300.0), 0.01, "--band")
+    (10.0, 300.0)
+    >>> check_band((10.0, 1000.0), 0.01, "--band")
+    Traceback (most recent call last):
+    synth.errors.DataError: --band: upper end 1000 rad/s is past the Nyquist frequency 314.2 rad/s (pi/dt, dt = 0.01 s)
+    """
+    vals = [float(v) for v in band]
+    shown = " ".join(f"{v:g}" for v in vals)
+    if len(vals) != 2 or not all(math.isfinite(v) and v > 0 for v in vals) or not vals[0] < vals[1]:
+        raise DataError(f"expected two increasing frequencies (each must be > 0 rad/s), got {shown}", where=where)
+    nyquist = math.pi / dt
+    if vals[0] >= nyquist:
+        raise DataError(f"{shown.replace(' ', '-')} rad/s lies wholly above the Nyquist frequency {nyquist:.4g} rad/s "
+                        f"(pi/dt, dt = {dt:g} s)", where=where)
+    if vals[1] > nyquist * (1 + 1e-6):
+        raise DataError(f"upper end {vals[1]:g} rad/s is past the Nyquist frequency {nyquist:.4g} rad/s "
+                        f"(pi/dt, dt = {dt:g} s)", where=where)
+    return vals[0], vals[1]
 
 def analyze_records(records: Sequence[DisturbanceRecord], noise: Sequence[DisturbanceRecord] = (),
                     **options: Any) -> PsdAnalysis:
@@ -269,3 +390,4 @@ def analyze_records(records: Sequence[DisturbanceRecord], noise: Sequence[Distur
     result = analyze_psd([r.x for r in records], dt0, noise=[r.x for r in noise] or None, unit=unit, **options)
     notes = tuple(f"{r.source}: {n}" for r in everything for n in r.notes)
     return PsdAnalysis(**{**result.__dict__, "notes": notes + result.notes})
+
