@@ -89,3 +89,28 @@ def test_a_lag_past_its_corner_is_not_called_an_integrator() -> None:
     m = hq_from_frd(w, 1 / (1j * w / 2 + 1), coherence=np.full(w.size, 0.99), averages=20)
     assert "integrator" not in m.response_type_reason
     assert "--response-type" in m.response_type_reason
+
+
+def test_options_of_the_other_source_and_bad_fit_bands_are_refused(run_cli, tmp_path) -> None:
+    w = np.logspace(-1, 1.3, 80)
+    frd = tmp_path / "fr.csv"
+    np.savetxt(frd, np.column_stack([w, 20 * np.log10(abs(G_mode(w))), _phase_deg(G_mode, w, -90.0)]),
+               delimiter=",", header="w,mag_db,phase_deg", comments="")
+    for args, flag in ((["--frd", str(frd), "--delay", "0.1"], "--delay"),
+                       (["--frd", str(frd), "--phase-fit", "line", "--fit-band", "-1", "5"], "--fit-band"),
+                       (["--frd", str(frd), "--fit-band", "5", "2"], "--fit-band"),
+                       (["--tf=1/(s+1)", "--averages", "3"], "--averages"),
+                       (["--tf=1/(s+1)", "--fit-band", "1", "2"], "--fit-band")):
+        r = run_cli("hq", *args)
+        assert r.code == 2 and flag in r.err and len(r.err.strip().splitlines()) == 1, (args, r.err)
+    with pytest.raises(Exception, match="fit_band"):
+        hq_from_frd(w, G_mode(w), fit_band=(-1.0, 5.0))
+
+
+def test_an_unstable_model_says_so() -> None:
+    from synth.ident.hq import hq_from_plant
+    from synth.plant import Plant
+
+    m = hq_from_plant(Plant.from_string("1/((s-0.5)*(s+4)*(s+20))"))
+    assert any("unstable" in n and "1 pole(s)" in n for n in m.notes)
+    assert not any("unstable" in n for n in hq_from_plant(Plant.from_string("1/((s+0.5)*(s+4))")).notes)

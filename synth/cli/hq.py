@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import sys
 from pathlib import Path
 from typing import Any
@@ -133,6 +134,24 @@ def _fmt(value: Any, unit: str, sigma: Any = None, digits: int = 4) -> str:
     return text + (f" +- {sigma:.2g}" if sigma is not None else "")
 
 
+def _check_options(args: argparse.Namespace) -> None:
+    """Options that belong to the other source, or a fit band that is no band: one line before any computation."""
+    from synth.errors import SynthError
+
+    if args.tf is not None:
+        for flag, given in (("--averages", args.averages is not None), ("--phase-fit", args.phase_fit != "auto"),
+                            ("--fit-band", args.fit_band is not None), ("--columns", bool(args.columns))):
+            if given:
+                raise SynthError("applies to a measured response (--frd) only; a --tf model's response is exact",
+                                 where=flag)
+    elif args.delay != 0.0:
+        raise SynthError("applies to --tf only: a measured response holds its delay already", where="--delay")
+    if args.fit_band is not None:
+        lo, hi = args.fit_band
+        if not (math.isfinite(lo) and math.isfinite(hi) and 0 < lo < hi):
+            raise SynthError(f"expected two increasing frequencies > 0 rad/s, got {lo:g} {hi:g}", where="--fit-band")
+
+
 def run(args: argparse.Namespace) -> int:
     from synth.cli._outputs import check_outputs
     from synth.cli._table import name_values
@@ -144,6 +163,7 @@ def run(args: argparse.Namespace) -> int:
 
     check_outputs(args.out, ["hq.json", "hq_bode.png"], [args.json], args.force,
                   inputs=[args.frd])  # before any computation
+    _check_options(args)
     if args.tf is not None:
         try:
             plant = Plant.from_string(args.tf, delay=args.delay)

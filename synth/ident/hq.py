@@ -81,6 +81,11 @@ def hq_from_plant(plant: Plant, response_type: str = "auto") -> HQMetrics:
     if not np.any(plant.num):
         raise ModelError("the transfer function is zero; it has no phase")
     notes: list[str] = []
+    unstable = [complex(x) for x in plant.poles() if x.real > 1e-9 * max(1.0, abs(x))]
+    if unstable:
+        notes.append(f"the model is unstable ({len(unstable)} pole(s) in the right half-plane, the largest real part "
+                     f"{max(x.real for x in unstable):.4g} rad/s): the bandwidth and phase delay criteria are meant "
+                     "for a stable response; these numbers are read off its frequency response only")
     integrators, sign = low_frequency_form(plant)
     if sign < 0:
         plant = plant.scaled(-1.0)
@@ -327,6 +332,9 @@ def hq_from_frd(w: Any, H: Any, coherence: Any = None, averages: Any = None,
     """
     check_choice(response_type, RESPONSE_TYPES, "response_type")
     check_choice(phase_fit, PHASE_FITS, "phase_fit")
+    if fit_band is not None and not (len(fit_band) == 2 and all(np.isfinite(fit_band))
+                                     and 0 < fit_band[0] < fit_band[1]):
+        raise DataError(f"expected two increasing frequencies > 0 rad/s, got {list(fit_band)}", where="fit_band")
     w, H, g2, nd = _validate_frd(w, H, coherence, averages)
     notes: list[str] = []
     phase = anchored_phase(H)
