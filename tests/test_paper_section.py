@@ -41,7 +41,7 @@ def test_disturbance_chain_on_the_synthetic_record(section):
     assert chain["bandwidth (ideal)"]["synth"] == pytest.approx(80.0, rel=0.02)
     assert chain["sensor noise floor"]["synth"] == pytest.approx(-30.0, abs=0.1)
     assert "157, 220, 283" in chain["supply spikes"]["how"]
-    assert d["disturbance"]["spec_entries"] == [{"type": "sensitivity", "max_db": -15.0, "band": [0, 30.2]},
+    assert d["disturbance"]["spec_entries"] == [{"type": "sensitivity", "max_db": -15.3, "band": [0, 29.7]},
                                                 {"type": "bandwidth", "min": 65.3}]
 
 
@@ -87,7 +87,7 @@ def test_design_report_section_html_json_and_figure(tmp_path):
     assert "Rotor and drive sizing" in html
     assert "Every paper number that does not reconcile (25 of 38 checked)" in html
     assert "eq. 15 slow pole (measured)" in html and "0.0042" in html
-    assert "{type: sensitivity, max_db: -15, band: [0, 30.2]}" in html
+    assert "{type: sensitivity, max_db: -15.3, band: [0, 29.7]}" in html
     assert 'src="paper_disturbance_requirements.png"' in html
 
 

@@ -34,11 +34,11 @@ def test_the_papers_chain_printed_and_written(run_cli, records, tmp_path):
     r = run_cli(*_args(records, "--resolution", "1.2", "--out", str(out)))
     assert r.code == 0, r.err
     # the seed's numbers: -15 dB below 30 rad/s, bandwidth between 60 and 80 rad/s
-    assert "{type: sensitivity, max_db: -15, band: [0, 30.2]}" in r.out
+    assert "{type: sensitivity, max_db: -15.3, band: [0, 29.7]}" in r.out  # this seed; -15 and 30 are the shape's
     assert "{type: bandwidth, min: 65.3}" in r.out and "meets it at 79.1 rad/s" in r.out
     assert "resolution 1.2 rad/s -44.2 dB" in r.out  # the resolution's floor lies 14 dB below the noise record's
     block = yaml.safe_load((out / "requirements.yaml").read_text())
-    assert block["requirements"] == [{"type": "sensitivity", "max_db": -15, "band": [0, 30.2]},
+    assert block["requirements"] == [{"type": "sensitivity", "max_db": -15.3, "band": [0, 29.7]},
                                       {"type": "bandwidth", "min": 65.3}]
     d = json.loads((out / "psd.json").read_text())
     req = d["requirements"]
