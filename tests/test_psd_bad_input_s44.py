@@ -227,3 +227,21 @@ def test_white_noise_cli_says_not_significant(run_cli, tmp_path):
     assert d["disturbance_power"] < 3.09 * d["disturbance_power_scatter"]
     r = run_cli("psd", "--data", p, "--time", "time", "--signal", "x")
     assert "not significant: the power above the floor" in r.out and "'type': 'bandwidth'" not in r.out
+
+
+def test_white_noise_has_no_trend() -> None:
+    """A black-box test saw white noise reported with 'trend +5.7 dB/decade', a line through its 3 lowest bins."""
+    from synth.ident.psd import analyze_psd
+
+    for seed in range(6):
+        x = np.random.default_rng(300 + seed).normal(0.0, 0.7, 30_000)
+        a = analyze_psd([x], 0.002)
+        assert a.trend is None and any("spectrum is at its floor" in n for n in a.notes)
+    t = np.arange(60_000) * 0.002  # a first-order disturbance (corner 20 rad/s) above a floor keeps its trend
+    rng = np.random.default_rng(9)
+    y = np.zeros(t.size)
+    e = rng.normal(0.0, 1.0, t.size)
+    for k in range(1, t.size):
+        y[k] = y[k - 1] * np.exp(-20 * 0.002) + e[k] * 0.3
+    a = analyze_psd([y + rng.normal(0.0, 0.01, t.size)], 0.002)
+    assert a.trend is not None and a.trend.slope_db_per_decade < -6.0

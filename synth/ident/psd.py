@@ -243,17 +243,24 @@ def analyze_psd(signals: Sequence[np.ndarray], dt: float, share: float = 0.9, ba
                 notes.append(f"the spectrum is not flat in the floor band ({flat.slope_db_per_decade:+.1f} dB/decade): "
                              "the floor is an upper bound; give a noise record or a floor band")
     floor_db = 10 * np.log10(floor)
+    at_floor = False
     if band is None:
         below = np.flatnonzero(median <= floor_db + KNEE_DB)
         knee = float(w[below[0]]) if below.size else float(w[-1])
+        at_floor = bool(below.size) and below[0] < 3
         band = (float(w[0]), max(knee, float(w[min(2, w.size - 1)])))
-        notes.append(f"trend band {band[0]:.4g}-{band[1]:.4g} rad/s: from the lowest bin to where the running "
-                     f"median comes within {KNEE_DB:g} dB of the floor")
-    try:
-        trend: Trend | None = fit_trend(w, S, band, mask)
-    except DataError as exc:
-        trend = None
-        notes.append(f"no trend: {exc.message}")
+        if not at_floor:
+            notes.append(f"trend band {band[0]:.4g}-{band[1]:.4g} rad/s: from the lowest bin to where the running "
+                         f"median comes within {KNEE_DB:g} dB of the floor")
+    trend: Trend | None = None
+    if at_floor:  # a slope through the first bins of a flat spectrum is their scatter, not a trend
+        notes.append(f"no trend: the running median is within {KNEE_DB:g} dB of the floor from the lowest bins on "
+                     "(the spectrum is at its floor)")
+    else:
+        try:
+            trend = fit_trend(w, S, band, mask)
+        except DataError as exc:
+            notes.append(f"no trend: {exc.message}")
     smooth = np.where(mask, 10 ** (median / 10) / (chi2_median(effective_dof(k)) / effective_dof(k)), S)
     total = float(np.sum(S) * dw)
     disturbance = float(np.sum(smooth - floor) * dw)
