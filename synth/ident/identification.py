@@ -21,6 +21,7 @@ from synth.errors import DataError, FitError, ModelError
 from synth.ident.directions import DirectionComparison, fit_by_direction
 from synth.ident.pair_relocation import relocate_pair
 from synth.ident.periodic_start import beyond_nyquist, fit_whole_record, refit_periodic_start, settling_time
+from synth.ident.start_transient import start_transient_failure
 from synth.ident.steps import StepAverage, average_steps, find_steps
 from synth.ident.structure import Structure, parse_structure
 from synth.ident.timefit import TimeFitResult, fit_structure
@@ -174,6 +175,8 @@ def identify(record: RecordLike, structure: Structure | str, delay: str | float 
     try:
         fit = fit_structure(data, structure, delay, sensor, periodic, check=True)
         failed = "" if avg is None else _implausible_average_fit(fit, record.dt)
+        if avg is None and (why := start_transient_failure(fit.t, fit.y, fit.yhat, settling_time(fit.measured))):
+            raise FitError(f"fit of {structure.formula!r} failed: {why}", where=record.source)
     except FitError as exc:
         if avg is None or average != "auto" or by_direction:
             raise
