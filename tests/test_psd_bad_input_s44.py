@@ -192,7 +192,7 @@ def test_jittered_stamps_keep_the_mean_square_and_the_floor(run_cli, tmp_path):
     assert r.code == 0, r.err
     d = json.loads(r.out)
     # before: mean square 0.3247 against the raw 0.4929, floor -38.8 dB against sigma^2 dt / pi = -35.06 dB
-    assert d["raw_mean_square"] == pytest.approx(float(np.var(x)), rel=1e-6)
+    assert d["raw_variance"] == pytest.approx(float(np.var(x)), rel=1e-6)
     assert d["total_power"] == pytest.approx(float(np.var(x)), rel=0.03)
     assert d["floor_db"] == pytest.approx(10 * math.log10(0.49 * 0.002 / math.pi), abs=0.5)
     notes = " ".join(d["notes"])
@@ -210,7 +210,7 @@ def test_irregular_stamps_interpolated_with_a_quantitative_note(run_cli, tmp_pat
     r = run_cli("psd", "--data", p, "--time", "time", "--signal", "x", "--json", "-")
     assert r.code == 0, r.err
     d = json.loads(r.out)
-    assert d["raw_mean_square"] == pytest.approx(float(np.var(x)), rel=1e-6)
+    assert d["raw_variance"] == pytest.approx(float(np.var(x)), rel=1e-6)
     notes = " ".join(d["notes"])
     assert "linear interpolation attenuates the spectrum" in notes and "dB at half the Nyquist" in notes
     r = run_cli("psd", "--data", p, "--time", "time", "--signal", "x")

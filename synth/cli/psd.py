@@ -22,7 +22,7 @@ feedback attenuates a disturbance only below the loop's bandwidth. No requiremen
 power above the floor is within the Welch estimate's chi-square scatter (false-alarm rate 0.1 %), and it is
 "undetermined" with fewer than 4 segments averaged. Bands must lie in (0, Nyquist]; uneven time stamps
 that jitter around a grid are used without interpolation (otherwise the note states the interpolation's
-attenuation), and the mean square is the raw samples'.
+attenuation), and the variance printed is the raw samples'.
 
 example:
   synth psd --data env.csv --data env2.csv --time t --signal speed --unit rad/s
@@ -107,7 +107,7 @@ def run(args: argparse.Namespace) -> int:
                              "give a factor of order 1", where="--factor")
         suggestion = suggest_bandwidth(a, args.factor)
     withheld = a.suggestion_withheld or "none: no disturbance power above the noise floor"
-    data = {**a.to_dict(), "raw_mean_square": raw_ms, "records": [r.to_dict() for r in records],
+    data = {**a.to_dict(), "raw_variance": raw_ms, "records": [r.to_dict() for r in records],
             "noise_records": [r.to_dict() for r in noise],
             "bandwidth_suggestion": suggestion.to_dict() if suggestion else
             {"status": withheld.split(":")[0], "reason": withheld}}
@@ -137,7 +137,8 @@ def run(args: argparse.Namespace) -> int:
         return 0
     if args.json:
         write_json(args.json, data, force=args.force)
-    u, u2 = args.unit or "unit", unit_squared(args.unit)
+    unit = args.unit or records[0].unit  # the header's unit when none is given
+    u, u2 = unit or "unit", unit_squared(unit)
     print(f"{args.signal} [{u}]: {len(records)} record(s), {a.segments} Welch segments of {a.segment_length:.4g} s, "
           f"resolution {a.resolution:.3g} rad/s")
     rows = [("noise floor", f"{a.floor_db:.1f} dB re 1 {u2}/(rad/s) ({a.floor_source}, "
@@ -149,7 +150,8 @@ def run(args: argparse.Namespace) -> int:
             (f"{100 * a.share:g} % of disturbance power below",
              f"{a.share_frequency:.4g} rad/s (spikes counted: {a.share_frequency_with_spikes:.4g} rad/s)"
              if a.share_frequency is not None else "undefined"),
-            ("mean square", f"{raw_ms:.4g} {u2} of the raw samples (the spectrum integrates to {a.total_power:.4g} "
+            ("variance", f"{raw_ms:.4g} {u2}, mean square about the mean of the raw samples (the spectrum "
+                         f"integrates to {a.total_power:.4g} "
                             f"{u2}; above the floor: {a.disturbance_power:.4g} {u2}, scatter "
                             f"{a.disturbance_power_scatter:.2g} {u2})")]
     if suggestion:

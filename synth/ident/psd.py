@@ -23,7 +23,7 @@ put together:
   the suggestion is "undetermined".
 - **Uneven time stamps** (:func:`synth.ident.psd_stamps.load_psd_record`): stamps jittering around a uniform grid are used as
   they are on that grid (interpolation would low-pass the spectrum); otherwise the linear interpolation
-  is kept and its attenuation stated; the mean square of the raw samples is reported either way.
+  is kept and its attenuation stated; the variance of the raw samples is reported either way.
 """
 
 from __future__ import annotations

@@ -35,7 +35,7 @@ def regrid_uneven(record: DisturbanceRecord, t: np.ndarray, x: np.ndarray) -> tu
       by interpolating white noise at the same stamps (Welch PSD over the white level), at half the Nyquist
       frequency and near it, and where it exceeds 1 dB.
 
-    Returns the record and the mean square (about the mean) of the raw samples [unit^2].
+    Returns the record and the variance (mean square about the mean) of the raw samples [unit^2].
 
     Examples
     --------
@@ -86,7 +86,7 @@ def regrid_uneven(record: DisturbanceRecord, t: np.ndarray, x: np.ndarray) -> tu
             f"resampled onto a uniform {dt:.4g} s grid by linear interpolation; linear interpolation attenuates the "
             f"spectrum (measured on white noise at these stamps): {kept_db(w_nyq / 2):.2g} dB at half the Nyquist "
             f"frequency ({w_nyq / 2:.4g} rad/s), {kept_db(w_nyq * 0.95):.2g} dB near the Nyquist frequency "
-            f"({w_nyq:.4g} rad/s); {where}. The mean square of the raw samples is {raw_ms:.4g}, of the "
+            f"({w_nyq:.4g} rad/s); {where}. The variance of the raw samples is {raw_ms:.4g}, of the "
             f"interpolated ones {float(np.var(record.x)):.4g}")
     return replace(record, notes=(*record.notes, note)), raw_ms
 
@@ -95,7 +95,7 @@ def load_psd_record(path: str | Path, time: str | None, signal: str, unit: str =
                     columns: Mapping[str, str] | None = None) -> tuple[DisturbanceRecord, float]:
     """:func:`synth.data.disturbance.load_disturbance`, uneven time stamps handled by :func:`regrid_uneven`.
 
-    Returns the record and the mean square (about the mean) of the raw samples [unit^2].
+    Returns the record and the variance (mean square about the mean) of the raw samples [unit^2].
 
     Examples
     --------
