@@ -47,7 +47,8 @@ Procedure (:func:`diagnose_effects`, options :class:`DiagnoseOptions`)
    held-out excess over the noise floor (the floor taken as at most the
    effect's own held-out ``J``: a model cannot beat the noise on held-out data,
    so one that gets below the floor's estimate shows the estimate is too high,
-   and has removed all of the excess that can be measured).
+   and has removed all of the excess that can be measured), and when its held-out ``J`` is below the
+   nominal model's too (a re-fit that made the held-out error worse is no baseline to explain the gap by).
 6. **Verdict.** Among the significant, relevant effects the one with the lowest
    held-out ``J`` leads unless a candidate with fewer free parameters (grid,
    factor and basis parameters the fit chose, :func:`synth.gap.attribution.parsimony.free_parameters`) is not
@@ -373,7 +374,9 @@ def diagnose_effects(plant: Plant, record: Record, validate: Record | Sequence[R
         joint = isinstance(fit, AugmentedFit)
         params = {k: float(fit.params[k]) for k in eff.parameter_names}
         unphysical = wrong_sign(eff, params, sp.train.t, sp.train.u, plant)
-        relevant = bool(significant and share_ref >= min_share and joint and not unphysical)
+        # and the model with the effect must do better than the nominal one too: after a re-fit that made the
+        # held-out error worse, beating the re-fit alone is not explaining the gap (share of it <= 0)
+        relevant = bool(significant and share_ref >= min_share and joint and not unphysical and j < j_nom)
         p_ci = fit.parameter_ci if joint else {}
         nominal = dict(fit.nominal) if joint else screened_coefficients(fit.plant)
         res = EffectResult(eff.label, params, p_ci, shrink, ci, significant, float(share), relevant, j, nominal,
