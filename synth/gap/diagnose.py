@@ -411,7 +411,7 @@ def diagnose(plant: Plant, record: RecordLike, validate: RecordLike | Sequence[R
             if a and b and a != b:
                 where = "validate" if len(held_out) == 1 else f"validate run {i + 1}"
                 raise DataError(f"{side} unit {b!r} differs from the record's {a!r}", where=where)
-    loc = localize_gap(plant, record, offset=offset, level=level)
+    loc = localize_gap(plant, record, offset=offset, level=level, burn_in=burn_in)
     progress.update(localization=loc, stage="attribution")
     att = diagnose_effects(plant, record, list(validate) if isinstance(validate, tuple) else validate,
                            options=DiagnoseOptions(candidates=effects, train_fraction=train_fraction, n_null=n_null,

@@ -154,7 +154,7 @@ class GapLocalization:
 
 def localize_gap(plant: Plant, record: Record, initial: str = "steady", offset: str | float = "fit",
                  n_bins: int = 5, level: float = 0.95, max_lag: int = 50, n_segments: int = 16,
-                 na: int = 4, nb: int = 10) -> GapLocalization:
+                 na: int = 4, nb: int = 10, burn_in: float = 0.0) -> GapLocalization:
     """Simulate ``plant`` on the record's input and localize its residual in time, frequency and regime.
 
     Parameters
@@ -171,6 +171,8 @@ def localize_gap(plant: Plant, record: Record, initial: str = "steady", offset: 
         Confidence level of the frequency and regime tests.
     max_lag, n_segments, na, nb : int
         Cross-correlation lags, Welch segments, error-model orders (see :mod:`synth.gap.where.frequency`).
+    burn_in : float
+        Seconds at the start left out of the residual (see :func:`synth.gap.where.residual.model_residual`).
 
     Examples
     --------
@@ -185,7 +187,7 @@ def localize_gap(plant: Plant, record: Record, initial: str = "steady", offset: 
     >>> loc.residual.nrmse < 0.05, loc.where.frequency.bands
     (True, [])
     """
-    residual = model_residual(plant, record, initial=initial, offset=offset)
+    residual = model_residual(plant, record, initial=initial, offset=offset, burn_in=burn_in)
     time = localize_time(residual, false_alarm=1.0 - level)
     frequency = localize_frequency(residual, max_lag=max_lag, n_segments=n_segments, na=na, nb=nb, level=level,
                                    plant=plant)

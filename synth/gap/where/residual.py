@@ -121,7 +121,8 @@ def gap_size(y: np.ndarray, e: np.ndarray) -> tuple[float, float]:
     return nrmse, 100.0 * (1.0 - nrmse)
 
 
-def model_residual(plant: Plant, record: Record, initial: str = "steady", offset: str | float = "fit") -> ModelResidual:
+def model_residual(plant: Plant, record: Record, initial: str = "steady", offset: str | float = "fit",
+                   burn_in: float = 0.0) -> ModelResidual:
     """Simulate ``plant`` on the record's input and return the residual.
 
     Parameters
@@ -134,6 +135,9 @@ def model_residual(plant: Plant, record: Record, initial: str = "steady", offset
         Initial condition, see :func:`synth.ident.simulate.simulate_plant`.
     offset : "fit", "none" or float
         Output offset (operating point): fitted by least squares, zero, or given.
+    burn_in : float
+        Seconds at the record's start left out of the residual (an unknown initial state): the model is simulated
+        from the start, and the residual, its offset and its size cover the samples after them.
 
     Returns
     -------
@@ -160,6 +164,13 @@ def model_residual(plant: Plant, record: Record, initial: str = "steady", offset
     if not isinstance(record, Record):
         raise ModelError(f"expected a Record, got {type(record).__name__}", where="record")
     y_sim = simulate_plant(plant, record.t, record.u, initial=initial)
+    if burn_in > 0:
+        keep = (record.t - record.t[0]) >= burn_in
+        if np.count_nonzero(keep) < 10:
+            raise ModelError(f"{burn_in:g} s leaves {int(np.count_nonzero(keep))} samples of the record "
+                             f"({record.duration:.4g} s)", where="burn_in")
+        y_sim = y_sim[keep]
+        record = record.segment(float(record.t[keep][0]), float(record.t[-1]))
     if isinstance(offset, str):
         if offset == "fit":
             c, mode = float(np.mean(record.y - y_sim)), "fit"
