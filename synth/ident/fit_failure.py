@@ -87,7 +87,7 @@ def fit_failure(parameters: dict[str, float], start: np.ndarray, status: str | N
     >>> fit_failure({"k": 2.0, "p": 3.0}, np.array([2.1, 2.9]), "Solve_Succeeded", True, 99.1, -452.67, 60.0)
     'the fitted delay is -452.67 s, outside [0, 60) s'
     >>> fit_failure({"k": 2.0, "p": 3.0}, np.array([2.1, 2.9]), "Solve_Succeeded", True, 0.2, 0.02, 2.0, 200, 4)
-    'fit 0.20 %: the model explains no more of the output than noise would (F-test p = 0.85)'
+    'fit 0.20 %: the fitted model explains no more of the output than noise would (F-test p = 0.85): a local...'
     >>> fit_failure({"k": 2.0, "p": 3.0}, np.array([2.1, 2.9]), "Solve_Succeeded", True, 99.1, 0.02, 60.0)
     ''
     >>> fit_failure({"k": 2.0, "p": 3.0}, np.array([2.1, 2.9]), "Maximum_Iterations_Exceeded", False, 98.6, 0.02,
@@ -119,8 +119,10 @@ def fit_failure(parameters: dict[str, float], start: np.ndarray, status: str | N
         f_stat = (explained / (free - 1)) / (max(1.0 - explained, 1e-300) / dof)
         p_value = float(f_sf(f_stat, free - 1, dof))
         if p_value > SIGNIFICANCE:
-            return (f"fit {fit_percent:.2f} %: the model explains no more of the output than noise would "
-                    f"(F-test p = {p_value:.2g})")
+            began = ", ".join(f"{k} = {float(v0):.3g}" for k, v0 in zip(parameters, np.asarray(start, float)))
+            return (f"fit {fit_percent:.2f} %: the fitted model explains no more of the output than noise would "
+                    f"(F-test p = {p_value:.2g}): a local minimum reached from the start ({began}), or a record "
+                    "without a response to its input")
     return ""
 
 
