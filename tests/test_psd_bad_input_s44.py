@@ -245,3 +245,16 @@ def test_white_noise_has_no_trend() -> None:
         y[k] = y[k - 1] * np.exp(-20 * 0.002) + e[k] * 0.3
     a = analyze_psd([y + rng.normal(0.0, 0.01, t.size)], 0.002)
     assert a.trend is not None and a.trend.slope_db_per_decade < -6.0
+
+
+def test_the_headers_unit_labels_the_text_and_the_variance_is_called_so(run_cli, tmp_path) -> None:
+    """The ESC thrust log's header says 'Thrust (gf)': the text said '[unit]' and called the variance 'mean square'."""
+    x = 5.0 + np.random.default_rng(3).normal(0.0, 0.7, 20_000)  # mean 5: variance 0.49, mean square about 25.5
+    path = tmp_path / "thrust.csv"
+    np.savetxt(path, np.column_stack([np.arange(x.size) * 0.002, x]), delimiter=",", header="Time (s),Thrust (gf)",
+               comments="")
+    r = run_cli("psd", "--data", str(path), "--time", "Time (s)", "--signal", "Thrust")
+    assert r.code == 0, r.err
+    assert "Thrust [gf]" in r.out and "[unit]" not in r.out
+    line = next(ln for ln in r.out.splitlines() if ln.strip().startswith("variance"))
+    assert float(line.split()[1]) == pytest.approx(float(np.var(x)), rel=1e-3) and "gf^2" in line
