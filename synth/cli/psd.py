@@ -80,7 +80,7 @@ def run(args: argparse.Namespace) -> int:
     from synth.cli._outputs import check_outputs
     from synth.cli._table import name_values
     from synth.data.readers import parse_column_map
-    from synth.errors import SynthError
+    from synth.errors import DataError, SynthError
     from synth.ident.bandwidth_suggestion import suggest_bandwidth
     from synth.ident.psd import MIN_SEGMENTS, analyze_records
     from synth.ident.psd_stamps import load_psd_record
@@ -95,19 +95,19 @@ def run(args: argparse.Namespace) -> int:
     records = [r for r, _ in loaded]
     noise = [load_psd_record(f, args.time, args.signal, args.unit, args.dt, columns)[0] for f in args.noise_data]
     _check_against_records(args, [*records, *noise])
-    raw_ms = sum(ms * r.x.size for r, ms in loaded) / sum(r.x.size for r in records)
+    raw_var = sum(ms * r.x.size for r, ms in loaded) / sum(r.x.size for r in records)
     a = analyze_records(records, noise, share=args.share, band=tuple(args.band) if args.band else None,
                         segment=args.segment, w_min=args.w_min,
                         floor_band=tuple(args.floor_band) if args.floor_band else None, spike_db=args.spike_db,
                         detrend=args.detrend)
     suggestion = None
     if a.share_frequency is not None and a.suggestion_withheld is None:
-        if not math.isfinite(args.factor * a.share_frequency):
-            raise SynthError(f"{args.factor:g} x the share frequency {a.share_frequency:.4g} rad/s is not finite; "
-                             "give a factor of order 1", where="--factor")
-        suggestion = suggest_bandwidth(a, args.factor)
+        try:
+            suggestion = suggest_bandwidth(a, args.factor)
+        except DataError as exc:  # a factor whose bandwidth is not finite
+            raise SynthError(exc.message, where="--factor") from None
     withheld = a.suggestion_withheld or "none: no disturbance power above the noise floor"
-    data = {**a.to_dict(), "raw_variance": raw_ms, "records": [r.to_dict() for r in records],
+    data = {**a.to_dict(), "raw_variance": raw_var, "records": [r.to_dict() for r in records],
             "noise_records": [r.to_dict() for r in noise],
             "bandwidth_suggestion": suggestion.to_dict() if suggestion else
             {"status": withheld.split(":")[0], "reason": withheld}}
@@ -150,7 +150,7 @@ def run(args: argparse.Namespace) -> int:
             (f"{100 * a.share:g} % of disturbance power below",
              f"{a.share_frequency:.4g} rad/s (spikes counted: {a.share_frequency_with_spikes:.4g} rad/s)"
              if a.share_frequency is not None else "undefined"),
-            ("variance", f"{raw_ms:.4g} {u2}, mean square about the mean of the raw samples (the spectrum "
+            ("variance", f"{raw_var:.4g} {u2}, mean square about the mean of the raw samples (the spectrum "
                          f"integrates to {a.total_power:.4g} "
                             f"{u2}; above the floor: {a.disturbance_power:.4g} {u2}, scatter "
                             f"{a.disturbance_power_scatter:.2g} {u2})")]

@@ -17,7 +17,7 @@ from synth.data.readers import TIME_UNITS, read_table
 from synth.data.record import uniform_columns
 from synth.errors import DataError
 
-__all__ = ["DisturbanceRecord", "disturbance_from_arrays", "load_disturbance"]
+__all__ = ["DisturbanceRecord", "RawColumns", "disturbance_from_arrays", "load_disturbance", "read_disturbance_columns"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -105,6 +105,38 @@ def load_disturbance(path: str | Path, time: str | None, signal: str, unit: str 
     Traceback (most recent call last):
     synth.errors.DataError: ...d.csv: signal column 'sped' not found; did you mean 'speed'? columns are t, speed
     """
+    raw = read_disturbance_columns(path, time, signal, unit, dt, columns)
+    record = disturbance_from_arrays(raw.t, raw.x, raw.column, raw.unit, raw.source, raw.time_name)
+    return replace(record, name=raw.name, notes=raw.notes + record.notes)
+
+
+@dataclass(frozen=True)
+class RawColumns:
+    """A disturbance channel as logged: time stamps [s] and values, before any check or resampling."""
+
+    t: np.ndarray
+    x: np.ndarray
+    column: str
+    name: str
+    unit: str
+    source: str
+    time_name: str
+    notes: tuple[str, ...]
+
+
+def read_disturbance_columns(path: str | Path, time: str | None, signal: str, unit: str = "",
+                             dt: float | None = None, columns: Mapping[str, str] | None = None) -> RawColumns:
+    """The time and signal columns of a file as logged (parameters as :func:`load_disturbance`, which checks and
+    resamples them).
+
+    Examples
+    --------
+    >>> import pathlib, tempfile
+    >>> p = pathlib.Path(tempfile.mkdtemp()) / "d.csv"
+    >>> _ = p.write_text("t,speed\\n0,1\\n0.0012,2\\n0.002,3\\n")
+    >>> read_disturbance_columns(p, "t", "speed").t.tolist()
+    [0.0, 0.0012, 0.002]
+    """
     path = Path(path)
     table = read_table(path, columns)
     t_key = table.find(time, "time") if time is not None else None
@@ -117,5 +149,4 @@ def load_disturbance(path: str | Path, time: str | None, signal: str, unit: str 
     else:
         t = table.columns[t_key] * TIME_UNITS.get(table.units.get(t_key, ""), 1.0)
     sig = table.signal(x_key, unit)
-    record = disturbance_from_arrays(t, x, x_key, sig.unit, str(path), t_key or "time")
-    return replace(record, name=sig.name, notes=table.notes + record.notes)
+    return RawColumns(t, x, x_key, sig.name, sig.unit, str(path), t_key or "time", tuple(table.notes))

@@ -69,9 +69,8 @@ def suggest_bandwidth(analysis: PsdAnalysis, factor: float = 1.0) -> BandwidthSu
     """
     if not (np.isfinite(factor) and factor > 0):
         raise DataError(f"factor must be > 0, got {factor!r}", where="psd: bandwidth factor")
-    withheld = getattr(analysis, "suggestion_withheld", None)
-    if withheld:
-        raise DataError(withheld, where="psd")
+    if analysis.suggestion_withheld:
+        raise DataError(analysis.suggestion_withheld, where="psd")
     if analysis.share_frequency is None:
         raise DataError("the spectrum has no disturbance power above its noise floor; no bandwidth follows from it",
                         where="psd")

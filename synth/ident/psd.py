@@ -36,7 +36,7 @@ from typing import Any
 import numpy as np
 
 from synth.data.disturbance import DisturbanceRecord
-from synth.distributions import chi2_median, norm_ppf
+from synth.distributions import chi2_median, chi2_sf, norm_ppf
 from synth.errors import DataError
 from synth.ident.spectrum_features import (
     Spike,
@@ -311,17 +311,13 @@ def _above_floor_scatter(floor: float, dw: float, bins: int, segments: int, floo
     >>> round(_above_floor_scatter(1.0, 1.0, 100, 40, 50, 40, True) / 100, 3)  # 100 bins, 40 segments
     0.033
     """
-    from scipy import special
-
-    from synth.distributions import chi2_ppf
-
     c = _HANN_BIN_VARIANCE_FACTOR
     nu, nu_f, n_f = effective_dof(segments), effective_dof(floor_segments), max(floor_bins, 1)
-    m = float(chi2_ppf(0.5, nu_f)) / nu_f
+    m = float(chi2_median(nu_f)) / nu_f
     f = _chi2_over_nu_pdf(m, nu_f)
     var = 2.0 * bins / nu + bins**2 / (4.0 * n_f * (f * m) ** 2)
     if overlap:
-        cov_band_median = (0.5 - float(special.chdtr(nu_f + 2.0, nu_f * m))) / f
+        cov_band_median = (float(chi2_sf(nu_f * m, nu_f + 2.0)) - 0.5) / f
         var -= 2.0 * bins * cov_band_median / m
     return float(floor * dw * math.sqrt(c * max(var, 2.0 * bins / nu * 0.1)))
 

@@ -13,16 +13,19 @@ from pathlib import Path
 
 import numpy as np
 
-from synth.data.disturbance import DisturbanceRecord, load_disturbance
+from synth.data.disturbance import DisturbanceRecord, disturbance_from_arrays, read_disturbance_columns
 from synth.ident.welch import welch_psd
 
-__all__ = ["load_psd_record", "regrid_uneven"]
+__all__ = ["load_psd_record", "psd_record"]
 
 
-def regrid_uneven(record: DisturbanceRecord, t: np.ndarray, x: np.ndarray) -> tuple[DisturbanceRecord, float]:
-    """Undo or qualify the linear interpolation of a record whose raw stamps ``t`` were uneven.
+def psd_record(t: np.ndarray, x: np.ndarray, name: str = "y", unit: str = "", source: str = "arrays",
+               time_name: str = "time", notes: tuple[str, ...] = ()) -> tuple[DisturbanceRecord, float]:
+    """A disturbance record for the Welch spectrum from samples at the logged stamps ``t``, and the variance (mean
+    square about the mean) of those samples [unit^2].
 
-    Linear interpolation onto a uniform grid low-pases the spectrum: a grid value a fraction ``p`` of the
+    Even stamps give the record :func:`synth.data.disturbance.disturbance_from_arrays` gives. Uneven ones are
+    resampled there by linear interpolation, which low-passes the spectrum: a grid value a fraction ``p`` of the
     way between two stamps one interval apart is ``(1-p) x_k + p x_{k+1}``, which passes
     ``1 - 2 p (1-p) (1 - cos w dt)`` of the power at ``w`` (a third at the Nyquist frequency, two thirds of a
     white signal's power, for ``p`` spread evenly). So:
@@ -35,23 +38,25 @@ def regrid_uneven(record: DisturbanceRecord, t: np.ndarray, x: np.ndarray) -> tu
       by interpolating white noise at the same stamps (Welch PSD over the white level), at half the Nyquist
       frequency and near it, and where it exceeds 1 dB.
 
-    Returns the record and the variance (mean square about the mean) of the raw samples [unit^2].
+    ``notes`` (the file's) come first in the record's notes.
 
     Examples
     --------
-    >>> from synth.data.disturbance import disturbance_from_arrays
     >>> rng = np.random.default_rng(0)
     >>> t = np.arange(4000) * 0.002 + rng.uniform(-0.0004, 0.0004, 4000); x = rng.normal(size=4000)
-    >>> r, ms = regrid_uneven(disturbance_from_arrays(t, x), t, x)
-    >>> bool(np.all(r.x == x)), round(ms, 3) == round(float(np.var(x)), 3), "not interpolated" in r.notes[-1]
+    >>> r, var = psd_record(t, x)
+    >>> bool(np.all(r.x == x)), round(var, 3) == round(float(np.var(x)), 3), "not interpolated" in r.notes[-1]
     (True, True, True)
     """
     t, x = np.asarray(t, float), np.asarray(x, float)
-    raw_ms = float(np.var(x))
-    keep = [n for n in record.notes if not n.startswith("resampled:")]
+    record = disturbance_from_arrays(t, x, name, unit, source, time_name)
+    raw_var = float(np.var(x))
+    stamps = t[np.r_[np.diff(t) > 0, True]]  # one per time stamp, as the resampling keeps
+    if record.t.size == stamps.size and np.array_equal(record.t, stamps):  # the logged times: nothing interpolated
+        return replace(record, notes=(*notes, *record.notes)), raw_var
     n = t.size
     steps = np.diff(t)
-    if n >= 2 and np.all(steps > 0):
+    if np.all(steps > 0):
         dt = float((t[-1] - t[0]) / (n - 1))
         dev = t - (t[0] + np.arange(n) * dt)
         if float(np.max(np.abs(dev))) < 0.45 * dt:
@@ -63,21 +68,20 @@ def regrid_uneven(record: DisturbanceRecord, t: np.ndarray, x: np.ndarray) -> tu
                     "would attenuate the spectrum, by up to 4.8 dB at the Nyquist frequency); the jitter keeps "
                     f"{10 * math.log10(max(coherent, 1e-300)):.2g} dB of a component at the Nyquist frequency "
                     f"{w_nyq:.4g} rad/s coherent (less below it) and spreads the rest as white noise")
-            grid = t[0] + np.arange(n) * dt
-            return replace(record, t=grid, x=x.copy(), notes=(*keep, note)), raw_ms
+            on_grid = disturbance_from_arrays(t[0] + np.arange(n) * dt, x, name, unit, source, time_name)
+            return replace(on_grid, notes=(*notes, *on_grid.notes, note)), raw_var
     grid, dt = record.t, record.dt
     w_nyq = math.pi / dt
     # what the interpolation does to a white signal at these very stamps, measured: its Welch PSD over the white level
     rng = np.random.default_rng(0)
-    zs = [rng.normal(size=n) for _ in range(4)]  # 4 white signals, 64-sample segments: the ratio within ~0.1 dB
-    wz, Sz, _ = welch_psd([np.interp(grid, t, z) for z in zs], dt, segment=64 * dt)
+    zs = [rng.normal(size=stamps.size) for _ in range(4)]  # 4 white signals, 64-sample segments: within ~0.1 dB
+    wz, Sz, _ = welch_psd([np.interp(grid, stamps, z) for z in zs], dt, segment=64 * dt)
     kept = Sz / (float(np.mean([np.var(z) for z in zs])) * dt / math.pi)
 
     def kept_db(w: float) -> float:
         return float(10 * np.log10(max(float(np.interp(w, wz, kept)), 1e-300)))
 
-    smooth_db = 10 * np.log10(np.maximum(kept, 1e-300))
-    below = np.flatnonzero(smooth_db < -1.0)
+    below = np.flatnonzero(kept < 10 ** (-1.0 / 10))
     w1 = float(wz[below[0]]) if below.size else None
     where = (f"more than 1 dB above about {w1:.4g} rad/s, so a roll-off toward the Nyquist frequency, and a share "
              "frequency or bandwidth suggestion drawn from it, may be the interpolation's own" if w1 is not None
@@ -86,14 +90,15 @@ def regrid_uneven(record: DisturbanceRecord, t: np.ndarray, x: np.ndarray) -> tu
             f"resampled onto a uniform {dt:.4g} s grid by linear interpolation; linear interpolation attenuates the "
             f"spectrum (measured on white noise at these stamps): {kept_db(w_nyq / 2):.2g} dB at half the Nyquist "
             f"frequency ({w_nyq / 2:.4g} rad/s), {kept_db(w_nyq * 0.95):.2g} dB near the Nyquist frequency "
-            f"({w_nyq:.4g} rad/s); {where}. The variance of the raw samples is {raw_ms:.4g}, of the "
+            f"({w_nyq:.4g} rad/s); {where}. The variance of the raw samples is {raw_var:.4g}, of the "
             f"interpolated ones {float(np.var(record.x)):.4g}")
-    return replace(record, notes=(*record.notes, note)), raw_ms
+    return replace(record, notes=(*notes, *record.notes, note)), raw_var
 
 
 def load_psd_record(path: str | Path, time: str | None, signal: str, unit: str = "", dt: float | None = None,
                     columns: Mapping[str, str] | None = None) -> tuple[DisturbanceRecord, float]:
-    """:func:`synth.data.disturbance.load_disturbance`, uneven time stamps handled by :func:`regrid_uneven`.
+    """:func:`synth.data.disturbance.load_disturbance` for a spectrum: the file read once, uneven time stamps
+    handled by :func:`psd_record`.
 
     Returns the record and the variance (mean square about the mean) of the raw samples [unit^2].
 
@@ -102,16 +107,10 @@ def load_psd_record(path: str | Path, time: str | None, signal: str, unit: str =
     >>> import pathlib, tempfile
     >>> p = pathlib.Path(tempfile.mkdtemp()) / "d.csv"
     >>> _ = p.write_text("t,x\\n" + "".join(f"{k * 0.001},{(-1) ** k}\\n" for k in range(20)))
-    >>> r, ms = load_psd_record(p, "t", "x")
-    >>> r.dt, ms
+    >>> r, var = load_psd_record(p, "t", "x")
+    >>> r.dt, var
     (0.001, 1.0)
     """
-    record = load_disturbance(path, time, signal, unit, dt, columns)
-    if time is None or not any(n.startswith("resampled:") for n in record.notes):
-        return record, float(np.var(record.x))
-    from synth.data.readers import TIME_UNITS, read_table
-
-    table = read_table(Path(path), columns)  # the raw stamps again: the record holds the interpolated samples
-    t_key, x_key = table.find(time, "time"), table.find(signal, "signal")
-    t = np.asarray(table.columns[t_key], float) * TIME_UNITS.get(table.units.get(t_key, ""), 1.0)
-    return regrid_uneven(record, t, np.asarray(table.columns[x_key], float))
+    raw = read_disturbance_columns(path, time, signal, unit, dt, columns)
+    record, raw_var = psd_record(raw.t, raw.x, raw.column, raw.unit, raw.source, raw.time_name, raw.notes)
+    return replace(record, name=raw.name), raw_var

@@ -340,7 +340,7 @@ def not_carried(diagnosis: EffectDiagnosis, confirm: int | None, min_share: floa
             if share < min_share:
                 reason = (f"fitted jointly and significant, but removes only {100 * share:.0f} % of the re-fit's "
                           f"excess over noise (needs {100 * min_share:.0f} %)")
-            elif "+" not in r.effect and r.j_heldout >= getattr(diagnosis, "j_nominal", float("inf")):
+            elif "+" not in r.effect and r.j_heldout >= diagnosis.j_nominal:
                 reason = (f"fitted jointly and significant against the re-fit, but its held-out error is no lower "
                           f"than the nominal model's ({r.j_heldout:.4g} >= {diagnosis.j_nominal:.4g}): the re-fit "
                           "made the held-out error worse, and beating it explains nothing")
