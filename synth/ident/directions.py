@@ -36,6 +36,8 @@ import numpy as np
 
 from synth.data.record import Record
 from synth.distributions import norm_sf
+from synth.errors import FitError
+from synth.ident.exchangeable import relabel_fit
 from synth.ident.steps import StepAverage, Steps, average_steps, find_steps
 from synth.ident.structure import Structure
 from synth.ident.timefit import TimeFitResult, fit_structure
@@ -140,7 +142,8 @@ class DirectionComparison:
 def compare_fits(up: TimeFitResult, down: TimeFitResult, alpha: float = ALPHA,
                  up_average: StepAverage | None = None, down_average: StepAverage | None = None,
                  unsettled: float = 0.0) -> DirectionComparison:
-    """Compare two independent fits of one structure parameter by parameter.
+    """Compare two independent fits of one structure parameter by parameter (``down`` relabelled within each
+    group of exchangeable parameters to match ``up``: :func:`synth.ident.exchangeable.relabel_fit`).
 
     Parameters
     ----------
@@ -173,6 +176,7 @@ def compare_fits(up: TimeFitResult, down: TimeFitResult, alpha: float = ALPHA,
     >>> c.significant, c.largest, round(c.difference["T"], 2)
     (True, 'T', 0.02)
     """
+    down = relabel_fit(down, up.parameters)
     names = [k for k in up.names if k != "offset" and k in down.parameters]
     diff = {k: float(up.parameters[k] - down.parameters[k]) for k in names}
     sd = {k: float(np.hypot(np.hypot(up.std[k], down.std[k]), UNSETTLED_FACTOR * unsettled
@@ -187,7 +191,7 @@ def compare_fits(up: TimeFitResult, down: TimeFitResult, alpha: float = ALPHA,
 
 def fit_by_direction(record: Record, structure: Structure | str, delay: str | float | None = None,
                      sensor: Plant | str | None = None, steps: Steps | None = None,
-                     alpha: float = ALPHA) -> DirectionComparison:
+                     alpha: float = ALPHA, start: dict[str, float] | None = None) -> DirectionComparison:
     """Fit the up steps and the down steps of a step train apart and compare them (the record's first step left
     out when its direction has another: its window holds whatever came before the record).
 
@@ -204,6 +208,10 @@ def fit_by_direction(record: Record, structure: Structure | str, delay: str | fl
         From :func:`synth.ident.steps.find_steps` (found here if not given).
     alpha : float
         Family-wise false-alarm probability of the comparison.
+    start : dict, optional
+        Where both fits start (the structure's parameters and a fitted delay, as a fit of both directions
+        together gives them): a few iterations from each direction's answer where the two agree. A direction
+        whose fit from there fails is fitted again from the deterministic start.
 
     Returns
     -------
@@ -238,9 +246,22 @@ def fit_by_direction(record: Record, structure: Structure | str, delay: str | fl
         compared = Steps(steps.index[1:], steps.direction[1:], steps.low, steps.high)
     up_avg = average_steps(record, compared, "edge", direction=1)
     down_avg = average_steps(record, compared, "edge", direction=-1)
-    up = fit_structure(up_avg.record(), structure, delay, sensor, check=True)
-    down = fit_structure(down_avg.record(), structure, delay, sensor, check=True)
+    up = _fit_direction(up_avg.record(), structure, delay, sensor, start)
+    down = _fit_direction(down_avg.record(), structure, delay, sensor, start)
+    if start is not None:  # labelled as the fit of both directions
+        up = relabel_fit(up, start)
     return compare_fits(up, down, alpha, up_avg, down_avg, unsettled_fraction(record, steps, [up.plant, down.plant]))
+
+
+def _fit_direction(record: Record, structure: Structure | str, delay: str | float | None,
+                   sensor: Plant | str | None, start: dict[str, float] | None) -> TimeFitResult:
+    """One direction's checked fit from ``start``, or from the deterministic start where that fails."""
+    if start is not None:
+        try:
+            return fit_structure(record, structure, delay, sensor, initial=start, check=True)
+        except FitError:
+            pass
+    return fit_structure(record, structure, delay, sensor, check=True)
 
 
 def unsettled_fraction(record: Record, steps: Steps, models: list[Plant]) -> float:

@@ -9,13 +9,18 @@ group to match a reference fit.
 
 from __future__ import annotations
 
+from dataclasses import replace
 from itertools import permutations
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from synth.ident.structure import Structure
 
-__all__ = ["align_labels", "exchangeable_groups"]
+if TYPE_CHECKING:
+    from synth.ident.timefit import TimeFitResult
+
+__all__ = ["align_labels", "exchangeable_groups", "relabel_fit"]
 
 
 def exchangeable_groups(structure: Structure) -> list[list[str]]:
@@ -70,6 +75,49 @@ def align_labels(values: dict[str, float], stds: dict[str, float], reference: di
     ({'p1': 1.0, 'p2': 10.0}, {'p1': 0.01, 'p2': 0.3})
     """
     out_v, out_s = dict(values), dict(stds)
+    for dst, src in _closest_labels(values, stds, reference, groups).items():
+        out_v[dst], out_s[dst] = values[src], stds.get(src, np.nan)
+    return out_v, out_s
+
+
+def relabel_fit(fit: TimeFitResult, reference: dict[str, float]) -> TimeFitResult:
+    """``fit`` with the values of each exchangeable group of its structure permuted to lie closest to
+    ``reference`` (as :func:`align_labels`), with their standard errors, intervals, covariance and starts: the
+    same model, labelled as the reference (two fits compared name by name then compare like with like).
+
+    Examples
+    --------
+    >>> from synth.data import record_from_arrays
+    >>> from synth.ident.simulate import simulate_plant
+    >>> from synth.ident.timefit import fit_structure
+    >>> from synth.plant import Plant
+    >>> t = np.arange(0, 6, 0.01); u = np.where(t >= 0.5, 1.0, 0.0)
+    >>> y = simulate_plant(Plant.from_string("2/((s+1)*(s+2))"), t, u)
+    >>> start = {"k": 2.0, "p1": 2.0, "p2": 1.0}
+    >>> fit = fit_structure(record_from_arrays(t, u, y), "k/((s+p1)*(s+p2))", initial=start)
+    >>> [round(fit.parameters[k], 4) for k in ("p1", "p2")]
+    [2.0, 1.0]
+    >>> again = relabel_fit(fit, {"k": 2.0, "p1": 1.0, "p2": 2.0})
+    >>> [round(again.parameters[k], 4) for k in ("p1", "p2")], again.plant.to_string(4) == fit.plant.to_string(4)
+    ([1.0, 2.0], True)
+    """
+    source = _closest_labels(fit.parameters, fit.std, reference, exchangeable_groups(fit.structure))
+    source = {dst: src for dst, src in source.items() if dst != src}
+    if not source:
+        return fit
+
+    def moved(d: dict) -> dict:
+        return {k: d[source.get(k, k)] for k in d}
+
+    order = [fit.names.index(source.get(k, k)) for k in fit.names]
+    return replace(fit, parameters=moved(fit.parameters), std=moved(fit.std), ci95=moved(fit.ci95),
+                   covariance=fit.covariance[np.ix_(order, order)], initial=moved(fit.initial))
+
+
+def _closest_labels(values: dict[str, float], stds: dict[str, float], reference: dict[str, float],
+                    groups: list[list[str]]) -> dict[str, str]:
+    """For each name of the groups, the name whose value it takes (the permutation closest to ``reference``)."""
+    source: dict[str, str] = {}
     for group in groups:
         if not all(k in values and k in reference for k in group):
             continue
@@ -79,6 +127,5 @@ def align_labels(values: dict[str, float], stds: dict[str, float], reference: di
                              for src, dst in zip(order, group)))
 
         best = min(permutations(group), key=cost)
-        for src, dst in zip(best, group):
-            out_v[dst], out_s[dst] = values[src], stds.get(src, np.nan)
-    return out_v, out_s
+        source.update(zip(group, best))
+    return source

@@ -212,7 +212,8 @@ def identify(record: RecordLike, structure: Structure | str, delay: str | float 
     directions, note = None, ""
     if two_ways and (compare_directions or by_direction):
         try:
-            directions = fit_by_direction(record, structure, delay, sensor, avg.steps)  # type: ignore[union-attr]
+            directions = fit_by_direction(record, structure, delay, sensor, avg.steps,  # type: ignore[union-attr]
+                                          start=dict(fit.parameters))
         except (DataError, ModelError, RuntimeError, ValueError, np.linalg.LinAlgError) as exc:  # FitError too
             if by_direction:
                 raise
