@@ -45,7 +45,9 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                         "acc[1], ...; a struct s.field); repeatable")
     p.add_argument("--dt", type=float, metavar="S", help="sample interval when the files have no time column")
     p.add_argument("--wmin", type=float, metavar="RAD_S", help="lowest frequency (default: what the runs support)")
-    p.add_argument("--wmax", type=float, metavar="RAD_S", help="highest frequency (default: a fifth of Nyquist)")
+    p.add_argument("--wmax", type=float, metavar="RAD_S",
+                   help="highest frequency (default: a fifth of Nyquist; a note says how far above it the response "
+                        "stays coherent, if it does)")
     p.add_argument("--windows", metavar="S,S,...", help="window lengths in s (default: 5, composite)")
     p.add_argument("--coherence", type=float, default=0.8, metavar="G2", help="coherence threshold (default 0.8)")
     p.add_argument("--points-per-decade", type=int, default=40, metavar="N",
@@ -189,6 +191,8 @@ def run(args: argparse.Namespace) -> int:
               + (f"{b.w_min:.4g}-{b.w_max:.4g} rad/s" if b.found else "none"))
         if b.note:
             print(f"note: {b.note}")
+        for note in resp.notes:
+            print(f"note: {note}")
         for note in resp.corrections:
             print(f"correction: {note}")
         if len(quality) == 1 and not args.off_axis and "warning" in quality[0].reason:

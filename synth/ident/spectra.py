@@ -29,8 +29,17 @@ from synth.ident.spectral_windows import (
     required_window,
     window_spectra,
 )
+from synth.ident.sweep_quality import UNDER_EXCITED_DB, excitation_deficit
 
-__all__ = ["FrequencyResponse", "correct_response", "frequency_response", "rate_to_attitude"]
+__all__ = ["DEFAULT_TOP", "LOOK_AHEAD_CAP", "LOOK_AHEAD_MIN_DECADES", "FrequencyResponse", "correct_response",
+           "frequency_response", "rate_to_attitude"]
+
+#: default upper end of the estimate, as a fraction of the Nyquist frequency
+DEFAULT_TOP = 0.2
+#: how far above the default top the estimate looks for coherent, excited data (fraction of Nyquist)
+LOOK_AHEAD_CAP = 0.8
+#: the coherent band must go on at least this far above the default top [decades] for a note
+LOOK_AHEAD_MIN_DECADES = 0.05
 
 
 @dataclass(frozen=True)
@@ -64,6 +73,13 @@ class FrequencyResponse:
         The runs.
     corrections : tuple of str
         Corrections applied (:func:`correct_response`), in words.
+    notes : tuple of str
+        What the user should know about the range, in words (e.g. data beyond the default top).
+    above_default_top : dict or None
+        With the default upper end, when the coherent band reaches it and the data support more:
+        ``default_top``, ``coherent_to``, ``excited_to`` [rad/s], and ``peak_w`` [rad/s] /
+        ``peak_db`` [dB over ``|H|`` at the default top] when ``|H|`` rises above it by 3 dB or more
+        (else ``None``).
 
     Examples
     --------
@@ -90,6 +106,8 @@ class FrequencyResponse:
     output: str = "y"
     sources: tuple[str, ...] = ()
     corrections: tuple[str, ...] = ()
+    notes: tuple[str, ...] = ()
+    above_default_top: dict[str, float | None] | None = None
 
     @property
     def magnitude_db(self) -> np.ndarray:
@@ -120,7 +138,8 @@ class FrequencyResponse:
                 "coherence": self.coherence, "random_error": self.random_error, "n_averages": self.n_averages,
                 "coherent_band": self.band.to_dict(), "windows_s": list(self.windows), "kind": self.kind,
                 "input": self.input, "output": self.output, "sources": list(self.sources),
-                "corrections": list(self.corrections),
+                "corrections": list(self.corrections), "notes": list(self.notes),
+                "above_default_top": self.above_default_top,
                 "units": {"w": "rad/s", "magnitude_db": "dB", "phase_deg": "deg"}}
 
 
@@ -142,7 +161,11 @@ def frequency_response(
         The runs (same sample rate); their segments are averaged together.
     w_min, w_max : float, optional
         Frequency range [rad/s]; defaults: the lowest frequency the runs support
-        (:func:`lowest_frequency`) and a fifth of the Nyquist frequency.
+        (:func:`lowest_frequency`) and a fifth of the Nyquist frequency (:data:`DEFAULT_TOP`).
+        With the default top, the data above it are looked at up to :data:`LOOK_AHEAD_CAP` of
+        Nyquist: when the coherent band reaches the default top and continues above it, the
+        result's ``notes`` say how far (and where ``|H|`` peaks there), so that a resonance just
+        above a fifth of Nyquist is not missed silently; ``above_default_top`` holds the numbers.
     windows : sequence of float, optional
         Window lengths [s]; default :func:`default_windows`: 5 lengths from the
         longest that fits :data:`MIN_SEGMENTS` times into the runs (at least
@@ -188,7 +211,7 @@ def frequency_response(
     nyquist = np.pi * fs
     given_min, given_max = w_min is not None, w_max is not None
     w_min = lowest_frequency(runs, overlap) if w_min is None else float(w_min)
-    w_max = 0.2 * nyquist if w_max is None else float(w_max)
+    w_max = DEFAULT_TOP * nyquist if w_max is None else float(w_max)
     if not (0 < w_min < w_max) and not (given_min and given_max):
         samples = max(r.t.size for r in runs)
         raise DataError(f"the record is too short for a frequency response: its {samples} samples "
@@ -222,9 +245,55 @@ def frequency_response(
         H = gxy / gxx
     err = random_error(coh, n_d)
     band = trim_to_excitation(coherent_band(grid, coh, coherence_threshold), grid, gxx)
+    above = None
+    if not given_max:
+        # as dense as the grid's top cell (in rad/s) up to the cap: wider cells would hold more FFT bins each,
+        # and the cost of their bin correlation grows as the cube of that count
+        dense = int(np.ceil(points_per_decade * LOOK_AHEAD_CAP / DEFAULT_TOP))
+        ext = log_grid(w_max, LOOK_AHEAD_CAP * nyquist, dense)[1:]
+        spectra = combine_windows([window_spectra(runs, fs, round(float(x) * fs), overlap, ext, detrend)
+                                   for x in lengths], ext)
+        above = _above_default_top(grid, gxx, gxy, coh, band, ext, *spectra[:3], coherence_threshold)
+    notes = (_above_note(above, nyquist),) if above else ()
     return FrequencyResponse(grid, H, coh, err, n_d, gxx, gyy, gxy, band, tuple(float(x) for x in lengths),
                              "measured", runs[0].input.label(), runs[0].output.label(),
-                             tuple(r.source for r in runs))
+                             tuple(r.source for r in runs), notes=notes, above_default_top=above)
+
+
+def _above_default_top(w: np.ndarray, gxx: np.ndarray, gxy: np.ndarray, coh: np.ndarray, band: CoherentBand,
+                       ext: np.ndarray, gxx_ext: np.ndarray, gyy_ext: np.ndarray, gxy_ext: np.ndarray,
+                       threshold: float) -> dict[str, float | None] | None:
+    """How far above the default top ``w[-1]`` the response stays coherent and the input excited (``None``
+    unless the coherent band reaches the top and goes on for at least :data:`LOOK_AHEAD_MIN_DECADES`)."""
+    if ext.size == 0 or not band.found or band.w_max < w[-1]:
+        return None
+    w_all, gxx_all = np.r_[w, ext], np.r_[gxx, gxx_ext]
+    coh_all = np.r_[coh, coherence_from_spectra(gxx_ext, gyy_ext, gxy_ext)]
+    wide = trim_to_excitation(coherent_band(w_all, coh_all, threshold), w_all, gxx_all)
+    if not wide.found or not wide.w_min <= w[-1] <= wide.w_max / 10 ** LOOK_AHEAD_MIN_DECADES:
+        return None
+    deficit = excitation_deficit(w_all, gxx_all, reference=band.contains(w_all))[w.size:]
+    short = np.flatnonzero(deficit > UNDER_EXCITED_DB)
+    excited_to = float(ext[short[0] - 1]) if short.size and short[0] > 0 else (
+        float(w[-1]) if short.size else float(ext[-1]))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        mag = 20.0 * np.log10(np.abs(np.r_[gxy[-1] / gxx[-1], gxy_ext / gxx_ext]))
+    inside = np.r_[True, wide.contains(ext)]
+    k = int(np.nanargmax(np.where(inside, mag, -np.inf)))
+    peak = k > 0 and mag[k] - mag[0] >= 3.0
+    return {"default_top": float(w[-1]), "coherent_to": float(wide.w_max), "excited_to": excited_to,
+            "peak_w": float(ext[k - 1]) if peak else None, "peak_db": float(mag[k] - mag[0]) if peak else None}
+
+
+def _above_note(above: dict[str, Any], nyquist: float) -> str:
+    """The sentence for :attr:`FrequencyResponse.notes` about the data above the default top."""
+    top, to = above["default_top"], above["coherent_to"]
+    at_least = "at least " if to >= LOOK_AHEAD_CAP * nyquist * (1 - 1e-9) else ""
+    peak = (f"; the measured |H| peaks there at {above['peak_w']:.4g} rad/s, {above['peak_db']:+.1f} dB over its "
+            f"value at {top:.4g} rad/s (a resonance above the default range?)" if above["peak_w"] is not None else "")
+    return (f"the coherent band reaches the default upper limit {top:.4g} rad/s (a fifth of the Nyquist frequency "
+            f"{nyquist:.4g} rad/s) and goes on: the input excites up to {above['excited_to']:.4g} rad/s and the "
+            f"response stays coherent up to {at_least}{to:.4g} rad/s{peak}; pass --wmax {to:.4g} to see above")
 
 
 def rate_to_attitude(resp: FrequencyResponse) -> FrequencyResponse:
