@@ -247,8 +247,7 @@ def frequency_response(
     band = trim_to_excitation(coherent_band(grid, coh, coherence_threshold), grid, gxx)
     above = None
     if not given_max:
-        # as dense as the grid's top cell (in rad/s) up to the cap: wider cells would hold more FFT bins each,
-        # and the cost of their bin correlation grows as the cube of that count
+        # as dense as the grid's top cell (in rad/s) up to the cap: a lightly damped peak located within a cell
         dense = int(np.ceil(points_per_decade * LOOK_AHEAD_CAP / DEFAULT_TOP))
         ext = log_grid(w_max, LOOK_AHEAD_CAP * nyquist, dense)[1:]
         spectra = combine_windows([window_spectra(runs, fs, round(float(x) * fs), overlap, ext, detrend)

@@ -201,9 +201,10 @@ def window_spectra(runs: list[Record], fs: float, nseg: int, overlap: float, gri
     rho = [1.0] + [_bin_rho(win, d) for d in range(1, 4)]
     cmax = int(c.max()) if c.size else 0
     bins_eff = np.ones(max(cmax, 1) + 1)   # a band narrower than the bin spacing: no cell holds a bin
-    for cc in range(2, cmax + 1):
-        d = np.abs(np.subtract.outer(np.arange(cc), np.arange(cc)))
-        bins_eff[cc] = cc * cc / np.sum(np.where(d < 4, np.take(rho, np.minimum(d, 3)), 0.0))
+    # cc bins of a cell, correlated rho[d] at d bins apart (none beyond 3): the sum of their correlation
+    # matrix is cc + 2 sum_d (cc - d) rho[d], in closed form (the matrix itself costs cc^2 per cell size)
+    cc = np.arange(2, cmax + 1, dtype=float)
+    bins_eff[2:] = cc * cc / (cc + 2.0 * sum(np.maximum(cc - d, 0.0) * rho[d] for d in range(1, 4)))
     n_d = n_eff * bins_eff[np.maximum(c, 1).astype(int)]
     length = nseg / fs
     return WindowSpectra(length, out[0], out[1], out[2] + 1j * out[3], n_d)
