@@ -54,7 +54,7 @@ def problem(index: int, seed: int = 0) -> dict:
             return f"{k}/({a}*s+1)"
         if kind == 2:
             return f"{k}/(({a}*s+1)*({b}*s+1))"
-        return f"{k / (z * a * b)}*(s+{z / scale})/((s+{1 / a})*(s+{1 / b}))"
+        return f"{k * scale / (z * a * b)}*(s+{z / scale})/((s+{1 / a})*(s+{1 / b}))"  # static gain k
 
     hold = float(rng.uniform(4, 12)) * max(t1, t1 * ratio)
     n = int(rng.integers(20_000, 60_001))
