@@ -21,6 +21,7 @@ from typing import Any
 import numpy as np
 from scipy.optimize import least_squares
 
+from synth.distributions import chi2_ppf
 from synth.errors import ModelError
 from synth.ident.structure import Structure
 from synth.plant import Plant
@@ -151,15 +152,17 @@ def _stable(den: np.ndarray) -> np.ndarray:
 
 
 def _srivc(t: np.ndarray, v: np.ndarray, y: np.ndarray, na: int, nb: int, delay: float, lam: float,
-           periodic: bool, iterations: int = 8) -> tuple[np.ndarray, np.ndarray, float]:
-    """SRIVC estimate of ``B(s)/A(s) exp(-delay s)`` from ``v`` to ``y`` (deviation signals)."""
+           periodic: bool, iterations: int = 8, offset: bool = False) -> tuple[np.ndarray, np.ndarray, float, float]:
+    """SRIVC estimate of ``B(s)/A(s) exp(-delay s)`` from ``v`` to ``y`` (deviation signals): ``num, den``, the
+    SSR of its simulation and its output offset (with ``offset``, a record from rest plus a free offset: the
+    offset is estimated and the SSR is that of the best offset; without, 0)."""
     duration = t[-1] - t[0] + (t[1] - t[0])
     den = np.poly(-lam * np.ones(na)) if na else np.array([1.0])
     num = None
     for it in range(iterations + 1):
         try:  # an iterate far off (e.g. poles far beyond the sampling rate) may overflow the filters
             with np.errstate(over="ignore", invalid="ignore"):
-                new_num, new_den = _srivc_step(t, v, y, na, nb, delay, periodic, duration, num, den)
+                new_num, new_den = _srivc_step(t, v, y, na, nb, delay, periodic, duration, num, den, offset)
         except (np.linalg.LinAlgError, ValueError, FloatingPointError):
             break
         if not (np.all(np.isfinite(new_num)) and np.all(np.isfinite(new_den))):
@@ -169,36 +172,42 @@ def _srivc(t: np.ndarray, v: np.ndarray, y: np.ndarray, na: int, nb: int, delay:
         if converged and it > 0:
             break
     if num is None:
-        return np.array([0.0]), den, float("inf")
+        return np.array([0.0]), den, float("inf"), 0.0
     reps = _reps(den, duration) if periodic else 1
     try:
         with np.errstate(over="ignore", invalid="ignore"):
             sim = _tile_filter(Plant(num, den, delay), t, v, periodic, reps)
     except (np.linalg.LinAlgError, ValueError, FloatingPointError):
-        return num, den, float("inf")
-    ssr = float(np.sum((y - sim) ** 2))
-    return num, den, ssr if np.isfinite(ssr) else float("inf")
+        return num, den, float("inf"), 0.0
+    level = float(np.mean(y - sim)) if offset else 0.0
+    ssr = float(np.sum((y - sim - level) ** 2))
+    return (num, den, ssr, level) if np.isfinite(ssr) else (num, den, float("inf"), 0.0)
 
 
 def _srivc_step(t: np.ndarray, v: np.ndarray, y: np.ndarray, na: int, nb: int, delay: float, periodic: bool,
-                duration: float, num: np.ndarray | None, den: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """One SRIVC iteration: the instrumental-variable estimate with the prefilter ``1/den``."""
+                duration: float, num: np.ndarray | None, den: np.ndarray,
+                offset: bool = False) -> tuple[np.ndarray, np.ndarray]:
+    """One SRIVC iteration: the instrumental-variable estimate with the prefilter ``1/den`` (with ``offset``, a
+    free output offset as one more regressor)."""
     reps = _reps(den, duration) if periodic else 1
     yf = _bank(den, t, y, na + 1, 0.0, periodic, reps)
     vf = _bank(den, t, v, nb + 1, delay, periodic, reps)
-    phi = np.column_stack([-yf[k] for k in range(na)] + vf)
+    # from rest with a free output offset b (the model class of the fit that follows): y = B/A v + b, so
+    # A(p) y_f = B(p) v_f + b (A/den) 1, which is b 1 where the iteration converges (den = A)
+    extra = [np.ones_like(y)] if offset else []
+    phi = np.column_stack([-yf[k] for k in range(na)] + vf + extra)
     if num is None:
         zeta = phi
     else:
         xhat = _tile_filter(Plant(num, den, delay), t, v, periodic, reps)
         xf = _bank(den, t, xhat, na, 0.0, periodic, reps)
-        zeta = np.column_stack([-xf[k] for k in range(na)] + vf)
+        zeta = np.column_stack([-xf[k] for k in range(na)] + vf + extra)
     try:
         est = np.linalg.solve(zeta.T @ phi, zeta.T @ yf[na])
     except np.linalg.LinAlgError:
         est = np.linalg.lstsq(phi, yf[na], rcond=None)[0]
     a = est[:na][::-1]
-    return est[na:][::-1], (_stable(np.r_[1.0, a]) if na else np.array([1.0]))
+    return est[na:na + nb + 1][::-1], (_stable(np.r_[1.0, a]) if na else np.array([1.0]))
 
 
 def srivc_with_root(t: np.ndarray, v: np.ndarray, y: np.ndarray, den: np.ndarray, nb: int, delay: float, root: float,
@@ -262,8 +271,14 @@ def _first_response(t: np.ndarray, w: np.ndarray, y: np.ndarray) -> float:
 
 
 def linear_initial_model(t: np.ndarray, w: np.ndarray, yd: np.ndarray, st: Structure, sensor: Plant | None, periodic: bool,
-                 delay: float | None) -> tuple[np.ndarray, np.ndarray, float]:
-    """Deterministic linear model (num, den of ``F``) and delay from SRIVC on a delay grid.
+                 delay: float | None) -> tuple[np.ndarray, np.ndarray, float, float]:
+    """Deterministic linear model (num, den of ``F``), delay and output offset from SRIVC on a delay grid.
+
+    A record that is not periodic is modelled as the fit that follows models it: ``F`` from rest at the first
+    sample plus an output offset. The offset is 0 (the reference levels, the output's mean before the first input
+    change, a steady state) unless the input moves from its first sample on and a free offset, one more regressor
+    of the instrumental-variable estimate, lowers the simulation error significantly (:func:`_needs_offset`): a
+    record cut out of a running excitation, whose first samples are no steady state, gets its offset estimated.
 
     Parameters
     ----------
@@ -285,6 +300,8 @@ def linear_initial_model(t: np.ndarray, w: np.ndarray, yd: np.ndarray, st: Struc
     num, den : numpy.ndarray
         Coefficients of ``F`` (highest power first).
     delay : float
+    offset : float
+        Output level at zero input deviation, relative to ``yd``'s reference (0 unless estimated).
 
     Examples
     --------
@@ -292,9 +309,21 @@ def linear_initial_model(t: np.ndarray, w: np.ndarray, yd: np.ndarray, st: Struc
     >>> from synth.ident.structure import parse_structure
     >>> t = np.arange(0, 3, 0.01); u = np.where(t >= 0.5, 1.0, 0.0)
     >>> y = simulate_plant(Plant.from_string("2/(s+3)"), t, u)
-    >>> num, den, d = linear_initial_model(t, u, y, parse_structure("k/(s+p)"), None, False, 0.0)
-    >>> (num / den[0]).round(4).tolist(), (den / den[0]).round(4).tolist(), d
-    ([2.0], [1.0, 3.0], 0.0)
+    >>> num, den, d, b = linear_initial_model(t, u, y, parse_structure("k/(s+p)"), None, False, 0.0)
+    >>> (num / den[0]).round(4).tolist(), (den / den[0]).round(4).tolist(), d, round(b, 6)
+    ([2.0], [1.0, 3.0], 0.0, 0.0)
+
+    The same plant under two sines that began 1 s before the record, its output shifted by -0.5: the first
+    samples are no steady state. The start is the plant (a few per cent off: the state at the first sample,
+    which the model from rest leaves out, decays within the record) and the output level ``G(0) u - 0.5``
+    (without the offset, SRIVC gives a pole at 5.3 rad/s and a static gain of 0.30).
+
+    >>> tl = np.arange(0, 21, 0.01); ul = 0.3 + np.sin(1.3 * tl) + np.sin(7.1 * tl)
+    >>> yl = simulate_plant(Plant.from_string("2/(s+3)"), tl, ul) - 0.5
+    >>> t, u, y = tl[100:] - tl[100], ul[100:], yl[100:]
+    >>> num, den, d, b = linear_initial_model(t, u - u[0], y - y[0], parse_structure("k/(s+p)"), None, False, 0.0)
+    >>> (num / den[0]).round(2).tolist(), (den / den[0]).round(2).tolist(), round(float(y[0] + b - 2 / 3 * u[0]), 2)
+    ([2.01], [1.0, 3.21], -0.58)
     """
     dt = t[1] - t[0]
     duration = t[-1] - t[0] + dt
@@ -308,20 +337,42 @@ def linear_initial_model(t: np.ndarray, w: np.ndarray, yd: np.ndarray, st: Struc
         grid = np.array([delay])
     lams = np.geomspace(20.0 / duration, 0.05 / dt, 5)
     mid = grid[len(grid) // 2]
-    best_lam = min(lams, key=lambda lam: _srivc(t, v, yd, na, nb, mid, lam, periodic, 4)[2])
-    fits = [(_srivc(t, v, yd, na, nb, d, best_lam, periodic), d) for d in grid]
-    (num, den, ssr), d0 = min(fits, key=lambda f: f[0][2])
+    screen = [_srivc(t, v, yd, na, nb, mid, lam, periodic, 4)[2] for lam in lams]
+    free = False
+    if not periodic and w.size > 1 and w[1] != w[0]:  # the input moves from its first sample on
+        free, screen = _needs_offset(t, v, yd, na, nb, mid, lams, screen)
+    best_lam = lams[int(np.argmin(screen))]
+    fits = [(_srivc(t, v, yd, na, nb, d, best_lam, periodic, offset=free), d) for d in grid]
+    (num, den, ssr, offset), d0 = min(fits, key=lambda f: f[0][2])
     if grid.size > 1:  # refine the delay between the neighbouring grid points
         from scipy.optimize import minimize_scalar
 
         step = grid[1] - grid[0]
-        sol = minimize_scalar(lambda d: _srivc(t, v, yd, na, nb, d, best_lam, periodic, 4)[2],
+        sol = minimize_scalar(lambda d: _srivc(t, v, yd, na, nb, d, best_lam, periodic, 4, free)[2],
                               bounds=(max(0.0, d0 - step), d0 + step), method="bounded",
                               options={"xatol": 0.1 * dt})
         if sol.fun < ssr:
             d0 = float(sol.x)
-            num, den, _ = _srivc(t, v, yd, na, nb, d0, best_lam, periodic)
-    return num, den, float(d0)
+            num, den, _, offset = _srivc(t, v, yd, na, nb, d0, best_lam, periodic, offset=free)
+    return num, den, float(d0), offset
+
+
+def _needs_offset(t: np.ndarray, v: np.ndarray, y: np.ndarray, na: int, nb: int, delay: float,
+                  lams: np.ndarray, fixed: list[float]) -> tuple[bool, list[float]]:
+    """Whether a record shows an output offset against its reference level: the SRIVC screen (4 iterations per
+    ``lambda``) with a free offset lowers the simulation error significantly (an F-test of the one more
+    parameter at 0.1 %) below the screen with the offset at 0 (its SSRs ``fixed``). Returns the answer and the
+    screen to pick ``lambda`` from.
+
+    Asked only where the input moves from its first sample on: the reference levels are then single samples of a
+    response in progress (a record cut out of a running excitation), whose level the SRIVC estimate without an
+    offset explains by a slow pole pair. An input that holds its first value a while gives the record's rest
+    before it (the fit's own assumption), and the output's mean over it is the reference."""
+    free = [_srivc(t, v, y, na, nb, delay, lam, False, 4, True)[2] for lam in lams]
+    best_fixed, best_free, dof = min(fixed), min(free), y.size - na - nb - 2
+    if dof > 0 and np.isfinite(best_free) and best_fixed - best_free > float(chi2_ppf(0.999, 1)) * best_free / dof:
+        return True, free
+    return False, fixed
 
 
 def map_to_structure(st: Structure, num: np.ndarray, den: np.ndarray) -> np.ndarray:

@@ -20,6 +20,7 @@ import ast
 import re
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
+from functools import lru_cache
 from typing import Any
 
 import numpy as np
@@ -307,6 +308,48 @@ class Structure:
             raise ModelError(f"structure {self.formula!r}: the denominator vanishes at these parameter values")
         return Plant(num, den, float(delay), **kwargs)
 
+    def sign_symmetries(self) -> list[tuple[str, ...]]:
+        """Sets of parameters whose joint change of sign leaves the transfer function unchanged.
+
+        In ``k*w^2/(s^2+2*z*w*s+w^2)``, ``(-w, -z)`` gives the same plant as ``(w, z)``: a fit may end on either.
+        Found by evaluating the coefficients with signs flipped at random values (a coincidence is not taken for a
+        symmetry); structures with more than 10 parameters are not searched.
+
+        Examples
+        --------
+        >>> parse_structure("k*w^2/(s^2+2*z*w*s+w^2)").sign_symmetries()
+        [('w', 'z')]
+        >>> parse_structure("k*(s+z)/((s+p1)*(s+p2))").sign_symmetries()
+        []
+        """
+        return list(_sign_symmetries(self.formula))
+
+    def canonical_signs(self, theta: Sequence[float]) -> tuple[np.ndarray, tuple[str, ...]]:
+        """The equivalent parameters (:meth:`sign_symmetries`) with the fewest negative values, ties going to the
+        one whose first negative value comes latest (``w > 0`` before ``z > 0``), and the names whose sign changed.
+
+        Examples
+        --------
+        >>> st = parse_structure("k*w^2/(s^2+2*z*w*s+w^2)")
+        >>> theta, flipped = st.canonical_signs([1.0, -445.0, -0.05])
+        >>> theta.tolist(), flipped
+        ([1.0, 445.0, 0.05], ('w', 'z'))
+        >>> st.canonical_signs([1.0, -2.0, 0.3])[0].tolist()
+        [1.0, 2.0, -0.3]
+        """
+        theta = np.asarray(theta, float).copy()
+        index = {n: i for i, n in enumerate(self.parameters)}
+
+        def key(names: tuple[str, ...]) -> tuple[int, tuple[bool, ...]]:
+            flipped = theta.copy()
+            flipped[[index[n] for n in names]] *= -1.0
+            negative = tuple(bool(v < 0) for v in flipped)
+            return sum(negative), negative
+
+        best = min([(), *self.sign_symmetries()], key=key)
+        theta[[index[n] for n in best]] *= -1.0
+        return theta, tuple(best)
+
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready description.
 
@@ -402,6 +445,29 @@ def parse_structure(formula: str) -> Structure:
     if nd > dd:
         raise ModelError(f"structure {formula!r} is improper (numerator degree {nd} > denominator degree {dd})")
     return Structure(formula.strip(), tuple(params), delay, nd, dd, tree)
+
+
+@lru_cache(maxsize=256)
+def _sign_symmetries(formula: str) -> tuple[tuple[str, ...], ...]:
+    """Non-empty parameter sets whose joint sign flip leaves the normalized coefficients of ``formula`` unchanged."""
+    st = parse_structure(formula)
+    names = st.parameters
+    if len(names) > 10:
+        return ()
+    theta = np.random.default_rng(20261205).uniform(0.5, 2.0, len(names))
+
+    def normalized(values: np.ndarray) -> np.ndarray:
+        num, den = st.coefficients(values)
+        lead = den[np.flatnonzero(den)[0]] if np.any(den) else 1.0
+        return np.r_[num, den] / lead
+
+    base = normalized(theta)
+    found = []
+    for mask in range(1, 2 ** len(names)):
+        signs = np.array([-1.0 if mask >> i & 1 else 1.0 for i in range(len(names))])
+        if np.allclose(normalized(signs * theta), base, rtol=1e-10, atol=1e-12 * float(np.max(np.abs(base)))):
+            found.append(tuple(n for i, n in enumerate(names) if mask >> i & 1))
+    return tuple(sorted(found, key=lambda g: (len(g), [names.index(n) for n in g])))
 
 
 def _rational_names(tree: ast.AST, delay_name: str) -> set[str]:

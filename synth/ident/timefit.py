@@ -347,9 +347,11 @@ def fit_structure(record: Record, structure: Structure | str, delay: str | float
         y_ref = float(np.mean(y[:max(1, k0)]))
         wd, yd = w, y - y_ref
     info: dict[str, Any] = {"method": "ipopt (casadi), Gauss-Newton Hessian", "starts": 0, "delay_shifts": 0}
+    lin_offset = 0.0
     if initial is None:
-        lin_num, lin_den, d0 = linear_initial_model(t, wd, yd, st, sensor, periodic, None if fit_delay else fixed_delay)
-        theta0 = map_to_structure(st, lin_num, lin_den)
+        lin_num, lin_den, d0, lin_offset = linear_initial_model(t, wd, yd, st, sensor, periodic,
+                                                                None if fit_delay else fixed_delay)
+        theta0 = st.canonical_signs(map_to_structure(st, lin_num, lin_den))[0]
         info["initialization"] = "SRIVC linear fit on a delay grid, mapped to the structure"
     else:
         missing = [k for k in st.parameters if k not in initial]
@@ -381,7 +383,7 @@ def fit_structure(record: Record, structure: Structure | str, delay: str | float
         info["method"] = "Levenberg-Marquardt, exact Jacobian by FFT convolution of the sensitivities"
     else:
         prob = SimulationErrorProblem(st, sensor, n, dt, periodic, theta0, fit_delay, y, has_d, weights)
-    b0 = y_ref if not periodic else y_ref - float(Plant(num_chk, den_chk).dc_gain()) * w_mean * (
+    b0 = y_ref + lin_offset if not periodic else y_ref - float(Plant(num_chk, den_chk).dc_gain()) * w_mean * (
         sensor.dc_gain() if sensor is not None else 1.0)
     initial_out = {**dict(zip(st.parameters, theta0.tolist())), delay_name: d0}
     unknown = sorted(set(lower or {}) - set(st.parameters))
@@ -423,6 +425,9 @@ def fit_structure(record: Record, structure: Structure | str, delay: str | float
     info.update(st_info)
     info["delay_shifts"] = shifts
     p = len(st.parameters)
+    theta_c, flipped = st.canonical_signs(xs[:p] * prob.scale)  # the same plant, e.g. w, z > 0 for (-w, -z)
+    if flipped and (lb is None or np.all(theta_c >= lb)):
+        xs, info["signs_flipped"] = np.r_[theta_c / prob.scale, xs[p:]], list(flipped)
     theta = xs[:p] * prob.scale
     if fit_delay:
         f_hat, b_hat = float(xs[p]), float(xs[p + 1])
