@@ -18,7 +18,6 @@ of the spec's problem, and the caller searches on from that point.
 from __future__ import annotations
 
 import numpy as np
-from scipy.optimize import linprog
 
 from synth.check import quick_check
 from synth.controllers import Controller
@@ -121,6 +120,8 @@ def ascent_probe(spec: Spec, controller: Controller, terms: list[tuple[str, str,
     for j, k in enumerate(free):
         lo, hi = bounds[k]
         box.append((0.0 if x[k] <= lo + 1e-12 * scales[j] else -1.0, 0.0 if x[k] >= hi - 1e-12 * scales[j] else 1.0))
+    from scipy.optimize import linprog  # imported when needed: scipy.optimize costs 0.3 s to import
+
     lp = linprog(np.append(np.zeros(n), -1.0), A_ub=np.array(rows), b_ub=np.zeros(len(rows)),
                  bounds=[*box, (None, 1.0)], method="highs")
     if lp.status != 0 or -lp.fun <= 1e-6:
