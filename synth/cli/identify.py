@@ -220,6 +220,8 @@ def _print(result: Any, args: argparse.Namespace, json_path: Path, figures: list
             print(f"note: {step['note']}")
     if fit.solver.get("covariance_note"):
         print(f"note on the std column: {fit.solver['covariance_note']}")
+    if fit.solver.get("nyquist_note"):
+        print(f"note: {fit.solver['nyquist_note']}")
     print(f"fit {fit.fit_percent:.2f} %, residual std {fit.residual_std:.3g}, "
           f"IPOPT {fit.solver.get('status')} ({fit.solver.get('iterations')} iterations)")
     print(f"plant: {fit.plant.to_string()}")

@@ -19,8 +19,9 @@ from synth.data.coerce import RecordLike, as_record
 from synth.data.record import Record
 from synth.errors import DataError, FitError, ModelError
 from synth.ident.directions import DirectionComparison, fit_by_direction
+from synth.ident.nyquist import beyond_nyquist
 from synth.ident.pair_relocation import relocate_pair
-from synth.ident.periodic_start import beyond_nyquist, fit_whole_record, refit_periodic_start, settling_time
+from synth.ident.periodic_start import fit_whole_record, refit_periodic_start, settling_time
 from synth.ident.start_transient import start_transient_failure
 from synth.ident.steps import StepAverage, average_steps, find_steps
 from synth.ident.structure import Structure, parse_structure

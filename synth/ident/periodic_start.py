@@ -26,13 +26,14 @@ import numpy as np
 from synth.data.record import Record
 from synth.errors import DataError, FitError, ModelError
 from synth.ident.identifiability import WEAK_RELATIVE_STD
+from synth.ident.nyquist import beyond_nyquist
 from synth.ident.simulate import simulate_plant
 from synth.ident.steps import StepAverage, average_steps
 from synth.ident.structure import Structure
 from synth.ident.timefit import TimeFitResult, fit_structure
 from synth.plant import Plant
 
-__all__ = ["WHOLE_RECORD_GAIN", "beyond_nyquist", "fit_whole_record", "predicted_whole_record_covariance",
+__all__ = ["WHOLE_RECORD_GAIN", "fit_whole_record", "predicted_whole_record_covariance",
            "refit_periodic_start", "settling_time", "starts_at_rest", "step_settling_time"]
 
 #: fit the whole record when it is predicted to shrink some parameter's standard error by this factor or more
@@ -50,20 +51,6 @@ def settling_time(plant: Plant, fraction: float = SETTLED) -> float:
     5.1
     """
     return plant.settling_time(float(np.log(1.0 / fraction)))
-
-
-def beyond_nyquist(plant: Plant, dt: float) -> bool:
-    """Whether ``plant`` has a pole or zero beyond the Nyquist frequency of samples ``dt`` apart, which no such
-    record resolves.
-
-    Examples
-    --------
-    >>> G = Plant.from_string("(s+5e4)/((s+1)*(s+3.7e4))")                     # Nyquist of 5 ms: 628 rad/s
-    >>> beyond_nyquist(G, 0.005), beyond_nyquist(Plant.from_string("1/(s+1)"), 0.005)
-    (True, False)
-    """
-    roots = np.concatenate([plant.poles(), plant.zeros()])
-    return bool(np.any(np.abs(roots) > np.pi / dt))
 
 
 def step_settling_time(plant: Plant, fraction: float = SETTLED) -> float:

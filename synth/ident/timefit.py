@@ -43,6 +43,7 @@ from synth.ident.covariance import fit_covariance
 from synth.ident.delay_samples import best_sample, walk_intervals
 from synth.ident.fit_failure import LIMIT_STATUSES, fit_failure, start_ssr
 from synth.ident.identifiability import TiedParameter, WeakParameter, coinciding, tied_to_weak, weak_parameters
+from synth.ident.nyquist import nyquist_note
 from synth.ident.residual_whiteness import correlated_residuals_note
 from synth.ident.sim_error_problem import SimulationErrorProblem
 from synth.ident.srivc import linear_initial_model, map_to_structure
@@ -482,6 +483,8 @@ def fit_structure(record: Record, structure: Structure | str, delay: str | float
         params[delay_name], std[delay_name] = float(d_hat), 0.0
     ci = {k: (params[k] - tq * std[k], params[k] + tq * std[k]) for k in params}
     plant = st.plant(theta, delay=d_hat, input=record.input, output=record.output, label="identified")
+    if nyquist_note(plant, dt):
+        info["nyquist_note"] = nyquist_note(plant, dt)
     measured = plant.series(sensor) if sensor is not None else plant
     if sensor is not None:
         measured = Plant(measured.num, measured.den, d_hat, record.input, record.output, "identified with sensor")
