@@ -13,6 +13,9 @@ from synth.ident.timefit import fit_structure
 from synth.ident.x4_record import SENSOR, STRUCTURE, TRUTH, x4_step_train
 from synth.plant import Plant
 
+# one worker: the module's X-4 identification (4.6 s) is computed once, not once per worker its tests land on
+pytestmark = pytest.mark.xdist_group("ident_timefit")
+
 
 @pytest.fixture(scope="module")
 def x4_result():
