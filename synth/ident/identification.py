@@ -185,12 +185,18 @@ def identify(record: RecordLike, structure: Structure | str, delay: str | float 
     if failed and average == "auto" and not by_direction:
         # the average's fit failed (e.g. IPOPT at its limit on a few short edge windows, or a diverged pole):
         # the whole record, which holds the same steps and assumes less, from its own deterministic start
+        missed_start = ""
         try:
             whole_fit = fit_structure(record, structure, delay, sensor, False, check=True)
+            missed_start = start_transient_failure(whole_fit.t, whole_fit.y, whole_fit.yhat,
+                                                   settling_time(whole_fit.measured))  # it too assumes rest at t = 0
+            if missed_start:
+                raise FitError(missed_start, where=record.source)
         except FitError as whole_error:
-            if fit is None:
+            if fit is None and not missed_start:
                 raise error from None  # both failed: the average's reason is the one to read
-            raise FitError(f"fit of {structure.formula!r} failed: the {avg.mode} average's {failed}, and the "
+            average_failed = failed if fit is not None else f"fit failed ({failed})"
+            raise FitError(f"fit of {structure.formula!r} failed: the {avg.mode} average's {average_failed}, and the "
                            f"whole record's fit failed too ({whole_error}); try another structure, a fixed delay "
                            "or a shorter part of the record", where=record.source) from None
         if not _unstable(whole_fit.measured):
