@@ -54,7 +54,10 @@ def test_json_keys_fit_and_verification(run_cli, files, tmp_path):
     fit = data["fit"]
     assert set(fit["parameters"]) == {"b0", "a1", "a0", "delay"} and fit["J"] > 0
     assert fit["parameters"]["b0"] == pytest.approx(31.6, rel=0.05)
-    assert data["verification"]["fit_percent"] > 90
+    # the runs are simulated from input samples held 20 ms, which lag a sine by half a sample: the sweep's response
+    # carries the plant's 41 ms and about 10 ms more, which a step (changing at a sample) does not show
+    assert fit["parameters"]["delay"] == pytest.approx(0.041 + 0.010, abs=0.004)
+    assert data["verification"]["fit_percent"] > 85
     assert (tmp_path / "rep" / "bode.png").exists() and (tmp_path / "rep" / "verify.png").exists()
     assert "coherent band" in res.out and "J = " in res.out
 

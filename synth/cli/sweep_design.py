@@ -21,9 +21,12 @@ DESCRIPTION = """Plan one frequency-sweep run and write its input as a CSV for t
 The recipe (synth.ident.sweep_design.design_sweep): the lowest frequency sets the longest period
 T_max = 2 pi / w_min; each run starts at trim with two cycles of T_max, then raises the frequency
 gradually (exponential sweep) up to w_max and returns to trim; a run lasts 90 s or 4.5 T_max, whichever
-is longer; 3 runs are flown and the best 2 concatenated. The input fades in and out over --fade seconds
-(raised cosine; default T_max / 4) so the rig starts and ends at trim. Time is in s, the input in the
-rig's units (--amplitude is the peak).
+is longer; 3 runs are flown and the best 2 concatenated. The input fades in over --fade seconds (raised
+cosine; default T_max / 4) so the rig starts at trim, and fades out the same way at the end. The whole
+band w_min-w_max is swept at full amplitude: the fade-out starts when the sweep reaches w_max and carries
+it on above (to the "fade-out" frequency printed), for at least the time the sweep needs to pass w_max
+cleanly, so the top of the band is excited as well as the rest; the run ends at trim. Time is in s, the
+input in the rig's units (--amplitude is the peak).
 
 The CSV has a first line naming synth (so re-running replaces it), then columns time_s and --name.
 An existing file that synth did not write is never replaced (--force to do so).
@@ -41,7 +44,9 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--duration", type=float, metavar="S",
                    help="length of one run [s] (default: the recipe's max(90 s, 4.5 T_max))")
     p.add_argument("--amplitude", type=float, default=1.0, help="peak input amplitude in input units (default 1)")
-    p.add_argument("--fade", type=float, metavar="S", help="raised-cosine fade-in and fade-out [s] (default T_max/4)")
+    p.add_argument("--fade", type=float, metavar="S",
+                   help="raised-cosine fade-in and fade-out [s] (default: in T_max/4; out the time the sweep needs "
+                        "to pass w_max cleanly, never less); the fade-out lies above w_max")
     p.add_argument("--sample-rate", type=float, metavar="HZ",
                    help="samples per second (default: 25 per period of w_max, rounded up)")
     p.add_argument("--reduce-above", type=float, metavar="HZ",
@@ -126,6 +131,13 @@ def run(args: argparse.Namespace) -> int:
     if 2 * fade >= plan.run_length:
         raise SynthError(f"fade-in plus fade-out ({2 * fade:g} s) must be shorter than the run ({plan.run_length:g} s)",
                          where="--fade")
+    try:
+        timing = plan.timing(args.fade)
+    except DataError as exc:
+        raise SynthError(exc.message, where="--fade" if args.fade is not None else "--duration") from None
+    if timing.w_end > 2.0 * plan.w_max:
+        notes.append(f"the fade-out ({timing.fade_out:.4g} s) carries the sweep on to {timing.w_end:.4g} rad/s, more "
+                     "than twice w_max: a shorter --fade or a longer --duration keeps it nearer")
     if fade > plan.t_max:
         notes.append(f"the fade ({fade:g} s) is longer than T_max ({plan.t_max:.4g} s): the first low-frequency cycle "
                      "is mostly faded out")
@@ -140,14 +152,16 @@ def run(args: argparse.Namespace) -> int:
                      f"({plan.w_min / (2 * math.pi):.3g} Hz): the low-frequency cycles are reduced too")
     try:
         reduce_above = None if args.reduce_above is None else 2.0 * math.pi * args.reduce_above
-        t, u = plan.signal(amplitude=args.amplitude, sample_rate=rate, fade=fade, reduce_above=reduce_above,
+        t, u = plan.signal(amplitude=args.amplitude, sample_rate=rate, fade=args.fade, reduce_above=reduce_above,
                            reduce_to=args.reduce_to)
     except DataError as exc:
-        raise SynthError(exc.message, where="--sample-rate" if "sample rate" in exc.message else "--amplitude") from None
+        where = "--sample-rate" if "sample rate" in exc.message else "--amplitude"
+        raise SynthError(exc.message, where="--fade" if "f_end" in exc.message and not args.sample_rate else where) from None
     out = Path(args.out)
     check_outputs(None, files=[out, args.json], force=args.force)
     header = (f"{GENERATOR}: frequency sweep {plan.w_min:g}-{plan.w_max:g} rad/s, {plan.run_length:g} s, amplitude "
-              f"{args.amplitude:g}, fade {fade:.4g} s, {rate:g} Hz")
+              f"{args.amplitude:g}, fade in {timing.fade_in:.4g} s, full amplitude to w_max at {timing.t_top:.4g} s, "
+              f"fade out {timing.fade_out:.4g} s up to {timing.w_end:.4g} rad/s, {rate:g} Hz")
     if args.reduce_above is not None:
         header += f", amplitude x {args.reduce_to:g} above {args.reduce_above:g} Hz"
         if 2.0 * math.pi * args.reduce_above >= plan.w_max:
@@ -156,7 +170,7 @@ def run(args: argparse.Namespace) -> int:
         raise SynthError("folder does not exist", where=str(out.parent))
     atomic_write_text(out, sweep_csv_text(t, u, args.name, header))
     data = {"generator": GENERATOR, **plan.to_dict(), "duration_s": plan.run_length, "amplitude": args.amplitude,
-            "fade_s": fade, "reduce_above_hz": args.reduce_above,
+            "fade_s": fade, **timing.to_dict(), "reduce_above_hz": args.reduce_above,
             "reduce_to": args.reduce_to if args.reduce_above is not None else None, "sample_rate_hz": rate,
             "samples": int(t.size), "recommended_run_length_s": recommended,
             "csv": str(out), "column": args.name, "notes": notes}
@@ -170,7 +184,10 @@ def run(args: argparse.Namespace) -> int:
             ("longest period T_max", f"{plan.t_max:.4g} s (2 cycles at the start: {low:.4g} s)"),
             ("run length", f"{plan.run_length:g} s (recipe: {recommended:g} s)"),
             ("runs", f"fly {plan.runs_flown}, concatenate the best {plan.runs_used}"),
-            ("amplitude", f"{args.amplitude:g} peak, fade in and out {fade:.4g} s (raised cosine)"),
+            ("swept at full amplitude", f"{plan.w_min:g}-{plan.w_max:g} rad/s (w_max at {timing.t_top:.4g} s)"),
+            ("amplitude", f"{args.amplitude:g} peak, fade in {timing.fade_in:.4g} s (raised cosine)"),
+            ("fade-out", f"{timing.fade_out:.4g} s (raised cosine) above w_max, sweeping on to {timing.w_end:.4g} rad/s"
+                         f" ({timing.w_end / (2 * math.pi):.3g} Hz); ends at rest"),
             ("sample rate", f"{rate:g} Hz, {t.size} samples"),
             ("analysis windows", ", ".join(f"{w:.3g}" for w in plan.windows) + " s")]
     print(name_values(rows, notes))
