@@ -178,15 +178,22 @@ def run(root: Path, args: list[str], tmp: Path) -> tuple[float, float]:
     argv = [sys.executable, "-m", "synth", *[a.replace("{out}", str(out / "r")) for a in args]]
     env = {**{k: v for k, v in os.environ.items() if k != "PYTHONDONTWRITEBYTECODE"},  # as a user's install
            "PYTHONPATH": str(root), **extra}
+    elapsed, cpu, _ = timed_run(argv, root, env)
+    return elapsed, cpu
+
+
+def timed_run(argv: list[str], root: Path, env: dict[str, str]) -> tuple[float, float, subprocess.CompletedProcess]:
+    """Wall and CPU (user + system) time of the command ``argv`` run in ``root``, and the finished process;
+    raises unless it exits 0 or 1 (1: a design that is infeasible, a check or a fit that fails, is still a run)."""
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
     t0 = time.perf_counter()
     proc = subprocess.run(argv, cwd=root, env=env, capture_output=True, text=True)
     elapsed = time.perf_counter() - t0
     after = resource.getrusage(resource.RUSAGE_CHILDREN)
     cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
-    if proc.returncode not in (0, 1):  # 1: a design that is infeasible or a check that fails is still a run
+    if proc.returncode not in (0, 1):
         raise RuntimeError(f"{' '.join(argv)} in {root} exited {proc.returncode}:\n{proc.stderr[-2000:]}")
-    return elapsed, cpu
+    return elapsed, cpu, proc
 
 
 def baseline_checkout(ref: str, tmp: Path) -> Path:

@@ -19,11 +19,8 @@ from __future__ import annotations
 import argparse
 import json
 import os
-import resource
-import subprocess
 import sys
 import tempfile
-import time
 from pathlib import Path
 
 import numpy as np
@@ -31,7 +28,7 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from benchmarks.cli_speed import baseline_checkout, remove_checkout  # noqa: E402
+from benchmarks.cli_speed import baseline_checkout, remove_checkout, timed_run  # noqa: E402
 from synth.ident.simulate import simulate_plant  # noqa: E402
 from synth.plant import Plant  # noqa: E402
 
@@ -77,14 +74,7 @@ def run(root: Path, csv: Path, structure: str, out: Path) -> tuple[float, float,
     argv = [sys.executable, "-m", "synth", "identify", "--data", str(csv), "--structure", structure, "--delay", "fit",
             "--no-figures", "--quiet", "--out", str(out), "--json", str(out / "r.json"), "--force"]
     env = {**os.environ, "PYTHONPATH": str(root), "SYNTH_IDENTIFY_CACHE": "off"}
-    before = resource.getrusage(resource.RUSAGE_CHILDREN)
-    t0 = time.perf_counter()
-    proc = subprocess.run(argv, cwd=root, env=env, capture_output=True, text=True)
-    wall = time.perf_counter() - t0
-    after = resource.getrusage(resource.RUSAGE_CHILDREN)
-    cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
-    if proc.returncode not in (0, 1):
-        raise RuntimeError(f"{' '.join(argv)} in {root} exited {proc.returncode}:\n{proc.stderr[-2000:]}")
+    wall, cpu, proc = timed_run(argv, root, env)
     return wall, cpu, json.loads((out / "r.json").read_text()) if proc.returncode == 0 else None
 
 

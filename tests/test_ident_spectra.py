@@ -38,7 +38,7 @@ def clean():
 def test_noise_free_estimate_matches_exact_response_over_band(clean):
     r = clean
     assert r.band.found and r.band.w_min == pytest.approx(0.4) and r.band.w_max > 8.0
-    # up to 8 rad/s (the band's top decade is kept out for the hold's lag below); the zero-order hold of the
+    # up to 8 rad/s: the zero-order hold of the
     # simulated 50 Hz input adds half a sample of lag (2.3 deg at 8 rad/s) to the exact G(jw)
     m = r.band.contains(r.w) & (r.w <= 8.0)
     H0 = PLANT.freqresp(r.w[m])
