@@ -226,6 +226,13 @@ def pair_profile(record: Record, fit: TimeFitResult) -> list[PairProfile]:
     >>> prof = pair_profile(rec, wrong)[0]
     >>> round(prof.zero, 2), round(prof.pole, 2), round(float(prof.locations[np.argmax(prof.drop)]), 1)
     (1.56, 1.75, 20.7)
+
+    :func:`relocate_pair` refits from there and keeps the better fit:
+
+    >>> from synth.ident.structure import parse_structure
+    >>> moved = relocate_pair(rec, wrong, parse_structure("k*(s+z)/((s+p1)*(s+p2))"), None, None)
+    >>> moved.plant.to_string(3), moved.solver["pair_profile"][-1]["refit"]
+    ('8.04*(s+21.2)/((s+19.4)*(s+2))', 'kept: a lower residual')
     """
     w = record.u - record.u[0]
     mask = np.ones(w.size, bool) if fit.weights is None else fit.weights > 0  # the samples the fit's cost used
@@ -281,19 +288,18 @@ def relocate_pair(record: Record, fit: TimeFitResult, structure: Structure, dela
 
     Examples
     --------
-    The record and the fit of :func:`pair_profile`'s example:
+    A relocation from a wrong basin ends :func:`pair_profile`'s example. A fit without a pole and a zero near
+    each other has no pair to profile and is returned as it is:
 
     >>> from synth.data import record_from_arrays
     >>> from synth.ident.simulate import simulate_plant
     >>> from synth.ident.structure import parse_structure
-    >>> t = np.arange(0, 40, 0.005); u = np.where((t % 4) < 2, 1.0, 0.0)
-    >>> y = simulate_plant(Plant.from_string("8*(s+22)/((s+2)*(s+20))"), t, u)
-    >>> rec = record_from_arrays(t, u, y + 0.01 * np.std(y) * np.random.default_rng(0).normal(size=t.size))
+    >>> t = np.arange(0, 8, 0.01); u = np.where((t % 4) < 2, 1.0, 0.0)
+    >>> y = simulate_plant(Plant.from_string("2*(s+20)/((s+2)*(s+5))"), t, u)
     >>> st = parse_structure("k*(s+z)/((s+p1)*(s+p2))")
-    >>> wrong = fit_structure(rec, st, initial={"k": 8, "z": 3, "p1": 2, "p2": 3.3})
-    >>> moved = relocate_pair(rec, wrong, st, None, None)
-    >>> moved.plant.to_string(3), moved.solver["pair_profile"][-1]["refit"]
-    ('8.04*(s+21.2)/((s+19.4)*(s+2))', 'kept: a lower residual')
+    >>> fit = fit_structure(record_from_arrays(t, u, y), st)
+    >>> relocate_pair(record_from_arrays(t, u, y), fit, st, None, None) is fit
+    True
     """
     profiles = pair_profile(record, fit)
     if not profiles:
