@@ -19,6 +19,9 @@ from synth.sim.blocks import RateLimit
 PLANT = "20/(s+10)"
 ROOT = Path(__file__).resolve().parents[1]
 
+# one worker: the 300,000-sample record is written once, and no two diagnoses with their own workers run at once
+pytestmark = pytest.mark.xdist_group("gap_interrupt")
+
 
 @pytest.fixture(scope="module")
 def big_csv(tmp_path_factory):
