@@ -260,17 +260,11 @@ def fit_by_direction(record: Record, structure: Structure | str, delay: str | fl
         compared = Steps(steps.index[1:], steps.direction[1:], steps.low, steps.high)
     up_avg = average_steps(record, compared, "edge", direction=1)
     down_avg = average_steps(record, compared, "edge", direction=-1)
-    up = _fit_direction(up_avg.record(), structure, delay, sensor, start)
-    down = _fit_direction(down_avg.record(), structure, delay, sensor, start)
+    up = fit_structure(up_avg.record(), structure, delay, sensor, initial=start, check=True)
+    down = fit_structure(down_avg.record(), structure, delay, sensor, initial=start, check=True)
     if start is not None:  # labelled as the fit of both directions
         up = relabel_fit(up, start)
     return compare_fits(up, down, alpha, up_avg, down_avg, unsettled_fraction(record, steps, [up.plant, down.plant]))
-
-
-def _fit_direction(record: Record, structure: Structure | str, delay: str | float | None,
-                   sensor: Plant | str | None, start: dict[str, float] | None) -> TimeFitResult:
-    """One direction's checked fit from ``start`` (the deterministic start without one)."""
-    return fit_structure(record, structure, delay, sensor, initial=start, check=True)
 
 
 def unsettled_fraction(record: Record, steps: Steps, models: list[Plant]) -> float:

@@ -38,13 +38,7 @@ def exchangeable_groups(structure: Structure) -> list[list[str]]:
     """
     names = list(structure.parameters)
     theta = np.random.default_rng(20261204).uniform(0.5, 2.0, len(names))
-
-    def normalized(values: np.ndarray) -> np.ndarray:
-        num, den = structure.coefficients(values)
-        scale = den[np.flatnonzero(den)[0]] if np.any(den) else 1.0
-        return np.r_[np.asarray(num, float), np.asarray(den, float)] / scale
-
-    base = normalized(theta)
+    base = structure.normalized_coefficients(theta)
     parent = list(range(len(names)))
 
     def root(i: int) -> int:
@@ -56,7 +50,7 @@ def exchangeable_groups(structure: Structure) -> list[list[str]]:
         for j in range(i + 1, len(names)):
             swapped = theta.copy()
             swapped[[i, j]] = swapped[[j, i]]
-            if np.allclose(normalized(swapped), base, rtol=1e-10, atol=1e-12):
+            if np.allclose(structure.normalized_coefficients(swapped), base, rtol=1e-10, atol=1e-12):
                 parent[root(j)] = root(i)
     groups: dict[int, list[str]] = {}
     for i, name in enumerate(names):

@@ -176,7 +176,7 @@ def identify(record: RecordLike, structure: Structure | str, delay: str | float 
     try:
         fit = fit_structure(data, structure, delay, sensor, periodic, check=True)
         failed = "" if avg is None else _implausible_average_fit(fit, record.dt)
-        if avg is None and (why := start_transient_failure(fit.t, fit.y, fit.yhat, settling_time(fit.measured))):
+        if avg is None and (why := _missed_start(fit)):
             raise FitError(f"fit of {structure.formula!r} failed: {why}", where=record.source)
     except FitError as exc:
         if avg is None or average != "auto" or by_direction:
@@ -188,8 +188,7 @@ def identify(record: RecordLike, structure: Structure | str, delay: str | float 
         missed_start = ""
         try:
             whole_fit = fit_structure(record, structure, delay, sensor, False, check=True)
-            missed_start = start_transient_failure(whole_fit.t, whole_fit.y, whole_fit.yhat,
-                                                   settling_time(whole_fit.measured))  # it too assumes rest at t = 0
+            missed_start = _missed_start(whole_fit)  # it too assumes the plant at rest at the first input sample
             if missed_start:
                 raise FitError(missed_start, where=record.source)
         except FitError as whole_error:
@@ -280,6 +279,12 @@ def _implausible_average_fit(fit: TimeFitResult, dt: float) -> str:
         return (f"its model {fit.plant.to_string(4)} has a pole or zero beyond the record's Nyquist frequency "
                 f"({np.pi / dt:.4g} rad/s)")
     return ""
+
+
+def _missed_start(fit: TimeFitResult) -> str:
+    """Why a whole-record fit misses the record's start (:func:`start_transient_failure` over the fitted model's
+    settling time), or ``""``."""
+    return start_transient_failure(fit.t, fit.y, fit.yhat, settling_time(fit.measured))
 
 
 def _unstable(plant: Plant) -> bool:

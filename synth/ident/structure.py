@@ -308,6 +308,19 @@ class Structure:
             raise ModelError(f"structure {self.formula!r}: the denominator vanishes at these parameter values")
         return Plant(num, den, float(delay), **kwargs)
 
+    def normalized_coefficients(self, theta: Sequence[float]) -> np.ndarray:
+        """Numerator then denominator coefficients at ``theta``, divided by the denominator's leading nonzero one:
+        equal for two parameter vectors exactly when they give the same transfer function.
+
+        Examples
+        --------
+        >>> parse_structure("k/(T*s+1)").normalized_coefficients([2.0, 0.5]).tolist()
+        [4.0, 1.0, 2.0]
+        """
+        num, den = self.coefficients(np.asarray(theta, float))
+        lead = den[np.flatnonzero(den)[0]] if np.any(den) else 1.0
+        return np.r_[np.asarray(num, float), np.asarray(den, float)] / lead
+
     def sign_symmetries(self) -> list[tuple[str, ...]]:
         """Sets of parameters whose joint change of sign leaves the transfer function unchanged.
 
@@ -455,17 +468,12 @@ def _sign_symmetries(formula: str) -> tuple[tuple[str, ...], ...]:
     if len(names) > 10:
         return ()
     theta = np.random.default_rng(20261205).uniform(0.5, 2.0, len(names))
-
-    def normalized(values: np.ndarray) -> np.ndarray:
-        num, den = st.coefficients(values)
-        lead = den[np.flatnonzero(den)[0]] if np.any(den) else 1.0
-        return np.r_[num, den] / lead
-
-    base = normalized(theta)
+    base = st.normalized_coefficients(theta)
     found = []
     for mask in range(1, 2 ** len(names)):
         signs = np.array([-1.0 if mask >> i & 1 else 1.0 for i in range(len(names))])
-        if np.allclose(normalized(signs * theta), base, rtol=1e-10, atol=1e-12 * float(np.max(np.abs(base)))):
+        flipped = st.normalized_coefficients(signs * theta)
+        if np.allclose(flipped, base, rtol=1e-10, atol=1e-12 * float(np.max(np.abs(base)))):
             found.append(tuple(n for i, n in enumerate(names) if mask >> i & 1))
     return tuple(sorted(found, key=lambda g: (len(g), [names.index(n) for n in g])))
 

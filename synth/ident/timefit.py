@@ -483,8 +483,8 @@ def fit_structure(record: Record, structure: Structure | str, delay: str | float
         params[delay_name], std[delay_name] = float(d_hat), 0.0
     ci = {k: (params[k] - tq * std[k], params[k] + tq * std[k]) for k in params}
     plant = st.plant(theta, delay=d_hat, input=record.input, output=record.output, label="identified")
-    if nyquist_note(plant, dt):
-        info["nyquist_note"] = nyquist_note(plant, dt)
+    if beyond := nyquist_note(plant, dt):
+        info["nyquist_note"] = beyond
     measured = plant.series(sensor) if sensor is not None else plant
     if sensor is not None:
         measured = Plant(measured.num, measured.den, d_hat, record.input, record.output, "identified with sensor")
