@@ -19,6 +19,13 @@ plant). Two rates:
   output offset) leaves out: on a short record with a slowly decaying mode that start-up transient biases even
   the fit from the truth by more than that, whatever the start.
 
+Since session 46 every whole-record fit tests its start state (:mod:`synth.ident.start_state`) and
+:func:`synth.ident.identification.identify` (``average="none"``) fits a record whose start state matters again
+from where it has died out (:mod:`synth.ident.unknown_start`). Each case is identified that way too:
+
+- after the start test: identify did not fail and every parameter lies within 5 of its reported standard errors;
+- start left out: identify left out a start (on a record from rest, a false alarm).
+
 Run:  nice -n 10 python benchmarks/ident_cut_records.py [--cases 60] [--seed 45] [--json out.jsonl]
       (PYTHONPATH=<other checkout> runs another version of synth on the same cases)
 """
@@ -34,6 +41,8 @@ import numpy as np
 from scipy.signal import butter, sosfilt
 
 from synth.data import record_from_arrays
+from synth.errors import FitError
+from synth.ident.identification import identify
 from synth.ident.simulate import simulate_plant
 from synth.ident.timefit import fit_structure
 from synth.plant import Plant
@@ -114,6 +123,18 @@ def run_case(case: dict[str, Any]) -> dict[str, Any]:
     to_ref = max(abs(got[p] - best[p]) / max(ref.std[p], 1e-300) for p in ("k", "w", "z"))
     failure = fit.solver.get("failure", "")
     worst = max(sigmas.values())
+    t1 = time.perf_counter()
+    try:
+        res = identify(record_from_arrays(case["t"], case["u"], case["y"]), STRUCTURE, average="none",
+                       compare_directions=False)
+        after, left_out, first = canonical(res.fit.parameters), bool(res.whole_record_note), \
+            float(res.fit.solver["start_state"]["first"])
+        after_sigmas = {p: abs(after[p] - case["truth"][p]) / max(res.fit.std[p], 1e-300) for p in ("k", "w", "z")}
+        after_failure = ""
+    except FitError as exc:
+        after_sigmas = {p: float("inf") for p in ("k", "w", "z")}
+        left_out, first, after_failure = False, float("nan"), str(exc)
+    after_seconds = time.perf_counter() - t1
     return {"seed": case["seed"], "index": case["index"], "n": case["n"], "dt": case["dt"], "kind": case["kind"],
             "start": case["start"], "truth": case["truth"], "fit": fit.parameters, "std": fit.std,
             "initial": fit.initial, "start_w_ratio": start["w"] / case["truth"]["w"], "start_z": start["z"],
@@ -121,7 +142,10 @@ def run_case(case: dict[str, Any]) -> dict[str, Any]:
             "to_truth_start_fit": to_ref, "truth_start_fit": ref.parameters,
             "in_basin": (not failure) and to_ref <= 0.5, "within_5_std": (not failure) and worst <= 5.0,
             "negative_w": fit.parameters["w"] < 0,
-            "seconds": elapsed}
+            "seconds": elapsed, "after_sigmas": after_sigmas, "after_worst_sigma": max(after_sigmas.values()),
+            "after_within_5_std": (not after_failure) and max(after_sigmas.values()) <= 5.0,
+            "start_left_out": left_out, "first_fitted": first, "after_failure": after_failure,
+            "after_seconds": after_seconds}
 
 
 def main() -> None:
@@ -131,7 +155,8 @@ def main() -> None:
     ap.add_argument("--seed", type=int, default=45)
     ap.add_argument("--json", default=None, help="append one JSON line per case")
     args = ap.parse_args()
-    hits = near = negative = 0
+    hits = near = negative = after_near = 0
+    left_out = {"rest": [0, 0], "cut": [0, 0]}  # start left out, cases
     done = 0
     for i in range(args.first, args.first + args.cases):
         row = run_case(make_case(args.seed, i))
@@ -139,17 +164,26 @@ def main() -> None:
         hits += row["in_basin"]
         near += row["within_5_std"]
         negative += row["negative_w"]
+        after_near += row["after_within_5_std"]
+        left_out[row["start"]][0] += row["start_left_out"]
+        left_out[row["start"]][1] += 1
         tr, st = row["truth"], row["initial"]
         print(f"{i:3d} n={row['n']:6d} dt={row['dt'] * 1e3:5.2f}ms {row['kind']:9s} {row['start']:4s} "
               f"w={tr['w']:8.2f} z={tr['z']:.3f} | start w={st['w']:10.3g} z={st['z']:8.3g} | "
               f"worst {row['worst_sigma']:9.3g} sd, {row['to_truth_start_fit']:9.3g} sd from the truth's fit, fit "
               f"{row['fit_percent']:6.2f} % {'OK ' if row['in_basin'] else 'OUT'} {row['seconds']:5.1f}s "
-              f"{row['failure'][:50]}", flush=True)
+              f"{row['failure'][:50]} | after the start test worst {row['after_worst_sigma']:8.3g} sd"
+              f"{(', from ' + format(row['first_fitted'], '.4g') + ' s') if row['start_left_out'] else ''} "
+              f"{row['after_seconds']:5.1f}s "
+              f"{row['after_failure'][:60]}", flush=True)
         if args.json:
             with open(args.json, "a") as fh:
                 fh.write(json.dumps(row) + "\n")
     print(f"in the truth's basin: {hits}/{done} ({100.0 * hits / max(done, 1):.1f} %); within 5 std of the truth: "
           f"{near}/{done} ({100.0 * near / max(done, 1):.1f} %); negative w reported: {negative}")
+    print(f"after the start test (identify): within 5 std {after_near}/{done}; start left out on "
+          f"{left_out['cut'][0]}/{left_out['cut'][1]} cut records and {left_out['rest'][0]}/{left_out['rest'][1]} "
+          "records from rest")
 
 
 if __name__ == "__main__":

@@ -2,7 +2,9 @@
 
 Found by a black-box test on the real HSM150 drive records: the torque is already at its first level at t = 0 while
 the speed starts from rest; the whole-record fit assumed the plant settled at that level, and returned K 6084 and
-T 0.68 s (fit 39.7 %, exit 0) where a fit after the start gives about 3710 and 1.42 s.
+T 0.68 s (fit 39.7 %, exit 0) where a fit after the start gives about 3710 and 1.42 s. Session 44 made that a failed
+fit; since session 46 the start state is tested (synth.ident.start_state) and left out where it matters
+(synth.ident.unknown_start): the record is fitted from where the start-up transient has died out.
 """
 
 from __future__ import annotations
@@ -31,10 +33,17 @@ def _record(start_at_rest: bool, seed: int) -> tuple[np.ndarray, np.ndarray, np.
 
 
 @pytest.mark.parametrize("seed", [0, 1])
-def test_a_record_starting_mid_transient_is_a_failed_fit(seed: int) -> None:
+def test_a_record_starting_mid_transient_is_fitted_after_its_start(seed: int) -> None:
     t, u, y = _record(False, seed)
-    with pytest.raises(FitError, match="not at rest at the first input sample"):
-        identify((t, u, y), "K/(T*s+1)")
+    res = identify((t, u, y), "K/(T*s+1)")
+    fit, test = res.fit, res.fit.solver["start_state"]
+    assert "does not start at rest" in res.whole_record_note and "weighted 0" in res.whole_record_note
+    # the free response 2 exp(-2 t) falls below the noise (0.01) after ln(200)/2 = 2.6 s: not before it, nor past
+    # the step at 10 s
+    assert 2.6 <= test["first"] < 10.0 and not test["matters"]
+    assert fit.weights is not None and fit.weights[t < test["first"] - 0.01].sum() == 0
+    assert fit.parameters["K"] == pytest.approx(2.0, abs=4 * fit.std["K"])
+    assert fit.parameters["T"] == pytest.approx(0.5, abs=4 * fit.std["T"])
 
 
 @pytest.mark.parametrize("seed", [0, 1])
@@ -46,12 +55,26 @@ def test_a_record_starting_settled_is_fitted(seed: int) -> None:
 
 
 def test_the_real_hsm150_record(run_cli) -> None:
+    """The README: a step from rest at t = 0 and one of -0.010 N m at 10 s, 63 % of it within 1.1-1.9 s; the
+    incremental gain from the 2-s means before each step's end is 3937 rad/s per N m on this run (computed here)."""
     path = HSM / "idf_neg_0.04_1.mat"
     if not path.exists():
         pytest.skip(f"needs the shared data folder {HSM} (present in CI and the dev workspace)")
+    import json
+
+    from scipy.io import loadmat
+
+    data = loadmat(path, squeeze_me=True)["data"]
+    t, torque, speed = data[:, 0], data[:, 4], data[:, 3]
+    gain = (speed[t >= 18.0].mean() - speed[(t >= 8.0) & (t < 10.0)].mean()) / (torque[-1] - torque[9000])
     r = run_cli("identify", "--data", str(path), "--columns", "data[0]=t,data[4]=torque,data[3]=speed", "--time", "t",
                 "--input", "torque", "--output", "speed", "--structure", "K/(T*s+1)", "--no-figures", "--json", "-")
-    assert r.code == 1 and "not at rest at the first input sample" in r.err and "--average edge" in r.err
+    assert r.code == 0, r.err
+    out = json.loads(r.out)
+    assert "does not start at rest" in out["whole_record"]
+    assert out["solver"]["start_state"]["first"] < 11.5  # the second step's transient stays in the fit
+    assert out["parameters"]["K"] == pytest.approx(gain, rel=0.05)
+    assert 1.1 <= out["parameters"]["T"] <= 1.9
 
 
 def _train_from_mid_transient(seed: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -79,8 +102,13 @@ def test_the_whole_record_fitted_after_a_failed_average_is_checked_at_its_start_
         return real(data, *args, **kwargs)
 
     monkeypatch.setattr(identification, "fit_structure", failing_on_the_average)
-    with pytest.raises(FitError, match="not at rest at the first input sample"):
-        identify((t, u, y), "K/(T*s+1)", compare_directions=False)
+    res = identify((t, u, y), "K/(T*s+1)", compare_directions=False)  # the fallback leaves the start out
+    assert "fitted the whole record instead, the record does not start at rest" in res.whole_record_note
+    assert res.fit.solver["start_state"]["first"] >= 2.6 and not res.fit.solver["start_state"]["matters"]
+    # (lsim interpolates the input linearly between samples: its eight edges are half a sample late against the
+    # zero-order hold the fit assumes, which pulls T by about 0.5 %, 7 std here)
+    assert res.fit.parameters["K"] == pytest.approx(2.0, rel=0.01)
+    assert res.fit.parameters["T"] == pytest.approx(0.5, rel=0.01)
     # the same record with the plant settled at the first input is fitted by the fallback, near the truth
     y_settled = y + 2.0 * np.exp(-2.0 * t)  # the response from y = 2 (settled at u = 1) instead of from rest
     res = identify((t, u, y_settled), "K/(T*s+1)", compare_directions=False)

@@ -22,10 +22,10 @@ from synth.ident.directions import DirectionComparison, fit_by_direction
 from synth.ident.nyquist import beyond_nyquist
 from synth.ident.pair_relocation import relocate_pair
 from synth.ident.periodic_start import fit_whole_record, refit_periodic_start, settling_time
-from synth.ident.start_transient import start_transient_failure
 from synth.ident.steps import StepAverage, average_steps, find_steps
 from synth.ident.structure import Structure, parse_structure
 from synth.ident.timefit import TimeFitResult, fit_structure
+from synth.ident.unknown_start import fit_from_unknown_start
 from synth.plant import Plant
 
 __all__ = ["IdentifyResult", "identify", "settling_time"]
@@ -50,7 +50,8 @@ class IdentifyResult:
     by_direction : bool
         The up and down fits are the result (a direction-dependent model was asked for).
     whole_record_note : str
-        Set when the edge windows were too short for the model to settle and the whole record was fitted.
+        Set when the edge windows were too short for the model to settle and the whole record was fitted, or when a
+        whole-record fit left out a start state that was not at rest (:mod:`synth.ident.unknown_start`).
 
     Examples
     --------
@@ -176,8 +177,6 @@ def identify(record: RecordLike, structure: Structure | str, delay: str | float 
     try:
         fit = fit_structure(data, structure, delay, sensor, periodic, check=True)
         failed = "" if avg is None else _implausible_average_fit(fit, record.dt)
-        if avg is None and (why := _missed_start(fit)):
-            raise FitError(f"fit of {structure.formula!r} failed: {why}", where=record.source)
     except FitError as exc:
         if avg is None or average != "auto" or by_direction:
             raise
@@ -185,24 +184,27 @@ def identify(record: RecordLike, structure: Structure | str, delay: str | float 
     if failed and average == "auto" and not by_direction:
         # the average's fit failed (e.g. IPOPT at its limit on a few short edge windows, or a diverged pole):
         # the whole record, which holds the same steps and assumes less, from its own deterministic start
-        missed_start = ""
+        def both_failed(whole_error: FitError) -> FitError:
+            average_failed = failed if fit is not None else f"fit failed ({failed})"
+            return FitError(f"fit of {structure.formula!r} failed: the {avg.mode} average's {average_failed}, and "
+                            f"the whole record's fit failed too ({whole_error}); try another structure, a fixed delay "
+                            "or a shorter part of the record", where=record.source)
+
         try:
             whole_fit = fit_structure(record, structure, delay, sensor, False, check=True)
-            missed_start = _missed_start(whole_fit)  # it too assumes the plant at rest at the first input sample
-            if missed_start:
-                raise FitError(missed_start, where=record.source)
         except FitError as whole_error:
-            if fit is None and not missed_start:
+            if fit is None:
                 raise error from None  # both failed: the average's reason is the one to read
-            average_failed = failed if fit is not None else f"fit failed ({failed})"
-            raise FitError(f"fit of {structure.formula!r} failed: the {avg.mode} average's {average_failed}, and the "
-                           f"whole record's fit failed too ({whole_error}); try another structure, a fixed delay "
-                           "or a shorter part of the record", where=record.source) from None
+            raise both_failed(whole_error) from None
         if not _unstable(whole_fit.measured):
             whole_fit = _other_pair_minima(record, whole_fit, structure, delay, sensor)
+            try:  # it too assumes the plant at rest at the first input sample
+                whole_fit, from_later = fit_from_unknown_start(record, whole_fit, structure, delay, sensor)
+            except FitError as whole_error:
+                raise both_failed(whole_error) from None
             return IdentifyResult(record, whole_fit, avg, None, "", False,
                                   f"the fit of the {avg.mode} average failed ({failed}); fitted the whole record "
-                                  "instead, from rest")
+                                  "instead, " + (from_later or "from rest"))
         if fit is None:
             raise FitError(f"fit of {structure.formula!r} failed: the {avg.mode} average's fit failed ({failed}) "
                            f"and the whole record's model is unstable ({whole_fit.measured.to_string(4)}); try "
@@ -215,6 +217,8 @@ def identify(record: RecordLike, structure: Structure | str, delay: str | float 
         if not whole:
             fit, avg, whole = refit_periodic_start(record, avg, fit, structure, delay, sensor)
     fit = _other_pair_minima(record, fit, structure, delay, sensor)
+    if avg is None:  # a start state that is not at rest is left out (synth.ident.unknown_start)
+        fit, whole = fit_from_unknown_start(record, fit, structure, delay, sensor)
     directions, note = None, ""
     if two_ways and (compare_directions or by_direction):
         try:
@@ -279,12 +283,6 @@ def _implausible_average_fit(fit: TimeFitResult, dt: float) -> str:
         return (f"its model {fit.plant.to_string(4)} has a pole or zero beyond the record's Nyquist frequency "
                 f"({np.pi / dt:.4g} rad/s)")
     return ""
-
-
-def _missed_start(fit: TimeFitResult) -> str:
-    """Why a whole-record fit misses the record's start (:func:`start_transient_failure` over the fitted model's
-    settling time), or ``""``."""
-    return start_transient_failure(fit.t, fit.y, fit.yhat, settling_time(fit.measured))
 
 
 def _unstable(plant: Plant) -> bool:

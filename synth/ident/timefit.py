@@ -47,6 +47,7 @@ from synth.ident.nyquist import nyquist_note
 from synth.ident.residual_whiteness import correlated_residuals_note
 from synth.ident.sim_error_problem import SimulationErrorProblem
 from synth.ident.srivc import linear_initial_model, map_to_structure
+from synth.ident.start_state import start_state_test
 from synth.ident.structure import Structure, parse_structure
 from synth.plant import Plant
 
@@ -488,6 +489,9 @@ def fit_structure(record: Record, structure: Structure | str, delay: str | float
     measured = plant.series(sensor) if sensor is not None else plant
     if sensor is not None:
         measured = Plant(measured.num, measured.den, d_hat, record.input, record.output, "identified with sensor")
+    if not periodic:  # a start state that is not at rest (synth.ident.start_state)
+        rows = np.arange(n) if mask is None else np.flatnonzero(mask)
+        info["start_state"] = start_state_test(J, resid, rows, n, measured, dt, d_hat, sd, values, names).to_dict()
     return TimeFitResult(st, params, std, ci, names, cov, float(d_hat), fit_delay, b_hat, float(sd[-1]),
                          fit_pct, float(np.sqrt(s2)), plant, sensor, measured, initial_out, info, t.copy(), y.copy(),
                          yhat, u0, periodic, weights)

@@ -1,0 +1,87 @@
+"""A whole-record fit whose record does not start at rest: fitted again from where the start state has died out.
+
+:mod:`synth.ident.start_state` tests every whole-record fit for a start state that matters; here such a fit is
+repeated with the samples weighted 0 (simulated from rest, not fitted) until the estimated free response has less
+energy left than one noise variance, at most a quarter of the samples left per round, from the previous fit's
+parameters, and tested again from its first fitted sample, for at most :data:`ROUNDS` refits, leaving out at most
+:data:`KEEP` of the record.
+"""
+
+from __future__ import annotations
+
+from synth.data.record import Record
+from synth.errors import DataError, FitError
+from synth.ident.start_state import ALPHA, StartState
+from synth.ident.structure import Structure
+from synth.ident.timefit import TimeFitResult, fit_structure
+from synth.plant import Plant
+
+__all__ = ["KEEP", "ROUNDS", "fit_from_unknown_start"]
+
+ROUNDS = 4
+"""Refits at most; each starts where the previous fit's estimated free response had died out."""
+
+KEEP = 0.75
+"""The refits leave out at most this share of the record."""
+
+
+def fit_from_unknown_start(record: Record, fit: TimeFitResult, structure: Structure, delay: str | float | None,
+                           sensor: Plant | str | None) -> tuple[TimeFitResult, str]:
+    """``fit`` (of the whole ``record`` from rest) where its start state does not matter
+    (``fit.solver["start_state"]``); else the record fitted again without its first samples, as above.
+    Returns the fit and a note (``""`` for the fit as given; otherwise also in ``solver["start_state_note"]``).
+
+    Raises
+    ------
+    FitError
+        The start state still matters after :data:`ROUNDS` refits, or more than :data:`KEEP` of the record would be
+        left out.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from synth.data import record_from_arrays
+    >>> from synth.ident.structure import parse_structure
+    >>> from scipy import signal
+    >>> t = np.arange(0.0, 30.0, 0.01); rng = np.random.default_rng(1)
+    >>> u = np.repeat(rng.normal(size=300), 10)
+    >>> sys = signal.StateSpace([[-0.5]], [[1.0]], [[1.0]], [[0.0]])   # k = 1, p = 0.5
+    >>> y = signal.lsim(sys, u, t, X0=[4.0], interp=False)[1] + 0.01 * rng.normal(size=t.size)
+    >>> record = record_from_arrays(t, u, y)
+    >>> first = fit_structure(record, "k/(s+p)")
+    >>> round(abs(first.parameters["p"] - 0.5) / first.std["p"])     # the fit from rest: biased
+    37
+    >>> fit, note = fit_from_unknown_start(record, first, parse_structure("k/(s+p)"), None, None)
+    >>> note[:35], bool(abs(fit.parameters["p"] - 0.5) < 3 * fit.std["p"])
+    ('the record does not start at rest: ', True)
+    """
+    test = StartState.from_dict(fit.solver["start_state"]) if "start_state" in fit.solver else None
+    if test is None or not test.matters:
+        return fit, ""
+    first_test, fitted, why = test, 0.0, f"after {ROUNDS} refits"
+    for _ in range(ROUNDS):
+        # the window comes from a fit the start state bent, whose modes may be far too slow: a quarter of what is
+        # left at most per round, the next round's fit (less bent) tells the rest
+        skip = test.first + min(max(test.window, 2.0 * record.dt), 0.25 * (record.duration - test.first))
+        if skip > KEEP * record.duration:
+            why = f"and leaving out {skip:.3g} s would keep less than {1 - KEEP:.0%} of the record"
+            break
+        weights = ((record.t - record.t[0]) >= skip - 1e-9 * record.dt).astype(float)
+        try:
+            fit = fit_structure(record, structure, delay, sensor, False, initial={**fit.parameters}, weights=weights,
+                                check=True)
+        except DataError as exc:
+            raise FitError(f"fit of {structure.formula!r} failed: the record does not start at rest and the fit "
+                           f"after its first {skip:.3g} s could not be made ({exc})", where=record.source) from None
+        fitted, test = skip, StartState.from_dict(fit.solver["start_state"])
+        if not test.matters:
+            note = (f"the record does not start at rest: the fitted model's free response from an unknown start "
+                    f"state takes {first_test.statistic:.3g} noise variances out of the residual (threshold "
+                    f"{first_test.threshold:.3g}, chi-square with {first_test.dof} degrees of freedom at {ALPHA:g}) "
+                    f"and would move {first_test.shifted} by {first_test.shift:.3g} std; fitted from "
+                    f"{test.first:.4g} s on, the samples before simulated from rest and weighted 0")
+            fit.solver["start_state_note"] = note
+            return fit, note
+    raise FitError(f"fit of {structure.formula!r} failed: the record does not start at rest, and its start state "
+                   f"still moves {test.shifted} by {test.shift:.3g} std with the first {fitted:.3g} s left out, {why}; "
+                   "cut the record to start at rest, or fit a shorter part of it", where=record.source)
