@@ -54,7 +54,7 @@ def test_a_record_starting_settled_is_fitted(seed: int) -> None:
     assert fit.parameters["T"] == pytest.approx(0.5, abs=4 * fit.std["T"] + 1e-3)
 
 
-def test_the_real_hsm150_record(run_cli) -> None:
+def test_the_real_hsm150_record(run_cli, tmp_path) -> None:
     """The README: a step from rest at t = 0 and one of -0.010 N m at 10 s, 63 % of it within 1.1-1.9 s; the
     incremental gain from the 2-s means before each step's end is 3937 rad/s per N m on this run (computed here)."""
     path = HSM / "idf_neg_0.04_1.mat"
@@ -68,7 +68,8 @@ def test_the_real_hsm150_record(run_cli) -> None:
     t, torque, speed = data[:, 0], data[:, 4], data[:, 3]
     gain = (speed[t >= 18.0].mean() - speed[(t >= 8.0) & (t < 10.0)].mean()) / (torque[-1] - torque[9000])
     r = run_cli("identify", "--data", str(path), "--columns", "data[0]=t,data[4]=torque,data[3]=speed", "--time", "t",
-                "--input", "torque", "--output", "speed", "--structure", "K/(T*s+1)", "--no-figures", "--json", "-")
+                "--input", "torque", "--output", "speed", "--structure", "K/(T*s+1)", "--no-figures", "--json", "-",
+                "--out", str(tmp_path / "out"))
     assert r.code == 0, r.err
     out = json.loads(r.out)
     assert "does not start at rest" in out["whole_record"]
