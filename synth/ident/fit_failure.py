@@ -13,7 +13,7 @@ import numpy as np
 from synth.distributions import f_sf
 
 __all__ = ["ABSURD_FACTOR", "CONVERGED_WITHIN", "FAILED_STATUSES", "LIMIT_STATUSES", "SIGNIFICANCE", "fit_failure",
-           "start_ssr"]
+           "remaining_improvement", "start_ssr"]
 
 #: IPOPT return statuses that end a fit without a usable optimum
 FAILED_STATUSES = ("Diverging_Iterates", "Maximum_Iterations_Exceeded", "Maximum_CpuTime_Exceeded",
@@ -177,3 +177,42 @@ def start_ssr(prob: Any, theta0: np.ndarray, d0: float, b0: float, w: np.ndarray
             r = r[mask]
         value = float(r @ r)
     return value if np.isfinite(value) else float("inf")
+
+
+def remaining_improvement(prob: Any, xs: np.ndarray, par: np.ndarray, J: np.ndarray,
+                           resid: np.ndarray, JtJ: np.ndarray, scale_vec: np.ndarray, s2: float, mask: np.ndarray | None,
+                           y: np.ndarray, lb: np.ndarray | None, fit_delay: bool, dt: float) -> float:
+    """How far a fit stopped at a limit still is from its optimum: ``sqrt`` of the best decrease of
+    ``SSR / s^2`` along the Gauss-Newton step (halved down to 1/32), i.e. in standard errors. ``prob`` is the fit's
+    problem (:class:`~synth.ident.sim_error_problem.SimulationErrorProblem` or its convolution counterpart), ``xs``
+    its scaled decision variables, ``J`` and ``resid`` the Jacobian (in the parameters' units) and residual on the
+    fitted samples (``mask``).
+
+    Examples
+    --------
+    >>> class Line:  # y = a t fitted as a scaled a (the decision variable 2 a)
+    ...     p, scale = 1, np.array([0.5])
+    ...     def yhat_fn(self, xs, par): return xs[0] * 0.5 * par
+    >>> t = np.arange(5.0)
+    >>> J, resid = t[:, None], 2.0 * t               # stopped at a = 0 where a = 2 fits
+    >>> round(remaining_improvement(Line(), np.array([0.0]), t, J, resid, J.T @ J, np.array([0.5]), 1.0, None,
+    ...                             2.0 * t, None, False, 0.1), 3)   # sqrt(SSR drop / s^2) = sqrt(120)
+    10.954
+    """
+    step = np.linalg.lstsq(JtJ, J.T @ resid, rcond=None)[0] / scale_vec
+    ssr0 = float(resid @ resid)
+    best = 0.0
+    for alpha in (1.0, 0.5, 0.25, 0.125, 0.0625, 0.03125):
+        trial = xs + alpha * step
+        p = prob.p
+        if lb is not None:
+            trial[:p] = np.maximum(trial[:p], lb / prob.scale)
+        if fit_delay:
+            trial[p] = min(max(trial[p], 0.0), dt)
+        r = y - np.asarray(prob.yhat_fn(trial, par)).ravel()
+        if mask is not None:
+            r = r[mask]
+        ssr = float(r @ r)
+        if np.isfinite(ssr):
+            best = max(best, (ssr0 - ssr) / s2)
+    return float(np.sqrt(best))

@@ -25,7 +25,7 @@ from scipy.stats import chi2
 
 from synth.plant import Plant
 
-__all__ = ["ALPHA", "ANCHORS", "MATERIAL", "StartState", "free_response_basis", "start_state_test"]
+__all__ = ["ALPHA", "ANCHORS", "MATERIAL", "StartState", "free_response_basis", "free_start_gram", "start_state_test"]
 
 ALPHA = 1e-3
 """False-alarm probability of the drop in residual energy on a record that starts at rest (white residuals)."""
@@ -110,6 +110,29 @@ def free_response_basis(plant: Plant, dt: float, length: int) -> np.ndarray:
     u, s, _ = np.linalg.svd(columns, full_matrices=False)
     keep = s > 1e-9 * s[0] if s.size and s[0] > 0 else np.zeros(s.size, dtype=bool)
     return u[:, keep]
+
+
+def free_start_gram(jacobian: np.ndarray, jtj: np.ndarray, rows: np.ndarray, n: int, den: np.ndarray,
+                    dt: float) -> np.ndarray:
+    """``J^T J`` with the free responses of a model with denominator ``den`` from the first fitted sample joined as
+    nuisance columns (after ``J``'s): the Gauss-Newton information of a fit whose start state is unknown. Its inverse's
+    leading block is the parameters' covariance with that state free (never smaller than ``J^T J``'s inverse).
+
+    Examples
+    --------
+    >>> t = np.arange(400) * 0.01
+    >>> J = np.column_stack([1 - np.exp(-t), np.ones(t.size)])   # a gain's and an offset's sensitivities
+    >>> gram = free_start_gram(J, J.T @ J, np.arange(t.size), t.size, np.array([1.0, 1.0]), 0.01)
+    >>> gram.shape, bool(np.linalg.inv(gram)[0, 0] > np.linalg.inv(J.T @ J)[0, 0])
+    ((3, 3), True)
+    """
+    k0 = int(rows[0])
+    model = Plant([1.0], den)
+    Q = free_response_basis(model, dt, _support(model, dt, n - k0))
+    head = int(np.searchsorted(rows - k0, Q.shape[0]))
+    phi = Q[rows[:head] - k0]
+    cross = jacobian[:head].T @ phi
+    return np.block([[jtj, cross], [cross.T, phi.T @ phi]])
 
 
 def _support(model: Plant, dt: float, available: int) -> int:

@@ -18,7 +18,8 @@ than the initial model, a fixed list of other starts is tried (multistart as a f
 Uncertainty
 -----------
 ``cov = s^2 (J^T J)^{-1}`` with ``s^2 = SSR/(N - p)`` and ``J`` the Jacobian
-of ``yhat`` in the parameters (delay and offset included); standard errors are
+of ``yhat`` in the parameters (delay and offset included; with ``free_start``, the
+state at the first fitted sample too, as a nuisance); standard errors are
 the square roots of its diagonal and the 95 % intervals ``theta +- t_{0.975,
 N-p} std``. This assumes white noise. With coloured noise (drift, a
 disturbance spectrum, or a model error) the residuals are correlated and these
@@ -41,13 +42,13 @@ from synth.errors import DataError, FitError, ModelError
 from synth.ident.convolution_problem import ConvolutionProblem
 from synth.ident.covariance import fit_covariance
 from synth.ident.delay_samples import best_sample, walk_intervals
-from synth.ident.fit_failure import LIMIT_STATUSES, fit_failure, start_ssr
+from synth.ident.fit_failure import LIMIT_STATUSES, fit_failure, remaining_improvement, start_ssr
 from synth.ident.identifiability import TiedParameter, WeakParameter, coinciding, tied_to_weak, weak_parameters
 from synth.ident.nyquist import nyquist_note
 from synth.ident.residual_whiteness import correlated_residuals_note
 from synth.ident.sim_error_problem import SimulationErrorProblem
 from synth.ident.srivc import linear_initial_model, map_to_structure
-from synth.ident.start_state import start_state_test
+from synth.ident.start_state import free_start_gram, start_state_test
 from synth.ident.structure import Structure, parse_structure
 from synth.plant import Plant
 
@@ -234,36 +235,12 @@ def _as_sensor(sensor: Plant | str | None) -> Plant | None:
         raise exc.located("sensor") from None
 
 
-def _remaining_improvement(prob: SimulationErrorProblem, xs: np.ndarray, par: np.ndarray, J: np.ndarray,
-                           resid: np.ndarray, JtJ: np.ndarray, scale_vec: np.ndarray, s2: float, mask: np.ndarray | None,
-                           y: np.ndarray, lb: np.ndarray | None, fit_delay: bool, dt: float) -> float:
-    """How far a fit stopped at a limit still is from its optimum: ``sqrt`` of the best decrease of
-    ``SSR / s^2`` along the Gauss-Newton step (halved down to 1/32), i.e. in standard errors."""
-    step = np.linalg.lstsq(JtJ, J.T @ resid, rcond=None)[0] / scale_vec
-    ssr0 = float(resid @ resid)
-    best = 0.0
-    for alpha in (1.0, 0.5, 0.25, 0.125, 0.0625, 0.03125):
-        trial = xs + alpha * step
-        p = prob.p
-        if lb is not None:
-            trial[:p] = np.maximum(trial[:p], lb / prob.scale)
-        if fit_delay:
-            trial[p] = min(max(trial[p], 0.0), dt)
-        r = y - np.asarray(prob.yhat_fn(trial, par)).ravel()
-        if mask is not None:
-            r = r[mask]
-        ssr = float(r @ r)
-        if np.isfinite(ssr):
-            best = max(best, (ssr0 - ssr) / s2)
-    return float(np.sqrt(best))
-
-
 def fit_structure(record: Record, structure: Structure | str, delay: str | float | None = None,
                   sensor: Plant | str | None = None, periodic: bool = False,
                   initial: dict[str, float] | None = None,
                   lower: dict[str, float] | None = None,
                   weights: np.ndarray | None = None, check: bool = False, solver: str = "auto",
-                  rtol: float = 0.0) -> TimeFitResult:
+                  rtol: float = 0.0, free_start: bool = False) -> TimeFitResult:
     """Fit a structure to a record by simulation error (casadi + IPOPT).
 
     Parameters
@@ -304,6 +281,9 @@ def fit_structure(record: Record, structure: Structure | str, delay: str | float
     rtol : float
         Convolution solver only: also converged when the SSR decrease still available is below ``rtol`` times
         the SSR (for callers that alternate fits to a tolerance of their own); default 0, to the noise floor.
+    free_start : bool
+        The plant's state at the first fitted sample is unknown: a nuisance in the covariance (the fit still
+        simulates from rest at the first sample; leave out a start that matters with ``weights``).
 
     Returns
     -------
@@ -449,9 +429,14 @@ def fit_structure(record: Record, structure: Structure | str, delay: str | float
         J, resid = J[mask], resid[mask]
     dof = resid.size - J.shape[1]
     s2 = float(np.sum(resid**2) / dof)
-    JtJ = J.T @ J
+    JtJ, rows = J.T @ J, (np.arange(n) if mask is None else np.flatnonzero(mask))
+    # a record known not to start at rest (synth.ident.unknown_start): the state at the first fitted sample is a
+    # nuisance whose uncertainty the parameters carry
+    gram = free_start_gram(J, JtJ, rows, n, np.polymul(st.coefficients(theta)[1], [1.0] if sensor is None else
+                                                       sensor.den), dt) if free_start else JtJ
     # an output interpolated from uneven stamps: its residuals understate the noise the estimates carry
-    cov, note = fit_covariance(JtJ, s2 * record.noise_factor, p if fit_delay else None, dt)
+    cov, note = fit_covariance(gram, s2 * record.noise_factor, p if fit_delay else None, dt)
+    cov = cov[:J.shape[1], :J.shape[1]]
     correlated = correlated_residuals_note(resid)
     if note or correlated:
         info["covariance_note"] = "; ".join(n for n in (note, correlated) if n)
@@ -459,7 +444,7 @@ def fit_structure(record: Record, structure: Structure | str, delay: str | float
         sd = np.sqrt(np.clip(np.diag(cov), 0.0, None))
     remaining = float("inf")
     if st_info.get("status") in LIMIT_STATUSES and s2 > 0 and np.all(np.isfinite(JtJ)):
-        remaining = _remaining_improvement(prob, xs, par, J, resid, JtJ, scale_vec, s2, mask, y, lb, fit_delay, dt)
+        remaining = remaining_improvement(prob, xs, par, J, resid, JtJ, scale_vec, s2, mask, y, lb, fit_delay, dt)
         info["remaining_improvement_std"] = remaining
     fitted = dict(zip(st.parameters, theta.tolist()))
     failure = fit_failure(fitted, theta0, st_info.get("status"),
@@ -490,7 +475,6 @@ def fit_structure(record: Record, structure: Structure | str, delay: str | float
     if sensor is not None:
         measured = Plant(measured.num, measured.den, d_hat, record.input, record.output, "identified with sensor")
     if not periodic:  # a start state that is not at rest (synth.ident.start_state)
-        rows = np.arange(n) if mask is None else np.flatnonzero(mask)
         info["start_state"] = start_state_test(J, resid, rows, n, measured, dt, d_hat, sd, values, names).to_dict()
     return TimeFitResult(st, params, std, ci, names, cov, float(d_hat), fit_delay, b_hat, float(sd[-1]),
                          fit_pct, float(np.sqrt(s2)), plant, sensor, measured, initial_out, info, t.copy(), y.copy(),

@@ -4,7 +4,8 @@
 repeated with the samples weighted 0 (simulated from rest, not fitted) until the estimated free response has less
 energy left than one noise variance, at most a quarter of the samples left per round, from the previous fit's
 parameters, and tested again from its first fitted sample, for at most :data:`ROUNDS` refits, leaving out at most
-:data:`KEEP` of the record.
+:data:`KEEP` of the record. The refits' covariance carries the state at their first fitted sample as a nuisance
+(``fit_structure(..., free_start=True)``): what is left of the start state there is unknown too.
 """
 
 from __future__ import annotations
@@ -69,7 +70,7 @@ def fit_from_unknown_start(record: Record, fit: TimeFitResult, structure: Struct
         weights = ((record.t - record.t[0]) >= skip - 1e-9 * record.dt).astype(float)
         try:
             fit = fit_structure(record, structure, delay, sensor, False, initial={**fit.parameters}, weights=weights,
-                                check=True)
+                                check=True, free_start=True)
         except DataError as exc:
             raise FitError(f"fit of {structure.formula!r} failed: the record does not start at rest and the fit "
                            f"after its first {skip:.3g} s could not be made ({exc})", where=record.source) from None
