@@ -84,7 +84,7 @@ def evaluate(kp: np.ndarray, ki: np.ndarray, delay: float, reqs: dict, w: np.nda
 
 
 def best_pi(delay: float, reqs: dict, objective: str, kp_max: float, ki_max: float, n: int = 61,
-            zooms: int = 4) -> tuple[float, float, float]:
+            zooms: int = 3) -> tuple[float, float, float]:
     """Best feasible (value, kp, ki) by a grid search zoomed around the best point."""
     w = frequency_grid(delay)
     kp_lo, kp_hi, ki_lo, ki_hi = 0.0, kp_max, 0.0, ki_max
