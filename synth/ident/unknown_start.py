@@ -71,9 +71,12 @@ def fit_from_unknown_start(record: Record, fit: TimeFitResult, structure: Struct
         try:
             fit = fit_structure(record, structure, delay, sensor, False, initial={**fit.parameters}, weights=weights,
                                 check=True, free_start=True)
-        except DataError as exc:
-            raise FitError(f"fit of {structure.formula!r} failed: the record does not start at rest and the fit "
-                           f"after its first {skip:.3g} s could not be made ({exc})", where=record.source) from None
+        except (DataError, FitError) as exc:
+            why = exc.message.removeprefix(f"fit of {structure.formula!r} failed: ")
+            raise FitError(f"fit of {structure.formula!r} failed: the record does not start at rest (its start state "
+                           f"would move {first_test.shifted} by {first_test.shift:.3g} std) and the fit after its first "
+                           f"{skip:.3g} s failed: {why}", where=record.source,
+                           status=getattr(exc, "status", None)) from None
         fitted, test = skip, StartState.from_dict(fit.solver["start_state"])
         if not test.matters:
             note = (f"the record does not start at rest: the fitted model's free response from an unknown start "
