@@ -126,13 +126,18 @@ def free_start_gram(jacobian: np.ndarray, jtj: np.ndarray, rows: np.ndarray, n: 
     >>> gram.shape, bool(np.linalg.inv(gram)[0, 0] > np.linalg.inv(J.T @ J)[0, 0])
     ((3, 3), True)
     """
-    k0 = int(rows[0])
-    model = Plant([1.0], den)
-    Q = free_response_basis(model, dt, _support(model, dt, n - k0))
-    head = int(np.searchsorted(rows - k0, Q.shape[0]))
-    phi = Q[rows[:head] - k0]
+    _, head, phi = _free_columns(Plant([1.0], den), dt, rows, n)
     cross = jacobian[:head].T @ phi
     return np.block([[jtj, cross], [cross.T, phi.T @ phi]])
+
+
+def _free_columns(model: Plant, dt: float, rows: np.ndarray, n: int) -> tuple[np.ndarray, int, np.ndarray]:
+    """The free responses from the first fitted sample: their basis over :func:`_support`'s samples, how many fitted
+    samples they reach, and their values there (zero beyond)."""
+    k0 = int(rows[0])
+    Q = free_response_basis(model, dt, _support(model, dt, n - k0))
+    head = int(np.searchsorted(rows - k0, Q.shape[0]))
+    return Q, head, Q[rows[:head] - k0]
 
 
 def _support(model: Plant, dt: float, available: int) -> int:
@@ -192,27 +197,24 @@ def start_state_test(jacobian: np.ndarray, residual: np.ndarray, rows: np.ndarra
     (True, True, 'p', 32)
     """
     k0 = int(rows[0])
-    length = _support(model, dt, n - k0)
-    Q = free_response_basis(model, dt, length)  # the free responses, zero beyond ``length`` (to 1e-9 of their start)
+    Q, head, phi = _free_columns(model, dt, rows, n)  # zero beyond Q's samples (to 1e-9 of their start)
     quiet = StartState(0.0, float("inf"), 0, 1.0, 0, 0.0, "", 0.0, k0 * dt)
     if Q.shape[1] == 0 or not (np.all(np.isfinite(jacobian)) and np.all(np.isfinite(residual))):
         return quiet
-    head = int(np.searchsorted(rows - k0, length))  # the fitted samples the free responses reach
     q = jacobian.shape[1]
     jtj, jtr, energy = jacobian.T @ jacobian, jacobian.T @ residual, float(residual @ residual)
     alone, rank_alone, ssr_alone = _least_squares(jtj, jtr, energy)
-    beta, dof, noise, statistic = _score(jacobian, residual, jtj, jtr, energy, Q[rows[:head] - k0], 0,
-                                         rank_alone, ssr_alone)
+    beta, dof, noise, statistic = _score(jacobian, residual, jtj, jtr, energy, phi, 0, rank_alone, ssr_alone)
     if dof < 1 or not noise > 0:
         return quiet
     # the same drop where nothing starts: residuals that are not white (a model error, coloured noise) raise it
     # there as much as at the start, a start state at the start only. Measured on the residual with the start's
     # estimated free response taken out: a slowly decaying one would reach the later samples and raise it there too
     rest = residual - jacobian @ beta[:q]
-    rest[:head] -= Q[rows[:head] - k0] @ beta[q:]
+    rest[:head] -= phi @ beta[q:]
     rest_jtr, rest_energy = jacobian.T @ rest, float(rest @ rest)
     _, _, rest_ssr = _least_squares(jtj, rest_jtr, rest_energy)
-    span = min(length, residual.size // 8)
+    span = min(Q.shape[0], residual.size // 8)
     first_spot = max(span, residual.size // 4)
     spots = np.unique(np.linspace(first_spot, residual.size - span, ANCHORS).astype(int)) \
         if residual.size - span > first_spot else np.array([], dtype=int)
