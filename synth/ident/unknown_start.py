@@ -6,9 +6,20 @@ energy left than one noise variance, at most a quarter of the samples left per r
 parameters, and tested again from its first fitted sample, for at most :data:`ROUNDS` refits, leaving out at most
 :data:`KEEP` of the record. The refits' covariance carries the state at their first fitted sample as a nuisance
 (``fit_structure(..., free_start=True)``): what is left of the start state there is unknown too.
+
+A start state that only *may* matter (:attr:`~synth.ident.start_state.StartState.masked`: significant, but not
+against a threshold inflated by residuals that are far from white, which a fit bent into another basin leaves
+everywhere) is left out only where the first refit without it is better, on the samples both fit, by more than the
+chi-square quantile at :data:`~synth.ident.start_state.ALPHA` with as many degrees of freedom as parameters;
+otherwise the fit from rest stands (``solver["start_state_refit"]`` says why).
 """
 
 from __future__ import annotations
+
+import sys
+
+import numpy as np
+from scipy.stats import chi2
 
 from synth.data.record import Record
 from synth.errors import DataError, FitError
@@ -40,7 +51,6 @@ def fit_from_unknown_start(record: Record, fit: TimeFitResult, structure: Struct
 
     Examples
     --------
-    >>> import numpy as np
     >>> from synth.data import record_from_arrays
     >>> from synth.ident.structure import parse_structure
     >>> from scipy import signal
@@ -57,10 +67,10 @@ def fit_from_unknown_start(record: Record, fit: TimeFitResult, structure: Struct
     ('the record does not start at rest: ', True)
     """
     test = StartState.from_dict(fit.solver["start_state"]) if "start_state" in fit.solver else None
-    if test is None or not test.matters:
+    if test is None or not (test.matters or test.masked):
         return fit, ""
-    first_test, fitted, why = test, 0.0, f"after {ROUNDS} refits"
-    for _ in range(ROUNDS):
+    first_test, fitted, why, original = test, 0.0, f"after {ROUNDS} refits", fit
+    for round_ in range(ROUNDS):
         # the window comes from a fit the start state bent, whose modes may be far too slow: a quarter of what is
         # left at most per round, the next round's fit (less bent) tells the rest
         skip = test.first + min(max(test.window, 2.0 * record.dt), 0.25 * (record.duration - test.first))
@@ -69,23 +79,65 @@ def fit_from_unknown_start(record: Record, fit: TimeFitResult, structure: Struct
             break
         weights = ((record.t - record.t[0]) >= skip - 1e-9 * record.dt).astype(float)
         try:
-            fit = fit_structure(record, structure, delay, sensor, False, initial={**fit.parameters}, weights=weights,
-                                check=True, free_start=True)
+            fit = _refit(record, structure, delay, sensor, weights, fit, alternative=round_ == 0)
         except (DataError, FitError) as exc:
+            if round_ == 0 and first_test.masked:
+                return original, ""  # a start that only may matter, and no fit without it to show that it does
             why = exc.message.removeprefix(f"fit of {structure.formula!r} failed: ")
             raise FitError(f"fit of {structure.formula!r} failed: the record does not start at rest (its start state "
                            f"would move {first_test.shifted} by {first_test.shift:.3g} std) and the fit after its first "
                            f"{skip:.3g} s failed: {why}", where=record.source,
                            status=getattr(exc, "status", None)) from None
+        gain = _gain_without_start(original, fit)
+        if round_ == 0 and first_test.masked and not gain > float(chi2.isf(ALPHA, len(fit.names))):
+            original.solver["start_state_refit"] = (f"without its first {skip:.3g} s the fit is no better on the "
+                                                    f"samples both fit ({gain:.3g} noise variances): kept")
+            return original, ""
         fitted, test = skip, StartState.from_dict(fit.solver["start_state"])
         if not test.matters:
+            masked = "" if not first_test.masked else (
+                f" (above the threshold scaled by {first_test.inflation:.3g} for residuals that are not white; the fit "
+                f"without the start is better by {gain:.3g} noise variances on the samples both fit)")
             note = (f"the record does not start at rest: the fitted model's free response from an unknown start "
                     f"state takes {first_test.statistic:.3g} noise variances out of the residual (threshold "
-                    f"{first_test.threshold:.3g}, chi-square with {first_test.dof} degrees of freedom at {ALPHA:g}) "
-                    f"and would move {first_test.shifted} by {first_test.shift:.3g} std; fitted from "
-                    f"{test.first:.4g} s on, the samples before simulated from rest and weighted 0")
+                    f"{first_test.threshold / first_test.inflation:.3g}, chi-square with {first_test.dof} degrees of "
+                    f"freedom at {ALPHA:g}){masked} and would move {first_test.shifted} by {first_test.shift:.3g} std; "
+                    f"fitted from {test.first:.4g} s on, the samples before simulated from rest and weighted 0")
             fit.solver["start_state_note"] = note
             return fit, note
     raise FitError(f"fit of {structure.formula!r} failed: the record does not start at rest, and its start state "
                    f"still moves {test.shifted} by {test.shift:.3g} std with the first {fitted:.3g} s left out, {why}; "
                    "cut the record to start at rest, or fit a shorter part of it", where=record.source)
+
+
+def _refit(record: Record, structure: Structure, delay: str | float | None, sensor: Plant | str | None,
+           weights: np.ndarray, fit: TimeFitResult, alternative: bool) -> TimeFitResult:
+    """The record fitted with ``weights`` from ``fit``'s parameters; with ``alternative`` also from the deterministic
+    start (a start state may have bent ``fit`` into another basin, which a refit from it keeps), the lower residual
+    kept. Raises the first start's error when neither succeeds."""
+    options = dict(weights=weights, check=True, free_start=True)
+    try:
+        kept = fit_structure(record, structure, delay, sensor, False, initial={**fit.parameters}, **options)
+    except (DataError, FitError):
+        if not alternative:
+            raise
+        kept, error = None, sys.exc_info()[1]
+    if alternative:
+        try:
+            other = fit_structure(record, structure, delay, sensor, False, **options)
+        except (DataError, FitError):
+            other = None
+        if other is not None and (kept is None or other.residual_std < kept.residual_std):
+            kept = other
+        if kept is None:
+            raise error
+    return kept
+
+
+def _gain_without_start(original: TimeFitResult, refit: TimeFitResult) -> float:
+    """How much lower the refit's residual energy is than the original fit's on the samples the refit fits, in the
+    refit's noise variances (chi-square with as many degrees of freedom as parameters where both fit the same)."""
+    mask = refit.weights > 0 if refit.weights is not None else np.ones(refit.t.size, dtype=bool)
+    before, after = original.residuals[mask], refit.residuals[mask]
+    noise = refit.residual_std ** 2
+    return float(before @ before - after @ after) / noise if noise > 0 else float("inf")
