@@ -186,3 +186,26 @@ def test_a_first_order_plant_on_jittered_stamps_is_not_biased(run_cli, tmp_path)
     assert r.code == 0, r.err
     p = json.loads((tmp_path / "id.json").read_text())["parameters"]
     assert abs(p["K"] / 3.0 - 1) < 0.002 and abs(p["T"] / 0.3 - 1) < 0.004
+
+
+def test_a_failed_fit_with_a_negative_delay_is_reported_not_raised_without_check(monkeypatch):
+    """Found by a helper's randomized test: fit_structure(check=False) on a cut record whose weighted fit ended with
+    the delay at -2.3 ms raised ModelError ('delay must be ... >= 0') from building the model; without ``check`` a
+    failed fit is reported in ``solver["failure"]`` (here forced: the delay walk's result is moved below 0)."""
+    import synth.ident.timefit as timefit
+
+    real = timefit.walk_intervals
+
+    def below_zero(*args, **kwargs):
+        xs, ssr, m, status, moves = real(*args, **kwargs)
+        xs = xs.copy()
+        xs[-2] = -0.003 - m * 0.01  # the fraction: the whole delay 3 ms below 0
+        return xs, ssr, m, status, moves
+
+    monkeypatch.setattr(timefit, "walk_intervals", below_zero)
+    t = np.arange(0, 4, 0.01)
+    u = np.where(t >= 0.5, 1.0, 0.0)
+    y = simulate_plant(Plant.from_string("2/(s+3)"), t, u)
+    res = fit_structure(record_from_arrays(t, u, y), "k/(s+p)", delay="fit")
+    assert "delay" in res.solver["failure"] and "outside" in res.solver["failure"]
+    assert res.delay == 0.0 and res.plant.delay == 0.0

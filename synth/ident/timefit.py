@@ -458,8 +458,8 @@ def fit_structure(record: Record, structure: Structure | str, delay: str | float
                        f"structure, a fixed delay or a shorter part of the record", where=record.source,
                        status=st_info.get("status"),
                        parameters={**fitted, delay_name: float(d_hat)})
-    if -1e-7 <= d_hat < 0.0:  # IPOPT relaxes the bound f >= 0 by 1e-8
-        d_hat = 0.0
+    if -1e-7 <= d_hat < 0.0 or (failure and d_hat < 0.0):  # IPOPT relaxes f >= 0 by 1e-8; a failed fit's delay
+        d_hat = 0.0  # below 0 is in solver["failure"], and its model (never a result) is built with none
     tq = float(t_ppf(0.975, dof))
     names = [*st.parameters, *([delay_name] if fit_delay else []), "offset"]
     values = [*theta.tolist(), *([d_hat] if fit_delay else []), b_hat]
