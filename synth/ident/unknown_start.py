@@ -16,8 +16,6 @@ otherwise the fit from rest stands (``solver["start_state_refit"]`` says why).
 
 from __future__ import annotations
 
-import sys
-
 import numpy as np
 from scipy.stats import chi2
 
@@ -116,22 +114,17 @@ def _refit(record: Record, structure: Structure, delay: str | float | None, sens
     start (a start state may have bent ``fit`` into another basin, which a refit from it keeps), the lower residual
     kept. Raises the first start's error when neither succeeds."""
     options = dict(weights=weights, check=True, free_start=True)
-    try:
-        kept = fit_structure(record, structure, delay, sensor, False, initial={**fit.parameters}, **options)
-    except (DataError, FitError):
-        if not alternative:
-            raise
-        kept, error = None, sys.exc_info()[1]
-    if alternative:
+    starts = [{**fit.parameters}, None] if alternative else [{**fit.parameters}]
+    fits: list[TimeFitResult] = []
+    errors: list[DataError | FitError] = []
+    for initial in starts:  # None: the deterministic start
         try:
-            other = fit_structure(record, structure, delay, sensor, False, **options)
-        except (DataError, FitError):
-            other = None
-        if other is not None and (kept is None or other.residual_std < kept.residual_std):
-            kept = other
-        if kept is None:
-            raise error
-    return kept
+            fits.append(fit_structure(record, structure, delay, sensor, False, initial=initial, **options))
+        except (DataError, FitError) as exc:
+            errors.append(exc)
+    if not fits:
+        raise errors[0]
+    return min(fits, key=lambda f: f.residual_std)
 
 
 def _gain_without_start(original: TimeFitResult, refit: TimeFitResult) -> float:
