@@ -25,7 +25,8 @@ from scipy.stats import chi2
 
 from synth.plant import Plant
 
-__all__ = ["ALPHA", "ANCHORS", "MATERIAL", "StartState", "free_response_basis", "free_start_gram", "start_state_test"]
+__all__ = ["ALPHA", "ANCHORS", "MATERIAL", "StartState", "free_columns", "free_response_basis", "free_start_gram",
+           "start_state_test"]
 
 ALPHA = 1e-3
 """False-alarm probability of the drop in residual energy on a record that starts at rest (white residuals)."""
@@ -120,32 +121,40 @@ def free_response_basis(plant: Plant, dt: float, length: int) -> np.ndarray:
     return u[:, keep]
 
 
-def free_start_gram(jacobian: np.ndarray, jtj: np.ndarray, rows: np.ndarray, n: int, den: np.ndarray,
-                    dt: float) -> np.ndarray:
-    """``J^T J`` with the free responses of a model with denominator ``den`` from the first fitted sample joined as
-    nuisance columns (after ``J``'s): the Gauss-Newton information of a fit whose start state is unknown. Its inverse's
-    leading block is the parameters' covariance with that state free (never smaller than ``J^T J``'s inverse).
+def free_columns(den: np.ndarray, dt: float, rows: np.ndarray, n: int) -> tuple[np.ndarray, int, np.ndarray]:
+    """The free responses of a model with denominator ``den`` from the first of the fitted samples ``rows`` (among
+    ``n``): their basis over the samples until they have decayed to 1e-9 of their start, how many fitted samples they
+    reach, and their values there (zero beyond). What :func:`free_start_gram` and :func:`start_state_test` share.
+
+    Examples
+    --------
+    >>> Q, head, phi = free_columns(np.array([1.0, 1.0]), 0.01, np.arange(50, 5000), 5000)   # 1/(s+1) from 0.5 s
+    >>> Q.shape[1], head, phi.shape                                            # 20.7 s to decay, 2072 samples
+    (1, 2073, (2073, 1))
+    """
+    model = Plant([1.0], den)
+    k0 = int(rows[0])
+    Q = free_response_basis(model, dt, _support(model, dt, n - k0))
+    head = int(np.searchsorted(rows - k0, Q.shape[0]))
+    return Q, head, Q[rows[:head] - k0]
+
+
+def free_start_gram(jacobian: np.ndarray, jtj: np.ndarray, columns: tuple[np.ndarray, int, np.ndarray]) -> np.ndarray:
+    """``J^T J`` with the free responses from the first fitted sample (:func:`free_columns`) joined as nuisance
+    columns (after ``J``'s): the Gauss-Newton information of a fit whose start state is unknown. Its inverse's leading
+    block is the parameters' covariance with that state free (never smaller than ``J^T J``'s inverse).
 
     Examples
     --------
     >>> t = np.arange(400) * 0.01
     >>> J = np.column_stack([1 - np.exp(-t), np.ones(t.size)])   # a gain's and an offset's sensitivities
-    >>> gram = free_start_gram(J, J.T @ J, np.arange(t.size), t.size, np.array([1.0, 1.0]), 0.01)
+    >>> gram = free_start_gram(J, J.T @ J, free_columns(np.array([1.0, 1.0]), 0.01, np.arange(t.size), t.size))
     >>> gram.shape, bool(np.linalg.inv(gram)[0, 0] > np.linalg.inv(J.T @ J)[0, 0])
     ((3, 3), True)
     """
-    _, head, phi = _free_columns(Plant([1.0], den), dt, rows, n)
+    _, head, phi = columns
     cross = jacobian[:head].T @ phi
     return np.block([[jtj, cross], [cross.T, phi.T @ phi]])
-
-
-def _free_columns(model: Plant, dt: float, rows: np.ndarray, n: int) -> tuple[np.ndarray, int, np.ndarray]:
-    """The free responses from the first fitted sample: their basis over :func:`_support`'s samples, how many fitted
-    samples they reach, and their values there (zero beyond)."""
-    k0 = int(rows[0])
-    Q = free_response_basis(model, dt, _support(model, dt, n - k0))
-    head = int(np.searchsorted(rows - k0, Q.shape[0]))
-    return Q, head, Q[rows[:head] - k0]
 
 
 def _support(model: Plant, dt: float, available: int) -> int:
@@ -170,20 +179,22 @@ def _least_squares(gram: np.ndarray, moment: np.ndarray, energy: float) -> tuple
     return coef, int(np.count_nonzero(keep)), max(0.0, energy - float(moment @ coef))
 
 
-def start_state_test(jacobian: np.ndarray, residual: np.ndarray, rows: np.ndarray, n: int, model: Plant, dt: float,
-                     delay: float, std: np.ndarray, values: np.ndarray, names: list[str]) -> StartState:
+def start_state_test(jacobian: np.ndarray, jtj: np.ndarray, residual: np.ndarray, rows: np.ndarray,
+                     columns: tuple[np.ndarray, int, np.ndarray], dt: float, delay: float, std: np.ndarray,
+                     values: np.ndarray, names: list[str]) -> StartState:
     """Test a whole-record fit (not periodic) for a start state that is not at rest.
 
     Parameters
     ----------
-    jacobian : numpy.ndarray
-        The model output's sensitivities to ``names`` on the fitted samples (rows), in the parameters' units.
+    jacobian, jtj : numpy.ndarray
+        The model output's sensitivities to ``names`` on the fitted samples (rows), in the parameters' units, and
+        ``J^T J``.
     residual : numpy.ndarray
         Measured minus model output on the fitted samples.
     rows : numpy.ndarray
-        Indices of the fitted samples among the record's ``n`` (increasing; the first is where the state is free).
-    model : Plant
-        The fitted model the record's output responds with (sensor included).
+        Indices of the fitted samples among the record's (increasing; the first is where the state is free).
+    columns : tuple
+        The fitted model's free responses from there (:func:`free_columns`, the sensor's poles included).
     dt, delay : float
         Sample time and the fitted delay [s].
     std, values : numpy.ndarray
@@ -205,12 +216,12 @@ def start_state_test(jacobian: np.ndarray, residual: np.ndarray, rows: np.ndarra
     (True, True, 'p', 32)
     """
     k0 = int(rows[0])
-    Q, head, phi = _free_columns(model, dt, rows, n)  # zero beyond Q's samples (to 1e-9 of their start)
+    Q, head, phi = columns  # zero beyond Q's samples (to 1e-9 of their start)
     quiet = StartState(0.0, float("inf"), 0, 1.0, 0, 0.0, "", 0.0, k0 * dt)
     if Q.shape[1] == 0 or not (np.all(np.isfinite(jacobian)) and np.all(np.isfinite(residual))):
         return quiet
     q = jacobian.shape[1]
-    jtj, jtr, energy = jacobian.T @ jacobian, jacobian.T @ residual, float(residual @ residual)
+    jtr, energy = jacobian.T @ residual, float(residual @ residual)
     alone, rank_alone, ssr_alone = _least_squares(jtj, jtr, energy)
     beta, dof, noise, statistic = _score(jacobian, residual, jtj, jtr, energy, phi, 0, rank_alone, ssr_alone)
     if dof < 1 or not noise > 0:

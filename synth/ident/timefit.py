@@ -48,7 +48,7 @@ from synth.ident.nyquist import nyquist_note
 from synth.ident.residual_whiteness import correlated_residuals_note
 from synth.ident.sim_error_problem import SimulationErrorProblem
 from synth.ident.srivc import linear_initial_model, map_to_structure
-from synth.ident.start_state import free_start_gram, start_state_test
+from synth.ident.start_state import free_columns, free_start_gram, start_state_test
 from synth.ident.structure import Structure, parse_structure
 from synth.plant import Plant
 
@@ -432,8 +432,9 @@ def fit_structure(record: Record, structure: Structure | str, delay: str | float
     JtJ, rows = J.T @ J, (np.arange(n) if mask is None else np.flatnonzero(mask))
     # a record known not to start at rest (synth.ident.unknown_start): the state at the first fitted sample is a
     # nuisance whose uncertainty the parameters carry
-    gram = free_start_gram(J, JtJ, rows, n, np.polymul(st.coefficients(theta)[1], [1.0] if sensor is None else
-                                                       sensor.den), dt) if free_start else JtJ
+    columns = None if periodic else free_columns(np.polymul(st.coefficients(theta)[1], [1.0] if sensor is None else
+                                                             sensor.den), dt, rows, n)
+    gram = free_start_gram(J, JtJ, columns) if free_start and columns is not None else JtJ
     # an output interpolated from uneven stamps: its residuals understate the noise the estimates carry
     cov, note = fit_covariance(gram, s2 * record.noise_factor, p if fit_delay else None, dt)
     cov = cov[:J.shape[1], :J.shape[1]]
@@ -475,7 +476,7 @@ def fit_structure(record: Record, structure: Structure | str, delay: str | float
     if sensor is not None:
         measured = Plant(measured.num, measured.den, d_hat, record.input, record.output, "identified with sensor")
     if not periodic:  # a start state that is not at rest (synth.ident.start_state)
-        info["start_state"] = start_state_test(J, resid, rows, n, measured, dt, d_hat, sd, values, names).to_dict()
+        info["start_state"] = start_state_test(J, JtJ, resid, rows, columns, dt, d_hat, sd, values, names).to_dict()
     return TimeFitResult(st, params, std, ci, names, cov, float(d_hat), fit_delay, b_hat, float(sd[-1]),
                          fit_pct, float(np.sqrt(s2)), plant, sensor, measured, initial_out, info, t.copy(), y.copy(),
                          yhat, u0, periodic, weights)
