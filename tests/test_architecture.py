@@ -254,6 +254,20 @@ def test_import_synth_loads_no_solver_or_plotting_library():
     assert out.stdout.strip() == "[]"
 
 
+def test_the_design_report_loads_no_signal_or_stats_package():
+    """The design report's modules (the seed's gap case among them, which imports identification) load neither
+    ``scipy.signal`` nor ``scipy.stats`` (0.34 s together): identification imports them where it calls them. A
+    module-level import in ``synth.ident.start_state`` cost every X-4 report that (session 47)."""
+    import subprocess
+    import sys
+
+    heavy = ("scipy.signal", "scipy.stats")
+    code = ("import sys, synth.report.design_report, synth.gap.x4_case, synth.gap.diagnose, synth.design; "
+            f"print([m for m in {heavy!r} if m in sys.modules])")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT, check=True)
+    assert out.stdout.strip() == "[]"
+
+
 def test_the_check_and_its_requirements_load_no_matrix_exponential():
     """``synth check`` on a spec without time responses stays light: the requirement types load the step's
     modules (scipy.linalg among them, 0.1 s) only when a step is computed (a module-level import of
