@@ -394,11 +394,25 @@ def fit_structure(record: Record, structure: Structure | str, delay: str | float
     init_ssr = float(np.sum((yd_fit - np.mean(yd_fit)) ** 2))
     y_fit = y if mask is None else y[mask]
     ssr_start = start_ssr(prob, theta0, d0, b0, w, y, mask, fit_delay, dt)
+    if isinstance(prob, SimulationErrorProblem) and (not st_info["success"] or not ssr <= min(init_ssr, ssr_start)):
+        # IPOPT lost its way from the start (a near cancellation trading with the delay leaves a valley its
+        # Gauss-Newton steps leave): Levenberg-Marquardt's damped steps from the same start, kept where better
+        ipopt, failed_status, failed_ssr, prob = prob, st_info.get("status"), ssr, ConvolutionProblem(
+            st, sensor, n, dt, periodic, theta0, fit_delay, y, has_d, weights)
+        cand = run(theta0, d0)
+        info["starts"] += 1
+        if (cand[3]["success"] or cand[3].get("status") in LIMIT_STATUSES) and cand[1] < ssr:  # fit_failure judges
+            xs, ssr, m, st_info, shifts = cand
+            info["method"] = ("Levenberg-Marquardt, exact Jacobian by FFT convolution of the sensitivities (IPOPT "
+                              f"from the same start: {failed_status}, its sum of squares {failed_ssr:.4g} against "
+                              f"{ssr_start:.4g} at the start)")
+        else:
+            prob = ipopt
     if not st_info["success"] or not np.isfinite(ssr) or ssr > min(init_ssr, ssr_start):
         for factor in (0.5, 2.0, 0.2, 5.0):
             cand = run(theta0 * factor, d0)
             info["starts"] += 1
-            if cand[3]["success"] and cand[1] < ssr:
+            if (cand[3]["success"] or cand[3].get("status") in LIMIT_STATUSES) and cand[1] < ssr:  # fit_failure judges
                 xs, ssr, m, st_info, shifts = cand
                 if st_info["success"] and ssr <= min(init_ssr, ssr_start):
                     break

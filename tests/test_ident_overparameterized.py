@@ -1,0 +1,55 @@
+"""A structure with more poles and zeros than the plant has, fitted with a free delay (issue 16, items 1 and 2).
+
+A first-order plant fitted as ``k (s + z)/((s + p1)(s + p2))``: the record pins down the plant's pole and its gain,
+while a zero and a pole that cancel can sit anywhere, trading with the delay. IPOPT's Gauss-Newton steps leave
+that valley from a start that already fits to the noise (sums of squares up to 25 times the start's), and the
+fit was reported as failed ("ended worse than its start", "IPOPT stopped with Maximum_Iterations_Exceeded") on 9
+of 32 such records of 2,000 samples (session 47; seeds 8-39 of this generator), after 3-16 s. Levenberg-
+Marquardt from the same start now takes over where IPOPT fails: the fit is returned, its cancelling pair and
+the delay marked weak. The reference is independent of synth's fit: the truth, and the noise it was drawn with.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from scipy import signal
+
+from synth.ident import identify
+
+STRUCTURE = "k*(s+z)/((s+p1)*(s+p2))"
+SAMPLE_TIME = 0.01
+NOISE = 0.02
+
+
+def first_order_record(seed: int, n: int = 2000) -> tuple[np.ndarray, np.ndarray, np.ndarray, float, float]:
+    """A random step train (levels in [-1, 1], 1-4 s each, at rest for the first second) through ``K/(T s + 1)``
+    held by a zero-order hold (scipy), white noise of std :data:`NOISE`: ``(t, u, y, K, T)``."""
+    rng = np.random.default_rng(seed)
+    t = np.arange(n) * SAMPLE_TIME
+    u = np.zeros(n)
+    k = 100
+    while k < n:
+        length = int(rng.integers(100, 400))
+        u[k:k + length] = rng.uniform(-1.0, 1.0)
+        k += length
+    T, K = rng.uniform(0.2, 1.0), rng.uniform(0.5, 3.0)
+    num, den, _ = signal.cont2discrete(([K], [T, 1.0]), SAMPLE_TIME, method="zoh")
+    y = signal.dlsim((np.ravel(num), den, SAMPLE_TIME), u)[1][:, 0] + NOISE * rng.normal(size=n)
+    return t, u, y, K, T
+
+
+@pytest.mark.parametrize("seed", [15, 16])
+def test_an_overparameterized_fit_with_a_free_delay_is_returned_with_its_cancelling_pair_weak(seed):
+    """Seeds 15 and 16 failed before (IPOPT: maximum iterations at 98.06 %; ended worse than its start)."""
+    t, u, y, K, T = first_order_record(seed)
+    fit = identify((t, u, y), STRUCTURE, delay="fit", average="none").fit
+    assert fit.solver["method"].startswith("Levenberg-Marquardt") and "IPOPT from the same start" in fit.solver["method"]
+    assert fit.residual_std == pytest.approx(NOISE, rel=0.05)  # fitted to the noise, no further
+    # the plant's own pole: one of the two, within 4 of its standard errors of the truth
+    own = min(("p1", "p2"), key=lambda p: abs(fit.parameters[p] - 1.0 / T))
+    assert abs(fit.parameters[own] - 1.0 / T) <= 4.0 * fit.std[own]
+    assert fit.plant.dc_gain() == pytest.approx(K, rel=0.01)
+    # the zero and the other pole cancel: marked weak, never given as confident numbers
+    other = "p2" if own == "p1" else "p1"
+    assert {w.name for w in fit.weak} >= {"z", other}
