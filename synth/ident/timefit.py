@@ -394,9 +394,11 @@ def fit_structure(record: Record, structure: Structure | str, delay: str | float
     init_ssr = float(np.sum((yd_fit - np.mean(yd_fit)) ** 2))
     y_fit = y if mask is None else y[mask]
     ssr_start = start_ssr(prob, theta0, d0, b0, w, y, mask, fit_delay, dt)
-    if isinstance(prob, SimulationErrorProblem) and (not st_info["success"] or not ssr <= min(init_ssr, ssr_start)):
+    if isinstance(prob, SimulationErrorProblem) and lb is None and (not st_info["success"]
+                                                                   or not ssr <= min(init_ssr, ssr_start)):
         # IPOPT lost its way from the start (a near cancellation trading with the delay leaves a valley its
         # Gauss-Newton steps leave): Levenberg-Marquardt's damped steps from the same start, kept where better
+        # (not with lower bounds, which IPOPT keeps as constraints and Levenberg-Marquardt only by clipping)
         ipopt, failed_status, failed_ssr, prob = prob, st_info.get("status"), ssr, ConvolutionProblem(
             st, sensor, n, dt, periodic, theta0, fit_delay, y, has_d, weights)
         cand = run(theta0, d0)
