@@ -129,17 +129,21 @@ def test_step_response_feasible_set_matches_a_dense_grid():
 
 
 # ------------------------------------------------------------------ no limit cycle
-def _brute_df_margin(text: str, k: float, delays: np.ndarray) -> float:
-    """Saturation: min over delays and negative-real-axis crossings of 1/|L|, on a dense grid."""
+def _brute_df_margin(text: str, k: float, tau: float, count: int = 301) -> float:
+    """Saturation: min over ``count`` delays evenly spaced in [0, tau] and negative-real-axis crossings of 1/|L|,
+    on a dense grid. From one delay to the next, L is multiplied by one step's factor e^(-j w tau/(count - 1))
+    (a product per delay instead of an exponential: relative rounding below 1e-13 after 300 steps); with
+    tau = 0 every delay is the same one, evaluated once."""
     w = np.geomspace(1e-2, 1e2, 400001)
     p = Plant.from_string(text)
-    L0 = k * np.polyval(p.num, 1j * w) / np.polyval(p.den, 1j * w)
+    L = k * np.polyval(p.num, 1j * w) / np.polyval(p.den, 1j * w)
+    step = np.exp(-1j * w * (tau / (count - 1)))
     best = np.inf
-    for tau in delays:
-        L = L0 * np.exp(-1j * w * tau)
+    for _ in range(count if tau > 0 else 1):
         i = np.flatnonzero((np.sign(L.imag[:-1]) != np.sign(L.imag[1:])) & (L.real[:-1] < 0))
         if i.size:
             best = min(best, float(np.min(1.0 / np.abs(L[i]))))
+        L = L * step
     return best
 
 
@@ -147,7 +151,7 @@ def _brute_df_margin(text: str, k: float, delays: np.ndarray) -> float:
 def test_no_limit_cycle_saturation_matches_a_brute_force_delay_sweep(k, tau):
     req = NoLimitCycle(delay=(0.0, tau), actuator=[{"type": "saturation", "min": -1, "max": 1}], confirm=False)
     r = req.evaluate(Loop(Plant.from_string(CUBIC), Controller("P", {"kp": k})))
-    ref = _brute_df_margin(CUBIC, k, np.linspace(0.0, tau, 301))
+    ref = _brute_df_margin(CUBIC, k, tau)
     assert r.details["gain_factor"] == pytest.approx(ref, rel=2e-4)
 
 
