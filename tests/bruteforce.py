@@ -24,32 +24,44 @@ def frequency_grid(delay: float) -> np.ndarray:
     return np.unique(np.concatenate([log, lin]))
 
 
-def evaluate(kp: np.ndarray, ki: np.ndarray, delay: float, reqs: dict, w: np.ndarray) -> dict[str, np.ndarray]:
-    """Requirements and measures for controllers kp[i] + ki[i]/s (1-D arrays of equal length)."""
+def evaluate(kp: np.ndarray, ki: np.ndarray, delay: float, reqs: dict, w: np.ndarray,
+             need: tuple[str, ...] = ("bandwidth", "crossover", "Ms"),
+             ki_over_s: np.ndarray | None = None) -> dict[str, np.ndarray]:
+    """Requirements and measures for controllers kp[i] + ki[i]/s (1-D arrays of equal length).
+
+    ``out["ok"]`` always, and the measures named in ``need`` (each is another pass over the grid: a search asks for
+    its objective's only). ``ki_over_s``: ``ki[:, None] / (j w)``, when the caller holds it (a grid search's ki
+    column is the same for every kp). Either gives the same numbers as computing everything."""
     s = 1j * w
     G = x4(s, delay)
     np.seterr(divide="ignore", invalid="ignore")
-    C = kp[:, None] + ki[:, None] / s[None, :]
+    C = kp[:, None] + (ki[:, None] / s[None, :] if ki_over_s is None else ki_over_s)
     L = C * G[None, :]
     S = 1 / (1 + L)
-    T = L / (1 + L)
     out: dict[str, np.ndarray] = {}
-    # stability: net crossings of the negative real axis left of -1 (upward minus downward)
+    # stability: net crossings of the negative real axis left of -1 (upward minus downward), the crossing's real
+    # part interpolated only where Im L changes sign
     im = L.imag
-    cross = np.sign(im[:, :-1]) != np.sign(im[:, 1:])
-    frac = im[:, :-1] / (im[:, :-1] - im[:, 1:] + 1e-300)
-    re_at = L.real[:, :-1] + frac * (L.real[:, 1:] - L.real[:, :-1])
-    left = cross & (re_at < -1)
-    up = left & (im[:, 1:] > im[:, :-1])
-    down = left & (im[:, 1:] < im[:, :-1])
-    stable = (up.sum(axis=1) - down.sum(axis=1)) == 0
+    sign = np.sign(im)
+    rows, cols = np.nonzero(sign[:, :-1] != sign[:, 1:])
+    a, b = im[rows, cols], im[rows, cols + 1]
+    frac = a / (a - b + 1e-300)
+    re_at = L.real[rows, cols] + frac * (L.real[rows, cols + 1] - L.real[rows, cols])
+    left = re_at < -1
+    net = np.bincount(rows[left & (b > a)], minlength=kp.size) - np.bincount(rows[left & (b < a)], minlength=kp.size)
+    stable = net == 0
     if np.all(ki == 0):  # type 0: also L(0) must not be left of -1
         stable &= (kp * x4(np.array([0.0]), 0.0)[0].real > -1)
     ok = stable.copy()
+    if "Ms" in reqs or "Ms" in need:
+        ms = 20 * np.log10(np.abs(S).max(axis=1))
     if "Ms" in reqs:
-        ok &= 20 * np.log10(np.abs(S).max(axis=1)) <= reqs["Ms"]
+        ok &= ms <= reqs["Ms"]
+    if "Mt" in reqs or "bandwidth" in need or "bw_min" in reqs:
+        T = L / (1 + L)
+        absT = np.abs(T)
     if "Mt" in reqs:
-        ok &= 20 * np.log10(np.abs(T).max(axis=1)) <= reqs["Mt"]
+        ok &= 20 * np.log10(absT.max(axis=1)) <= reqs["Mt"]
     if "KS" in reqs:
         ok &= 20 * np.log10(np.abs(C * S).max(axis=1)) <= reqs["KS"]
     if "slew" in reqs:
@@ -60,27 +72,34 @@ def evaluate(kp: np.ndarray, ki: np.ndarray, delay: float, reqs: dict, w: np.nda
         db, g = reqs["static"]
         static = np.where(ki > 0, -np.inf, 20 * np.log10(np.abs(1 / (1 + kp * g))))
         ok &= static <= db
-    t0 = np.where(ki > 0, 1.0, np.abs(kp * x4(np.array([0.0]), 0.0)[0] / (1 + kp * x4(np.array([0.0]), 0.0)[0])))
-    level = LEVEL_3DB * t0[:, None]
-    below = np.abs(T) < level
-    k = np.argmax(below, axis=1)
-    rows = np.arange(k.size)
-    km1 = np.maximum(k - 1, 0)
-    m0, m1 = np.abs(T[rows, km1]) - level[:, 0], np.abs(T[rows, k]) - level[:, 0]
-    frac = np.clip(m0 / np.where(m0 - m1 == 0, 1, m0 - m1), 0, 1)  # interpolate the crossing in log w
-    crossing = np.exp(np.log(w[km1]) + frac * (np.log(w[k]) - np.log(w[km1])))
-    first = np.where(below.any(axis=1), crossing, np.inf)
-    first = np.where(t0 > 0, first, np.nan)  # no loop gain: T = 0, no bandwidth
-    out["bandwidth"] = first
-    if "bw_min" in reqs:
-        ok &= np.nan_to_num(first, nan=-1.0) >= reqs["bw_min"]
-    mag = np.abs(L)
-    above = mag >= 1
-    out["crossover"] = np.where(above.any(axis=1) & ~above.all(axis=1),
-                                w[np.clip(np.argmax(~above, axis=1), 0, w.size - 1)], 0.0)
-    out["Ms"] = 20 * np.log10(np.abs(S).max(axis=1))
+    if "bandwidth" in need or "bw_min" in reqs:
+        t0 = np.where(ki > 0, 1.0, np.abs(kp * x4(np.array([0.0]), 0.0)[0] / (1 + kp * x4(np.array([0.0]), 0.0)[0])))
+        level = LEVEL_3DB * t0[:, None]
+        below = absT < level
+        k = np.argmax(below, axis=1)
+        rows = np.arange(k.size)
+        km1 = np.maximum(k - 1, 0)
+        m0, m1 = absT[rows, km1] - level[:, 0], absT[rows, k] - level[:, 0]
+        frac = np.clip(m0 / np.where(m0 - m1 == 0, 1, m0 - m1), 0, 1)  # interpolate the crossing in log w
+        crossing = np.exp(np.log(w[km1]) + frac * (np.log(w[k]) - np.log(w[km1])))
+        first = np.where(below.any(axis=1), crossing, np.inf)
+        first = np.where(t0 > 0, first, np.nan)  # no loop gain: T = 0, no bandwidth
+        out["bandwidth"] = first
+        if "bw_min" in reqs:
+            ok &= np.nan_to_num(first, nan=-1.0) >= reqs["bw_min"]
+    if "crossover" in need:
+        mag = np.abs(L)
+        above = mag >= 1
+        out["crossover"] = np.where(above.any(axis=1) & ~above.all(axis=1),
+                                    w[np.clip(np.argmax(~above, axis=1), 0, w.size - 1)], 0.0)
+    if "Ms" in need:
+        out["Ms"] = ms
     out["ok"] = ok & (np.abs(kp) + np.abs(ki) > 0)
     return out
+
+
+_NEED = {"bandwidth": ("bandwidth",), "crossover": ("crossover",), "peak_sensitivity": ("Ms",)}
+"""The measure each objective's score reads (:func:`_score`); the gains' objectives read none."""
 
 
 def best_pi(delay: float, reqs: dict, objective: str, kp_max: float, ki_max: float, n: int = 61,
@@ -92,13 +111,19 @@ def best_pi(delay: float, reqs: dict, objective: str, kp_max: float, ki_max: flo
     for _ in range(zooms + 1):
         kps = np.linspace(kp_lo, kp_hi, n)
         kis = np.linspace(ki_lo, ki_hi, n)
+        ki_over_s = kis[:, None] / (1j * w)[None, :]
         for kp in kps:
-            res = evaluate(np.full(n, kp), kis, delay, reqs, w)
-            score = _score(res, kis, objective)
+            # integral_gain scores ki itself: only a ki above the best so far can replace it
+            cols = np.flatnonzero(kis > best[0]) if objective == "integral_gain" else np.arange(n)
+            if cols.size == 0:
+                continue
+            res = evaluate(np.full(cols.size, kp), kis[cols], delay, reqs, w, _NEED.get(objective, ()),
+                           ki_over_s[cols])
+            score = _score(res, kis[cols], objective)
             score[~res["ok"]] = -np.inf
             j = int(np.argmax(score))
             if score[j] > best[0]:
-                best = (float(score[j]), float(kp), float(kis[j]))
+                best = (float(score[j]), float(kp), float(kis[cols[j]]))
         dkp, dki = (kp_hi - kp_lo) / (n - 1), (ki_hi - ki_lo) / (n - 1)
         kp_lo, kp_hi = max(0.0, best[1] - 3 * dkp), min(kp_max, best[1] + 3 * dkp)
         ki_lo, ki_hi = max(0.0, best[2] - 3 * dki), min(ki_max, best[2] + 3 * dki)
@@ -114,7 +139,7 @@ def best_p(delay: float, reqs: dict, objective: str, kp_max: float, n: int = 200
     for _ in range(zooms + 1):
         kps = np.linspace(lo, hi, n)
         for chunk in np.array_split(np.arange(n), max(1, n // 100)):
-            res = evaluate(kps[chunk], np.zeros(chunk.size), delay, reqs, w)
+            res = evaluate(kps[chunk], np.zeros(chunk.size), delay, reqs, w, _NEED.get(objective, ()))
             score = _score(res, kps[chunk], objective)
             score[~res["ok"]] = -np.inf
             j = int(np.argmax(score))
