@@ -394,27 +394,28 @@ def fit_structure(record: Record, structure: Structure | str, delay: str | float
     init_ssr = float(np.sum((yd_fit - np.mean(yd_fit)) ** 2))
     y_fit = y if mask is None else y[mask]
     ssr_start = start_ssr(prob, theta0, d0, b0, w, y, mask, fit_delay, dt)
-    if isinstance(prob, SimulationErrorProblem) and lb is None and (not st_info["success"]
-                                                                   or not ssr <= min(init_ssr, ssr_start)):
-        # IPOPT lost its way from the start (a near cancellation trading with the delay leaves a valley its
-        # Gauss-Newton steps leave): Levenberg-Marquardt's damped steps from the same start, kept where better
-        # (not with lower bounds, which IPOPT keeps as constraints and Levenberg-Marquardt only by clipping)
+    def below_zero(fit: tuple) -> bool:  # a whole delay below 0: no plant's (fit_failure)
+        return fit_delay and fit[2] * dt + float(fit[0][len(st.parameters)]) < 0.0
+    lost = below_zero((xs, ssr, m)) or not st_info["success"] or not ssr <= min(init_ssr, ssr_start)
+    if isinstance(prob, SimulationErrorProblem) and lb is None and lost:
+        # IPOPT lost its way (a cancelling pair trading with the delay, or the delay's bound at 0 missed): Levenberg-
+        # Marquardt from the same start; not with lower bounds (IPOPT's constraints, Levenberg-Marquardt's clipping)
         ipopt, failed_status, failed_ssr, prob = prob, st_info.get("status"), ssr, ConvolutionProblem(
             st, sensor, n, dt, periodic, theta0, fit_delay, y, has_d, weights)
         cand = run(theta0, d0)
         info["starts"] += 1
-        if (cand[3]["success"] or cand[3].get("status") in LIMIT_STATUSES) and cand[1] < ssr:  # fit_failure judges
+        if (cand[3]["success"] or cand[3].get("status") in LIMIT_STATUSES) and not below_zero(cand) \
+                and (cand[1] < ssr or below_zero((xs, ssr, m))):  # fit_failure judges it
             xs, ssr, m, st_info, shifts = cand
-            info["method"] = ("Levenberg-Marquardt, exact Jacobian by FFT convolution of the sensitivities (IPOPT "
-                              f"from the same start: {failed_status}, its sum of squares {failed_ssr:.4g} against "
-                              f"{ssr_start:.4g} at the start)")
+            info["method"] = (f"Levenberg-Marquardt, exact Jacobian by FFT convolution of the sensitivities (IPOPT "
+                              f"from the same start: {failed_status}, SSR {failed_ssr:.4g}, {ssr_start:.4g} at the start)")
         else:
             prob = ipopt
     if not st_info["success"] or not np.isfinite(ssr) or ssr > min(init_ssr, ssr_start):
         for factor in (0.5, 2.0, 0.2, 5.0):
             cand = run(theta0 * factor, d0)
             info["starts"] += 1
-            if (cand[3]["success"] or cand[3].get("status") in LIMIT_STATUSES) and cand[1] < ssr:  # fit_failure judges
+            if cand[3]["success"] and cand[1] < ssr:
                 xs, ssr, m, st_info, shifts = cand
                 if st_info["success"] and ssr <= min(init_ssr, ssr_start):
                     break
