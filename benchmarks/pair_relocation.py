@@ -103,8 +103,9 @@ def wrong_start(truth: dict[str, float], kind: int) -> dict[str, float]:
     return start
 
 
-def run(seed: int) -> list[dict[str, Any]]:
-    """Every start of problem ``seed``: the fit's, the relocation's and the reference's SSR in noise variances."""
+def run(seed: int, fits: dict[str, tuple[Any, Any]] | None = None) -> list[dict[str, Any]]:
+    """Every start of problem ``seed``: the fit's, the relocation's and the reference's SSR in noise variances.
+    ``fits``, when given, receives each start's ``(fit, relocated fit)`` under its name in :data:`STARTS`."""
     p = problem(seed)
     rec = record_from_arrays(p["t"], p["u"], p["y"])
     st = parse_structure(p["structure"])
@@ -138,6 +139,8 @@ def run(seed: int) -> list[dict[str, Any]]:
         t0 = time.perf_counter()
         moved = relocate_pair(rec, fit, st, p["delay_option"], p["sensor"])
         seconds = time.perf_counter() - t0
+        if fits is not None:
+            fits[name] = (fit, moved)
         before, after = ssr(fit) - reference, ssr(moved) - reference
         rows.append({**row, "fit_above_reference": before, "relocated_above_reference": after,
                      "caught": before > 2.0, "recovered": before > 2.0 and after <= 0.5,
