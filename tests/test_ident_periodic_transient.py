@@ -75,12 +75,12 @@ def test_a_train_that_settles_keeps_every_period_after_the_first() -> None:
 def test_a_short_rest_before_a_train_that_never_settles_is_fitted_on_the_whole_record() -> None:
     """3/((s+1)(s+3)), 1.5 s half periods after 3 s at the high level: the periodic average (its mean removed)
     gave k a spread of 0.07 over 20 seeds; the whole record, whose transition from rest carries the static
-    gain, 0.012."""
+    gain, 0.012. Three noise seeds here: each must be fitted whole and hold k within 4 of its standard errors."""
     t = np.arange(0, 30, 0.01)
     u = np.where(t < 3.0, 1.0, 1.0 - (((t - 3.0) // 1.5) % 2 == 0))
     y = simulate_plant(Plant.from_string("3/((s+1)*(s+3))"), t, u)
     est, std = [], []
-    for seed in range(6):
+    for seed in range(3):
         r = identify((t, u, y + 0.01 * np.random.default_rng(100 + seed).normal(size=t.size)), "k/((s+p1)*(s+p2))")
         assert "predicted" in r.whole_record_note and "fitted it instead" in r.whole_record_note, r.whole_record_note
         est.append(r.fit.parameters["k"])
