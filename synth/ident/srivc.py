@@ -39,9 +39,10 @@ def _expm_np(M: np.ndarray) -> np.ndarray:
     norm = float(np.max(np.sum(np.abs(M), axis=0))) if M.size else 0.0
     k = max(0, int(np.ceil(np.log2(norm))) + 2) if norm > 0 else 0
     X = M / 2.0**k
-    E = np.eye(M.shape[0])
+    eye = np.eye(M.shape[0])  # one identity for all 16 terms (each step makes a new E)
+    E = eye
     for j in range(16, 0, -1):
-        E = np.eye(M.shape[0]) + (X @ E) / j
+        E = eye + (X @ E) / j
     for _ in range(k):
         E = E @ E
     return E
@@ -84,7 +85,7 @@ def filter_bank(den: np.ndarray, dt: float, x: np.ndarray, count: int, delay: fl
     >>> [round(float(v[-1]), 6) for v in filter_bank(np.array([1.0, 2.0]), 0.01, x, 2)]
     [0.31606, 0.367879]
     """
-    from scipy.signal import lfilter, ss2tf
+    from scipy.signal import lfilter
 
     den = np.asarray(den, float) / den[0]
     n = den.size - 1
@@ -102,6 +103,9 @@ def filter_bank(den: np.ndarray, dt: float, x: np.ndarray, count: int, delay: fl
         return out
 
     late, early = shift(x, z.steps), shift(x, z.steps + 1)
+    # scipy.signal.ss2tf's transfer function of (Ad, Bk, C, 0), written out: its denominator, det(zI - Ad), is the
+    # same for every k and Bk (formed once here, not once per call), its numerator det(zI - Ad + Bk C) - den
+    dd = np.poly(z.Ad)
     out = []
     for k in range(min(count, n)):
         C = np.zeros((1, n))
@@ -109,8 +113,8 @@ def filter_bank(den: np.ndarray, dt: float, x: np.ndarray, count: int, delay: fl
         y = np.zeros_like(x)
         for Bk, xin in ((z.B_late, late), (z.B_early, early)):
             if np.any(Bk):
-                num, dd = ss2tf(z.Ad, Bk[:, None], C, np.zeros((1, 1)))
-                y = y + lfilter(num[0], dd, xin)
+                num = np.poly(z.Ad - np.dot(Bk[:, None], C)) + (np.zeros(1) - 1) * dd
+                y = y + lfilter(num, dd, xin)
         out.append(y)
     if count > n:
         direct = shift(x, z.steps + (1 if z.fraction > 0 else 0))
