@@ -39,14 +39,19 @@ def first_order_record(seed: int, n: int = 2000) -> tuple[np.ndarray, np.ndarray
     return t, u, y, K, T
 
 
-@pytest.mark.parametrize("seed", [10, 15, 16])
-def test_an_overparameterized_fit_with_a_free_delay_is_returned_with_its_cancelling_pair_weak(seed):
+@pytest.mark.parametrize(("seed", "solver"), [(10, "ipopt"), (11, "Levenberg-Marquardt"),
+                                              (15, "Levenberg-Marquardt"), (16, "Levenberg-Marquardt")])
+def test_an_overparameterized_fit_with_a_free_delay_is_returned_with_its_cancelling_pair_weak(seed, solver):
     """Seeds 15 and 16 failed before (IPOPT: maximum iterations at 98.06 %; ended worse than its start); seed 10
     with a delay of -0.84 ms (IPOPT's bounded solve at the first sample interval stopped at its iteration limit, the
-    unbounded one in the next interval went below 0)."""
+    unbounded one in the next interval went below 0); Levenberg-Marquardt from the same start took over. Seed 11
+    was returned as a result at 29 % fit with a delay of 1.07 s: SRIVC's iteration on the delay grid left a fit
+    at the noise for one far off at the true delay 0, so the grid chose 1.5 s; its best iterate is now kept (seed
+    10's start is then good enough for IPOPT)."""
     t, u, y, K, T = first_order_record(seed)
     fit = identify((t, u, y), STRUCTURE, delay="fit", average="none").fit
-    assert fit.solver["method"].startswith("Levenberg-Marquardt") and "IPOPT from the same start" in fit.solver["method"]
+    assert fit.solver["method"].startswith(solver)
+    assert solver == "ipopt" or "IPOPT from the same start" in fit.solver["method"]
     assert fit.residual_std == pytest.approx(NOISE, rel=0.05)  # fitted to the noise, no further
     assert fit.delay >= 0.0
     # the plant's own pole: one of the two, within 4 of its standard errors of the truth

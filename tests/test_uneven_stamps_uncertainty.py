@@ -49,16 +49,18 @@ def test_reported_std_matches_the_scatter_over_jittered_records():
 
 
 @pytest.mark.slow
-def test_an_edge_average_fitted_beyond_nyquist_falls_back_to_the_whole_record():
+def test_an_edge_average_fit_that_fails_falls_back_to_the_whole_record():
     """Case 10 of benchmarks/uneven_stamps.py, noise seed 18 (found by that black-box benchmark): ``k/((s+p1)(s+p2))``
     with a fitted delay on bursty stamps. The 0.7 s edge average was fitted by k = -2.16e5, poles at 669 and 9,511
     rad/s (the grid's Nyquist frequency: 321 rad/s), a delay of 107 ms, and returned as the result with a reported
-    std of 0.17 on p2. That fit is now a failure of the average, and the whole record is fitted instead."""
+    std of 0.17 on p2. That fit is now a failure of the average, and the whole record is fitted instead. (Since
+    SRIVC keeps its best iterate, session 48, the average's fit ends on an unstable model, a failure too.)"""
     bench = pytest.importorskip("benchmarks.uneven_stamps")
     case = bench.make_case(10)
     y = bench.clean_output(case) + np.random.default_rng([10, 7919, 18]).normal(0, case.noise_std, case.t.size)
     res = identify((case.t, case.u, y), case.structure, delay="fit", compare_directions=False)
-    assert "beyond the record's Nyquist frequency" in res.whole_record_note
+    assert res.whole_record_note.startswith("the fit of the edge average failed")
+    assert "beyond the record's Nyquist frequency" in res.whole_record_note or "is unstable" in res.whole_record_note
     assert res.fit.t.size == res.record.n  # the whole record
     for name, truth in {**case.truth, "delay": case.delay}.items():
         assert abs(res.fit.parameters[name] - truth) < 4 * res.fit.std[name], (name, res.fit.parameters[name], truth)
