@@ -37,7 +37,8 @@ ABSURD_FACTOR = 1e8
 
 def fit_failure(parameters: dict[str, float], start: np.ndarray, status: str | None, success: bool,
                 fit_percent: float, delay: float | None, duration: float, samples: int = 0, free: int = 0,
-                remaining_step: float = float("inf"), start_fit_percent: float = float("nan")) -> str:
+                remaining_step: float = float("inf"), start_fit_percent: float = float("nan"),
+                solver: str = "IPOPT") -> str:
     """Why a finished fit is not a result, or ``""`` if it is one.
 
     A fit fails when the solver diverged or stopped at a limit (:data:`FAILED_STATUSES`), a
@@ -74,6 +75,9 @@ def fit_failure(parameters: dict[str, float], start: np.ndarray, status: str | N
         The fit (same measure as ``fit_percent``) of the starting values, NaN when unknown. The residual norm
         is ``1 - fit/100`` of the output's spread, so the fit is worse than its start when
         ``100 - fit_percent`` exceeds ``100 - start_fit_percent`` by more than a relative ``1e-6``.
+    solver : str
+        The solver that made the fit, as the message names it (IPOPT, or Levenberg-Marquardt: both report
+        IPOPT's status strings).
 
     Returns
     -------
@@ -103,7 +107,7 @@ def fit_failure(parameters: dict[str, float], start: np.ndarray, status: str | N
     limited = status in LIMIT_STATUSES and remaining_step < CONVERGED_WITHIN
     if not success and status in FAILED_STATUSES and not limited:
         detail = ", ".join(x for x in (shown, f"fit {_percent(fit_percent)} %" if np.isfinite(fit_percent) else "") if x)
-        return f"IPOPT stopped with {status}" + (f" ({detail})" if detail else "")
+        return f"{solver} stopped with {status}" + (f" ({detail})" if detail else "")
     if bad:
         return f"parameters at absurd magnitudes ({shown})"
     if delay is not None and not (np.isfinite(delay) and -1e-7 <= delay < duration):  # IPOPT relaxes bounds by 1e-8

@@ -12,19 +12,17 @@ Delay search
 The fractional delay ``f`` is bounded in ``[0, dt]``; if it ends on a bound, the
 whole-sample part ``m`` moves by one sample and the fit is repeated (at ``f = dt`` the
 models for ``m`` and ``m + 1`` coincide, so the cost is continuous in ``d``).
-IPOPT starts at the deterministic initial model. Only if it fails, or ends worse
-than the initial model, a fixed list of other starts is tried (multistart as a fallback).
+IPOPT starts at the deterministic initial model; only where it fails or ends worse than
+it, Levenberg-Marquardt from the same start and scaled starts are tried, and a start no
+Gauss-Newton step improves is kept (:mod:`synth.ident.start_kept`).
 
 Uncertainty
 -----------
-``cov = s^2 (J^T J)^{-1}`` with ``s^2 = SSR/(N - p)`` and ``J`` the Jacobian
-of ``yhat`` in the parameters (delay and offset included; with ``free_start``, the
-state at the first fitted sample too, as a nuisance); standard errors are
-the square roots of its diagonal and the 95 % intervals ``theta +- t_{0.975,
-N-p} std``. This assumes white noise. With coloured noise (drift, a
-disturbance spectrum, or a model error) the residuals are correlated and these
-standard errors are too small; averaging a step train and checking the
-residual plot helps.
+``cov = s^2 (J^T J)^{-1}`` with ``s^2 = SSR/(N - p)`` and ``J`` the Jacobian of ``yhat`` in
+the parameters (delay and offset included; with ``free_start``, the state at the first fitted
+sample too, as a nuisance); standard errors are the square roots of its diagonal and the 95 %
+intervals ``theta +- t_{0.975, N-p} std``. This assumes white noise: with coloured noise (drift,
+a disturbance, a model error) the residuals are correlated and these standard errors too small.
 
 ``fit_percent = 100 (1 - ||y - yhat|| / ||y - mean(y)||)``.
 """
@@ -48,6 +46,7 @@ from synth.ident.nyquist import nyquist_note
 from synth.ident.residual_whiteness import correlated_residuals_note
 from synth.ident.sim_error_problem import SimulationErrorProblem
 from synth.ident.srivc import linear_initial_model, map_to_structure
+from synth.ident.start_kept import START_CONVERGED, converged_start
 from synth.ident.start_state import free_columns, free_start_gram, start_state_test
 from synth.ident.structure import Structure, parse_structure
 from synth.plant import Plant
@@ -68,22 +67,19 @@ class TimeFitResult:
     ----------
     structure : Structure
     parameters : dict
-        Fitted values named as in the formula, plus the delay (under the
-        formula's delay name, else ``"delay"``).
+        Fitted values named as in the formula, plus the delay (under the formula's delay name, else ``"delay"``).
     std, ci95 : dict
         Standard errors and 95 % confidence intervals, same keys (a fixed delay has std 0).
     names : list of str
-        Order of the rows and columns of ``covariance`` (parameters, delay if
-        fitted, then ``"offset"``).
+        Order of the rows and columns of ``covariance`` (parameters, delay if fitted, then ``"offset"``).
     covariance : numpy.ndarray
     delay : float
         Delay [s].
     delay_fitted : bool
     offset, offset_std : float
         Output level ``b`` at the reference input ``u_0`` and its standard error.
-    fit_percent : float
-    residual_std : float
-        ``sqrt(SSR / (N - p))``.
+    fit_percent, residual_std : float
+        The fit and ``sqrt(SSR / (N - p))``.
     plant : Plant
         The fitted ``F`` with its delay.
     sensor : Plant or None
@@ -93,7 +89,7 @@ class TimeFitResult:
     initial : dict
         The deterministic initial values handed to IPOPT.
     solver : dict
-        IPOPT status, iterations, starts tried, delay shifts.
+        Status (IPOPT's, or ``Start_Converged``: :mod:`synth.ident.start_kept`), iterations, starts, delay shifts.
     t, y, yhat : numpy.ndarray
         The fitted data and the model output (for figures; not in ``to_dict``).
     periodic : bool
@@ -246,8 +242,7 @@ def fit_structure(record: Record, structure: Structure | str, delay: str | float
     Parameters
     ----------
     record : Record
-        Uniformly sampled input and output (for a step train, the averaged
-        period from :func:`synth.ident.steps.average_steps`).
+        Uniformly sampled input and output (for a step train, the averaged period from :func:`~.steps.average_steps`).
     structure : Structure or str
         E.g. ``"k*(s+z)/((s+p1)*(s+p2))"`` or ``"K*exp(-Td*s)/(T1*s+1)^2"``.
     delay : {"fit", float, None}
@@ -259,15 +254,13 @@ def fit_structure(record: Record, structure: Structure | str, delay: str | float
         The record is one period of a periodic response (initial state periodic),
         else the plant starts at rest at the first input sample.
     initial : dict, optional
-        Starting values (structure names, optionally ``delay``) instead of the
-        deterministic initialization.
+        Starting values (structure names, optionally ``delay``) instead of the deterministic initialization.
     lower : dict, optional
         Lower bounds of structure parameters (e.g. ``{"p": 0.0}`` keeps a pole in the
         left half-plane); the others are free.
     weights : numpy.ndarray, optional
-        Per-sample 0/1 weights of the cost (0: simulated but not fitted, e.g. held-out
-        segments or a start-up transient from an unknown initial state); the residual
-        statistics use the weighted samples only.
+        Per-sample 0/1 weights of the cost (0: simulated but not fitted, e.g. held-out segments or a start-up
+        transient from an unknown initial state); the residual statistics use the weighted samples only.
     check : bool
         Raise :class:`~synth.errors.FitError` when the fit failed (what :func:`synth.ident.identification.identify`,
         ``synth identify`` and :func:`synth.ident.directions.fit_by_direction` do). Without it the reason is in
@@ -421,6 +414,10 @@ def fit_structure(record: Record, structure: Structure | str, delay: str | float
                     break
     if fit_delay and st.num_degree >= st.den_degree:  # a jump at the delay: each sample interval its own valley
         xs, ssr, m, st_info, shifts = best_sample(run, xs, ssr, m, st_info, shifts, prob.scale, dt, info)
+    if not ssr <= ssr_start and (kept := converged_start(prob, theta0, d0, b0, w, y, mask, fit_delay, dt, lb)):
+        info["method"] += (f"; the start kept: the solver ended above it ({st_info.get('status')}, SSR {ssr:.6g} "
+                           f"against {ssr_start:.6g}); a Gauss-Newton step from it gains {kept[2]:.2g} std at most")
+        (xs, m, _), ssr, shifts, st_info = kept, ssr_start, 0, {**st_info, "success": True, "status": START_CONVERGED}
     info.update(st_info)
     info["delay_shifts"] = shifts
     p = len(st.parameters)
@@ -468,7 +465,8 @@ def fit_structure(record: Record, structure: Structure | str, delay: str | float
     failure = fit_failure(fitted, theta0, st_info.get("status"),
                           bool(st_info.get("success")), fit_pct, d_hat if fit_delay else None, n * dt,
                           int(y_fit.size), p_total, remaining,
-                          float(100.0 * (1.0 - np.sqrt(ssr_start) / np.linalg.norm(y_fit - np.mean(y_fit)))))
+                          float(100.0 * (1.0 - np.sqrt(ssr_start) / np.linalg.norm(y_fit - np.mean(y_fit)))),
+                          "Levenberg-Marquardt" if isinstance(prob, ConvolutionProblem) else "IPOPT")
     info["failure"] = failure
     if failure and check:
         met = coinciding(fitted)  # stalled where two roots meet: say so

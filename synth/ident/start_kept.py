@@ -1,0 +1,93 @@
+"""A deterministic start that is already an optimum, kept where the solver ended above it.
+
+The SRIVC start (:mod:`synth.ident.srivc`) is an instrumental-variable estimate of the same model; on a record it
+resolves well it is already at the simulation-error optimum to within the noise. Along a nearly cancelling pair the
+cost is flat, and IPOPT (or Levenberg-Marquardt after it) can drift along that valley and stop at its iteration
+limit a little above where it began: a first-order-plus-one-pair fit ended at 98.10710 % against 98.10713 % at its
+start, and was reported as failed ("ended worse than its start"). When no Gauss-Newton step from the start lowers
+the sum of squares by more than :data:`~synth.ident.fit_failure.CONVERGED_WITHIN` standard errors (the test a fit
+stopped at its iteration limit passes, :func:`~synth.ident.fit_failure.remaining_improvement`), the start is a
+converged fit and is the answer; otherwise the fit fails as before.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from synth.ident.fit_failure import CONVERGED_WITHIN, remaining_improvement
+
+__all__ = ["START_CONVERGED", "converged_start"]
+
+START_CONVERGED = "Start_Converged"
+"""The solver status a fit reports when its start was kept (:func:`converged_start`)."""
+
+
+def converged_start(prob: Any, theta0: np.ndarray, d0: float, b0: float, w: np.ndarray, y: np.ndarray,
+                    mask: np.ndarray | None, fit_delay: bool, dt: float,
+                    lower: np.ndarray | None) -> tuple[np.ndarray, int, float] | None:
+    """The start as the fit's decision variables, its delay's whole samples and how far it is from an optimum (in
+    standard errors), when that is less than :data:`~synth.ident.fit_failure.CONVERGED_WITHIN`; else None.
+
+    Parameters
+    ----------
+    prob : SimulationErrorProblem or ConvolutionProblem
+        The fit's problem (its ``scale``, ``inputs``, ``yhat_fn`` and ``jac_fn``).
+    theta0 : numpy.ndarray
+        Starting structure parameters.
+    d0, b0 : float
+        Starting delay [s] and output offset.
+    w, y : numpy.ndarray
+        The input relative to its first sample, and the measured output.
+    mask : numpy.ndarray or None
+        The fitted samples (None: all).
+    fit_delay : bool
+        Whether the delay is a decision variable (its fraction of a sample is then one).
+    dt : float
+        Sample interval [s].
+    lower : numpy.ndarray or None
+        Lower bounds of the structure parameters: a start below one is never kept.
+
+    Returns
+    -------
+    (numpy.ndarray, int, float) or None
+
+    Examples
+    --------
+    A noisy step's least-squares fit of ``k/(s + p)`` is kept; the truth it was drawn from is not an optimum of
+    that record (about one standard error away, as an estimate's scatter says), nor is twice the gain:
+
+    >>> from synth.ident.convolution_problem import ConvolutionProblem
+    >>> from synth.ident.structure import parse_structure
+    >>> st, t = parse_structure("k/(s+p)"), np.arange(400) * 0.01
+    >>> w = (t >= 0.5).astype(float)
+    >>> y = 2.0 * (1 - np.exp(-(t - 0.5).clip(0))) + 0.01 * np.random.default_rng(0).normal(size=t.size)
+    >>> prob = ConvolutionProblem(st, None, t.size, 0.01, False, np.array([2.0, 1.0]), False, y, False, None)
+    >>> xs, _, _ = prob.solve(np.array([1.0, 1.0, 0.0]), prob.inputs(w, 0, 0.0))
+    >>> best = xs[:2] * prob.scale
+    >>> x, m, left = converged_start(prob, best, 0.0, xs[2], w, y, None, False, 0.01, None)
+    >>> m, bool(left < 0.1)
+    (0, True)
+    >>> [converged_start(prob, theta, 0.0, 0.0, w, y, None, False, 0.01, None) is None
+    ...  for theta in (np.array([2.0, 1.0]), np.array([4.0, 1.0]))]
+    [True, True]
+    """
+    if lower is not None and not np.all(theta0 >= lower):
+        return None
+    m = int(np.floor(d0 / dt + 1e-9))
+    f = d0 - m * dt
+    x0 = np.r_[theta0 / prob.scale, f, b0] if fit_delay else np.r_[theta0 / prob.scale, b0]
+    par = prob.inputs(w, m) if fit_delay else prob.inputs(w, m, f)
+    scale = np.r_[prob.scale, 1.0, 1.0] if fit_delay else np.r_[prob.scale, 1.0]
+    with np.errstate(all="ignore"):
+        J = np.asarray(prob.jac_fn(x0, par)) / scale[None, :]
+        resid = y - np.asarray(prob.yhat_fn(x0, par)).ravel()
+    if mask is not None:
+        J, resid = J[mask], resid[mask]
+    dof = resid.size - J.shape[1]
+    s2 = float(resid @ resid) / dof if dof > 0 else float("nan")
+    if not (np.isfinite(s2) and s2 > 0 and np.all(np.isfinite(J))):
+        return None
+    left = remaining_improvement(prob, x0, par, J, resid, J.T @ J, scale, s2, mask, y, lower, fit_delay, dt)
+    return (x0, m, left) if left < CONVERGED_WITHIN else None
