@@ -9,9 +9,13 @@ failure. The converged start is the least-squares optimum found by an unpatched 
 
 from __future__ import annotations
 
+import io
+from contextlib import redirect_stdout
+
 import numpy as np
 import pytest
 
+from synth.cli import main
 from synth.data.record import Record
 from synth.errors import FitError
 from synth.ident import timefit
@@ -79,3 +83,17 @@ def test_a_start_that_is_no_optimum_still_fails(record, monkeypatch):
 
 def test_the_solver_status_is_known_to_the_fit_module():
     assert timefit.START_CONVERGED == START_CONVERGED == "Start_Converged"
+
+
+def test_the_command_line_says_the_start_was_kept(record, monkeypatch, tmp_path):
+    best = fit_structure(record, "k/(s+p)", check=True)
+    _uphill(monkeypatch, record, {"k": best.parameters["k"], "p": best.parameters["p"], "offset": best.offset})
+    path = tmp_path / "r.csv"
+    np.savetxt(path, np.column_stack([record.t, record.u, record.y]), delimiter=",", header="t,u,y", comments="")
+    out = io.StringIO()
+    with redirect_stdout(out):
+        code = main(["identify", "--data", str(path), "--time", "t", "--input", "u", "--output", "y", "--structure",
+                     "k/(s+p)", "--average", "none", "--no-figures", "--out", str(tmp_path / "rep")])
+    assert code == 0
+    assert "the start kept (IPOPT ended above it after 100 iterations)" in out.getvalue() \
+        or "the start kept (Levenberg-Marquardt ended above it after 100 iterations)" in out.getvalue(), out.getvalue()

@@ -222,8 +222,11 @@ def _print(result: Any, args: argparse.Namespace, json_path: Path, figures: list
         print(f"note on the std column: {fit.solver['covariance_note']}")
     if fit.solver.get("nyquist_note"):
         print(f"note: {fit.solver['nyquist_note']}")
-    print(f"fit {fit.fit_percent:.2f} %, residual std {fit.residual_std:.3g}, "
-          f"IPOPT {fit.solver.get('status')} ({fit.solver.get('iterations')} iterations)")
+    solver = "Levenberg-Marquardt" if fit.solver.get("method", "").startswith("Levenberg-Marquardt") else "IPOPT"
+    status, iterations = fit.solver.get("status"), fit.solver.get("iterations")
+    ending = (f"the start kept ({solver} ended above it after {iterations} iterations)" if status == "Start_Converged"
+              else f"{solver} {status} ({iterations} iterations)")
+    print(f"fit {fit.fit_percent:.2f} %, residual std {fit.residual_std:.3g}, {ending}")
     print(f"plant: {fit.plant.to_string()}")
     if result.directions is not None:
         comp = result.directions
