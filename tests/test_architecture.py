@@ -11,7 +11,10 @@ from __future__ import annotations
 
 import ast
 from collections import defaultdict
+from functools import cache
 from pathlib import Path
+
+import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
 PACKAGE = ROOT / "synth"
@@ -49,6 +52,9 @@ LAYERS: dict[str, int] = {
     "synth.cli": 9, "synth.__main__": 10, "synth": 10,
 }
 
+# one worker: the package's modules are parsed once per process (_tree), not once per test
+pytestmark = pytest.mark.xdist_group("architecture")
+
 MAX_LINES = 550  # "about 500": a module past this is split along its concepts
 
 
@@ -72,6 +78,12 @@ def layer_of(module: str) -> int:
     raise AssertionError(f"{module} is in no layer: add it to LAYERS in tests/test_architecture.py")
 
 
+@cache
+def _tree(path: Path) -> ast.Module:
+    """The parsed source of ``path``, parsed once per process (the tests only walk the trees)."""
+    return ast.parse(path.read_text())
+
+
 def _type_checking_nodes(tree: ast.AST) -> set[int]:
     skip: set[int] = set()
     for node in ast.walk(tree):
@@ -84,9 +96,10 @@ def _type_checking_nodes(tree: ast.AST) -> set[int]:
     return skip
 
 
-def _imports(module: str, path: Path) -> list[tuple[str, str, int]]:
+@cache
+def _imports(module: str, path: Path) -> tuple[tuple[str, str, int], ...]:
     """(imported module, imported name or '', line) for every synth import of ``module``."""
-    tree = ast.parse(path.read_text())
+    tree = _tree(path)
     skip = _type_checking_nodes(tree)
     package = module if path.name == "__init__.py" else module.rpartition(".")[0]
     found = []
@@ -108,7 +121,7 @@ def _imports(module: str, path: Path) -> list[tuple[str, str, int]]:
             for alias in node.names:
                 if alias.name == "synth" or alias.name.startswith("synth."):
                     found.append((alias.name, "", node.lineno))
-    return found
+    return tuple(found)
 
 
 def _graph() -> dict[str, set[str]]:
@@ -175,7 +188,7 @@ def test_no_import_from_a_higher_layer():
 def test_no_private_name_crosses_a_module_line():
     crossing = []
     for module, path in MODULES.items():
-        tree = ast.parse(path.read_text())
+        tree = _tree(path)
         aliases: dict[str, str] = {}
         for target, name, line in _imports(module, path):
             if name.startswith("_") and not name.startswith("__") and target != module:
@@ -204,7 +217,7 @@ def test_every_public_module_declares_its_public_names():
     for path in MODULES.values():
         if any(part.startswith("_") and part != "__init__" for part in path.relative_to(ROOT).with_suffix("").parts):
             continue  # private modules (synth/sim/_kernel.py, ...) and __main__
-        tree = ast.parse(path.read_text())
+        tree = _tree(path)
         names = {t.id for node in tree.body if isinstance(node, ast.Assign | ast.AnnAssign)
                  for t in (node.targets if isinstance(node, ast.Assign) else [node.target]) if isinstance(t, ast.Name)}
         if "__all__" not in names:
