@@ -9,15 +9,29 @@ average, the windows are 5.32 s, their fit holds, and the whole record is refitt
 than the model's settling time). The fallback itself is tested on a fit made to fail.
 """
 
+from functools import cache
+
 import numpy as np
 import pytest
 
 from synth.ident import identify
 
+pytestmark = pytest.mark.xdist_group("ident_average_fallback")  # one worker: case 9 is made once (_clean_case9)
+
+
+@cache
+def _clean_case9():
+    """The benchmark's case 9 (its noise-free output simulated by scipy's dlsim, ~0.7 s): the same for every seed,
+    made once per process; its arrays are read-only, so nothing can change them for the next test."""
+    case = pytest.importorskip("benchmarks.ident_crb").make_case(9, 16000)
+    case.u.setflags(write=False)
+    case.y0.setflags(write=False)
+    return case
+
 
 def _case9(seed: int):
     crb = pytest.importorskip("benchmarks.ident_crb")
-    case = crb.make_case(9, 16000)
+    case = _clean_case9()
     t = np.arange(case.samples) * crb.DT
     y = 3.0 + case.y0 + case.sigma * np.random.default_rng(seed).normal(size=case.samples)
     return case, (t, case.u, y), crb.sensor_text(case.sensor)
