@@ -48,8 +48,8 @@ def _boundary_function(c0: Rational | None, c1: Rational, num: np.ndarray, den: 
         s = 1j * np.asarray(w, dtype=float)
         e = np.exp(-delay * s)
         n, d = np.polyval(num, s), np.polyval(den, s)
-        X = np.polyval(b0, s) * d + np.polyval(a0, s) * n * e
-        Y = np.polyval(b0, s) * d
+        Y = np.polyval(b0, s) * d  # once: X's first term is the same product
+        X = Y + np.polyval(a0, s) * n * e
         U = np.polyval(a1, s) * n * e
         V = np.polyval(b1, s) * d
         return X * V, Y * U
