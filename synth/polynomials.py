@@ -220,6 +220,8 @@ def horner(coeffs: np.ndarray, x: np.ndarray) -> np.ndarray:
     coeffs = np.asarray(coeffs)
     x = np.asarray(x)
     y = np.zeros(np.broadcast_shapes(x.shape, coeffs.shape[:1] + (1,) * (x.ndim - 1)), dtype=np.result_type(x, coeffs))
-    for j in range(coeffs.shape[1]):
-        y = y * x + coeffs[:, j].reshape((-1,) + (1,) * (x.ndim - 1))
+    column = (-1,) + (1,) * (x.ndim - 1)
+    for j in range(coeffs.shape[1]):  # y = y * x + c, in place (the same operations, no temporaries)
+        y *= x
+        y += coeffs[:, j].reshape(column)
     return y
