@@ -13,7 +13,7 @@ import numpy as np
 from synth.distributions import f_sf
 
 __all__ = ["ABSURD_FACTOR", "CONVERGED_WITHIN", "FAILED_STATUSES", "LIMIT_STATUSES", "SIGNIFICANCE", "fit_failure",
-           "remaining_improvement", "start_ssr"]
+           "remaining_improvement", "start_point", "start_ssr"]
 
 #: IPOPT return statuses that end a fit without a usable optimum
 FAILED_STATUSES = ("Diverging_Iterates", "Maximum_Iterations_Exceeded", "Maximum_CpuTime_Exceeded",
@@ -171,16 +171,36 @@ def start_ssr(prob: Any, theta0: np.ndarray, d0: float, b0: float, w: np.ndarray
     >>> start_ssr(prob, np.array([2.0, 1.0]), 0.0, 0.0, w, y, None, False, 0.01) < 1e-3
     True
     """
-    m = int(np.floor(d0 / dt + 1e-9))
-    f = d0 - m * dt
-    x0 = np.r_[theta0 / prob.scale, f, b0] if fit_delay else np.r_[theta0 / prob.scale, b0]
-    par = prob.inputs(w, m) if fit_delay else prob.inputs(w, m, f)
+    x0, par, _ = start_point(prob, theta0, d0, b0, w, fit_delay, dt)
     with np.errstate(all="ignore"):
         r = y - np.asarray(prob.yhat_fn(x0, par)).ravel()
         if mask is not None:
             r = r[mask]
         value = float(r @ r)
     return value if np.isfinite(value) else float("inf")
+
+
+def start_point(prob: Any, theta0: np.ndarray, d0: float, b0: float, w: np.ndarray, fit_delay: bool,
+                dt: float) -> tuple[np.ndarray, Any, int]:
+    """The starting values as the fit's decision variables (scaled parameters, the delay's fraction of a sample when
+    it is fitted, the offset), the problem's inputs for the delay's whole samples, and those samples
+    (arguments as :func:`start_ssr`'s).
+
+    Examples
+    --------
+    >>> from synth.ident.convolution_problem import ConvolutionProblem
+    >>> from synth.ident.structure import parse_structure
+    >>> t = np.arange(100) * 0.01; w = (t >= 0.2).astype(float)
+    >>> prob = ConvolutionProblem(parse_structure("k/(s+p)"), None, t.size, 0.01, False, np.array([2.0, 4.0]), True,
+    ...                           w, False, None)
+    >>> x0, _, m = start_point(prob, np.array([2.0, 4.0]), 0.035, 0.5, w, True, 0.01)
+    >>> x0.round(6).tolist(), m
+    ([1.0, 1.0, 0.005, 0.5], 3)
+    """
+    m = int(np.floor(d0 / dt + 1e-9))
+    f = d0 - m * dt
+    x0 = np.r_[theta0 / prob.scale, f, b0] if fit_delay else np.r_[theta0 / prob.scale, b0]
+    return x0, (prob.inputs(w, m) if fit_delay else prob.inputs(w, m, f)), m
 
 
 def remaining_improvement(prob: Any, xs: np.ndarray, par: np.ndarray, J: np.ndarray,

@@ -16,7 +16,7 @@ from typing import Any
 
 import numpy as np
 
-from synth.ident.fit_failure import CONVERGED_WITHIN, remaining_improvement
+from synth.ident.fit_failure import CONVERGED_WITHIN, remaining_improvement, start_point
 
 __all__ = ["START_CONVERGED", "converged_start"]
 
@@ -32,20 +32,8 @@ def converged_start(prob: Any, theta0: np.ndarray, d0: float, b0: float, w: np.n
 
     Parameters
     ----------
-    prob : SimulationErrorProblem or ConvolutionProblem
-        The fit's problem (its ``scale``, ``inputs``, ``yhat_fn`` and ``jac_fn``).
-    theta0 : numpy.ndarray
-        Starting structure parameters.
-    d0, b0 : float
-        Starting delay [s] and output offset.
-    w, y : numpy.ndarray
-        The input relative to its first sample, and the measured output.
-    mask : numpy.ndarray or None
-        The fitted samples (None: all).
-    fit_delay : bool
-        Whether the delay is a decision variable (its fraction of a sample is then one).
-    dt : float
-        Sample interval [s].
+    prob, theta0, d0, b0, w, y, mask, fit_delay, dt
+        As :func:`~synth.ident.fit_failure.start_ssr`'s (the problem needs ``jac_fn`` too).
     lower : numpy.ndarray or None
         Lower bounds of the structure parameters: a start below one is never kept.
 
@@ -75,10 +63,7 @@ def converged_start(prob: Any, theta0: np.ndarray, d0: float, b0: float, w: np.n
     """
     if lower is not None and not np.all(theta0 >= lower):
         return None
-    m = int(np.floor(d0 / dt + 1e-9))
-    f = d0 - m * dt
-    x0 = np.r_[theta0 / prob.scale, f, b0] if fit_delay else np.r_[theta0 / prob.scale, b0]
-    par = prob.inputs(w, m) if fit_delay else prob.inputs(w, m, f)
+    x0, par, m = start_point(prob, theta0, d0, b0, w, fit_delay, dt)
     scale = np.r_[prob.scale, 1.0, 1.0] if fit_delay else np.r_[prob.scale, 1.0]
     with np.errstate(all="ignore"):
         J = np.asarray(prob.jac_fn(x0, par)) / scale[None, :]
