@@ -181,14 +181,17 @@ def parse_text(text: str, source: str = NO_SOURCE) -> Spec:
     ...
     synth.errors.SpecError: my.yaml:4: requirements[0].min: expected a number, got 'two'
     """
+    loader = _Loader(text)  # composed once: the node tree for line numbers, constructed into the data
     try:
-        root = yaml.compose(text, Loader=_Loader)
-        data = yaml.load(text, Loader=_Loader)
+        root = loader.get_single_node()
+        data = None if root is None else loader.construct_document(root)
     except yaml.YAMLError as exc:
         mark = getattr(exc, "problem_mark", None)
         where = f"{source}:{mark.line + 1}" if mark is not None else source
         problem = getattr(exc, "problem", None) or str(exc)
         raise SpecError(f"invalid YAML: {problem}", where=where) from None
+    finally:
+        loader.dispose()
     if data is None:
         raise SpecError("the spec file is empty", where=source)
     if not isinstance(data, dict):
