@@ -145,3 +145,24 @@ def test_near_misses_score_better_stay_stable_and_miss_a_requirement() -> None:
         assert not synth.check(spec, c).feasible
     worst = [min(r.slack for r in synth.check(spec, c).requirements) for c in near]
     assert worst == sorted(worst, reverse=True)  # least violating first
+
+
+def test_a_second_near_miss_apart_from_the_first_reaches_another_basin() -> None:
+    """Seed 26 #41 (a lead-lag on 697.5/(s (s + 65.4)) behind 47 ms, |S| <= -15 dB on [0.022, 2.2] rad/s, peak
+    |KS| <= 24.9 dB, bandwidth >= 3.5 rad/s, minimize peak |S|): the local stages and the polish from the least
+    violating near miss end at a lead (k at its bound 3.05, z 47.5, p 125) with 5.43 dB, 10.2 % above the
+    reference's best, a lag (k 0.66, z 4.33, p 1.23) with 4.58 dB. Every near miss close to the first is a lead;
+    the second start, the least violating one apart from it in the box, is a lag and polishes to the reference's
+    basin. Judged against the stored reference (its best point and its check)."""
+    import json
+    from pathlib import Path
+
+    from benchmarks.design_verification import generate
+
+    stored = next(r for r in map(json.loads, (Path(__file__).resolve().parents[1] / "reports" / "design_verification"
+                                              / "seed26_s44.jsonl").read_text().splitlines()) if r["index"] == 41)
+    rec = run_problem(generate(42, 26)[41], time_limit=120.0, stored=stored)
+    assert rec["outcome"] == "agree feasible" and rec["synth_passes_reference"], rec["outcome"]
+    assert rec["objective_gap"] <= 0.01, rec["objective_gap"]  # was 0.102
+    assert rec["synth_params"]["z"] > rec["synth_params"]["p"]  # a lag
+    assert "(the second led to this design)" in rec["synth_verdict"]

@@ -321,6 +321,32 @@ def _polished_from(spec: Spec, starts: list[Controller], terms: list[tuple[str, 
     return out
 
 
+def _near_starts(near: list[Controller]) -> str:
+    """The near misses polished from (:func:`synth.synthesis.screen.screen_near_improving`), in words.
+
+    Examples
+    --------
+    >>> _near_starts([Controller("P", {"kp": 1.0})])
+    'the one that misses them by the least'
+    """
+    return "the one that misses them by the least" + (
+        " and the least violating one apart from it in the box" if len(near) > 1 else "")
+
+
+def _near_outcome(count: int, led: int | None) -> str:
+    """What the polishes from ``count`` near misses gave: ``led`` is the one whose polish gave the design.
+
+    Examples
+    --------
+    >>> _near_outcome(1, 0), _near_outcome(2, 1), _near_outcome(2, None)
+    ('led to this design', '(the second led to this design)', '(both ended at no better design)')
+    """
+    if count == 1:
+        return "ended at no better design" if led is None else "led to this design"
+    return "(both ended at no better design)" if led is None else \
+        f"(the {('first', 'second')[led]} led to this design)"
+
+
 def _design(spec: Spec, settings: ConvexSettings, nlp: bool | str, explain: bool = True) -> DesignResult:
     terms = objective_terms(spec)
     try:
@@ -382,20 +408,22 @@ def _design(spec: Spec, settings: ConvexSettings, nlp: bool | str, explain: bool
         above = value + IMPROVEMENT * max(abs(value), 1e-12)
         starts = screen_improving(spec, terms, above)
         near = [] if starts else screen_near_improving(spec, terms, above)
-        found.extend(_polished_from(spec, starts + near, terms, runs[0][0].grid, settings, unconverged))
+        polished = [_polished_from(spec, [c], terms, runs[0][0].grid, settings, unconverged) for c in starts + near]
+        found.extend(kc for p in polished for kc in p)
         stages.append(f"random screen of the bounds ({screen_size(spec)} controllers): {len(starts)} scored more "
                       "than 1 % better on its grid" + (", NLP polish from each" if starts else "")
-                      + (", NLP polish from the least violating of those that score better" if near else ""))
+                      + (f", NLP polish from {_near_starts(near)} of those that score better" if near else ""))
         screened = (f"a random screen of {screen_size(spec)} controllers over the bounds found "
                     + (f"{len(starts)} scoring more than 1 % better on its grid, polished" if starts
                        else "none scoring more than 1 % better on its grid"))
         if starts or near:
             candidates, passed = _certify_best(spec, found, terms, per_decade, cache)
-            if near:  # (the screen's starts were none: a design polished from the screen came from the near miss)
-                screened += (", and of those that score better but miss the requirements, an NLP polish from the "
-                             "one that misses them by the least " + (
-                                 "led to this design" if passed is not None and passed[0] == "nlp from screen"
-                                 else "ended at no better design"))
+            if near:  # (the screen's starts were none: a design polished from the screen came from a near miss)
+                led = [k for k, p in enumerate(polished) if passed is not None and passed[0] == "nlp from screen"
+                       and any(c is passed[1] for _, c in p)]
+                screened += (", and of those that score better but miss the requirements, "
+                             + ("an NLP polish from " if len(near) == 1 else "NLP polishes from ")
+                             + _near_starts(near) + " " + _near_outcome(len(near), led[0] if led else None))
     if passed is None and nlp:  # the local stages found nothing that certifies: starts from the whole box
         announce(f"nothing certified: screen of {screen_size(spec)} controllers")
         starts = screen_starts(spec)
