@@ -412,7 +412,8 @@ def _design(spec: Spec, settings: ConvexSettings, nlp: bool | str, explain: bool
         found.extend(kc for p in polished for kc in p)
         stages.append(f"random screen of the bounds ({screen_size(spec)} controllers): {len(starts)} scored more "
                       "than 1 % better on its grid" + (", NLP polish from each" if starts else "")
-                      + (f", NLP polish from {_near_starts(near)} of those that score better" if near else ""))
+                      + (", NLP polish from the least violating of those that score better" if near else "")
+                      + (" and from the least violating one apart from it in the box" if len(near) > 1 else ""))
         screened = (f"a random screen of {screen_size(spec)} controllers over the bounds found "
                     + (f"{len(starts)} scoring more than 1 % better on its grid, polished" if starts
                        else "none scoring more than 1 % better on its grid"))
