@@ -30,3 +30,25 @@ def test_stable_third_order_plant_has_only_the_upward_one() -> None:
 def test_integrator_has_no_phase_crossing_at_zero_frequency() -> None:
     e = check_point([1.0], [1.0, 1.0, 0.0], 0.0, SPEC, {"kp": 1.0})
     assert e.values["0:margins:gm"] == np.inf
+
+
+def test_phase_margin_at_gain_crossovers_closer_than_the_grid_spacing() -> None:
+    """Seed 28 #20: a lightly damped pair lifts |L| through 1 at 108.198 and 108.254 rad/s, 0.05 % apart, where
+    the dense grid's points lie 0.14 % apart. The smallest phase margin is at those crossovers (26.95 deg), not at
+    the first one (81.42 deg); both values from a 4-million-point grid computed here."""
+    num = np.polymul([1433.56], np.polymul([1, 173.19], [1, 89.2659]))
+    den = np.polymul(np.polymul([1, 46.9125, 13165.1], [1, 33.1147]), [1, 2.24929])
+    delay, params = 0.00900017, {"k": 21.745873780847806, "z": 63.07452735763219, "p": 1725.9027618925775}
+    spec = {"requirements": [{"type": "sensitivity", "max_db": -18.19, "band": [0.0, 4.65428]},  # (sets the grid)
+                             {"type": "margins", "phase_margin_deg": 41.278}],
+            "controller": {"type": "leadlag", "bounds": {"k": [0.0, 28.7588], "z": [2.04013, 816.05],
+                                                          "p": [2.04013, 2040.12]}}}  # (the grid's range)
+    w = np.logspace(1, 3, 4_000_001)
+    s = 1j * w
+    L = np.polyval(num, s) / np.polyval(den, s) * params["k"] * (s + params["z"]) / (s + params["p"]) \
+        * np.exp(-s * delay)
+    at = np.flatnonzero(np.diff(np.sign(np.abs(L) - 1)))
+    assert w[at].round(1).tolist() == [38.2, 108.2, 108.3]
+    e = check_point(num.tolist(), den.tolist(), delay, spec, params)
+    assert e.values["1:margins:pm"] == pytest.approx(np.min(180 + np.degrees(np.angle(L[at]))), abs=0.01)
+    assert not e.feasible(1e-4)
