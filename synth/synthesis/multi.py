@@ -52,6 +52,7 @@ from synth.synthesis.polish_skip import exact_forms, polish_redundant
 from synth.synthesis.rational_rescale import rescaled_run
 from synth.synthesis.scalar import design_scalar
 from synth.synthesis.screen import SCREEN_ITERATIONS, screen_improving, screen_near_improving, screen_size, screen_starts
+from synth.synthesis.screen_polish import near_outcome_text, near_starts_text, polished_from
 from synth.synthesis.stabilizing_slices import open_loop_unstable, slices_text, stabilizing_slices
 
 __all__ = ["STRUCTURAL", "STRUCTURAL_REFINEMENTS", "certificate_density", "choose", "conflict_set", "convex_runs",
@@ -308,45 +309,6 @@ def initial_in_bounds(spec: Spec) -> Controller | None:
     return start if all(lo <= start.parameters[p] <= hi for p, (lo, hi) in bounds.items()) else None
 
 
-def _polished_from(spec: Spec, starts: list[Controller], terms: list[tuple[str, str, float]], grid: np.ndarray,
-                   settings: ConvexSettings, unconverged: set[str]) -> list[tuple[str, Controller]]:
-    """Screened starts and what a short NLP polish (3 rounds of :data:`SCREEN_ITERATIONS`) made of each, as
-    candidates for the certificate; where a polish stopped unconverged joins ``unconverged`` (as text)."""
-    out: list[tuple[str, Controller]] = []
-    for c in starts:
-        res = polish(list(spec.requirements), spec.plants(), c, spec.controller.all_bounds(), terms, grid,
-                     settings.per_decade, settings.stability_level, rounds=3, max_iter=SCREEN_ITERATIONS)
-        unconverged.update(h["controller"] for h in res.history if h.get("offered"))
-        out.extend([("screen", c), *(("nlp from screen", r) for r in reversed(res.candidates))])
-    return out
-
-
-def _near_starts(near: list[Controller]) -> str:
-    """The near misses polished from (:func:`synth.synthesis.screen.screen_near_improving`), in words.
-
-    Examples
-    --------
-    >>> _near_starts([Controller("P", {"kp": 1.0})])
-    'the one that misses them by the least'
-    """
-    return "the one that misses them by the least" + (
-        " and the least violating one apart from it in the box" if len(near) > 1 else "")
-
-
-def _near_outcome(count: int, led: int | None) -> str:
-    """What the polishes from ``count`` near misses gave: ``led`` is the one whose polish gave the design.
-
-    Examples
-    --------
-    >>> _near_outcome(1, 0), _near_outcome(2, 1), _near_outcome(2, None)
-    ('led to this design', '(the second led to this design)', '(both ended at no better design)')
-    """
-    if count == 1:
-        return "ended at no better design" if led is None else "led to this design"
-    return "(both ended at no better design)" if led is None else \
-        f"(the {('first', 'second')[led]} led to this design)"
-
-
 def _design(spec: Spec, settings: ConvexSettings, nlp: bool | str, explain: bool = True) -> DesignResult:
     terms = objective_terms(spec)
     try:
@@ -408,7 +370,7 @@ def _design(spec: Spec, settings: ConvexSettings, nlp: bool | str, explain: bool
         above = value + IMPROVEMENT * max(abs(value), 1e-12)
         starts = screen_improving(spec, terms, above)
         near = [] if starts else screen_near_improving(spec, terms, above)
-        polished = [_polished_from(spec, [c], terms, runs[0][0].grid, settings, unconverged) for c in starts + near]
+        polished = [polished_from(spec, [c], terms, runs[0][0].grid, settings, unconverged) for c in starts + near]
         found.extend(kc for p in polished for kc in p)
         stages.append(f"random screen of the bounds ({screen_size(spec)} controllers): {len(starts)} scored more "
                       "than 1 % better on its grid" + (", NLP polish from each" if starts else "")
@@ -424,11 +386,11 @@ def _design(spec: Spec, settings: ConvexSettings, nlp: bool | str, explain: bool
                        and any(c is passed[1] for _, c in p)]
                 screened += (", and of those that score better but miss the requirements, "
                              + ("an NLP polish from " if len(near) == 1 else "NLP polishes from ")
-                             + _near_starts(near) + " " + _near_outcome(len(near), led[0] if led else None))
+                             + near_starts_text(near) + " " + near_outcome_text(len(near), led[0] if led else None))
     if passed is None and nlp:  # the local stages found nothing that certifies: starts from the whole box
         announce(f"nothing certified: screen of {screen_size(spec)} controllers")
         starts = screen_starts(spec)
-        found.extend(_polished_from(spec, starts, terms, runs[0][0].grid, settings, unconverged))
+        found.extend(polished_from(spec, starts, terms, runs[0][0].grid, settings, unconverged))
         stages.append(f"random screen of the bounds ({screen_size(spec)} controllers, every requirement and plant): "
                       f"NLP polish from the {len(starts)} least violating (at most 3 rounds of {SCREEN_ITERATIONS} "
                       "iterations each)")
