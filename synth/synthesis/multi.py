@@ -54,6 +54,7 @@ from synth.synthesis.scalar import design_scalar
 from synth.synthesis.screen import SCREEN_ITERATIONS, screen_improving, screen_near_improving, screen_size, screen_starts
 from synth.synthesis.screen_polish import near_outcome_text, near_starts_text, polished_from
 from synth.synthesis.stabilizing_slices import open_loop_unstable, slices_text, stabilizing_slices
+from synth.synthesis.start_spread import near_starts_for
 
 __all__ = ["STRUCTURAL", "STRUCTURAL_REFINEMENTS", "certificate_density", "choose", "conflict_set", "convex_runs",
            "design_convex", "design_trial", "design_with_integral_action", "exact_forms", "infeasible_verdict",
@@ -369,7 +370,7 @@ def _design(spec: Spec, settings: ConvexSettings, nlp: bool | str, explain: bool
         announce(f"screen of {screen_size(spec)} controllers for better starts")
         above = value + IMPROVEMENT * max(abs(value), 1e-12)
         starts = screen_improving(spec, terms, above)
-        near = [] if starts else screen_near_improving(spec, terms, above)
+        near = [] if starts else screen_near_improving(spec, terms, above, keep=near_starts_for(spec))
         polished = [polished_from(spec, [c], terms, runs[0][0].grid, settings, unconverged) for c in starts + near]
         found.extend(kc for p in polished for kc in p)
         stages.append(f"random screen of the bounds ({screen_size(spec)} controllers): {len(starts)} scored more "
