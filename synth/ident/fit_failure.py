@@ -13,7 +13,7 @@ import numpy as np
 from synth.distributions import f_sf
 
 __all__ = ["ABSURD_FACTOR", "CONVERGED_WITHIN", "FAILED_STATUSES", "LIMIT_STATUSES", "SIGNIFICANCE", "fit_failure",
-           "remaining_improvement", "start_point", "start_ssr"]
+           "remaining_improvement", "scaled_jacobian", "start_point", "start_ssr"]
 
 #: IPOPT return statuses that end a fit without a usable optimum
 FAILED_STATUSES = ("Diverging_Iterates", "Maximum_Iterations_Exceeded", "Maximum_CpuTime_Exceeded",
@@ -201,6 +201,33 @@ def start_point(prob: Any, theta0: np.ndarray, d0: float, b0: float, w: np.ndarr
     f = d0 - m * dt
     x0 = np.r_[theta0 / prob.scale, f, b0] if fit_delay else np.r_[theta0 / prob.scale, b0]
     return x0, (prob.inputs(w, m) if fit_delay else prob.inputs(w, m, f)), m
+
+
+def scaled_jacobian(prob: Any, xs: np.ndarray, par: Any, y: np.ndarray, yhat: np.ndarray, mask: np.ndarray | None,
+                    fit_delay: bool) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The Jacobian of ``yhat`` in the fit's parameters (unscaled: structure parameters, the delay's fraction when
+    fitted, the offset), the residual ``y - yhat`` (both on the fitted samples of ``mask``) and the scale that
+    unscales them, as :func:`remaining_improvement` and the covariance take them.
+
+    Examples
+    --------
+    >>> from synth.ident.convolution_problem import ConvolutionProblem
+    >>> from synth.ident.structure import parse_structure
+    >>> t = np.arange(100) * 0.01; w = (t >= 0.2).astype(float)
+    >>> prob = ConvolutionProblem(parse_structure("k/(s+p)"), None, t.size, 0.01, False, np.array([2.0, 4.0]), False,
+    ...                           w, False, None)
+    >>> x, par = np.array([1.0, 1.0, 0.0]), prob.inputs(w, 0, 0.0)
+    >>> yhat = np.asarray(prob.yhat_fn(x, par)).ravel()
+    >>> J, resid, scale = scaled_jacobian(prob, x, par, yhat + 0.1, yhat, t >= 0.5, False)
+    >>> J.shape, float(resid.max()), scale.tolist()
+    ((50, 3), 0.1, [2.0, 4.0, 1.0])
+    """
+    scale = np.r_[prob.scale, 1.0, 1.0] if fit_delay else np.r_[prob.scale, 1.0]
+    J = np.asarray(prob.jac_fn(xs, par)) / scale[None, :]
+    resid = y - yhat
+    if mask is not None:
+        J, resid = J[mask], resid[mask]
+    return J, resid, scale
 
 
 def remaining_improvement(prob: Any, xs: np.ndarray, par: np.ndarray, J: np.ndarray,

@@ -16,7 +16,7 @@ from typing import Any
 
 import numpy as np
 
-from synth.ident.fit_failure import CONVERGED_WITHIN, remaining_improvement, start_point
+from synth.ident.fit_failure import CONVERGED_WITHIN, remaining_improvement, scaled_jacobian, start_point
 
 __all__ = ["START_CONVERGED", "converged_start"]
 
@@ -64,12 +64,9 @@ def converged_start(prob: Any, theta0: np.ndarray, d0: float, b0: float, w: np.n
     if lower is not None and not np.all(theta0 >= lower):
         return None
     x0, par, m = start_point(prob, theta0, d0, b0, w, fit_delay, dt)
-    scale = np.r_[prob.scale, 1.0, 1.0] if fit_delay else np.r_[prob.scale, 1.0]
     with np.errstate(all="ignore"):
-        J = np.asarray(prob.jac_fn(x0, par)) / scale[None, :]
-        resid = y - np.asarray(prob.yhat_fn(x0, par)).ravel()
-    if mask is not None:
-        J, resid = J[mask], resid[mask]
+        J, resid, scale = scaled_jacobian(prob, x0, par, y, np.asarray(prob.yhat_fn(x0, par)).ravel(), mask,
+                                          fit_delay)
     dof = resid.size - J.shape[1]
     s2 = float(resid @ resid) / dof if dof > 0 else float("nan")
     if not (np.isfinite(s2) and s2 > 0 and np.all(np.isfinite(J))):

@@ -40,7 +40,7 @@ from synth.errors import DataError, FitError, ModelError
 from synth.ident.convolution_problem import ConvolutionProblem
 from synth.ident.covariance import fit_covariance
 from synth.ident.delay_samples import best_sample, walk_intervals
-from synth.ident.fit_failure import LIMIT_STATUSES, fit_failure, remaining_improvement, start_ssr
+from synth.ident.fit_failure import LIMIT_STATUSES, fit_failure, remaining_improvement, scaled_jacobian, start_ssr
 from synth.ident.identifiability import TiedParameter, WeakParameter, coinciding, tied_to_weak, weak_parameters
 from synth.ident.nyquist import nyquist_note
 from synth.ident.residual_whiteness import correlated_residuals_note
@@ -435,12 +435,7 @@ def fit_structure(record: Record, structure: Structure | str, delay: str | float
     yhat = np.asarray(prob.yhat_fn(xs, par)).ravel()
     resid_fit = (y - yhat) if mask is None else (y - yhat)[mask]
     fit_pct = float(100.0 * (1.0 - np.linalg.norm(resid_fit) / np.linalg.norm(y_fit - np.mean(y_fit))))
-    J = np.asarray(prob.jac_fn(xs, par))
-    scale_vec = np.r_[prob.scale, 1.0, 1.0] if fit_delay else np.r_[prob.scale, 1.0]
-    J = J / scale_vec[None, :]
-    resid = y - yhat
-    if mask is not None:
-        J, resid = J[mask], resid[mask]
+    J, resid, scale_vec = scaled_jacobian(prob, xs, par, y, yhat, mask, fit_delay)
     dof = resid.size - J.shape[1]
     s2 = float(np.sum(resid**2) / dof)
     JtJ, rows = J.T @ J, (np.arange(n) if mask is None else np.flatnonzero(mask))

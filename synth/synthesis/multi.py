@@ -387,7 +387,7 @@ def _design(spec: Spec, settings: ConvexSettings, nlp: bool | str, explain: bool
                        and any(c is passed[1] for _, c in p)]
                 screened += (", and of those that score better but miss the requirements, "
                              + ("an NLP polish from " if len(near) == 1 else "NLP polishes from ")
-                             + near_starts_text(near) + " " + near_outcome_text(len(near), led[0] if led else None))
+                             + near_starts_text(len(near)) + " " + near_outcome_text(len(near), led[0] if led else None))
     if passed is None and nlp:  # the local stages found nothing that certifies: starts from the whole box
         announce(f"nothing certified: screen of {screen_size(spec)} controllers")
         starts = screen_starts(spec)

@@ -38,16 +38,16 @@ def polished_from(spec: Spec, starts: list[Controller], terms: list[tuple[str, s
     return out
 
 
-def near_starts_text(near: list[Controller]) -> str:
-    """The near misses polished from (:func:`synth.synthesis.screen.screen_near_improving`), in words.
+def near_starts_text(count: int) -> str:
+    """The ``count`` near misses polished from (:func:`synth.synthesis.screen.screen_near_improving`), in words.
 
     Examples
     --------
-    >>> near_starts_text([Controller("P", {"kp": 1.0})])
+    >>> near_starts_text(1)
     'the one that misses them by the least'
     """
     return "the one that misses them by the least" + (
-        " and the least violating one apart from it in the box" if len(near) > 1 else "")
+        " and the least violating one apart from it in the box" if count > 1 else "")
 
 
 def near_outcome_text(count: int, led: int | None) -> str:
