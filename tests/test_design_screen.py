@@ -166,3 +166,25 @@ def test_a_second_near_miss_apart_from_the_first_reaches_another_basin() -> None
     assert rec["objective_gap"] <= 0.01, rec["objective_gap"]  # was 0.102
     assert rec["synth_params"]["z"] > rec["synth_params"]["p"]  # a lag
     assert "(the second led to this design)" in rec["synth_verdict"]
+
+
+def test_near_misses_are_found_below_a_first_pool_of_unstable_loops() -> None:
+    """Seed 28 #20 (a lead-lag on a plant with a mode of damping 0.2 behind 9 ms, |S| <= -18.2 dB up to 4.65 rad/s,
+    phase margin 41.3 deg, maximize bandwidth): of the 308 screened controllers that score above 134.7 rad/s, the
+    192 that meet the sensitivity bound best all destabilize the loop. Their roots alone were counted, so the
+    screen offered no near miss although stable ones score better further down."""
+    import json
+    from pathlib import Path
+
+    from synth.loop import Loop
+    from synth.synthesis.screen import NEAR_POOL, screen_near_improving, screen_scores
+
+    stored = next(r for r in map(json.loads, (Path(__file__).resolve().parents[1] / "reports" / "design_verification"
+                                              / "seed28_s49.jsonl").read_text().splitlines()) if r["index"] == 20)
+    spec, terms = parse_spec(stored["spec"]), [("bandwidth", "maximize", 1.0)]
+    assert np.sum(screen_scores(spec, screen_points(spec), terms) > 134.7) > NEAR_POOL
+    near = screen_near_improving(spec, terms, 134.7, keep=2)
+    assert len(near) == 2
+    for c in near:
+        assert Loop(spec.nominal_plant(), c).stability().stable
+        assert not synth.check(spec, c).feasible

@@ -235,7 +235,8 @@ def screen_improving(spec: Spec, terms: list[tuple[str, str, float]], above: flo
 
 
 NEAR_POOL = 192
-"""Controllers scoring better whose closed-loop roots :func:`screen_near_improving` counts, at most."""
+"""Controllers scoring better whose closed-loop roots :func:`screen_near_improving` counts at once (the next as
+many only while fewer than it picks are stable)."""
 
 
 def screen_near_improving(spec: Spec, terms: list[tuple[str, str, float]], above: float, keep: int = 2,
@@ -254,7 +255,8 @@ def screen_near_improving(spec: Spec, terms: list[tuple[str, str, float]], above
     Every point is scored at once (:func:`screen_scores`); those that score better are taken in the order of
     their worst slack on the requirements that count no closed-loop roots (every loop taken as stable); the
     first :data:`NEAR_POOL` of them have their closed-loop roots counted (in one batch: counted a few at a time,
-    the batches' fixed costs outweighed the counts saved). The stable ones' slack on the requirements that
+    the batches' fixed costs outweighed the counts saved), and the next as many while fewer than ``keep`` are
+    stable. The stable ones' slack on the requirements that
     count roots (margins) is evaluated in that order, a few at a time, only until no later point can rank among
     the picks (:func:`_best_bounded`: a point's worst slack is at most its slack on the other requirements):
     the same picks as evaluating every one of them (servo_pid's screen: 8 of 12 stable points).
@@ -282,10 +284,14 @@ def screen_near_improving(spec: Spec, terms: list[tuple[str, str, float]], above
     heavy = [r for r in spec.requirements if r.type in STABILITY_BASED]
     better = np.flatnonzero(screen_scores(spec, controllers, terms) > above)
     light_worst = _worst_slack(controllers, better, light, plants, assume_stable=True)
-    top = np.argsort(-light_worst, kind="stable")[:NEAR_POOL]
-    better, light_worst = better[top], light_worst[top]
-    better, light_worst = better[light_worst > -np.inf], light_worst[light_worst > -np.inf]
-    stable = _worst_slack(controllers, better, [], plants, stable_only=True) > -np.inf  # in one batch
+    order = np.argsort(-light_worst, kind="stable")
+    order = order[light_worst[order] > -np.inf]
+    stable: list[int] = []
+    for first in range(0, order.size, NEAR_POOL):  # a pool's roots in one batch; the next pool while too few
+        pool = order[first:first + NEAR_POOL]  # are stable (those meeting the light requirements best may all be
+        stable.extend(pool[_worst_slack(controllers, better[pool], [], plants, stable_only=True) > -np.inf])
+        if len(stable) >= keep:  # unstable: seed 28 #20's first 192 of 308)
+            break
     better, light_worst = better[stable], light_worst[stable]
 
     def heavy_slack(chunk: np.ndarray) -> np.ndarray:  # every loop of these is stable: roots not counted again
