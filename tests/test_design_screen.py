@@ -165,7 +165,13 @@ def test_a_second_near_miss_apart_from_the_first_reaches_another_basin() -> None
     assert rec["outcome"] == "agree feasible" and rec["synth_passes_reference"], rec["outcome"]
     assert rec["objective_gap"] <= 0.01, rec["objective_gap"]  # was 0.102
     assert rec["synth_params"]["z"] > rec["synth_params"]["p"]  # a lag
-    assert "(the second led to this design)" in rec["synth_verdict"]
+    # since session 50 the screen of 1536 points holds a lag that meets the requirements; the near misses (the
+    # draw of 384) are still a lead and, apart from it, a lag: the second start alone reaches the basin
+    from synth.synthesis.screen import screen_near_improving
+
+    spec = synth.parse_spec(stored["spec"])
+    first, second = screen_near_improving(spec, spec.objective.terms(), -5.43 * (1 - 0.01), keep=2)
+    assert first.parameters["z"] < first.parameters["p"] and second.parameters["z"] > second.parameters["p"]
 
 
 def test_near_misses_are_found_below_a_first_pool_of_unstable_loops() -> None:
@@ -177,13 +183,13 @@ def test_near_misses_are_found_below_a_first_pool_of_unstable_loops() -> None:
     from pathlib import Path
 
     from synth.loop import Loop
-    from synth.synthesis.screen import NEAR_POOL, screen_near_improving, screen_scores
+    from synth.synthesis.screen import NEAR_POOL, SCREEN_POINTS, screen_near_improving, screen_scores
 
     stored = next(r for r in map(json.loads, (Path(__file__).resolve().parents[1] / "reports" / "design_verification"
                                               / "seed28_s49.jsonl").read_text().splitlines()) if r["index"] == 20)
     spec, terms = parse_spec(stored["spec"]), [("bandwidth", "maximize", 1.0)]
-    assert np.sum(screen_scores(spec, screen_points(spec), terms) > 134.7) > NEAR_POOL
-    near = screen_near_improving(spec, terms, 134.7, keep=2)
+    assert np.sum(screen_scores(spec, screen_points(spec, SCREEN_POINTS), terms) > 134.7) > NEAR_POOL
+    near = screen_near_improving(spec, terms, 134.7, keep=2, n=SCREEN_POINTS)
     assert len(near) == 2
     for c in near:
         assert Loop(spec.nominal_plant(), c).stability().stable

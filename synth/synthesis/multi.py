@@ -51,10 +51,9 @@ from synth.synthesis.pattern import BOUNDARY_CHECKS, pattern_search
 from synth.synthesis.polish_skip import exact_forms, polish_redundant
 from synth.synthesis.rational_rescale import rescaled_run
 from synth.synthesis.scalar import design_scalar
-from synth.synthesis.screen import SCREEN_ITERATIONS, screen_improving, screen_near_improving, screen_size, screen_starts
-from synth.synthesis.screen_polish import near_outcome_text, near_starts_text, polished_from
+from synth.synthesis.screen import SCREEN_ITERATIONS, screen_improving, screen_size, screen_starts
+from synth.synthesis.screen_polish import near_misses_polished, near_misses_text, polished_from
 from synth.synthesis.stabilizing_slices import open_loop_unstable, slices_text, stabilizing_slices
-from synth.synthesis.start_spread import near_starts_for
 
 __all__ = ["STRUCTURAL", "STRUCTURAL_REFINEMENTS", "certificate_density", "choose", "conflict_set", "convex_runs",
            "design_convex", "design_trial", "design_with_integral_action", "exact_forms", "infeasible_verdict",
@@ -370,9 +369,17 @@ def _design(spec: Spec, settings: ConvexSettings, nlp: bool | str, explain: bool
         announce(f"screen of {screen_size(spec)} controllers for better starts")
         above = value + IMPROVEMENT * max(abs(value), 1e-12)
         starts = screen_improving(spec, terms, above)
-        near = [] if starts else screen_near_improving(spec, terms, above, keep=near_starts_for(spec))
-        polished = [polished_from(spec, [c], terms, runs[0][0].grid, settings, unconverged) for c in starts + near]
-        found.extend(kc for p in polished for kc in p)
+        found.extend(kc for c in starts for kc in polished_from(spec, [c], terms, runs[0][0].grid, settings,
+                                                                  unconverged))
+        if starts:
+            candidates, passed = _certify_best(spec, found, terms, per_decade, cache)
+        near, near_polished = [], []
+        if passed is not None and score(Loop(nominal, passed[1]), terms) < above:  # no start led 1 % higher: the
+            # near misses (seed 16 #118: a screen of 1536 held starts, which polished back to the old basin)
+            near, near_polished = near_misses_polished(spec, terms, above, runs[0][0].grid, settings, unconverged)
+            found.extend(kc for p in near_polished for kc in p)
+            if near:
+                candidates, passed = _certify_best(spec, found, terms, per_decade, cache)
         stages.append(f"random screen of the bounds ({screen_size(spec)} controllers): {len(starts)} scored more "
                       "than 1 % better on its grid" + (", NLP polish from each" if starts else "")
                       + (", NLP polish from the least violating of those that score better" if near else "")
@@ -380,14 +387,8 @@ def _design(spec: Spec, settings: ConvexSettings, nlp: bool | str, explain: bool
         screened = (f"a random screen of {screen_size(spec)} controllers over the bounds found "
                     + (f"{len(starts)} scoring more than 1 % better on its grid, polished" if starts
                        else "none scoring more than 1 % better on its grid"))
-        if starts or near:
-            candidates, passed = _certify_best(spec, found, terms, per_decade, cache)
-            if near:  # (the screen's starts were none: a design polished from the screen came from a near miss)
-                led = [k for k, p in enumerate(polished) if passed is not None and passed[0] == "nlp from screen"
-                       and any(c is passed[1] for _, c in p)]
-                screened += (", and of those that score better but miss the requirements, "
-                             + ("an NLP polish from " if len(near) == 1 else "NLP polishes from ")
-                             + near_starts_text(len(near)) + " " + near_outcome_text(len(near), led[0] if led else None))
+        if near:
+            screened += near_misses_text(near_polished, passed)
     if passed is None and nlp:  # the local stages found nothing that certifies: starts from the whole box
         announce(f"nothing certified: screen of {screen_size(spec)} controllers")
         starts = screen_starts(spec)

@@ -19,22 +19,18 @@ import numpy as np
 from synth.controllers import Controller
 from synth.loop_batch import LoopBatch
 from synth.spec import Spec
+from synth.synthesis.screen_sizes import (
+    MANY_FROM_PARAMETERS,
+    SCREEN_POINTS,
+    SCREEN_POINTS_MANY,
+    near_screen_size,
+    screen_size,
+)
 from synth.synthesis.start_spread import apart
 
-__all__ = ["NEAR_POOL", "PARAMETER_MEASURES", "SCREEN_ITERATIONS", "SCREEN_POINTS", "SCREEN_POINTS_MANY",
-           "screen_improving", "screen_near_improving", "screen_points", "screen_scores", "screen_size",
-           "screen_starts"]
-
-SCREEN_POINTS = 384
-"""Controllers drawn by the screen for up to three free parameters (:func:`screen_size`)."""
-
-SCREEN_POINTS_MANY = 1536
-"""Controllers drawn for a rational controller or four free parameters or more: their feasible sets are thin in
-the box, and 384 draws missed the basin of the best designs. The draw holds the 384 of the smaller screen
-(:func:`screen_points`). On the 13 rational problems of the design benchmark whose objective was more than 1 %
-worse than the reference's: seed 14 #69 8.2 % -> 0.5 %, seed 12 #68 10.6 % -> 6.3 %, seed 11 #191 1.5 % ->
-1.1 %, the other ten as before; their design time 1-2x. (An independent draw of 1536, not holding the 384,
-moved others and lost some: seed 11 #38 91 % -> -12 %, but seed 12 #284 82 % -> 94 % and seed 1 #19 3 % -> 14 %.)"""
+__all__ = ["MANY_FROM_PARAMETERS", "NEAR_POOL", "PARAMETER_MEASURES", "SCREEN_ITERATIONS", "SCREEN_POINTS",
+           "SCREEN_POINTS_MANY", "near_screen_size", "screen_improving", "screen_near_improving", "screen_points",
+           "screen_scores", "screen_size", "screen_starts"]
 
 STABILITY_BASED = ("margins", "delay_margin")
 """Requirement types whose batch form counts every loop's closed-loop roots (milliseconds per loop): the
@@ -46,23 +42,6 @@ PARAMETER_MEASURES = ("integral_gain", "low_frequency_gain")
 SCREEN_ITERATIONS = 300
 """IPOPT iterations per round of a polish from a screened start (a start far from any optimum must not cost
 a minute: the polish from the convex answer keeps the full limit)."""
-
-
-def screen_size(spec: Spec) -> int:
-    """Controllers the screen draws for ``spec``: :data:`SCREEN_POINTS`, or :data:`SCREEN_POINTS_MANY` for a
-    rational controller or four free parameters or more.
-
-    Examples
-    --------
-    >>> from synth.spec import parse_spec
-    >>> spec = parse_spec({"name": "r", "plant": {"tf": "1/(s+1)"}, "requirements": [{"type": "bandwidth",
-    ...                    "min": 1.0}], "controller": {"type": "rational", "order": [1, 2]}})
-    >>> screen_size(spec), screen_size(spec.model_copy(update={"controller": spec.controller.model_copy(
-    ...     update={"type": "PI", "order": None})}))
-    (1536, 384)
-    """
-    many = spec.controller.type == "rational" or len(spec.controller.free_parameters()) >= 4
-    return SCREEN_POINTS_MANY if many else SCREEN_POINTS
 
 
 def screen_points(spec: Spec, n: int | None = None) -> list[Controller]:
@@ -277,7 +256,7 @@ def screen_near_improving(spec: Spec, terms: list[tuple[str, str, float]], above
     >>> apart(near[0].parameters, near[1].parameters, spec.controller.all_bounds())
     True
     """
-    n = screen_size(spec) if n is None else n
+    n = near_screen_size(spec) if n is None else n
     controllers = screen_points(spec, n)
     plants = spec.plants()
     light = [r for r in spec.requirements if r.type not in STABILITY_BASED]

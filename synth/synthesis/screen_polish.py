@@ -9,9 +9,10 @@ from synth.controllers import Controller
 from synth.spec import Spec
 from synth.synthesis.convex_settings import ConvexSettings
 from synth.synthesis.nlp import polish
-from synth.synthesis.screen import SCREEN_ITERATIONS
+from synth.synthesis.screen import SCREEN_ITERATIONS, screen_near_improving
+from synth.synthesis.start_spread import near_starts_for
 
-__all__ = ["near_outcome_text", "near_starts_text", "polished_from"]
+__all__ = ["near_misses_polished", "near_misses_text", "near_outcome_text", "near_starts_text", "polished_from"]
 
 
 def polished_from(spec: Spec, starts: list[Controller], terms: list[tuple[str, str, float]], grid: np.ndarray,
@@ -62,3 +63,40 @@ def near_outcome_text(count: int, led: int | None) -> str:
         return "ended at no better design" if led is None else "led to this design"
     return "(both ended at no better design)" if led is None else \
         f"(the {('first', 'second')[led]} led to this design)"
+
+
+def near_misses_polished(spec: Spec, terms: list[tuple[str, str, float]], above: float, grid: np.ndarray,
+                         settings: ConvexSettings, unconverged: set[str]
+                         ) -> tuple[list[Controller], list[list[tuple[str, Controller]]]]:
+    """The near misses that score above ``above`` (:func:`synth.synthesis.screen.screen_near_improving`, as many as
+    :func:`synth.synthesis.start_spread.near_starts_for` asks) and what :func:`polished_from` made of each.
+
+    Examples
+    --------
+    >>> from synth.spec import parse_spec
+    >>> spec = parse_spec({"name": "pi", "plant": {"tf": "1/(s+1)^3"}, "requirements": [{"type":
+    ...                    "peak_sensitivity", "max_db": 3}], "controller": {"type": "PI", "bounds": {"kp": [0, 5],
+    ...                    "ki": [0, 5]}}, "objective": {"maximize": "integral_gain"}})
+    >>> near, polished = near_misses_polished(spec, [("integral_gain", "maximize", 1.0)], 0.3, np.logspace(-2, 2, 81),
+    ...                                       ConvexSettings(), set())
+    >>> len(near), [kind for kind, _ in polished[0]][0]
+    (1, 'screen')
+    """
+    near = screen_near_improving(spec, terms, above, keep=near_starts_for(spec))
+    return near, [polished_from(spec, [c], terms, grid, settings, unconverged) for c in near]
+
+
+def near_misses_text(polished: list[list[tuple[str, Controller]]], passed: tuple[str, Controller] | None) -> str:
+    """The verdict's words for the polishes from the near misses (:func:`near_misses_polished`), given the design
+    certified after them.
+
+    Examples
+    --------
+    >>> c = Controller("P", {"kp": 1.0})
+    >>> near_misses_text([[("screen", c)]], ("nlp", c))[-75:]
+    'an NLP polish from the one that misses them by the least led to this design'
+    """
+    led = [k for k, p in enumerate(polished) if passed is not None and any(c is passed[1] for _, c in p)]
+    return (", and of those that score better but miss the requirements, "
+            + ("an NLP polish from " if len(polished) == 1 else "NLP polishes from ")
+            + near_starts_text(len(polished)) + " " + near_outcome_text(len(polished), led[0] if led else None))
