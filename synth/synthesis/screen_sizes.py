@@ -10,12 +10,12 @@ SCREEN_POINTS = 384
 """Controllers drawn by the screen for fewer than :data:`MANY_FROM_PARAMETERS` free parameters (:func:`screen_size`)."""
 
 SCREEN_POINTS_MANY = 1536
-"""Controllers drawn for a rational controller or :data:`MANY_FROM_PARAMETERS` free parameters or more: their
-feasible sets are thin in the box, and 384 draws missed the basin of the best designs. The draw holds the 384 of
-the smaller screen (:func:`screen_points`). On the 13 rational problems of the design benchmark whose objective was
-more than 1 % worse than the reference's: seed 14 #69 8.2 % -> 0.5 %, seed 12 #68 10.6 % -> 6.3 %, seed 11 #191 1.5 % ->
-1.1 %, the other ten as before; their design time 1-2x. (An independent draw of 1536, not holding the 384,
-moved others and lost some: seed 11 #38 91 % -> -12 %, but seed 12 #284 82 % -> 94 % and seed 1 #19 3 % -> 14 %.)"""
+"""Controllers drawn for a rational controller or :data:`MANY_FROM_PARAMETERS` free parameters or more: their feasible
+sets are thin in the box, and 384 draws missed the basin of the best designs. The draw holds the 384 of the smaller
+screen (:func:`synth.synthesis.screen.screen_points`). On the 13 rational problems of the design benchmark whose
+objective was more than 1 % worse than the reference's: seed 14 #69 8.2 % -> 0.5 %, seed 12 #68 10.6 % -> 6.3 %, seed
+11 #191 1.5 % -> 1.1 %, the other ten as before; their design time 1-2x. (An independent draw of 1536, not holding the
+384, moved others and lost some: seed 11 #38 91 % -> -12 %, but seed 12 #284 82 % -> 94 % and seed 1 #19 3 % -> 14 %.)"""
 
 MANY_FROM_PARAMETERS = 3
 """Free parameters from which the screen draws :data:`SCREEN_POINTS_MANY` (a lead-lag, a PID with its filter fixed).
