@@ -433,9 +433,8 @@ def fit_structure(record: Record, structure: Structure | str, delay: str | float
         par = prob.inputs(w, m, f_hat)
     d_hat = m * dt + f_hat
     yhat = np.asarray(prob.yhat_fn(xs, par)).ravel()
-    resid_fit = (y - yhat) if mask is None else (y - yhat)[mask]
-    fit_pct = float(100.0 * (1.0 - np.linalg.norm(resid_fit) / np.linalg.norm(y_fit - np.mean(y_fit))))
     J, resid, scale_vec = scaled_jacobian(prob, xs, par, y, yhat, mask, fit_delay)
+    fit_pct = float(100.0 * (1.0 - np.linalg.norm(resid) / np.linalg.norm(y_fit - np.mean(y_fit))))
     dof = resid.size - J.shape[1]
     s2 = float(np.sum(resid**2) / dof)
     JtJ, rows = J.T @ J, (np.arange(n) if mask is None else np.flatnonzero(mask))

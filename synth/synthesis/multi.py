@@ -374,8 +374,9 @@ def _design(spec: Spec, settings: ConvexSettings, nlp: bool | str, explain: bool
         if starts:
             candidates, passed = _certify_best(spec, found, terms, per_decade, cache)
         near, near_polished = [], []
-        if passed is not None and score(Loop(nominal, passed[1]), terms) < above:  # no start led 1 % higher: the
-            # near misses (seed 16 #118: a screen of 1536 held starts, which polished back to the old basin)
+        if passed is not None and (score(Loop(nominal, passed[1]), terms) if starts else value) < above:  # no start: the
+            # near misses, as when no start led 1 % higher (seed 16 #118: a screen of 1536 held starts, which polished
+            # back to the old basin)
             near, near_polished = near_misses_polished(spec, terms, above, runs[0][0].grid, settings, unconverged)
             found.extend(kc for p in near_polished for kc in p)
             if near:

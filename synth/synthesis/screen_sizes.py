@@ -4,7 +4,8 @@ from __future__ import annotations
 
 from synth.spec import Spec
 
-__all__ = ["MANY_FROM_PARAMETERS", "SCREEN_POINTS", "SCREEN_POINTS_MANY", "near_screen_size", "screen_size"]
+__all__ = ["MANY_FROM_PARAMETERS", "NEAR_MANY_FROM_PARAMETERS", "SCREEN_POINTS", "SCREEN_POINTS_MANY", "near_screen_size",
+           "screen_size"]
 
 SCREEN_POINTS = 384
 """Controllers drawn by the screen for fewer than :data:`MANY_FROM_PARAMETERS` free parameters (:func:`screen_size`)."""
@@ -25,6 +26,9 @@ random points), a thin ridge up to the best, 146.1 rad/s, where the mode's |L| p
 0.16 % above the bandwidth's level. The screen of 384 held none of them, the screen of 1536 three, and the
 design ends at 145.9 rad/s instead of 137.6 (four free parameters until session 50)."""
 
+NEAR_MANY_FROM_PARAMETERS = 4
+"""Free parameters from which the near-miss screen draws :data:`SCREEN_POINTS_MANY` (:func:`near_screen_size`)."""
+
 
 def screen_size(spec: Spec) -> int:
     """Controllers the screen draws for ``spec``: :data:`SCREEN_POINTS`, or :data:`SCREEN_POINTS_MANY` for a
@@ -39,16 +43,15 @@ def screen_size(spec: Spec) -> int:
     ...     update={"type": "PI", "order": None})}))
     (1536, 384)
     """
-    many = spec.controller.type == "rational" or len(spec.controller.free_parameters()) >= MANY_FROM_PARAMETERS
-    return SCREEN_POINTS_MANY if many else SCREEN_POINTS
+    return _draw_size(spec, MANY_FROM_PARAMETERS)
 
 
 def near_screen_size(spec: Spec) -> int:
     """Controllers the near-miss screen (:func:`screen_near_improving`) draws: :data:`SCREEN_POINTS_MANY` for a
-    rational controller or four free parameters or more, else :data:`SCREEN_POINTS`. For three, the least violating
-    near miss of the smaller draw is the start validated on the design benchmark; the larger draw's is another
-    point (seed 16 #118, a PID: one that polishes to nothing certified, where the smaller draw's reaches the best
-    basin, 12.8 % above the local stages' design).
+    rational controller or :data:`NEAR_MANY_FROM_PARAMETERS` free parameters or more, else :data:`SCREEN_POINTS`. For
+    three, the least violating near miss of the smaller draw is the start validated on the design benchmark; the
+    larger draw's is another point (seed 16 #118, a PID: one that polishes to nothing certified, where the smaller
+    draw's reaches the best basin, 12.8 % above the local stages' design).
 
     Examples
     --------
@@ -58,5 +61,11 @@ def near_screen_size(spec: Spec) -> int:
     >>> screen_size(spec), near_screen_size(spec)
     (1536, 384)
     """
-    many = spec.controller.type == "rational" or len(spec.controller.free_parameters()) >= 4
+    return _draw_size(spec, NEAR_MANY_FROM_PARAMETERS)
+
+
+def _draw_size(spec: Spec, many_from: int) -> int:
+    """:data:`SCREEN_POINTS_MANY` for a rational controller or ``many_from`` free parameters or more, else
+    :data:`SCREEN_POINTS`."""
+    many = spec.controller.type == "rational" or len(spec.controller.free_parameters()) >= many_from
     return SCREEN_POINTS_MANY if many else SCREEN_POINTS
