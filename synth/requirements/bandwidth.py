@@ -7,7 +7,7 @@ from typing import TYPE_CHECKING, Any, ClassVar, Literal
 import numpy as np
 from pydantic import PositiveFloat, model_validator
 
-from synth.freqgrid import batch_first_crossing, log_grids
+from synth.batch_bandwidth import batch_bandwidths
 from synth.requirements.base import Bound, Requirement, RequirementResult, fmt, register
 from synth.requirements.margins import closed_loop_unstable, unstable_result, with_unstable_rows
 
@@ -74,15 +74,7 @@ class Bandwidth(Requirement):
 
     def batch_slack(self, batch: LoopBatch, per_decade: int = 80) -> np.ndarray:
         """Vectorized slack: every loop's first -3 dB crossing of ``|T|`` at once (as ``Loop.bandwidth``)."""
-        from synth.loop import BANDWIDTH_LEVEL
-
-        t0 = batch.T0()
-        ranges = batch.frequency_ranges
-        lowest = np.array([np.min(w) / 100.0 if w.size else np.inf for w in batch.gain_crossovers()])
-        grid = log_grids(np.fmin(ranges[:, 0], lowest), ranges[:, 1] * 10, per_decade)  # as Loop.bandwidth
-        cross, below = batch_first_crossing(lambda w: np.abs(batch.T(w)), t0 * BANDWIDTH_LEVEL, grid)
-        wb = np.where(below, grid[:, 0], np.where(np.isnan(cross), np.inf, cross))  # as first_fall
-        wb = np.where((t0 == 0.0) | ~np.isfinite(t0), np.nan, wb)
+        wb = batch_bandwidths(batch, per_decade)
         slack = np.full(wb.shape, np.inf)
         with np.errstate(divide="ignore", invalid="ignore"):
             if self.min is not None:

@@ -16,6 +16,7 @@ from collections.abc import Callable
 
 import numpy as np
 
+from synth.batch_bandwidth import batch_bandwidths
 from synth.controllers import Controller
 from synth.loop_batch import LoopBatch
 from synth.spec import Spec
@@ -187,22 +188,18 @@ def screen_improving(spec: Spec, terms: list[tuple[str, str, float]], above: flo
     [True, True, True]
     """
     from synth.loop import Loop
-    from synth.objectives import score
 
     n = screen_size(spec) if n is None else n
     controllers = screen_points(spec, n)
-    plants, nominal = spec.plants(), spec.nominal_plant()
+    plants = spec.plants()
     light = [r for r in spec.requirements if r.type not in STABILITY_BASED]
     heavy = [r for r in spec.requirements if r.type in STABILITY_BASED]
     idx = np.arange(len(controllers))
     if not all(name in PARAMETER_MEASURES for name, _, _ in terms):  # else the score is cheaper than any slack
         idx = _meeting(controllers, idx, light, plants, assume_stable=True)
-    scored = []
-    for i in idx:  # the objective before the requirements that count closed-loop roots (the costly part)
-        with np.errstate(all="ignore"):
-            value = score(Loop(nominal, controllers[i]), terms)
-        if np.isfinite(value) and value > above:
-            scored.append((value, int(i)))
+    # the objective before the requirements that count closed-loop roots (the costly part), every loop at once
+    values = screen_scores(spec, [controllers[i] for i in idx], terms, exact=True)
+    scored = [(float(v), int(i)) for v, i in zip(values, idx) if np.isfinite(v) and v > above]
     if all(name in PARAMETER_MEASURES for name, _, _ in terms):
         idx = _meeting(controllers, np.array([i for _, i in scored], int), light, plants, assume_stable=True)
         meeting = set(idx.tolist())
@@ -341,11 +338,13 @@ def _best_bounded(order: np.ndarray, bound: np.ndarray, value: Callable[[np.ndar
     return [i for _, _, i in found[:need]]
 
 
-def screen_scores(spec: Spec, controllers: list[Controller], terms: list[tuple[str, str, float]]) -> np.ndarray:
+def screen_scores(spec: Spec, controllers: list[Controller], terms: list[tuple[str, str, float]],
+                  exact: bool = False) -> np.ndarray:
     """Every controller's objective (:func:`synth.objectives.score` on the nominal plant, every loop taken as
-    stable), the bandwidth read off one grid for all at once (:func:`_grid_bandwidths`), the other
-    measures loop by loop (the parameter measures cost nothing); ``-inf`` where it is not a number. For
-    ranking starts only: the polish and the certificate judge the designs.
+    stable), the bandwidth read off one grid for all at once (:func:`_grid_bandwidths`; with ``exact``, each
+    loop's ``Loop.bandwidth`` by :func:`synth.batch_bandwidth.batch_bandwidths`, also all at once), the other
+    measures loop by loop (the parameter measures cost nothing); ``-inf`` where it is not a number. Without
+    ``exact``, for ranking starts only: the polish and the certificate judge the designs.
 
     Examples
     --------
@@ -362,8 +361,12 @@ def screen_scores(spec: Spec, controllers: list[Controller], terms: list[tuple[s
     nominal = spec.nominal_plant()
     total = np.zeros(len(controllers))
     for name, sense, weight in terms:
+        if name == "bandwidth" and not controllers:
+            continue
         if name == "bandwidth":
-            value = _grid_bandwidths(LoopBatch(nominal, controllers))
+            with np.errstate(all="ignore"):
+                batch = LoopBatch(nominal, controllers)
+                value = batch_bandwidths(batch) if exact else _grid_bandwidths(batch)
         else:
             with np.errstate(all="ignore"):
                 value = np.array([measure(name).evaluate(Loop(nominal, c)) for c in controllers], float)
