@@ -17,7 +17,7 @@ from synth.controllers import Controller, as_controller
 from synth.freqgrid import characteristic_range, first_fall, log_grid
 from synth.narrow_peaks import LIGHT_DAMPING, narrow_peak_frequencies
 from synth.plant import Plant, as_plant
-from synth.polynomials import dc_value, format_factored, horner, magnitude_squared_in_w2, trim
+from synth.polynomials import dc_value, format_factored, horner, magnitude_squared_in_w2, polymul, trim
 from synth.stability import StabilityResult, closed_loop_stability, stability_floor
 from synth.stability_sets import gain_margin_factors
 
@@ -128,12 +128,12 @@ class Loop:
     @cached_property
     def num(self) -> np.ndarray:
         """Numerator of the rational part of L."""
-        return trim(np.polymul(self.controller.tf()[0], self.plant.num))
+        return trim(polymul(self.controller.tf()[0], self.plant.num))
 
     @cached_property
     def den(self) -> np.ndarray:
         """Denominator of the rational part of L."""
-        return trim(np.polymul(self.controller.tf()[1], self.plant.den))
+        return trim(polymul(self.controller.tf()[1], self.plant.den))
 
     @property
     def delay(self) -> float:
@@ -351,7 +351,7 @@ class Loop:
             roots = np.roots(trim(np.polyadd(self.den, self.num)))
             return roots[np.argsort(-roots.real)]
         pn, pd = _pade(self.delay, pade_order)
-        return self.quasi_roots(np.roots(trim(np.polyadd(np.polymul(self.den, pd), np.polymul(self.num, pn)))))
+        return self.quasi_roots(np.roots(trim(np.polyadd(polymul(self.den, pd), polymul(self.num, pn)))))
 
     def quasi_roots(self, seeds: np.ndarray) -> np.ndarray:
         """Roots of ``den(s) + num(s) exp(-delay s)`` by Newton's method from ``seeds`` (the converged ones,

@@ -15,7 +15,7 @@ from itertools import pairwise
 import numpy as np
 
 from synth.errors import ModelError
-from synth.polynomials import largest_crossing, shifted, trim, value_at_infinity
+from synth.polynomials import largest_crossing, polymul, shifted, trim, value_at_infinity
 from synth.rootfind import bisect_roots
 from synth.stability import MAX_PHASE_POINTS, PHASE_STEP, Rational, characteristic_scale, closed_loop_stability
 
@@ -90,8 +90,8 @@ def stability_boundaries(
     a1, b1 = c1
     a0, b0 = c0 if c0 is not None else (np.array([0.0]), np.array([1.0]))
     h, rho = _boundary_function(c0, c1, num, den, delay)
-    loop0_num, loop0_den = np.polymul(a0, num), np.polymul(b0, den)
-    loop1_num, loop1_den = np.polymul(a1, num), np.polymul(b1, den)
+    loop0_num, loop0_den = polymul(a0, num), polymul(b0, den)
+    loop1_num, loop1_den = polymul(a1, num), polymul(b1, den)
     w_a = largest_crossing(loop0_num, loop0_den, 0.5) if np.any(a0 != 0) else 0.0
     w_b = largest_crossing(loop1_num, loop1_den, 0.5 / max(rho_max, 1e-300))
     lo_scale, hi_scale = characteristic_scale(a0, b0, a1, b1, num, den, delay=delay)
@@ -138,7 +138,7 @@ def _combine(c0: Rational | None, c1: Rational, rho: float) -> Rational:
     if c0 is None:
         return rho * np.asarray(a1, float), np.asarray(b1, float)
     a0, b0 = c0
-    return np.polyadd(np.polymul(a0, b1), rho * np.polymul(a1, b0)), np.polymul(b0, b1)
+    return np.polyadd(polymul(a0, b1), rho * polymul(a1, b0)), polymul(b0, b1)
 
 
 ROOTS_PER_CROSSING = 4
@@ -224,7 +224,7 @@ def affine_stability_intervals(
 
     def unstable_at(r: float) -> int:
         cn, cd = _combine(c0, c1, r)
-        ln, ld = np.polymul(cn, num), np.polymul(cd, den)
+        ln, ld = polymul(cn, num), polymul(cd, den)
         if np.all(ln == 0):
             return int(np.sum(np.roots(trim(den)).real >= 0)) if trim(den).size > 1 else 0
         return closed_loop_stability(ln, ld, delay).unstable_poles
@@ -295,7 +295,7 @@ def affine_root_counts(
         cn, cd = _combine(c0, c1, r)
         while cn.size > 1 and cd.size > 1 and cn[-1] == 0.0 and cd[-1] == 0.0:  # C0 + 0 C1 = C0: s cancels
             cn, cd = cn[:-1], cd[:-1]
-        return closed_loop_stability(np.polymul(cn, num), np.polymul(cd, den), delay, floor).unstable_poles
+        return closed_loop_stability(polymul(cn, num), polymul(cd, den), delay, floor).unstable_poles
 
     piece = np.searchsorted(edges, values) if edges.size else np.zeros(values.size, dtype=int)
     near = np.zeros(values.size, bool) if edges.size == 0 else \

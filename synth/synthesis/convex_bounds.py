@@ -48,7 +48,7 @@ import numpy as np
 
 from synth.loop import BANDWIDTH_LEVEL
 from synth.plant import Plant
-from synth.polynomials import dc_value
+from synth.polynomials import dc_value, polymul
 from synth.requirements.base import magnitude
 from synth.synthesis.cvxpy_loader import cp
 from synth.synthesis.parametrization import Affine, Parametrization
@@ -339,7 +339,7 @@ class T0:
 
     def value(self, rho: np.ndarray, plant_index: np.ndarray) -> np.ndarray:
         cn, cd = self.par.controller(rho).tf()
-        l0 = np.array([dc_value(np.polymul(cn, p.num), np.polymul(cd, p.den)) for p in self.plants])
+        l0 = np.array([dc_value(polymul(cn, p.num), polymul(cd, p.den)) for p in self.plants])
         with np.errstate(divide="ignore", invalid="ignore"):
             t0 = np.where(np.isinf(l0), 1.0, np.abs(l0 / (1.0 + l0)))
         return t0[plant_index]
