@@ -30,7 +30,8 @@ LAYERS: dict[str, int] = {
     "synth.worker_pool": 0,
     # 1 models: plants, controllers, the loop and its exact stability, records
     "synth.plant": 1, "synth.controllers": 1, "synth.stability": 1, "synth.stability_sets": 1, "synth.freqgrid": 1,
-    "synth.unity_gain": 1, "synth.narrow_peaks": 1,
+    "synth.unity_gain": 1, "synth.narrow_peaks": 1, "synth.first_crossing": 1,
+    "synth.batch_bandwidth": 1,
     "synth.loop": 1, "synth.loop_batch": 1, "synth.loop_memo": 1, "synth.timeresp": 1, "synth.delayed_step": 1,
     "synth.objectives": 1, "synth.data": 1,
     # 2 analyses on a model: requirements, simulation, identification
