@@ -41,8 +41,6 @@ def _bracketed_min(curve: Callable[[np.ndarray], np.ndarray], a: np.ndarray, x: 
     return fx, np.exp(x)
 
 
-
-
 def batch_first_crossing(curve: Curve, level: np.ndarray, grid: np.ndarray,
                          lengths: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Lowest frequency of each row where ``curve(w)`` falls below ``level`` on a positive ``grid`` ``(n, m)``:

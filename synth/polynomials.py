@@ -29,8 +29,8 @@ def trim(p: np.ndarray) -> np.ndarray:
 
 def polymul(a: Any, b: Any) -> np.ndarray:
     """``np.polymul(a, b)`` of two coefficient arrays, bit for bit (leading zeros dropped, as its ``poly1d``
-    drops them, then one convolution), without building ``poly1d`` objects (a quarter of the cost of a loop's
-    polynomials in the design's inner loops).
+    drops them, then one convolution), without building ``poly1d`` objects (the design tests' 207,000 calls spent
+    5.5 s of a 113 s profile in them).
 
     Examples
     --------
