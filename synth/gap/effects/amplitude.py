@@ -31,6 +31,7 @@ import numpy as np
 from synth.errors import ModelError
 from synth.gap.effects.base import Effect, Params
 from synth.ident.simulate import simulate_plant
+from synth.jit import jit
 from synth.plant import Plant
 
 __all__ = ["DuffingEffect", "cubic_feedback"]
@@ -95,26 +96,49 @@ def cubic_feedback(plant: Plant, u: np.ndarray, dt: float, cubic: float) -> np.n
         x = np.linalg.solve(np.eye(n) - Ad, Bd * w_rest)
     except np.linalg.LinAlgError:
         x = np.zeros(n)
-    c = cubic / k0
     limit = 1e3 * (1.0 + abs(k0) * float(np.max(np.abs(ud))))
-    w = np.empty_like(ud)
-    Adl, Bdl, Cl = Ad.tolist(), Bd.tolist(), C.tolist()
-    cad = (C @ Ad).tolist()
-    cbd = float(C @ Bd)
-    xs = x.tolist()
+    C = np.ascontiguousarray(C, float)
+    w = _spring_inputs(np.ascontiguousarray(ud, float), np.ascontiguousarray(Ad), np.ascontiguousarray(Bd), C,
+                       np.ascontiguousarray(C @ Ad), float(C @ Bd), np.array(x, float), cubic / k0, limit)
+    return np.r_[w[k:], np.full(k, w[-1])] if k > 0 else w
+
+
+@jit
+def _spring_inputs(ud, Ad, Bd, C, cad, cbd, x, c, limit):
+    """The loop of :func:`cubic_feedback`, sample by sample (each input depends on the state the last one left):
+    every sum taken in index order, the clamps as Python's ``max(-limit, min(limit, v))``."""
+    n = x.size
+    w = np.empty(ud.size)
+    xs = x.copy()
+    nxt = np.empty(n)
     for i in range(ud.size):
-        ui = float(ud[i])
-        y0 = sum(ci * xi for ci, xi in zip(Cl, xs))
-        a = sum(ci * xi for ci, xi in zip(cad, xs))
-        y0 = max(-limit, min(limit, y0))  # a diverging spring stays finite (and fits badly)
+        ui = ud[i]
+        y0 = 0.0
+        a = 0.0
+        for j in range(n):
+            y0 += C[j] * xs[j]
+        for j in range(n):
+            a += cad[j] * xs[j]
+        y0 = _clamp(y0, limit)  # a diverging spring stays finite (and fits badly)
         wi = ui - c * y0 * y0 * y0
         for _ in range(3):  # the force at the sample's midpoint output: Newton on w = u - c m^3
-            m = max(-limit, min(limit, 0.5 * (y0 + a + cbd * wi)))
+            m = _clamp(0.5 * (y0 + a + cbd * wi), limit)
             f = wi - ui + c * m * m * m
             wi -= f / (1.0 + 1.5 * c * m * m * cbd)
         w[i] = wi
-        xs = [sum(q * xj for q, xj in zip(row, xs)) + b * wi for row, b in zip(Adl, Bdl)]
-    return np.r_[w[k:], np.full(k, w[-1])] if k > 0 else w
+        for r in range(n):
+            s = 0.0
+            for j in range(n):
+                s += Ad[r, j] * xs[j]
+            nxt[r] = s + Bd[r] * wi
+        xs[:] = nxt
+    return w
+
+
+@jit
+def _clamp(v, limit):
+    low = v if v < limit else limit  # min(limit, v)
+    return low if low > -limit else -limit  # max(-limit, low)
 
 
 @dataclass(frozen=True)
