@@ -8,7 +8,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from synth.first_crossing import batch_first_crossing
-from synth.freqgrid import log_grids
+from synth.freqgrid import log_grid_sizes, log_grids
 
 if TYPE_CHECKING:
     from synth.loop_batch import LoopBatch
@@ -35,24 +35,22 @@ def batch_bandwidths(batch: LoopBatch, per_decade: int = 80) -> np.ndarray:
     >>> [round(Loop(G, c).bandwidth(), 6) for c in cs]
     [1.880124, 34.310076, 103.578655]
     """
-    from synth.loop import BANDWIDTH_LEVEL, Loop
+    from synth.loop import BANDWIDTH_LEVEL, Loop, bandwidth_span
     from synth.loop_batch import LoopBatch
 
     t0 = batch.T0()
     out = np.full(len(batch), np.nan)
-    lo, hi = batch.frequency_ranges[:, 0].copy(), batch.frequency_ranges[:, 1].copy()
-    for i, w in enumerate(batch.gain_crossovers()):  # as Loop.bandwidth
-        if w.size:
-            lo[i], hi[i] = min(lo[i], float(np.min(w)) / 100.0), max(hi[i], float(np.max(w)) * 100.0)
-    hi = hi * 10
+    spans = [bandwidth_span(lo, hi, w) for (lo, hi), w in zip(batch.frequency_ranges, batch.gain_crossovers())]
+    lo, hi = np.array(spans, float).reshape(-1, 2).T
     with np.errstate(all="ignore"):
         decades = np.log10(hi / lo)
-        sizes = np.maximum(2, np.ceil(per_decade * np.where(np.isfinite(decades), decades, 0.0)).astype(int) + 1)
     measured = (t0 != 0.0) & np.isfinite(t0)
     odd = measured & ~((lo > 0) & np.isfinite(decades))
     for i in np.flatnonzero(odd):  # a grid log_grid refuses: the loop's own answer (its error)
         out[i] = Loop(batch.plant, batch.controllers[i]).bandwidth(per_decade)
     rows = np.flatnonzero(measured & ~odd)
+    sizes = np.zeros(len(batch), int)
+    sizes[rows] = log_grid_sizes(lo[rows], hi[rows], per_decade)
     if rows.size > CHUNK:
         rows = rows[np.argsort(sizes[rows], kind="stable")]
     for start in range(0, rows.size, CHUNK):

@@ -18,7 +18,7 @@ from synth.rootfind import bisect_roots
 
 __all__ = ["DEFAULT_PER_DECADE", "Curve", "band_grid", "band_grids", "batch_first_crossing", "batch_peak",
            "bracketed_maxima", "characteristic_range", "corner_frequencies", "crossings", "first_fall", "log_grid",
-           "log_grids", "neighbour_brackets", "peak", "refine_maxima", "resolving_grid"]
+           "log_grid_sizes", "log_grids", "neighbour_brackets", "peak", "refine_maxima", "resolving_grid"]
 
 Curve = Callable[[np.ndarray], np.ndarray]
 
@@ -327,7 +327,7 @@ def log_grids(w_lo: np.ndarray, w_hi: np.ndarray, per_decade: int = DEFAULT_PER_
     w_lo, w_hi = np.asarray(w_lo, float), np.asarray(w_hi, float)
     pairs, inverse = np.unique(np.column_stack([w_lo, w_hi]), axis=0, return_inverse=True)
     lo, hi = pairs[:, 0], pairs[:, 1]
-    sizes = np.maximum(2, np.ceil(per_decade * np.log10(hi / lo)).astype(int) + 1)
+    sizes = log_grid_sizes(lo, hi, per_decade)
     # np.geomspace's own arithmetic, all rows at once: 10 ** (log10 lo + k step), the ends set exactly
     log_lo, log_hi = np.log10(lo), np.log10(hi)
     k = np.arange(int(sizes.max()), dtype=float)
@@ -335,6 +335,18 @@ def log_grids(w_lo: np.ndarray, w_hi: np.ndarray, per_decade: int = DEFAULT_PER_
     padded[:, 0] = lo
     padded[k[None, :] >= (sizes - 1)[:, None]] = np.repeat(hi, sizes.max() - sizes + 1)
     return padded[np.ravel(inverse)]
+
+
+def log_grid_sizes(w_lo: np.ndarray, w_hi: np.ndarray, per_decade: int = DEFAULT_PER_DECADE) -> np.ndarray:
+    """The number of points of each :func:`log_grid` from ``w_lo[i]`` to ``w_hi[i]`` (the rows of
+    :func:`log_grids` before its padding).
+
+    Examples
+    --------
+    >>> log_grid_sizes(np.array([1.0, 10.0]), np.array([100.0, 100.0]), 1), log_grid(1.0, 100.0, 1).size
+    (array([3, 2]), 3)
+    """
+    return np.maximum(2, np.ceil(per_decade * np.log10(np.asarray(w_hi, float) / w_lo)).astype(int) + 1)
 
 
 def band_grids(band: tuple[float, float], auto: np.ndarray, per_decade: int = DEFAULT_PER_DECADE) -> np.ndarray:

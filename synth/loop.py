@@ -21,7 +21,7 @@ from synth.polynomials import dc_value, format_factored, horner, magnitude_squar
 from synth.stability import StabilityResult, closed_loop_stability, stability_floor
 from synth.stability_sets import gain_margin_factors
 
-__all__ = ["BANDWIDTH_LEVEL", "Loop", "Margins"]
+__all__ = ["BANDWIDTH_LEVEL", "Loop", "Margins", "bandwidth_span"]
 
 BANDWIDTH_LEVEL = 10 ** (-3 / 20)
 """|T| relative to |T(0)| that defines the closed-loop bandwidth (-3 dB)."""
@@ -80,6 +80,22 @@ class Margins:
         if out["lower_phase_crossover"] is None:
             del out["lower_phase_crossover"]
         return out
+
+
+def bandwidth_span(lo: float, hi: float, crossovers: np.ndarray) -> tuple[float, float]:
+    """The frequencies :meth:`Loop.bandwidth` searches, from a loop's :attr:`Loop.frequency_range` ``(lo, hi)`` and
+    its gain crossovers: two decades beyond the crossovers too, and one more above.
+
+    Examples
+    --------
+    >>> bandwidth_span(0.1, 100.0, np.array([5000.0]))
+    (0.1, 5000000.0)
+    """
+    if crossovers.size:  # |T| falls near a crossover, which moves with the gain, not with the corners: a low-gain
+        # loop's far below them, and a PI's with its integral corner at 1e-3 rad/s on 1.15/s (no other corner) at
+        # 1.7 rad/s, above a range that ended at 0.11 rad/s (seed 9 #28: "inf")
+        lo, hi = min(lo, float(np.min(crossovers)) / 100.0), max(hi, float(np.max(crossovers)) * 100.0)
+    return lo, hi * 10
 
 
 @dataclass(frozen=True, eq=False, init=False)
@@ -279,13 +295,8 @@ class Loop:
         if t0 == 0.0 or not np.isfinite(t0):
             return float("nan")
         level = t0 * BANDWIDTH_LEVEL
-        lo, hi = self.frequency_range
-        crossovers = self.gain_crossovers()
-        if crossovers.size:  # |T| falls near a crossover, which moves with the gain, not with the corners: a
-            # low-gain loop's far below them, and a PI's with its integral corner at 1e-3 rad/s on 1.15/s (no
-            # other corner) at 1.7 rad/s, above a range that ended at 0.11 rad/s (seed 9 #28: "inf")
-            lo, hi = min(lo, float(np.min(crossovers)) / 100.0), max(hi, float(np.max(crossovers)) * 100.0)
-        return first_fall(lambda w: np.abs(self.T(w)), level, log_grid(lo, hi * 10, per_decade))
+        return first_fall(lambda w: np.abs(self.T(w)), level,
+                          log_grid(*bandwidth_span(*self.frequency_range, self.gain_crossovers()), per_decade))
 
     # ------------------------------------------------------------------ stability
     @cached_property

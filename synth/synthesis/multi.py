@@ -267,7 +267,7 @@ def _certify(spec: Spec, controller: Controller, per_decade: int) -> Certificate
 
 
 def _certify_best(spec: Spec, found: list[tuple[str, Controller]], terms: list[tuple[str, str, float]],
-                  per_decade: int, cache: dict[int, Certificate] | None = None
+                  per_decade: int, cache: dict[int, Certificate] | None = None, scores: list[float] | None = None
                   ) -> tuple[list[tuple[str, Controller, Certificate]], tuple[str, Controller, Certificate] | None]:
     """The best-scoring candidate that passes the certificate, and every candidate certified on the way.
 
@@ -275,10 +275,12 @@ def _certify_best(spec: Spec, found: list[tuple[str, Controller]], terms: list[t
     same choice as certifying all of them and taking the best that passed (ties keep the earlier
     candidate), without certifying designs that could not be chosen. When none passes, all are certified
     and returned in their original order. ``cache`` keeps certificates by candidate index across calls
-    (a list that only grows at its end).
+    (a list that only grows at its end), ``scores`` the candidates' scores in their order (a design certifies
+    up to seven times as candidates are added: each candidate is scored once).
     """
     nominal = spec.nominal_plant()
-    scores = [score(Loop(nominal, c), terms) for _, c in found]
+    scores = [] if scores is None else scores
+    scores.extend(score(Loop(nominal, c), terms) for _, c in found[len(scores):])
     order = sorted(range(len(found)), key=lambda i: -scores[i])  # stable: ties keep the original order
     certified: dict[int, Certificate] = {} if cache is None else cache
     for i in order:
@@ -333,9 +335,10 @@ def _design(spec: Spec, settings: ConvexSettings, nlp: bool | str, explain: bool
         stages[0] += f", {len(runs)} fixed values of {STRUCTURAL[spec.controller.type]}"
     stages[0] += "".join(f"; {r.note}" for _, r in runs if r.note)
     cache: dict[int, Certificate] = {}
+    scores: list[float] = []
     redundant = polish_redundant(spec, [r for _, r in runs]) if nlp is True else None
     if redundant is not None:
-        _, passed = _certify_best(spec, found, terms, per_decade, cache)
+        _, passed = _certify_best(spec, found, terms, per_decade, cache, scores)
         if passed is not None:
             nlp = False
             extras["synthesis"]["nlp_skipped"] = redundant
@@ -363,7 +366,7 @@ def _design(spec: Spec, settings: ConvexSettings, nlp: bool | str, explain: bool
             unconverged.update(h["controller"] for h in res.history if h.get("offered"))
             stages.append(f"NLP polish from the spec's initial controller ({res.iterations} iterations, "
                           f"{res.status})")
-    candidates, passed = _certify_best(spec, found, terms, per_decade, cache)
+    candidates, passed = _certify_best(spec, found, terms, per_decade, cache, scores)
     if passed is not None and nlp and spec.objective is not None:  # a local optimum? better points elsewhere
         value = score(Loop(nominal, passed[1]), terms)
         announce(f"screen of {screen_size(spec)} controllers for better starts")
@@ -372,7 +375,7 @@ def _design(spec: Spec, settings: ConvexSettings, nlp: bool | str, explain: bool
         found.extend(kc for c in starts for kc in polished_from(spec, [c], terms, runs[0][0].grid, settings,
                                                                   unconverged))
         if starts:
-            candidates, passed = _certify_best(spec, found, terms, per_decade, cache)
+            candidates, passed = _certify_best(spec, found, terms, per_decade, cache, scores)
         near, near_polished = [], []
         if passed is not None and (score(Loop(nominal, passed[1]), terms) if starts else value) < above:  # no start: the
             # near misses, as when no start led 1 % higher (seed 16 #118: a screen of 1536 held starts, which polished
@@ -380,7 +383,7 @@ def _design(spec: Spec, settings: ConvexSettings, nlp: bool | str, explain: bool
             near, near_polished = near_misses_polished(spec, terms, above, runs[0][0].grid, settings, unconverged)
             found.extend(kc for p in near_polished for kc in p)
             if near:
-                candidates, passed = _certify_best(spec, found, terms, per_decade, cache)
+                candidates, passed = _certify_best(spec, found, terms, per_decade, cache, scores)
         stages.append(f"random screen of the bounds ({screen_size(spec)} controllers): {len(starts)} scored more "
                       "than 1 % better on its grid" + (", NLP polish from each" if starts else "")
                       + (", NLP polish from the least violating of those that score better" if near else "")
@@ -397,14 +400,14 @@ def _design(spec: Spec, settings: ConvexSettings, nlp: bool | str, explain: bool
         stages.append(f"random screen of the bounds ({screen_size(spec)} controllers, every requirement and plant): "
                       f"NLP polish from the {len(starts)} least violating (at most 3 rounds of {SCREEN_ITERATIONS} "
                       "iterations each)")
-        candidates, passed = _certify_best(spec, found, terms, per_decade, cache)
+        candidates, passed = _certify_best(spec, found, terms, per_decade, cache, scores)
     if nlp and passed is not None and spec.objective is not None and optimality_of(passed[0], str(passed[1]),
                                                                                    unconverged).local:
         climbed, steps = climb(spec, passed[1], terms, settings.stability_level)  # the claim, on the exact check
         if steps:
             found.append(("ascent probe", climbed))
             stages.append(f"first-order test of the {passed[0]} design on the exact requirements: {steps} steps up")
-            candidates, passed = _certify_best(spec, found, terms, per_decade, cache)
+            candidates, passed = _certify_best(spec, found, terms, per_decade, cache, scores)
     searched = ""
     if passed is not None and spec.objective is not None \
             and not optimality_of(passed[0], str(passed[1]), unconverged).local:
@@ -426,7 +429,7 @@ def _design(spec: Spec, settings: ConvexSettings, nlp: bool | str, explain: bool
                 unconverged.update(h["controller"] for h in res.history if h.get("offered"))
                 stages.append(f"NLP polish from the pattern search's design ({res.iterations} iterations, "
                               f"{res.status})")
-            candidates, passed = _certify_best(spec, found, terms, per_decade, cache)
+            candidates, passed = _certify_best(spec, found, terms, per_decade, cache, scores)
         if passed is not None and passed[0] not in ("pattern search", "nlp from pattern search"):
             searched = ("a pattern search on the exact check from it found a better point that failed the dense "
                         "certificate" if search.improved else "a pattern search on the exact check from it found no "

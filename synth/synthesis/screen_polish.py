@@ -12,7 +12,7 @@ from synth.synthesis.nlp import polish
 from synth.synthesis.screen import SCREEN_ITERATIONS, screen_near_improving
 from synth.synthesis.start_spread import near_starts_for
 
-__all__ = ["near_misses_polished", "near_misses_text", "near_outcome_text", "near_starts_text", "polished_from"]
+__all__ = ["near_misses_polished", "near_misses_text", "polished_from"]
 
 
 def polished_from(spec: Spec, starts: list[Controller], terms: list[tuple[str, str, float]], grid: np.ndarray,
@@ -39,24 +39,24 @@ def polished_from(spec: Spec, starts: list[Controller], terms: list[tuple[str, s
     return out
 
 
-def near_starts_text(count: int) -> str:
+def _near_starts_text(count: int) -> str:
     """The ``count`` near misses polished from (:func:`synth.synthesis.screen.screen_near_improving`), in words.
 
     Examples
     --------
-    >>> near_starts_text(1)
+    >>> _near_starts_text(1)
     'the one that misses them by the least'
     """
     return "the one that misses them by the least" + (
         " and the least violating one apart from it in the box" if count > 1 else "")
 
 
-def near_outcome_text(count: int, led: int | None) -> str:
+def _near_outcome_text(count: int, led: int | None) -> str:
     """What the polishes from ``count`` near misses gave: ``led`` is the one whose polish gave the design.
 
     Examples
     --------
-    >>> near_outcome_text(1, 0), near_outcome_text(2, 1), near_outcome_text(2, None)
+    >>> _near_outcome_text(1, 0), _near_outcome_text(2, 1), _near_outcome_text(2, None)
     ('led to this design', '(the second led to this design)', '(both ended at no better design)')
     """
     if count == 1:
@@ -99,4 +99,4 @@ def near_misses_text(polished: list[list[tuple[str, Controller]]], passed: tuple
     led = [k for k, p in enumerate(polished) if passed is not None and any(c is passed[1] for _, c in p)]
     return (", and of those that score better but miss the requirements, "
             + ("an NLP polish from " if len(polished) == 1 else "NLP polishes from ")
-            + near_starts_text(len(polished)) + " " + near_outcome_text(len(polished), led[0] if led else None))
+            + _near_starts_text(len(polished)) + " " + _near_outcome_text(len(polished), led[0] if led else None))
