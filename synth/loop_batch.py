@@ -451,8 +451,8 @@ class LoopBatch:
             keep = (far[local] < 0.5 / cap) | (grid[local, idx + 1] <= tops[local])
             local, idx = local[keep], idx[keep]
         rows = which[local]
-        wc = bisect_roots(lambda w: self.rows_L(rows, w).imag, grid[local, idx], grid[local, idx + 1]) \
-            if local.size else np.zeros(0)
+        wc = bisect_roots(lambda w, j: self.rows_L(rows[j], w).imag, grid[local, idx], grid[local, idx + 1],
+                          indexed=True) if local.size else np.zeros(0)
         Lc = self.rows_L(rows, wc)
         with np.errstate(divide="ignore", invalid="ignore"):
             return local, np.where(Lc.real < 0, -1.0 / Lc.real, np.nan)

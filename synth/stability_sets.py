@@ -120,7 +120,7 @@ def stability_boundaries(
     sign = np.sign(hv)
     idx = np.flatnonzero(sign[:-1] * sign[1:] < 0)
     exact = np.flatnonzero((sign == 0) & (np.arange(sign.size) > 0) & (np.abs(hv) <= 1e-14 * scale))
-    w_cross = np.concatenate([[0.0], bisect_roots(h, w[idx], w[idx + 1]), w[exact]])
+    w_cross = np.concatenate([[0.0], bisect_roots(lambda x, _: h(x), w[idx], w[idx + 1], indexed=True), w[exact]])
     r_cross = rho(w_cross)
     keep = np.isfinite(r_cross) & (np.abs(r_cross) <= rho_max)
     found = list(zip(r_cross[keep].tolist(), w_cross[keep].tolist()))

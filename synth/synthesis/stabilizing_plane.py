@@ -428,7 +428,7 @@ def _edge_crossings(curve: _Curve, w: np.ndarray, u: np.ndarray, v: np.ndarray, 
     k = k[(np.maximum(u[k], u[k + 1]) >= -_NEAR) & (np.minimum(u[k], u[k + 1]) <= 1 + _NEAR)]
     if k.size == 0:
         return []
-    return curve.at(bisect_roots(lambda x: curve.at(x)[1] - edge, w[k], w[k + 1]))[0].tolist()
+    return curve.at(bisect_roots(lambda x, _: curve.at(x)[1] - edge, w[k], w[k + 1], indexed=True))[0].tolist()
 
 
 def _zero_line(curve: _Curve) -> np.ndarray | None:
