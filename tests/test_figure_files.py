@@ -39,3 +39,29 @@ def test_a_short_log_axis_and_a_chosen_locator_are_left_alone(tmp_path):
         ax.xaxis.set_minor_locator(LogLocator(subs=(1.5, 3.0, 7.0)))
 
     assert tuple(np.asarray(_minor_subs(tmp_path, chosen), float)) == (1.5, 3.0, 7.0)
+
+
+def test_log_tick_labels_are_plain_unicode_and_mathtext_is_not_parsed(tmp_path, monkeypatch):
+    import matplotlib.mathtext
+
+    parsed = []
+    original_parse = matplotlib.mathtext.MathTextParser.parse
+    monkeypatch.setattr(matplotlib.mathtext.MathTextParser, "parse",
+                        lambda self, s, *a, **k: parsed.append(s) or original_parse(self, s, *a, **k))
+    fig, ax = plt.subplots()
+    ax.loglog([0.001, 100.0], [0.5, 3.0])  # y spans less than a decade: its minor ticks get labels (2x10^0 ...)
+    labels = {}
+    original = fig.savefig
+
+    def spy(*args, **kwargs):
+        result = original(*args, **kwargs)
+        labels["x"] = [t.get_text() for t in ax.get_xticklabels()]
+        labels["y"] = [t.get_text() for t in ax.yaxis.get_minorticklabels() if t.get_text()]
+        return result
+
+    fig.savefig = spy
+    save_figure(fig, tmp_path / "f.png")
+    assert "10\u207b\u00b3" in labels["x"] and "10\u00b2" in labels["x"] and "10\u2070" in labels["x"]
+    assert "2\u00d710\u2070" in labels["y"] and "6\u00d710\u207b\u00b9" in labels["y"]
+    assert not any("$" in t for t in labels["x"] + labels["y"])
+    assert parsed == []

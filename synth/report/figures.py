@@ -249,9 +249,9 @@ def delay_chart(rows: list[dict[str, Any]], marks: dict[str, float], path: Path)
 
 
 def warm_up() -> None:
-    """Draw one log-log figure into memory: matplotlib's font lookup and its tick-label (mathtext) parser are
-    set up once, and the labels 10^-6 ... 10^8 parsed at the figures' dpi, here rather than in the report's
-    figures (the design command does this on one core while the design runs on the other).
+    """Draw one log-log figure into memory: matplotlib's font lookup and text layout are set up once, here
+    rather than in the report's first figure (the design command does this on one core while the design runs on
+    the other).
 
     Examples
     --------
@@ -259,14 +259,15 @@ def warm_up() -> None:
     """
     import io
 
-    from synth.figure_files import DPI
+    from synth.figure_files import DPI, plain_log_tick_labels
 
-    # the tick labels of log axes (10^k, mathtext) parsed at the dpi the figures are written at: matplotlib
-    # keeps each parse, and the report's figures are drawn in this process or in a child forked from it
+    # drawn as the report's figures are (save_figure's tick labels, at their dpi): the report's figures are drawn
+    # in this process or in a child forked from it
     fig, ax = plt.subplots(figsize=(6, 4))
     ax.loglog([1e-6, 1e8], [1e-6, 1e8], label="x")
     ax.set_xlabel("x [rad/s]")
     ax.legend()
+    plain_log_tick_labels(fig)
     fig.set_dpi(DPI)
     fig.tight_layout()
     fig.set_layout_engine(None)  # as figure_files.save_figure: one draw, not two
