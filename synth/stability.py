@@ -147,8 +147,14 @@ def characteristic_scale(*polys: np.ndarray, delay: float = 0.0) -> tuple[float,
     return float(min(mags)), float(max(mags))
 
 
-def _axis_poles(den: np.ndarray) -> tuple[int, int, list[tuple[float, int]]]:
-    """(open RHP pole count, poles at the origin, [(w_k > 0, multiplicity)])."""
+def _axis_poles(den: np.ndarray, near: float | None = None) -> tuple[int, int, list[tuple[float, int]]]:
+    """(open RHP pole count, poles at the origin, [(w_k > 0, multiplicity)]).
+
+    A root within ``1e-9 max(1, |r|)`` of the axis counts as on it, one within ``1e-10`` of the largest root
+    (at least 1) as at the origin. ``near`` (a thousandth of the stability floor, on the count of a loop shifted
+    by that floor) caps both at ``near`` (and ``1e-9 |r|`` off the origin): a slow plant's floor (1e-9 rad/s for
+    poles at 1e-3 rad/s) moves an integrator's pole no further than the absolute 1e-9, which put it back on the
+    axis and broke the count."""
     den = trim(den)
     n_origin = 0
     while den.size > 1 and den[-1] == 0.0:
@@ -156,7 +162,11 @@ def _axis_poles(den: np.ndarray) -> tuple[int, int, list[tuple[float, int]]]:
         n_origin += 1
     roots = np.roots(den) if den.size > 1 else np.array([])
     tol = 1e-9 * np.maximum(1.0, np.abs(roots))
-    tiny = np.abs(roots) <= 1e-10 * max(1.0, float(np.abs(roots).max(initial=0.0)))
+    tiny_level = 1e-10 * max(1.0, float(np.abs(roots).max(initial=0.0)))
+    if near is not None:
+        tol = np.minimum(tol, np.maximum(near, 1e-9 * np.abs(roots)))
+        tiny_level = min(tiny_level, near)
+    tiny = np.abs(roots) <= tiny_level
     roots = np.where(tiny, 0.0, roots)  # numerically at the origin
     on_axis = np.abs(roots.real) <= tol
     n_rhp = int(np.sum((roots.real > 0) & ~on_axis))
@@ -270,7 +280,9 @@ def closed_loop_stability(num: np.ndarray, den: np.ndarray, delay: float = 0.0, 
     if floor <= 0.0 or not exact.stable:
         return exact
     try:
-        moved = _count(shifted(num, floor) * np.exp(floor * delay), shifted(den, floor), delay)
+        # the shifted poles are told apart from the axis at a thousandth of the floor (absolute tolerances would
+        # put an integrator moved by a slow plant's floor back on the axis)
+        moved = _count(shifted(num, floor) * np.exp(floor * delay), shifted(den, floor), delay, near=1e-3 * floor)
     except RuntimeError:  # open-loop poles within the floor of the origin: the shifted count cannot be trusted
         return StabilityResult(False, 0, exact.open_loop_unstable_poles, exact.method + "; the count on the loop "
                                "shifted by the stability floor failed (open-loop poles within the floor of the "
@@ -281,11 +293,11 @@ def closed_loop_stability(num: np.ndarray, den: np.ndarray, delay: float = 0.0, 
                            None, float(floor))
 
 
-def _count(num: np.ndarray, den: np.ndarray, delay: float) -> StabilityResult:
+def _count(num: np.ndarray, den: np.ndarray, delay: float, near: float | None = None) -> StabilityResult:
     num, den = trim(np.asarray(num, float)), trim(np.asarray(den, float))
     if num.size > den.size:
         raise ModelError("loop transfer function is improper")
-    n_rhp, n_origin, axis = _axis_poles(den)
+    n_rhp, n_origin, axis = _axis_poles(den, near)
     shared_origin = 0
     while shared_origin < min(num.size, den.size) - 1 and num[-1 - shared_origin] == 0.0 \
             and den[-1 - shared_origin] == 0.0:
