@@ -63,3 +63,25 @@ def test_verdicts_are_the_same_in_seconds_and_in_hours(seed):
                 assert stable == (rightmost < 0)
                 agree += 1
     assert agree >= 60
+
+
+def test_a_pi_design_on_a_thermal_process_is_the_fast_design_in_slow_time():
+    """The black-box test's design: 0.5/((1000 s + 1)(100 s + 1)) behind 50 s, margins 6 dB / 45 deg, maximize ki.
+    It answered ki = 2.7e-12 ("certified"); the same problem 1000 times faster gives ki = 15.87, i.e. 0.01587."""
+    from synth.design import design
+    from synth.spec import parse_spec
+
+    def spec(scale: float) -> str:
+        return f"""
+name: thermal
+plant: {{tf: "0.5/(({1000 / scale:g}*s+1)*({100 / scale:g}*s+1))", delay: {50 / scale:g}}}
+controller: {{type: PI, bounds: {{kp: [0, 30], ki: [0, {0.1 * scale:g}]}}}}
+requirements:
+  - {{type: margins, gain_margin_db: 6, phase_margin_deg: 45}}
+objective: {{maximize: integral_gain}}"""
+
+    slow, fast = design(parse_spec(spec(1.0))), design(parse_spec(spec(1000.0)))
+    assert slow.feasible and fast.feasible
+    assert fast.controller.parameters["ki"] > 10.0  # far from zero: a real integral gain
+    assert slow.controller.parameters["ki"] * 1000.0 == pytest.approx(fast.controller.parameters["ki"], rel=1e-3)
+    assert slow.controller.parameters["kp"] == pytest.approx(fast.controller.parameters["kp"], rel=1e-3)
