@@ -10,6 +10,7 @@ from pydantic import PositiveFloat, field_validator
 from synth.freqgrid import log_grid, peak
 from synth.requirements.base import Bound, Requirement, RequirementResult, db, fmt, register
 from synth.requirements.margins import closed_loop_unstable, unstable_result
+from synth.requirements.sensitivity import with_narrow_peaks
 
 if TYPE_CHECKING:
     from synth.loop import Loop
@@ -84,7 +85,9 @@ class DiskMargin(Requirement):
             return unstable_result(self, loop, "disk margin")
         c = (self.skew - 1.0) / 2.0
         lo, hi = loop.frequency_range
-        grid = log_grid(lo, hi * 10, per_decade)
+        # with points at the loop's narrow peaks: a mode of damping 0.003 at 1234 rad/s put a disk margin of 0.667
+        # between two grid points, and 1.04 was reported (found by a black-box test)
+        grid = with_narrow_peaks(log_grid(lo, hi * 10, per_decade), loop, (0.0, np.inf))
         value, w = peak(lambda w: np.abs(loop.S(w) + c), grid)
         value = max(value, abs(1.0 + c) if loop.L(np.array([hi * 10]))[0] == 0 else 0.0)
         alpha = 1.0 / value if value > 0 else np.inf
