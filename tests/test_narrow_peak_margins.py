@@ -75,3 +75,22 @@ def test_the_reported_disk_margin_case():
     result = DiskMargin(min=0.8).evaluate(loop)
     assert not result.met and result.value == pytest.approx(0.6666, abs=2e-4)
     assert result.binding_frequency == pytest.approx(1234.0, rel=1e-3)
+
+
+def test_a_design_behind_a_sharp_mode_keeps_its_disk_margin_by_the_dense_grid():
+    """The black-box test's design: 1e6/((s+1)(s^2 + 0.02 s + 1e6)) (damping 1e-5 at 1000 rad/s), PI, disk margin
+    >= 0.8, maximize ki. Certified before with PI(0.019, 1.382), whose disk margin is 0.051."""
+    from synth.design import design
+    from synth.spec import parse_spec
+
+    result = design(parse_spec("""
+name: sharp
+plant: {tf: "1e6/((s+1)*(s^2+0.02*s+1e6))"}
+controller: {type: PI, bounds: {kp: [0, 1], ki: [0, 5]}}
+requirements:
+  - {type: disk_margin, min: 0.8}
+objective: {maximize: integral_gain}"""))
+    assert result.feasible
+    kp, ki = result.controller.parameters["kp"], result.controller.parameters["ki"]
+    num, den = np.array([1e6]), np.polymul([1.0, 1.0], [1.0, 0.02, 1e6])
+    assert 1.0 / _dense_max(num, den, kp, ki, 1000.0, -0.5) >= 0.8 * (1 - 1e-3)
