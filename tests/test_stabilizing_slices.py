@@ -41,6 +41,8 @@ def test_the_design_verdict_and_json_say_where_the_stabilizing_set_is():
     kp_lo = result.to_dict()["stabilizing_slices"]["kp"][0][0]
     assert kp_lo == pytest.approx(0.5 + ki / 4, rel=1e-5)
     assert "Around this design the loop stays stable" in result.verdict
+    # the intervals' ends that the stability floor sets (not a root crossing the axis) are named as such
+    assert "every closed-loop root left of -1e-06 rad/s, synth's stability floor" in result.verdict
 
 
 def test_a_stable_plant_gets_no_slices_sentence():

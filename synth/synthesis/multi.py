@@ -457,7 +457,7 @@ def _design(spec: Spec, settings: ConvexSettings, nlp: bool | str, explain: bool
         result.verdict = (f"{controller} meets all {len(spec.requirements)} requirements and keeps the loop "
                           f"stable on {len(spec.plants())} plant(s) ({_describe(spec, label)}).") + objective_note(label) \
             + edge.warning() + (f" Optimality: {optimality.basis}." if spec.objective is not None else "") \
-            + slices_text(slices) + reference_verdict(spec, ref)
+            + slices_text(slices, spec.plants()) + reference_verdict(spec, ref)
         return result
     if feasible_runs:  # optimal on the grid but none survives the certificate
         stage, controller, certificate = candidates[-1]

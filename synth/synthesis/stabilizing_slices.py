@@ -12,8 +12,10 @@ from __future__ import annotations
 import numpy as np
 
 from synth.controllers import Controller
+from synth.plant import Plant
 from synth.requirements.base import fmt
 from synth.spec import Spec
+from synth.stability import stability_floor
 from synth.synthesis.axis_starts import SCANNED_TYPES
 from synth.synthesis.gainset import ScalarFamily, stability_set
 
@@ -64,13 +66,18 @@ def stabilizing_slices(spec: Spec, controller: Controller) -> dict[str, list[tup
     return out
 
 
-def slices_text(slices: dict[str, list[tuple[float, float]]]) -> str:
-    """The verdict's sentence on :func:`stabilizing_slices` ("" when there are none).
+def slices_text(slices: dict[str, list[tuple[float, float]]], plants: list[Plant] | None = None) -> str:
+    """The verdict's sentence on :func:`stabilizing_slices` ("" when there are none); with the ``plants``, it names
+    the stability floor the intervals keep every closed-loop root left of (the largest of the plants'
+    :func:`synth.stability.stability_floor`): an end the floor sets is no root crossing the axis (a PI whose ki
+    is tiny leaves a root near ``-ki/kp``, which a larger kp brings within the floor).
 
     Examples
     --------
     >>> slices_text({"kp": [(0.75, 5.0)], "ki": [(0.0, 6.0)]})[-52:]
     'the others fixed) for kp in [0.75, 5], ki in [0, 6].'
+    >>> print(slices_text({"kp": [(4.0, 31.28)]}, [Plant.from_string("5/((s-2)*(s+10))")])[-99:])
+    or kp in [4, 31.28] (stable: every closed-loop root left of -2e-06 rad/s, synth's stability floor).
     """
     if not slices:
         return ""
@@ -78,5 +85,7 @@ def slices_text(slices: dict[str, list[tuple[float, float]]]) -> str:
     for name, intervals in slices.items():
         ranges = " or ".join(f"[{fmt(a)}, {fmt(b)}]" for a, b in intervals) or "no value"
         parts.append(f"{name} in {ranges}")
+    floor = max((stability_floor(p.num, p.den, p.delay) for p in plants), default=0.0) if plants else 0.0
+    note = f" (stable: every closed-loop root left of -{fmt(floor)} rad/s, synth's stability floor)" if floor else ""
     return (" Around this design the loop stays stable (exact, D-decomposition, one gain moved at a time, the others "
-            "fixed) for " + ", ".join(parts) + ".")
+            "fixed) for " + ", ".join(parts) + note + ".")
