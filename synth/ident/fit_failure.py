@@ -13,7 +13,7 @@ import numpy as np
 from synth.distributions import f_sf
 
 __all__ = ["ABSURD_FACTOR", "CONVERGED_WITHIN", "FAILED_STATUSES", "LIMIT_STATUSES", "SIGNIFICANCE", "fit_failure",
-           "remaining_improvement", "scaled_jacobian", "start_point", "start_ssr"]
+           "remaining_improvement", "roots_beyond_record", "scaled_jacobian", "start_point", "start_ssr"]
 
 #: IPOPT return statuses that end a fit without a usable optimum
 FAILED_STATUSES = ("Diverging_Iterates", "Maximum_Iterations_Exceeded", "Maximum_CpuTime_Exceeded",
@@ -38,15 +38,16 @@ ABSURD_FACTOR = 1e8
 def fit_failure(parameters: dict[str, float], start: np.ndarray, status: str | None, success: bool,
                 fit_percent: float, delay: float | None, duration: float, samples: int = 0, free: int = 0,
                 remaining_step: float = float("inf"), start_fit_percent: float = float("nan"),
-                solver: str = "IPOPT") -> str:
+                solver: str = "IPOPT", ridge: str = "") -> str:
     """Why a finished fit is not a result, or ``""`` if it is one.
 
     A fit fails when the solver diverged or stopped at a limit (:data:`FAILED_STATUSES`), a
     parameter is not finite or ``ABSURD_FACTOR`` times larger than both its start and 1, the fit is
     no better than the output's mean (``fit_percent <= 0``) or than noise would be (given ``samples``
     and ``free``: the F-test of the explained variance against the residual one has a p-value above
-    ``SIGNIFICANCE``), a fitted delay lies outside ``[0, duration)``, or the fit ended with a larger residual
-    than its own start had (``start_fit_percent``): a local solver that moved uphill did not converge.
+    ``SIGNIFICANCE``), a fitted delay lies outside ``[0, duration)``, the fit ended with a larger residual
+    than its own start had (``start_fit_percent``): a local solver that moved uphill did not converge, or the
+    model has a pole or zero far outside what the record resolves (``ridge``).
 
     Parameters
     ----------
@@ -78,6 +79,12 @@ def fit_failure(parameters: dict[str, float], start: np.ndarray, status: str | N
     solver : str
         The solver that made the fit, as the message names it (IPOPT, or Levenberg-Marquardt: both report
         IPOPT's status strings).
+    ridge : str
+        :func:`roots_beyond_record` of the fitted model: a fit with a pole or zero there ended on a ridge of its
+        structure that the record cannot tell apart from its limit (``K (1 - a s)`` with ``K -> 0``,
+        ``a -> inf``: a differentiator), where neither the solver's status nor the remaining step says how far
+        the optimum is (seen: fit 36 % "converged" where the record's optimum fits 95 %). A failure, named after
+        the other reasons (the F-test's on noise).
 
     Returns
     -------
@@ -127,7 +134,32 @@ def fit_failure(parameters: dict[str, float], start: np.ndarray, status: str | N
             return (f"fit {fit_percent:.2f} %: the fitted model explains no more of the output than noise would "
                     f"(F-test p = {p_value:.2g}): a local minimum reached from the start ({began}), or a record "
                     "without a response to its input")
+    if ridge:
+        return f"{solver} ended ({status}) on a ridge of the structure ({ridge}, fit {_percent(fit_percent)} %)"
     return ""
+
+
+def roots_beyond_record(num: np.ndarray, den: np.ndarray, duration: float, dt: float) -> str:
+    """The model's poles and zeros more than a thousand times slower than the record is long (``|r| < 1e-3 /
+    duration``) or faster than its Nyquist frequency (``|r| > 1e3 pi / dt``), in words; ``""`` if none.
+
+    Examples
+    --------
+    >>> roots_beyond_record(np.array([-0.88, 5e-6]), np.polymul([0.3, 1.0], [0.3, 1.0]), 60.0, 0.01)
+    'a zero at 5.68e-06 rad/s, far below what 60 s resolve'
+    >>> roots_beyond_record(np.array([-1.5, 3.0]), np.polymul([1.0, 1.0], [0.25, 1.0]), 60.0, 0.01)
+    ''
+    """
+    words = []
+    for kind, poly in (("zero", num), ("pole", den)):
+        poly = np.trim_zeros(np.asarray(poly, float), "f")
+        roots = np.abs(np.roots(poly)) if poly.size > 1 else np.zeros(0)
+        roots = roots[roots > 0]  # an integrator or a differentiator is a structure's own choice
+        words += [f"a {kind} at {r:.3g} rad/s, far below what {duration:.3g} s resolve" for r in roots
+                  if r < 1e-3 / duration]
+        words += [f"a {kind} at {r:.3g} rad/s, far beyond the Nyquist frequency {np.pi / dt:.3g} rad/s" for r in roots
+                  if r > 1e3 * np.pi / dt]
+    return "; ".join(words)
 
 
 def _percent(value: float) -> str:

@@ -19,6 +19,7 @@ from synth.data.coerce import RecordLike, as_record
 from synth.data.record import Record
 from synth.errors import DataError, FitError, ModelError
 from synth.ident.directions import DirectionComparison, fit_by_direction
+from synth.ident.fit_failure import LIMIT_STATUSES
 from synth.ident.nyquist import beyond_nyquist
 from synth.ident.pair_relocation import relocate_pair
 from synth.ident.periodic_start import fit_whole_record, refit_periodic_start, settling_time
@@ -306,19 +307,27 @@ def _refit_unsettled(record: Record, avg: StepAverage, fit: TimeFitResult, struc
     # frequency, which no sampled record resolves: then the whole record's own deterministic start comes first
     beyond = beyond_nyquist(fit.plant, record.dt)
     starts = [("its own start", None), ("the edge fit", {**fit.parameters})]
-    failures = []
+    failures, fits = [], []
     for name, initial in starts if beyond else starts[::-1]:
         try:
-            whole = fit_structure(record, structure, delay, sensor, False, initial=initial, weights=weights,
-                                  check=True)
-            break
+            fits.append((name, fit_structure(record, structure, delay, sensor, False, initial=initial,
+                                             weights=weights, check=True)))
         except (DataError, FitError) as exc:
             failures.append(f"from {name}: {exc}")
-    else:
+            continue
+        if fits[-1][1].solver.get("status") not in LIMIT_STATUSES:
+            break
+        # stopped at its iteration limit with little left to gain along its way (accepted, not converged): the
+        # other start too, the lower residual kept (an edge fit distorted by a right-half-plane zero's undershoot
+        # led a refit onto the ridge K -> 0, a -> inf of K(1 - a s)/(...) at 36 % where the own start reaches 95 %)
+    if not fits:
         return fit, f"the edge windows ({window:.3g} s) are shorter than the model's settling time " \
                     f"({settle:.3g} s); the whole-record fit failed ({'; '.join(failures)}), so the edge fit is " \
                     f"kept (biased)"
-    start = f"from {name}" + (f" (it failed {failures[0]})" if failures else "")
+    name, whole = min(fits, key=lambda named: named[1].residual_std)
+    others = [f"from {other}: fit {f.fit_percent:.4g} %, {f.solver.get('status')}" for other, f in fits if other != name]
+    start = f"from {name}" + (f" (it failed {failures[0]})" if failures else "") \
+        + (f" (better than the fit {others[0]})" if others else "")
     return whole, (f"the edge windows ({window:.3g} s) are shorter than the model's settling time ({settle:.3g} s): "
                    f"fitted the whole record instead {start}, the first {skip:.3g} s (start-up from an unknown "
                    f"state) weighted 0")

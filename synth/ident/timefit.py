@@ -40,7 +40,14 @@ from synth.errors import DataError, FitError, ModelError
 from synth.ident.convolution_problem import ConvolutionProblem
 from synth.ident.covariance import fit_covariance
 from synth.ident.delay_samples import best_sample, walk_intervals
-from synth.ident.fit_failure import LIMIT_STATUSES, fit_failure, remaining_improvement, scaled_jacobian, start_ssr
+from synth.ident.fit_failure import (
+    LIMIT_STATUSES,
+    fit_failure,
+    remaining_improvement,
+    roots_beyond_record,
+    scaled_jacobian,
+    start_ssr,
+)
 from synth.ident.identifiability import TiedParameter, WeakParameter, coinciding, tied_to_weak, weak_parameters
 from synth.ident.nyquist import nyquist_note
 from synth.ident.residual_whiteness import correlated_residuals_note
@@ -456,11 +463,12 @@ def fit_structure(record: Record, structure: Structure | str, delay: str | float
         remaining = remaining_improvement(prob, xs, par, J, resid, JtJ, scale_vec, s2, mask, y, lb, fit_delay, dt)
         info["remaining_improvement_std"] = remaining
     fitted = dict(zip(st.parameters, theta.tolist()))
+    ridge = roots_beyond_record(*st.coefficients(theta), n * dt, dt)
     failure = fit_failure(fitted, theta0, st_info.get("status"),
                           bool(st_info.get("success")), fit_pct, d_hat if fit_delay else None, n * dt,
                           int(y_fit.size), p_total, remaining,
                           float(100.0 * (1.0 - np.sqrt(ssr_start) / np.linalg.norm(y_fit - np.mean(y_fit)))),
-                          "Levenberg-Marquardt" if isinstance(prob, ConvolutionProblem) else "IPOPT")
+                          "Levenberg-Marquardt" if isinstance(prob, ConvolutionProblem) else "IPOPT", ridge)
     info["failure"] = failure
     if failure and check:
         met = coinciding(fitted)  # stalled where two roots meet: say so
