@@ -30,8 +30,8 @@ def psd_record(t: np.ndarray, x: np.ndarray, name: str = "y", unit: str = "", so
     ``1 - 2 p (1-p) (1 - cos w dt)`` of the power at ``w`` (a third at the Nyquist frequency, two thirds of a
     white signal's power, for ``p`` spread evenly). So:
 
-    - stamps that jitter around a uniform grid (every stamp within 45 % of an interval of its slot from the
-      first to the last stamp, strictly increasing) give the samples as they are on that grid, not
+    - stamps that jitter around a uniform grid (every stamp within 45 % of an interval of its slot on the grid
+      fitted to them by least squares, strictly increasing) give the samples as they are on that grid, not
       interpolated. The jitter ``e`` only keeps ``|mean(exp(j w e))|^2`` of a component at ``w`` coherent
       (the rest becomes a white floor); the note states it at the Nyquist frequency;
     - other uneven stamps (gaps) keep the interpolated record, and the note states the attenuation, measured
@@ -57,8 +57,10 @@ def psd_record(t: np.ndarray, x: np.ndarray, name: str = "y", unit: str = "", so
     n = t.size
     steps = np.diff(t)
     if np.all(steps > 0):
-        dt = float((t[-1] - t[0]) / (n - 1))
-        dev = t - (t[0] + np.arange(n) * dt)
+        # the grid fitted to all the stamps (least squares): one through the first and the last stamp carries
+        # their own jitter, and stamps jittered uniformly by +-30 % of an interval then strayed 60 % from it
+        dt, t0 = (float(c) for c in np.polyfit(np.arange(n, dtype=float), t, 1))
+        dev = t - (t0 + np.arange(n) * dt)
         if float(np.max(np.abs(dev))) < 0.45 * dt:
             w_nyq = math.pi / dt
             coherent = float(np.abs(np.mean(np.exp(1j * w_nyq * dev))) ** 2)
@@ -68,7 +70,7 @@ def psd_record(t: np.ndarray, x: np.ndarray, name: str = "y", unit: str = "", so
                     "would attenuate the spectrum, by up to 4.8 dB at the Nyquist frequency); the jitter keeps "
                     f"{10 * math.log10(max(coherent, 1e-300)):.2g} dB of a component at the Nyquist frequency "
                     f"{w_nyq:.4g} rad/s coherent (less below it) and spreads the rest as white noise")
-            on_grid = disturbance_from_arrays(t[0] + np.arange(n) * dt, x, name, unit, source, time_name)
+            on_grid = disturbance_from_arrays(t0 + np.arange(n) * dt, x, name, unit, source, time_name)
             return replace(on_grid, notes=(*notes, *on_grid.notes, note)), raw_var
     grid, dt = record.t, record.dt
     w_nyq = math.pi / dt
