@@ -71,3 +71,23 @@ def test_a_failed_average_fit_falls_back_to_the_whole_record(monkeypatch):
         in res.whole_record_note
     for name in ("p1", "p2"):
         assert res.fit.parameters[name] == pytest.approx(case.truth[name], rel=0.15)
+
+
+def test_a_train_too_fast_to_average_is_fitted_as_it_is():
+    """Found by a black-box test: a random telegraph whose levels last 0.15-1 s at 20 Hz (some edges 3 samples apart)
+    was refused, 'steps are only 3 samples apart; too short to average', exit 2, although the user asked for no
+    averaging (the default tries it). Fitted as it is, the record gives the truth within its std."""
+    from scipy.signal import cont2discrete, lfilter
+
+    rng = np.random.default_rng(0)
+    dt, n = 0.05, 4000
+    t = np.arange(n) * dt
+    holds = rng.integers(3, 21, n)  # 0.15-1 s per level
+    u = np.repeat(np.where(np.arange(holds.size) % 2 == 0, 1.0, 0.0), holds)[:n]
+    b, a, _ = cont2discrete(([1.5], [0.5, 1.0]), dt, method="zoh")  # 1.5/(0.5 s + 1), held input
+    delayed = np.r_[np.full(40, u[0]), u[:-40]]  # a 2 s delay: 40 samples, at rest at the first level before
+    y = 1.5 * u[0] + lfilter(np.ravel(b), np.ravel(a), delayed - u[0]) + 0.01 * rng.normal(size=n)
+    res = identify((t, u, y), "K/(T*s+1)", "fit")
+    assert res.average is None and "not averaged as a step train (steps are only" in res.whole_record_note
+    for name, truth in (("K", 1.5), ("T", 0.5), ("delay", 2.0)):
+        assert abs(res.fit.parameters[name] - truth) < 4 * res.fit.std[name] + 1e-9, name

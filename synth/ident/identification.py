@@ -162,12 +162,17 @@ def identify(record: RecordLike, structure: Structure | str, delay: str | float 
     if average not in ("auto", "cycle", "edge", "none"):
         raise ModelError(f"average must be 'auto', 'cycle', 'edge' or 'none', got {average!r}")
     avg = None
-    data, periodic = record, False
+    data, periodic, not_averaged = record, False, ""
     if average != "none" and _two_level(record.u):
         steps = find_steps(record)
         if steps.count >= 2 or average in ("cycle", "edge"):
-            avg = average_steps(record, steps, "auto" if average == "auto" else average)
-            data, periodic = avg.record(), avg.periodic
+            try:
+                avg = average_steps(record, steps, "auto" if average == "auto" else average)
+                data, periodic = avg.record(), avg.periodic
+            except DataError as exc:  # e.g. levels held 3 samples: what was not asked for is not an error
+                if average != "auto":
+                    raise
+                not_averaged = f"not averaged as a step train ({exc.message}): fitted as it is"
     if isinstance(structure, str):
         structure = parse_structure(structure)
     two_ways = avg is not None and bool(np.any(avg.steps.direction > 0) and np.any(avg.steps.direction < 0))
@@ -231,7 +236,8 @@ def identify(record: RecordLike, structure: Structure | str, delay: str | float 
             note = f"up and down steps not compared: {exc}"
     if by_direction and directions is not None:
         _require_settled_windows(directions, record.source)
-    return IdentifyResult(record, fit, avg, directions, note, by_direction, whole)
+    return IdentifyResult(record, fit, avg, directions, note, by_direction,
+                          "; ".join(x for x in (not_averaged, whole) if x))
 
 
 def _require_settled_windows(directions: DirectionComparison, source: str) -> None:
