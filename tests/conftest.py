@@ -19,6 +19,12 @@ SHARED = Path(os.environ.get("SYNTH_SHARED", ROOT.parent / "shared"))
 X4_PLANT = "23*(s+0.43)/((s+9.6)*(s+0.54))"
 
 
+def pytest_collection_modifyitems(session: pytest.Session, config: pytest.Config, items: list[pytest.Item]) -> None:
+    """Tests marked ``slow`` first (a stable sort, so the rest keep their order): the workers take tests in this
+    order, and the longest started last kept one core busy while the other had finished (pyproject's marker)."""
+    items.sort(key=lambda item: item.get_closest_marker("slow") is None)
+
+
 def shared_path(*parts: str) -> Path:
     """Path inside ../shared, skipping the test with a clear reason if it is absent."""
     path = SHARED.joinpath(*parts)

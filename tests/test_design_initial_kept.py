@@ -25,6 +25,7 @@ SPEC = {"name": "rand_19_24", "plant": {"tf": "17.3423*1/((s+9.36186))", "delay"
 START = {"k": 2.39046, "z": 5.346957630567468, "p": 21.586876511349203}  # the reference's best point
 
 
+@pytest.mark.slow
 def test_a_feasible_start_the_stages_miss_is_kept_and_polished():
     spec = parse_spec({**SPEC, "controller": {**SPEC["controller"], "initial": START}})
     start = Controller("leadlag", START)

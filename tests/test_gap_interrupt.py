@@ -20,7 +20,7 @@ PLANT = "20/(s+10)"
 ROOT = Path(__file__).resolve().parents[1]
 
 # one worker: the 300,000-sample record is written once, and no two diagnoses with their own workers run at once
-pytestmark = pytest.mark.xdist_group("gap_interrupt")
+pytestmark = [pytest.mark.xdist_group("gap_interrupt"), pytest.mark.slow]  # 24 s on one worker: started first
 
 
 @pytest.fixture(scope="module")

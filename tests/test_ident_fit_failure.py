@@ -132,6 +132,7 @@ def test_a_fit_worse_than_its_start_is_a_failure():
                                             -8.47e91, 0.02, 60.0)
 
 
+@pytest.mark.slow
 def test_ipopt_from_a_far_start_does_not_return_a_fit_worse_than_the_start():
     """Session 33 found IPOPT, started from a pair cancelled in the right half-plane (the pair relocation
     benchmark's problem 14, 4,000 samples), end at k = 2e-9, a pole at +1.33 and a delay of 2.3 s with fit 1.12 %,

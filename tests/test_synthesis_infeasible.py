@@ -2,6 +2,8 @@
 
 import json
 
+import pytest
+
 from synth.design import design
 from synth.spec import parse_spec
 
@@ -49,6 +51,7 @@ objective: {{maximize: integral_gain}}
     assert result.check.requirements[1].value <= -15.0
 
 
+@pytest.mark.slow
 def test_requirement_unreachable_alone_is_the_whole_conflict_and_the_cli_exits_1(run_cli, tmp_path):
     # -15 dB up to 30 rad/s: brute force gives -8.1 dB at best for any stable PI loop with this delay
     path = tmp_path / "alone.yaml"
