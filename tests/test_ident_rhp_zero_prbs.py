@@ -59,7 +59,7 @@ def test_identify_matches_an_output_error_fit(seed, truth, hold, dt, n):
     assert abs(k - truth[0]) < 5 * fit.std["K"] + 1e-3 and abs(slow - true_slow) < 5 * max(fit.std["T1"], fit.std["T2"])
 
 
-@pytest.mark.parametrize("seed", [1, 3])
+@pytest.mark.parametrize("seed", [3])  # seed 1 ends at the iteration limit on the ridge: fit_failure's example
 def test_a_fit_on_the_ridge_of_its_structure_is_a_failure_not_a_result(seed):
     """The same plant entered from rest at u = 0 with the PRBS at +-1 from the first sample (a record that begins
     with a step it does not show): the deterministic start lands at K = 0, a = 5e6 and the fit ends there, 'Solve_

@@ -104,6 +104,10 @@ def fit_failure(parameters: dict[str, float], start: np.ndarray, status: str | N
     >>> fit_failure({"k": 2.0, "p": 3.0}, np.array([2.1, 2.9]), "Maximum_Iterations_Exceeded", False, 98.6, 0.02,
     ...             60.0, remaining_step=0.004)  # stopped at the limit, but converged within its uncertainty
     ''
+    >>> fit_failure({"K": 5e-6, "a": 1.8e5}, np.array([1e-5, 1.2e5]), "Maximum_Iterations_Exceeded", False, 35.2, None,
+    ...             60.0, remaining_step=1e-4, ridge="a zero at 5.6e-06 rad/s, far below what 60 s resolve")
+    'IPOPT ended (Maximum_Iterations_Exceeded) on a ridge of the structure (a zero at 5.6e-06 rad/s, far below what 60 s
+    resolve, fit 35.20 %)'
     >>> fit_failure({"k": 2e-12, "p": -3.2}, np.array([2.1, 2.9]), "Solved_To_Acceptable_Level", True, 1.74, 9.36,
     ...             60.0, start_fit_percent=96.1)
     'the fit ended worse than its start (fit 1.74 % against 96.10 % at the start): the solver moved away'
