@@ -14,6 +14,7 @@ from synth.loop import Loop
 from synth.plant import Plant
 from synth.polynomials import value_at_infinity
 from synth.requirements.base import fmt
+from synth.requirements.sensitivity import with_narrow_peaks
 
 __all__ = ["NEAR_EDGE", "EdgeDistance", "edge_distance"]
 
@@ -112,7 +113,7 @@ def edge_distance(plants: list[Plant], controller: Controller, per_decade: int =
         loop = Loop(plant, controller)
         # the loop's narrow peaks added: a closed-loop mode of damping 1e-5 passes 0.05 from -1 within 0.01 rad/s
         # of 1000 rad/s, between two points 1.4 rad/s apart (found by a black-box test)
-        grid = np.union1d(np.concatenate([[0.0], loop.grid(per_decade)]), loop.narrow_peaks)
+        grid = with_narrow_peaks(np.concatenate([[0.0], loop.grid(per_decade)]), loop, (0.0, np.inf))
         peak_s, w = peak(lambda x, loop=loop: np.abs(loop.S(x)), grid)
         distance = 0.0 if not np.isfinite(peak_s) else (1.0 / peak_s if peak_s > 0 else float("inf"))
         at_infinity = _distance_at_infinity(loop)

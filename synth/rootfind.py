@@ -39,7 +39,7 @@ def bisect_roots(f, lo: np.ndarray, hi: np.ndarray, iterations: int = 200, *, in
     f_hi = np.asarray(f(hi), dtype=float)
     lo, hi = _ends_at_roots(lo, hi, f_lo, f_hi)
     side = np.zeros(lo.shape, int)  # which end was kept last time (-1 lo, +1 hi): Illinois halves its value
-    done = (hi - lo <= 1e-14 * np.maximum(1.0, np.abs(hi))) | (f_lo == 0) | (f_hi == 0)
+    done = _narrow(lo, hi) | (f_lo == 0) | (f_hi == 0)
     for k in range(iterations):
         if np.all(done):
             break
@@ -59,7 +59,7 @@ def _bisect_open(f, lo: np.ndarray, hi: np.ndarray, iterations: int) -> np.ndarr
     f_hi = np.asarray(f(hi, every), dtype=float).ravel()
     lo, hi = _ends_at_roots(lo, hi, f_lo, f_hi)
     side = np.zeros(lo.shape, int)
-    open_ = np.flatnonzero(~((hi - lo <= 1e-14 * np.maximum(1.0, np.abs(hi))) | (f_lo == 0) | (f_hi == 0)))
+    open_ = np.flatnonzero(~(_narrow(lo, hi) | (f_lo == 0) | (f_hi == 0)))
     for k in range(iterations):
         if open_.size == 0:
             break
@@ -76,6 +76,11 @@ def _ends_at_roots(lo: np.ndarray, hi: np.ndarray, f_lo: np.ndarray, f_hi: np.nd
                    ) -> tuple[np.ndarray, np.ndarray]:
     """A bracket with ``f = 0`` at an end closed onto that end (its midpoint is then the root)."""
     return np.where(f_hi == 0, hi, lo), np.where((f_lo == 0) & (f_hi != 0), lo, hi)
+
+
+def _narrow(lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+    """Brackets narrower than the tolerance, ``1e-14 max(1, |hi|)``."""
+    return hi - lo <= 1e-14 * np.maximum(1.0, np.abs(hi))
 
 
 def _next_point(lo: np.ndarray, hi: np.ndarray, f_lo: np.ndarray, f_hi: np.ndarray, k: int) -> np.ndarray:
@@ -100,4 +105,4 @@ def _step(lo, hi, f_lo, f_hi, side, x, fx, live):
     side = np.where(left, 1, np.where(right, -1, side))
     lo = np.where(hit, x, lo)
     hi = np.where(hit, x, hi)
-    return lo, hi, f_lo, f_hi, side, hit | (hi - lo <= 1e-14 * np.maximum(1.0, np.abs(hi)))
+    return lo, hi, f_lo, f_hi, side, hit | _narrow(lo, hi)
