@@ -52,6 +52,8 @@ def simulate_plant(plant: Plant, t: np.ndarray, u: np.ndarray, initial: str = "s
         ``"steady"``: the plant starts at rest at the steady state of the first
         input sample (output ``G(0) u[0]``; the input before ``t[0]`` equals
         ``u[0]``); ``"zero"``: it starts from zero state with zero input before ``t[0]``.
+        A plant with an integrator has no steady output: ``"steady"`` starts it at rest with output 0 and its
+        input's deviation from ``u[0]`` driving it (as :func:`synth.ident.timefit.fit_structure` assumes).
 
     Returns
     -------
@@ -75,12 +77,8 @@ def simulate_plant(plant: Plant, t: np.ndarray, u: np.ndarray, initial: str = "s
     if initial not in ("steady", "zero"):
         raise ModelError(f"initial must be 'steady' or 'zero', got {initial!r}")
     u0 = u[0] if initial == "steady" else 0.0
-    y0 = 0.0
-    if initial == "steady" and u0 != 0.0:
-        gain = plant.dc_gain()
-        if not np.isfinite(gain):
-            raise ModelError("the plant has no finite steady state (integrator); use initial='zero'")
-        y0 = gain * u0
+    gain = plant.dc_gain() if u0 != 0.0 else 0.0
+    y0 = gain * u0 if np.isfinite(gain) else 0.0  # an integrator at rest: its level is the caller's offset
     w = u - u0
     A, B, C, D = tf_to_ss(plant.num, plant.den)
     z = delayed_zoh(A, B, dt, plant.delay) if A.size else None

@@ -146,7 +146,7 @@ def model_residual(plant: Plant, record: Record, initial: str = "steady", offset
     Raises
     ------
     ModelError
-        A bad ``offset`` or ``initial``, or a plant without a steady state with ``initial="steady"``.
+        A bad ``offset`` or ``initial``.
 
     Examples
     --------
