@@ -4,12 +4,13 @@ Every other candidate is screened on top of the accepted effect
 (:class:`synth.gap.attribution.composite.NestedEffect`, the accepted effect's parameters fixed; an
 effect that ``folds_into_plant``, the extra delay, is folded into the linear model instead), the best
 two are re-fitted jointly with the nominal coefficients, and the better one is judged against the
-model before it.
+model before it, or against its own fit with the further effect switched off where that is better: an effect
+gets no credit for what the re-fit of the nominal coefficients alone gains.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
@@ -112,11 +113,16 @@ class ForwardSelection:
         if best is None:
             return None
         nested, fit, yhat, s = best
+        second = nested.second
+        # the joint fit re-fits the nominal coefficients too: what that alone gains over the accepted model (the
+        # fit with the second effect switched off) is not the second effect's credit
+        alone = self.sums(replace(fit, params={**fit.params, **second.off()}).predict(self.t_ev, self.u_ev))
+        if np.isfinite(alone.sum()) and alone.sum() < s_a.sum():
+            s_a = alone
         j_a, j = float(s_a.sum() / self.n_held), float(s.sum() / self.n_held)
         ci = self.ratio_ci(s, s_a)
         share = share_of_excess(j_a, j, self.floor)
         significant = bool(ci[0] > self.threshold)
-        second = nested.second
         params = {k: float(fit.params[k]) for k in second.parameter_names}
         unphysical = wrong_sign(second, params, self.t_tr, self.u_tr, self.plant)
         accepted = bool(significant and share >= self.min_share and not unphysical)
