@@ -40,6 +40,7 @@ from synth.gap.effects.registry import DEFAULT_CANDIDATES, aux_candidates, make_
 from synth.gap.preflight import check_model
 from synth.gap.where.clipping import Clipping, record_clipping
 from synth.gap.where.localize import GapLocalization, localize_gap
+from synth.gap.where.start import start_transient_warning
 from synth.plant import Plant, Signal
 
 __all__ = ["MODEL_FILE_SUFFIXES", "Diagnosis", "as_validation", "check_candidates", "diagnose", "heldout_warnings",
@@ -425,6 +426,7 @@ def diagnose(plant: Plant, record: RecordLike, validate: RecordLike | Sequence[R
     progress["stage"] = "done"
     clips = record_clipping(record)
     warnings: list[str] = [] if held_out else heldout_warnings(record, None, split, train_fraction)
+    warnings += [w for w in [start_transient_warning(plant, loc.residual)] if w]  # after any burn-in
     for i, v in enumerate(held_out):
         clips += record_clipping(v, "validate" if len(held_out) == 1 else f"validate {i + 1}")
         warnings += [w.replace("the validation record", f"validation run {i + 1}") if len(held_out) > 1 else w
