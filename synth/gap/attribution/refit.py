@@ -48,6 +48,7 @@ from synth.data.record import record_from_arrays
 from synth.errors import DataError, ModelError
 from synth.gap.attribution.convergence import cannot_reach
 from synth.gap.attribution.golden import golden_section, log_bracket, parabolic_section
+from synth.gap.attribution.joint_search import fewest_limits, ranges_within, search_from_points
 from synth.gap.attribution.nominal import monomial, nominal_structure, plant_from_values
 from synth.gap.attribution.profile import profile_interval, profile_level
 from synth.gap.effects.base import Effect, Params
@@ -432,8 +433,20 @@ def fit_augmented(plant: Plant, t: np.ndarray, u: np.ndarray, y: np.ndarray, eff
             points += extra
             same += extra
             best = min(points, key=lambda p: p.ssr)
+        if refine and eff.joint_search:
+            signal = y if getattr(eff, "placement", eff.side) == "output" else u
+            extra = search_from_points(lambda prm, w: _fit_point(plant, eff, prm, t, u, y, formula, w, weights, warm=True),
+                                       list(eff.grid_names), points, start_values, 0.05 * float(np.ptp(signal)),
+                                       n_fit)
+            for p in extra:
+                p.key = key
+            points += extra
+            same += extra
+            best = fewest_limits(points, list(eff.grid_names), n_fit)
         ci[key] = profile_interval([(p.params.get(key, np.nan), p.ssr) for p in same],
                                        (best.params[key], best.ssr), n_fit)
+        if eff.joint_search:
+            ci.update(ranges_within(list(eff.grid_names), points, best, profile_level(best.ssr, n_fit)))
     return AugmentedFit(effect, best.plant, best.params, best.offset, best.nominal, ci, best.ssr, n_fit,
                         [(p.params, p.ssr) for p in points], best.solver)
 

@@ -91,6 +91,7 @@ class SaturationEffect(Effect):
 
     placement: str = "input"
     name: ClassVar[str] = "saturation"
+    joint_search: ClassVar[bool] = True
     parameter_names: ClassVar[tuple[str, ...]] = ("lower", "upper")
     grid_names: ClassVar[tuple[str, ...]] = ("lower", "upper")
     spellings: ClassVar[dict[str, dict[str, str]]] = {
@@ -133,6 +134,10 @@ class SaturationEffect(Effect):
         # and both limits at once, each at the same fraction of the span from its end: an actuator's range clips
         # both ways, which one limit at a time fits only as a one-sided clip plus a bias
         both = [{"upper": hi - f * span, "lower": lo + f * span} for f in fractions if f < 0.5]
+        # ... and around the command's median: a wound-up integrator drives the command past each limit unevenly
+        mid = float(np.median(u))
+        both += [{"upper": mid + h, "lower": mid - h} for h in np.quantile(np.abs(u - mid), (0.65, 0.8, 0.9, 0.95))
+                 if lo < mid - h and mid + h < hi]
         return ([{"upper": x} for x in sorted(uppers, reverse=True)] + [{"lower": x} for x in sorted(lowers)]
                 + both)
 
@@ -145,14 +150,17 @@ class SaturationEffect(Effect):
         return [{"upper": hi - f * span} for f in fractions] + [{"lower": lo + f * span} for f in fractions]
 
     def seed_grid(self, point: Params, u_train: np.ndarray | None = None) -> list[Params]:
-        """One limit at a time, as the effect's own grid, bracketed by +-5 % of the command's span.
+        """One limit at a time, as the effect's own grid, bracketed by +-5 % of the command's span, and with the
+        other limit added beyond 5, 10 and 20 % of the training command's samples.
 
         The screen held the denominator fixed, which biases the limit.
 
         Examples
         --------
         >>> [g["upper"] for g in SaturationEffect().seed_grid({"upper": 5.0, "lower": -np.inf}, np.array([0.0, 10.0]))]
-        [4.5, 4.8, 5.0, 5.2, 5.5]
+        [4.5, 4.8, 5.0, 5.2, 5.5, 5.0, 5.0, 5.0]
+        >>> SaturationEffect().seed_grid({"upper": 5.0}, np.linspace(0.0, 10.0, 101))[5:]
+        [{'upper': 5.0, 'lower': 0.5}, {'upper': 5.0, 'lower': 1.0}, {'upper': 5.0, 'lower': 2.0}]
         """
         side = "upper" if np.isfinite(point.get("upper", np.inf)) else "lower"
         other = "lower" if side == "upper" else "upper"
@@ -161,7 +169,14 @@ class SaturationEffect(Effect):
             return [{"upper": point["upper"] + a * span, "lower": point["lower"] + b * span}
                     for a in (-0.03, 0.0, 0.03) for b in (-0.03, 0.0, 0.03)]
         grid = [{side: point[side] + f * span} for f in (-0.05, -0.02, 0.0, 0.02, 0.05)]
-        return [{k: v for k, v in g.items() if k != other} for g in grid]
+        one_sided = [{k: v for k, v in g.items() if k != other} for g in grid]
+        if u_train is None:
+            return one_sided
+        # the other limit too, beyond 5-20 % of the samples: a one-sided screen may hide a two-sided range, and
+        # the joint fit searches both limits together from the best two-sided point
+        levels = np.quantile(u_train, (0.05, 0.1, 0.2) if other == "lower" else (0.95, 0.9, 0.8))
+        return one_sided + [{side: point[side], other: float(x)} for x in levels
+                            if (x < point[side]) == (other == "lower")]
 
     def clip(self, x: np.ndarray, params: Params) -> np.ndarray:
         """``x`` limited to ``[lower, upper]`` (unchanged when neither limit is finite).

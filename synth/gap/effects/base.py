@@ -180,6 +180,8 @@ class Effect:
     excluded_because: ClassVar[str] = ""
     golden_search: ClassVar[bool] = True
     folds_into_plant: ClassVar[bool] = False
+    #: grid parameters a fit also searches together from its best point (:mod:`synth.gap.attribution.joint_search`)
+    joint_search: ClassVar[bool] = False
 
     @property
     def label(self) -> str:
