@@ -14,7 +14,10 @@ import yaml
 SPECS = sorted((Path(__file__).resolve().parents[1] / "specs").glob("*.yaml"))
 VALUES = [None, -1, 0, 1e308, float("nan"), float("inf"), -1e-300, "abc", "", [], {}, [1], [1, 2, 3], [2, 1],
           [-1, 1], [0, 0], True, "1/(s+1)", "s", "1/s^2", "(s-1)/(s+1)", "1/0", "1/(s+1", 1e-12, 3, "P(3)"]
-CASES = 150
+CASES = 120
+"""The first 120 draws of the seeded sequence (150 before): they hold every exit code (0 once, 1 eleven times,
+2 the rest), every spec, and one mutated spec whose plant is identified from its data (the run that costs
+5 s; the sequence's second such run, draw 138, repeated that path for another 6 s)."""
 
 
 def _paths(node, prefix=()):
