@@ -19,7 +19,7 @@ __all__ = ["fewest_limits", "ranges_within", "search_from_points", "search_joint
 
 
 def search_jointly(fit: Callable[[dict[str, float]], Any], best_params: dict[str, float], names: list[str],
-                   steps: list[float], noise_ssr: float, max_fits: int = 60) -> list[Any]:
+                   steps: list[float], noise_ssr: float, max_fits: int = 40) -> list[Any]:
     """Nelder-Mead over ``names`` from ``best_params``; every point fitted, in order.
 
     Parameters
@@ -63,7 +63,7 @@ def search_jointly(fit: Callable[[dict[str, float]], Any], best_params: dict[str
     x0 = np.array([best_params[k] for k in names], float)
     simplex = np.vstack([x0] + [x0 + np.eye(len(names))[i] * steps[i] for i in range(len(names))])
     minimize(cost, x0, method="Nelder-Mead",
-             options={"initial_simplex": simplex, "maxfev": max_fits, "xatol": 1e-3 * min(steps),
+             options={"initial_simplex": simplex, "maxfev": max_fits, "xatol": 0.02 * min(steps),
                       "fatol": noise_ssr})
     return points
 
