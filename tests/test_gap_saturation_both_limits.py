@@ -45,7 +45,7 @@ def _loop(seed):
 
 @pytest.mark.slow
 def test_both_limits_of_a_wound_up_loop_are_found_within_3_percent():
-    for seed in range(3):
+    for seed in (0, 2, 3):  # of seeds 0-9 (all pass), three whose grid fits are cheap: 1 and 4 take 11-17 s
         plant, t, u, y, lower, upper = _loop(seed)
         m = N // 2
         assert np.mean(u[:m] > upper) > 0.05 and np.mean(u[:m] < lower) > 0.05, seed  # both clip in training
