@@ -22,7 +22,7 @@ from synth.errors import SynthError
 from synth.forked import allow_fork
 from synth.version import __version__
 
-__all__ = ["EXIT_BAD_INPUT", "EXIT_NOT_MET", "EXIT_OK", "GC_YOUNG_THRESHOLD", "build_parser", "main"]
+__all__ = ["EXIT_BAD_INPUT", "EXIT_NOT_MET", "EXIT_OK", "GC_YOUNG_THRESHOLD", "build_parser", "joined_values", "main"]
 
 EXIT_OK, EXIT_NOT_MET, EXIT_BAD_INPUT = 0, 1, 2
 
@@ -81,6 +81,38 @@ def entry() -> None:
     sys.exit(code)
 
 
+def joined_values(parser: argparse.ArgumentParser, argv: list[str]) -> list[str]:
+    """``argv`` with an option's value that starts with "-" but is no option of the command joined to it by "=".
+
+    argparse takes ``--tf -2/(s+1)`` for two options and refuses; ``--tf=-2/(s+1)`` is what the user meant.
+
+    Examples
+    --------
+    >>> joined_values(build_parser(), ["hq", "--tf", "-2/(s+1)", "--delay", "0.01"])
+    ['hq', '--tf=-2/(s+1)', '--delay', '0.01']
+    >>> joined_values(build_parser(), ["check", "a.yaml", "--controller", "-q"])  # -q is an option of check
+    ['check', 'a.yaml', '--controller', '-q']
+    """
+    sub = next((a for a in parser._actions if isinstance(a, argparse._SubParsersAction)), None)
+    command = sub.choices.get(argv[0]) if sub is not None and argv else None
+    if command is None:
+        return argv
+    taking = {o for a in command._actions if a.option_strings and a.nargs is None and not isinstance(
+        a, (argparse._StoreConstAction, argparse._HelpAction, argparse._VersionAction)) for o in a.option_strings}
+    known = {o for a in command._actions for o in a.option_strings}
+    out: list[str] = []
+    i = 0
+    while i < len(argv):
+        if (argv[i] in taking and i + 1 < len(argv) and argv[i + 1].startswith("-") and len(argv[i + 1]) > 1
+                and not argv[i + 1].startswith("--") and argv[i + 1][:2] not in known):
+            out.append(f"{argv[i]}={argv[i + 1]}")
+            i += 2
+            continue
+        out.append(argv[i])
+        i += 1
+    return out
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``synth`` command.
 
@@ -90,7 +122,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     0
     """
     parser = build_parser()
-    args = parser.parse_args(argv)
+    args = parser.parse_args(joined_values(parser, list(sys.argv[1:] if argv is None else argv)))
     allow_fork()  # reports and designs may use the second core (synth.forked; SYNTH_JOBS=1 turns it off)
     if not getattr(args, "_run", None):
         parser.print_help()
