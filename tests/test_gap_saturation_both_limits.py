@@ -8,13 +8,13 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from scipy.signal import cont2discrete, tf2ss
 
 from synth.data import record_from_arrays
 from synth.gap.attribution.refit import fit_augmented
 from synth.gap.diagnose import diagnose
 from synth.gap.effects import make_effect
 from synth.plant import Plant
+from tests.pi_loop import digital_pi_loop
 
 DT, N = 0.005, 6000
 
@@ -31,15 +31,8 @@ def _loop(seed):
         r[k:k + hold] = rng.uniform(-1.2, 1.2) * gain
         k += hold
     kp, ki = rng.uniform(0.5, 1.5) / gain, rng.uniform(2.0, 5.0) / gain
-    A, B, C, D = tf2ss(num, den)
-    Ad, Bd, Cd, _, _ = cont2discrete((A, B, C, D), DT, method="zoh")
     noise = rng.normal(0, 0.005 * gain, N)
-    x, integral, u, y = np.zeros(A.shape[0]), 0.0, np.zeros(N), np.zeros(N)
-    for k in range(N):
-        y[k] = (Cd @ x).item() + noise[k]
-        integral += ki * DT * (r[k] - y[k])
-        u[k] = kp * (r[k] - y[k]) + integral  # logged: the controller's output, before the limits
-        x = Ad @ x + Bd.ravel() * min(max(u[k], lower), upper)
+    u, y = digital_pi_loop(num, den, kp, ki, r, noise, DT, lower, upper)
     return Plant(np.array(num, float), den), np.arange(N) * DT, u, y, lower, upper
 
 

@@ -8,28 +8,13 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from scipy.signal import cont2discrete, tf2ss
 
 from synth.data import record_from_arrays
 from synth.gap.diagnose import diagnose
 from synth.plant import Plant
+from tests.pi_loop import digital_pi_loop
 
 DT = 0.005
-
-
-def _closed_loop(num, den, kp, ki, r, noise):
-    """Digital PI at ``DT`` around the continuous plant (exact zero-order hold); logged command and output."""
-    A, B, C, D = tf2ss(num, den)
-    Ad, Bd, Cd, _, _ = cont2discrete((A, B, C, D), DT, method="zoh")
-    x, integral = np.zeros(A.shape[0]), 0.0
-    u, y = np.zeros(r.size), np.zeros(r.size)
-    for k in range(r.size):
-        y[k] = (Cd @ x).item() + noise[k]
-        e = r[k] - y[k]
-        integral += ki * DT * e
-        u[k] = kp * e + integral
-        x = Ad @ x + Bd.ravel() * u[k]
-    return u, y
 
 
 @pytest.mark.slow
@@ -41,8 +26,8 @@ def test_a_single_lag_is_not_given_a_quantizer_for_what_the_refit_gains():
         r[k:k + hold] = rng.uniform(-1, 1)
         k += hold
     tau = rng.uniform(0.05, 0.1)  # the unmodelled input lag: 0.0830 s
-    u, y = _closed_loop([20.0], np.polymul(np.polymul([1, 2], [1, 5]), [tau, 1]), 1.0, 3.0, r,
-                        rng.normal(0, 0.005, n))
+    u, y = digital_pi_loop([20.0], np.polymul(np.polymul([1, 2], [1, 5]), [tau, 1]), 1.0, 3.0, r,
+                           rng.normal(0, 0.005, n), DT)
     d = diagnose(Plant.from_string("20/((s+2)*(s+5))"), record_from_arrays(np.arange(n) * DT, u, y),
                  candidates=["lag", "quantization"], n_boot=200)
     assert d.verdict["effects"] == ["lag"], d.summary  # was ['lag', 'quantization'], shrinkage 0.062

@@ -97,8 +97,7 @@ def joined_values(parser: argparse.ArgumentParser, argv: list[str]) -> list[str]
     command = sub.choices.get(argv[0]) if sub is not None and argv else None
     if command is None:
         return argv
-    taking = {o for a in command._actions if a.option_strings and a.nargs is None and not isinstance(
-        a, (argparse._StoreConstAction, argparse._HelpAction, argparse._VersionAction)) for o in a.option_strings}
+    taking = {o for a in command._actions if a.option_strings and a.nargs is None for o in a.option_strings}  # one value
     known = {o for a in command._actions for o in a.option_strings}
     out: list[str] = []
     i = 0

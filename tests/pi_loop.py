@@ -1,0 +1,24 @@
+"""A digital PI loop simulated by scipy, the truth of the diagnosis tests (not synth's simulator)."""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy.signal import cont2discrete, tf2ss
+
+
+def digital_pi_loop(num, den, kp: float, ki: float, r: np.ndarray, noise: np.ndarray, dt: float,
+                    lower: float = -np.inf, upper: float = np.inf) -> tuple[np.ndarray, np.ndarray]:
+    """A PI at ``dt`` around the continuous plant ``num/den`` (exact zero-order hold), its measurement ``noise`` fed
+    back, the plant driven by the command limited to ``[lower, upper]``; returns the logged command (the
+    controller's output, before the limits: a wound-up integrator) and the measured output."""
+    A, B, C, D = tf2ss(num, den)
+    Ad, Bd, Cd, _, _ = cont2discrete((A, B, C, D), dt, method="zoh")
+    x, integral = np.zeros(A.shape[0]), 0.0
+    u, y = np.zeros(r.size), np.zeros(r.size)
+    for k in range(r.size):
+        y[k] = (Cd @ x).item() + noise[k]
+        e = r[k] - y[k]
+        integral += ki * dt * e
+        u[k] = kp * e + integral
+        x = Ad @ x + Bd.ravel() * min(max(u[k], lower), upper)
+    return u, y
