@@ -16,9 +16,27 @@ from synth.errors import ModelError
 from synth.first_crossing import batch_first_crossing
 from synth.rootfind import bisect_roots
 
-__all__ = ["DEFAULT_PER_DECADE", "Curve", "band_grid", "band_grids", "batch_first_crossing", "batch_peak",
-           "bracketed_maxima", "characteristic_range", "corner_frequencies", "crossings", "first_fall", "log_grid",
-           "log_grid_sizes", "log_grids", "neighbour_brackets", "peak", "refine_maxima", "resolving_grid"]
+__all__ = [
+    "DEFAULT_PER_DECADE",
+    "Curve",
+    "band_grid",
+    "band_grids",
+    "batch_first_crossing",
+    "batch_peak",
+    "bracketed_maxima",
+    "characteristic_range",
+    "corner_frequencies",
+    "crossings",
+    "first_fall",
+    "grid_decades",
+    "log_grid",
+    "log_grid_sizes",
+    "log_grids",
+    "neighbour_brackets",
+    "peak",
+    "refine_maxima",
+    "resolving_grid",
+]
 
 Curve = Callable[[np.ndarray], np.ndarray]
 
@@ -58,6 +76,21 @@ def corner_frequencies(*polys: np.ndarray) -> tuple[float, float]:
     return (float(min(mags)), float(max(mags))) if mags else (np.nan, np.nan)
 
 
+def grid_decades(w_lo: float, w_hi: float) -> float:
+    """Decades from ``w_lo`` to ``w_hi``; a :class:`~synth.errors.ModelError` when they are not finite (one line).
+
+    Examples
+    --------
+    >>> grid_decades(1.0, 100.0)
+    2.0
+    """
+    decades = float(np.log10(w_hi / w_lo)) if w_lo > 0 else np.inf
+    if not np.isfinite(decades):  # e.g. 1 / delay underflowed: a plant delay of 1e308 s
+        raise ModelError(f"cannot grid the frequencies from {w_lo:g} to {w_hi:g} rad/s (a delay, pole or zero at an "
+                         "extreme scale?)")
+    return decades
+
+
 def log_grid(w_lo: float, w_hi: float, per_decade: int = DEFAULT_PER_DECADE) -> np.ndarray:
     """Logarithmic grid from ``w_lo`` to ``w_hi`` (both > 0).
 
@@ -70,10 +103,7 @@ def log_grid(w_lo: float, w_hi: float, per_decade: int = DEFAULT_PER_DECADE) -> 
     ...
     synth.errors.ModelError: cannot grid the frequencies from 1e-310 to 1000 rad/s (a delay, pole or zero at an ...
     """
-    decades = np.log10(w_hi / w_lo) if w_lo > 0 else np.inf
-    if not np.isfinite(decades):  # e.g. 1 / delay underflowed: a plant delay of 1e308 s
-        raise ModelError(f"cannot grid the frequencies from {w_lo:g} to {w_hi:g} rad/s (a delay, pole or zero at an "
-                         "extreme scale?)")
+    decades = grid_decades(w_lo, w_hi)
     n = max(2, int(np.ceil(per_decade * decades)) + 1)
     return np.geomspace(w_lo, w_hi, n)
 

@@ -15,6 +15,7 @@ from itertools import pairwise
 import numpy as np
 
 from synth.errors import ModelError
+from synth.freqgrid import grid_decades
 from synth.polynomials import largest_crossing, polymul, shifted, trim, value_at_infinity
 from synth.rootfind import bisect_roots
 from synth.stability import MAX_PHASE_POINTS, PHASE_STEP, Rational, characteristic_scale, closed_loop_stability
@@ -105,7 +106,7 @@ def stability_boundaries(
         w_max = max(w_max, 10.0 * hi_scale + 4.0 * np.pi / delay)
         w_lin = w_max
     w_min = 1e-4 * lo_scale
-    grid = [np.geomspace(w_min, w_max, int(100 * np.log10(w_max / w_min)) + 2)]
+    grid = [np.geomspace(w_min, w_max, int(100 * grid_decades(w_min, w_max)) + 2)]
     if delay > 0:  # the delay's phase, sampled finely up to the last frequency where |L0 + rho L1| can be 1
         points = int(np.ceil(w_lin * delay / PHASE_STEP)) + 2
         if points > MAX_PHASE_POINTS:

@@ -38,8 +38,13 @@ def test_a_requirement_type_that_is_not_a_name_is_an_unknown_type(run_cli, tmp_p
 
 def test_a_delay_too_long_to_grid_is_one_line(run_cli, tmp_path):
     """A plant delay of 1e308 s puts the frequency grid's lower end at 1e-310 rad/s: the grid cannot be made,
-    and the check says so instead of an OverflowError traceback."""
-    r = run_cli("check", _spec(tmp_path, plant={**X4["plant"], "delay": 1e308}), "--controller", "P(3)")
+    and the check says so instead of an OverflowError traceback. The loop's stability cannot be counted either,
+    and a requirement that presumes a stable loop says so without a grid."""
+    path = _spec(tmp_path, plant={**X4["plant"], "delay": 1e308})
+    r = run_cli("check", path, "--controller", "P(3)")
+    assert r.code == 1 and "Traceback" not in r.err
+    assert r.out.count("closed loop not certified stable") == 3  # the stability row and both requirements
+    r = run_cli("design", path, "--no-report", "--force")  # its stability set grids the frequencies
     assert r.code == 2 and "Traceback" not in r.err
     assert r.err.strip().splitlines() == [r.err.strip()] and "cannot grid the frequencies" in r.err
 

@@ -15,7 +15,8 @@ from synth.controllers import Controller
 from synth.design import design
 from synth.loop import Loop
 from synth.plant import Plant
-from synth.requirements import Bandwidth, MarginsRequirement
+from synth.loop_batch import LoopBatch
+from synth.requirements import Bandwidth, MarginsRequirement, PeakComplementary, PeakSensitivity, Sensitivity
 from synth.spec import parse_spec
 from synth.stability import STABILITY_FLOOR
 
@@ -51,6 +52,41 @@ def test_margins_and_bandwidth_are_never_met_on_an_unstable_or_marginal_loop(k):
         assert not r.met and r.slack < 0 and np.isnan(r.value)
         assert ("UNSTABLE" if k < 0.5 else "marginally stable") in r.message and "undefined" in r.message
         assert r.details["closed_loop_stable"] is False
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_closed_loop_magnitudes_are_met_only_on_stable_loops(seed):
+    """|S| over a band, peak |S| and peak |T| of random plants (some open-loop unstable) under P gains on both
+    sides of their stability limits: met only where numpy's closed-loop roots are all in the left half-plane
+    (an unstable loop's |S(jw)| can be small: P(0.05) on this file's plant has peak |S| 0.92 dB), the scalar
+    and the batch slack agree in sign, and on stable loops the peak is a dense grid's."""
+    rng = np.random.default_rng(seed)
+    poles = [rng.uniform(0.2, 2.0), rng.uniform(-6.0, 2.0), -rng.uniform(5.0, 20.0)]  # high gain stabilizes (2 zeros)
+    num = rng.uniform(1.0, 20.0) * np.poly(-rng.uniform(0.5, 5.0, size=2))
+    den = np.poly(poles)
+    plant = Plant(num, den)
+    gains = np.geomspace(0.01, 50.0, 25)
+    reqs = [Sensitivity(max_db=20.0, band=(0.0, 1.0)), PeakSensitivity(max_db=20.0), PeakComplementary(max_db=20.0)]
+    batch = LoopBatch(plant, [Controller("P", {"kp": float(k)}) for k in gains])
+    w = np.geomspace(1e-3, 1e7, 150000)  # relative degree 1: |S| -> 1 as w -> inf
+    seen = set()
+    for req in reqs:
+        batch_slacks = req.batch_slack(batch)
+        for k, batch_slack in zip(gains, batch_slacks):
+            stable = bool(np.all(np.roots(np.polyadd(den, k * num)).real < 0))
+            r = req.evaluate(Loop(plant, Controller("P", {"kp": float(k)})))
+            assert (batch_slack >= 0) == r.met
+            if not stable:
+                assert not r.met and np.isnan(r.value) and "UNSTABLE" in r.message
+                seen.add("unstable")
+            else:
+                L = k * np.polyval(num, 1j * w) / np.polyval(den, 1j * w)
+                curve = np.abs(L / (1 + L)) if isinstance(req, PeakComplementary) else np.abs(1 / (1 + L))
+                if isinstance(req, Sensitivity):
+                    curve = curve[w <= 1.0]
+                assert r.value == pytest.approx(20 * np.log10(curve.max()), abs=0.01)
+                seen.add("stable")
+    assert seen == {"stable", "unstable"}
 
 
 def test_check_on_unstable_and_marginal_loops_gives_a_verdict(run_cli):

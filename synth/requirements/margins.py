@@ -161,6 +161,11 @@ def unstable_result(req: Requirement, loop: Loop, what: str, **details: Any) -> 
         why = f"closed loop marginally stable (a root on the imaginary axis at {fmt(st.marginal_frequency)} rad/s)"
     elif st.neutral_gain is not None:
         why = f"closed loop UNSTABLE (|L(j inf)| = {fmt(st.neutral_gain)} >= 1 with a delay: neutral type)"
+    elif st.method.startswith("not counted") or (st.near_axis is not None and st.unstable_poles == 0):
+        why = "closed loop not certified stable (see its stability row)"
+    elif st.near_axis is not None:
+        why = (f"closed loop not stable in practice ({st.unstable_poles} root(s) within {fmt(st.near_axis)} of the "
+               "imaginary axis)")
     else:
         why = f"closed loop UNSTABLE ({st.unstable_poles} root(s) in the closed right half-plane)"
     bound_field = next((f for f in req.bounds if getattr(req, f, None) is not None), None)

@@ -22,6 +22,7 @@ from synth.requirements.base import (
     fmt,
     register,
 )
+from synth.requirements.margins import closed_loop_unstable, unstable_result, with_unstable_rows
 
 if TYPE_CHECKING:
     from synth.loop import Loop
@@ -79,9 +80,11 @@ class Sensitivity(BandMixin, Requirement):
     max_db: FiniteFloat
     title: ClassVar[str] = "sensitivity over a band"
     bounds: ClassVar[dict[str, Bound]] = MAX_DB
-    example: ClassVar[dict[str, Any]] = {"type": "sensitivity", "max_db": -15.0, "band": (0.0, 30.0)}
+    example: ClassVar[dict[str, Any]] = {"type": "sensitivity", "max_db": -15.0, "band": (0.0, 5.0)}
 
     def evaluate(self, loop: Loop, per_decade: int = 80) -> RequirementResult:
+        if closed_loop_unstable(loop):
+            return unstable_result(self, loop, f"|S| {band_text(self.band)}", band=list(self.band))
         grid = with_narrow_peaks(band_grid(self.band, loop.frequency_range, per_decade), loop, self.band)
         value, w_peak = peak(lambda w: np.abs(loop.S(w)), grid)
         value_db = db(value)
@@ -110,7 +113,7 @@ class Sensitivity(BandMixin, Requirement):
         """Vectorized slack: the peak of every loop's ``|S|`` over the band at once."""
         grid = band_grids(self.band, batch.frequency_ranges, per_decade)
         value, _ = batch_peak(lambda w: np.abs(batch.S(w)), grid)
-        return (self.max_db - db_values(value)) * NEPER_PER_DB
+        return with_unstable_rows(self, batch, (self.max_db - db_values(value)) * NEPER_PER_DB)
 
 
 @register
@@ -232,9 +235,12 @@ class PeakRequirement(Requirement):
             grid = log_grids(ranges[:, 0], ranges[:, 1] * 10, per_decade)
             grid = np.column_stack([grid, ranges[:, 1] * FAR])  # the limit w -> inf (|KS| -> |C(inf)|)
         value, _ = batch_peak(curve, grid)
-        return (self.max_db - db_values(value)) * NEPER_PER_DB
+        return with_unstable_rows(self, batch, (self.max_db - db_values(value)) * NEPER_PER_DB)
 
     def evaluate(self, loop: Loop, per_decade: int = 80) -> RequirementResult:
+        if closed_loop_unstable(loop):
+            return unstable_result(self, loop, f"peak {self.symbol}",
+                                   band=None if self.band is None else list(self.band))
         if self.band is not None:  # checked when the spec was read
             grid = with_narrow_peaks(band_grid(self.band, loop.frequency_range, per_decade), loop, self.band)
             where = band_text(self.band)
