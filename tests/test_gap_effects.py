@@ -80,6 +80,17 @@ def test_saturation_limit_recovered_with_a_profile_interval():
     assert lo <= fit.params["upper"] <= hi and hi - lo < 0.05
 
 
+def test_a_negative_lower_limit_gets_a_profile_interval_around_it():
+    """A saturation's lower limit is negative: its interval is profiled in the log of its magnitude (it was
+    ``(x, x)``: only positive parameters were profiled), and a value fitted twice counts at its lower SSR."""
+    u = U - 0.8  # from -0.8 to 0.7: the lower limit -0.5 is reached, no upper limit is
+    y = make_effect("saturation").apply(G, T, u, {"lower": -0.5}) + 0.01 * np.random.default_rng(0).normal(size=T.size)
+    fit = fit_augmented(G_OFF, T, u, y, make_effect("saturation"))
+    assert fit.params["lower"] == pytest.approx(-0.5, abs=0.005) and fit.params["upper"] == np.inf
+    lo, hi = fit.parameter_ci["lower"]
+    assert lo < fit.params["lower"] < hi and hi - lo < 0.02
+
+
 def test_unknown_effect_and_bad_placement():
     with pytest.raises(ModelError, match="unknown effect"):
         make_effect("flux_capacitor")

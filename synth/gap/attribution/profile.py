@@ -30,12 +30,15 @@ def profile_level(best_ssr: float, n: int) -> float:
 
 
 def profile_interval(points: Sequence[tuple[float, float]], best: tuple[float, float], n: int) -> tuple[float, float]:
-    """95 % profile interval of a positive parameter from ``(value, SSR)`` points fitted at fixed values.
+    """95 % profile interval of a parameter of one sign from ``(value, SSR)`` points fitted at fixed values.
+
+    A negative parameter (a saturation's lower limit) is profiled in the log of its magnitude, as a positive
+    one in its log; points of the other sign are ignored.
 
     Parameters
     ----------
     points : sequence of (float, float)
-        Parameter values and their training SSR (non-finite or non-positive values are ignored).
+        Parameter values and their training SSR (non-finite values and those not of the best's sign are ignored).
     best : (float, float)
         The best value and its SSR.
     n : int
@@ -44,7 +47,7 @@ def profile_interval(points: Sequence[tuple[float, float]], best: tuple[float, f
     Returns
     -------
     (float, float)
-        Lower and upper end; ``(x, x)`` when nothing can be said (no usable points).
+        Lower and upper end; ``(x, x)`` when nothing can be said (no usable points, a best value of 0).
 
     Examples
     --------
@@ -52,12 +55,23 @@ def profile_interval(points: Sequence[tuple[float, float]], best: tuple[float, f
     >>> lo, hi = profile_interval(pts, (1.0, 100.0), 1000)
     >>> round(lo, 4), round(hi, 4)  # the level lies between 0.8 and 1.0, and 1.0 and 1.25: interpolated in log
     (0.9957, 1.0043)
+    >>> lo, hi = profile_interval([(-x, s) for x, s in pts], (-1.0, 100.0), 1000)
+    >>> round(lo, 4), round(hi, 4)
+    (-1.0043, -0.9957)
     """
-    pts = sorted(((float(x), float(s)) for x, s in points if np.isfinite(s) and np.isfinite(x) and x > 0),
-                 key=lambda p: p[0])
-    level = profile_level(best[1], n)
     x0 = float(best[0])
-    if not pts or not (np.isfinite(x0) and x0 > 0):
+    if not (np.isfinite(x0) and x0 != 0.0):
+        return (x0, x0)
+    if x0 < 0:
+        lo, hi = profile_interval([(-float(x), s) for x, s in points], (-x0, best[1]), n)
+        return (-hi, -lo)
+    lowest: dict[float, float] = {}  # the profile: at a value fitted more than once, the lowest SSR
+    for x, s in points:
+        if np.isfinite(s) and np.isfinite(x) and x > 0:
+            lowest[float(x)] = min(float(s), lowest.get(float(x), np.inf))
+    pts = sorted(lowest.items())
+    level = profile_level(best[1], n)
+    if not pts:
         return (x0, x0)
     xs = np.log([p[0] for p in pts])
     ss = np.array([p[1] for p in pts])
