@@ -14,8 +14,8 @@ from synth.check import check
 from synth.controllers import Controller
 from synth.design import design
 from synth.loop import Loop
-from synth.plant import Plant
 from synth.loop_batch import LoopBatch
+from synth.plant import Plant
 from synth.requirements import Bandwidth, MarginsRequirement, PeakComplementary, PeakSensitivity, Sensitivity
 from synth.spec import parse_spec
 from synth.stability import STABILITY_FLOOR
