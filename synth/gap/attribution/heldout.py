@@ -59,8 +59,8 @@ Procedure (:func:`diagnose_effects`, options :class:`DiagnoseOptions`)
    displaced and by how much). ``["parameter_mismatch"]`` if no effect is
    relevant but the re-fit shrinks the gap significantly; ``[]`` when there is
    no gap. Candidates whose held-out ``J`` does not differ from the leader's
-   beyond the bootstrap interval and whose held-out outputs differ by less than
-   the noise floor's standard deviation are *indistinguishable* from it,
+   beyond the bootstrap interval, or whose held-out outputs differ by less than
+   a tenth of the noise floor's standard deviation, are *indistinguishable* from it,
    reported as a group with the experiment that would separate them.
 
 7. **Further effects** (``max_effects``, forward selection): every other candidate
@@ -410,10 +410,10 @@ def diagnose_effects(plant: Plant, record: Record, validate: Record | Sequence[R
             same_j = d_lo <= 0.0 <= d_hi
             gap_ab = (yhat - y_best)[held]
             rms_diff = float(np.sqrt(np.mean((demean(gap_ab, groups) if fit_offset else gap_ab) ** 2)))
-            close = rms_diff < sigma
-            # outputs a tenth of the noise apart: any difference in J is the noise's, whatever the bootstrap says
+            # outputs a tenth of the noise apart: any difference in J is the noise's, whatever the bootstrap says;
+            # outputs apart by more with the same J: the record prefers neither (both can miss it alike)
             same_j = same_j or rms_diff < 0.1 * sigma
-            if same_j and close:
+            if same_j:
                 group.append(res.effect)
                 experiments.append(separating_experiment(best.effect, res.effect, t_ev[held], y_best[held], yhat[held]))
         if len(group) > 1:

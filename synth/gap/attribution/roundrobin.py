@@ -19,8 +19,8 @@ same plant (a lab's open-loop step and its closed-loop steps) can. Procedure
    thresholds (conservative), relevant when it also removes ``min_share`` of the
    re-fit's pooled excess over the noise floor and it was fitted jointly in every
    fold; the simplest relevant candidate not beaten significantly leads; candidates
-   whose pooled ``J`` does not differ from the leader's and whose outputs differ by
-   less than the noise are indistinguishable. One effect at most (no forward selection).
+   whose pooled ``J`` does not differ from the leader's, or whose outputs differ by
+   less than a tenth of the noise, are indistinguishable. One effect at most (no forward selection).
 4. **Parameters** are reported per training run: their spread across runs is how
    well the data pin the effect down.
 """
@@ -296,7 +296,7 @@ def _pool(folds: list[EffectDiagnosis], names: list[str], blocks: int, n_boot: i
             same_j = float(np.quantile(d, 0.025)) <= 0.0 <= float(np.quantile(d, 0.975))
             y_e = np.concatenate([f.segments.predictions[e.effect] for f in folds])
             rms = float(np.sqrt(np.mean((y_e - y_best) ** 2)))
-            if (same_j and rms < sigma) or rms < 0.1 * sigma:
+            if same_j or rms < 0.1 * sigma:
                 group.append(e.effect)
                 experiments.append(separating_experiment(best.effect, e.effect, np.arange(y_best.size), y_best, y_e))
         if len(group) > 1:
