@@ -11,8 +11,8 @@ def digital_pi_loop(num, den, kp: float, ki: float, r: np.ndarray, noise: np.nda
                     delay_samples: int = 0, integrate_after: bool = False) -> tuple[np.ndarray, np.ndarray]:
     """A PI at ``dt`` around the continuous plant ``num/den`` (exact zero-order hold), its measurement ``noise`` fed
     back, the plant driven by the command limited to ``[lower, upper]`` and ``delay_samples`` samples late (the
-    integral updated before the command, or with ``integrate_after`` after it); returns the logged command (the controller's output, before the limits: a wound-up integrator) and the
-    measured output."""
+    integral updated before the command, or with ``integrate_after`` after it); returns the logged command (the
+    controller's output, before the limits: a wound-up integrator) and the measured output."""
     A, B, C, D = tf2ss(num, den)
     Ad, Bd, Cd, _, _ = cont2discrete((A, B, C, D), dt, method="zoh")
     x, integral = np.zeros(A.shape[0]), 0.0
