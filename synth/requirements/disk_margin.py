@@ -8,6 +8,7 @@ import numpy as np
 from pydantic import PositiveFloat, field_validator
 
 from synth.freqgrid import log_grid, peak
+from synth.polynomials import value_at_infinity
 from synth.requirements.base import Bound, Requirement, RequirementResult, db, fmt, register
 from synth.requirements.margins import closed_loop_unstable, unstable_result
 from synth.requirements.sensitivity import with_narrow_peaks
@@ -15,7 +16,7 @@ from synth.requirements.sensitivity import with_narrow_peaks
 if TYPE_CHECKING:
     from synth.loop import Loop
 
-__all__ = ["DiskMargin", "disk_gain_phase"]
+__all__ = ["DiskMargin", "disk_gain_phase", "high_frequency_limit"]
 
 
 def disk_gain_phase(alpha: float, skew: float = 0.0) -> tuple[float, float, float]:
@@ -87,9 +88,12 @@ class DiskMargin(Requirement):
         lo, hi = loop.frequency_range
         # with points at the loop's narrow peaks: a mode of damping 0.003 at 1234 rad/s put a disk margin of 0.667
         # between two grid points, and 1.04 was reported (found by a black-box test)
-        grid = with_narrow_peaks(log_grid(lo, hi * 10, per_decade), loop, (0.0, np.inf))
+        # with w = 0: a negative DC loop gain near -1 peaks there (0.0255 was reported for 0.00501; a black-box test)
+        grid = with_narrow_peaks(np.r_[0.0, log_grid(lo, hi * 10, per_decade)], loop, (0.0, np.inf))
         value, w = peak(lambda w: np.abs(loop.S(w) + c), grid)
-        value = max(value, abs(1.0 + c) if loop.L(np.array([hi * 10]))[0] == 0 else 0.0)
+        limit = high_frequency_limit(value_at_infinity(loop.num, loop.den), loop.delay, c)
+        if limit > value:
+            value, w = limit, np.inf
         alpha = 1.0 / value if value > 0 else np.inf
         g_lo, g_hi, pm = disk_gain_phase(alpha, self.skew)
         lo_db, hi_db = db(g_lo), db(g_hi)
@@ -102,3 +106,21 @@ class DiskMargin(Requirement):
                            gain_margin_db=hi_db, lower_gain_margin_db=lo_db,
                            phase_margin_deg=pm, grid_points_per_decade=per_decade,
                            grid=[float(grid[0]), float(grid[-1])])
+
+
+def high_frequency_limit(l_inf: float, delay: float, c: float) -> float:
+    """The supremum of ``|S + c|`` as ``w -> inf``: ``|1/(1 + L(inf)) + c|``; with a delay, ``L(jw)`` circles at
+    radius ``|L(inf)|`` and the supremum is over that circle (3,601 angles).
+
+    Examples
+    --------
+    >>> high_frequency_limit(0.0, 0.1, -0.5), round(high_frequency_limit(0.5, 0.0, -0.5), 4)
+    (0.5, 0.1667)
+    >>> round(high_frequency_limit(0.5, 0.1, -0.5), 4)  # 1/(1 - 0.5) - 0.5
+    1.5
+    """
+    if l_inf == 0.0 or delay == 0.0:
+        return float(abs(1.0 / (1.0 + l_inf) + c)) if l_inf != -1.0 else float("inf")
+    circle = abs(l_inf) * np.exp(1j * np.linspace(0.0, 2.0 * np.pi, 3601))
+    with np.errstate(divide="ignore"):
+        return float(np.max(np.abs(1.0 / (1.0 + circle) + c)))
