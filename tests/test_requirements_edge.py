@@ -12,6 +12,7 @@ import pytest
 from synth.controllers import Controller
 from synth.design import design
 from synth.loop import Loop
+from synth.loop_batch import LoopBatch
 from synth.plant import Plant
 from synth.requirements import DelayMargin, DiskMargin, NoLimitCycle, StepResponse
 from synth.requirements.no_limit_cycle import critical_gain_factor
@@ -34,6 +35,27 @@ def test_delay_margin_matches_python_control(k):
     r = DelayMargin(min=0.01).evaluate(Loop(Plant.from_string(X4), Controller("P", {"kp": k})))
     assert r.value == pytest.approx(np.radians(pm) / wc, rel=1e-6)
     assert r.details["determined"] and r.details["nyquist_stable_at_bound"] == r.met
+
+
+@pytest.mark.parametrize("k", [0.5, 0.999, 1.0, 3.0])
+def test_delay_margin_of_a_biproper_loop_that_stays_near_one_at_high_frequency(k):
+    """P(k) on (s + 2)/(s + 1): |L(j inf)| = k. From k = 1 on, any added delay tau leaves roots at
+    Re s = ln(k)/tau >= 0 (neutral type): the delay margin is 0 (a black-box test read "inf s", no crossover).
+    Below 1 the margin is the crossovers' (none at k = 0.5). The reference: the roots of the loop with a
+    high-order Pade delay (numpy), counted on the right half-plane."""
+    loop = Loop(Plant.from_string("(s+2)/(s+1)"), Controller("P", {"kp": k}))
+    req = DelayMargin(min=0.05)
+    r = req.evaluate(loop)
+    num, den = control.pade(0.05, 12)
+    cl = np.polyadd(np.polymul([1.0, 1.0], den), k * np.polymul([1.0, 2.0], num))
+    unstable_with_delay = bool(np.any(np.roots(cl).real > 1e-9))
+    if k >= 1.0:
+        assert r.value == 0.0 and not r.met and "neutral-type" in r.message
+        assert unstable_with_delay or k == 1.0  # k = 1: the roots sit on the axis in the limit
+    else:  # k = 0.5: |L| < 1 everywhere (no crossover); k = 0.999: a crossover, 80 ms
+        assert r.value > 0.05 and r.met and not unstable_with_delay
+    batch = LoopBatch(loop.plant, [loop.controller])
+    assert (req.batch_slack(batch)[0] >= 0) == r.met
 
 
 def test_delay_margin_feasible_set_is_the_d_decomposition_with_the_delay():

@@ -8,6 +8,7 @@ import numpy as np
 from pydantic import PositiveFloat
 
 from synth.errors import ModelError
+from synth.polynomials import value_at_infinity
 from synth.requirements.base import Bound, Requirement, RequirementResult, fmt, register
 from synth.requirements.margins import closed_loop_unstable, unstable_result, with_unstable_rows
 from synth.stability import closed_loop_stability
@@ -74,6 +75,9 @@ class DelayMargin(Requirement):
             return unstable_result(self, loop, "delay margin")
         per_crossover = delay_margins_per_crossover(loop)
         dm, wc = min(((d, w) for w, _, d in per_crossover), default=(np.inf, None))
+        l_inf = abs(value_at_infinity(loop.num, loop.den))
+        if l_inf >= 1.0:  # any added delay: neutral type, infinitely many roots at Re s = ln|L(j inf)|/delay >= 0
+            dm, wc = 0.0, None
         slack = float(np.log(dm / self.min)) if dm > 0 else -np.inf
         try:
             nyquist = closed_loop_stability(loop.num, loop.den, loop.delay + self.min).stable
@@ -86,8 +90,13 @@ class DelayMargin(Requirement):
         crossings = ", ".join(f"PM {fmt(pm)} deg at {fmt(w)} rad/s" for w, pm, _ in per_crossover) or "no crossover"
         check = "" if nyquist is None else (
             f"; Nyquist count with {fmt(self.min * 1e3)} ms added: {'stable' if nyquist else 'UNSTABLE'}")
-        msg = (f"delay margin {fmt(dm * 1e3)} ms >= {fmt(self.min * 1e3)} ms: {verdict} "
-               f"(exact: min over {len(per_crossover)} crossover(s) of PM/wc; {crossings}{check})")
+        if l_inf >= 1.0:
+            agree, verdict = True, "NOT met"
+            msg = (f"delay margin 0 ms >= {fmt(self.min * 1e3)} ms: NOT met (|L(j inf)| = {fmt(l_inf)} >= 1: any "
+                   "added delay makes the loop neutral-type unstable, infinitely many roots in the right half-plane)")
+        else:
+            msg = (f"delay margin {fmt(dm * 1e3)} ms >= {fmt(self.min * 1e3)} ms: {verdict} "
+                   f"(exact: min over {len(per_crossover)} crossover(s) of PM/wc; {crossings}{check})")
         return self.result(value=dm, bound=self.min, unit="s", slack=slack, margin=dm - self.min,
                            binding_frequency=wc, message=msg, method="min over gain crossovers of PM/wc",
                            crossovers=[{"frequency": w, "phase_margin_deg": pm, "delay_margin": d}
@@ -119,6 +128,8 @@ class DelayMargin(Requirement):
             pm = (phase + 180.0) % 360.0
             pm = np.where((pm == 0.0) & (phase != -180.0), 360.0, pm)
             np.minimum.at(dm, rows, np.radians(pm) / wc)
+        l_inf = np.array([abs(value_at_infinity(n, d)) for n, d in zip(batch.num, batch.den)])
+        dm = np.where(l_inf >= 1.0, 0.0, dm)  # neutral type with any added delay (the scalar form)
         with np.errstate(divide="ignore"):
             values = np.where(dm > 0, np.log(np.where(dm > 0, dm, 1.0) / self.min), -np.inf)
         return with_unstable_rows(self, batch, values)
