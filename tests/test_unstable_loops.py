@@ -120,6 +120,8 @@ def test_margins_of_an_open_loop_unstable_plant_report_the_lower_gain_limit():
         r = MarginsRequirement(gain_margin_db=6).evaluate(Loop(Plant.from_string(PLANT), Controller("P", {"kp": k})))
         assert r.met == (20 * np.log10(k / 0.5) >= 6)
         assert r.value == pytest.approx(20 * np.log10(k / 0.5), abs=1e-6)
+        # the line says which way the gain may move (it read "gain margin 11.1 dB" as if it could rise by that)
+        assert f"gain margin {20 * np.log10(k / 0.5):.4g} dB downward" in r.message and "rise by inf dB" in r.message
 
 
 def test_design_over_an_unstable_plant_states_the_stabilizing_set():

@@ -66,6 +66,9 @@ class MarginsRequirement(Requirement):
         parts = self._parts(m)
         slack, name, value, bound, unit, w = min(parts, key=lambda p: p[0])
         texts = [f"{p[1]} {fmt(p[2])} {p[4]} (min {fmt(p[3])})" for p in parts]
+        if self.gain_margin_db is not None and -m.lower_gain_margin_db < m.gain_margin_db:  # the downward one binds
+            texts[0] = (f"gain margin {fmt(parts[0][2])} dB downward (min {fmt(self.gain_margin_db)}; the loop gain "
+                        f"may fall by that much, and rise by {fmt(m.gain_margin_db)} dB)")
         msg = f"{'; '.join(texts)}: {'met' if slack >= 0 else 'NOT met'}, tightest: {name}"
         return self.result(value=value, bound=bound, unit=unit, slack=slack, margin=value - bound,
                            binding_frequency=w, message=msg, binding=name, **m.to_dict())
