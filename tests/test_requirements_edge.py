@@ -56,6 +56,9 @@ def test_delay_margin_of_a_biproper_loop_that_stays_near_one_at_high_frequency(k
         assert r.value > 0.05 and r.met and not unstable_with_delay
     batch = LoopBatch(loop.plant, [loop.controller])
     assert (req.batch_slack(batch)[0] >= 0) == r.met
+    # the margins' delay margin (scalar and batch) is the same number
+    assert loop.margins().delay_margin == pytest.approx(r.value)
+    assert batch.phase_and_delay_margins()[1][0] == pytest.approx(r.value)
 
 
 def test_delay_margin_feasible_set_is_the_d_decomposition_with_the_delay():
