@@ -401,12 +401,17 @@ def _delayed_step(loop: Loop, t: np.ndarray, decided: Callable[[LinearStep], boo
 
 
 def _between_samples(t: np.ndarray, h: float, values: np.ndarray) -> np.ndarray:
-    """A bound on the error of :func:`_on_grid`'s linear interpolation at ``t``: an eighth of the second
-    difference of ``values`` around the interval (``h^2 |y''| / 8``; at the delay's kink it covers the kink)."""
-    i = np.clip((t / h).astype(np.int64), 1, values.size - 3)
+    """A bound on the error of :func:`_on_grid`'s linear interpolation at ``t``: the second difference of
+    ``values`` around the interval times ``f (1 - f) / 2`` at the fraction ``f`` of the interval
+    (``h^2 |y''| f (1 - f) / 2``, at most an eighth; at the delay's kink it covers the kink). A time on a sample
+    is exact: a loop whose response jumps at the delay's multiples (a biproper one) got an eighth of the jump at
+    its samples there (an error of 0.062 of the final value reported for 1e-4)."""
+    x = t / h
+    i = np.clip(x.astype(np.int64), 1, values.size - 3)
+    frac = np.clip(x - np.minimum(x.astype(np.int64), values.size - 2), 0.0, 1.0)
     second = np.maximum(np.abs(values[i + 1] - 2.0 * values[i] + values[i - 1]),
                         np.abs(values[i + 2] - 2.0 * values[i + 1] + values[i]))
-    return second / 8.0
+    return second * frac * (1.0 - frac) / 2.0
 
 
 def _on_grid(t: np.ndarray, h: float, values: np.ndarray) -> np.ndarray:
