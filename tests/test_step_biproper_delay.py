@@ -33,7 +33,7 @@ def _reference(t_out: np.ndarray) -> np.ndarray:
         return KP * (1.0 - (u_at(s - TAU, k - 1) + x)) + KI * z
 
     state = np.zeros(2)
-    for k in range(int(round(T_END / TAU))):
+    for k in range(round(T_END / TAU)):
         def rhs(t, s, k=k):
             late = u_at(t - TAU, k - 1)
             return [-s[0] + late, 1.0 - (late + s[0])]
