@@ -118,18 +118,7 @@ class DelayMargin(Requirement):
         >>> bool(np.allclose(req.batch_slack(batch), [req.slack(Loop(G, c)) for c in batch.controllers]))
         True
         """
-        crossings = batch.gain_crossovers()
-        dm = np.full(len(batch), np.inf)
-        rows = np.concatenate([np.full(c.size, i) for i, c in enumerate(crossings)]).astype(int)
-        if rows.size:
-            wc = np.concatenate(crossings)
-            L = batch.rows_L(rows, wc)
-            phase = np.degrees(np.angle(L))
-            pm = (phase + 180.0) % 360.0
-            pm = np.where((pm == 0.0) & (phase != -180.0), 360.0, pm)
-            np.minimum.at(dm, rows, np.radians(pm) / wc)
-        l_inf = np.array([abs(value_at_infinity(n, d)) for n, d in zip(batch.num, batch.den)])
-        dm = np.where(l_inf >= 1.0, 0.0, dm)  # neutral type with any added delay (the scalar form)
+        _, dm = batch.phase_and_delay_margins()  # 0 where |L(j inf)| >= 1, as the scalar form
         with np.errstate(divide="ignore"):
             values = np.where(dm > 0, np.log(np.where(dm > 0, dm, 1.0) / self.min), -np.inf)
         return with_unstable_rows(self, batch, values)
