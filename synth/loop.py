@@ -17,8 +17,8 @@ from synth.controllers import Controller, as_controller
 from synth.freqgrid import characteristic_range, first_fall, log_grid
 from synth.narrow_peaks import LIGHT_DAMPING, narrow_peak_frequencies
 from synth.plant import Plant, as_plant
-from synth.polynomials import dc_value, format_factored, horner, magnitude_squared_in_w2, polymul, trim, value_at_infinity
-from synth.stability import StabilityResult, closed_loop_stability, stability_floor
+from synth.polynomials import dc_value, format_factored, horner, magnitude_squared_in_w2, polymul, trim
+from synth.stability import StabilityResult, closed_loop_stability, neutral_with_any_delay, stability_floor
 from synth.stability_sets import gain_margin_factors
 
 __all__ = ["BANDWIDTH_LEVEL", "Loop", "Margins", "bandwidth_span"]
@@ -346,7 +346,7 @@ class Loop:
             # extra delay turns L(j wc) clockwise: it reaches -1 after the phase margin taken in (0, 360] deg
             turn = this if this > 0 else this + 360.0
             dm = min(dm, np.radians(turn) / wc) if this != 0.0 else 0.0
-        if abs(value_at_infinity(self.num, self.den)) >= 1.0:  # any added delay: neutral type (|L(j inf)| >= 1)
+        if neutral_with_any_delay(self.num, self.den):  # any added delay: neutral type (|L(j inf)| >= 1)
             dm = 0.0
         stable = self.stability().stable
         return Margins(float(gm), float(lgm), w_hi, pm, wpm, float(dm) if stable else 0.0, stable, w_lo)

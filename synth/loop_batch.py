@@ -24,7 +24,7 @@ from synth.polynomial_rows import (
     row_roots,
     row_unit_crossings,
 )
-from synth.polynomials import dc_value, horner, value_at_infinity
+from synth.polynomials import dc_value, horner
 from synth.rootfind import bisect_roots
 
 __all__ = ["LoopBatch"]
@@ -321,8 +321,10 @@ class LoopBatch:
                 # extra delay turns L(j wc) clockwise: the phase margin taken in (0, 360] deg, as Loop.margins
                 turn = np.where(this > 0, this, this + 360.0)
                 np.minimum.at(dm, rows, np.where(this != 0, np.radians(turn) / wc, 0.0))
-        l_inf = np.array([abs(value_at_infinity(n, d)) for n, d in zip(self.num, self.den)])
-        return pm, np.where(l_inf >= 1.0, 0.0, dm)  # any added delay: neutral type (|L(j inf)| >= 1)
+        from synth.stability import neutral_with_any_delay
+
+        neutral = np.array([neutral_with_any_delay(n, d) for n, d in zip(self.num, self.den)], dtype=bool)
+        return pm, np.where(neutral, 0.0, dm)  # any added delay: neutral type (|L(j inf)| >= 1)
 
     def upper_gain_margins(self, limit: float = 1e4, per_decade: int = 100) -> np.ndarray:
         """Each loop's smallest gain factor above 1 that puts a closed-loop root on the imaginary axis

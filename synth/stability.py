@@ -33,6 +33,7 @@ __all__ = [
     "StabilityResult",
     "characteristic_scale",
     "closed_loop_stability",
+    "neutral_with_any_delay",
     "stability_floor",
 ]
 
@@ -130,6 +131,19 @@ def stability_floor(num: np.ndarray, den: np.ndarray, delay: float = 0.0) -> flo
 @lru_cache(maxsize=64)
 def _plant_floor(num: bytes, den: bytes, delay: float) -> float:
     return STABILITY_FLOOR * characteristic_scale(np.frombuffer(num), np.frombuffer(den), delay=delay)[0]
+
+
+def neutral_with_any_delay(num: np.ndarray, den: np.ndarray) -> bool:
+    """Whether the loop ``num/den`` has ``|L(j inf)| >= 1``: behind any delay it is then a neutral-type loop, with
+    roots at ``Re s -> ln|L(j inf)| / delay >= 0`` (its delay margin is 0).
+
+    Examples
+    --------
+    >>> neutral_with_any_delay(np.array([3.0, 6.0]), np.array([1.0, 1.0])), neutral_with_any_delay(np.array([3.0]),
+    ...                                                                                              np.array([1.0, 1.0]))
+    (True, False)
+    """
+    return abs(value_at_infinity(num, den)) >= 1.0
 
 
 def characteristic_scale(*polys: np.ndarray, delay: float = 0.0) -> tuple[float, float]:
@@ -323,7 +337,7 @@ def _count(num: np.ndarray, den: np.ndarray, delay: float, near: float | None = 
         # 1 + L(0) = 0: a closed-loop root at s = 0 (e.g. a gain on the edge of the stability floor)
         return StabilityResult(False, 1, n_rhp, "Nyquist argument principle, exact delay", 0.0)
     c_inf = value_at_infinity(num, den)
-    if abs(c_inf) >= 1.0:  # 1 + c e^{-s delay} -> 0 far out: roots with Re s -> ln|c| / delay >= 0
+    if neutral_with_any_delay(num, den):  # 1 + c e^{-s delay} -> 0 far out: roots with Re s -> ln|c| / delay >= 0
         return StabilityResult(False, 1, n_rhp, "neutral-type loop: |L(j inf)| >= 1 with a delay",
                                neutral_gain=float(abs(c_inf)))
     level = max(0.5, 0.5 * (1.0 + abs(c_inf)))

@@ -11,7 +11,7 @@ from synth.errors import ModelError
 from synth.polynomials import value_at_infinity
 from synth.requirements.base import Bound, Requirement, RequirementResult, fmt, register
 from synth.requirements.margins import closed_loop_unstable, unstable_result, with_unstable_rows
-from synth.stability import closed_loop_stability
+from synth.stability import closed_loop_stability, neutral_with_any_delay
 
 if TYPE_CHECKING:
     from synth.loop import Loop
@@ -75,8 +75,8 @@ class DelayMargin(Requirement):
             return unstable_result(self, loop, "delay margin")
         per_crossover = delay_margins_per_crossover(loop)
         dm, wc = min(((d, w) for w, _, d in per_crossover), default=(np.inf, None))
-        l_inf = abs(value_at_infinity(loop.num, loop.den))
-        if l_inf >= 1.0:  # any added delay: neutral type, infinitely many roots at Re s = ln|L(j inf)|/delay >= 0
+        neutral = neutral_with_any_delay(loop.num, loop.den)
+        if neutral:  # any added delay: infinitely many roots at Re s = ln|L(j inf)|/delay >= 0
             dm, wc = 0.0, None
         slack = float(np.log(dm / self.min)) if dm > 0 else -np.inf
         try:
@@ -90,8 +90,9 @@ class DelayMargin(Requirement):
         crossings = ", ".join(f"PM {fmt(pm)} deg at {fmt(w)} rad/s" for w, pm, _ in per_crossover) or "no crossover"
         check = "" if nyquist is None else (
             f"; Nyquist count with {fmt(self.min * 1e3)} ms added: {'stable' if nyquist else 'UNSTABLE'}")
-        if l_inf >= 1.0:
+        if neutral:
             agree, verdict = True, "NOT met"
+            l_inf = abs(value_at_infinity(loop.num, loop.den))
             msg = (f"delay margin 0 ms >= {fmt(self.min * 1e3)} ms: NOT met (|L(j inf)| = {fmt(l_inf)} >= 1: any "
                    "added delay makes the loop neutral-type unstable, infinitely many roots in the right half-plane)")
         else:
