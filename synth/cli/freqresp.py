@@ -206,7 +206,11 @@ def run(args: argparse.Namespace) -> int:
                       f"{q.input_db_spread:.1f} dB, output asymmetry {q.output_asymmetry:+.2f}{off}")
         if fit is not None:
             print(f"fit {fit.structure} over {fit.w_range[0]:.4g}-{fit.w_range[1]:.4g} rad/s: {fit.tf_text()}")
-            print("  " + ", ".join(f"{k} = {v:.6g}" for k, v in fit.parameters.items()) + f"; J = {fit.J:.4g}")
+            sd = fit.uncertainty.std if fit.uncertainty is not None else {}
+            print("  " + ", ".join(f"{k} = {v:.6g}" + (f" +- {sd[k]:.3g}" if k in sd else "")
+                                   for k, v in fit.parameters.items()) + f"; J = {fit.J:.4g}")
+            for line in fit.uncertainty.lines() if fit.uncertainty is not None else []:
+                print("  " + line)
         if verification is not None:
             print(f"step verification ({verification.source}): fit {verification.fit_percent:.1f} %, "
                   f"NRMSE {verification.nrmse:.4f}")

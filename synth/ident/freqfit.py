@@ -184,6 +184,10 @@ class FreqFit:
         IPOPT's return status.
     fit_percent : float
         :func:`fit_percent` over the fitted range.
+    uncertainty : FreqFitUncertainty or None
+        The parameters' standard errors and the weakly identifiable ones
+        (:mod:`synth.ident.freqfit_uncertainty`); None when the response came without its random error
+        (plain arrays).
 
     Examples
     --------
@@ -205,6 +209,7 @@ class FreqFit:
     w: np.ndarray = field(repr=False)
     H_model: np.ndarray = field(repr=False)
     fit_percent: float = float("nan")
+    uncertainty: Any = None
 
     def tf_text(self) -> str:
         """The fitted model in factored form (with ``exp(-tau*s)``)."""
@@ -227,6 +232,7 @@ class FreqFit:
                 "poles": [[float(p.real), float(p.imag)] for p in self.plant.poles()],
                 "w_range": list(self.w_range), "n_points": self.n_points, "delay_fitted": self.delay_fitted,
                 "status": self.status, "fit_percent": self.fit_percent,
+                "uncertainty": None if self.uncertainty is None else self.uncertainty.to_dict(),
                 "cost": "J = (20/n) sum W_gamma [W_g dB^2 + W_p deg^2], W_g = 1, W_p = 0.01745"}
 
 
@@ -300,12 +306,14 @@ def _ipopt(structure: Any, w: np.ndarray, H: np.ndarray, coh: np.ndarray, theta0
     return xs[:npar], tau, str(solver.stats()["return_status"])
 
 
-def _data(resp: FrequencyResponse | tuple[Any, Any, Any]) -> tuple[np.ndarray, np.ndarray, np.ndarray, tuple | None]:
+def _data(resp: FrequencyResponse | tuple[Any, Any, Any]
+          ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray | None, tuple | None]:
+    """Frequencies, response, coherence, random error (None for plain arrays) and the coherent band."""
     if isinstance(resp, FrequencyResponse):
         band = (resp.band.w_min, resp.band.w_max) if resp.band.found else None
-        return resp.w, resp.H, resp.coherence, band
+        return resp.w, resp.H, resp.coherence, np.asarray(resp.random_error, float), band
     w, H, coh = (np.asarray(a) for a in resp)
-    return np.asarray(w, float), np.asarray(H, complex), np.asarray(coh, float), None
+    return np.asarray(w, float), np.asarray(H, complex), np.asarray(coh, float), None, None
 
 
 def fit_frequency_response(
@@ -354,12 +362,13 @@ def fit_frequency_response(
     >>> {k: round(v, 3) for k, v in sorted(fit.parameters.items())}
     {'Td': 0.041, 'k': 31.6, 'p1': 0.49, 'p2': 2.3}
     """
-    w_all, H_all, coh_all, band = _data(resp)
+    w_all, H_all, coh_all, eps_all, band = _data(resp)
     lo, hi = w_range if w_range is not None else (band if band is not None else (w_all.min(), w_all.max()))
     if band is None and w_range is None and isinstance(resp, FrequencyResponse):
         raise DataError("no coherent band to fit; give the range explicitly (--fit-range)")
     keep = (w_all >= lo * (1 - 1e-12)) & (w_all <= hi * (1 + 1e-12)) & np.isfinite(H_all) & (np.abs(H_all) > 0)
     w, H, coh = w_all[keep], H_all[keep], coh_all[keep]
+    eps = eps_all[keep] if eps_all is not None else None
     text = structure.formula if isinstance(structure, Structure) else str(structure)
     orders = parse_orders(text) if not isinstance(structure, Structure) else None
     st: Any = _Orders(*orders) if orders else (structure if isinstance(structure, Structure) else parse_structure(text))
@@ -409,7 +418,16 @@ def fit_frequency_response(
             raise ModelError(f"structure {text!r}: no start converged")
         theta = min(results, key=lambda r: r[0] if np.isfinite(r[0]) else np.inf)[1]
         theta, tau, status = _ipopt(st, w, H, coh, theta, tau0, fit_delay, delay_max)
-    return _checked(st, theta, float(tau), text, w, H, coh, bool(fit_delay), status, own_delay, min_fit_percent)
+    fit = _checked(st, theta, float(tau), text, w, H, coh, bool(fit_delay), status, own_delay, min_fit_percent)
+    if eps is None:
+        return fit
+    from dataclasses import replace
+
+    from synth.ident.freqfit_uncertainty import fit_uncertainty
+
+    delay_name = own_delay if isinstance(own_delay, str) else "delay"
+    return replace(fit, uncertainty=fit_uncertainty(st, theta, float(tau), bool(fit_delay), w, H, coh, eps,
+                                                    (W_G, W_P), delay_name))
 
 
 def _checked(st: Any, theta: np.ndarray, tau: float, text: str, w: np.ndarray, H: np.ndarray, coh: np.ndarray,
