@@ -46,8 +46,9 @@ def coherence_random_error(coherence: np.ndarray | float, averages: float) -> np
     >>> round(float(coherence_random_error(0.8, 10)), 4)
     0.1118
     """
-    g2 = np.clip(np.asarray(coherence, float), 1e-12, 1.0)
-    return np.sqrt(1.0 - g2) / (np.sqrt(g2) * np.sqrt(2.0 * averages))
+    from synth.ident.coherence import random_error
+
+    return random_error(np.clip(np.asarray(coherence, float), 1e-12, 1.0), averages)  # finite at gamma^2 = 0
 
 
 # --------------------------------------------------------------------------- a model's exact response
