@@ -148,11 +148,20 @@ def neutral_with_any_delay(num: np.ndarray, den: np.ndarray) -> bool:
 
 def characteristic_scale(*polys: np.ndarray, delay: float = 0.0) -> tuple[float, float]:
     """Smallest and largest characteristic frequencies (rad/s): root magnitudes and 1/delay."""
-    mags = []
+    roots = []
     for p in polys:
         p = trim(np.asarray(p, float))
         if p.size > 1:
-            r = np.abs(np.roots(p))
+            roots.append(np.roots(p))
+    return _scale_of_roots(roots, delay)
+
+
+def _scale_of_roots(roots: list[np.ndarray], delay: float) -> tuple[float, float]:
+    """:func:`characteristic_scale` from each polynomial's roots (its roots at the origin may be left out)."""
+    mags = []
+    for r in roots:
+        r = np.abs(r)
+        if r.size:
             mags.extend(r[r > 1e-10 * max(1.0, float(r.max()))].tolist())
     if delay > 0:
         mags.append(1.0 / delay)
@@ -161,20 +170,22 @@ def characteristic_scale(*polys: np.ndarray, delay: float = 0.0) -> tuple[float,
     return float(min(mags)), float(max(mags))
 
 
-def _axis_poles(den: np.ndarray, near: float | None = None) -> tuple[int, int, list[tuple[float, int]]]:
+def _axis_poles(den: np.ndarray, near: float | None = None,
+                roots: np.ndarray | None = None) -> tuple[int, int, list[tuple[float, int]]]:
     """(open RHP pole count, poles at the origin, [(w_k > 0, multiplicity)]).
 
     A root within ``1e-9 max(1, |r|)`` of the axis counts as on it, one within ``1e-10`` of the largest root
     (at least 1) as at the origin. ``near`` (a thousandth of the stability floor, on the count of a loop shifted
     by that floor) caps both at ``near`` (and ``1e-9 |r|`` off the origin): a slow plant's floor (1e-9 rad/s for
     poles at 1e-3 rad/s) moves an integrator's pole no further than the absolute 1e-9, which put it back on the
-    axis and broke the count."""
+    axis and broke the count. ``roots``: those of ``den`` without its trailing zeros, when the caller has them."""
     den = trim(den)
     n_origin = 0
     while den.size > 1 and den[-1] == 0.0:
         den = den[:-1]
         n_origin += 1
-    roots = np.roots(den) if den.size > 1 else np.array([])
+    if roots is None:
+        roots = np.roots(den) if den.size > 1 else np.array([])
     tol = 1e-9 * np.maximum(1.0, np.abs(roots))
     tiny_level = 1e-10 * max(1.0, float(np.abs(roots).max(initial=0.0)))
     if near is not None:
@@ -201,9 +212,10 @@ class _ReturnDifference:
     """F(s) = 1 + num(s)/den(s) * exp(-delay*s), and the loop's nonzero open-loop poles and zeros (``corners``,
     where :func:`_segment_phase` samples each segment first)."""
 
-    def __init__(self, num: np.ndarray, den: np.ndarray, delay: float) -> None:
+    def __init__(self, num: np.ndarray, den: np.ndarray, delay: float, roots: np.ndarray | None = None) -> None:
         self.num, self.den, self.delay = num, den, delay
-        roots = np.concatenate([np.roots(p) if p.size > 1 else np.zeros(0, complex) for p in (num, den)])
+        if roots is None:  # the open-loop zeros and poles, unless the caller has them
+            roots = np.concatenate([np.roots(p) if p.size > 1 else np.zeros(0, complex) for p in (num, den)])
         self.corners = roots[np.abs(roots) > 0]
 
     def __call__(self, s: np.ndarray) -> np.ndarray:
@@ -311,7 +323,9 @@ def _count(num: np.ndarray, den: np.ndarray, delay: float, near: float | None = 
     num, den = trim(np.asarray(num, float)), trim(np.asarray(den, float))
     if num.size > den.size:
         raise ModelError("loop transfer function is improper")
-    n_rhp, n_origin, axis = _axis_poles(den, near)
+    stripped = den[:max(1, np.flatnonzero(den)[-1] + 1)] if np.any(den) else den  # without poles at the origin
+    pole_roots = np.roots(stripped) if stripped.size > 1 else np.zeros(0, complex)
+    n_rhp, n_origin, axis = _axis_poles(den, near, pole_roots)
     shared_origin = 0
     while shared_origin < min(num.size, den.size) - 1 and num[-1 - shared_origin] == 0.0 \
             and den[-1 - shared_origin] == 0.0:
@@ -341,7 +355,8 @@ def _count(num: np.ndarray, den: np.ndarray, delay: float, near: float | None = 
         return StabilityResult(False, 1, n_rhp, "neutral-type loop: |L(j inf)| >= 1 with a delay",
                                neutral_gain=float(abs(c_inf)))
     level = max(0.5, 0.5 * (1.0 + abs(c_inf)))
-    w_lo_scale, _ = characteristic_scale(num, den, delay=delay)
+    zero_roots = np.roots(num) if num.size > 1 else np.zeros(0, complex)  # the poles' are computed once above
+    w_lo_scale, _ = _scale_of_roots([zero_roots, pole_roots], delay)
     w_top = largest_crossing(num, den, level)
     axis_max = max((w for w, _ in axis), default=0.0)
     w_top = max(w_top * 1.05, 2.0 * axis_max, 1e-3 * w_lo_scale)
@@ -351,7 +366,7 @@ def _count(num: np.ndarray, den: np.ndarray, delay: float, near: float | None = 
                                f"falls to {level:g}, more than synth resolves "
                                f"({MAX_PHASE_POINTS * PHASE_STEP / (2 * np.pi):.3g} turns): not certified stable")
 
-    F = _ReturnDifference(num, den, delay)
+    F = _ReturnDifference(num, den, delay, np.concatenate([zero_roots, pole_roots]))
     eps0 = 1e-6 * w_lo_scale
     total_half = 0.0
     min_f = np.inf
