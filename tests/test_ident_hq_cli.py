@@ -134,3 +134,38 @@ def test_frd_from_freqresp_uses_its_recorded_averaging_count(run_cli, tmp_path):
     assert recorded["uncertainty"]["w180"] == pytest.approx(single["uncertainty"]["w180"] / np.sqrt(nd_w180), rel=1e-9)
     assert not any("n_d = 1 assumed" in note for note in recorded["notes"])
     assert f"averaging count per frequency: n_d = {nd_w180:.3g} at w180" in recorded["notes"]
+
+
+def test_frd_from_freqresp_is_read_within_its_coherent_band(run_cli, tmp_path):
+    """A freqresp JSON keeps every frequency it estimated, trusted or not; hq reads only its coherent band. A
+    black-box test's record (an integrating attitude response behind 70 ms, swept 2-45 rad/s) had a phase
+    unwrapped from leakage below the band: w180 0.114 rad/s and tau_p 39.2 s instead of 11.6 rad/s and 0.049 s.
+    Here the points below the band carry a phase that falls 360 deg over a decade (as that leakage did)."""
+    import json
+
+    import numpy as np
+
+    from synth.ident.hq import hq_from_plant
+    from synth.plant import Plant
+
+    G = Plant.from_string("11.87/(s*(s+12.22))", delay=0.0695)
+    w = np.geomspace(0.06, 60, 120)
+    H = G.freqresp(w)
+    low = w < 2.0
+    H[low] = np.abs(H[low]) * np.exp(1j * (np.angle(H[low]) - 2 * np.pi * np.log10(2.0 / w[low])))
+    coherence = np.where(low, 0.5, 0.99)
+    doc = {"w": w.tolist(), "magnitude_db": (20 * np.log10(np.abs(H))).tolist(),
+           "phase_deg": np.degrees(np.angle(H)).tolist(), "coherence": coherence.tolist(),
+           "n_averages": [10.0] * w.size, "coherent_band": {"w_min": float(w[~low][0]), "w_max": float(w[-1])}}
+    path = tmp_path / "fr.json"
+    path.write_text(json.dumps(doc))
+    exact = hq_from_plant(G)
+    res = run_cli("hq", "--frd", str(path), "--json", "-")
+    assert res.code == 0, res.err
+    got = json.loads(res.out)
+    assert got["w180"] == pytest.approx(exact.w180, rel=2e-3)
+    assert got["phase_delay"] == pytest.approx(exact.phase_delay, rel=2e-2)
+    assert got["frequency_band_used"][0] == pytest.approx(float(w[~low][0]))
+    assert "used the coherent band" in got["notes"][0]
+    every = json.loads(run_cli("hq", "--frd", str(path), "--json", "-", "--all-points").out)
+    assert every["w180"] != pytest.approx(exact.w180, rel=0.05)  # the old answer: undefined here

@@ -48,6 +48,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--response-type", choices=["auto", "rate", "attitude"], default="auto",
                    help="rate: bandwidth is the lesser of phase and gain bandwidths; attitude: the phase "
                         "bandwidth; auto (default): an integrator at low frequency means rate")
+    p.add_argument("--all-points", action="store_true",
+                   help="a synth freqresp JSON: use every frequency, not only its coherent band")
     p.add_argument("--averages", type=float, help="number of averages behind a measured response (uncertainty)")
     p.add_argument("--phase-fit", choices=["auto", "raw", "line"], default="auto",
                    help="measured data: how the phase at 2 w180 is read (default auto)")
@@ -62,9 +64,10 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 def read_frd(path: str | Path, columns: dict[str, str] | None = None) -> dict[str, Any]:
     """Read a measured frequency response: ``synth freqresp`` JSON or CSV ``w, mag_db, phase_deg[, coherence]``.
 
-    Returns ``{"w", "H", "coherence", "averages"}`` (``H`` complex). ``averages`` is the JSON's
+    Returns ``{"w", "H", "coherence", "averages", "band"}`` (``H`` complex). ``averages`` is the JSON's
     ``averages`` (one number) or, in a ``synth freqresp`` result, its ``n_averages`` (one per
-    frequency); ``None`` for a CSV. CSV headers may carry units (``w (rad/s)``, ``mag_db [dB]``);
+    frequency); ``None`` for a CSV. ``band``: the coherent band ``(w_min, w_max)`` a ``synth freqresp``
+    result records, else ``None``. CSV headers may carry units (``w (rad/s)``, ``mag_db [dB]``);
     ``columns`` renames CSV columns first (``{"omega": "w"}``).
 
     Examples
@@ -90,9 +93,12 @@ def read_frd(path: str | Path, columns: dict[str, str] | None = None) -> dict[st
         except ValueError as exc:
             raise DataError(f"not valid JSON: {exc}", where=str(path)) from None
         keys = {"w": "w", "mag_db": "magnitude_db", "phase_deg": "phase_deg", "coherence": "coherence"}
-        averages = None
+        averages, band = None, None
         if isinstance(data, dict):   # a number given by hand, else the per-frequency count synth freqresp records
             averages = data.get("averages", data.get("n_averages"))
+            found = data.get("coherent_band")
+            if isinstance(found, dict) and all(isinstance(found.get(k), (int, float)) for k in ("w_min", "w_max")):
+                band = (float(found["w_min"]), float(found["w_max"]))
     else:
         table = read_table(path, columns)
         data = {}
@@ -104,7 +110,7 @@ def read_frd(path: str | Path, columns: dict[str, str] | None = None) -> dict[st
             if key is not None:
                 data[name] = table.columns[table.find(key)]
         keys = {"w": "w", "mag_db": "mag_db", "phase_deg": "phase_deg", "coherence": "coherence"}
-        averages = None
+        averages, band = None, None
     if not isinstance(data, dict):
         raise DataError("expected an object with w, magnitude_db, phase_deg", where=str(path))
     cols: dict[str, Any] = {}
@@ -124,7 +130,48 @@ def read_frd(path: str | Path, columns: dict[str, str] | None = None) -> dict[st
             raise DataError(f"column '{key}': {bad.size} value(s) are NaN or inf (first at row {bad[0]})",
                             where=str(path))
     H = 10 ** (cols["mag_db"] / 20) * np.exp(1j * np.radians(cols["phase_deg"]))
-    return {"w": cols["w"], "H": H, "coherence": cols["coherence"], "averages": averages}
+    return {"w": cols["w"], "H": H, "coherence": cols["coherence"], "averages": averages, "band": band}
+
+
+def within_band(frd: dict[str, Any], where: str) -> tuple[dict[str, Any], str | None]:
+    """The response restricted to the coherent band it records (``read_frd``'s ``band``), and a note saying
+    so; unchanged (and no note) without a band or when every point lies in it. Outside its band freqresp's
+    estimate is leakage or noise whatever its coherence: a phase unwrapped from there put w180 at 0.11 rad/s
+    and tau_p at 39 s for a loop whose w180 is 11.6 rad/s (a black-box test).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> frd = {"w": np.array([0.1, 1.0, 2.0, 3.0, 50.0]), "H": np.ones(5, complex), "coherence": None,
+    ...        "averages": [1, 2, 3, 4, 5], "band": (1.0, 3.0)}
+    >>> kept, note = within_band(frd, "f.json"); kept["w"].tolist(), kept["averages"], note[:40]
+    ([1.0, 2.0, 3.0], [2, 3, 4], 'used the coherent band 1-3 rad/s that fr')
+    """
+    import numpy as np
+
+    from synth.errors import DataError
+
+    band, w = frd.get("band"), frd["w"]
+    if band is None:
+        return frd, None
+    keep = (w >= band[0] * (1 - 1e-9)) & (w <= band[1] * (1 + 1e-9))
+    if keep.all():
+        return frd, None
+    if np.count_nonzero(keep) < 3:
+        raise DataError(f"the coherent band {band[0]:.4g}-{band[1]:.4g} rad/s it records holds "
+                        f"{np.count_nonzero(keep)} frequencies: too few for the metrics (--all-points uses every "
+                        "frequency, trusted or not)", where=where)
+    out = dict(frd)
+    for key in ("w", "H", "coherence"):
+        if out[key] is not None:
+            out[key] = out[key][keep]
+    averages = out["averages"]
+    if isinstance(averages, list) and len(averages) == w.size:
+        out["averages"] = [a for a, k in zip(averages, keep) if k]
+    note = (f"used the coherent band {band[0]:.4g}-{band[1]:.4g} rad/s that freqresp recorded "
+            f"({np.count_nonzero(keep)} of {w.size} frequencies): outside it the estimate is not trusted "
+            "(--all-points uses every frequency)")
+    return out, note
 
 
 def _fmt(value: Any, unit: str, sigma: Any = None, digits: int = 4) -> str:
@@ -163,6 +210,7 @@ def run(args: argparse.Namespace) -> int:
 
     check_outputs(args.out, ["hq.json", "hq_bode.png"], [args.json], args.force,
                   inputs=[args.frd])  # before any computation
+    band_note = None
     _check_options(args)
     if args.tf is not None:
         try:
@@ -173,6 +221,8 @@ def run(args: argparse.Namespace) -> int:
         title = plant.to_string()
     else:
         frd = read_frd(args.frd, parse_column_map(args.columns))
+        if not args.all_points:
+            frd, band_note = within_band(frd, str(args.frd))
         averages = args.averages if args.averages is not None else frd["averages"]
         try:
             m = hq_from_frd(frd["w"], frd["H"], frd["coherence"], averages, args.response_type, args.phase_fit,
@@ -181,6 +231,9 @@ def run(args: argparse.Namespace) -> int:
             raise exc.located(args.frd) if exc.where == "frequency response" else exc from None
         title = str(args.frd)
     data = m.to_dict()
+    if band_note is not None:
+        data["notes"] = [band_note, *data.get("notes", [])]
+        data["frequency_band_used"] = [float(m.w[0]), float(m.w[-1])]
     at_w1 = None
     if args.w1 is not None:  # phase delay at a stated w1 (issue 19): synth.ident.phase_delay
         from synth.ident.phase_delay import phase_delay_at
@@ -202,7 +255,8 @@ def run(args: argparse.Namespace) -> int:
     if args.json:
         write_json(args.json, data, force=args.force)
     u = m.uncertainty or {}
-    below = f"below {m.w[0]:.4g} rad/s (the lowest frequency measured)" if m.below_data else ""
+    lowest = "the coherent band's lowest frequency" if band_note else "the lowest frequency measured"
+    below = f"below {m.w[0]:.4g} rad/s ({lowest})" if m.below_data else ""
     rows = [("w180", _fmt(m.w180, "rad/s", u.get("w180"))),
             ("bandwidth_phase (-135 deg)", below if "phase" in m.below_data
              else _fmt(m.bandwidth_phase, "rad/s", u.get("bandwidth_phase"))),
@@ -216,7 +270,8 @@ def run(args: argparse.Namespace) -> int:
     if at_w1 is not None:
         rows.append((f"phase delay at w1 = {at_w1.w1:g}", f"{at_w1.phase_delay:.3g} s  (phase {at_w1.phase_deg:.1f} deg "
                                                           f"at {at_w1.w1:g} rad/s, {at_w1.method})"))
-    print(name_values(rows, m.notes + (at_w1.notes if at_w1 is not None else ())))
+    print(name_values(rows, ((band_note,) if band_note else ()) + tuple(m.notes)
+                      + (tuple(at_w1.notes) if at_w1 is not None else ())))
     if out:
         print(f"wrote {out.path}/hq.json and {out.path}/hq_bode.png")
     return 0
