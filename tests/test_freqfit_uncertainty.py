@@ -91,3 +91,21 @@ def test_a_delay_fitted_at_zero_is_held_there(run_cli, tmp_path) -> None:
     assert u_["at_bound"] == ["delay"] and "delay" not in u_["std"]
     assert u_["std"]["k"] < 0.05 * fit["parameters"]["k"]  # about 1.5 %: noise 0.01 on a gain of 10
     assert "k = 10" in res.out and " +- " in res.out and "delay ended at its bound" in res.out
+
+
+def test_a_range_outside_the_coherent_band_is_said_and_a_pole_the_band_cannot_place_is_a_failure(run_cli, tmp_path):
+    """A black-box test fitted 20-100 rad/s of a sweep coherent to 30 rad/s: nothing said so, and the fit
+    returned a pole at 7e12 rad/s (others at -1.2e17 with gains of -8.8e16) as a result, exit 0."""
+    t, u, y = _sweep(0, 0.01, dt=0.005)
+    data = tmp_path / "sweep.csv"
+    np.savetxt(data, np.column_stack([t, u, y]), delimiter=",", header="t,u,y", comments="")
+    resp = frequency_response(record_from_arrays(t, u, y), w_min=0.3, w_max=30.0)
+    lo, hi = resp.band.w_min, resp.band.w_max
+    fit = fit_frequency_response(resp, QUADRATIC, w_range=(0.5 * lo, 0.5 * hi), delay=0.0)
+    assert len(fit.notes) == 1 and "reaches outside the coherent band" in fit.notes[0]
+    inside = fit_frequency_response(resp, QUADRATIC, w_range=(1.5 * lo, 0.5 * hi), delay=0.0)
+    assert inside.notes == ()
+    res = run_cli("freqresp", "--data", str(data), "--fit", "k*(s+z)/((s+p1)*(s+p2))", "--fit-range", "20:100")
+    assert res.code == 1, res.out + res.err
+    assert "times above the band" in res.err and "the band cannot place it" in res.err
+    assert len(res.err.strip().splitlines()) == 1

@@ -211,6 +211,8 @@ def run(args: argparse.Namespace) -> int:
                                    for k, v in fit.parameters.items()) + f"; J = {fit.J:.4g}")
             for line in fit.uncertainty.lines() if fit.uncertainty is not None else []:
                 print("  " + line)
+            for note in fit.notes:
+                print(f"  warning: {note}")
         if verification is not None:
             print(f"step verification ({verification.source}): fit {verification.fit_percent:.1f} %, "
                   f"NRMSE {verification.nrmse:.4f}")

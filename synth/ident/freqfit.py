@@ -34,7 +34,7 @@ from synth.ident.structure import Structure, parse_structure
 from synth.plant import Plant
 from synth.polynomials import format_factored
 
-__all__ = ["IPOPT_OPTIONS", "MIN_FIT_PERCENT", "SOLVED", "W_G", "W_P", "FreqFit", "FrequencyFitError",
+__all__ = ["ABSURD_ROOT", "IPOPT_OPTIONS", "MIN_FIT_PERCENT", "SOLVED", "W_G", "W_P", "FreqFit", "FrequencyFitError",
            "coherence_weight", "fit_cost", "fit_frequency_response", "fit_percent", "parse_orders"]
 
 W_G = 1.0
@@ -47,6 +47,9 @@ IPOPT_OPTIONS = {"ipopt.print_level": 0, "print_time": False, "ipopt.sb": "yes",
 SOLVED = ("Solve_Succeeded", "Solved_To_Acceptable_Level")
 #: a fit below this percentage (see :func:`fit_percent`) is a failure, not a result
 MIN_FIT_PERCENT = 50.0
+#: a fitted pole or zero this many times above the fitted band's top is a failure: the band cannot place it
+#: (a black-box test's short-band fits returned poles at -1.2e17 rad/s with gains of -8.8e16 as results)
+ABSURD_ROOT = 1e6
 
 
 class FrequencyFitError(RuntimeError):
@@ -188,6 +191,8 @@ class FreqFit:
         The parameters' standard errors and the weakly identifiable ones
         (:mod:`synth.ident.freqfit_uncertainty`); None when the response came without its random error
         (plain arrays).
+    notes : tuple of str
+        What the user should know about the fit (a range reaching outside the coherent band).
 
     Examples
     --------
@@ -210,6 +215,7 @@ class FreqFit:
     H_model: np.ndarray = field(repr=False)
     fit_percent: float = float("nan")
     uncertainty: Any = None
+    notes: tuple[str, ...] = ()
 
     def tf_text(self) -> str:
         """The fitted model in factored form (with ``exp(-tau*s)``)."""
@@ -233,6 +239,7 @@ class FreqFit:
                 "w_range": list(self.w_range), "n_points": self.n_points, "delay_fitted": self.delay_fitted,
                 "status": self.status, "fit_percent": self.fit_percent,
                 "uncertainty": None if self.uncertainty is None else self.uncertainty.to_dict(),
+                "notes": list(self.notes),
                 "cost": "J = (20/n) sum W_gamma [W_g dB^2 + W_p deg^2], W_g = 1, W_p = 0.01745"}
 
 
@@ -419,10 +426,15 @@ def fit_frequency_response(
         theta = min(results, key=lambda r: r[0] if np.isfinite(r[0]) else np.inf)[1]
         theta, tau, status = _ipopt(st, w, H, coh, theta, tau0, fit_delay, delay_max)
     fit = _checked(st, theta, float(tau), text, w, H, coh, bool(fit_delay), status, own_delay, min_fit_percent)
-    if eps is None:
-        return fit
     from dataclasses import replace
 
+    if band is not None and w_range is not None and (w[0] < band[0] * (1 - 1e-9) or w[-1] > band[1] * (1 + 1e-9)):
+        outside = int(np.count_nonzero((w < band[0] * (1 - 1e-9)) | (w > band[1] * (1 + 1e-9))))
+        fit = replace(fit, notes=(f"the fit range {w[0]:.4g}-{w[-1]:.4g} rad/s reaches outside the coherent band "
+                                  f"{band[0]:.4g}-{band[1]:.4g} rad/s: {outside} of its {w.size} points are not "
+                                  "trusted (leakage or noise whatever their coherence)",))
+    if eps is None:
+        return fit
     from synth.ident.freqfit_uncertainty import fit_uncertainty
 
     delay_name = own_delay if isinstance(own_delay, str) else "delay"
@@ -453,6 +465,12 @@ def _checked(st: Any, theta: np.ndarray, tau: float, text: str, w: np.ndarray, H
     if not percent >= min_fit_percent:
         raise FrequencyFitError(f"fit of {text!r} over {band} failed: fit {percent:.1f} % < {min_fit_percent:g} % "
                                 f"(IPOPT {status}); {hint}", status, percent, text)
+    roots = np.concatenate([np.roots(p) for p in (num, den) if np.asarray(p).size > 1] or [np.zeros(0)])
+    if roots.size and np.max(np.abs(roots)) > ABSURD_ROOT * w[-1]:
+        far = roots[np.argmax(np.abs(roots))]
+        raise FrequencyFitError(f"fit of {text!r} over {band} failed: a pole or zero at {abs(far):.3g} rad/s, more "
+                                f"than {ABSURD_ROOT:.0e} times above the band (IPOPT {status}): the band cannot place "
+                                f"it; {hint}", status, percent, text)
     params = {name: float(v) for name, v in zip(st.parameters, theta)}
     params[own_delay if isinstance(own_delay, str) else "delay"] = tau
     return FreqFit(plant, params, fit_cost(H_model, H, coh), text, (float(w[0]), float(w[-1])), int(w.size),
