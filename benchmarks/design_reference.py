@@ -270,16 +270,32 @@ class LoopModel:
         """Every requirement of a stable loop, on the grid ``g``."""
         ev = Evaluation(p, True, 0, dense=dense)
         w = g["w"]
-        C = np.polyval(cn, 1j * w) / np.polyval(cd, 1j * w)
-        L = g["G"] * C
-        ev.values["min|1+L|"] = float(np.min(np.abs(1 + L)))
+
+        def parts(x: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+            """``A = den cd``, ``B = num cn e^{-s delay}`` and ``cn den`` at ``s = jx``: S = A/(A+B), T = B/(A+B),
+            KS = cn den/(A+B), finite where an open-loop pole lies on the axis (a controller's s^2 + a0: its
+            frequency is on the grid near the axis, where C = inf made 1/(1 + L) NaN; seed 31 #26)."""
+            s = 1j * np.asarray(x, float)
+            den = np.polyval(self.den, s)
+            return den * np.polyval(cd, s), np.polyval(self.num, s) * np.polyval(cn, s) * np.exp(-self.delay * s), \
+                np.polyval(cn, s) * den
+
+        A, B, X = parts(w)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            ev.values["min|1+L|"] = float(np.min(np.abs((A + B)[A != 0] / A[A != 0])))
+
+        def curve(name: str, x: np.ndarray) -> np.ndarray:
+            a, b, xx = parts(x) if x is not w else (A, B, X)
+            return np.abs({"S": a, "T": b, "KS": xx}[name] / (a + b))
+
+        with np.errstate(divide="ignore", invalid="ignore"):
+            L = g["G"] * np.polyval(cn, 1j * w) / np.polyval(cd, 1j * w)  # the margins read L itself
 
         def Lf(x: float) -> complex:
             return complex(self.G(np.array([x]))[0] * np.polyval(cn, 1j * x) / np.polyval(cd, 1j * x))
 
-        funcs = {"S": lambda x: abs(1 / (1 + Lf(x))), "T": lambda x: abs(Lf(x) / (1 + Lf(x))),
-                 "KS": lambda x: abs(np.polyval(cn, 1j * x) / np.polyval(cd, 1j * x) / (1 + Lf(x)))}
-        curves = {"S": np.abs(1 / (1 + L)), "T": np.abs(L / (1 + L)), "KS": np.abs(C / (1 + L))}
+        funcs = {name: (lambda x, name=name: float(curve(name, np.array([x]))[0])) for name in ("S", "T", "KS")}
+        curves = {name: curve(name, w) for name in ("S", "T", "KS")}
 
         def peak(name: str, band: tuple[float, float] | None = None) -> float:
             y, ww = curves[name], w

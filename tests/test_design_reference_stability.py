@@ -60,3 +60,33 @@ def test_count_matches_mpmath_on_random_loops(seed: int) -> None:
     want = _mp_unstable(num, den, cn, cd)
     e = check_point(num, den, 0.0, spec, params)
     assert e.unstable_poles == want and e.stable == (want == 0)
+
+
+def test_the_reference_reads_a_controller_with_poles_on_the_axis() -> None:
+    """Seed 31 #26: synth designed a rational controller with poles at 0 and +-46.75j (a0 = a2 = 0) on an
+    unstable plant behind 41 ms, peak |S| 8.9914 dB against a bound of 8.99169 dB. The reference's grid holds
+    the pole's frequency (it adds points around axis roots), where C = inf made 1/(1 + L) NaN: "false feasible".
+    It now evaluates S = den cd / (den cd + num cn e^{-s delay}), finite there; the peak agrees with 1/(1 + L)
+    on a dense grid that steps around the pole."""
+    import numpy as np
+
+    from benchmarks.design_reference import check_point
+
+    spec = {"name": "rand_31_26", "plant": {"tf": "921596/((s-1.35446)*(s+56.1443)*(s+93.6049)*(s+2.35737))",
+                                            "delay": 0.0409807},
+            "controller": {"type": "rational", "order": [2, 3],
+                           "bounds": {"b0": [-262210.0, 262210.0], "b1": [-20372.9, 20372.9], "b2": [-1582.92, 1582.92],
+                                      "a0": [0.0, 2878190.0], "a1": [0.0, 223627.0], "a2": [0.0, 17375.2]}},
+            "requirements": [{"type": "peak_sensitivity", "max_db": 8.99169}], "objective": {"maximize": "bandwidth"}}
+    num, den = [921596.0], np.poly([1.35446, -56.1443, -93.6049, -2.35737]).tolist()
+    params = {"b0": 0.7383344842725702, "b1": 570.7369962451746, "b2": 131.86008522616646, "a0": 0.0,
+              "a1": 2185.5567628997396, "a2": 0.0}
+    ev = check_point(num, den, 0.0409807, spec, params)
+    assert ev.stable and np.isfinite(ev.values["0:peak_sensitivity"])
+    w = np.geomspace(1e-3, 1e4, 400_001)
+    w = w[np.abs(w - np.sqrt(params["a1"])) > 1e-6]
+    s = 1j * w
+    L = 921596.0 / np.polyval(den, s) * np.exp(-0.0409807 * s) * np.polyval([params["b2"], params["b1"], params["b0"]], s) \
+        / np.polyval([1.0, 0.0, params["a1"], 0.0], s)
+    assert ev.values["0:peak_sensitivity"] == pytest.approx(20 * np.log10(np.max(np.abs(1 / (1 + L)))), abs=1e-4)
+    assert ev.slacks["0:peak_sensitivity"] > 0  # met: 8.9914 dB <= 8.99169 dB
