@@ -438,8 +438,8 @@ def fit_frequency_response(
     from synth.ident.freqfit_uncertainty import fit_uncertainty
 
     delay_name = own_delay if isinstance(own_delay, str) else "delay"
-    return replace(fit, uncertainty=fit_uncertainty(st, theta, float(tau), bool(fit_delay), w, H, coh, eps,
-                                                    (W_G, W_P), delay_name))
+    return replace(fit, uncertainty=fit_uncertainty(st, theta, float(tau), bool(fit_delay), w, H,
+                                                    coherence_weight(coh), eps, (W_G, W_P), delay_name))
 
 
 def _checked(st: Any, theta: np.ndarray, tau: float, text: str, w: np.ndarray, H: np.ndarray, coh: np.ndarray,

@@ -166,8 +166,8 @@ def _lag1(z: np.ndarray) -> float:
 
 
 def fit_uncertainty(structure: Any, theta: np.ndarray, tau: float, fit_delay: bool, w: np.ndarray, H: np.ndarray,
-                    coherence: np.ndarray, random_error: np.ndarray, weights: tuple[float, float] = (1.0, 0.01745),
-                    delay_name: str = "delay") -> FreqFitUncertainty:
+                    coherence_weights: np.ndarray, random_error: np.ndarray,
+                    weights: tuple[float, float] = (1.0, 0.01745), delay_name: str = "delay") -> FreqFitUncertainty:
     """The standard errors of a frequency-response fit's parameters (module text).
 
     Parameters
@@ -180,9 +180,9 @@ def fit_uncertainty(structure: Any, theta: np.ndarray, tau: float, fit_delay: bo
         The fitted or fixed delay [s].
     fit_delay : bool
         Whether the delay was fitted (then it is a parameter, named ``delay_name``).
-    w, H, coherence, random_error : numpy.ndarray
-        The grid points of the fitted range: frequency [rad/s], measured response, ``gamma^2``, normalized
-        random error.
+    w, H, coherence_weights, random_error : numpy.ndarray
+        The grid points of the fitted range: frequency [rad/s], measured response, the cost's coherence weight
+        ``W_gamma`` (:func:`synth.ident.freqfit.coherence_weight`), normalized random error.
     weights : (float, float)
         The cost's ``W_g`` (per dB^2) and ``W_p`` (per deg^2).
     delay_name : str
@@ -201,8 +201,6 @@ def fit_uncertainty(structure: Any, theta: np.ndarray, tau: float, fit_delay: bo
     >>> round(u.std["b0"] / 4.0, 4) < 0.01, u.residual_correlation
     (True, 0.0)
     """
-    from synth.ident.freqfit import coherence_weight
-
     at_bound = (delay_name,) if fit_delay and tau <= 1e-9 else ()  # IPOPT's delay at its lower bound 0
     fit_delay = fit_delay and not at_bound
     names = tuple(structure.parameters) + ((delay_name,) if fit_delay else ())
@@ -221,7 +219,7 @@ def fit_uncertainty(structure: Any, theta: np.ndarray, tau: float, fit_delay: bo
     J = np.column_stack(columns)
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
         r = np.log(np.exp(base) / H)
-    wg = coherence_weight(coherence)
+    wg = np.asarray(coherence_weights, float)
     W = np.r_[wg * weights[0] * _LN_TO_DB ** 2, wg * weights[1] * _RAD_TO_DEG ** 2]
     eps = np.asarray(random_error, float)
     rho = min(max(0.5 * (_lag1(r.real) + _lag1(r.imag)), 0.0), MAX_RESIDUAL_CORRELATION)
