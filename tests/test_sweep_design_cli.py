@@ -59,6 +59,17 @@ def test_duration_fade_sample_rate_and_json(run_cli, tmp_path):
 def test_shorter_than_the_recipe_is_noted(run_cli, tmp_path):
     r = run_cli("sweep-design", "--w-min", "0.4", "--w-max", "12", "--duration", "60", "--out", str(tmp_path / "s.csv"))
     assert r.code == 0 and "shorter than the recipe's 90 s" in r.out
+    assert "a short sweep" not in r.out  # 28.6 s of sweep after the low cycles: 49 % of the recipe's 58.6 s
+
+
+def test_a_run_that_leaves_the_sweep_a_few_seconds_says_so(run_cli, tmp_path):
+    """A black-box test: 300 s from 0.044 rad/s, whose two low cycles take 285.7 s, left 14.3 s to sweep 1.8
+    decades (4 % of the recipe's 357 s) with only a note about fewer windows."""
+    r = run_cli("sweep-design", "--w-min", "0.04398", "--w-max", "3.062", "--duration", "300", "--sample-rate", "20",
+                "--out", str(tmp_path / "s.csv"))
+    assert r.code == 0, r.err
+    line = next(x for x in r.out.splitlines() if "a short sweep" in x)
+    assert "14.3 s for 1.8 decades, 4 % of the recipe's 357.2 s" in line
 
 
 def test_never_overwrites_a_users_file_but_replaces_its_own(run_cli, tmp_path):

@@ -8,7 +8,7 @@ import sys
 from pathlib import Path
 from typing import Any
 
-__all__ = ["COMMAND", "DESCRIPTION", "HELP", "ORDER", "add_arguments", "run", "sweep_csv_text"]
+__all__ = ["COMMAND", "DESCRIPTION", "HELP", "ORDER", "SHORT_SWEEP", "add_arguments", "run", "sweep_csv_text"]
 
 MAX_SAMPLES = 20_000_000
 """Most samples one run's CSV may hold (about 0.5 GB of text)."""
@@ -36,6 +36,10 @@ example:
   synth sweep-design --w-min 1 --w-max 300 --duration 120 --amplitude 20 --sample-rate 1000 --out rotor_sweep.csv
 
 exit codes: 0 written, 2 bad input"""
+
+
+SHORT_SWEEP = 0.25
+"""A sweep (the run after its two low-frequency cycles) shorter than this share of the recipe's gets a warning."""
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
@@ -126,6 +130,14 @@ def run(args: argparse.Namespace) -> int:
                              f"(2 T_max = {low:.4g} s); give more than that or raise --w-min", where="--duration")
         if args.duration < recommended:
             notes.append(f"the run is shorter than the recipe's {recommended:g} s: fewer averaging windows of 2 T_max")
+            swept, recipe = args.duration - low, recommended - low
+            if swept < SHORT_SWEEP * recipe:  # the two low cycles take nearly all of the run
+                decades = math.log10(plan.w_max / plan.w_min)
+                share = 100 * swept / recipe
+                notes.append(f"a short sweep: after the two low-frequency cycles ({low:.4g} s) the sweep gets "
+                             f"{swept:.3g} s for {decades:.2g} decades, {share:.2g} % of the recipe's {recipe:.4g} s: "
+                             "every frequency above the lowest gets that share of its cycles (less coherence there); "
+                             "a longer --duration or a higher --w-min")
         plan = dataclasses.replace(plan, run_length=float(args.duration))
     fade = 0.25 * plan.t_max if args.fade is None else float(args.fade)
     if 2 * fade >= plan.run_length:
