@@ -84,6 +84,7 @@ def test_out_folder_and_table_uncertainty(run_cli, tmp_path):
 
 @pytest.mark.parametrize(("args", "content", "match"), [
     (["--tf", "1/(s^2+s"], None, "--tf"),
+    (["--tf", "1/(s^2+s+1)", "--all-points"], None, "--all-points: applies to a measured response"),
     (["--frd", "{f}"], "w,mag_db\n1,0\n2,1\n", "column 'phase_deg' not found"),
     (["--frd", "{f}"], "w,mag_db,phase_deg\n1,0,-90\n2,nan,-100\n3,1,-110\n4,1,-120\n", "'mag_db': 1 value"),
     (["--frd", "{f}"], "w,mag_db,phase_deg\n1,0,-90\n3,0,-100\n2,1,-110\n4,1,-120\n", "increase strictly"),

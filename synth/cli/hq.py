@@ -187,7 +187,8 @@ def _check_options(args: argparse.Namespace) -> None:
 
     if args.tf is not None:
         for flag, given in (("--averages", args.averages is not None), ("--phase-fit", args.phase_fit != "auto"),
-                            ("--fit-band", args.fit_band is not None), ("--columns", bool(args.columns))):
+                            ("--fit-band", args.fit_band is not None), ("--columns", bool(args.columns)),
+                            ("--all-points", args.all_points)):
             if given:
                 raise SynthError("applies to a measured response (--frd) only; a --tf model's response is exact",
                                  where=flag)
