@@ -244,6 +244,7 @@ def frequency_response(
     with np.errstate(divide="ignore", invalid="ignore"):
         H = gxy / gxx
     err = random_error(coh, n_d)
+    H, err, low_note = _whole_run_low_end(runs, grid, H, err, gyy, coh, max(lengths))
     band = trim_to_excitation(coherent_band(grid, coh, coherence_threshold), grid, gxx)
     above = None
     if not given_max:
@@ -253,10 +254,27 @@ def frequency_response(
         spectra = combine_windows([window_spectra(runs, fs, round(float(x) * fs), overlap, ext, detrend)
                                    for x in lengths], ext)
         above = _above_default_top(grid, gxx, gxy, coh, band, ext, *spectra[:3], coherence_threshold)
-    notes = (_above_note(above, nyquist),) if above else ()
+    notes = ((_above_note(above, nyquist),) if above else ()) + ((low_note,) if low_note else ())
     return FrequencyResponse(grid, H, coh, err, n_d, gxx, gyy, gxy, band, tuple(float(x) for x in lengths),
                              "measured", runs[0].input.label(), runs[0].output.label(),
                              tuple(r.source for r in runs), notes=notes, above_default_top=above)
+
+
+def _whole_run_low_end(runs: list[Record], grid: np.ndarray, H: np.ndarray, err: np.ndarray, gyy: np.ndarray,
+                       coh: np.ndarray, longest: float) -> tuple[np.ndarray, np.ndarray, str | None]:
+    """``H`` and its random error with the points below :data:`~synth.ident.whole_run.WHOLE_RUN_PERIODS` periods of
+    the longest window taken from the whole runs, when every run starts and ends at rest (and a note saying so)."""
+    from synth.ident.whole_run import WHOLE_RUN_PERIODS, at_rest, whole_run_response
+
+    low = grid < WHOLE_RUN_PERIODS * 2.0 * np.pi / longest
+    if not np.any(low) or not all(at_rest(r) for r in runs):
+        return H, err, None
+    gnn = np.maximum(np.nan_to_num(gyy * (1.0 - coh)), 0.0)
+    H, err = np.array(H, complex), np.array(err, float)
+    H[low], err[low] = whole_run_response(runs, grid[low], gnn[low])
+    return H, err, (f"below {grid[low][-1]:.4g} rad/s ({WHOLE_RUN_PERIODS:g} periods of the longest window) the "
+                    "response is the ratio of the whole runs' transforms: every run starts and ends at rest, and a "
+                    "window's taper biases a sweep's lowest frequencies")
 
 
 def _above_default_top(w: np.ndarray, gxx: np.ndarray, gxy: np.ndarray, coh: np.ndarray, band: CoherentBand,
