@@ -28,7 +28,7 @@ def _runs(rest: bool) -> list:
     return runs
 
 
-def test_the_low_end_of_a_sweep_from_rest_is_the_whole_run_ratio() -> None:
+def test_the_low_end_of_a_sweep_from_rest_is_the_whole_run_ratio(monkeypatch) -> None:
     """A black-box test's case: with the composite alone the 60 s window was 6-15 deg off below 0.5 rad/s
     (random errors 0.14-3 deg); over 44 random sweeps only 26 % of the band's lowest fifth lay within two random
     errors. From the whole runs the phase is within 2 deg of the truth over the band's lowest half decade."""
@@ -41,12 +41,8 @@ def test_the_low_end_of_a_sweep_from_rest_is_the_whole_run_ratio() -> None:
     assert low.sum() >= 8 and np.max(np.abs(err)) < 2.0, err.round(2)
     from synth.ident import spectra
 
-    composite = spectra._whole_run_low_end  # the composite alone, for the comparison
-    try:
-        spectra._whole_run_low_end = lambda runs, grid, H, err, gyy, coh, longest: (H, err, None)
-        old = frequency_response(runs)
-    finally:
-        spectra._whole_run_low_end = composite
+    monkeypatch.setattr(spectra, "_whole_run_low_end", lambda runs, grid, H, err, gyy, coh, longest: (H, err, None))
+    old = frequency_response(runs)  # the composite alone, for the comparison
     old_err = np.degrees(np.angle(old.H[low] / PLANT.freqresp(resp.w[low])))
     assert np.max(np.abs(old_err)) > 5.0  # the windows' bias this replaces
 

@@ -23,7 +23,7 @@ from __future__ import annotations
 
 import re
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
@@ -426,8 +426,6 @@ def fit_frequency_response(
         theta = min(results, key=lambda r: r[0] if np.isfinite(r[0]) else np.inf)[1]
         theta, tau, status = _ipopt(st, w, H, coh, theta, tau0, fit_delay, delay_max)
     fit = _checked(st, theta, float(tau), text, w, H, coh, bool(fit_delay), status, own_delay, min_fit_percent)
-    from dataclasses import replace
-
     if band is not None and w_range is not None and (w[0] < band[0] * (1 - 1e-9) or w[-1] > band[1] * (1 + 1e-9)):
         outside = int(np.count_nonzero((w < band[0] * (1 - 1e-9)) | (w > band[1] * (1 + 1e-9))))
         fit = replace(fit, notes=(f"the fit range {w[0]:.4g}-{w[-1]:.4g} rad/s reaches outside the coherent band "
@@ -465,7 +463,7 @@ def _checked(st: Any, theta: np.ndarray, tau: float, text: str, w: np.ndarray, H
     if not percent >= min_fit_percent:
         raise FrequencyFitError(f"fit of {text!r} over {band} failed: fit {percent:.1f} % < {min_fit_percent:g} % "
                                 f"(IPOPT {status}); {hint}", status, percent, text)
-    roots = np.concatenate([np.roots(p) for p in (num, den) if np.asarray(p).size > 1] or [np.zeros(0)])
+    roots = np.concatenate([plant.poles(), plant.zeros()])  # the fitted plant's own
     if roots.size and np.max(np.abs(roots)) > ABSURD_ROOT * w[-1]:
         far = roots[np.argmax(np.abs(roots))]
         raise FrequencyFitError(f"fit of {text!r} over {band} failed: a pole or zero at {abs(far):.3g} rad/s, more "

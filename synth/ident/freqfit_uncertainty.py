@@ -15,7 +15,7 @@ The grid points are not independent: the log grid is denser than a long window's
 a point's spectral estimate shares the data of its neighbours (lag-1 correlations of 0.4-0.99 across noise
 seeds on a 40-per-decade grid). The factor ``kappa = (1 + rho) / (1 - rho)`` is the variance of a sum of
 first-order-autocorrelated errors over that of independent ones, with ``rho`` the lag-1 autocorrelation of the
-fit's own standardized residuals ``r_k / eps_k`` along the grid (capped at :data:`MAX_RESIDUAL_CORRELATION`).
+fit's own residuals ``r_k`` (log magnitude and phase) along the grid (capped at :data:`MAX_RESIDUAL_CORRELATION`).
 Where the structure misses the response, the residuals are smooth, ``rho`` is near 1, and the standard errors
 grow: the report then says so (a misfit is not noise). On 40 noise seeds of a swept ``10 (s+2)/((s+1)(s+20))``
 with output noise, the reported standard errors were 0.99-1.16 times the parameters' scatter over 0.5-20 rad/s
@@ -47,7 +47,7 @@ MAX_RESIDUAL_CORRELATION = 0.95
 """Cap on the residuals' lag-1 correlation ``rho`` (``kappa`` at most 39)."""
 
 MISFIT_CORRELATION = 0.9
-"""A lag-1 correlation of the standardized residuals above this says the structure misses the response (a
+"""A lag-1 correlation of the residuals above this says the structure misses the response (a
 smooth error along the band, not the spectral estimate's scatter)."""
 
 _LN_TO_DB = 20.0 / np.log(10.0)
@@ -69,7 +69,7 @@ class FreqFitUncertainty:
     correlation : numpy.ndarray
         Correlation matrix of the parameters (rows and columns in ``names`` order).
     residual_correlation : float
-        ``rho``: lag-1 autocorrelation of the standardized residuals along the grid.
+        ``rho``: lag-1 autocorrelation of the residuals along the grid.
     inflation : float
         ``kappa = (1 + rho) / (1 - rho)``, the variance factor for neighbouring points' shared data.
     points : int
