@@ -38,8 +38,15 @@ def start(tmp_path: Path) -> subprocess.Popen:
     spec.write_text(SPEC, encoding="utf-8")
     cmd = [sys.executable, "-m", "synth", "tradeoff", str(spec), "--sweep",
            "requirements.peak_sensitivity.max_db=3:10:40", "--out", str(tmp_path / "out"), "--workers", "2", "-q"]
+    # SIGINT at its default, as a terminal starts a command: a suite launched in the background by a
+    # non-interactive shell inherits SIGINT ignored, Python then keeps ignoring it, and the Ctrl-C never arrives
     return subprocess.Popen(cmd, cwd=str(ROOT), env={**os.environ, "PYTHONPATH": str(ROOT)},
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True)
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True,
+                            preexec_fn=_default_sigint)
+
+
+def _default_sigint() -> None:
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
 
 
 def workers_of(proc: subprocess.Popen, timeout: float = 120.0) -> list[psutil.Process]:
