@@ -153,6 +153,28 @@ def test_split_unit_styles():
     assert split_unit("()") == ("()", "")
 
 
+@pytest.mark.parametrize(("unit", "scale"), [("msec", 1e-3), ("millis", 1e-3), ("MS", 1e-3), ("usec", 1e-6),
+                                           ("seconds", 1.0), ("minutes", 60.0)])
+def test_other_spellings_of_a_time_unit_are_converted(tmp_path, unit, scale):
+    """Found by a black-box test: ``Time [msec]`` was taken for seconds (a 0.3 s time constant identified as
+    300 s, a 5 Hz spike put at 0.0 rad/s)."""
+    p = tmp_path / "r.csv"
+    p.write_text(f"Time [{unit}],u,y\n" + "".join(f"{k * 10},{int(k > 3)},{k * k}\n" for k in range(10)))
+    r = load_record(p, "Time", "u", "y")
+    assert r.t[1] == pytest.approx(10 * scale, rel=1e-12)
+    assert r.notes == ((f"time column 'Time [{unit}]' converted from {unit} to s",) if scale != 1.0 else ())
+
+
+def test_a_time_column_in_a_unit_that_is_no_time_is_refused_in_one_line(tmp_path, run_cli):
+    p = tmp_path / "r.csv"
+    p.write_text("t [furlong],u,y\n" + "".join(f"{k},{int(k > 3)},{k * k}\n" for k in range(10)))
+    with pytest.raises(DataError, match=r"r.csv: time column 't \[furlong\]' is in 'furlong', not a time unit"):
+        load_record(p, "t", "u", "y")
+    res = run_cli("identify", "--data", str(p), "--time", "t", "--input", "u", "--output", "y", "--structure",
+                  "K/(T*s+1)", "--out", str(tmp_path / "out"))
+    assert res.code == 2 and len(res.err.strip().splitlines()) == 1 and "furlong" in res.err
+
+
 def test_time_in_ms_is_converted_and_noted(tmp_path):
     p = tmp_path / "r.csv"
     p.write_text("Time (ms),u,y\n" + "".join(f"{k * 10},{int(k > 3)},{k * k}\n" for k in range(10)))

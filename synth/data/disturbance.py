@@ -13,7 +13,7 @@ from typing import Any
 
 import numpy as np
 
-from synth.data.readers import TIME_UNITS, read_table
+from synth.data.readers import read_table, time_scale
 from synth.data.record import uniform_columns
 from synth.errors import DataError
 
@@ -147,6 +147,6 @@ def read_disturbance_columns(path: str | Path, time: str | None, signal: str, un
             raise DataError("no time column given: give the sample interval dt > 0 s", where=str(path))
         t = np.arange(x.size) * float(dt)
     else:
-        t = table.columns[t_key] * TIME_UNITS.get(table.units.get(t_key, ""), 1.0)
+        t = table.columns[t_key] * time_scale(table.units.get(t_key, ""), t_key, str(path))
     sig = table.signal(x_key, unit)
     return RawColumns(t, x, x_key, sig.name, sig.unit, str(path), t_key or "time", tuple(table.notes))

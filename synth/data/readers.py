@@ -33,11 +33,41 @@ import numpy as np
 from synth.errors import DataError
 from synth.plant import Signal
 
-__all__ = ["TIME_UNITS", "Table", "parse_column_map", "read_table", "split_unit", "table_from_columns"]
+__all__ = ["TIME_UNITS", "Table", "parse_column_map", "read_table", "split_unit", "table_from_columns",
+           "time_scale"]
 
-#: seconds per unit of a time column, by the unit its header states
-TIME_UNITS: dict[str, float] = {"s": 1.0, "sec": 1.0, "ms": 1e-3, "us": 1e-6, "µs": 1e-6, "μs": 1e-6,
-                                "ns": 1e-9, "min": 60.0, "h": 3600.0}
+#: seconds per unit of a time column, by the unit its header states (matched without regard to case)
+TIME_UNITS: dict[str, float] = {
+    "s": 1.0, "sec": 1.0, "secs": 1.0, "second": 1.0, "seconds": 1.0,
+    "ms": 1e-3, "msec": 1e-3, "msecs": 1e-3, "millis": 1e-3, "millisecond": 1e-3, "milliseconds": 1e-3,
+    "us": 1e-6, "µs": 1e-6, "μs": 1e-6, "usec": 1e-6, "usecs": 1e-6, "micros": 1e-6, "microsecond": 1e-6,
+    "microseconds": 1e-6, "ns": 1e-9, "nsec": 1e-9, "nanosecond": 1e-9, "nanoseconds": 1e-9,
+    "min": 60.0, "mins": 60.0, "minute": 60.0, "minutes": 60.0, "h": 3600.0, "hr": 3600.0, "hrs": 3600.0,
+    "hour": 3600.0, "hours": 3600.0}
+
+
+def time_scale(unit: str, column: str, source: str) -> float:
+    """Seconds per unit of the time column ``column`` whose header states ``unit`` (1 when it states none).
+
+    A unit that is not a time unit is an error: taking ``Time [msec]`` for seconds turned a 0.3 s time constant
+    into 300 s without a word.
+
+    Examples
+    --------
+    >>> time_scale("ms", "t", "a.csv"), time_scale("msec", "t", "a.csv"), time_scale("", "t", "a.csv")
+    (0.001, 0.001, 1.0)
+    >>> time_scale("V", "t", "a.csv")
+    Traceback (most recent call last):
+    ...
+    synth.errors.DataError: a.csv: time column 't' is in 'V', not a time unit synth knows (s, ms, us, ns, min, h)
+    """
+    if not unit:
+        return 1.0
+    scale = TIME_UNITS.get(unit) or TIME_UNITS.get(unit.lower())
+    if scale is None:
+        raise DataError(f"time column '{column}' is in '{unit}', not a time unit synth knows (s, ms, us, ns, min, h)",
+                        where=source)
+    return scale
 
 _UNIT = re.compile(r"^(?P<name>.*?)\s*(?:\((?P<p>[^()]*)\)|\[(?P<b>[^\[\]]*)\])\s*$")
 _LISTED = 30  # names listed in a "not found" message

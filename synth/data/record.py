@@ -18,7 +18,7 @@ from typing import Any
 import numpy as np
 
 from synth.data.interpolated_noise import interpolation_noise_factor
-from synth.data.readers import TIME_UNITS, Table, read_table, table_from_columns
+from synth.data.readers import Table, read_table, table_from_columns, time_scale
 from synth.errors import DataError
 from synth.plant import Signal
 
@@ -453,7 +453,7 @@ def record_from_columns(
         other = next((r for r, k in roles[:i] if k == key), None)
         if other is not None:
             raise DataError(f"column '{key}' is given as both the {other} and the {role} column", where=table.source)
-    scale = 1.0 if from_dt else TIME_UNITS.get(table.units.get(t_name, ""), 1.0)
+    scale = 1.0 if from_dt else time_scale(table.units.get(t_name, ""), t_name, table.source)
     t = np.arange(table.columns[u_name].size) * float(dt or 0) if from_dt else table.columns[t_name] * scale
     scaled = scale != 1.0
     notes = table.notes + ((f"time column '{t_name}' converted from {table.units[t_name]} to s",) if scaled else ())
