@@ -175,6 +175,23 @@ def test_a_time_column_in_a_unit_that_is_no_time_is_refused_in_one_line(tmp_path
     assert res.code == 2 and len(res.err.strip().splitlines()) == 1 and "furlong" in res.err
 
 
+@pytest.mark.parametrize("form", ["units row", "percent comment", "excel sep"])
+def test_a_units_row_a_matlab_comment_and_an_excel_separator_line_are_read(tmp_path, form):
+    """Found by a black-box test: each of these was refused with "no numeric columns found"."""
+    rows = "".join(f"{k * 10};{int(k > 3)};{k * k}\n" for k in range(10))
+    text = {"units row": "t;u;y\nms;V;rad/s\n" + rows, "percent comment": "% logged by MATLAB\nt;u;y\n" + rows,
+            "excel sep": "sep=;\nt;u;y\n" + rows}[form]
+    p = tmp_path / "r.csv"
+    p.write_text(text)
+    r = load_record(p, "t", "u", "y")
+    assert r.y.tolist() == [float(k * k) for k in range(10)] and r.u.tolist() == [float(k > 3) for k in range(10)]
+    if form == "units row":  # the time in ms, the signals' units from the row
+        assert r.dt == 0.01 and r.input.unit == "V" and r.output.unit == "rad/s"
+        assert "read the units from the row under the header" in r.notes
+    else:
+        assert r.dt == 10.0 and r.output.unit == ""
+
+
 def test_time_in_ms_is_converted_and_noted(tmp_path):
     p = tmp_path / "r.csv"
     p.write_text("Time (ms),u,y\n" + "".join(f"{k * 10},{int(k > 3)},{k * k}\n" for k in range(10)))

@@ -21,6 +21,7 @@ from __future__ import annotations
 import csv
 import difflib
 import io
+import itertools
 import re
 import warnings
 from collections.abc import Iterable, Mapping
@@ -280,6 +281,32 @@ def _delimiter(header: str, first: str | None) -> str | None:
     return best[0] if best else None
 
 
+COMMENT_MARKS = ("#", "%")
+"""A line of a CSV file starting with one of these is a comment (``%``: MATLAB's)."""
+
+_EXCEL_SEPARATOR = re.compile(r'"?sep=(.)"?')
+
+
+def _units_row(lines: list[tuple[int, str]], delimiter: str | None) -> list[str] | None:
+    """The units of a row under the header that holds no number while the row after it holds numbers only (a
+    units row: ``s,V,rad/s``), each without brackets; ``None`` when the second line is not such a row."""
+    if len(lines) < 3:
+        return None
+    cells, after = _cells(lines[1][1], delimiter), _cells(lines[2][1], delimiter)
+    if not any(cells) or any(_number(c, delimiter) is not None for c in cells if c):
+        return None
+    if not after or any(_number(c, delimiter) is None for c in after if c):
+        return None
+    return [c.strip().strip("[]()").strip() for c in cells]
+
+
+def _number(cell: str, delimiter: str | None) -> float | None:
+    try:
+        return float(cell)
+    except ValueError:
+        return _decimal_comma(cell, delimiter)
+
+
 def _cells(line: str, delimiter: str | None) -> list[str]:
     if delimiter is None:
         return [c.strip('"') for c in line.split()]
@@ -294,26 +321,35 @@ def _read_csv(path: Path) -> Table:
     except UnicodeDecodeError:
         raise DataError("not a text CSV file", where=str(path)) from None
     lines: list[tuple[int, str]] = []
-    comments = 0
+    comments, marks = 0, set()
     for number, line in enumerate(text.splitlines(), start=1):
         stripped = line.strip()
-        if stripped.startswith("#"):
+        if stripped.startswith(COMMENT_MARKS):
             comments += 1
+            marks.add(stripped[0])
         elif stripped:
             lines.append((number, stripped))
+    stated = _EXCEL_SEPARATOR.fullmatch(lines[0][1]) if lines else None
+    lines = lines[1:] if stated else lines  # Excel's "sep=;" first line states the separator
     if not lines:
         raise DataError("file is empty", where=str(path))
-    delimiter = _delimiter(lines[0][1], lines[1][1] if len(lines) > 1 else None)
+    delimiter = stated.group(1) if stated else _delimiter(lines[0][1], lines[1][1] if len(lines) > 1 else None)
     header = _cells(lines[0][1], delimiter)
     if delimiter is None and len(lines) > 1 and len(_cells(lines[1][1], None)) == 1:
         header = [lines[0][1].strip('"')]  # one column: its header may hold spaces ("speed (rad/s)")
+    row_units = _units_row(lines, delimiter)
+    if row_units is not None:  # a row of units under the header (s, V, rad/s): the header's units, read once
+        lines = [lines[0], *lines[2:]]
+        header = [h if split_unit(h)[1] or not u else f"{h} [{u}]" for h, u in
+                  itertools.zip_longest(header, row_units[:len(header)], fillvalue="")]
     keep = [i for i, h in enumerate(header) if h]
     twice = {h: [i + 1 for i in keep if header[i] == h] for h in {header[i] for i in keep}}
     twice = {h: at for h, at in twice.items() if len(at) > 1}  # a header written twice: which one is meant?
     order = tuple(dict.fromkeys(header[i] for i in keep))  # file order, a doubled header once
     keep = [i for i in keep if header[i] not in twice]
     names = [header[i] for i in keep]
-    notes = (f"skipped {comments} comment line(s) starting with #",) if comments else ()
+    notes = (f"skipped {comments} comment line(s) starting with {' or '.join(sorted(marks))}",) if comments else ()
+    notes += ("read the units from the row under the header",) if row_units is not None else ()
     doubled = {h: f"column '{h}' appears {len(at)} times in the header (columns {', '.join(map(str, at))}); "
                "rename all but one in the file" for h, at in twice.items()}
     fast = _numeric_body(lines[1:], delimiter, len(header))
