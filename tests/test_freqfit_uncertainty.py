@@ -109,3 +109,27 @@ def test_a_range_outside_the_coherent_band_is_said_and_a_pole_the_band_cannot_pl
     assert res.code == 1, res.out + res.err
     assert "times above the band" in res.err and "the band cannot place it" in res.err
     assert len(res.err.strip().splitlines()) == 1
+
+
+def test_a_fitted_delay_beside_large_coefficients_keeps_every_error_finite() -> None:
+    """Found by a black-box test on the Silverbox record (``--fit 0/2`` over 100-1500 rad/s): a fitted delay of
+    4e-6 s beside b0 and a0 near 2e5 put the curvature's diagonal 17 decades apart, below numpy's rank
+    tolerance, and every parameter was reported "+- inf" and weakly identifiable. On a response of that shape
+    the errors are finite, and b0's and a0's are those of the same fit with the delay fixed (the delay's column
+    is nearly orthogonal to theirs)."""
+    from synth.ident.freqfit import _Orders
+    from synth.ident.freqfit_uncertainty import fit_uncertainty
+
+    w = np.linspace(100.0, 1500.0, 400)
+    s = 1j * w
+    theta, tau = np.array([187_000.0, 46.0, 193_000.0]), 4e-6
+    rng = np.random.default_rng(3)
+    H = theta[0] / (s ** 2 + theta[1] * s + theta[2]) * np.exp(-s * tau) * np.exp(0.01 * rng.normal(size=w.size)
+                                                                                + 0.01j * rng.normal(size=w.size))
+    eps = np.full(w.size, 0.01)
+    free = fit_uncertainty(_Orders(0, 2), theta, tau, True, w, H, np.ones(w.size), eps)
+    held = fit_uncertainty(_Orders(0, 2), theta, tau, False, w, H, np.ones(w.size), eps)
+    assert all(np.isfinite(v) and v > 0 for v in free.std.values()), free.std
+    assert not free.weak
+    for name in ("b0", "a0"):
+        assert free.std[name] == pytest.approx(held.std[name], rel=0.5), (name, free.std[name], held.std[name])

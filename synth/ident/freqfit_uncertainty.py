@@ -228,8 +228,13 @@ def fit_uncertainty(structure: Any, theta: np.ndarray, tau: float, fit_delay: bo
     S = np.where(W > 0, S, 0.0)  # a point of zero coherence weighs nothing, whatever its error
     A = J.T @ (W[:, None] * J)
     B = J.T @ ((W ** 2 * S)[:, None] * J)
-    if np.all(np.isfinite(A)) and np.all(np.isfinite(B)) and np.linalg.matrix_rank(A) == x.size:
-        Ai = np.linalg.inv(A)
+    # the rank and the inverse on the columns scaled to unit curvature: a delay's column (about w) beside a gain's
+    # (about 1/b0) put A's diagonal 17 decades apart on the Silverbox record, below numpy's rank tolerance
+    diag = np.diag(A)
+    scale = 1.0 / np.sqrt(np.where(np.isfinite(diag) & (diag > 0), diag, 1.0))
+    As = A * np.outer(scale, scale)
+    if np.all(np.isfinite(A)) and np.all(np.isfinite(B)) and np.linalg.matrix_rank(As) == x.size:
+        Ai = np.linalg.inv(As) * np.outer(scale, scale)
         cov = Ai @ B @ Ai
     else:  # the band cannot tell some parameters apart at all
         cov = np.full((x.size, x.size), np.inf)
