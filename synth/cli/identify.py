@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import math
 import sys
 from pathlib import Path
 from typing import Any
@@ -56,9 +57,11 @@ with the input held between samples (a step stays a step) and the output interpo
 --x4-demo uses a SYNTHETIC X-4 step train generated from the seed paper's model
 (not measured data; see synth.ident.x4_record).
 
-A fit that fails (IPOPT diverged or hit its iteration limit, parameters at absurd magnitudes,
-a fitted delay outside the record, a fit no better than the output's mean or than noise) is
-never written as a result: one line says what failed and what to try, exit 1.
+A fit that fails (IPOPT diverged, or hit its iteration limit more than 0.1 standard errors from
+the optimum, parameters at absurd magnitudes, a fitted delay outside the record, a fit no better
+than the output's mean or than noise) is never written as a result: one line says what failed and
+what to try, exit 1. A fit stopped at its limit closer than that has converged as far as the record
+can tell; the status line says how close.
 
 exit codes: 0 identified, 1 the fit failed, 2 bad input"""
 
@@ -224,8 +227,11 @@ def _print(result: Any, args: argparse.Namespace, json_path: Path, figures: list
         print(f"note: {fit.solver['nyquist_note']}")
     solver = "Levenberg-Marquardt" if fit.solver.get("method", "").startswith("Levenberg-Marquardt") else "IPOPT"
     status, iterations = fit.solver.get("status"), fit.solver.get("iterations")
+    remaining = fit.solver.get("remaining_improvement_std")
+    at_limit = (f"; stopped at its limit within {max(remaining, 0.01):.2g} standard errors of the optimum, converged "
+                "as far as the record can tell" if remaining is not None and math.isfinite(remaining) else "")
     ending = (f"the start kept ({solver} ended above it after {iterations} iterations)" if status == "Start_Converged"
-              else f"{solver} {status} ({iterations} iterations)")
+              else f"{solver} {status} ({iterations} iterations{at_limit})")
     print(f"fit {fit.fit_percent:.2f} %, residual std {fit.residual_std:.3g}, {ending}")
     print(f"plant: {fit.plant.to_string()}")
     if result.directions is not None:
