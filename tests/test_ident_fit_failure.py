@@ -246,3 +246,20 @@ def test_a_fit_at_its_iteration_limit_says_how_close_it_is_to_the_optimum(run_cl
            " tell" in res.out
     help_text = run_cli("identify", "--help").out
     assert "more than 0.1 standard errors from\nthe optimum" in help_text
+
+
+def test_a_fixed_delay_as_long_as_the_record_is_refused_in_one_line(run_cli, tmp_path):
+    """Found by a black-box test: ``--delay 100`` on a 40 s step train was fitted ("fit 94.02 %", a plant
+    ``exp(-100*s)...``, exit 0) though no output sample can answer the input 100 s later."""
+    t = np.arange(0.0, 40.0, 0.01)
+    u = ((t % 4.0) >= 2.0) * 1.0
+    y = 2.5 * (1.0 - np.exp(-np.clip(t % 4.0 - 2.0, 0.0, None) / 0.3)) * u + 0.01 * np.random.default_rng(0).normal(
+        size=t.size)
+    path = tmp_path / "r.csv"
+    np.savetxt(path, np.c_[t, u, y], delimiter=",", header="t,u,y", comments="")
+    res = run_cli("identify", "--data", str(path), "--structure", "K/(T*s+1)", "--delay", "100", "--no-figures",
+                  "--out", str(tmp_path / "o"))
+    assert res.code == 2 and res.out == ""
+    lines = res.err.strip().splitlines()
+    assert len(lines) == 1 and "the fixed delay 100 s is outside [0, 39.99) s, the record's length" in lines[0]
+    assert not (tmp_path / "o").exists()
