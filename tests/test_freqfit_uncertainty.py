@@ -117,8 +117,8 @@ def test_a_fitted_delay_beside_large_coefficients_keeps_every_error_finite() -> 
     tolerance, and every parameter was reported "+- inf" and weakly identifiable. On a response of that shape
     the errors are finite, and b0's and a0's are those of the same fit with the delay fixed (the delay's column
     is nearly orthogonal to theirs)."""
-    from synth.ident.freqfit import _Orders
     from synth.ident.freqfit_uncertainty import fit_uncertainty
+    from synth.ident.structure import parse_structure
 
     w = np.linspace(100.0, 1500.0, 400)
     s = 1j * w
@@ -127,8 +127,9 @@ def test_a_fitted_delay_beside_large_coefficients_keeps_every_error_finite() -> 
     H = theta[0] / (s ** 2 + theta[1] * s + theta[2]) * np.exp(-s * tau) * np.exp(0.01 * rng.normal(size=w.size)
                                                                                 + 0.01j * rng.normal(size=w.size))
     eps = np.full(w.size, 0.01)
-    free = fit_uncertainty(_Orders(0, 2), theta, tau, True, w, H, np.ones(w.size), eps)
-    held = fit_uncertainty(_Orders(0, 2), theta, tau, False, w, H, np.ones(w.size), eps)
+    structure = parse_structure("b0/(s^2+a1*s+a0)")
+    free = fit_uncertainty(structure, theta, tau, True, w, H, np.ones(w.size), eps)
+    held = fit_uncertainty(structure, theta, tau, False, w, H, np.ones(w.size), eps)
     assert all(np.isfinite(v) and v > 0 for v in free.std.values()), free.std
     assert not free.weak
     for name in ("b0", "a0"):
