@@ -263,3 +263,29 @@ def test_a_fixed_delay_as_long_as_the_record_is_refused_in_one_line(run_cli, tmp
     lines = res.err.strip().splitlines()
     assert len(lines) == 1 and "the fixed delay 100 s is outside [0, 39.99) s, the record's length" in lines[0]
     assert not (tmp_path / "o").exists()
+
+
+def test_an_integrating_structure_on_a_step_train_is_fitted_without_averaging(run_cli, tmp_path):
+    """Found by a black-box test: ``K/(s*(T*s+1))`` on a 0/1 step train exited 2 ("a periodic fit needs a model
+    without an integrator", no file named, nothing about ``--average none``, which fits it). The default average
+    now leaves such a structure's record as it is; an average asked for is refused with the way out."""
+    from scipy import signal
+
+    t = np.arange(0.0, 30.0, 0.01)
+    u = ((t % 3.0) >= 1.5) * 1.0
+    _, y, _ = signal.lsim(signal.lti([3.0], [0.2, 1.0, 0.0]), u, t)  # 3/(s (0.2 s + 1)), scipy's own simulation
+    y = y + 0.01 * np.random.default_rng(1).normal(size=t.size)
+    path = tmp_path / "r.csv"
+    np.savetxt(path, np.c_[t, u, y], delimiter=",", header="t,u,y", comments="")
+    res = run_cli("identify", "--data", str(path), "--structure", "K/(s*(T*s+1))", "--no-figures", "--out",
+                  str(tmp_path / "o"), "--json", str(tmp_path / "fit.json"))
+    assert res.code == 0, res.err
+    assert "not averaged as a step train (the structure integrates" in res.out
+    import json
+
+    p = json.loads((tmp_path / "fit.json").read_text())["parameters"]
+    assert p["K"] == pytest.approx(3.0, rel=0.01) and p["T"] == pytest.approx(0.2, rel=0.03)
+    asked = run_cli("identify", "--data", str(path), "--structure", "K/(s*(T*s+1))", "--average", "cycle",
+                    "--no-figures", "--out", str(tmp_path / "o2"))
+    assert asked.code == 2 and len(asked.err.strip().splitlines()) == 1
+    assert "r.csv" in asked.err and "--average none" in asked.err

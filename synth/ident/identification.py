@@ -164,7 +164,12 @@ def identify(record: RecordLike, structure: Structure | str, delay: str | float 
     _check_fixed_delay(delay, record)
     avg = None
     data, periodic, not_averaged = record, False, ""
-    if average != "none" and _two_level(record.u):
+    if isinstance(structure, str):
+        structure = parse_structure(structure)
+    integrates = _integrates(structure)
+    if average == "auto" and integrates and _two_level(record.u):  # a periodic average needs a steady state
+        not_averaged = "not averaged as a step train (the structure integrates: no periodic state): fitted as it is"
+    elif average != "none" and _two_level(record.u):
         steps = find_steps(record)
         if steps.count >= 2 or average in ("cycle", "edge"):
             try:
@@ -174,8 +179,6 @@ def identify(record: RecordLike, structure: Structure | str, delay: str | float 
                 if average != "auto":
                     raise
                 not_averaged = f"not averaged as a step train ({exc.message}): fitted as it is"
-    if isinstance(structure, str):
-        structure = parse_structure(structure)
     two_ways = avg is not None and bool(np.any(avg.steps.direction > 0) and np.any(avg.steps.direction < 0))
     if by_direction and not two_ways:
         raise DataError("by direction needs a step train with up and down steps (averaged, not average='none')",
@@ -267,6 +270,18 @@ def _require_settled_windows(directions: DirectionComparison, source: str) -> No
                    f"({100 * directions.unsettled:.2g} % of a step left when the next came), which the per-direction "
                    f"fits take as rest; that moves {name} by about {allowance:.3g}, more than its std ({std:.2g}); "
                    f"use {advice}, or identify without a direction-dependent model", where=source)
+
+
+def _integrates(structure: Structure) -> bool:
+    """Whether the structure has a pole at 0 whatever its parameters (``K/(s*(T*s+1))``).
+
+    Examples
+    --------
+    >>> _integrates(parse_structure("K/(s*(T*s+1))")), _integrates(parse_structure("K/(T*s+1)"))
+    (True, False)
+    """
+    den = structure.coefficients(np.ones(len(structure.parameters)))[1]
+    return bool(den.size > 1 and den[-1] == 0.0)
 
 
 def _check_fixed_delay(delay: str | float | None, record: Record) -> None:

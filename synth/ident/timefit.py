@@ -347,7 +347,9 @@ def fit_structure(record: Record, structure: Structure | str, delay: str | float
     num_chk, den_chk = st.coefficients(theta0)
     full_den = np.polymul(den_chk, sensor.den) if sensor is not None else den_chk
     if periodic and abs(np.polyval(full_den, 0.0)) < 1e-12 * np.max(np.abs(full_den)):
-        raise DataError("a periodic fit needs a model without an integrator (its periodic state is not unique)")
+        raise DataError("a periodic fit (an averaged step train) needs a model without an integrator (its periodic "
+                        "state is not unique); fit the record as it is (average='none', --average none)",
+                        where=record.source)
     has_d = (st.num_degree == st.den_degree) and sensor is None
     mask = None
     if weights is not None:
