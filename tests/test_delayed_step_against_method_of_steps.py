@@ -255,3 +255,18 @@ def test_a_step_that_settles_below_zero_is_measured(seed):
     ref_settling = float(t[outside[-1] + 1]) if outside.size else 0.0
     assert abs(result.details["settling_time"] - ref_settling) < 5e-3 * max(1.0, ref_settling)
     assert abs(result.details["overshoot"] - max(0.0, 100 * (float(np.max(ref / final)) - 1.0))) < 0.05
+
+
+def test_a_peak_between_the_output_samples_is_measured():
+    """Found by a black-box test: a lead-lag on ``13.08/s`` behind 3.26 s peaks at a corner near two delays, between
+    the step's output samples (16 ms apart): synth measured 2.785 % with an error of 2.3e-5 and called a 2.8 %
+    limit met; the method of steps says 2.826 %."""
+    plant = Plant.from_string("13.0822/s", delay=3.26)
+    controller = Controller("leadlag", {"k": 0.4996, "z": 0.4095, "p": 14.67})
+    result = StepResponse(max_overshoot=2.8).evaluate(Loop(plant, controller))
+    t = np.linspace(6.0, 7.0, 20_001)  # around the peak (the reference integrates from 0 either way)
+    ref = _reference(plant.num, plant.den, plant.delay, *controller.tf(), 7.0, np.r_[0.0, t])[1:]
+    peak = 100 * (float(np.max(ref)) - 1.0)
+    assert peak > 2.81
+    assert abs(result.details["overshoot"] - peak) < 0.005, (result.details["overshoot"], peak)
+    assert not result.met

@@ -390,7 +390,8 @@ class StepResponse(Requirement):
 
         settled = False
         for doublings in range(plan.start, plan.last + 1):
-            run = linear_step(loop, decided=bounds_agree, times=doubling_grid(plan.first, doublings, INTERVALS))
+            run = linear_step(loop, decided=bounds_agree, times=doubling_grid(plan.first, doublings, INTERVALS),
+                              extremes=True)
             t, y = run.t, run.y
             tail = t >= 0.75 * horizon
             settled = bool(np.all(np.abs(y[tail] - final) <= band)) and plan.after(horizon) <= TAIL_SHARE * band
