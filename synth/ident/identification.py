@@ -347,10 +347,22 @@ def _refit_unsettled(record: Record, avg: StepAverage, fit: TimeFitResult, struc
                      delay: str | float | None, sensor: Plant | str | None) -> tuple[TimeFitResult, str]:
     """Edge windows assume the plant at rest before each step; if the fitted model does not settle within
     a window, fit the whole record instead (from the edge fit, the start-up weighted 0), which assumes nothing."""
+    from synth.ident.directions import UNSETTLED_FACTOR, unsettled_fraction
+
     window = float(avg.t[-1] + record.dt)
     settle = settling_time(fit.measured)
-    if not np.isfinite(settle) or settle <= window:
+    if not np.isfinite(settle):
         return fit, ""
+    left = unsettled_fraction(record, avg.steps, [fit.measured])
+    finest = min((s / abs(v) for v, s in zip(fit.parameters.values(), fit.std.values())
+                  if v != 0 and np.isfinite(s) and s > 0), default=np.inf)
+    if settle <= window and not UNSETTLED_FACTOR * left > finest:
+        return fit, ""
+    why = (f"the edge windows ({window:.3g} s) are shorter than the model's settling time ({settle:.3g} s)"
+           if settle > window else
+           f"the steps left {100 * left:.2g} % of a step unsettled when the next came, a bias of up to "
+           f"{100 * UNSETTLED_FACTOR * left:.2g} % in the edge fit, more than its parameters' finest relative "
+           f"standard error ({100 * finest:.2g} %)")
     skip = min(settle, 0.25 * record.duration)
     weights = ((record.t - record.t[0]) >= skip).astype(float)
     # the edge fit is the natural start, unless the average pulled a pole or zero beyond the record's Nyquist
@@ -371,16 +383,13 @@ def _refit_unsettled(record: Record, avg: StepAverage, fit: TimeFitResult, struc
         # other start too, the lower residual kept (an edge fit distorted by a right-half-plane zero's undershoot
         # led a refit onto the ridge K -> 0, a -> inf of K(1 - a s)/(...) at 36 % where the own start reaches 95 %)
     if not fits:
-        return fit, f"the edge windows ({window:.3g} s) are shorter than the model's settling time " \
-                    f"({settle:.3g} s); the whole-record fit failed ({'; '.join(failures)}), so the edge fit is " \
-                    f"kept (biased)"
+        return fit, f"{why}; the whole-record fit failed ({'; '.join(failures)}), so the edge fit is kept (biased)"
     name, whole = min(fits, key=lambda named: named[1].residual_std)
     others = [f"from {other}: fit {f.fit_percent:.4g} %, {f.solver.get('status')}" for other, f in fits if other != name]
     start = f"from {name}" + (f" (it failed {failures[0]})" if failures else "") \
         + (f" (better than the fit {others[0]})" if others else "")
-    return whole, (f"the edge windows ({window:.3g} s) are shorter than the model's settling time ({settle:.3g} s): "
-                   f"fitted the whole record instead {start}, the first {skip:.3g} s (start-up from an unknown "
-                   f"state) weighted 0")
+    return whole, (f"{why}: fitted the whole record instead {start}, the first {skip:.3g} s (start-up from an "
+                   f"unknown state) weighted 0")
 
 
 def _refit_from_rest(record: Record, avg: StepAverage, fit: TimeFitResult, structure: Structure,
