@@ -71,6 +71,9 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--time", metavar="COL", help="time column, with or without its unit (default: the first)")
     p.add_argument("--input", metavar="COL", help="input column (the command; default: the second)")
     p.add_argument("--output", metavar="COL", help="output column (default: the third)")
+    p.add_argument("--dt", type=float, metavar="S",
+                   help="sample interval when the file has no time column (input and output default to the first "
+                        "two columns)")
     p.add_argument("--columns", metavar="OLD=NEW,...", action="append", default=[],
                    help="rename columns before picking them, e.g. acc[0]=accel_x (a MAT matrix gives acc[0], "
                         "acc[1], ...; a struct s.field); repeatable")
@@ -142,7 +145,7 @@ def run(args: argparse.Namespace) -> int:
     except ModelError as exc:
         raise exc.located("--structure") from None
     record = load_record(args.data, args.time, args.input, args.output, input_unit=args.input_unit,
-                         output_unit=args.output_unit, columns=parse_column_map(args.columns))
+                         output_unit=args.output_unit, dt=args.dt, columns=parse_column_map(args.columns))
     try:
         result = identify(record, structure, args.delay, args.sensor, args.average, by_direction=args.by_direction)
     except FitError as exc:  # the options were valid; the structure does not fit this record
