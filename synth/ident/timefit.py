@@ -347,9 +347,8 @@ def fit_structure(record: Record, structure: Structure | str, delay: str | float
     num_chk, den_chk = st.coefficients(theta0)
     full_den = np.polymul(den_chk, sensor.den) if sensor is not None else den_chk
     if periodic and abs(np.polyval(full_den, 0.0)) < 1e-12 * np.max(np.abs(full_den)):
-        raise DataError("a periodic fit (an averaged step train) needs a model without an integrator (its periodic "
-                        "state is not unique); fit the record as it is (average='none', --average none)",
-                        where=record.source)
+        raise DataError("a periodic fit (an averaged step train) needs a model without an integrator (no unique "
+                        "periodic state); fit the record as it is (average='none', --average none)", record.source)
     has_d = (st.num_degree == st.den_degree) and sensor is None
     mask = None
     if weights is not None:
@@ -392,9 +391,8 @@ def fit_structure(record: Record, structure: Structure | str, delay: str | float
 
     xs, ssr, m, st_info, shifts = run(theta0, d0)
     info["starts"] = 1
-    yd_fit = yd if mask is None else yd[mask]
+    yd_fit, y_fit = (yd, y) if mask is None else (yd[mask], y[mask])
     init_ssr = float(np.sum((yd_fit - np.mean(yd_fit)) ** 2))
-    y_fit = y if mask is None else y[mask]
     ssr_start = start_ssr(prob, theta0, d0, b0, w, y, mask, fit_delay, dt)
     def below_zero(fit: tuple) -> bool:  # a whole delay below 0: no plant's (fit_failure)
         return fit_delay and fit[2] * dt + float(fit[0][len(st.parameters)]) < 0.0
