@@ -354,8 +354,8 @@ def _refit_unsettled(record: Record, avg: StepAverage, fit: TimeFitResult, struc
     if not np.isfinite(settle):
         return fit, ""
     left = unsettled_fraction(record, avg.steps, [fit.measured])
-    finest = min((s / abs(v) for v, s in zip(fit.parameters.values(), fit.std.values())
-                  if v != 0 and np.isfinite(s) and s > 0), default=np.inf)
+    finest = min((fit.std[k] / abs(v) for k, v in fit.parameters.items()
+                  if v != 0 and np.isfinite(fit.std.get(k, np.nan)) and fit.std[k] > 0), default=np.inf)
     if settle <= window and not UNSETTLED_FACTOR * left > finest:
         return fit, ""
     why = (f"the edge windows ({window:.3g} s) are shorter than the model's settling time ({settle:.3g} s)"
