@@ -389,3 +389,26 @@ def test_resampled_command_edges_stay_where_they_were_written():
     np.testing.assert_allclose(recovered, written, rtol=0, atol=1e-9 * dt)
     others = np.setdiff1d(np.arange(r.t.size), inside)
     assert np.all(np.isin(r.u[others], [-1.0, 1.0]))  # every other sample holds a written level exactly
+
+
+def test_a_command_change_hidden_in_a_gap_of_the_time_stamps_is_noted(tmp_path, run_cli):
+    """Found by a black-box test: a 0.3 s dropout hiding one edge of a step train put K 3 % off (44 of its standard
+    errors) without a word. The record now says that the command changed inside the gap, and identify prints how
+    the record was read; the same dropout where the command holds is only resampled."""
+    from synth.data import record_from_arrays
+
+    t = np.arange(0.0, 40.0, 0.01)
+    u = ((t % 4.0) >= 2.0) * 1.0
+    y = np.cumsum(u) * 0.01
+    for start, hidden in ((23.9, True), (24.9, False)):  # the command changes every 2 s: at 24 s, not at 25 s
+        keep = (t <= start) | (t >= start + 0.3)
+        rec = record_from_arrays(t[keep], u[keep], y[keep])
+        noted = [n for n in rec.notes if "changed inside a" in n]
+        assert bool(noted) == hidden, (start, rec.notes)
+        assert any(n.startswith("resampled") for n in rec.notes)
+    keep = (t <= 23.9) | (t >= 24.2)  # the edge at 24 s falls in the gap
+    path = tmp_path / "g.csv"
+    np.savetxt(path, np.c_[t[keep], u[keep], y[keep]], delimiter=",", header="t,u,y", comments="")
+    res = run_cli("identify", "--data", str(path), "--structure", "K/s", "--average", "none", "--no-figures",
+                  "--out", str(tmp_path / "o"))
+    assert "note: 'u' changed inside a 0.31 s gap in the time stamps (t = 23.89-24.2 s)" in res.out, res.out + res.err

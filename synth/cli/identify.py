@@ -203,6 +203,8 @@ def _print(result: Any, args: argparse.Namespace, json_path: Path, figures: list
     rows.append(["offset", f"{fit.offset:.6g}", f"{fit.offset_std:.3g}", ""])
     print(f"{args.data}{' (SYNTHETIC)' if args.x4_demo else ''}: {fit.structure.formula}"
           f"{', sensor ' + fit.sensor.to_string() if fit.sensor is not None else ''}")
+    for note in result.record.notes:  # how the record was read (resampled, converted, gaps): what the fit rests on
+        print(f"note: {note}")
     avg = result.average
     if avg is not None:
         print(f"averaged {avg.count} {avg.mode}s ({avg.up} up, {avg.down} down steps, {avg.dropped} dropped): "
