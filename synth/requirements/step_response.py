@@ -33,7 +33,10 @@ POLE_DOUBLINGS = 30
 poles span more than 50:1, and a slow pole's tail may need more than :data:`MAX_DOUBLINGS` of it (a PI on
 ``1/((s+1)(0.001 s+1))``, poles -999, -1.84, -0.163, settling at 19.7 s: "undetermined within 3.075 s", 0.012 s
 doubled 8 times; a PID's design on ``12.98/s`` called "infeasible" for the same reason). The horizon then starts
-where the tail says and may double twice more."""
+where the tail says and may double twice more. Only without a delay, where the step is exact and each doubling
+costs 4,000 samples: a delayed loop's step is simulated, and a design's candidates with a slow pole then ran
+up to the simulation's limit each (a delayed PID of the step-design benchmark's seed 56, #9: 13.5 -> 200 s);
+a delayed loop keeps :data:`MAX_DOUBLINGS` (a PID on ``12.98/s`` behind 5.2 ms is still "undetermined")."""
 
 TAIL_SHARE = 0.05
 """What the step may still move after the horizon, as a share of the settling band (``settle_band`` times the
@@ -307,8 +310,10 @@ class StepResponse(Requirement):
         with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
             needed = np.log(np.maximum(weights * poles.size / (TAIL_SHARE * band), 1.0)) / -poles.real
         longest = float(np.max(needed, initial=0.0))
-        start = 0 if longest <= first else int(min(POLE_DOUBLINGS, np.ceil(np.log2(longest / first))))
-        return _Plan(final, poles, weights, band, first, start, max(MAX_DOUBLINGS, start + 2))
+        cap = POLE_DOUBLINGS if loop.delay == 0.0 else MAX_DOUBLINGS  # a delayed loop's step is simulated
+        start = 0 if longest <= first else int(min(cap, np.ceil(np.log2(longest / first))))
+        return _Plan(final, poles, weights, band, first, start, max(MAX_DOUBLINGS, start + 2) if cap > MAX_DOUBLINGS
+                     else MAX_DOUBLINGS)
 
     def _exact_outcomes(self, loops: list[Loop]) -> list[_Outcome]:
         """The step of each loop (stable, without a delay), all at once: the loops needing the same doublings
