@@ -417,30 +417,39 @@ def _with_extremes(t: np.ndarray, y: np.ndarray, error: np.ndarray, dt: float, f
 
     Examples
     --------
-    >>> fine = np.array([0.0, 0.5, 1.2, 1.0, 1.0])  # held at 0.25 s: a peak at 0.5 s
-    >>> out = _with_extremes(np.array([0.0, 1.0]), np.array([0.0, 1.0]), np.zeros(2), 0.25, fine, fine[::2],
-    ...                      np.zeros(2))
-    >>> out[0].tolist(), out[1].tolist()
-    ([0.0, 0.5, 1.0], [0.0, 1.2, 1.0])
+    >>> fine = np.r_[np.linspace(0, 1.2, 6), np.linspace(1.15, 1.0, 11)]  # held at 0.25 s: a peak at 1.25 s
+    >>> out = _with_extremes(np.array([0.0, 2.0, 4.0]), fine[[0, 8, 16]], np.zeros(3), 0.25, fine, fine[::2],
+    ...                      np.zeros(5))
+    >>> out[0].tolist(), np.round(out[1], 3).tolist()
+    ([0.0, 1.25, 2.0, 4.0], [0.0, 1.2, 1.12, 1.0])
     """
-    times = dt * np.arange(fine.size)
-    inside = times <= t[-1] * (1.0 + 1e-12)
-    times = times[inside]
-    with np.errstate(over="ignore", invalid="ignore"):
-        values = fine[inside] + _on_grid(times, 2.0 * dt, fine[::2] - half) + _on_grid(times, 4.0 * dt, gap)
-    if times.size < 3 or not np.all(np.isfinite(values)) or not np.all(np.isfinite(y)):
+    last = min(int(np.floor(t[-1] * (1.0 + 1e-12) / dt)), fine.size - 1)  # the fine samples within t
+    if last < 8 or not np.all(np.isfinite(y)):
         return t, y, dt, error
-    second = np.abs(np.diff(fine[inside], 2))
-    extra = [k for k, beyond in ((int(np.argmax(values)), values.max() > y.max()),
-                                 (int(np.argmin(values)), values.min() < y.min())) if beyond]
-    extra = sorted({k for k in extra if not np.any(np.isclose(t, times[k], rtol=0.0, atol=1e-12 * t[-1]))})
+    with np.errstate(over="ignore", invalid="ignore"):  # the extrapolated response at every fourth sample first
+        coarse = (fine[::4] + (fine[::2] - half)[::2] + gap)[:last // 4 + 1]
+    if not np.all(np.isfinite(coarse)):
+        return t, y, dt, error
+    extra = []
+    for j, higher in ((int(np.argmax(coarse)), True), (int(np.argmin(coarse)), False)):
+        lo, hi = max(4 * j - 4, 0), min(4 * j + 4, last)  # then every sample around it
+        times = dt * np.arange(lo, hi + 1)
+        with np.errstate(over="ignore", invalid="ignore"):
+            values = fine[lo:hi + 1] + _on_grid(times, 2.0 * dt, fine[::2] - half) + _on_grid(times, 4.0 * dt, gap)
+        k = int(np.argmax(values) if higher else np.argmin(values))
+        if ((values[k] > y.max()) if higher else (values[k] < y.min())) and not np.any(
+                np.isclose(t, times[k], rtol=0.0, atol=1e-12 * t[-1])):
+            i = lo + k
+            second = np.abs(np.diff(fine[max(i - 2, 0):i + 3], 2))
+            extra.append((times[k], values[k], float(_on_grid(times[k:k + 1], 4.0 * dt, np.abs(gap))[0])
+                          + float(np.max(second, initial=0.0)) / 8))
     if not extra:
         return t, y, dt, error
-    at = np.array([times[k] for k in extra])
-    bound = np.array([float(_on_grid(times[k:k + 1], 4.0 * dt, np.abs(gap))[0])
-                      + float(np.max(second[max(k - 2, 0):k + 1], initial=0.0)) / 8 for k in extra])
+    extra = sorted({e[0]: e for e in extra}.values())
+    at = np.array([e[0] for e in extra])
     where = np.searchsorted(t, at)
-    return (np.insert(t, where, at), np.insert(y, where, values[extra]), dt, np.insert(error, where, bound))
+    return (np.insert(t, where, at), np.insert(y, where, [e[1] for e in extra]), dt,
+            np.insert(error, where, [e[2] for e in extra]))
 
 
 def _between_samples(t: np.ndarray, h: float, values: np.ndarray) -> np.ndarray:
