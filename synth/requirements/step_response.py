@@ -310,10 +310,11 @@ class StepResponse(Requirement):
         with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
             needed = np.log(np.maximum(weights * poles.size / (TAIL_SHARE * band), 1.0)) / -poles.real
         longest = float(np.max(needed, initial=0.0))
-        cap = POLE_DOUBLINGS if loop.delay == 0.0 else MAX_DOUBLINGS  # a delayed loop's step is simulated
-        start = 0 if longest <= first else int(min(cap, np.ceil(np.log2(longest / first))))
-        return _Plan(final, poles, weights, band, first, start, max(MAX_DOUBLINGS, start + 2) if cap > MAX_DOUBLINGS
-                     else MAX_DOUBLINGS)
+        exact = loop.delay == 0.0  # a delayed loop's step is simulated: it keeps MAX_DOUBLINGS
+        start = 0 if longest <= first else int(min(POLE_DOUBLINGS if exact else MAX_DOUBLINGS,
+                                                   np.ceil(np.log2(longest / first))))
+        last = max(MAX_DOUBLINGS, start + 2) if exact else MAX_DOUBLINGS
+        return _Plan(final, poles, weights, band, first, start, last)
 
     def _exact_outcomes(self, loops: list[Loop]) -> list[_Outcome]:
         """The step of each loop (stable, without a delay), all at once: the loops needing the same doublings
