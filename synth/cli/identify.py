@@ -207,7 +207,8 @@ def _print(result: Any, args: argparse.Namespace, json_path: Path, figures: list
         print(f"note: {note}")
     avg = result.average
     if avg is not None:
-        print(f"averaged {avg.count} {avg.mode}s ({avg.up} up, {avg.down} down steps, {avg.dropped} dropped): "
+        print(f"averaged {avg.count} {avg.mode}s ({avg.up} up, {avg.down} down steps, {avg.dropped} dropped"
+              f"{f', {avg.in_gaps} of them holding a gap in the log' if avg.in_gaps else ''}): "
               f"SNR {avg.snr_before_db:.1f} dB -> {avg.snr_after_db:.1f} dB "
               f"(noise std {avg.noise_std_before:.3g} -> {avg.noise_std_after:.3g}, step {avg.step_size:.4g})")
     if result.whole_record_note:

@@ -17,6 +17,7 @@ from typing import Any
 
 import numpy as np
 
+from synth.data.gaps import find_gaps, hidden_changes
 from synth.data.interpolated_noise import interpolation_noise_factor
 from synth.data.readers import Table, read_table, table_from_columns, time_scale
 from synth.errors import DataError
@@ -54,6 +55,9 @@ class Record:
         What a fit's white-noise variance estimate is multiplied by for its parameters' uncertainty: 1, unless
         the output was interpolated from uneven time stamps (then adjacent samples share logged samples' noise;
         :func:`synth.data.interpolated_noise.interpolation_noise_factor`).
+    gaps : tuple of (float, float)
+        Gaps in the logged time stamps (:func:`synth.data.gaps.find_gaps`): the stamps before and after each. The
+        samples inside were made up by the resampling; fits weight them 0 and averages leave them out.
 
     Examples
     --------
@@ -72,6 +76,7 @@ class Record:
     source: str = "arrays"
     notes: tuple[str, ...] = ()
     noise_factor: float = 1.0
+    gaps: tuple[tuple[float, float], ...] = ()
 
     @property
     def n(self) -> int:
@@ -106,7 +111,8 @@ class Record:
         if np.count_nonzero(keep) < 2:
             raise DataError(f"segment [{t0}, {t1}] s holds fewer than 2 samples", where=self.source)
         return Record(self.t[keep], self.u[keep], self.y[keep], self.input, self.output,
-                      {k: v[keep] for k, v in self.aux.items()}, self.source, self.notes, self.noise_factor)
+                      {k: v[keep] for k, v in self.aux.items()}, self.source, self.notes, self.noise_factor,
+                      tuple(g for g in self.gaps if g[1] > t0 and g[0] < t1))
 
     def require_duration(self, w_min: float) -> None:
         """Raise unless the record is long enough to resolve ``w_min`` [rad/s].
@@ -139,7 +145,8 @@ class Record:
                 "input": {"name": self.input.name, "unit": self.input.unit},
                 "output": {"name": self.output.name, "unit": self.output.unit},
                 "aux": sorted(self.aux), "notes": list(self.notes),
-                **({"noise_factor": self.noise_factor} if self.noise_factor != 1.0 else {})}
+                **({"noise_factor": self.noise_factor} if self.noise_factor != 1.0 else {}),
+                **({"gaps": [list(g) for g in self.gaps]} if self.gaps else {})}
 
 
 def uniform_columns(
@@ -216,40 +223,10 @@ def uniform_columns(
         steps = np.diff(tt)
     spread = (steps.max() - steps.min()) / np.median(steps)
     if spread > IRREGULAR_TOLERANCE:
-        notes += _hidden_changes(tt, arrays, [h for h in held if h in arrays], steps)
+        notes += hidden_changes(tt, arrays, [h for h in held if h in arrays])
         tt, arrays, note = _resample(tt, arrays, [h for h in held if h in arrays])
         notes += (f"resampled: sample intervals ranged {steps.min():.4g}-{steps.max():.4g} s; {note}",)
     return tt, arrays, notes
-
-
-GAP_FACTOR = 5.0
-"""An interval between time stamps this many times the median is a gap in the log (:func:`_hidden_changes`)."""
-
-
-def _hidden_changes(tt: np.ndarray, arrays: dict[str, np.ndarray], held: list[str], steps: np.ndarray
-                    ) -> tuple[str, ...]:
-    """A note for each held column (the command) that changed across a gap in the time stamps: the record does not
-    say when (a 0.3 s dropout hiding one edge of a step train put K 3 % off, 44 of its standard errors, without a
-    word).
-
-    Examples
-    --------
-    >>> t = np.r_[np.arange(0, 1, 0.01), np.arange(1.3, 2, 0.01)]; u = (t > 1.1) * 1.0
-    >>> _hidden_changes(t, {"u": u}, ["u"], np.diff(t))[0][:60]
-    "'u' changed inside a 0.31 s gap in the time stamps (t = 0.99"
-    """
-    gaps = np.flatnonzero(steps > GAP_FACTOR * np.median(steps))
-    out = []
-    for h in held:
-        hidden = [k for k in gaps if arrays[h][k + 1] != arrays[h][k]]
-        if hidden:
-            k = hidden[0]
-            more = f" (and {len(hidden) - 1} more)" if len(hidden) > 1 else ""
-            out.append(f"'{h}' changed inside a {steps[k]:.3g} s gap in the time stamps (t = {tt[k]:.6g}-"
-                       f"{tt[k + 1]:.6g} s){more}: the record does not say when; the command as logged holds its old "
-                       "level to the gap's end, so a fit may place that edge late (cut the record there, or give it "
-                       "a weight of 0)")
-    return tuple(out)
 
 
 def _resample(tt: np.ndarray, arrays: dict[str, np.ndarray], held: list[str]
@@ -364,7 +341,8 @@ def record_from_arrays(
             notes += (f"the interpolated output shares each logged sample's noise between grid samples: a fit's "
                       f"noise variance is taken {noise_factor:.3g} times its residuals' for the parameters' "
                       "uncertainty",)
-    return Record(tt, uu, yy, input, output, arrays, source, notes, float(noise_factor))
+    gaps = find_gaps(np.asarray(t, dtype=float).ravel())  # none on a uniform grid
+    return Record(tt, uu, yy, input, output, arrays, source, notes, float(noise_factor), gaps)
 
 
 def read_columns(path: str | Path) -> dict[str, np.ndarray]:

@@ -37,7 +37,7 @@ import numpy as np
 from synth.data.record import Record
 from synth.distributions import norm_sf
 from synth.ident.exchangeable import relabel_fit
-from synth.ident.steps import StepAverage, Steps, average_steps, find_steps
+from synth.ident.steps import StepAverage, Steps, average_steps, find_steps, late_steps
 from synth.ident.structure import Structure
 from synth.ident.timefit import TimeFitResult, fit_structure
 from synth.plant import Plant
@@ -283,7 +283,8 @@ def unsettled_fraction(record: Record, steps: Steps, models: list[Plant]) -> flo
     from synth.ident.simulate import simulate_plant
 
     edges = np.asarray(record.t, float)[steps.index]
-    gaps = np.diff(edges)
+    late = late_steps(record, steps)  # shown late by a gap in the log: their windows are not averaged
+    gaps = np.diff(edges)[~(late[1:] | late[:-1])]
     if gaps.size == 0:
         return 0.0
     grid = np.linspace(0.0, float(gaps.max()), 4001)

@@ -16,6 +16,7 @@ from typing import Any
 import numpy as np
 
 from synth.data.coerce import RecordLike, as_record
+from synth.data.gaps import gap_weights
 from synth.data.record import Record
 from synth.errors import DataError, FitError, ModelError
 from synth.ident.directions import DirectionComparison, fit_by_direction
@@ -208,6 +209,7 @@ def identify(record: RecordLike, structure: Structure | str, delay: str | float 
             raise both_failed(whole_error) from None
         if not _unstable(whole_fit.measured):
             whole_fit = _other_pair_minima(record, whole_fit, structure, delay, sensor)
+            whole_fit = _settle_after_hidden_edges(record, whole_fit, structure, delay, sensor)
             try:  # it too assumes the plant at rest at the first input sample
                 whole_fit, from_later = fit_from_unknown_start(record, whole_fit, structure, delay, sensor)
             except FitError as whole_error:
@@ -228,6 +230,7 @@ def identify(record: RecordLike, structure: Structure | str, delay: str | float 
             fit, avg, whole = refit_periodic_start(record, avg, fit, structure, delay, sensor)
     fit = _other_pair_minima(record, fit, structure, delay, sensor)
     if avg is None:  # a start state that is not at rest is left out (synth.ident.unknown_start)
+        fit = _settle_after_hidden_edges(record, fit, structure, delay, sensor)
         fit, whole = fit_from_unknown_start(record, fit, structure, delay, sensor)
     directions, note = None, ""
     if two_ways and (compare_directions or by_direction):
@@ -322,6 +325,25 @@ def _other_pair_minima(record: Record, fit: TimeFitResult, structure: Structure,
     return relocate_pair(record, fit, structure, delay, sensor)
 
 
+def _settle_after_hidden_edges(record: Record, fit: TimeFitResult, structure: Structure, delay: str | float | None,
+                               sensor: Plant | str | None) -> TimeFitResult:
+    """A fit of the whole record refitted with the model's settling time after each gap in the log that hid a
+    command change weighted 0 (:func:`synth.data.gaps.gap_weights`): the edge came at an unknown time inside the
+    gap, so the simulated response to it is wrong until it has settled. As it is when there is no such gap, the
+    model does not settle, or the refit fails (the record's note names the gap)."""
+    settle = settling_time(fit.measured)
+    if not record.gaps or fit.periodic or fit.t.size != record.n or not np.isfinite(settle):
+        return fit
+    weights = gap_weights(record.t, record.u, record.gaps, settle, fit.weights)
+    if weights is None or (fit.weights is not None and np.array_equal(weights, fit.weights)):
+        return fit
+    try:
+        return fit_structure(record, structure, delay, sensor, False, initial={**fit.parameters}, weights=weights,
+                             check=True)
+    except (DataError, FitError):
+        return fit
+
+
 def _implausible_average_fit(fit: TimeFitResult, dt: float) -> str:
     """Why the fit of a step average is not a model of the record ('' when it may be): unstable although the
     steps settle, or a pole or zero of the identified plant beyond the record's Nyquist frequency, which no
@@ -364,7 +386,7 @@ def _refit_unsettled(record: Record, avg: StepAverage, fit: TimeFitResult, struc
            f"{100 * UNSETTLED_FACTOR * left:.2g} % in the edge fit, more than its parameters' finest relative "
            f"standard error ({100 * finest:.2g} %)")
     skip = min(settle, 0.25 * record.duration)
-    weights = ((record.t - record.t[0]) >= skip).astype(float)
+    weights = gap_weights(record.t, record.u, record.gaps, settle, ((record.t - record.t[0]) >= skip).astype(float))
     # the edge fit is the natural start, unless the average pulled a pole or zero beyond the record's Nyquist
     # frequency, which no sampled record resolves: then the whole record's own deterministic start comes first
     beyond = beyond_nyquist(fit.plant, record.dt)
@@ -407,7 +429,7 @@ def _refit_from_rest(record: Record, avg: StepAverage, fit: TimeFitResult, struc
     if not np.isfinite(settle) or first <= 0 or (first < settle and not fit.weak):
         return fit, ""
     skip = min(settle, first)
-    weights = ((record.t - record.t[0]) >= skip).astype(float)
+    weights = gap_weights(record.t, record.u, record.gaps, settle, ((record.t - record.t[0]) >= skip).astype(float))
     try:
         whole = fit_whole_record(record, structure, delay, sensor, {**fit.parameters}, weights)
     except (DataError, FitError) as exc:

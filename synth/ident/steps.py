@@ -37,15 +37,17 @@ and ``sigma`` the standard deviation of the noise:
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from itertools import pairwise
 from typing import Any
 
 import numpy as np
 
+from synth.data.gaps import gap_mask
 from synth.data.record import Record, record_from_arrays
 from synth.errors import DataError
 from synth.plant import Signal
 
-__all__ = ["StepAverage", "Steps", "average_steps", "find_steps"]
+__all__ = ["StepAverage", "Steps", "average_steps", "find_steps", "late_steps"]
 
 
 @dataclass(frozen=True)
@@ -165,7 +167,7 @@ class StepAverage:
         Up and down steps inside the averaged windows.
     dropped : int
         Windows not used (the first period in ``"cycle"`` mode; in ``"edge"`` mode a last step closer to the
-        record's end than the shortest time between two steps).
+        record's end than the shortest time between two steps; in both, windows that hold a gap in the log).
     step_size : float
         Output step size of the averaged response (see the module docstring).
     noise_std_before, noise_std_after : float
@@ -180,6 +182,9 @@ class StepAverage:
         Sample of the record where the first averaged window starts (``"cycle"`` mode; 0 otherwise).
     noise_factor : float
         The record's :attr:`~synth.data.Record.noise_factor`, carried to :meth:`record`.
+    in_gaps : int
+        Windows left out because they hold samples a gap in the log made up (:mod:`synth.data.gaps`; counted in
+        ``dropped`` too).
     """
 
     mode: str
@@ -203,6 +208,7 @@ class StepAverage:
     up_index: int = 0
     first_window: int = 0
     noise_factor: float = 1.0
+    in_gaps: int = 0
 
     def record(self) -> Record:
         """The averaged window as a :class:`~synth.data.Record` (time starting at the window's start).
@@ -233,22 +239,44 @@ class StepAverage:
                 "step_size": self.step_size, "noise_std_before": self.noise_std_before,
                 "noise_std_after": self.noise_std_after, "snr_before_db": self.snr_before_db,
                 "snr_after_db": self.snr_after_db, "snr_gain_db": self.snr_after_db - self.snr_before_db,
-                "periodic": self.periodic, "steps": self.steps.to_dict()}
+                "periodic": self.periodic, "steps": self.steps.to_dict(), "in_gaps": self.in_gaps}
 
 
-def _is_periodic(steps: Steps) -> tuple[int, int] | None:
-    """``(period, high samples)`` if the steps alternate at a constant period (to one sample)."""
+def _is_periodic(steps: Steps, late: np.ndarray | None = None) -> tuple[int, int] | None:
+    """``(period, high samples)`` if the steps alternate at a constant period (to one sample), not counting the
+    intervals that end or start at a step marked ``late`` (its edge hidden in a gap of the log, :func:`late_steps`)."""
     d, i = steps.direction, steps.index
-    ups = i[d > 0]
-    if ups.size < 2 or np.any(d[1:] == d[:-1]):
+    late = np.zeros(i.size, bool) if late is None else late
+    if np.sum(d > 0) < 2 or np.any(d[1:] == d[:-1]):
         return None
-    periods = np.diff(ups)
-    if np.ptp(periods) > 1:
-        return None
-    high_times = [int(i[k + 1] - i[k]) for k in range(i.size - 1) if d[k] > 0]
-    if not high_times or np.ptp(high_times) > 1:
+    up = np.flatnonzero(d > 0)
+    periods = [int(i[b] - i[a]) for a, b in pairwise(up) if not (late[a] or late[b])]
+    high_times = [int(i[k + 1] - i[k]) for k in range(i.size - 1) if d[k] > 0 and not (late[k] or late[k + 1])]
+    if not periods or not high_times or np.ptp(periods) > 1 or np.ptp(high_times) > 1:
         return None
     return int(np.min(periods)), int(np.min(high_times))
+
+
+def late_steps(record: Record, steps: Steps) -> np.ndarray:
+    """Steps whose edge a gap in the log hid: the sample before the step was made up by the gap
+    (:func:`synth.data.gaps.gap_mask`), so the step shows at the gap's end, late by up to the gap.
+
+    Examples
+    --------
+    >>> t = np.r_[np.arange(0, 1, 0.01), np.arange(1.3, 3, 0.01)]
+    >>> rec = record_from_arrays(t, ((t > 1.1) & (t < 2)) * 1.0, np.sin(t))
+    >>> late_steps(rec, find_steps(rec)).tolist()   # the up step hidden in the gap, the down step on time
+    [True, False]
+    """
+    made_up = gap_mask(record.t, record.gaps)
+    return made_up[np.maximum(steps.index - 1, 0)]
+
+
+def _clear(record: Record, starts: np.ndarray, length: int) -> np.ndarray:
+    """Windows ``[start, start + length)`` that hold no sample a gap in the log made up."""
+    made_up = np.concatenate([[0], np.cumsum(gap_mask(record.t, record.gaps))])
+    lo, hi = np.clip(starts, 0, record.n), np.clip(starts + length, 0, record.n)
+    return made_up[hi] - made_up[lo] == 0
 
 
 def _noise(windows: np.ndarray) -> tuple[float, float]:
@@ -319,7 +347,7 @@ def average_steps(record: Record, steps: Steps | None = None, mode: str = "auto"
         if not np.any(steps.direction == direction):
             raise DataError(f"no {'up' if direction > 0 else 'down'} step in the input", where=record.source)
         return _average_edges(record, steps, pre, direction)
-    periodic = _is_periodic(steps)
+    periodic = _is_periodic(steps, late_steps(record, steps))
     if mode == "cycle" and periodic is None:
         raise DataError("the input is not a periodic square wave (steps must alternate at a constant period); "
                         "use mode='edge'", where=record.source)
@@ -335,6 +363,9 @@ def _average_cycles(record: Record, steps: Steps, period: int, high: int, settle
     keep = (starts >= 0) & (starts + period <= record.n)
     first = int(np.argmax(keep)) if np.any(keep) else 0
     keep &= starts - steps.index[0] >= settle / record.dt - 1e-9
+    clear = _clear(record, starts, period)
+    in_gaps = int(np.sum(keep & ~clear))
+    keep &= clear
     use = [s for j, s in enumerate(starts) if keep[j] and j > first]  # drop the period holding the first step
     if not use and np.count_nonzero(keep) == 1:
         raise DataError("only one complete period in the record; a periodic average needs two", where=record.source)
@@ -350,13 +381,14 @@ def _average_cycles(record: Record, steps: Steps, period: int, high: int, settle
     t = (np.arange(period) - low_time) * record.dt
     return StepAverage("cycle", t, u, y, len(use), len(use), len(use), int(ups.size) - len(use), step, before, after,
                        _snr(step, before), _snr(step, after), True, steps, record.input, record.output, record.source,
-                       low_time, int(use[0]), record.noise_factor)
+                       low_time, int(use[0]), record.noise_factor, in_gaps)
 
 
 def _average_edges(record: Record, steps: Steps, pre: float | None, direction: int = 0) -> StepAverage:
     # the window is the shortest time between two steps; a last step closer to the record's end than that is
     # left out (its window would run past the end) rather than shortening every window to what is left of it
-    between = np.diff(steps.index)
+    late = late_steps(record, steps)
+    between = np.diff(steps.index)[~(late[1:] | late[:-1])]  # a late step's intervals do not set the window
     tail = record.n - int(steps.index[-1])
     post = int(np.min(between)) if between.size else tail
     keep = steps.direction == direction if direction else np.ones(steps.count, bool)
@@ -367,11 +399,17 @@ def _average_edges(record: Record, steps: Steps, pre: float | None, direction: i
         if not np.any(keep):
             post = tail  # the only step of its direction: its window is what the record has
             keep[-1], cut = True, 0
-    idx, dirs = steps.index[keep], steps.direction[keep]
     if pre is None:
         n_pre = min(max(1, post // 10), int(steps.index[0]))
     else:
         n_pre = round(pre / record.dt)
+    clear = _clear(record, steps.index - n_pre, n_pre + post)
+    in_gaps = int(np.sum(keep & ~clear))
+    if in_gaps and np.any(keep & clear):
+        keep &= clear
+    else:
+        in_gaps = 0  # every window holds a gap: averaged as they are (the fit weights the made-up samples 0)
+    idx, dirs = steps.index[keep], steps.direction[keep]
     if n_pre < 1 or n_pre > idx[0]:
         raise DataError(f"need at least one sample before the first step (at t = {record.t[idx[0]]:g} s) and pre "
                         f"<= the time before it", where=record.source)
@@ -389,6 +427,6 @@ def _average_edges(record: Record, steps: Steps, pre: float | None, direction: i
     before, after = _noise(yw)
     t = np.arange(-n_pre, post) * record.dt
     ups = int(np.sum(dirs > 0))
-    return StepAverage("edge", t, u, y, int(idx.size), ups, int(idx.size) - ups, cut, step, before, after,
+    return StepAverage("edge", t, u, y, int(idx.size), ups, int(idx.size) - ups, cut + in_gaps, step, before, after,
                        _snr(step, before), _snr(step, after), False, steps, record.input, record.output, record.source,
-                       n_pre, 0, record.noise_factor)
+                       n_pre, 0, record.noise_factor, in_gaps)

@@ -2,10 +2,9 @@
 
 The model, its exact zero-order-hold discretization with a fractional delay and the
 Gauss-Newton IPOPT problem are in :mod:`synth.ident.sim_error_problem`; the
-deterministic start (SRIVC on a delay grid, mapped onto the structure) in
-:mod:`synth.ident.srivc`. Here: the fit itself (the whole-sample delay search, the
-fallback starts) and its uncertainty; :func:`synth.ident.identification.identify` averages a
-step train first.
+deterministic start (SRIVC on a delay grid, mapped onto the structure) in :mod:`synth.ident.srivc`. Here: the
+fit itself (the whole-sample delay search, the fallback starts) and its uncertainty;
+:func:`synth.ident.identification.identify` averages a step train first.
 
 Delay search
 ------------
@@ -34,6 +33,7 @@ from typing import Any
 
 import numpy as np
 
+from synth.data.gaps import gap_weights
 from synth.data.record import Record
 from synth.distributions import t_ppf
 from synth.errors import DataError, FitError, ModelError
@@ -267,7 +267,8 @@ def fit_structure(record: Record, structure: Structure | str, delay: str | float
         left half-plane); the others are free.
     weights : numpy.ndarray, optional
         Per-sample 0/1 weights of the cost (0: simulated but not fitted, e.g. held-out segments or a start-up
-        transient from an unknown initial state); the residual statistics use the weighted samples only.
+        transient from an unknown initial state); the residual statistics use the weighted samples only. Samples
+        that gaps in the record's log made up are weighted 0 too (:func:`synth.data.gaps.gap_weights`).
     check : bool
         Raise :class:`~synth.errors.FitError` when the fit failed (what :func:`synth.ident.identification.identify`,
         ``synth identify`` and :func:`synth.ident.directions.fit_by_direction` do). Without it the reason is in
@@ -350,15 +351,14 @@ def fit_structure(record: Record, structure: Structure | str, delay: str | float
         raise DataError("a periodic fit (an averaged step train) needs a model without an integrator (no unique "
                         "periodic state); fit the record as it is (average='none', --average none)", record.source)
     has_d = (st.num_degree == st.den_degree) and sensor is None
-    mask = None
     if weights is not None:
         weights = np.asarray(weights, float)
         if weights.shape != (n,) or not np.all((weights == 0) | (weights == 1)):
             raise ModelError(f"weights must be {n} values of 0 or 1", where="weights")
-        mask = weights > 0
-        if int(mask.sum()) <= p_total + 1:
-            raise DataError(f"{int(mask.sum())} weighted samples cannot determine {p_total} parameters",
-                            where=record.source)
+    weights = gap_weights(t, u, record.gaps, weights=weights)  # what gaps in the log made up: weight 0
+    mask = None if weights is None else weights > 0
+    if mask is not None and int(mask.sum()) <= p_total + 1:
+        raise DataError(f"{int(mask.sum())} weighted samples cannot determine {p_total} parameters", record.source)
     if solver not in ("auto", "ipopt", "convolution"):
         raise ModelError(f"solver must be 'auto', 'ipopt' or 'convolution', got {solver!r}", where="solver")
     if solver == "convolution" or (solver == "auto" and n > LONG_RECORD):
