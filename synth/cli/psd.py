@@ -149,7 +149,9 @@ def run(args: argparse.Namespace) -> int:
                                  for s in a.spikes[:8]) + (" ..." if len(a.spikes) > 8 else "") or "none"),
             (f"{100 * a.share:g} % of disturbance power below",
              f"{a.share_frequency:.4g} rad/s (spikes counted: {a.share_frequency_with_spikes:.4g} rad/s)"
-             if a.share_frequency is not None else "undefined"),
+             if a.share_frequency is not None else "undefined" + (
+                 f" (spikes counted: {a.share_frequency_with_spikes:.4g} rad/s)"
+                 if a.share_frequency_with_spikes is not None else "")),
             ("variance", f"{raw_var:.4g} {u2}, mean square about the mean of the raw samples (the spectrum "
                          f"integrates to {a.total_power:.4g} "
                             f"{u2}; above the floor: {a.disturbance_power:.4g} {u2}, scatter "

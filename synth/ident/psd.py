@@ -28,6 +28,7 @@ put together:
 
 from __future__ import annotations
 
+import contextlib
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
@@ -269,10 +270,18 @@ def analyze_psd(signals: Sequence[np.ndarray], dt: float, share: float = 0.9, ba
     wf = wf_spikes = None
     sq = unit_squared(unit)
     if disturbance <= SIGNIFICANCE_Z * scatter:
-        withheld = (f"not significant: the power above the floor, {disturbance:.3g} {sq} "
+        broadband = "the broadband power above the floor (spikes left out)" if spikes else "the power above the floor"
+        withheld = (f"not significant: {broadband}, {disturbance:.3g} {sq} "
                     f"({100 * disturbance / total:.2g} % of the mean square), is within the scatter of the Welch "
                     f"estimate ({SIGNIFICANCE_Z:.2f} sigma = {SIGNIFICANCE_Z * scatter:.3g} {sq}, chi-square with "
                     f"{effective_dof(k):.3g} degrees of freedom per bin; false-alarm rate {100 * FALSE_ALARM_RATE:g} %)")
+        if spikes:  # a tone far above the floor is significant: say what it carries, and where the power lies with it
+            tones = float(np.sum((S - smooth)[mask]) * dw)
+            withheld += (f"; the {len(spikes)} spike(s) carry {tones:.3g} {sq} ({100 * tones / total:.3g} % of the "
+                         "mean square): tones, listed with their amplitudes, which a loop rejects only with its "
+                         "bandwidth above them (or a notch)")
+            with contextlib.suppress(DataError):
+                wf_spikes = share_frequency(w, S - floor, share)
         notes.append(f"no share frequency and no bandwidth requirement: {withheld}")
     else:
         try:
