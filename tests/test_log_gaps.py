@@ -103,3 +103,4 @@ def test_a_hidden_edge_no_longer_biases_the_fit_on_random_trains():
             if average == "auto" and res.average is not None:
                 assert res.average.in_gaps >= 1
     assert worst > 0.0
+

@@ -244,7 +244,7 @@ def identify(record: RecordLike, structure: Structure | str, delay: str | float 
     if by_direction and directions is not None:
         _require_settled_windows(directions, record.source)
     return IdentifyResult(record, fit, avg, directions, note, by_direction,
-                          "; ".join(x for x in (not_averaged, whole) if x))
+                          "; ".join(x for x in (not_averaged, whole, _aliased_delay(delay, fit, avg)) if x))
 
 
 def _require_settled_windows(directions: DirectionComparison, source: str) -> None:
@@ -285,6 +285,23 @@ def _integrates(structure: Structure) -> bool:
     """
     den = structure.coefficients(np.ones(len(structure.parameters)))[1]
     return bool(den.size > 1 and den[-1] == 0.0)
+
+
+def _aliased_delay(delay: str | float | None, fit: TimeFitResult, avg: StepAverage | None) -> str:
+    """A note when a fixed delay is a period or more of the periodic average that was fitted: the periodic steady
+    state cannot tell it from its remainder (4.05 s on a 4 s train fits as 0.05 s does)."""
+    if avg is None or not fit.periodic or delay is None or isinstance(delay, bool):
+        return ""
+    try:
+        value = float(delay)  # "fit" is not a number
+    except (TypeError, ValueError):
+        return ""
+    period = float(avg.t[-1] - avg.t[0] + avg.t[1] - avg.t[0])
+    if not value >= period:
+        return ""
+    return (f"the fixed delay {value:.6g} s is not shorter than the averaged train's period ({period:.6g} s): its "
+            f"periodic steady state fits {value % period:.6g} s exactly as well, so the record does not confirm the "
+            "delay as given")
 
 
 def _check_fixed_delay(delay: str | float | None, record: Record) -> None:
