@@ -125,8 +125,7 @@ def split_heldout(plant: Plant, record: Record, validate: Record | Sequence[Reco
     joined = None
     if validate is None and split == "tail":
         k = round(train_fraction * record.n)
-        train = Record(record.t[:k], record.u[:k], record.y[:k], record.input, record.output, source=record.source,
-                       noise_factor=record.noise_factor)
+        train = record.segment(float(record.t[0]), float(record.t[k - 1]))  # keeps its notes and gaps
         evaluated = record
         held = np.arange(record.n) >= k
     elif validate is None:  # interleaved: odd segments held out, the fits count the even ones
