@@ -104,3 +104,20 @@ def test_a_hidden_edge_no_longer_biases_the_fit_on_random_trains():
                 assert res.average.in_gaps >= 1
     assert worst > 0.0
 
+
+
+def test_a_record_not_at_rest_keeps_the_settling_after_a_hidden_edge_out_of_its_fit():
+    """The fit that leaves out a start not at rest (synth.ident.unknown_start) weights the settling after the
+    hidden edge 0 as well, and lands within 4 reported std of the truth."""
+    rng = np.random.default_rng(5)
+    for _ in range(2):
+        t, u, y, truth = _train(rng, False, hide_edge=True)
+        i = int(np.flatnonzero(np.diff(u))[0]) + 5  # five samples after the first edge: the plant is moving
+        res = identify((t[i:], u[i:], y[i:]), "K/(T*s+1)", delay="fit", average="none", compare_directions=False)
+        assert "does not start at rest" in res.whole_record_note
+        fit = res.fit
+        (before, after), = find_gaps(t[i:])
+        settling = (fit.t > before + 1e-6) & (fit.t < after + truth["T"])  # the logged sample at `before` counts
+        assert settling.any() and np.all(fit.weights[settling] == 0)
+        for name, value in truth.items():
+            assert abs(fit.parameters[name] - value) < 4.0 * fit.std[name], (name, fit.parameters, truth, fit.std)

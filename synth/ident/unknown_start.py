@@ -76,6 +76,8 @@ def fit_from_unknown_start(record: Record, fit: TimeFitResult, structure: Struct
             why = f"and leaving out {skip:.3g} s would keep less than {1 - KEEP:.0%} of the record"
             break
         weights = ((record.t - record.t[0]) >= skip - 1e-9 * record.dt).astype(float)
+        if original.weights is not None and original.weights.shape == weights.shape:
+            weights = weights * original.weights  # what the fit left out already (e.g. after a gap in the log)
         try:
             fit = _refit(record, structure, delay, sensor, weights, fit, alternative=round_ == 0)
         except (DataError, FitError) as exc:
