@@ -7,8 +7,8 @@ poles, integrators, right-half-plane zeros, lightly damped pairs, delays). It wa
 problems of indices 0-92 whose synth design and reference search took the least CPU time in one run, per
 structure, before the outcome was looked at. (The PID pair was chosen again in session 57, when the first pair,
 #14 and #90, had come to take 9-19 s each: over all 93 problems as PIDs, timed in one run, the two cheapest on which
-synth gives a verdict, #48 and #70, 0.5-0.6 s; the two cheaper still, #55 and #74, end "undetermined" and would
-test no PID design.) Asserted: synth never says "infeasible" where the reference
+synth gives a verdict, #48 and #70, 0.5 and 0.8 s (the median PID: 13 s); #55, #74, #47 and #82, as cheap, end
+"undetermined" and would test no PID design.) Asserted: synth never says "infeasible" where the reference
 holds a point that passes its dense check, synth's design always passes that check, synth never crashes (a
 one-line ``SynthError`` is a refusal, not a crash), and its objective is never more than 5 % worse than the
 reference's best and within 1 % of it in at least 95 % of the feasible problems. Eight more problems have
