@@ -67,8 +67,9 @@ def gap_mask(t: np.ndarray, gaps: Sequence[tuple[float, float]]) -> np.ndarray:
 def gap_weights(t: np.ndarray, u: np.ndarray, gaps: Sequence[tuple[float, float]], settle: float = 0.0,
                 weights: np.ndarray | None = None) -> np.ndarray | None:
     """0/1 weights of a fit that leave out what gaps made up: the samples inside each gap, and after a gap across
-    which the command ``u`` changed (its edge came at an unknown time inside) the next ``settle`` seconds too,
-    while the response to that edge (simulated at the gap's end) differs from the true one. ``weights``, if given,
+    which the command ``u`` changed (its edge came at an unknown time inside), or one longer than the command's
+    shortest hold (it may hide a change and its return), the next ``settle`` seconds too, while the response to
+    what it hid differs from the simulated one. ``weights``, if given,
     are multiplied in. ``None`` when there is nothing to leave out and no ``weights``.
 
     Examples
@@ -82,13 +83,16 @@ def gap_weights(t: np.ndarray, u: np.ndarray, gaps: Sequence[tuple[float, float]
     """
     if not gaps:
         return weights
-    t = np.asarray(t, float)
+    t, u = np.asarray(t, float), np.asarray(u, float)
     keep = ~gap_mask(t, gaps)
     tol = 1e-9 * max(1.0, float(np.max(np.abs(t))))
+    changes = t[np.flatnonzero(np.diff(u) != 0) + 1]
+    shortest = float(np.min(np.diff(changes))) if changes.size > 1 else np.inf  # the command's shortest hold
     for before, after in gaps:
         k0, k1 = np.searchsorted(t, [before, after], side="left")
         k1 = min(int(k1), t.size - 1)
-        if u[k1] != u[min(int(k0), t.size - 1)]:
+        # a change shows as a different level at the gap's ends; a gap longer than a hold may hide two
+        if u[k1] != u[min(int(k0), t.size - 1)] or after - before > shortest:
             keep &= ~((t > before + tol) & (t < after + settle - tol))
     out = keep.astype(float)
     return out if weights is None else out * np.asarray(weights, float)

@@ -370,7 +370,8 @@ def _average_cycles(record: Record, steps: Steps, period: int, high: int, settle
     if not use and np.count_nonzero(keep) == 1:
         raise DataError("only one complete period in the record; a periodic average needs two", where=record.source)
     if not use:
-        raise DataError("no complete period of the step train in the record", where=record.source)
+        held = f" without a gap in the log ({in_gaps} hold one)" if in_gaps else ""
+        raise DataError(f"no complete period of the step train in the record{held}", where=record.source)
     idx = np.asarray(use)[:, None] + np.arange(period)[None, :]
     yw, uw = record.y[idx], record.u[idx]
     y, u = yw.mean(axis=0), uw.mean(axis=0)
@@ -388,7 +389,7 @@ def _average_edges(record: Record, steps: Steps, pre: float | None, direction: i
     # the window is the shortest time between two steps; a last step closer to the record's end than that is
     # left out (its window would run past the end) rather than shortening every window to what is left of it
     late = late_steps(record, steps)
-    between = np.diff(steps.index)[~(late[1:] | late[:-1])]  # a late step's intervals do not set the window
+    between = np.diff(steps.index)[~late[:-1]]  # the interval after a late step is shorter than the plant's was
     tail = record.n - int(steps.index[-1])
     post = int(np.min(between)) if between.size else tail
     keep = steps.direction == direction if direction else np.ones(steps.count, bool)
@@ -405,10 +406,10 @@ def _average_edges(record: Record, steps: Steps, pre: float | None, direction: i
         n_pre = round(pre / record.dt)
     clear = _clear(record, steps.index - n_pre, n_pre + post)
     in_gaps = int(np.sum(keep & ~clear))
-    if in_gaps and np.any(keep & clear):
-        keep &= clear
-    else:
-        in_gaps = 0  # every window holds a gap: averaged as they are (the fit weights the made-up samples 0)
+    keep &= clear
+    if not np.any(keep):
+        raise DataError(f"every step window holds samples that a gap in the log made up ({in_gaps} windows): none is "
+                        "left to average; fit the record as it is (average='none')", where=record.source)
     idx, dirs = steps.index[keep], steps.direction[keep]
     if n_pre < 1 or n_pre > idx[0]:
         raise DataError(f"need at least one sample before the first step (at t = {record.t[idx[0]]:g} s) and pre "
