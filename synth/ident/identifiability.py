@@ -186,9 +186,9 @@ def weak_parameters(names: list[str], values: dict[str, float], covariance: np.n
         elif not np.isfinite(sd[i]):
             reason = "its standard error is not finite"
         elif rel > WEAK_RELATIVE_STD:
-            reason = f"std {100 * rel:.3g} % of the value"
+            reason = f"std {100 * rel:.3g} % of {_reference(value, ref, dt)}"
         elif abs(rho) >= TIED_CORRELATION and rel > TIED_RELATIVE_STD:
-            reason = f"std {100 * rel:.3g} % of the value, tied to another parameter"
+            reason = f"std {100 * rel:.3g} % of {_reference(value, ref, dt)}, tied to another parameter"
         else:
             continue
         lo, hi = intervals.get(name, (float("nan"), float("nan")))
@@ -275,6 +275,18 @@ def tied_to_weak(names: list[str], values: dict[str, float], covariance: np.ndar
         if size >= TIED_TO_WEAK:
             out.append(TiedParameter(name, float(values[name]), float(sd[i]), names[j], float(corr[i, j])))
     return out
+
+
+def _reference(value: float, ref: float, dt: float) -> str:
+    """What a relative std is relative to: the value, or one sample interval for a delay shorter than one (a delay
+    fitted at 0 was "std 30.8 % of the value").
+
+    Examples
+    --------
+    >>> _reference(0.5, 0.5, 0.01), _reference(0.0, 0.01, 0.01)
+    ('the value', 'one sample interval (0.01 s; the delay is shorter)')
+    """
+    return "the value" if ref == abs(value) else f"one sample interval ({dt:.3g} s; the delay is shorter)"
 
 
 def _std_and_correlation(cov: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
