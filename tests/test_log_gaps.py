@@ -89,7 +89,6 @@ def test_a_hidden_edge_no_longer_biases_the_fit_on_random_trains():
     """Random first- and second-order trains, each with a dropout hiding an edge: every parameter within 4
     reported standard errors of the truth, with the default averaging and with none (the old code: 44 of them)."""
     rng = np.random.default_rng(20261205)
-    worst = 0.0
     for case in range(4):
         second = case % 2 == 1
         t, u, y, truth = _train(rng, second, hide_edge=True)
@@ -99,11 +98,9 @@ def test_a_hidden_edge_no_longer_biases_the_fit_on_random_trains():
             fit = res.fit
             for name, value in truth.items():
                 z = abs(fit.parameters[name] - value) / fit.std[name]
-                worst = max(worst, z)
                 assert z < 4.0, (case, average, name, fit.parameters, truth, fit.std)
             if average == "auto" and res.average is not None:
                 assert res.average.in_gaps >= 1
-    assert worst > 0.0
 
 
 

@@ -58,7 +58,7 @@ def gap_mask(t: np.ndarray, gaps: Sequence[tuple[float, float]]) -> np.ndarray:
     """
     t = np.asarray(t, float)
     out = np.zeros(t.size, dtype=bool)
-    tol = 1e-9 * max(1.0, float(np.max(np.abs(t)))) if t.size else 0.0
+    tol = _tolerance(t)
     for before, after in gaps:
         out |= (t > before + tol) & (t < after - tol)
     return out
@@ -69,8 +69,8 @@ def gap_weights(t: np.ndarray, u: np.ndarray, gaps: Sequence[tuple[float, float]
     """0/1 weights of a fit that leave out what gaps made up: the samples inside each gap, and after a gap across
     which the command ``u`` changed (its edge came at an unknown time inside), or one longer than the command's
     shortest hold (it may hide a change and its return), the next ``settle`` seconds too, while the response to
-    what it hid differs from the simulated one. ``weights``, if given,
-    are multiplied in. ``None`` when there is nothing to leave out and no ``weights``.
+    what it hid differs from the simulated one. ``weights``, if given, are multiplied in. ``None`` when there is
+    nothing to leave out and no ``weights``.
 
     Examples
     --------
@@ -85,7 +85,7 @@ def gap_weights(t: np.ndarray, u: np.ndarray, gaps: Sequence[tuple[float, float]
         return weights
     t, u = np.asarray(t, float), np.asarray(u, float)
     keep = ~gap_mask(t, gaps)
-    tol = 1e-9 * max(1.0, float(np.max(np.abs(t))))
+    tol = _tolerance(t)
     changes = t[np.flatnonzero(np.diff(u) != 0) + 1]
     shortest = float(np.min(np.diff(changes))) if changes.size > 1 else np.inf  # the command's shortest hold
     for before, after in gaps:
@@ -96,6 +96,11 @@ def gap_weights(t: np.ndarray, u: np.ndarray, gaps: Sequence[tuple[float, float]
             keep &= ~((t > before + tol) & (t < after + settle - tol))
     out = keep.astype(float)
     return out if weights is None else out * np.asarray(weights, float)
+
+
+def _tolerance(t: np.ndarray) -> float:
+    """Times within this of a logged stamp are that stamp (a grid rebuilt by ``linspace`` differs by rounding)."""
+    return 1e-9 * max(1.0, float(np.max(np.abs(t)))) if t.size else 0.0
 
 
 def hidden_changes(tt: np.ndarray, arrays: dict[str, np.ndarray], held: list[str]) -> tuple[str, ...]:

@@ -424,7 +424,7 @@ def _refit_unsettled(record: Record, avg: StepAverage, fit: TimeFitResult, struc
            f"{100 * UNSETTLED_FACTOR * left:.2g} % in the edge fit, more than its parameters' finest relative "
            f"standard error ({100 * finest:.2g} %)")
     skip = min(settle, 0.25 * record.duration)
-    weights = after_gaps(record, fit.measured, ((record.t - record.t[0]) >= skip).astype(float))
+    weights = after_gaps(record, fit.measured, skip=skip)
     # the edge fit is the natural start, unless the average pulled a pole or zero beyond the record's Nyquist
     # frequency, which no sampled record resolves: then the whole record's own deterministic start comes first
     beyond = beyond_nyquist(fit.plant, record.dt)
@@ -467,7 +467,7 @@ def _refit_from_rest(record: Record, avg: StepAverage, fit: TimeFitResult, struc
     if not np.isfinite(settle) or first <= 0 or (first < settle and not fit.weak):
         return fit, ""
     skip = min(settle, first)
-    weights = after_gaps(record, fit.measured, ((record.t - record.t[0]) >= skip).astype(float))
+    weights = after_gaps(record, fit.measured, skip=skip)
     try:
         whole = fit_whole_record(record, structure, delay, sensor, {**fit.parameters}, weights)
     except (DataError, FitError) as exc:

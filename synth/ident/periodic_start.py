@@ -61,9 +61,13 @@ left a mismatch of about 0.4 % of the step after it, which on a record with an e
 of its standard errors off."""
 
 
-def after_gaps(record: Record, model: Plant, weights: np.ndarray | None) -> np.ndarray | None:
-    """``weights`` with what the record's gaps made up left out, and :data:`GAP_SETTLED` settling of ``model`` after a
-    gap that may hide a change (:func:`synth.data.gaps.gap_weights`)."""
+def after_gaps(record: Record, model: Plant, weights: np.ndarray | None = None, skip: float | None = None
+               ) -> np.ndarray | None:
+    """``weights`` (or, with ``skip``, 0 over the record's first ``skip`` seconds and 1 after) with what the record's
+    gaps made up left out, and :data:`GAP_SETTLED` settling of ``model`` after a gap that may hide a change
+    (:func:`synth.data.gaps.gap_weights`)."""
+    if skip is not None:
+        weights = ((record.t - record.t[0]) >= skip).astype(float)
     return gap_weights(record.t, record.u, record.gaps, settling_time(model, GAP_SETTLED), weights)
 
 
@@ -235,7 +239,7 @@ def refit_periodic_start(record: Record, avg: StepAverage, fit: TimeFitResult, s
         return fit, avg, ""
     at_rest = starts_at_rest(record, first)
     skip = 0.0 if at_rest else min(slowest, 0.25 * record.duration)
-    weights = after_gaps(record, fit.measured, ((record.t - record.t[0]) >= skip).astype(float))
+    weights = after_gaps(record, fit.measured, skip=skip)
     try:
         names, cov = predicted_whole_record_covariance(record, fit, structure, avg.noise_std_before, weights)
     except (ModelError, ValueError):
@@ -313,7 +317,7 @@ def _refit_transient(record: Record, avg: StepAverage, fit: TimeFitResult, struc
     """No averaged period free of the start-up transient can be fitted (``reason``): the whole record, its first
     settling time (at most half the record) weighted 0, from the periodic fit."""
     skip = min(settle, 0.5 * record.duration)
-    weights = after_gaps(record, fit.measured, ((record.t - record.t[0]) >= skip).astype(float))
+    weights = after_gaps(record, fit.measured, skip=skip)
     why = (f"the averaged periods begin {lead:.3g} s into the train, within the model's settling time "
            f"({settle:.3g} s), so the average holds part of the start-up transient, and {reason}")
     try:

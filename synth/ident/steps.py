@@ -242,11 +242,10 @@ class StepAverage:
                 "periodic": self.periodic, "steps": self.steps.to_dict(), "in_gaps": self.in_gaps}
 
 
-def _is_periodic(steps: Steps, late: np.ndarray | None = None) -> tuple[int, int] | None:
+def _is_periodic(steps: Steps, late: np.ndarray) -> tuple[int, int] | None:
     """``(period, high samples)`` if the steps alternate at a constant period (to one sample), not counting the
     intervals that end or start at a step marked ``late`` (its edge hidden in a gap of the log, :func:`late_steps`)."""
     d, i = steps.direction, steps.index
-    late = np.zeros(i.size, bool) if late is None else late
     if np.sum(d > 0) < 2 or np.any(d[1:] == d[:-1]):
         return None
     up = np.flatnonzero(d > 0)
