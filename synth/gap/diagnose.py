@@ -427,6 +427,11 @@ def diagnose(plant: Plant, record: RecordLike, validate: RecordLike | Sequence[R
     clips = record_clipping(record)
     warnings: list[str] = [] if held_out else heldout_warnings(record, None, split, train_fraction)
     warnings += [w for w in [start_transient_warning(plant, loc.residual)] if w]  # after any burn-in
+    if loc.residual.left_out:
+        warnings.append(f"{loc.residual.left_out} samples ({loc.residual.left_out * loc.residual.dt:.3g} s) not "
+                        f"judged: what {len(record.gaps)} gap(s) in the log made up, and the model's settling after "
+                        "those that may hide a command change (the model's response there is to an edge at the "
+                        "wrong time)")
     for i, v in enumerate(held_out):
         clips += record_clipping(v, "validate" if len(held_out) == 1 else f"validate {i + 1}")
         warnings += [w.replace("the validation record", f"validation run {i + 1}") if len(held_out) > 1 else w

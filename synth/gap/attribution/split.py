@@ -18,6 +18,7 @@ import numpy as np
 from synth.data.record import Record
 from synth.errors import ModelError
 from synth.gap.attribution.stitch import settle_time, stitch_runs
+from synth.ident.periodic_start import after_gaps
 from synth.plant import Plant
 
 __all__ = ["HeldoutSplit", "block_ids", "split_heldout"]
@@ -140,6 +141,11 @@ def split_heldout(plant: Plant, record: Record, validate: Record | Sequence[Reco
         joined = stitch_runs(runs, settle_time(plant))
         evaluated = Record(joined.t, joined.u, joined.y, record.input, record.output, source="validation runs")
         held = joined.run >= 0
+    judged_tr, judged_ev = after_gaps(train, plant), after_gaps(evaluated, plant)  # None without gaps
+    if judged_tr is not None:  # what a gap in the log made up, and the settling after a change one may hide
+        train_mask = judged_tr > 0 if train_mask is None else train_mask & (judged_tr > 0)
+    if judged_ev is not None:
+        held = held & (judged_ev > 0)
     t_tr, t_ev = train.t, evaluated.t
     if burn_in > 0.0:
         settled_tr = t_tr >= t_tr[0] + burn_in
@@ -148,6 +154,8 @@ def split_heldout(plant: Plant, record: Record, validate: Record | Sequence[Reco
                                                                                            nan=-1.0) >= burn_in))
         if int(train_mask.sum()) < 20:
             raise ModelError(f"a burn-in of {burn_in:g} s leaves too few training samples", where="burn_in")
+    if train_mask is not None and int(train_mask.sum()) < 20:
+        raise ModelError(f"gaps in the log leave {int(train_mask.sum())} training samples", where="record")
     n_held = int(held.sum())
     groups = None if joined is None else joined.run[held]  # the held-out run of each held-out sample
     for r in range(1 if runs is None else len(runs)):
@@ -156,5 +164,7 @@ def split_heldout(plant: Plant, record: Record, validate: Record | Sequence[Reco
             where = "record" if runs is None else f"validate run {r + 1}"
             raise ModelError(f"{n_r} held-out samples are too few for {blocks} segments", where=where)
     settled = (t_ev >= t_ev[0] + burn_in) if runs is None else held
+    if judged_ev is not None:
+        settled = settled & (judged_ev > 0)
     return HeldoutSplit(train, evaluated, held, train_mask, groups, settled, 1 if runs is None else len(runs),
                         validate is not None, split if validate is None else "validation")

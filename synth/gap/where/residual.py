@@ -25,6 +25,7 @@ import numpy as np
 
 from synth.data.record import Record
 from synth.errors import ModelError
+from synth.ident.periodic_start import after_gaps
 from synth.ident.simulate import simulate_plant
 from synth.plant import Plant
 
@@ -53,6 +54,11 @@ class ModelResidual:
         ``||e|| / ||y - mean(y)||``.
     fit_percent : float
         ``100 (1 - nrmse)``.
+    left_out : int
+        Samples not judged because a gap in the record's log made them up, or they fall within the model's
+        settling after a gap that may hide a command change (:func:`synth.ident.periodic_start.after_gaps`): there
+        the model's response is to an edge at the wrong time. ``y_model`` is ``y`` on them (no residual), and
+        the offset and the NRMSE are of the other samples.
 
     Examples
     --------
@@ -76,6 +82,7 @@ class ModelResidual:
     initial: str
     nrmse: float
     fit_percent: float
+    left_out: int = 0
 
     @property
     def dt(self) -> float:
@@ -101,7 +108,8 @@ class ModelResidual:
         ['fit_percent', 'initial', 'nrmse', 'offset', 'offset_mode', 'rms', 'samples']
         """
         return {"nrmse": self.nrmse, "fit_percent": self.fit_percent, "rms": self.rms, "offset": self.offset,
-                "offset_mode": self.offset_mode, "initial": self.initial, "samples": int(self.t.size)}
+                "offset_mode": self.offset_mode, "initial": self.initial, "samples": int(self.t.size),
+                **({"left_out_for_gaps_in_the_log": self.left_out} if self.left_out else {})}
 
 
 def gap_size(y: np.ndarray, e: np.ndarray) -> tuple[float, float]:
@@ -171,9 +179,15 @@ def model_residual(plant: Plant, record: Record, initial: str = "steady", offset
                              f"({record.duration:.4g} s)", where="burn_in")
         y_sim = y_sim[keep]
         record = record.segment(float(record.t[keep][0]), float(record.t[-1]))
+    judged = after_gaps(record, plant)
+    judged = np.ones(record.n, bool) if judged is None else judged > 0
+    if np.count_nonzero(judged) < 10:
+        raise ModelError(f"gaps in the log leave {int(np.count_nonzero(judged))} samples of the record to judge "
+                         "(each gap's made-up samples, and the model's settling after one that may hide a command "
+                         "change, are left out)", where="record")
     if isinstance(offset, str):
         if offset == "fit":
-            c, mode = float(np.mean(record.y - y_sim)), "fit"
+            c, mode = float(np.mean((record.y - y_sim)[judged])), "fit"
         elif offset == "none":
             c, mode = 0.0, "none"
         else:
@@ -182,7 +196,8 @@ def model_residual(plant: Plant, record: Record, initial: str = "steady", offset
         c, mode = float(offset), "given"
         if not np.isfinite(c):
             raise ModelError(f"must be finite, got {offset!r}", where="offset")
-    y_model = y_sim + c
+    y_model = np.where(judged, y_sim + c, record.y)
     e = record.y - y_model
-    nrmse, fit = gap_size(record.y, e)
-    return ModelResidual(record.t, record.u, record.y, y_model, e, c, mode, initial, nrmse, fit)
+    nrmse, fit = gap_size(record.y[judged], e[judged])
+    return ModelResidual(record.t, record.u, record.y, y_model, e, c, mode, initial, nrmse, fit,
+                         int(record.n - np.count_nonzero(judged)))
