@@ -159,3 +159,20 @@ def test_black_box_findings_on_gaps_hiding_edges():
             identify((t, u, y), "K/(T*s+1)", delay="fit", compare_directions=False)  # not a biased result
     t, u, y = _square(4.0, 3000, 0, [(11.5, 18.5)], 2)
     _within(identify((t, u, y), "K/(T*s+1)", delay="fit", compare_directions=False).fit, {"K": 2.0, "T": 0.5})
+
+
+@pytest.mark.parametrize("dt", [0.01, 0.002, 1 / 3])
+def test_a_ramp_logged_with_a_dropout_keeps_the_logs_own_grid(dt: float) -> None:
+    """A command changing at every stamp (a ramp), logged regularly but for one dropout: the grid is the log's own
+    interval and every logged sample is on it, as logged. The ramp's changes, a rounding below the interval
+    apart, had made one interval more over the record (0.0099983 s for 0.01 s: every sample interpolated, the
+    noise smoothed, and diagnose's noise floor 39 % low)."""
+    t = np.arange(6000) * dt
+    u = 0.5 * t
+    y = np.random.default_rng(0).normal(size=t.size)
+    keep = (t < 1020 * dt) | (t > 1050 * dt)
+    rec = record_from_arrays(t[keep], u[keep], y[keep])
+    assert rec.n == 6000 and rec.t[1] - rec.t[0] == pytest.approx(dt, rel=1e-12)
+    on_grid = np.flatnonzero(keep)
+    assert np.max(np.abs(rec.y[on_grid] - y[keep])) < 1e-9  # the logged samples themselves, not interpolated
+    assert len(rec.gaps) == 1
