@@ -68,3 +68,34 @@ def test_diagnose_names_the_truth_with_three_dropouts_over_edges(case: int) -> N
     assert judged(d, c["truth"], c["values"]), (c["truth"], c["values"], d["verdict"], d["effects"][:1])
     if c["truth"] == "none":
         assert d["gap"]["nrmse"] < 0.02, d["gap"]["nrmse"]  # the 1 % noise: the true model's record
+
+
+def _pulse_record(gaps: list[tuple[float, float]], seconds: float = 60.0):
+    dt = 0.01
+    t = np.arange(0.0, seconds, dt)
+    u = np.where((t % 2) >= 1, 1.0, 0.0)
+    num, den, _ = signal.cont2discrete(([2.0], [0.2, 1.0]), dt, method="zoh")
+    y = signal.lfilter(np.ravel(num), den, u) + 0.01 * np.random.default_rng(5).standard_normal(t.size)
+    keep = np.ones(t.size, bool)
+    for a, b in gaps:
+        keep &= (t <= a) | (t >= b)
+    return record_from_arrays(t[keep], u[keep], y[keep], source="pulses.csv")
+
+
+def test_a_training_half_mostly_dropped_is_refused_in_one_line_naming_the_file() -> None:
+    """A 28.5 s dropout in the 30 s training half: the fits would see 1.7 % of it (shrinkages of -5e5 and -3e9 were
+    printed, exit 0)."""
+    with pytest.raises(ModelError, match=r"gaps in the log leave \d+\.\d% of the training part") as info:
+        diagnose(Plant.from_string("2/(0.2*s+1)"), _pulse_record([(0.5, 29.0)]), candidates=["delay"], n_null=3)
+    assert info.value.where == "pulses.csv"
+
+
+def test_gaps_in_a_validation_record_are_left_out_and_said() -> None:
+    clean = _pulse_record([])
+    gapped = _pulse_record([(10.8, 11.3), (30.9, 31.2)])
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        d = diagnose(Plant.from_string("2/(0.2*s+1)"), clean, validate=gapped, candidates=["delay"], n_null=3)
+    said = [w for w in d.warnings if "the validation record's log" in w]
+    assert len(said) == 1 and said[0].split(" samples")[0].isdigit() and int(said[0].split(" ")[0]) > 0
+    assert d.verdict["status"] == "none", d.verdict  # the true model

@@ -41,6 +41,7 @@ from synth.gap.preflight import check_model
 from synth.gap.where.clipping import Clipping, record_clipping
 from synth.gap.where.localize import GapLocalization, localize_gap
 from synth.gap.where.start import start_transient_warning
+from synth.ident.periodic_start import after_gaps
 from synth.plant import Plant, Signal
 
 __all__ = ["MODEL_FILE_SUFFIXES", "Diagnosis", "as_validation", "check_candidates", "diagnose", "heldout_warnings",
@@ -428,15 +429,23 @@ def diagnose(plant: Plant, record: RecordLike, validate: RecordLike | Sequence[R
     warnings: list[str] = [] if held_out else heldout_warnings(record, None, split, train_fraction)
     warnings += [w for w in [start_transient_warning(plant, loc.residual)] if w]  # after any burn-in
     if loc.residual.left_out:
-        warnings.append(f"{loc.residual.left_out} samples ({loc.residual.left_out * loc.residual.dt:.3g} s) not "
-                        f"judged: what {len(record.gaps)} gap(s) in the log made up, and the model's settling after "
-                        "those that may hide a command change (the model's response there is to an edge at the "
-                        "wrong time)")
+        warnings.append(_not_judged(loc.residual.left_out, loc.residual.dt, len(record.gaps), "the log"))
     for i, v in enumerate(held_out):
         clips += record_clipping(v, "validate" if len(held_out) == 1 else f"validate {i + 1}")
         warnings += [w.replace("the validation record", f"validation run {i + 1}") if len(held_out) > 1 else w
                      for w in heldout_warnings(record, v)]
+        judged = after_gaps(v, plant)
+        if judged is not None and np.any(judged <= 0):
+            label = "the validation record's log" if len(held_out) == 1 else f"validation run {i + 1}'s log"
+            warnings.append(_not_judged(int(np.sum(judged <= 0)), 1.0 / v.fs, len(v.gaps), label))
     return Diagnosis(plant, record, validate, loc, att, tuple(clips), tuple(warnings))
+
+
+def _not_judged(n: int, dt: float, gaps: int, log: str) -> str:
+    """The warning for ``n`` samples (``dt`` apart) that ``gaps`` gaps in ``log`` leave unjudged."""
+    return (f"{n} samples ({n * dt:.3g} s) not judged: what {gaps} gap(s) in {log} made up, and the model's "
+            "settling after those that may hide a command change (the model's response there is to an edge at the "
+            "wrong time)")
 
 
 def heldout_warnings(record: Record, validate: Record | None = None, split: str = "tail",
