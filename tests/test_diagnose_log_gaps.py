@@ -68,6 +68,7 @@ def test_diagnose_names_the_truth_with_three_dropouts_over_edges(case: int) -> N
     assert judged(d, c["truth"], c["values"]), (c["truth"], c["values"], d["verdict"], d["effects"][:1])
     if c["truth"] == "none":
         assert d["gap"]["nrmse"] < 0.02, d["gap"]["nrmse"]  # the 1 % noise: the true model's record
+    assert not any("may hide a command change and its return" in w for w in d["warnings"])
 
 
 def _pulse_record(gaps: list[tuple[float, float]], seconds: float = 60.0):
@@ -99,3 +100,24 @@ def test_gaps_in_a_validation_record_are_left_out_and_said() -> None:
     said = [w for w in d.warnings if "the validation record's log" in w]
     assert len(said) == 1 and said[0].split(" samples")[0].isdigit() and int(said[0].split(" ")[0]) > 0
     assert d.verdict["status"] == "none", d.verdict  # the true model
+
+
+def test_a_pulse_hidden_in_a_dropout_with_equal_ends_is_named_and_not_called_noise() -> None:
+    """A 0.4 s pulse inside a 0.8 s dropout whose ends hold one level (a black-box helper's case): the log cannot
+    show it, so its response is judged; 94 % of the true model's residual then lay in the second after the dropout,
+    and the verdict said "within the noise floor (J/sigma^2 = 37.93)". Now the dropout is named, and the headline
+    does not call it noise."""
+    dt = 0.01
+    t = np.arange(0.0, 60.0, dt)
+    u = np.where((t % 4) >= 2, 1.0, 0.0)
+    hidden = np.where((t >= 48.6) & (t < 49.0), 1.0, u)  # inside 48.4-49.2 s, where u is 0 at both ends
+    num, den, _ = signal.cont2discrete(([2.0], [0.2, 1.0]), dt, method="zoh")
+    y = signal.lfilter(np.ravel(num), den, hidden) + 0.01 * np.random.default_rng(2).standard_normal(t.size)
+    keep = (t <= 48.4) | (t >= 49.2)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        d = diagnose(Plant.from_string("2/(0.2*s+1)"), record_from_arrays(t[keep], u[keep], y[keep]),
+                     candidates=["delay"], n_null=3)
+    named = [w for w in d.warnings if "may hide a command change and its return" in w]
+    assert len(named) == 1 and "t = 48.4-49.2 s" in named[0], d.warnings
+    assert "within the noise floor" not in d.verdict["headline"] and "No gap beyond" not in d.summary

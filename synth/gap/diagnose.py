@@ -35,11 +35,12 @@ from synth.data.coerce import RecordLike, as_record
 from synth.data.record import Record
 from synth.errors import DataError, ModelError
 from synth.gap.attribution.heldout import DiagnoseOptions, diagnose_effects
-from synth.gap.attribution.verdict import EffectDiagnosis, aux_explained, not_carried
+from synth.gap.attribution.verdict import CONCENTRATED_RATIO, EffectDiagnosis, aux_explained, not_carried
 from synth.gap.effects.registry import DEFAULT_CANDIDATES, aux_candidates, make_effect
 from synth.gap.preflight import check_model
 from synth.gap.where.clipping import Clipping, record_clipping
 from synth.gap.where.localize import GapLocalization, localize_gap
+from synth.gap.where.residual import hidden_pulse_warnings, not_judged_warning
 from synth.gap.where.start import start_transient_warning
 from synth.ident.periodic_start import after_gaps
 from synth.plant import Plant, Signal
@@ -214,7 +215,10 @@ class Diagnosis:
         status = v["status"]
         gap = f"{100 * self.localization.residual.nrmse:.0f} % NRMSE"
         if status == "none":
-            return f"No gap beyond the measurement noise (gap {gap})."
+            ratio = self.attribution.j_nominal / self.attribution.noise_floor
+            return (f"No gap beyond the measurement noise (gap {gap})." if ratio < CONCENTRATED_RATIO else
+                    f"No consistent gap (gap {gap}): the held-out error is {ratio:.3g} times the noise floor, but it "
+                    "comes from a few segments of the record.")
         if status == "effect":
             best = next(e for e in self.attribution.effects if e.effect == v["effects"][0])
             params = ", ".join(f"{k} = {_fmt(x)}" for k, x in best.parameters.items()
@@ -429,7 +433,8 @@ def diagnose(plant: Plant, record: RecordLike, validate: RecordLike | Sequence[R
     warnings: list[str] = [] if held_out else heldout_warnings(record, None, split, train_fraction)
     warnings += [w for w in [start_transient_warning(plant, loc.residual)] if w]  # after any burn-in
     if loc.residual.left_out:
-        warnings.append(_not_judged(loc.residual.left_out, loc.residual.dt, len(record.gaps), "the log"))
+        warnings.append(not_judged_warning(loc.residual.left_out, loc.residual.dt, len(record.gaps), "the log"))
+    warnings += hidden_pulse_warnings(record, loc.residual, plant)
     for i, v in enumerate(held_out):
         clips += record_clipping(v, "validate" if len(held_out) == 1 else f"validate {i + 1}")
         warnings += [w.replace("the validation record", f"validation run {i + 1}") if len(held_out) > 1 else w
@@ -437,15 +442,8 @@ def diagnose(plant: Plant, record: RecordLike, validate: RecordLike | Sequence[R
         judged = after_gaps(v, plant)
         if judged is not None and np.any(judged <= 0):
             label = "the validation record's log" if len(held_out) == 1 else f"validation run {i + 1}'s log"
-            warnings.append(_not_judged(int(np.sum(judged <= 0)), 1.0 / v.fs, len(v.gaps), label))
+            warnings.append(not_judged_warning(int(np.sum(judged <= 0)), 1.0 / v.fs, len(v.gaps), label))
     return Diagnosis(plant, record, validate, loc, att, tuple(clips), tuple(warnings))
-
-
-def _not_judged(n: int, dt: float, gaps: int, log: str) -> str:
-    """The warning for ``n`` samples (``dt`` apart) that ``gaps`` gaps in ``log`` leave unjudged."""
-    return (f"{n} samples ({n * dt:.3g} s) not judged: what {gaps} gap(s) in {log} made up, and the model's "
-            "settling after those that may hide a command change (the model's response there is to an edge at the "
-            "wrong time)")
 
 
 def heldout_warnings(record: Record, validate: Record | None = None, split: str = "tail",
