@@ -263,17 +263,26 @@ def frequency_response(
 def _whole_run_low_end(runs: list[Record], grid: np.ndarray, H: np.ndarray, err: np.ndarray, gyy: np.ndarray,
                        coh: np.ndarray, longest: float) -> tuple[np.ndarray, np.ndarray, str | None]:
     """``H`` and its random error with the points below :data:`~synth.ident.whole_run.WHOLE_RUN_PERIODS` periods of
-    the longest window taken from the whole runs, when every run starts and ends at rest (and a note saying so)."""
+    the longest window taken from the whole runs (and a note saying so): the ratio of their transforms when every
+    run starts and ends at rest, else the local rational method, which removes each run's transient."""
+    from synth.ident.local_rational import local_rational_response
     from synth.ident.whole_run import WHOLE_RUN_PERIODS, at_rest, whole_run_response
 
     low = grid < WHOLE_RUN_PERIODS * 2.0 * np.pi / longest
-    if not np.any(low) or not all(at_rest(r) for r in runs):
+    if not np.any(low):
         return H, err, None
-    gnn = np.maximum(np.nan_to_num(gyy * (1.0 - coh)), 0.0)
     H, err = np.array(H, complex), np.array(err, float)
-    H[low], err[low] = whole_run_response(runs, grid[low], gnn[low])
-    return H, err, (f"below {grid[low][-1]:.4g} rad/s ({WHOLE_RUN_PERIODS:g} periods of the longest window) the "
-                    "response is the ratio of the whole runs' transforms: every run starts and ends at rest, and a "
+    head = f"below {grid[low][-1]:.4g} rad/s ({WHOLE_RUN_PERIODS:g} periods of the longest window) the response is"
+    if all(at_rest(r) for r in runs):
+        gnn = np.maximum(np.nan_to_num(gyy * (1.0 - coh)), 0.0)
+        H[low], err[low] = whole_run_response(runs, grid[low], gnn[low])
+        return H, err, (f"{head} the ratio of the whole runs' transforms: every run starts and ends at rest, and a "
+                        "window's taper biases a sweep's lowest frequencies")
+    H_lrm, err_lrm = local_rational_response(runs, grid[low])
+    H[low] = np.where(np.isfinite(H_lrm), H_lrm, H[low])
+    err[low] = np.where(np.isfinite(H_lrm), err_lrm, err[low])
+    return H, err, (f"{head} from the whole runs' transforms with each run's transient removed (the local rational "
+                    "method, 13 neighbouring frequencies per run): a run does not start and end at rest, and a "
                     "window's taper biases a sweep's lowest frequencies")
 
 
