@@ -37,7 +37,9 @@ def test_a_sweep_s_band_starts_where_the_sweep_does():
     j = int(np.argmin(abs(r.w - uncut.w_min)))
     err_new = abs(20 * np.log10(abs(r.H[i])) - exact_db(r.w[i]))
     err_old = abs(20 * np.log10(abs(r.H[j])) - exact_db(r.w[j]))
-    assert err_old > 6 and err_new < err_old / 2
+    # the composite was 7.7 dB off below the sweep's start; the local rational method (a record not at rest) is
+    # 0.86 dB off there, 2.8 of its random errors: still worse than inside the band, which stays cut
+    assert err_new < 0.5 and err_old > 2 * err_new
     assert r.band.to_dict()["note"] == r.band.note
 
 
