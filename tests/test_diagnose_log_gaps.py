@@ -37,6 +37,7 @@ def test_the_residual_of_the_true_model_is_the_noise_with_an_edge_hidden() -> No
     # the made-up samples (4.8-5.25 s) and 6.9 time constants of settling after the gap's end: about 1.6 s
     assert 150 <= dropped.left_out <= 200, dropped.left_out
     assert dropped.nrmse == pytest.approx(clean.nrmse, rel=0.3)  # was 0.07 against 0.006: the late edge
+    assert dropped.rms == pytest.approx(clean.rms, rel=0.1)  # over the judged samples: the noise's 0.02
     assert dropped.to_dict()["left_out_for_gaps_in_the_log"] == dropped.left_out
     assert "left_out_for_gaps_in_the_log" not in clean.to_dict()
     judged_part = np.abs(dropped.e) > 0

@@ -166,8 +166,9 @@ def split_heldout(plant: Plant, record: Record, validate: Record | Sequence[Reco
                                                                                            nan=-1.0) >= burn_in))
         if int(train_mask.sum()) < 20:
             raise ModelError(f"a burn-in of {burn_in:g} s leaves too few training samples", where="burn_in")
-    if train_mask is not None and int(train_mask.sum()) < 20:
-        raise ModelError(f"gaps in the log leave {int(train_mask.sum())} training samples", where="record")
+    if judged_tr is not None and int(train_mask.sum()) < 20:
+        raise ModelError(f"gaps in the log leave {int(train_mask.sum())} training samples",
+                         where=train.source or "record")
     n_held = int(held.sum())
     groups = None if joined is None else joined.run[held]  # the held-out run of each held-out sample
     for r in range(1 if runs is None else len(runs)):

@@ -92,8 +92,8 @@ class ModelResidual:
 
     @property
     def rms(self) -> float:
-        """Root mean square of the residual (output units)."""
-        return float(np.sqrt(np.mean(self.e**2)))
+        """Root mean square of the residual over the judged samples (output units)."""
+        return float(np.sqrt(np.sum(self.e**2) / max(self.t.size - self.left_out, 1)))
 
     def to_dict(self) -> dict[str, Any]:
         """The ``"gap"`` part of the diagnosis JSON.
