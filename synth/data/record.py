@@ -238,13 +238,11 @@ def _resample(tt: np.ndarray, arrays: dict[str, np.ndarray], held: list[str]
         changes = tt[np.flatnonzero(np.diff(arrays[h]) != 0) + 1]
         if changes.size > 1:
             target = min(target, max(float(np.min(np.diff(changes))), median / 4))
-    if target > median * (1.0 - 1e-6):  # a command changing at every stamp: the median (not its rounding)
-        target = median
     span = float(tt[-1] - tt[0])
     ratio = span / target
-    # a regular log with gaps spans a whole number of intervals: that number, not one more for a rounding
-    # (a ramp's changes 0.0099999 s apart made 6,000 intervals of 0.0099983 s out of 5,999 of 0.01 s, and every
-    # logged sample an interpolated one)
+    # a regular log with gaps spans a whole number of intervals: that number, not one more for a rounding (a ramp,
+    # changing at every stamp, has changes 0.0099999 s apart: 6,000 intervals of 0.0099983 s came out of 5,999 of
+    # 0.01 s, and every logged sample an interpolated one)
     n = max(1, round(ratio) if abs(ratio - round(ratio)) <= 1e-6 * ratio else int(np.ceil(ratio)))
     grid = np.linspace(tt[0], tt[-1], n + 1)
     dt = span / n

@@ -58,7 +58,7 @@ def local_rational_response(runs: Sequence[Record], w: np.ndarray) -> tuple[np.n
     err = np.full(w.size, np.nan)
     per_run = []
     for run in runs:
-        dw = 2.0 * np.pi / (run.n * float(run.t[1] - run.t[0]))
+        dw = 2.0 * np.pi * run.fs / run.n
         per_run.append((run.t - run.t[0], dw, np.asarray(run.u, float) - float(np.mean(run.u)),
                         np.asarray(run.y, float) - float(np.mean(run.y))))
     scale = max(p[1] for p in per_run) * HALF_WIDTH  # offsets in units of the widest neighbourhood: order one
@@ -73,8 +73,7 @@ def local_rational_response(runs: Sequence[Record], w: np.ndarray) -> tuple[np.n
             k = np.arange(-HALF_WIDTH, HALF_WIDTH + 1) + shift
             if (r, shift) not in offsets:
                 offsets[r, shift] = np.exp(-1j * np.outer(k * dw, t))
-            weighted = np.exp(-1j * wi * t) * np.stack([du, dy])  # 2 x N
-            U, Y = offsets[r, shift] @ weighted.T[:, 0], offsets[r, shift] @ weighted.T[:, 1]
+            U, Y = (offsets[r, shift] @ (np.exp(-1j * wi * t)[:, None] * np.c_[du, dy])).T
             x = (k * dw / scale)[:, None] ** powers
             block = np.zeros((k.size, width), complex)
             block[:, :n_coef] = U[:, None] * x

@@ -272,7 +272,7 @@ def _whole_run_low_end(runs: list[Record], grid: np.ndarray, H: np.ndarray, err:
     """``H`` and its random error with the points below :data:`~synth.ident.whole_run.WHOLE_RUN_PERIODS` periods of
     the longest window taken from the whole runs (and a note saying so): the ratio of their transforms when every
     run starts and ends at rest, else the local rational method, which removes each run's transient."""
-    from synth.ident.local_rational import local_rational_response
+    from synth.ident.local_rational import HALF_WIDTH, local_rational_response
     from synth.ident.whole_run import WHOLE_RUN_PERIODS, at_rest, whole_run_response
 
     low = grid < WHOLE_RUN_PERIODS * 2.0 * np.pi / longest
@@ -290,9 +290,10 @@ def _whole_run_low_end(runs: list[Record], grid: np.ndarray, H: np.ndarray, err:
     H[low] = np.where(use, H_lrm, H[low])
     err[low] = np.where(use, err_lrm, err[low])
     return H, err, (f"{head} from the whole runs' transforms with each run's transient removed (the local rational "
-                    f"method, 13 neighbouring frequencies per run) at {int(use.sum())} of its {int(low.sum())} points "
-                    "(the composite where that method's random error is over 3 times the composite's): a run does "
-                    "not start and end at rest, and a window's taper biases a sweep's lowest frequencies")
+                    f"method, {2 * HALF_WIDTH + 1} neighbouring frequencies per run) at {int(use.sum())} of its "
+                    f"{int(low.sum())} points (the composite where that method's random error is over "
+                    f"{LRM_ERROR_LIMIT:g} times the composite's): a run does not start and end at rest, and a "
+                    "window's taper biases a sweep's lowest frequencies")
 
 
 def _above_default_top(w: np.ndarray, gxx: np.ndarray, gxy: np.ndarray, coh: np.ndarray, band: CoherentBand,

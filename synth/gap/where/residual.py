@@ -55,11 +55,11 @@ class ModelResidual:
         ``||e|| / ||y - mean(y)||``.
     fit_percent : float
         ``100 (1 - nrmse)``.
-    left_out : int
-        Samples not judged because a gap in the record's log made them up, or they fall within the model's
+    judged : numpy.ndarray of bool or None
+        The samples judged (None: all). Not judged: what a gap in the record's log made up, and the model's
         settling after a gap that may hide a command change (:func:`synth.ident.periodic_start.after_gaps`): there
         the model's response is to an edge at the wrong time. ``y_model`` is ``y`` on them (no residual), and
-        the offset and the NRMSE are of the other samples.
+        the offset and the NRMSE are of the other samples; :attr:`left_out` counts them.
 
     Examples
     --------
@@ -83,7 +83,12 @@ class ModelResidual:
     initial: str
     nrmse: float
     fit_percent: float
-    left_out: int = 0
+    judged: np.ndarray | None = None
+
+    @property
+    def left_out(self) -> int:
+        """Samples not judged (:attr:`judged`)."""
+        return 0 if self.judged is None else int(self.t.size - np.count_nonzero(self.judged))
 
     @property
     def dt(self) -> float:
@@ -180,8 +185,8 @@ def model_residual(plant: Plant, record: Record, initial: str = "steady", offset
                              f"({record.duration:.4g} s)", where="burn_in")
         y_sim = y_sim[keep]
         record = record.segment(float(record.t[keep][0]), float(record.t[-1]))
-    judged = after_gaps(record, plant)
-    judged = np.ones(record.n, bool) if judged is None else judged > 0
+    weights = after_gaps(record, plant)
+    judged = np.ones(record.n, bool) if weights is None else weights > 0
     if np.count_nonzero(judged) < 10:
         raise ModelError(f"gaps in the log leave {int(np.count_nonzero(judged))} samples of the record to judge "
                          "(each gap's made-up samples, and the model's settling after one that may hide a command "
@@ -201,7 +206,7 @@ def model_residual(plant: Plant, record: Record, initial: str = "steady", offset
     e = record.y - y_model
     nrmse, fit = gap_size(record.y[judged], e[judged])
     return ModelResidual(record.t, record.u, record.y, y_model, e, c, mode, initial, nrmse, fit,
-                         int(record.n - np.count_nonzero(judged)))
+                         None if weights is None else judged)
 
 
 def not_judged_warning(n: int, dt: float, gaps: int, log: str) -> str:
@@ -244,7 +249,7 @@ def hidden_pulse_warnings(record: Record, residual: ModelResidual, plant: Plant)
         return []
     settle = max(float(settling_time(plant, GAP_SETTLED)), 5.0 * residual.dt)
     e2 = residual.e**2
-    judged = residual.y_model != residual.y
+    judged = np.ones(e2.size, bool) if residual.judged is None else residual.judged
     typical = float(np.mean(e2[judged])) if np.any(judged) else 0.0
     out = []
     for before, after in record.gaps:
