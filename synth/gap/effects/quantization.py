@@ -21,6 +21,7 @@ from dataclasses import dataclass
 from typing import ClassVar
 
 import numpy as np
+from scipy.fft import next_fast_len
 
 from synth.errors import ModelError
 from synth.gap.effects.base import Effect, Params, command_span, log_grid, unit_numerators
@@ -159,7 +160,7 @@ def _batch_ssr(v: np.ndarray, y: np.ndarray, steps: list[np.ndarray], consts: li
     """
     n, m = v.shape
     dv = np.diff(v, axis=0)
-    size = 1 << int(np.ceil(np.log2(2 * n)))
+    size = next_fast_len(2 * n - 1, real=True)  # a linear convolution of two n-sample signals, no wrap-around
     fdv = np.fft.rfft(dv, size, axis=0)
     cols = []
     for s, c in zip(steps, consts):
