@@ -6,7 +6,10 @@ signs). The input is a step train: levels drawn in 150-250 PWM (the first 200), 
 withheld (a dead zone, a delay, a drift, a backlash or a rate limit, each several times the noise). The
 estimation record has ``n`` samples, the validation record (another step train, same plant and effect)
 ``0.8 n`` samples, as in issue 17 (20,000 + 16,000). One diagnosis (:func:`synth.gap.diagnose.diagnose`:
-localization and attribution with every default candidate, 2 worker processes) per record.
+localization and attribution with every default candidate, 2 worker processes) per record. With ``--input smooth``
+the command varies continuously instead (white noise low-passed at 0.5 Hz, scaled to 150-250 PWM about 200, as a
+closed loop's command is): thousands of distinct values, which the quantizer's dense search cannot reduce to a
+few levels.
 
 Each diagnosis runs in a fresh process (``--one``; the time is the diagnosis alone, without imports): wall
 time, and CPU time of the process and its worker processes (on a loaded machine the CPU time is the
@@ -21,6 +24,7 @@ supply-sag candidate costs several times a quantizer's), so ``--seeds`` draws se
 
 Run:  python benchmarks/gap/diagnose_speed.py [--sizes 2000 20000 100000 1000000] [--effects ...] [--seeds 1]
       [--baseline-ref REF | --no-baseline] [--timeout 600] [--baseline-max 100000] [--jobs 1]
+      [--input steps|smooth]
 """
 
 from __future__ import annotations
@@ -80,12 +84,23 @@ def step_train(n: int, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray
     return t, levels[np.searchsorted(edges, t, side="right") - 1]
 
 
-def case(effect: str, n: int, seed: int = 0) -> tuple[Record, Record]:
-    """The estimation record (``n`` samples) and the validation record (``0.8 n``) with ``effect`` withheld."""
+def smooth_command(n: int, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
+    """``n`` samples of a continuously varying command: white noise through a first-order low-pass at 0.5 Hz
+    (exact discretization), scaled to 150-250 PWM about 200."""
+    from scipy.signal import lfilter
+
+    a = np.exp(-2.0 * np.pi * 0.5 * DT)
+    x = lfilter([1.0 - a], [1.0, -a], rng.normal(size=n))
+    return np.arange(n) * DT, 200.0 + 50.0 * x / np.max(np.abs(x))
+
+
+def case(effect: str, n: int, seed: int = 0, kind: str = "steps") -> tuple[Record, Record]:
+    """The estimation record (``n`` samples) and the validation record (``0.8 n``) with ``effect`` withheld;
+    ``kind`` is the command (``"steps"``: :func:`step_train`, ``"smooth"``: :func:`smooth_command`)."""
     rng = np.random.default_rng([seed, n, list(EFFECTS).index(effect)])
     out = []
     for m in (n, int(0.8 * n)):
-        t, u = step_train(m, rng)
+        t, u = (smooth_command if kind == "smooth" else step_train)(m, rng)
         params = dict(EFFECTS[effect])
         if effect == "drift":
             params["slope"] = 3.0 / float(t[-1])
@@ -94,7 +109,7 @@ def case(effect: str, n: int, seed: int = 0) -> tuple[Record, Record]:
     return out[0], out[1]
 
 
-def run_one(effect: str, n: int, workers: int = 2, seed: int = 0) -> dict[str, object]:
+def run_one(effect: str, n: int, workers: int = 2, seed: int = 0, kind: str = "steps") -> dict[str, object]:
     """Time one diagnosis of the ``effect`` case of ``n`` samples, record ``seed`` (this checkout's code)."""
     import resource
 
@@ -104,7 +119,7 @@ def run_one(effect: str, n: int, workers: int = 2, seed: int = 0) -> dict[str, o
         return sum(r.ru_utime + r.ru_stime for r in (resource.getrusage(resource.RUSAGE_SELF),
                                                       resource.getrusage(resource.RUSAGE_CHILDREN)))
 
-    rec, val = case(effect, n, seed)
+    rec, val = case(effect, n, seed, kind)
     t0, c0 = time.perf_counter(), cpu()
     fd = os.dup(2)
     try:  # casadi writes its warnings to file descriptor 2
@@ -117,13 +132,13 @@ def run_one(effect: str, n: int, workers: int = 2, seed: int = 0) -> dict[str, o
     return {"seconds": time.perf_counter() - t0, "cpu": cpu() - c0, "verdict": list(dg.verdict["effects"])}
 
 
-def timed(tree: Path, effect: str, n: int, timeout: float, seed: int = 0) -> dict[str, object]:
+def timed(tree: Path, effect: str, n: int, timeout: float, seed: int = 0, kind: str = "steps") -> dict[str, object]:
     """One diagnosis by the code in ``tree`` (this checkout or the baseline worktree), in a fresh process.
 
     ``seconds`` is the diagnosis alone (no imports, no record generation); ``None`` when it did not finish
     within ``timeout`` seconds or failed (``verdict`` then says which).
     """
-    cmd = [sys.executable, str(tree / "benchmarks/gap/diagnose_speed.py"), "--one", effect, str(n), str(seed)]
+    cmd = [sys.executable, str(tree / "benchmarks/gap/diagnose_speed.py"), "--one", effect, str(n), str(seed), kind]
     env = dict(os.environ, PYTHONPATH=str(tree))
     try:
         out = subprocess.run(cmd, cwd=tree, env=env, capture_output=True, text=True, timeout=timeout, check=False)
@@ -145,10 +160,12 @@ def main(argv: list[str] | None = None) -> None:
     ap.add_argument("--baseline-max", type=int, default=100000, help="largest size the baseline is run at")
     ap.add_argument("--jobs", type=int, default=1, help="diagnoses run at once (compare CPU times then)")
     ap.add_argument("--seeds", type=int, default=1, help="records per effect and size")
-    ap.add_argument("--one", nargs=3, metavar=("EFFECT", "N", "SEED"), help=argparse.SUPPRESS)
+    ap.add_argument("--input", choices=["steps", "smooth"], default="steps", help="the command: a step train or "
+                    "a continuously varying (closed-loop-like) command")
+    ap.add_argument("--one", nargs=4, metavar=("EFFECT", "N", "SEED", "INPUT"), help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
     if args.one:
-        print(json.dumps(run_one(args.one[0], int(args.one[1]), seed=int(args.one[2]))))
+        print(json.dumps(run_one(args.one[0], int(args.one[1]), seed=int(args.one[2]), kind=args.one[3])))
         return
     tmp = None
     if not args.no_baseline:
@@ -164,7 +181,7 @@ def main(argv: list[str] | None = None) -> None:
 
     def work(task: tuple[str, str, int, int]) -> None:
         where, effect, n, seed = task
-        results[task] = timed(ROOT if where == "new" else tree, effect, n, args.timeout, seed)
+        results[task] = timed(ROOT if where == "new" else tree, effect, n, args.timeout, seed, args.input)
         print(f"{where} {effect} {n} #{seed}: {results[task]}", file=sys.stderr, flush=True)
 
     try:
