@@ -51,3 +51,37 @@ def test_convolution_and_ipopt_reach_the_same_fit(seed, periodic, weighted):
         assert abs(b.parameters[name] - truth[name]) < 5 * b.std[name], name
     assert abs(a.offset - b.offset) < 1e-3 * a.offset_std
     assert np.max(np.abs(a.yhat - b.yhat)) < 1e-3 * a.residual_std
+
+
+def test_a_fit_started_where_an_earlier_one_was_reuses_its_build_and_its_answer():
+    """The symbolic build is kept by structure, sensor, dt, start and delay mode: a re-fit started at the same
+    coefficients (every grid point of a gap re-fit) reuses it, a different start or sensor builds its own, and the
+    fit is the same either way."""
+    from synth.ident.convolution_problem import ConvolutionProblem
+    from synth.ident.structure import parse_structure
+
+    st = parse_structure("k*(s+z)/((s+p1)*(s+p2))")
+    theta = np.array([2.0, 3.0, 1.0, 9.0])
+    sensor = Plant.from_string("2400/((s+40)*(s+60))")
+    n = 400
+    y = np.zeros(n)
+
+    def make(th, sen=None, fit_delay=True):
+        return ConvolutionProblem(st, sen, n, DT, False, th, fit_delay, y, False)
+
+    first = make(theta)
+    assert make(theta.copy())._mats is first._mats
+    assert make(theta * (1 + 1e-12))._mats is not first._mats
+    assert make(theta, sensor)._mats is not first._mats
+    assert make(theta, fit_delay=False)._mats is not first._mats
+    assert make(theta, fit_delay=False).q == 4 and first.q == 5
+
+    plant, _, rng, truth = _case(2)  # no sensor
+    t = np.arange(1500) * DT
+    u = np.where(rng.random(9) < 0.5, 0.0, 1.0)[(np.arange(1500) // 200)]
+    rec = record_from_arrays(t, u, simulate_plant(plant, t, u) + 0.01 * rng.normal(size=t.size))
+    init = {k: truth[k] * 1.1 for k in ("k", "z", "p1", "p2")}
+    fits = [fit_structure(rec, "k*(s+z)/((s+p1)*(s+p2))", delay="fit", initial={**init, "delay": 0.01},
+                          solver="convolution") for _ in range(2)]
+    assert fits[0].parameters == fits[1].parameters and fits[0].delay == fits[1].delay
+    assert abs(fits[0].parameters["p1"] - truth["p1"]) < 0.1 * truth["p1"]

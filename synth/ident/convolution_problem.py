@@ -36,6 +36,8 @@ from synth.plant import Plant
 __all__ = ["ConvolutionProblem"]
 
 _BLOCK = 256  # samples per block of the impulse response
+_BUILT_KEEP = 64  # symbolic builds kept for reuse (a few MB)
+_BUILT: dict[tuple[Any, ...], tuple[Any, int, int]] = {}
 _MAX_ITER = 100
 _PROGRESS_WINDOW = 50
 _MAX_ITER_PROGRESSING = 1000
@@ -77,38 +79,23 @@ class ConvolutionProblem:
 
     def __init__(self, st: Structure, sensor: Plant | None, n: int, dt: float, periodic: bool, theta0: np.ndarray,
                  fit_delay: bool, y: np.ndarray, has_d: bool, weights: np.ndarray | None = None) -> None:
-        import casadi as ca
-
         self.n, self.dt, self.periodic, self.fit_delay = n, dt, periodic, fit_delay
-        self.p = p = len(st.parameters)
+        self.p = len(st.parameters)
         self.scale = np.where(np.abs(theta0) > 1e-8, np.abs(theta0), 1.0)
         self.y = np.asarray(y, float)
         self.mask = None if weights is None else np.asarray(weights, float) > 0
         self.col = 1 if (fit_delay or has_d) else 0
-        xi, f = ca.SX.sym("xi", p), ca.SX.sym("f")
-        num, den = with_sensor(*st.casadi_coefficients(xi * ca.DM(self.scale)), sensor)
-        num0, den0 = with_sensor(*[list(c) for c in st.coefficients(theta0)], sensor)
-        order = len(den) - 1
-        if order == 0:
-            raise ModelError(f"structure {st.formula!r}: a static gain needs no dynamic fit")
-        A0 = np.asarray(companion_form(num0, den0)[0], float)
-        _, (scl, _) = matrix_balance(A0, permute=False, separate=True)
-        Tm, Ti = np.diag(scl), np.diag(1.0 / scl)
-        A_l, C_l, D = companion_form(num, den)
-        A = ca.DM(Ti) @ ca.vertcat(*[ca.horzcat(*row) for row in A_l]) @ ca.DM(Tm)
-        C = ca.horzcat(*C_l) @ ca.DM(Tm)
-        Mnum = np.zeros((order + 1, order + 1))
-        Mnum[:order, :order] = Ti @ A0 @ Tm
-        Mnum[:order, order] = Ti[:, -1]
-        squarings = int(max(0, np.ceil(np.log2(max(float(np.linalg.norm(Mnum * dt, 1)), 1e-12)))) + 4)
-        M = ca.vertcat(ca.horzcat(A, ca.DM(Ti[:, -1])), ca.SX.zeros(1, order + 1))
-        E_dt, E_rest, E_f = (taylor_expm(M * step, squarings, symbolic="SX") for step in (dt, dt - f, f))
-        B_late = E_rest[:order, order]
-        B_early = E_rest[:order, :order] @ E_f[:order, order]
-        mats = ca.vertcat(ca.vec(E_dt[:order, :order]), B_late, B_early, ca.vec(C), D)
-        q = ca.vertcat(xi, f) if fit_delay else xi
-        self._mats = ca.Function("mats", [xi, f], [mats, ca.jacobian(mats, q)])
-        self.order, self.q = order, q.numel()
+        theta0 = np.asarray(theta0, float)
+        key = (st.formula, tuple(st.parameters), None if sensor is None else (sensor.num.tobytes(), sensor.den.tobytes()),
+               float(dt), theta0.tobytes(), bool(fit_delay))
+        built = _BUILT.pop(key, None)  # popped and put back: the dict's order is the recency of use
+        if built is None:
+            built = _build(st, sensor, dt, theta0, self.scale, fit_delay)
+        _BUILT[key] = built
+        while len(_BUILT) > _BUILT_KEEP:
+            del _BUILT[next(iter(_BUILT))]
+        self._mats, self.order, self.q = built
+
 
     # ------------------------------------------------------------ evaluation
 
@@ -296,3 +283,39 @@ class ConvolutionProblem:
                 status = "Solve_Succeeded"
                 break
         return x, ssr, {"status": status, "iterations": it, "success": status == "Solve_Succeeded"}
+
+
+def _build(st: Structure, sensor: Plant | None, dt: float, theta0: np.ndarray, scale: np.ndarray,
+           fit_delay: bool) -> tuple[Any, int, int]:
+    """The casadi function of the discrete matrices and their Jacobian, the model's order and the number of ``q``.
+
+    Built in scaled parameters ``xi = theta / scale`` with the state balanced at ``theta0``: a function of the
+    structure, the sensor, ``dt``, ``theta0`` and whether the delay is fitted alone, so a fit started where an
+    earlier one was (a re-fit's every grid point starts at the nominal coefficients) reuses the earlier one's.
+    """
+    import casadi as ca
+
+    p = len(st.parameters)
+    xi, f = ca.SX.sym("xi", p), ca.SX.sym("f")
+    num, den = with_sensor(*st.casadi_coefficients(xi * ca.DM(scale)), sensor)
+    num0, den0 = with_sensor(*[list(c) for c in st.coefficients(theta0)], sensor)
+    order = len(den) - 1
+    if order == 0:
+        raise ModelError(f"structure {st.formula!r}: a static gain needs no dynamic fit")
+    A0 = np.asarray(companion_form(num0, den0)[0], float)
+    _, (scl, _) = matrix_balance(A0, permute=False, separate=True)
+    Tm, Ti = np.diag(scl), np.diag(1.0 / scl)
+    A_l, C_l, D = companion_form(num, den)
+    A = ca.DM(Ti) @ ca.vertcat(*[ca.horzcat(*row) for row in A_l]) @ ca.DM(Tm)
+    C = ca.horzcat(*C_l) @ ca.DM(Tm)
+    Mnum = np.zeros((order + 1, order + 1))
+    Mnum[:order, :order] = Ti @ A0 @ Tm
+    Mnum[:order, order] = Ti[:, -1]
+    squarings = int(max(0, np.ceil(np.log2(max(float(np.linalg.norm(Mnum * dt, 1)), 1e-12)))) + 4)
+    M = ca.vertcat(ca.horzcat(A, ca.DM(Ti[:, -1])), ca.SX.zeros(1, order + 1))
+    E_dt, E_rest, E_f = (taylor_expm(M * step, squarings, symbolic="SX") for step in (dt, dt - f, f))
+    B_late = E_rest[:order, order]
+    B_early = E_rest[:order, :order] @ E_f[:order, order]
+    mats = ca.vertcat(ca.vec(E_dt[:order, :order]), B_late, B_early, ca.vec(C), D)
+    q = ca.vertcat(xi, f) if fit_delay else xi
+    return ca.Function("mats", [xi, f], [mats, ca.jacobian(mats, q)]), order, int(q.numel())
