@@ -106,3 +106,23 @@ def test_golden_search_skipped_only_where_the_profile_is_flat():
     sharp = refit.fit_augmented(G, t, u, y_rl, rate)
     assert len(sharp.profile) > len(rate.data_grid(t, u, y_rl, G))
     assert sharp.params["rate"] == pytest.approx(4.0, rel=0.01)
+
+
+def test_a_start_with_a_denominator_coefficient_stopped_at_zero_is_a_start_not_another_structure():
+    """A re-fit whose lower bound stopped a coefficient at exactly 0 (seed 0, case 32 of the withheld-effect
+    benchmark: ``d0 = 0``) is where every candidate's joint fit starts; each was refused as "not the structure" of
+    the nominal, and the diagnosis fell back to the screen alone. The coefficient now starts at 0 and stays >= 0."""
+    from synth.errors import ModelError
+    from synth.gap.attribution.refit import fit_augmented
+
+    truth = Plant.from_string("3/(s^2+2.5*s+1.5)")
+    t = np.arange(0, 12, 0.01)
+    u = np.where((t % 4) >= 2, 1.0, 0.0) + 0.5 * (t >= 6)
+    y = make_effect("backlash").apply(truth, t, u, {"width": 0.2})
+    nominal = Plant.from_string("3.1/(s^2+2.4*s+1.6)")
+    start = Plant(nominal.num, [1.0, 2.4, 0.0])
+    fit = fit_augmented(nominal, t, u, y, make_effect("backlash"), start=start)
+    assert abs(fit.params["width"] - 0.2) < 0.01
+    assert fit.nominal["d0"] >= 0.0 and abs(fit.nominal["d0"] - 1.5) < 0.05
+    with pytest.raises(ModelError, match="does not have the structure"):
+        fit_augmented(nominal, t, u, y, make_effect("backlash"), start=Plant.from_string("3/(s+2)"))

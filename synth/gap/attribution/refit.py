@@ -214,7 +214,7 @@ def _stable_bounds(plant: Plant, start: dict[str, float]) -> dict[str, float] | 
     poles = plant.poles()
     if poles.size == 0 or np.max(poles.real) >= 0.0:
         return None
-    return {k: 0.0 for k, v in start.items() if k.startswith("d") and k != "delay" and v > 0.0} or None
+    return {k: 0.0 for k in start if k.startswith("d") and k != "delay"} or None
 
 
 def _basis_step(effect: Effect, G: Plant, params: Params, t: np.ndarray, u: np.ndarray, y: np.ndarray,
@@ -403,11 +403,11 @@ def fit_augmented(plant: Plant, t: np.ndarray, u: np.ndarray, y: np.ndarray, eff
     u = np.asarray(u, float)
     y = np.asarray(y, float)
     formula, start_values = nominal_structure(plant)
-    if start is not None:
+    if start is not None:  # it may hold a coefficient at exactly 0 (a re-fit stopped at its bound): a start of 0
         formula_s, values_s = nominal_structure(start)
-        if formula_s != formula:
+        if (start.num.size, start.den.size) != (plant.num.size, plant.den.size) or not set(values_s) <= set(start_values):
             raise ModelError(f"start {formula_s} does not have the structure {formula}", where="start")
-        start_values = values_s
+        start_values = {k: values_s.get(k, 0.0) for k in start_values}
     eff = effect if effect is not None else _NoEffect()
     grid = eff.data_grid(t, u, y, plant) if grid is None else [dict(g) for g in grid]
     if weights is not None:
