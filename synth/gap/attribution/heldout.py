@@ -361,7 +361,9 @@ def diagnose_effects(plant: Plant, record: Record, validate: Record | Sequence[R
 
     fits = candidate_fits(plant, effects, refit, sp.train, sp.evaluated, confirm, train_mask, workers, progress)
 
-    by_label = {eff.label: (eff, fit) for eff, fit, _, _ in fits}
+    # the form a joint fit kept (a dead zone's center held at rest or fitted) is what its parameters count
+    by_label = {eff.label: (fit.effect if isinstance(fit, AugmentedFit) and fit.effect is not None else eff, fit)
+                for eff, fit, _, _ in fits}
     results: list[tuple[EffectResult, np.ndarray, np.ndarray]] = []
     for eff, fit, _, yhat in fits:
         s = sums(yhat)

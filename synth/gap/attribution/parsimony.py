@@ -52,9 +52,10 @@ def share_of_excess(j_before: float, j: float, floor: float) -> float:
 def free_parameters(effect: Effect, params: dict[str, float]) -> int:
     """Parameters the fit of ``effect`` chose: its grid, factor and basis parameters with a finite value.
 
-    A parameter the effect fixes from the record (a dead zone's center, the static map's center and
-    scale) is not chosen by the fit, and a limit left at infinity (the unused side of a one-sided
-    saturation) is not a parameter of the fitted model. An effect that declares no grid, factor or
+    A parameter the effect fixes from the record (a dead zone's center held at the command at rest, the
+    static map's center and scale) is not chosen by the fit (a dead zone whose center was fitted counts
+    it), and a limit left at infinity (the unused side of a one-sided saturation) is not a parameter of
+    the fitted model. An effect that declares no grid, factor or
     basis parameters counts its ``parameter_names``.
 
     Examples
@@ -66,6 +67,8 @@ def free_parameters(effect: Effect, params: dict[str, float]) -> int:
     1
     >>> free_parameters(make_effect("deadzone"), {"width": 0.1, "center": 2.0})
     1
+    >>> free_parameters(make_effect("deadzone").nested_variants()[1], {"width": 0.1, "center": 2.0})
+    2
     """
     names = tuple(dict.fromkeys((*effect.grid_names, *effect.factor_names, *effect.basis_names)))
     return sum(1 for name in names or effect.parameter_names if np.isfinite(params.get(name, np.nan)))

@@ -49,6 +49,7 @@ from synth.errors import DataError, ModelError
 from synth.gap.attribution.convergence import cannot_reach
 from synth.gap.attribution.golden import golden_section, log_bracket, parabolic_section
 from synth.gap.attribution.joint_search import fewest_limits, ranges_within, search_from_points
+from synth.gap.attribution.nested import fit_nested
 from synth.gap.attribution.nominal import monomial, nominal_structure, plant_from_values
 from synth.gap.attribution.profile import profile_interval, profile_level
 from synth.gap.effects.base import Effect, Params
@@ -399,6 +400,10 @@ def fit_augmented(plant: Plant, t: np.ndarray, u: np.ndarray, y: np.ndarray, eff
     >>> round(f.params["rate"], 1), f.plant.to_string(2)
     (4.0, '10/(s+5)')
     """
+    variants = effect.nested_variants() if effect is not None and refine else None
+    if variants is not None:  # e.g. a dead zone around the command at rest, or with a center of its own
+        return fit_nested(fit_augmented, *variants, plant, t, u, y, grid, start=start, weights=weights,
+                          early_stop=early_stop)
     t = np.asarray(t, float)
     u = np.asarray(u, float)
     y = np.asarray(y, float)

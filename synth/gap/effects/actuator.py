@@ -15,7 +15,8 @@ The blocks run on the measured command with the block equations of :mod:`synth.s
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from collections.abc import Callable
+from dataclasses import dataclass, replace
 from typing import Any, ClassVar
 
 import numpy as np
@@ -24,6 +25,7 @@ from synth.errors import ModelError
 from synth.gap.effects.base import Effect, Params, command_span, log_grid, slowest_pole
 from synth.gap.effects.block_memo import run_block
 from synth.plant import Plant
+from synth.search import hooke_jeeves
 from synth.sim.blocks import Backlash, DeadZone, RateLimit, Saturation
 
 __all__ = ["BacklashEffect", "DeadzoneEffect", "RateLimitEffect", "SaturationEffect"]
@@ -215,20 +217,65 @@ class SaturationEffect(Effect):
 class DeadzoneEffect(Effect):
     """Dead zone of half-width ``width`` around ``center`` (:class:`synth.sim.blocks.DeadZone`).
 
-    The center is the command at rest (the first sample) unless given: the
-    drive does not move until the command leaves the band around where it rests.
+    Where the band sits is ``center_search``:
+
+    - ``"tested"`` (the candidate ``deadzone``): the fit tries both of the others and keeps the fitted center only
+      when its training SSR is lower by more than the 95 % point of chi-square with one degree of freedom, in
+      noise variances (:meth:`nested_variants`); a drive that does not move until the command leaves a band
+      around where it rests needs no center of its own, a log that starts away from the band does;
+    - ``"rest"``: the command at rest (the first sample), not a fitted parameter;
+    - ``"fitted"``: searched with the width (then a second free parameter).
 
     Examples
     --------
     >>> import numpy as np
     >>> DeadzoneEffect().input_map(np.array([0.0, 0.5, 3.0]), 1.0, {"width": 1.0, "center": 0.0}).tolist()
     [0.0, 0.0, 2.0]
+    >>> DeadzoneEffect().grid_names, DeadzoneEffect(center_search="fitted").grid_names
+    (('width',), ('width', 'center'))
     """
+
+    center_search: str = "tested"
 
     name: ClassVar[str] = "deadzone"
     parameter_names: ClassVar[tuple[str, ...]] = ("width", "center")
-    grid_names: ClassVar[tuple[str, ...]] = ("width",)
     default_candidates: ClassVar[tuple[str, ...]] = ("deadzone",)
+
+    def __post_init__(self) -> None:
+        if self.center_search not in ("tested", "rest", "fitted"):
+            raise ModelError(f"center_search must be 'tested', 'rest' or 'fitted', got {self.center_search!r}",
+                             where="effect deadzone")
+
+    @property
+    def grid_names(self) -> tuple[str, ...]:  # type: ignore[override]
+        return ("width", "center") if self.center_search == "fitted" else ("width",)
+
+    @property
+    def joint_search(self) -> bool:  # type: ignore[override]
+        return self.center_search == "fitted"
+
+    def nested_variants(self) -> tuple[Effect, Effect] | None:
+        return (replace(self, center_search="rest"), replace(self, center_search="fitted")) \
+            if self.center_search == "tested" else None
+
+    def admissible(self, params: Params, u: np.ndarray) -> bool:
+        """Whether the command passes through the band: at least 2 % of its samples on each side of it.
+
+        A band that reaches past the command's end is a saturation and a shift (the fit cannot tell them apart);
+        it is not a dead zone of its own center (the band around the command at rest is always admissible).
+
+        Examples
+        --------
+        >>> u = np.linspace(0.0, 10.0, 101)
+        >>> DeadzoneEffect().admissible({"width": 1.0, "center": 5.0}, u)
+        True
+        >>> DeadzoneEffect().admissible({"width": 2.0, "center": 9.0}, u)
+        False
+        """
+        w, c = params.get("width", 0.0), params.get("center", 0.0)
+        if w <= 0.0 or c == float(u[0]):
+            return True
+        return bool(min(np.mean(u < c - w), np.mean(u > c + w)) >= 0.02)
 
     def off(self) -> Params:
         return {"width": 0.0, "center": 0.0}
@@ -237,12 +284,78 @@ class DeadzoneEffect(Effect):
         return {"width": (0.0, command_span(u))}
 
     def grid(self, t: np.ndarray, u: np.ndarray, plant: Plant) -> list[Params]:
-        span, c = command_span(u), float(u[0])
-        return [{"width": float(f * span), "center": c} for f in (0.02, 0.05, 0.1, 0.2, 0.35, 0.5)]
+        span = command_span(u)
+        centers = [float(u[0])] if self.center_search != "fitted" else _inner_quantiles(u)
+        return [g for g in ({"width": float(f * span), "center": c} for c in centers for f in _WIDTHS
+                            if self.center_search != "fitted" or f in _FITTED_WIDTHS) if self.admissible(g, u)]
+
+    def screen_grid(self, t: np.ndarray, u: np.ndarray, y: np.ndarray, plant: Plant,
+                    mask: np.ndarray | None = None) -> list[Params]:
+        """The widths around the command at rest and, unless the center is held there, around the command's
+        deciles 10-90 % (the screen's points cost milliseconds), those the command passes through
+        (:meth:`admissible`).
+
+        Examples
+        --------
+        >>> t = np.arange(0, 1, 0.01); u = np.linspace(0.0, 10.0, t.size)
+        >>> len(DeadzoneEffect().screen_grid(t, u, u, Plant.from_string("1/(s+1)")))  # 6 widths at rest, 33 off it
+        39
+        """
+        span = command_span(u)
+        centers = [float(u[0])] + ([] if self.center_search == "rest" else _inner_quantiles(u))
+        return [g for g in ({"width": float(f * span), "center": c} for c in centers for f in _WIDTHS)
+                if self.admissible(g, u)]
+
+    def refine_screen(self, cost: Callable[[Params], float], best: Params, t: np.ndarray, u: np.ndarray,
+                      plant: Plant) -> Params:
+        """From a best point away from the command at rest: a pattern search of width and center together, kept
+        only when it beats the best width around the command at rest by the likelihood-ratio test of the joint fit
+        (3.84 noise variances ``SSR/N`` of the screen's SSR), so that a second parameter does not win the screen's
+        ranking on noise.
+
+        Examples
+        --------
+        >>> t = np.arange(0, 1, 0.01); u = np.linspace(0.0, 10.0, t.size)
+        >>> cost = lambda p: 1.0 + (p["width"] - 0.7) ** 2 + (p["center"] - 3.3) ** 2
+        >>> p = DeadzoneEffect().refine_screen(cost, {"width": 0.5, "center": 3.0}, t, u, Plant.from_string("1"))
+        >>> round(p["width"], 2), round(p["center"], 2)
+        (0.7, 3.3)
+        >>> flat = lambda p: 1.0 + 1e-3 * (p["center"] - 3.3) ** 2  # off rest by less than the test asks
+        >>> DeadzoneEffect().refine_screen(flat, {"width": 0.5, "center": 3.0}, t, u, Plant.from_string("1"))["center"]
+        0.0
+        """
+        rest = float(u[0])
+        if self.center_search == "rest" or best.get("center") == rest:
+            return best
+        span = command_span(u)
+
+        def located(z: np.ndarray) -> Params:
+            return {**best, "width": float(z[0] * span), "center": float(z[1] * span)}
+
+        lo, hi = np.array([0.0, float(np.min(u))]) / span, np.array([1.0, float(np.max(u))]) / span
+        found = hooke_jeeves(lambda z: float(cost(located(z))) if self.admissible(located(z), u) else np.inf,
+                             np.array([best["width"], best["center"]]) / span,
+                             lo, hi, lambda a, b: a < b - 1e-12 * abs(b), 0.02, 2e-4, 80)
+        off = min((best, located(found.z)), key=cost)
+        at_rest = [{**best, "width": float(f * span), "center": rest} for f in _WIDTHS]
+        w0 = min(at_rest, key=cost)["width"] / span
+        held = hooke_jeeves(lambda z: float(cost({**best, "width": float(z[0] * span), "center": rest})),
+                            np.array([w0]), np.array([0.0]), np.array([1.0]), lambda a, b: a < b - 1e-12 * abs(b),
+                            0.25 * w0, 2e-4, 40)
+        on = {**best, "width": float(held.z[0] * span), "center": rest}
+        return off if cost(off) < cost(on) - 3.84 * cost(off) / max(u.size, 1) else on
 
     def input_map(self, u: np.ndarray, dt: float, params: Params) -> np.ndarray:
         w = params.get("width", 0.0)
         return u if w <= 0 else run_block(DeadZone(w, params.get("center", 0.0)), u, dt)
+
+
+_WIDTHS = (0.02, 0.05, 0.1, 0.2, 0.35, 0.5)  # dead-zone half-widths, in command spans
+_FITTED_WIDTHS = (0.05, 0.2)  # ... at each decile when the center is fitted without a screened start
+
+
+def _inner_quantiles(u: np.ndarray) -> list[float]:
+    return [float(q) for q in np.quantile(u, np.linspace(0.1, 0.9, 9))]
 
 
 @dataclass(frozen=True)

@@ -402,6 +402,15 @@ class Effect:
         """Whether it may change the rational part of the linear model (a lag, a resonance; not a delay)."""
         return type(self).augment_plant is not Effect.augment_plant
 
+    def admissible(self, params: Params, u: np.ndarray) -> bool:
+        """Whether ``params`` describe this effect on the command ``u`` and not another one (default: always)."""
+        return True
+
+    def nested_variants(self) -> tuple[Effect, Effect] | None:
+        """A simpler and a richer form the joint fit tries both of (the richer kept only when significantly
+        better; :func:`synth.gap.attribution.refit.fit_augmented`), or ``None`` (default): one form."""
+        return None
+
     def data_grid(self, t: np.ndarray, u: np.ndarray, y: np.ndarray, plant: Plant) -> list[Params]:
         """Grid built from the record's output as well (default: :meth:`grid`)."""
         return self.grid(t, u, plant)
