@@ -28,6 +28,7 @@ def test_an_off_center_dead_zone_is_named_with_its_center(seed: int) -> None:
     found = next(e for e in d.attribution.effects if e.effect == "deadzone").parameters
     assert abs(found["center"] - center) < 0.2, (found, center)
     assert abs(found["width"] - width) < 0.1 * width, (found, width)
+    assert f"center = {found['center']:.4g}" in d.summary  # a fitted center is part of the headline
 
 
 @pytest.mark.parametrize("seed", [3])
