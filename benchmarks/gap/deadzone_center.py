@@ -1,7 +1,8 @@
 """Dead zones wherever their band is: named, located and sized, on records simulated without synth.
 
 A generated record: a random stable second-order plant (poles 1-4 and 6-20 rad/s, DC gain 0.5-3), a smooth random
-command (white noise low-passed at 0.3 Hz, scaled to 0-10, held at its first value for the first 2 s), 3,000
+command (white noise low-passed at 0.3 Hz, scaled to 0-10; ``--command steps``: a step train of levels uniform over
+0-10, each held 1-3 s), held at its first value for the first 2 s, 3,000
 samples at 0.01 s for estimation and as many for validation, noise 1 % of the output's spread. The dead zone
 (half-width 0.5-1.2) sits
 
@@ -17,7 +18,7 @@ its denominator coefficients -3 % and +2 % off. Each record is diagnosed with th
 Scored: the verdict is ``deadzone`` alone; the center within 0.2 (2 % of the command's span) and the width within
 10 % of the truth; and which form the fit kept (the center fitted, or held at the command at rest).
 
-Run:  python benchmarks/gap/deadzone_center.py [--seeds 40] [--kinds off rest] [--jobs 2]
+Run:  python benchmarks/gap/deadzone_center.py [--seeds 40] [--kinds off rest] [--command smooth|steps] [--jobs 2]
 """
 
 from __future__ import annotations
@@ -51,7 +52,17 @@ def dead_zone(x: np.ndarray, width: float, center: float) -> np.ndarray:
     return np.where(x > center + width, x - width, np.where(x < center - width, x + width, center))
 
 
-def records(seed: int, kind: str = "off") -> tuple[Plant, Record, Record, float, float]:
+def _command(rng: np.random.Generator, command: str) -> np.ndarray:
+    """A smooth random command, or a step train (levels uniform over 0-10, each held 1-3 s), over 0-10."""
+    if command == "steps":
+        levels, holds = rng.uniform(0.0, 10.0, size=N), rng.integers(100, 301, size=N)
+        return np.repeat(levels, holds)[:N]
+    a = np.exp(-2.0 * np.pi * 0.3 * DT)
+    x = signal.lfilter([1.0 - a], [1.0, -a], rng.normal(size=N))
+    return 10.0 * (x - x.min()) / np.ptp(x)
+
+
+def records(seed: int, kind: str = "off", command: str = "smooth") -> tuple[Plant, Record, Record, float, float]:
     """The nominal model, the estimation and validation records, the band's true center and half-width.
 
     Raises
@@ -63,11 +74,9 @@ def records(seed: int, kind: str = "off") -> tuple[Plant, Record, Record, float,
     p1, p2, gain = rng.uniform(1.0, 4.0), rng.uniform(6.0, 20.0), rng.uniform(0.5, 3.0)
     num, den = np.array([gain * p1 * p2]), np.polymul([1.0, p1], [1.0, p2])
     disc = signal.cont2discrete(signal.tf2ss(num, den), DT, method="zoh")
-    a = np.exp(-2.0 * np.pi * 0.3 * DT)
     commands = []
-    for _ in range(2):  # estimation, validation: smooth commands over 0-10, at rest for 2 s first
-        x = signal.lfilter([1.0 - a], [1.0, -a], rng.normal(size=N))
-        u = 10.0 * (x - x.min()) / np.ptp(x)
+    for _ in range(2):  # estimation, validation: commands over 0-10, at rest for 2 s first
+        u = _command(rng, command)
         commands.append(np.r_[np.full(200, u[0]), u[:-200]])
     width = float(rng.uniform(0.5, 1.2))
     start = commands[0][0]
@@ -92,9 +101,9 @@ def score(job: tuple[int, str]) -> dict:
     """One record's diagnosis against its truth."""
     from synth.gap.diagnose import diagnose
 
-    seed, kind = job
+    seed, kind, command = job
     try:
-        nominal, rec, val, center, width = records(seed, kind)
+        nominal, rec, val, center, width = records(seed, kind, command)
     except ValueError:  # not a record of its kind: left out
         return {"seed": seed, "kind": kind, "skipped": True}
     t0 = time.process_time()
@@ -112,9 +121,10 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--seeds", type=int, default=40)
     ap.add_argument("--kinds", nargs="+", default=["off", "rest"], choices=["off", "rest"])
+    ap.add_argument("--command", default="smooth", choices=["smooth", "steps"])
     ap.add_argument("--jobs", type=int, default=2)
     args = ap.parse_args()
-    jobs = [(s, k) for k in args.kinds for s in range(args.seeds)]
+    jobs = [(s, k, args.command) for k in args.kinds for s in range(args.seeds)]
     with ProcessPoolExecutor(args.jobs) as pool:
         rows = [r for r in pool.map(score, jobs) if not r.get("skipped")]
     print("| band | records | named `deadzone` | center and width within 0.2 / 10 % | center fitted | "
