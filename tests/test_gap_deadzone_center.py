@@ -49,3 +49,21 @@ def test_a_band_away_from_rest_is_fitted_and_counts_two_parameters() -> None:
     assert free_parameters(fit.effect, fit.params) == 2
     held = fit_augmented(nominal, rec.t, rec.u, rec.y, DeadzoneEffect(center_search="rest"))
     assert held.params["center"] == rec.u[0] and held.ssr > 10 * fit.ssr
+
+
+def test_a_command_with_no_band_to_pass_through_gets_the_dead_zone_at_rest_not_a_crash():
+    """A command at rest for 96 % of the record: every decile is the rest value, and no band there has samples on
+    both sides (not admissible), so the fitted form has no start and the band at rest is the answer."""
+    import numpy as np
+
+    from synth.plant import Plant
+
+    t = np.arange(0, 20, 0.01)
+    u = np.where(t >= 19.2, 1.0, 0.0)
+    G = Plant.from_string("2/(0.3*s+1)")
+    assert DeadzoneEffect(center_search="fitted").grid(t, u, G) == []
+    y = DeadzoneEffect().apply(G, t, u, {"width": 0.3, "center": 0.0})
+    y = y + 0.01 * np.random.default_rng(0).normal(size=t.size)
+    fit = fit_augmented(G, t, u, y, DeadzoneEffect())
+    assert fit.effect.center_search == "rest" and fit.params["center"] == 0.0  # (one step: its width is a gain)
+    assert fit.ssr < 2.0 * t.size * 0.01**2  # at the noise

@@ -78,9 +78,9 @@ def fit_nested(fit: Callable[..., Any], simpler: Effect, richer: Effect, plant: 
     ('fitted', 3.0, 0.8)
     """
     own = simpler.data_grid(t, u, y, plant)
-    mine, others = split_grid(simpler, grid, own) if grid is not None else (own, None)
+    mine, others = split_grid(simpler, grid, own) if grid is not None else (own, richer.data_grid(t, u, y, plant))
     base = fit(plant, t, u, y, simpler, grid=mine or own, **options)
-    if others is not None and not others:
+    if not others:  # the screen's best was the simpler form, or the richer one has no admissible start here
         return base
     try:
         rich = fit(plant, t, u, y, richer, grid=others, **options)

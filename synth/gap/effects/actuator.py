@@ -262,7 +262,8 @@ class DeadzoneEffect(Effect):
         """Whether the command passes through the band: at least 2 % of its samples on each side of it.
 
         A band that reaches past the command's end is a saturation and a shift (the fit cannot tell them apart);
-        it is not a dead zone of its own center (the band around the command at rest is always admissible).
+        it is not a dead zone of its own center. (The band around the command at rest is not judged so: it is the
+        candidate's form that needs no center of its own.)
 
         Examples
         --------
@@ -273,7 +274,7 @@ class DeadzoneEffect(Effect):
         False
         """
         w, c = params.get("width", 0.0), params.get("center", 0.0)
-        if w <= 0.0 or c == float(u[0]):
+        if w <= 0.0:
             return True
         return bool(min(np.mean(u < c - w), np.mean(u > c + w)) >= 0.02)
 
@@ -285,9 +286,10 @@ class DeadzoneEffect(Effect):
 
     def grid(self, t: np.ndarray, u: np.ndarray, plant: Plant) -> list[Params]:
         span = command_span(u)
-        centers = [float(u[0])] if self.center_search != "fitted" else _inner_quantiles(u)
-        return [g for g in ({"width": float(f * span), "center": c} for c in centers for f in _WIDTHS
-                            if self.center_search != "fitted" or f in _FITTED_WIDTHS) if self.admissible(g, u)]
+        if self.center_search != "fitted":
+            return [{"width": float(f * span), "center": float(u[0])} for f in _WIDTHS]
+        return [g for g in ({"width": float(f * span), "center": c} for c in _inner_quantiles(u) for f in _FITTED_WIDTHS)
+                if self.admissible(g, u)]
 
     def screen_grid(self, t: np.ndarray, u: np.ndarray, y: np.ndarray, plant: Plant,
                     mask: np.ndarray | None = None) -> list[Params]:
@@ -301,10 +303,12 @@ class DeadzoneEffect(Effect):
         >>> len(DeadzoneEffect().screen_grid(t, u, u, Plant.from_string("1/(s+1)")))  # 6 widths at rest, 33 off it
         39
         """
+        at_rest = self.grid(t, u, plant) if self.center_search != "fitted" else []
+        if self.center_search == "rest":
+            return at_rest
         span = command_span(u)
-        centers = [float(u[0])] + ([] if self.center_search == "rest" else _inner_quantiles(u))
-        return [g for g in ({"width": float(f * span), "center": c} for c in centers for f in _WIDTHS)
-                if self.admissible(g, u)]
+        return at_rest + [g for g in ({"width": float(f * span), "center": c} for c in _inner_quantiles(u)
+                                      for f in _WIDTHS) if self.admissible(g, u)]
 
     def refine_screen(self, cost: Callable[[Params], float], best: Params, t: np.ndarray, u: np.ndarray,
                       plant: Plant) -> Params:
