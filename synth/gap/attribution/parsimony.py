@@ -13,7 +13,7 @@ import numpy as np
 
 from synth.gap.effects.base import Effect
 
-__all__ = ["free_parameters", "parsimonious_lead", "share_of_excess"]
+__all__ = ["fitted_form", "free_parameters", "parsimonious_lead", "share_of_excess"]
 
 
 def share_of_excess(j_before: float, j: float, floor: float) -> float:
@@ -72,6 +72,27 @@ def free_parameters(effect: Effect, params: dict[str, float]) -> int:
     """
     names = tuple(dict.fromkeys((*effect.grid_names, *effect.factor_names, *effect.basis_names)))
     return sum(1 for name in names or effect.parameter_names if np.isfinite(params.get(name, np.nan)))
+
+
+def fitted_form(effect: Effect, parameter_ci: dict[str, Any]) -> Effect:
+    """The form of ``effect`` a joint fit kept, read from its intervals (what a verdict pooled over runs has).
+
+    The richer of its :meth:`~synth.gap.effects.base.Effect.nested_variants` when an interval is given for a
+    parameter only the richer one fits (a dead zone's fitted center), else the simpler one (or ``effect`` itself).
+
+    Examples
+    --------
+    >>> from synth.gap.effects import make_effect
+    >>> fitted_form(make_effect("deadzone"), {"width": (0.1, 0.2), "center": (2.9, 3.1)}).center_search
+    'fitted'
+    >>> fitted_form(make_effect("deadzone"), {"width": (0.1, 0.2)}).center_search
+    'rest'
+    """
+    variants = effect.nested_variants()
+    if variants is None:
+        return effect
+    simpler, richer = variants
+    return richer if (set(richer.grid_names) - set(simpler.grid_names)) & set(parameter_ci) else simpler
 
 
 def parsimonious_lead(candidates: list[tuple[str, np.ndarray]], counts: list[int], advantage_ci: Any,

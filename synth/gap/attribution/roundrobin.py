@@ -36,7 +36,7 @@ import numpy as np
 from synth.data.record import Record
 from synth.errors import ModelError
 from synth.gap.attribution.heldout import DiagnoseOptions, diagnose_effects
-from synth.gap.attribution.parsimony import free_parameters, parsimonious_lead, share_of_excess
+from synth.gap.attribution.parsimony import fitted_form, free_parameters, parsimonious_lead, share_of_excess
 from synth.gap.attribution.verdict import EffectDiagnosis, separating_experiment
 from synth.gap.effects.registry import DEFAULT_CANDIDATES, make_effect
 from synth.plant import Plant
@@ -281,8 +281,10 @@ def _pool(folds: list[EffectDiagnosis], names: list[str], blocks: int, n_boot: i
     if not gap_present:
         effects, status = [], "none"
     elif relevant:
-        counts_p = [free_parameters(make_effect(e.effect), next(p for p in e.parameters if p is not None))
-                    for e in relevant]
+        # a nested effect's richer form (a dead zone's fitted center) when any run's fit kept it
+        counts_p = [free_parameters(max((fitted_form(make_effect(e.effect), b[e.effect].parameter_ci) for b in by_fold),
+                                        key=lambda f: len(f.grid_names)),
+                                    next(p for p in e.parameters if p is not None)) for e in relevant]
         lead, parsimony = parsimonious_lead([(e.effect, sums[e.effect]) for e in relevant], counts_p, ratio_ci,
                                              threshold)
         best = relevant[lead]
