@@ -3,7 +3,7 @@
 A generated record: a random stable second-order plant (poles 1-4 and 6-20 rad/s, DC gain 0.5-3), a smooth random
 command (white noise low-passed at 0.3 Hz, scaled to 0-10; ``--command steps``: a step train of levels uniform over
 0-10, each held 1-3 s), held at its first value for the first 2 s, 3,000
-samples at 0.01 s for estimation and as many for validation, noise 1 % of the output's spread. The dead zone
+samples at 0.01 s for estimation and as many for validation, noise 1 % of the output's spread (``--noise``). The dead zone
 (half-width 0.5-1.2) sits
 
 - ``off``: 1.5-3 units from where the estimation command starts, inside 2.5-7.5 (a log that starts away from the
@@ -18,7 +18,8 @@ its denominator coefficients -3 % and +2 % off. Each record is diagnosed with th
 Scored: the verdict is ``deadzone`` alone; the center within 0.2 (2 % of the command's span) and the width within
 10 % of the truth; and which form the fit kept (the center fitted, or held at the command at rest).
 
-Run:  python benchmarks/gap/deadzone_center.py [--seeds 40] [--kinds off rest] [--command smooth|steps] [--jobs 2]
+Run:  python benchmarks/gap/deadzone_center.py [--seeds 40] [--kinds off rest] [--command smooth|steps]
+      [--noise 0.01] [--jobs 2]
 """
 
 from __future__ import annotations
@@ -62,7 +63,8 @@ def _command(rng: np.random.Generator, command: str) -> np.ndarray:
     return 10.0 * (x - x.min()) / np.ptp(x)
 
 
-def records(seed: int, kind: str = "off", command: str = "smooth") -> tuple[Plant, Record, Record, float, float]:
+def records(seed: int, kind: str = "off", command: str = "smooth",
+            noise: float = 0.01) -> tuple[Plant, Record, Record, float, float]:
     """The nominal model, the estimation and validation records, the band's true center and half-width.
 
     Raises
@@ -89,7 +91,7 @@ def records(seed: int, kind: str = "off", command: str = "smooth") -> tuple[Plan
         v = dead_zone(u, width, center)
         _, y, _ = signal.dlsim(disc, v - v[0])
         y = np.ravel(y) + gain * float(v[0])  # started in the steady state of the first held command
-        y = y + 0.01 * np.std(y) * rng.normal(size=N)
+        y = y + noise * np.std(y) * rng.normal(size=N)
         out.append(record_from_arrays(np.arange(N) * DT, u, y))
     if kind == "off" and abs(commands[0][0] - center) <= 2.0 * width:
         raise ValueError(f"record {seed}: the band is where the command starts")
@@ -97,13 +99,13 @@ def records(seed: int, kind: str = "off", command: str = "smooth") -> tuple[Plan
     return nominal, out[0], out[1], center, width
 
 
-def score(job: tuple[int, str]) -> dict:
+def score(job: tuple[int, str, str, float]) -> dict:
     """One record's diagnosis against its truth."""
     from synth.gap.diagnose import diagnose
 
-    seed, kind, command = job
+    seed, kind, command, noise = job
     try:
-        nominal, rec, val, center, width = records(seed, kind, command)
+        nominal, rec, val, center, width = records(seed, kind, command, noise)
     except ValueError:  # not a record of its kind: left out
         return {"seed": seed, "kind": kind, "skipped": True}
     t0 = time.process_time()
@@ -122,9 +124,10 @@ def main() -> None:
     ap.add_argument("--seeds", type=int, default=40)
     ap.add_argument("--kinds", nargs="+", default=["off", "rest"], choices=["off", "rest"])
     ap.add_argument("--command", default="smooth", choices=["smooth", "steps"])
+    ap.add_argument("--noise", type=float, default=0.01, help="output noise, a fraction of the output's spread")
     ap.add_argument("--jobs", type=int, default=2)
     args = ap.parse_args()
-    jobs = [(s, k, args.command) for k in args.kinds for s in range(args.seeds)]
+    jobs = [(s, k, args.command, args.noise) for k in args.kinds for s in range(args.seeds)]
     with ProcessPoolExecutor(args.jobs) as pool:
         rows = [r for r in pool.map(score, jobs) if not r.get("skipped")]
     print("| band | records | named `deadzone` | center and width within 0.2 / 10 % | center fitted | "
