@@ -221,8 +221,9 @@ class Diagnosis:
                     "comes from a few segments of the record.")
         if status == "effect":
             best = next(e for e in self.attribution.effects if e.effect == v["effects"][0])
-            params = ", ".join(f"{k} = {_fmt(x)}" for k, x in best.parameters.items()  # fixed by the record: not
-                               if k not in ("center", "scale") or k in best.parameter_ci)  # shown (fitted: shown)
+            # a center or scale the record fixes stays out; a fitted one (it has an interval) is shown
+            params = ", ".join(f"{k} = {_fmt(x)}" for k, x in best.parameters.items()
+                               if k not in ("center", "scale") or k in best.parameter_ci)
             text = (f"The gap ({gap}) is explained by {best.effect.replace('_', ' ')} ({params}): it removes "
                     f"{100 * best.share_of_gap:.0f} % of the held-out error above the noise floor.")
             if v["indistinguishable"]:

@@ -7,6 +7,7 @@ model's held-out excess over the noise floor another one removes.
 
 from __future__ import annotations
 
+from collections.abc import Collection
 from typing import Any
 
 import numpy as np
@@ -55,8 +56,8 @@ def free_parameters(effect: Effect, params: dict[str, float]) -> int:
     A parameter the effect fixes from the record (a dead zone's center held at the command at rest, the
     static map's center and scale) is not chosen by the fit (a dead zone whose center was fitted counts
     it), and a limit left at infinity (the unused side of a one-sided saturation) is not a parameter of
-    the fitted model. An effect that declares no grid, factor or
-    basis parameters counts its ``parameter_names``.
+    the fitted model. An effect that declares no grid, factor or basis parameters counts its
+    ``parameter_names``.
 
     Examples
     --------
@@ -74,11 +75,12 @@ def free_parameters(effect: Effect, params: dict[str, float]) -> int:
     return sum(1 for name in names or effect.parameter_names if np.isfinite(params.get(name, np.nan)))
 
 
-def fitted_form(effect: Effect, parameter_ci: dict[str, Any]) -> Effect:
+def fitted_form(effect: Effect, parameter_ci: Collection[str]) -> Effect:
     """The form of ``effect`` a joint fit kept, read from its intervals (what a verdict pooled over runs has).
 
-    The richer of its :meth:`~synth.gap.effects.base.Effect.nested_variants` when an interval is given for a
-    parameter only the richer one fits (a dead zone's fitted center), else the simpler one (or ``effect`` itself).
+    The richer of its :meth:`~synth.gap.effects.base.Effect.nested_variants` when ``parameter_ci`` (the intervals,
+    or just their names) holds a parameter only the richer one fits (a dead zone's fitted center), else the simpler
+    one (or ``effect`` itself).
 
     Examples
     --------

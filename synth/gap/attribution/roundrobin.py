@@ -281,10 +281,10 @@ def _pool(folds: list[EffectDiagnosis], names: list[str], blocks: int, n_boot: i
     if not gap_present:
         effects, status = [], "none"
     elif relevant:
-        # a nested effect's richer form (a dead zone's fitted center) when any run's fit kept it
-        counts_p = [free_parameters(max((fitted_form(make_effect(e.effect), b[e.effect].parameter_ci) for b in by_fold),
-                                        key=lambda f: len(f.grid_names)),
-                                    next(p for p in e.parameters if p is not None)) for e in relevant]
+        # a nested effect's richer form (a dead zone's fitted center) when any run's fit kept it: the runs' intervals
+        forms = [fitted_form(make_effect(e.effect), {k for b in by_fold for k in b[e.effect].parameter_ci})
+                 for e in relevant]
+        counts_p = [free_parameters(f, next(p for p in e.parameters if p is not None)) for f, e in zip(forms, relevant)]
         lead, parsimony = parsimonious_lead([(e.effect, sums[e.effect]) for e in relevant], counts_p, ratio_ci,
                                              threshold)
         best = relevant[lead]

@@ -336,9 +336,12 @@ class DeadzoneEffect(Effect):
         def located(z: np.ndarray) -> Params:
             return {**best, "width": float(z[0] * span), "center": float(z[1] * span)}
 
+        def located_cost(z: np.ndarray) -> float:
+            p = located(z)
+            return float(cost(p)) if self.admissible(p, u) else np.inf
+
         lo, hi = np.array([0.0, float(np.min(u))]) / span, np.array([1.0, float(np.max(u))]) / span
-        found = hooke_jeeves(lambda z: float(cost(located(z))) if self.admissible(located(z), u) else np.inf,
-                             np.array([best["width"], best["center"]]) / span,
+        found = hooke_jeeves(located_cost, np.array([best["width"], best["center"]]) / span,
                              lo, hi, lambda a, b: a < b - 1e-12 * abs(b), 0.02, 2e-4, 80)
         off = min((best, located(found.z)), key=cost)
         at_rest = [{**best, "width": float(f * span), "center": rest} for f in _WIDTHS]
