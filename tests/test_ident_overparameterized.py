@@ -39,7 +39,7 @@ def first_order_record(seed: int, n: int = 2000) -> tuple[np.ndarray, np.ndarray
     return t, u, y, K, T
 
 
-@pytest.mark.parametrize(("seed", "solver"), [(10, "ipopt"), (11, "Levenberg-Marquardt"),
+@pytest.mark.parametrize(("seed", "solver"), [(10, "Levenberg-Marquardt"), (11, "Levenberg-Marquardt"),
                                               (15, "Levenberg-Marquardt"), (16, "Levenberg-Marquardt")])
 def test_an_overparameterized_fit_with_a_free_delay_is_returned_with_its_cancelling_pair_weak(seed, solver):
     """Seeds 15 and 16 failed before (IPOPT: maximum iterations at 98.06 %; ended worse than its start); seed 10
@@ -47,17 +47,25 @@ def test_an_overparameterized_fit_with_a_free_delay_is_returned_with_its_cancell
     unbounded one in the next interval went below 0); Levenberg-Marquardt from the same start took over. Seed 11
     was returned as a result at 29 % fit with a delay of 1.07 s: SRIVC's iteration on the delay grid left a fit
     at the noise for one far off at the true delay 0, so the grid chose 1.5 s; its best iterate is now kept (seed
-    10's start is then good enough for IPOPT)."""
+    10's start is then good enough for IPOPT). IPOPT's fit of seed 10 leaves the pair at -269/-902 with a delay of
+    2.4 ms; the pair relocation's refit from the pair at the plant's pole (Levenberg-Marquardt, which crawled to its
+    iteration limit against the delay's bound at 0 until its steps kept a variable the bound holds fixed) is kept
+    at 31.9 noise variances of SSR lower, with the delay 0."""
     t, u, y, K, T = first_order_record(seed)
     fit = identify((t, u, y), STRUCTURE, delay="fit", average="none").fit
     assert fit.solver["method"].startswith(solver)
-    assert solver == "ipopt" or "IPOPT from the same start" in fit.solver["method"]
+    relocated = any(step.get("refit") == "kept: a lower residual" for step in fit.solver.get("pair_profile", []))
+    assert solver == "ipopt" or "IPOPT from the same start" in fit.solver["method"] or relocated
+    assert relocated or seed != 10
     assert fit.residual_std == pytest.approx(NOISE, rel=0.05)  # fitted to the noise, no further
     assert fit.delay >= 0.0
     # the plant's own pole: one of the two, within 4 of its standard errors of the truth
     own = min(("p1", "p2"), key=lambda p: abs(fit.parameters[p] - 1.0 / T))
     assert abs(fit.parameters[own] - 1.0 / T) <= 4.0 * fit.std[own]
-    assert fit.plant.dc_gain() == pytest.approx(K, rel=0.01)
+    # the gain the record shows: the step response five of the plant's time constants on (a pair that cancels near
+    # the origin, as seed 10's does at 0.0063/0.0067 rad/s, moves the gain at s = 0, which 20 s of record cannot see)
+    _, step = signal.step((fit.plant.num, fit.plant.den), T=[0.0, 5.0 * T])
+    assert step[-1] == pytest.approx(K * (1.0 - np.exp(-5.0)), rel=0.01)
     # the zero and the other pole cancel: marked weak, never given as confident numbers
     other = "p2" if own == "p1" else "p1"
     assert {w.name for w in fit.weak} >= {"z", other}

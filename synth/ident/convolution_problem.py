@@ -256,18 +256,23 @@ class ConvolutionProblem:
                                  and history[-_PROGRESS_WINDOW - 1] - ssr > ssr / dof):
             it += 1
             g, H = J.T @ r, J.T @ J
-            d = np.maximum(np.diag(H), 1e-300)
+            # a variable at a bound that the SSR pushes further out stays there: the step is taken in the others
+            # (a clipped full step moved them to make up for a move the bound then refused, and crawled)
+            free = ~(((x <= lb) & (g < 0)) | ((x >= ub) & (g > 0)))
+            g_free, H_free = g[free], H[np.ix_(free, free)]
+            d = np.maximum(np.diag(H_free), 1e-300)
             try:
-                gn = np.linalg.lstsq(H, g, rcond=None)[0]
+                gn = np.linalg.lstsq(H_free, g_free, rcond=None)[0]
             except np.linalg.LinAlgError:
-                gn = np.zeros_like(g)
-            remaining = float(g @ gn)  # the Gauss-Newton decrease of the SSR still available
+                gn = np.zeros_like(g_free)
+            remaining = float(g_free @ gn)  # the Gauss-Newton decrease of the SSR still available
             if remaining <= 1e-8 * ssr / dof or remaining <= max(1e-15, rtol) * ssr:
                 status = "Solve_Succeeded"
                 break
             accepted = False
+            step = np.zeros_like(x)
             while lam < 1e12:
-                step = np.linalg.solve(H + lam * np.diag(d), g)
+                step[free] = np.linalg.solve(H_free + lam * np.diag(d), g_free)
                 trial = np.clip(x + step, lb, ub)
                 r_new = self._residual(trial, par, False)[0]
                 with np.errstate(all="ignore"):
