@@ -52,13 +52,33 @@ def test_a_delay_held_at_its_bound_converges_to_the_bounded_optimum(seed: int) -
     fit = fit_structure(record_from_arrays(t, u, y), "K/(T*s+1)", "fit", solver="convolution")
     assert fit.solver["status"] == "Solve_Succeeded" and fit.solver["iterations"] <= 25, fit.solver
     assert fit.delay == 0.0
-    w = u - u[0]
-    ref = optimize.least_squares(lambda x: y - _reference_model(x, w, dt), x0=[2.0, T, 0.5 * dt, 0.0],
-                                 bounds=([-np.inf, 1e-6, 0.0, -np.inf], np.inf), x_scale=[1.0, T, dt, 1.0],
-                                 xtol=1e-12, ftol=1e-14, gtol=1e-12)
-    assert ref.success and ref.x[2] == pytest.approx(0.0, abs=1e-9)  # the reference holds the delay at 0 too
+    ref = _reference(t, u, y, dt, T)
     ssr_fit, ssr_ref = float(np.sum((y - fit.yhat) ** 2)), 2.0 * float(ref.cost)
     assert ssr_fit <= ssr_ref * (1.0 + 1e-9)  # at the bounded optimum (before: 0.04-0.7 % above it)
     assert ssr_ref <= ssr_fit * (1.0 + 1e-6)
     for name, value in zip(("K", "T"), ref.x[:2]):
         assert abs(fit.parameters[name] - value) <= 0.01 * fit.std[name], name
+
+
+@pytest.mark.parametrize("seed", [6, 9])
+def test_ipopt_at_its_limit_on_the_bound_gives_way_to_the_converged_fit_there(seed: int) -> None:
+    """On records of 2,000-6,000 samples IPOPT fits first; with the delay's bound at 0 active it can run its 300
+    iterations at the optimum, its SSR taken 1e-8 past the bound (IPOPT's relaxation) and so a hair below what any
+    delay of 0 or more gives. Levenberg-Marquardt from the same start converges there; its answer was refused for
+    not being lower, and the fit went on to four restarts (or ended at the limit). It is kept now."""
+    t, u, y, dt, T = _record(seed)
+    fit = fit_structure(record_from_arrays(t, u, y), "K/(T*s+1)", "fit")
+    assert "IPOPT from the same start: Maximum_Iterations_Exceeded" in fit.solver["method"]
+    assert fit.solver["status"] == "Solve_Succeeded" and fit.solver["starts"] == 2, fit.solver
+    ref = _reference(t, u, y, dt, T)
+    assert float(np.sum((y - fit.yhat) ** 2)) <= 2.0 * float(ref.cost) * (1.0 + 1e-9)
+
+
+def _reference(t: np.ndarray, u: np.ndarray, y: np.ndarray, dt: float, T: float) -> optimize.OptimizeResult:
+    """The bounded optimum by scipy, from the truth's gain and time constant."""
+    w = u - u[0]
+    ref = optimize.least_squares(lambda x: y - _reference_model(x, w, dt), x0=[2.0, T, 0.5 * dt, 0.0],
+                                 bounds=([-np.inf, 1e-6, 0.0, -np.inf], np.inf), x_scale=[1.0, T, dt, 1.0],
+                                 xtol=1e-12, ftol=1e-14, gtol=1e-12)
+    assert ref.success and ref.x[2] == pytest.approx(0.0, abs=1e-9)  # the reference holds the delay at 0 too
+    return ref
