@@ -18,7 +18,7 @@ import numpy as np
 
 from synth.ident.fit_failure import CONVERGED_WITHIN, remaining_improvement, scaled_jacobian, start_point
 
-__all__ = ["START_CONVERGED", "converged_start"]
+__all__ = ["START_CONVERGED", "converged_replaces", "converged_start"]
 
 START_CONVERGED = "Start_Converged"
 """The solver status a fit reports when its start was kept (:func:`converged_start`)."""
@@ -73,3 +73,32 @@ def converged_start(prob: Any, theta0: np.ndarray, d0: float, b0: float, w: np.n
         return None
     left = remaining_improvement(prob, x0, par, J, resid, J.T @ J, scale, s2, mask, y, lower, fit_delay, dt)
     return (x0, m, left) if left < CONVERGED_WITHIN else None
+
+
+def converged_replaces(candidate: dict[str, Any], candidate_ssr: float, current: dict[str, Any], current_ssr: float,
+                       noise_dof: int) -> bool:
+    """Whether a converged fit replaces one that stopped at a limit with an SSR at most a hundredth of a noise variance
+    below it: the same answer, and one that says it converged.
+
+    IPOPT with the delay's bound at 0 active can run its 300 iterations at the optimum, its SSR taken 1e-8 past the
+    bound (IPOPT's bound relaxation), so a hair below what any delay of 0 or more gives; Levenberg-Marquardt from the
+    same start converges there.
+
+    Parameters
+    ----------
+    candidate, current : dict
+        The solvers' status dicts (``"success"``).
+    candidate_ssr, current_ssr : float
+        Their sums of squared residuals.
+    noise_dof : int
+        Samples fitted less parameters: ``current_ssr / noise_dof`` is the noise variance.
+
+    Examples
+    --------
+    >>> converged_replaces({"success": True}, 6.1873412, {"success": False}, 6.1873396, 1998)
+    True
+    >>> converged_replaces({"success": True}, 6.19, {"success": False}, 6.18, 1998)
+    False
+    """
+    return bool(candidate["success"]) and not current["success"] \
+        and candidate_ssr <= current_ssr * (1.0 + 0.01 / noise_dof)

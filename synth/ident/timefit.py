@@ -53,7 +53,7 @@ from synth.ident.nyquist import nyquist_note
 from synth.ident.residual_whiteness import correlated_residuals_note
 from synth.ident.sim_error_problem import SimulationErrorProblem
 from synth.ident.srivc import linear_initial_model, map_to_structure
-from synth.ident.start_kept import START_CONVERGED, converged_start
+from synth.ident.start_kept import START_CONVERGED, converged_replaces, converged_start
 from synth.ident.start_state import free_columns, free_start_gram, start_state_test
 from synth.ident.structure import Structure, parse_structure
 from synth.plant import Plant
@@ -396,13 +396,6 @@ def fit_structure(record: Record, structure: Structure | str, delay: str | float
     ssr_start = start_ssr(prob, theta0, d0, b0, w, y, mask, fit_delay, dt)
     def below_zero(fit: tuple) -> bool:  # a whole delay below 0: no plant's (fit_failure)
         return fit_delay and fit[2] * dt + float(fit[0][len(st.parameters)]) < 0.0
-    def converged_there(fit: tuple, ssr_now: float, info_now: dict | None = None) -> bool:
-        # a converged fit within a hundredth of a noise variance of the SSR of one that stopped at its limit (IPOPT
-        # with the delay's bound at 0 active can run its 300 iterations there, its SSR taken 1e-8 past the bound):
-        # the same answer, and one that says it converged
-        return bool(fit[3]["success"]) and not (info_now or st_info)["success"] \
-            and fit[1] <= ssr_now * (1.0 + 0.01 / noise_dof)
-
     lost = below_zero((xs, ssr, m)) or not st_info["success"] or not ssr <= min(init_ssr, ssr_start)
     if isinstance(prob, SimulationErrorProblem) and lb is None and lost:
         # IPOPT lost its way (a cancelling pair trading with the delay, or the delay's bound at 0 missed): Levenberg-
@@ -411,8 +404,8 @@ def fit_structure(record: Record, structure: Structure | str, delay: str | float
             st, sensor, n, dt, periodic, theta0, fit_delay, y, has_d, weights)
         cand = run(theta0, d0)
         info["starts"] += 1
-        if (cand[3]["success"] or cand[3].get("status") in LIMIT_STATUSES) and not below_zero(cand) \
-                and (cand[1] < ssr or below_zero((xs, ssr, m)) or converged_there(cand, ssr)):  # fit_failure judges it
+        if (cand[3]["success"] or cand[3].get("status") in LIMIT_STATUSES) and not below_zero(cand) and (  # judged later
+                cand[1] < ssr or below_zero((xs, ssr, m)) or converged_replaces(cand[3], cand[1], st_info, ssr, noise_dof)):
             xs, ssr, m, st_info, shifts = cand
             info["method"] = (f"Levenberg-Marquardt, exact Jacobian by FFT convolution of the sensitivities (IPOPT "
                               f"from the same start: {failed_status}, SSR {failed_ssr:.4g}, {ssr_start:.4g} at the start)")
@@ -422,7 +415,7 @@ def fit_structure(record: Record, structure: Structure | str, delay: str | float
         for factor in (0.5, 2.0, 0.2, 5.0):
             cand = run(theta0 * factor, d0)
             info["starts"] += 1
-            if cand[3]["success"] and (cand[1] < ssr or converged_there(cand, ssr, st_info)):
+            if cand[3]["success"] and (cand[1] < ssr or converged_replaces(cand[3], cand[1], st_info, ssr, noise_dof)):
                 xs, ssr, m, st_info, shifts = cand
                 if st_info["success"] and ssr <= min(init_ssr, ssr_start):
                     break
