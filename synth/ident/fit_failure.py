@@ -286,20 +286,32 @@ def remaining_improvement(prob: Any, xs: np.ndarray, par: np.ndarray, J: np.ndar
     ...                             2.0 * t, None, False, 0.1), 3)   # sqrt(SSR drop / s^2) = sqrt(120)
     10.954
     """
-    step = np.linalg.lstsq(JtJ, J.T @ resid, rcond=None)[0] / scale_vec
+    g, p = J.T @ resid, prob.p
+    steps = [np.linalg.lstsq(JtJ, g, rcond=None)[0] / scale_vec]
+    lo, hi = np.full(xs.size, -np.inf), np.full(xs.size, np.inf)
+    if lb is not None:
+        lo[:p] = lb / prob.scale
+    if fit_delay:
+        lo[p], hi[p] = 0.0, dt
+    target = np.clip(xs + steps[0], lo, hi)
+    held = target != xs + steps[0]
+    if held.any():  # the step past a bound, clipped, moves the others for a move the bound refuses: also the step
+        # with those held at their bounds, the others' Gauss-Newton step given that
+        move = np.zeros(xs.size)
+        move[held] = (target[held] - xs[held]) * scale_vec[held]
+        free = ~held
+        move[free] = np.linalg.lstsq(JtJ[np.ix_(free, free)], g[free] - JtJ[np.ix_(free, held)] @ move[held],
+                                     rcond=None)[0]
+        steps.append(move / scale_vec)
     ssr0 = float(resid @ resid)
     best = 0.0
-    for alpha in (1.0, 0.5, 0.25, 0.125, 0.0625, 0.03125):
-        trial = xs + alpha * step
-        p = prob.p
-        if lb is not None:
-            trial[:p] = np.maximum(trial[:p], lb / prob.scale)
-        if fit_delay:
-            trial[p] = min(max(trial[p], 0.0), dt)
-        r = y - np.asarray(prob.yhat_fn(trial, par)).ravel()
-        if mask is not None:
-            r = r[mask]
-        ssr = float(r @ r)
-        if np.isfinite(ssr):
-            best = max(best, (ssr0 - ssr) / s2)
+    for step in steps:
+        for alpha in (1.0, 0.5, 0.25, 0.125, 0.0625, 0.03125):
+            trial = np.clip(xs + alpha * step, lo, hi)
+            r = y - np.asarray(prob.yhat_fn(trial, par)).ravel()
+            if mask is not None:
+                r = r[mask]
+            ssr = float(r @ r)
+            if np.isfinite(ssr):
+                best = max(best, (ssr0 - ssr) / s2)
     return float(np.sqrt(best))
