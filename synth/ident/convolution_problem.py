@@ -234,7 +234,9 @@ class ConvolutionProblem:
         Converged when the Gauss-Newton decrease of the SSR still available is below ``1e-8`` of the noise
         variance ``SSR/dof``, or below ``rtol`` times the SSR (a caller that iterates fits to a looser tolerance
         of its own). The status strings are IPOPT's (``Solve_Succeeded``, ``Maximum_Iterations_Exceeded``,
-        ``Diverging_Iterates``), so :func:`synth.ident.fit_failure.fit_failure` reads them alike.
+        ``Diverging_Iterates``), so :func:`synth.ident.fit_failure.fit_failure` reads them alike. A variable at a
+        bound (``lower``, the delay's fraction) that the gradient pushes further out is held there: the step and the
+        convergence test are taken in the others, and a step is clipped at the bounds.
         """
         lb, ub = -np.inf * np.ones(x0.size), np.inf * np.ones(x0.size)
         if lower is not None:
