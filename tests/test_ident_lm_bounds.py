@@ -4,8 +4,9 @@ A plant with a little lead (a zero well above its pole) fitted as ``K/(T*s+1)`` 
 is below 0, so the fit ends with the delay at its bound 0. The steps clipped at the bound used to move the other
 parameters for a delay move the bound then refused; the fit crawled to its iteration limit (125-1,000 iterations,
 1-121 s, SSR 0.04-74 % above the optimum on records of 2,000-30,000 samples). The steps now leave a parameter the
-bound holds where it is. Judged against an independent reference written here: the record's exact sampled model
-(zero-order hold, the delay's fraction of a sample) by ``scipy.signal.lfilter``, fitted by
+bound holds where it is. Judged against an independent reference (the model of
+``benchmarks/ident_delay_at_bound.py``, written from the model's definition with scipy only: the record's exact
+sampled model, zero-order hold and the delay's fraction of a sample, by ``scipy.signal.lfilter``), fitted by
 ``scipy.optimize.least_squares`` with the same bound.
 """
 
@@ -13,8 +14,9 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from scipy import optimize, signal
+from scipy import optimize
 
+from benchmarks.ident_delay_at_bound import model
 from synth.data import record_from_arrays
 from synth.ident.simulate import simulate_plant
 from synth.ident.timefit import fit_structure
@@ -32,18 +34,6 @@ def _record(seed: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, float, float
     u = ((np.arange(n) // hold) % 2).astype(float)
     y = simulate_plant(Plant.from_string(f"2*({lead}*s+1)/({T}*s+1)"), t, u) + 0.01 * rng.normal(size=n)
     return t, u, y, dt, T
-
-
-def _reference_model(x: np.ndarray, w: np.ndarray, dt: float) -> np.ndarray:
-    """``b + K/(T s + 1) e^(-d s)`` applied to ``w`` held between samples, sampled exactly, from rest."""
-    K, T, d, b = x
-    m, f = int(np.floor(d / dt)), d - np.floor(d / dt) * dt
-    a = np.exp(-dt / T)
-    late = K * (1.0 - np.exp(-(dt - f) / T))  # the sample w_{k-m} over the last dt - f of the interval
-    early = K * np.exp(-(dt - f) / T) * (1.0 - np.exp(-f / T))  # w_{k-m-1} over its first f
-    shifted = np.concatenate([np.zeros(m), w])[:w.size]
-    v = late * shifted + early * np.concatenate([[0.0], shifted[:-1]])
-    return b + signal.lfilter([0.0, 1.0], [1.0, -a], v)
 
 
 @pytest.mark.parametrize("seed", [0, 1, 3, 8])
@@ -77,7 +67,7 @@ def test_ipopt_at_its_limit_on_the_bound_gives_way_to_the_converged_fit_there(se
 def _reference(t: np.ndarray, u: np.ndarray, y: np.ndarray, dt: float, T: float) -> optimize.OptimizeResult:
     """The bounded optimum by scipy, from the truth's gain and time constant."""
     w = u - u[0]
-    ref = optimize.least_squares(lambda x: y - _reference_model(x, w, dt), x0=[2.0, T, 0.5 * dt, 0.0],
+    ref = optimize.least_squares(lambda x: y - model(1, x, w, dt), x0=[2.0, T, 0.5 * dt, 0.0],
                                  bounds=([-np.inf, 1e-6, 0.0, -np.inf], np.inf), x_scale=[1.0, T, dt, 1.0],
                                  xtol=1e-12, ftol=1e-14, gtol=1e-12)
     assert ref.success and ref.x[2] == pytest.approx(0.0, abs=1e-9)  # the reference holds the delay at 0 too

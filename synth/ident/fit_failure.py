@@ -293,8 +293,9 @@ def remaining_improvement(prob: Any, xs: np.ndarray, par: np.ndarray, J: np.ndar
         lo[:p] = lb / prob.scale
     if fit_delay:
         lo[p], hi[p] = 0.0, dt
-    target = np.clip(xs + steps[0], lo, hi)
-    held = target != xs + steps[0]
+    full = xs + steps[0]
+    target = np.clip(full, lo, hi)
+    held = target != full
     if held.any():  # the step past a bound, clipped, moves the others for a move the bound refuses: also the step
         # with those held at their bounds, the others' Gauss-Newton step given that
         move = np.zeros(xs.size)

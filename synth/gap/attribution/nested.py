@@ -1,10 +1,10 @@
 """An effect fitted in a simpler and a richer form, the richer kept only when the record demands it.
 
 A dead zone's band either sits around where the command rests (its center fixed by the record) or somewhere else
-(its center a second fitted parameter). The richer form always fits the training record at least as well; it is
-kept when its training SSR is lower by more than ``critical`` noise variances ``SSR/N`` (the likelihood-ratio
-test of one extra parameter at 95 %: 3.84), so that a parameter the data do not ask for is neither reported nor
-counted against the effect (:func:`synth.gap.attribution.parsimony.free_parameters`).
+(its center a second fitted parameter). The richer form always fits the training record at least as well; it is kept
+when its training SSR is lower by more than ``critical`` noise variances ``SSR/N`` (the likelihood-ratio test of one
+extra parameter at 95 %: :data:`~synth.gap.effects.base.NESTED_CRITICAL`), so that a parameter the data do not ask
+for is neither reported nor counted against the effect (:func:`synth.gap.attribution.parsimony.free_parameters`).
 """
 
 from __future__ import annotations
@@ -15,7 +15,7 @@ from typing import Any
 import numpy as np
 
 from synth.errors import ModelError
-from synth.gap.effects.base import Effect, Params
+from synth.gap.effects.base import NESTED_CRITICAL, Effect, Params
 from synth.plant import Plant
 
 __all__ = ["fit_nested", "split_grid"]
@@ -37,7 +37,7 @@ def split_grid(simpler: Effect, grid: list[Params], own: list[Params]) -> tuple[
 
 
 def fit_nested(fit: Callable[..., Any], simpler: Effect, richer: Effect, plant: Plant, t: np.ndarray, u: np.ndarray,
-               y: np.ndarray, grid: list[Params] | None, critical: float = 3.84, **options: Any) -> Any:
+               y: np.ndarray, grid: list[Params] | None, critical: float = NESTED_CRITICAL, **options: Any) -> Any:
     """Fit both forms and keep the richer one only when its training SSR is lower by ``critical`` noise variances
     and its parameters are admissible (:meth:`synth.gap.effects.base.Effect.admissible`).
 

@@ -22,7 +22,7 @@ from typing import Any, ClassVar
 import numpy as np
 
 from synth.errors import ModelError
-from synth.gap.effects.base import Effect, Params, command_span, log_grid, slowest_pole
+from synth.gap.effects.base import NESTED_CRITICAL, Effect, Params, command_span, log_grid, slowest_pole
 from synth.gap.effects.block_memo import run_block
 from synth.plant import Plant
 from synth.search import hooke_jeeves
@@ -343,14 +343,15 @@ class DeadzoneEffect(Effect):
         lo, hi = np.array([0.0, float(np.min(u))]) / span, np.array([1.0, float(np.max(u))]) / span
         found = hooke_jeeves(located_cost, np.array([best["width"], best["center"]]) / span,
                              lo, hi, lambda a, b: a < b - 1e-12 * abs(b), 0.02, 2e-4, 80)
-        off = min((best, located(found.z)), key=cost)
+        cost_best = cost(best)  # the searches' values are their points' costs: each is evaluated once
+        off, cost_off = (located(found.z), found.value) if found.value < cost_best else (best, cost_best)
         at_rest = [{**best, "width": float(f * span), "center": rest} for f in _WIDTHS]
         w0 = min(at_rest, key=cost)["width"] / span
         held = hooke_jeeves(lambda z: float(cost({**best, "width": float(z[0] * span), "center": rest})),
                             np.array([w0]), np.array([0.0]), np.array([1.0]), lambda a, b: a < b - 1e-12 * abs(b),
                             0.25 * w0, 2e-4, 40)
         on = {**best, "width": float(held.z[0] * span), "center": rest}
-        return off if cost(off) < cost(on) - 3.84 * cost(off) / max(u.size, 1) else on
+        return off if cost_off < held.value - NESTED_CRITICAL * cost_off / max(u.size, 1) else on
 
     def input_map(self, u: np.ndarray, dt: float, params: Params) -> np.ndarray:
         w = params.get("width", 0.0)

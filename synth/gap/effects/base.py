@@ -37,10 +37,16 @@ from synth.errors import ModelError
 from synth.ident.simulate import simulate_plant
 from synth.plant import Plant
 
-__all__ = ["Effect", "Params", "command_span", "fastest_pole", "log_grid", "slowest_pole", "unit_numerators"]
+__all__ = ["NESTED_CRITICAL", "Effect", "Params", "command_span", "fastest_pole", "log_grid", "slowest_pole",
+           "unit_numerators"]
 
 Params = dict[str, float]
 """An effect's parameter values by name."""
+
+NESTED_CRITICAL = 3.84
+"""Noise variances ``SSR/N`` of SSR the richer of an effect's :meth:`Effect.nested_variants` must gain over the
+simpler one, in the screen and in the joint fit: the likelihood-ratio test of one extra parameter at 95 % (the
+chi-square quantile to two decimals)."""
 
 
 def command_span(u: np.ndarray) -> float:
