@@ -43,10 +43,7 @@ __all__ = ["NESTED_CRITICAL", "Effect", "Params", "command_span", "fastest_pole"
 Params = dict[str, float]
 """An effect's parameter values by name."""
 
-NESTED_CRITICAL = 3.84
-"""Noise variances ``SSR/N`` of SSR the richer of an effect's :meth:`Effect.nested_variants` must gain over the
-simpler one, in the screen and in the joint fit: the likelihood-ratio test of one extra parameter at 95 % (the
-chi-square quantile to two decimals)."""
+NESTED_CRITICAL = 3.84  # noise variances of SSR a richer nested form must gain (one parameter's LR test at 95 %)
 
 
 def command_span(u: np.ndarray) -> float:
