@@ -1,0 +1,84 @@
+"""The NLP polish's limited-memory solves with the SR1 update beside BFGS (as it is), on the same NLPs in one run.
+
+IPOPT's limited-memory Hessian approximates the Hessian of the Lagrangian. BFGS keeps that approximation positive
+definite; the polish's Lagrangian is not (its constraints bend both ways: crossover conditions, peaks held at
+their frequencies). On the test suite's second-order rational design (``tests/test_synthesis_rational.py``) the
+BFGS rounds crawled about 900 iterations of a constant small step each. This benchmark asks whether the
+symmetric rank-one update (``limited_memory_update_type sr1``), which may be indefinite, helps in general: it
+runs the designs of stored benchmark problems (seeds 24-28 of ``benchmarks/design_verification.py``, controllers
+other than P, a random sample), records every NLP the polish builds (``polish_helper_units.capture``), and solves
+each limited-memory one again with either update from the same start. The exact-Hessian solves are left out:
+the update does not apply to them.
+
+Per NLP it compares IPOPT's time, iterations, status and the objective at the answer (both answers feasible to
+1e-6). It measures single NLPs, not designs: the rounds and stages after a different answer are not followed.
+
+Run:  python benchmarks/polish_sr1.py [--problems 30] [--seed 1]
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import random
+import sys
+import time
+from pathlib import Path
+from typing import Any
+
+import casadi as ca
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+from benchmarks.polish_helper_units import ROWS, capture
+
+UPDATES = ("bfgs", "sr1")
+
+
+def solve_with(nlp: dict[str, Any], update: str) -> dict[str, Any]:
+    """Solve one captured NLP with the limited-memory ``update``."""
+    v = ca.MX.sym("v", nlp["x0"].size)
+    f, g = nlp["problem"](v)
+    solver = ca.nlpsol("polish", "ipopt", {"x": v, "f": f, "g": g},
+                       {**nlp["options"], "ipopt.limited_memory_update_type": update})
+    t0 = time.perf_counter()
+    res = solver(x0=nlp["x0"], lbx=nlp["lbx"], ubx=nlp["ubx"], lbg=nlp["lbg"], ubg=nlp["ubg"])
+    stats = solver.stats()
+    gv = np.asarray(res["g"]).ravel()
+    violation = float(np.max(np.concatenate([[0.0], nlp["lbg"] - gv, gv - nlp["ubg"]])))
+    return {"seconds": time.perf_counter() - t0, "iterations": int(stats["iter_count"]),
+            "success": bool(stats["success"]), "f": float(res["f"]), "violation": violation}
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--problems", type=int, default=30)
+    parser.add_argument("--seed", type=int, default=1, help="the sample's shuffle")
+    args = parser.parse_args()
+    rows = [json.loads(line) for line in ROWS.read_text().splitlines() if line.strip()]
+    rows = [r for r in rows if r["controller"] != "P" and (r.get("synth_cpu_seconds") or 99.0) < 15.0]
+    random.Random(args.seed).shuffle(rows)
+    nlps = [n for n in capture(rows[: args.problems])
+            if n["options"].get("ipopt.hessian_approximation") == "limited-memory"]
+    pairs = [tuple(solve_with(n, u) for u in UPDATES) for n in nlps]
+    print(f"\n{len(nlps)} limited-memory NLPs from {args.problems} designs\n")
+    print("| update | IPOPT seconds | iterations | converged | over 300 iterations |")
+    print("|---|---|---|---|---|")
+    for k, name in enumerate(UPDATES):
+        print(f"| {name} | {sum(p[k]['seconds'] for p in pairs):.2f} | {sum(p[k]['iterations'] for p in pairs)} | "
+              f"{sum(p[k]['success'] for p in pairs)} of {len(pairs)} | "
+              f"{sum(p[k]['iterations'] > 300 for p in pairs)} |")
+    both = [(a, b) for a, b in pairs if a["violation"] < 1e-6 and b["violation"] < 1e-6]
+    tol = [1e-6 * max(1.0, abs(a["f"])) for a, _ in both]
+    better = sum(b["f"] < a["f"] - t for (a, b), t in zip(both, tol))
+    worse = sum(b["f"] > a["f"] + t for (a, b), t in zip(both, tol))
+    print(f"\nobjective at the answer, sr1 against bfgs ({len(both)} NLPs with both answers feasible): "
+          f"better {better}, the same {len(both) - better - worse}, worse {worse}")
+    for i, (a, b) in enumerate(pairs):
+        if a["violation"] < 1e-6 and b["violation"] < 1e-6 and abs(b["f"] - a["f"]) > 1e-6 * max(1.0, abs(a["f"])):
+            print(f"  NLP {i}: bfgs f={a['f']:.6g} ({a['iterations']} it), sr1 f={b['f']:.6g} ({b['iterations']} it)")
+
+
+if __name__ == "__main__":
+    main()
