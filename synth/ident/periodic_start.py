@@ -253,8 +253,11 @@ def refit_periodic_start(record: Record, avg: StepAverage, fit: TimeFitResult, s
     gains = {k: fit.std[k] / v for k, v in predicted.items() if v > 0}
     best = max(gains, key=lambda k: gains[k]) if gains else None
     if best is not None and gains[best] >= WHOLE_RECORD_GAIN:
+        from synth.ident.delay_alias import whole_record_start
+
+        initial, alias = whole_record_start(record, avg, fit, structure, weights)  # the delay's alias it prefers
         try:
-            whole = fit_whole_record(record, structure, delay, sensor, {**fit.parameters}, weights)
+            whole = fit_whole_record(record, structure, delay, sensor, initial, weights)
         except (DataError, FitError) as exc:
             note = f"the whole-record fit, predicted {gains[best]:.3g} times as precise in {best}, failed ({exc})"
             trimmed, avg, why = _drop_transient_periods(record, avg, fit, structure, delay, sensor, settle, train)
@@ -265,7 +268,7 @@ def refit_periodic_start(record: Record, avg: StepAverage, fit: TimeFitResult, s
         return whole, avg, (f"the whole record, {start}, is predicted {gains[best]:.3g} times as precise in {best} "
                             f"as the periodic average, whose mean is removed, because the {first:.3g} s of constant "
                             "input before the train and the transition into it carry the static gain: fitted it "
-                            "instead")
+                            "instead" + (f"; {alias}" if alias else ""))
     return _drop_transient_periods(record, avg, fit, structure, delay, sensor, settle, train)
 
 
