@@ -179,7 +179,8 @@ def resolving_grid(w_lo: float, w_hi: float, per_decade: int, max_step: float | 
     if coarse.size == 0:
         return grid
     top = float(grid[-1]) if even_until is None else min(float(even_until), float(grid[-1]))
-    even = np.arange(float(grid[coarse[0]]) + max_step, top, max_step)[:max_points]
+    start = float(grid[coarse[0]])  # the cap before the points are made: a delay of 1e8 s asked for 1e10 of them
+    even = np.arange(start + max_step, min(top, start + max_step * (max_points + 0.5)), max_step)
     return np.union1d(grid, even)
 
 

@@ -4,11 +4,18 @@ import numpy as np
 import pytest
 
 from synth.controllers import Controller
+from synth.freqgrid import log_grid, resolving_grid
 from synth.loop import Loop
 from synth.plant import Plant
 from synth.requirements import PeakSensitivity
 from synth.synthesis.convex_settings import ConvexSettings, design_grid
-from synth.synthesis.delay_grid import DELAY_STEP, LOOP_GAIN_FLOOR, MAX_DELAY_POINTS, controller_gain_bound
+from synth.synthesis.delay_grid import (
+    DELAY_STEP,
+    LOOP_GAIN_FLOOR,
+    MAX_DELAY_POINTS,
+    controller_gain_bound,
+    delay_points,
+)
 from synth.synthesis.parametrization import parametrize
 
 REQ = [PeakSensitivity(type="peak_sensitivity", max_db=6)]
@@ -100,3 +107,13 @@ def test_pid_behind_a_long_delay_designs_near_the_reference_optimum():
     e = check_point(p.num, p.den, p.delay, p.spec, dict(d.controller.parameters))
     assert e.feasible(1e-3)
     assert e.objective >= 0.95 * 0.9796
+
+
+def test_a_delay_beyond_reason_gets_at_most_the_capped_points_without_making_the_rest():
+    """A black-box test's plant delay of 1e8 s made ``np.arange`` build 1.4e9 design frequencies (10.6 GiB) to keep
+    400, and ``synth design`` ended in a MemoryError traceback; at 1e14 s that array would be 80 TB."""
+    g = np.geomspace(0.01, 100.0, 161)
+    extra = delay_points([Plant.from_string("1/(s+1)", delay=1e14)], g, lambda w: 5.0 + 5.0 / w)
+    assert extra.size == MAX_DELAY_POINTS and extra[1] - extra[0] == pytest.approx(np.pi / 4 / 1e14)
+    dense = resolving_grid(0.01, 100.0, 40, max_step=np.pi / 4 / 1e14, max_points=1000)
+    assert dense.size <= 1000 + log_grid(0.01, 100.0, 40).size

@@ -130,4 +130,5 @@ def delay_points(plants: list[Plant], grid: np.ndarray,
         return np.array([])
     last = float(dense[reach[-1]])  # the grid points around the last frequency that can reach the floor
     stop = float(grid[min(int(np.searchsorted(grid, last)), grid.size - 1)])
-    return np.arange(start + step, stop, step)[:MAX_DELAY_POINTS]
+    # the cap before the points are made: a delay of 1e8 s asked for 1.4e9 of them (10.6 GiB), to keep 400
+    return np.arange(start + step, min(stop, start + step * (MAX_DELAY_POINTS + 0.5)), step)
