@@ -8,7 +8,7 @@ import numpy as np
 from pydantic import PositiveFloat, model_validator
 
 from synth.batch_bandwidth import batch_bandwidths
-from synth.requirements.base import Bound, Requirement, RequirementResult, fmt, register
+from synth.requirements.base import Bound, Requirement, RequirementResult, fmt, register, tracking_note
 from synth.requirements.margins import closed_loop_unstable, unstable_result, with_unstable_rows
 
 if TYPE_CHECKING:
@@ -68,9 +68,9 @@ class Bandwidth(Requirement):
         met = slack >= 0
         msg = (f"closed-loop bandwidth {fmt(wb)} rad/s {rel} {fmt(bound)} rad/s: "
                f"{'met' if met else 'NOT met'} (loop crossover {fmt(wc)} rad/s)")
-        return self.result(value=wb, bound=bound, unit="rad/s", slack=slack, margin=margin,
-                           binding_frequency=wb if np.isfinite(wb) else None, message=msg,
-                           crossover=wc, T0=loop.T0())
+        return tracking_note(self.result(value=wb, bound=bound, unit="rad/s", slack=slack, margin=margin,
+                                         binding_frequency=wb if np.isfinite(wb) else None, message=msg,
+                                         crossover=wc, T0=loop.T0()), loop)
 
     def batch_slack(self, batch: LoopBatch, per_decade: int = 80) -> np.ndarray:
         """Vectorized slack: every loop's first -3 dB crossing of ``|T|`` at once (as ``Loop.bandwidth``)."""

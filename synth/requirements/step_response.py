@@ -10,7 +10,7 @@ import numpy as np
 from pydantic import NonNegativeFloat, PositiveFloat, model_validator
 
 from synth.loop_memo import LoopMemo
-from synth.requirements.base import Bound, Requirement, RequirementResult, fmt, register
+from synth.requirements.base import Bound, Requirement, RequirementResult, fmt, register, tracking_note
 from synth.requirements.margins import UNSTABLE_SLACK, closed_loop_unstable, unstable_result
 from synth.requirements.simulated import SimulatedStep, simulated_step
 from synth.sim.spec import SimulationSpec
@@ -194,7 +194,7 @@ class StepResponse(Requirement):
             return unstable_result(self, loop, "step response")
         if self.under == "simulation":
             return self._simulated(loop, None)
-        linear = self._linear(loop)
+        linear = tracking_note(self._linear(loop), loop)
         return linear if self.under == "linear" else self._simulated(loop, linear)
 
     def stable_slack(self, loop: Loop, per_decade: int = 80) -> float:
