@@ -340,7 +340,7 @@ class Loop:
         pm, wpm, dm = np.inf, None, np.inf
         for wc in self.gain_crossovers():
             phase = np.degrees(np.angle(self.L(np.array([wc]))[0]))
-            this = (phase + 180.0 + 180.0) % 360.0 - 180.0  # wrapped to [-180, 180)
+            this = 180.0 - (-phase) % 360.0  # phase + 180 wrapped to (-180, 180]: L = +1 is 180 deg from -1
             if this < pm:
                 pm, wpm = float(this), float(wc)
             # extra delay turns L(j wc) clockwise: it reaches -1 after the phase margin taken in (0, 360] deg

@@ -315,7 +315,7 @@ class LoopBatch:
             with np.errstate(divide="ignore", invalid="ignore"):
                 L = horner(self.num[rows], s[:, None])[:, 0] / horner(self.den[rows], s[:, None])[:, 0] \
                     * np.exp(-s * self.plant.delay)
-            this = (np.degrees(np.angle(L)) + 360.0) % 360.0 - 180.0
+            this = 180.0 - (-np.degrees(np.angle(L))) % 360.0  # wrapped to (-180, 180], as Loop.margins
             np.minimum.at(pm, rows, this)
             with np.errstate(divide="ignore", invalid="ignore"):
                 # extra delay turns L(j wc) clockwise: the phase margin taken in (0, 360] deg, as Loop.margins

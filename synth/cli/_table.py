@@ -44,7 +44,8 @@ def requirement_rows(results: list[RequirementResult], requirements: list[Requir
     for r in results:
         if r.type == "stability":
             value = "stable" if r.met else "not certified" if "not certified stable" in r.message else \
-                f"{int(r.value)} unstable root(s)"
+                "marginally stable" if r.message.startswith("closed loop marginally stable") else \
+                f"{int(r.value)} unstable root(s)"  # the line below the table says the same
             bound = "stable"
         else:
             value, bound = f"{fmt(r.value)} {r.unit}", next(reqs).report_row(r).bound_text()
