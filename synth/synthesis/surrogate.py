@@ -246,9 +246,11 @@ def _last_resort(spec: Spec, plain: DesignResult | None, free: DesignResult, tri
         found = exact_search(spec, near)
     searched = None
     if found.controller is not None:
+        walked = ("; one of them reached by a walk on the requirements' worst slack from the least violating "
+                  "sample" if found.walked else "")
         how = (f"found by a search of the bounds on the exact check ({found.samples} controllers sampled, "
                f"{found.checked_samples} checked in order of score; pattern search from the best {found.starts} "
-               f"that passed, a few sample spacings apart; {found.checks} "
+               f"that passed, a few sample spacings apart{walked}; {found.checks} "
                f"checks), as {tried} designs under the surrogate found none that passes")
         base = plain if plain is not None else free
         searched = _certified(spec, replace(base, method=base.method + none_passes), None, tried,
