@@ -103,3 +103,14 @@ def test_a_single_run_says_where_its_input_is_under_excited(run_cli, files, tmp_
                   "--wmin", "0.4", "--wmax", "12", "--out", str(tmp_path / "d"))
     assert res.code == 0, res.err
     assert "run quality" not in res.out and "coherent band" in res.out
+
+
+@pytest.mark.parametrize(("args", "said"), [
+    (["--fit-range", "1:5"], "nothing is fitted without --fit"),
+    (["--fit", "k/(s+p)", "--fit-range", "10:1"], "must be LO:HI with 0 < LO < HI"),
+])
+def test_a_fit_range_without_a_fit_or_reversed_is_refused(run_cli, files, args, said):
+    # a black-box test (session 62): both were accepted, the first silently ignored
+    res = run_cli("freqresp", "--data", files["runs"][0], *args)
+    lines = res.err.strip().splitlines()
+    assert res.code == 2 and len(lines) == 1 and "--fit-range" in lines[0] and said in lines[0], res.err

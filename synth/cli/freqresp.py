@@ -137,6 +137,11 @@ def run(args: argparse.Namespace) -> int:
     if args.delay != "fit":
         delay = _floats(args.delay, "--delay", 1)[0] if args.delay not in ("0", "0.0") else 0.0
     fit_range = tuple(_floats(args.fit_range, "--fit-range", 2, ":")) if args.fit_range else None
+    if fit_range is not None and not args.fit:
+        raise SynthError("nothing is fitted without --fit STRUCTURE (a black-box test's range was silently ignored)",
+                         where="--fit-range")
+    if fit_range is not None and not 0 < fit_range[0] < fit_range[1]:
+        raise SynthError(f"must be LO:HI with 0 < LO < HI in rad/s, got {args.fit_range}", where="--fit-range")
     resp = frequency_response(runs, args.wmin, args.wmax, windows=windows, coherence_threshold=args.coherence,
                               points_per_decade=args.points_per_decade)
     if sensor is not None or args.skew:
