@@ -45,7 +45,7 @@ from synth.synthesis.convex_settings import ConvexSettings
 from synth.synthesis.integral_action import integral_only, objective_terms, without_integral_action
 from synth.synthesis.nlp import polish
 from synth.synthesis.no_start import no_start_result
-from synth.synthesis.optimality import optimality_of
+from synth.synthesis.optimality import Optimality, optimality_of
 from synth.synthesis.parametrization import STRUCTURAL, parametrize, reference_frequency, structural_values
 from synth.synthesis.pattern import BOUNDARY_CHECKS, pattern_search
 from synth.synthesis.polish_skip import exact_forms, polish_redundant
@@ -445,7 +445,8 @@ def _design(spec: Spec, settings: ConvexSettings, nlp: bool | str, explain: bool
             "note": "no objective in the spec: the most robust design (smallest peak |S|) is returned"}
         extras["synthesis"]["chosen"] = stage
         optimality = optimality_of(stage, str(controller), unconverged, "; ".join(x for x in (searched, screened) if x),
-                                   settings.stability_level)
+                                   settings.stability_level) if spec.controller.free_parameters() else Optimality(
+            True, stage, "the only controller the bounds allow (every parameter fixed): nothing to optimize")
         extras["optimality"] = optimality.to_dict()
         slices = stabilizing_slices(spec, controller) if open_loop_unstable(spec) else {}
         if slices:
