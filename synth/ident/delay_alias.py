@@ -53,6 +53,12 @@ class AliasScreen:
         Weighted sum of squared residuals of each alias, the output offset fitted.
     noise_var : float
         The noise variance the differences are measured in: the best alias's residual variance.
+
+    Examples
+    --------
+    >>> scr = AliasScreen(2.0, np.array([0.3, 1.3, 2.3]), np.array([1.0, -1.0, 1.0]), np.array([9.0, 7.0, 1.0]), 1.0)
+    >>> scr.best, scr.margin, scr.resolved
+    (2, 6.0, True)
     """
 
     period: float
