@@ -20,6 +20,7 @@ from synth.data.record import Record
 from synth.errors import DataError, FitError, ModelError
 from synth.ident.delay_alias import ambiguity_note, whole_record_start
 from synth.ident.directions import DirectionComparison, fit_by_direction
+from synth.ident.edge_check import EDGE_MISFIT, edge_misfit
 from synth.ident.nyquist import beyond_nyquist
 from synth.ident.pair_relocation import relocate_pair
 from synth.ident.periodic_start import after_gaps, fit_whole_record, refit_periodic_start, settling_time
@@ -417,15 +418,18 @@ def _refit_unsettled(record: Record, avg: StepAverage, fit: TimeFitResult, struc
     left = unsettled_fraction(record, avg.steps, [fit.measured])
     finest = min((fit.std[k] / abs(v) for k, v in fit.parameters.items()
                   if v != 0 and np.isfinite(fit.std.get(k, np.nan)) and fit.std[k] > 0), default=np.inf)
-    if settle <= window and not UNSETTLED_FACTOR * left > finest:
+    skip = min(settle, 0.25 * record.duration)
+    weights = after_gaps(record, fit.measured, skip=skip)
+    misfit = 0.0 if settle > window or UNSETTLED_FACTOR * left > finest else edge_misfit(record, fit.measured, weights)
+    if settle <= window and not UNSETTLED_FACTOR * left > finest and not misfit > EDGE_MISFIT:
         return fit, ""
     why = (f"the edge windows ({window:.3g} s) are shorter than the model's settling time ({settle:.3g} s)"
            if settle > window else
            f"the steps left {100 * left:.2g} % of a step unsettled when the next came, a bias of up to "
            f"{100 * UNSETTLED_FACTOR * left:.2g} % in the edge fit, more than its parameters' finest relative "
-           f"standard error ({100 * finest:.2g} %)")
-    skip = min(settle, 0.25 * record.duration)
-    weights = after_gaps(record, fit.measured, skip=skip)
+           f"standard error ({100 * finest:.2g} %)" if UNSETTLED_FACTOR * left > finest else
+           f"the edge fit's model misses the whole record by {misfit:.3g} times its noise level (the windows assume "
+           "rest before each step and the response within the window: a delay longer than the windows breaks both)")
     # the edge fit is the natural start, unless the average pulled a pole or zero beyond the record's Nyquist
     # frequency, which no sampled record resolves: then the whole record's own deterministic start comes first
     beyond = beyond_nyquist(fit.plant, record.dt)

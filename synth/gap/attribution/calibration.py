@@ -11,33 +11,12 @@ from __future__ import annotations
 
 import numpy as np
 
-from synth.errors import ModelError
 from synth.gap.attribution.refit import AugmentedFit, fit_augmented
+from synth.ident.noise_floor import noise_sigma
 from synth.ident.simulate import simulate_plant
 from synth.plant import Plant
 
 __all__ = ["demean", "linearized_null", "noise_sigma", "refit_null"]
-
-
-def noise_sigma(e: np.ndarray) -> float:
-    """Robust white-noise standard deviation from the second difference (MAD): ``1.4826 MAD / sqrt(6)``.
-
-    Raises
-    ------
-    ModelError
-        Fewer than five samples.
-
-    Examples
-    --------
-    >>> e = 0.1 * np.random.default_rng(0).normal(size=20000)
-    >>> round(float(noise_sigma(e + np.linspace(0, 5, e.size))), 2)  # a slow error barely enters a second difference
-    0.1
-    """
-    d2 = np.diff(np.asarray(e, float), 2)
-    if d2.size < 3:
-        raise ModelError("too few held-out samples to estimate the noise floor", where="record")
-    mad = float(np.median(np.abs(d2 - np.median(d2))))
-    return 1.4826 * mad / np.sqrt(6.0)
 
 
 def demean(x: np.ndarray, groups: np.ndarray | None = None) -> np.ndarray:
