@@ -11,26 +11,13 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from scipy import signal
 
+from benchmarks.ident_delay_alias import DT, simulate
 from synth.data import record_from_arrays
 from synth.ident.delay_alias import screen_aliases
 from synth.ident.identification import identify
 from synth.ident.simulate import simulate_plant
 from synth.plant import Plant
-
-DT = 0.01
-FINE = 10
-
-
-def simulate(num: list[float], den: list[float], u: np.ndarray, delay: float) -> np.ndarray:
-    """The plant's output at the samples, the input held, the delay a whole number of fine steps."""
-    a, b, c, d, _ = signal.cont2discrete(signal.tf2ss(num, den), DT / FINE, method="zoh")
-    fine = np.repeat(u, FINE)
-    k = round(delay / (DT / FINE))
-    fine = np.r_[np.zeros(k), fine[: fine.size - k]]
-    _, y, _ = signal.dlsim((a, b, c, d, DT / FINE), fine)
-    return y.ravel()[::FINE]
 
 
 def square_train(n: int, rest: float, period: float, duty: float) -> np.ndarray:
