@@ -309,7 +309,10 @@ def remaining_improvement(prob: Any, xs: np.ndarray, par: np.ndarray, J: np.ndar
     for step in steps:
         for alpha in (1.0, 0.5, 0.25, 0.125, 0.0625, 0.03125):
             trial = np.clip(xs + alpha * step, lo, hi)
-            r = y - np.asarray(prob.yhat_fn(trial, par)).ravel()
+            try:
+                r = y - np.asarray(prob.yhat_fn(trial, par)).ravel()
+            except RuntimeError:  # casadi could not evaluate the model there (a matrix exponential overflowed)
+                continue
             if mask is not None:
                 r = r[mask]
             ssr = float(r @ r)
