@@ -8,8 +8,9 @@ import numpy as np
 from pydantic import PositiveFloat, model_validator
 
 from synth.batch_bandwidth import batch_bandwidths
-from synth.requirements.base import Bound, Requirement, RequirementResult, fmt, register, tracking_note
+from synth.requirements.base import Bound, Requirement, RequirementResult, fmt, register
 from synth.requirements.margins import closed_loop_unstable, unstable_result, with_unstable_rows
+from synth.requirements.tracking import tracking_note
 
 if TYPE_CHECKING:
     from synth.loop import Loop

@@ -10,9 +10,10 @@ import numpy as np
 from pydantic import NonNegativeFloat, PositiveFloat, model_validator
 
 from synth.loop_memo import LoopMemo
-from synth.requirements.base import Bound, Requirement, RequirementResult, fmt, register, tracking_note
+from synth.requirements.base import Bound, Requirement, RequirementResult, fmt, register
 from synth.requirements.margins import UNSTABLE_SLACK, closed_loop_unstable, unstable_result
 from synth.requirements.simulated import SimulatedStep, simulated_step
+from synth.requirements.tracking import tracking_note
 from synth.sim.spec import SimulationSpec
 
 if TYPE_CHECKING:
