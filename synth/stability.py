@@ -26,14 +26,17 @@ from synth.errors import ModelError
 from synth.polynomials import largest_crossing, shifted, trim, value_at_infinity
 
 __all__ = [
+    "BLUR_DEGREE",
     "MAX_PHASE_POINTS",
     "PHASE_STEP",
+    "ROOT_PERTURBATION",
     "STABILITY_FLOOR",
     "Rational",
     "StabilityResult",
     "characteristic_scale",
     "closed_loop_stability",
     "neutral_with_any_delay",
+    "root_blur",
     "stability_floor",
 ]
 
@@ -319,6 +322,41 @@ def closed_loop_stability(num: np.ndarray, den: np.ndarray, delay: float = 0.0, 
                            None, float(floor))
 
 
+ROOT_PERTURBATION = 1e-14
+"""Relative change of a characteristic polynomial's coefficients by which :func:`root_blur` tests its roots."""
+
+BLUR_DEGREE = 16
+"""Least degree of a characteristic polynomial whose roots :func:`root_blur` tests (below it, clustered roots that
+rounding could push across the axis need coefficients no plant here has)."""
+
+
+def root_blur(char: np.ndarray, roots: np.ndarray) -> float | None:
+    """How far a relative change of :data:`ROOT_PERTURBATION` in ``char``'s coefficients moves a root whose
+    distance from the imaginary axis is no more than twice that move, or None when every root stays put (or the
+    degree is below :data:`BLUR_DEGREE`). Expanded coefficients of ``(s + 1)^110`` (up to 1e32) put 14 roots of a
+    stable loop in the right half-plane (a black-box test); their positions are that uncertain.
+
+    Examples
+    --------
+    >>> char = np.poly(-np.ones(110)); char[-1] += 0.3
+    >>> root_blur(char, np.roots(char)) is not None
+    True
+    >>> char = np.poly(-np.arange(1.0, 21.0) / 4)  # 20 distinct poles, 0.25 apart
+    >>> root_blur(char, np.roots(char)) is None
+    True
+    """
+    if roots.size < BLUR_DEGREE:
+        return None
+    worst = None
+    for pattern in (np.resize([1.0, -1.0], char.size), np.resize([1.0, 1.0, -1.0], char.size)):
+        moved = np.roots(char * (1.0 + ROOT_PERTURBATION * pattern))
+        shift = np.min(np.abs(roots[:, None] - moved[None, :]), axis=1)
+        blurred = np.abs(roots.real) <= 2.0 * shift
+        if np.any(blurred):
+            worst = max(worst or 0.0, float(np.max(shift[blurred])))
+    return worst
+
+
 def _count(num: np.ndarray, den: np.ndarray, delay: float, near: float | None = None) -> StabilityResult:
     num, den = trim(np.asarray(num, float)), trim(np.asarray(den, float))
     if num.size > den.size:
@@ -342,6 +380,12 @@ def _count(num: np.ndarray, den: np.ndarray, delay: float, near: float | None = 
         tol = 1e-9 * np.maximum(1.0, np.abs(roots))
         n_bad = int(np.sum(roots.real >= -tol))
         marginal = roots[np.abs(roots.real) < tol]
+        blur = root_blur(trim(char), roots)
+        if blur is not None:
+            return StabilityResult(False, max(n_bad, 1), n_rhp, f"not counted: the characteristic polynomial of "
+                                   f"degree {roots.size} places its roots only to {blur:.2g} rad/s (a relative change "
+                                   f"of {ROOT_PERTURBATION:g} in its coefficients moves a root that far, as far as it "
+                                   "is from the imaginary axis): not certified stable")
         return StabilityResult(
             n_bad == 0, n_bad, n_rhp, "polynomial roots",
             float(np.abs(marginal[0].imag)) if marginal.size else None,
