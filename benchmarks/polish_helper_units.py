@@ -84,15 +84,36 @@ def solve_in_units(nlp: dict[str, Any], helper_units: bool) -> dict[str, Any]:
             "success": bool(stats["success"]), "f": float(res["f"]), "violation": violation}
 
 
-def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--problems", type=int, default=30)
-    parser.add_argument("--seed", type=int, default=1, help="the sample's shuffle")
-    args = parser.parse_args()
+def sampled_rows(problems: int, seed: int) -> list[dict[str, Any]]:
+    """``problems`` stored design problems (controllers other than P, under 15 s of synth's CPU), shuffled by
+    ``seed``."""
     rows = [json.loads(line) for line in ROWS.read_text().splitlines() if line.strip()]
     rows = [r for r in rows if r["controller"] != "P" and (r.get("synth_cpu_seconds") or 99.0) < 15.0]
-    random.Random(args.seed).shuffle(rows)
-    nlps = capture(rows[: args.problems])
+    random.Random(seed).shuffle(rows)
+    return rows[:problems]
+
+
+def objective_counts(pairs: list[tuple[dict[str, Any], dict[str, Any]]]) -> tuple[int, int, int]:
+    """Of the pairs whose answers are both feasible (1e-6): how many, and how many the second solve made better
+    and worse (beyond a relative 1e-6)."""
+    both = [(a, b) for a, b in pairs if a["violation"] < 1e-6 and b["violation"] < 1e-6]
+    tol = [1e-6 * max(1.0, abs(a["f"])) for a, _ in both]
+    better = sum(b["f"] < a["f"] - t for (a, b), t in zip(both, tol))
+    worse = sum(b["f"] > a["f"] + t for (a, b), t in zip(both, tol))
+    return len(both), better, worse
+
+
+def parsed_args() -> argparse.Namespace:
+    """``--problems`` and ``--seed``."""
+    parser = argparse.ArgumentParser(description=(sys.modules["__main__"].__doc__ or "").splitlines()[0])
+    parser.add_argument("--problems", type=int, default=30)
+    parser.add_argument("--seed", type=int, default=1, help="the sample's shuffle")
+    return parser.parse_args()
+
+
+def main() -> None:
+    args = parsed_args()
+    nlps = capture(sampled_rows(args.problems, args.seed))
     pairs = [(solve_in_units(n, False), solve_in_units(n, True)) for n in nlps]
     print(f"\n{len(nlps)} NLPs from {args.problems} designs\n")
     print("| helpers in units of | IPOPT seconds | iterations | converged |")
@@ -100,12 +121,9 @@ def main() -> None:
     for k, name in enumerate(("one (as it is)", "their starts")):
         print(f"| {name} | {sum(p[k]['seconds'] for p in pairs):.2f} | {sum(p[k]['iterations'] for p in pairs)} | "
               f"{sum(p[k]['success'] for p in pairs)} of {len(pairs)} |")
-    both = [(a, b) for a, b in pairs if a["violation"] < 1e-6 and b["violation"] < 1e-6]
-    tol = [1e-6 * max(1.0, abs(a["f"])) for a, _ in both]
-    better = sum(b["f"] < a["f"] - t for (a, b), t in zip(both, tol))
-    worse = sum(b["f"] > a["f"] + t for (a, b), t in zip(both, tol))
-    print(f"\nobjective at the answer, units of the starts against one ({len(both)} NLPs with both answers feasible): "
-          f"better {better}, the same {len(both) - better - worse}, worse {worse}")
+    both, better, worse = objective_counts(pairs)
+    print(f"\nobjective at the answer, units of the starts against one ({both} NLPs with both answers feasible): "
+          f"better {better}, the same {both - better - worse}, worse {worse}")
 
 
 if __name__ == "__main__":

@@ -18,16 +18,13 @@ Run:  python benchmarks/polish_sr1.py [--problems 30] [--seed 1]
 
 from __future__ import annotations
 
-import argparse
-import json
-import random
 import sys
 from pathlib import Path
 from typing import Any
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from benchmarks.polish_helper_units import ROWS, capture, solve_in_units
+from benchmarks.polish_helper_units import capture, objective_counts, parsed_args, sampled_rows, solve_in_units
 
 UPDATES = ("bfgs", "sr1")
 
@@ -38,14 +35,8 @@ def solve_with(nlp: dict[str, Any], update: str) -> dict[str, Any]:
 
 
 def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--problems", type=int, default=30)
-    parser.add_argument("--seed", type=int, default=1, help="the sample's shuffle")
-    args = parser.parse_args()
-    rows = [json.loads(line) for line in ROWS.read_text().splitlines() if line.strip()]
-    rows = [r for r in rows if r["controller"] != "P" and (r.get("synth_cpu_seconds") or 99.0) < 15.0]
-    random.Random(args.seed).shuffle(rows)
-    nlps = [n for n in capture(rows[: args.problems])
+    args = parsed_args()
+    nlps = [n for n in capture(sampled_rows(args.problems, args.seed))
             if n["options"].get("ipopt.hessian_approximation") == "limited-memory"]
     pairs = [tuple(solve_with(n, u) for u in UPDATES) for n in nlps]
     print(f"\n{len(nlps)} limited-memory NLPs from {args.problems} designs\n")
@@ -55,12 +46,9 @@ def main() -> None:
         print(f"| {name} | {sum(p[k]['seconds'] for p in pairs):.2f} | {sum(p[k]['iterations'] for p in pairs)} | "
               f"{sum(p[k]['success'] for p in pairs)} of {len(pairs)} | "
               f"{sum(p[k]['iterations'] > 300 for p in pairs)} |")
-    both = [(a, b) for a, b in pairs if a["violation"] < 1e-6 and b["violation"] < 1e-6]
-    tol = [1e-6 * max(1.0, abs(a["f"])) for a, _ in both]
-    better = sum(b["f"] < a["f"] - t for (a, b), t in zip(both, tol))
-    worse = sum(b["f"] > a["f"] + t for (a, b), t in zip(both, tol))
-    print(f"\nobjective at the answer, sr1 against bfgs ({len(both)} NLPs with both answers feasible): "
-          f"better {better}, the same {len(both) - better - worse}, worse {worse}")
+    both, better, worse = objective_counts(pairs)
+    print(f"\nobjective at the answer, sr1 against bfgs ({both} NLPs with both answers feasible): "
+          f"better {better}, the same {both - better - worse}, worse {worse}")
     for i, (a, b) in enumerate(pairs):
         if a["violation"] < 1e-6 and b["violation"] < 1e-6 and abs(b["f"] - a["f"]) > 1e-6 * max(1.0, abs(a["f"])):
             print(f"  NLP {i}: bfgs f={a['f']:.6g} ({a['iterations']} it), sr1 f={b['f']:.6g} ({b['iterations']} it)")

@@ -86,21 +86,21 @@ class AliasScreen:
         return self.margin >= ALIAS_CRITICAL
 
 
-def _lagged_sums(a: np.ndarray, r: np.ndarray) -> np.ndarray:
-    """``c[k] = sum_i a[i] r[i - k]`` for ``k = 0 .. n-1`` (``r`` zero before its start): the sums of ``a`` times
-    ``r`` delayed by every whole number of samples, by one FFT correlation.
+def _lagged_sums(a_spectrum: np.ndarray, r: np.ndarray, size: int) -> np.ndarray:
+    """``c[k] = sum_i a[i] r[i - k]`` for ``k = 0 .. n-1`` (``r`` zero before its start; ``a_spectrum`` is
+    ``rfft(a, size)`` with ``size >= 2 n - 1``): the sums of ``a`` times ``r`` delayed by every whole number of
+    samples, by one FFT correlation.
 
     Examples
     --------
-    >>> _lagged_sums(np.array([1.0, 2.0, 3.0]), np.array([1.0, 10.0, 100.0])).round(9).tolist()
+    >>> from scipy import fft
+    >>> a = np.array([1.0, 2.0, 3.0])
+    >>> _lagged_sums(fft.rfft(a, 6), np.array([1.0, 10.0, 100.0]), 6).round(9).tolist()
     [321.0, 32.0, 3.0]
     """
     from scipy import fft
 
-    n = a.size
-    size = fft.next_fast_len(2 * n - 1, real=True)
-    full = fft.irfft(fft.rfft(a, size) * np.conj(fft.rfft(r, size)), size)
-    return full[:n]
+    return fft.irfft(a_spectrum * np.conj(fft.rfft(r, size)), size)[: r.size]
 
 
 def screen_aliases(t: np.ndarray, u: np.ndarray, y: np.ndarray, model: Plant, period_samples: int,
@@ -140,16 +140,22 @@ def screen_aliases(t: np.ndarray, u: np.ndarray, y: np.ndarray, model: Plant, pe
     shortest = max(d0 - m0 * half, 0.0)
     last = int(np.floor((max(max_delay, d0) - shortest) / half + 1e-9))
     ms = sorted(range(last + 1), key=lambda m: (abs(m - m0), m))[:MAX_ALIASES]
+    from scipy import fft
+
     wts = np.ones_like(y) if weights is None else np.asarray(weights, float)
     total = float(wts.sum())
     wy = wts * y
-    base = float(np.dot(wy, y)) - float(wy.sum()) ** 2 / total  # the weighted squares of y about its mean
+    wy_sum = float(wy.sum())
+    base = float(np.dot(wy, y)) - wy_sum ** 2 / total  # the weighted squares of y about its mean
+    size = fft.next_fast_len(2 * t.size - 1, real=True)
+    wy_spectrum, w_spectrum = fft.rfft(wy, size), fft.rfft(wts, size)
     sums = {}  # per extra half sample: sum w y R_k, sum w R_k, sum w R_k^2 at every shift k of the shortest alias
 
     def lagged(extra: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         if extra not in sums:
             resp = simulate_plant(Plant(model.num, model.den, delay=shortest + extra * dt), t, w, initial="zero")
-            sums[extra] = (_lagged_sums(wy, resp), _lagged_sums(wts, resp), _lagged_sums(wts, resp * resp))
+            sums[extra] = (_lagged_sums(wy_spectrum, resp, size), _lagged_sums(w_spectrum, resp, size),
+                           _lagged_sums(w_spectrum, resp * resp, size))
         return sums[extra]
 
     signs = np.array([(-1.0) ** (m - m0) for m in ms])
@@ -161,7 +167,7 @@ def screen_aliases(t: np.ndarray, u: np.ndarray, y: np.ndarray, model: Plant, pe
             continue
         wyr, wr, wrr = (c[k] for c in lagged(0.5 * ((m * period_samples) % 2)))
         # y - s R_k with its weighted mean removed: sum w r^2 - (sum w r)^2 / W
-        ssr[i] = base - 2 * signs[i] * (wyr - float(wy.sum()) * wr / total) + (wrr - wr * wr / total)
+        ssr[i] = base - 2 * signs[i] * (wyr - wy_sum * wr / total) + (wrr - wr * wr / total)
     delays = np.array([d0 if m == m0 else shortest + m * half for m in ms])
     # the best alias's residual variance: the noise's if that alias is right, more (a stricter test) if not
     return AliasScreen(period, delays, signs, ssr, float(ssr.min() / max(total - 1.0, 1.0)))

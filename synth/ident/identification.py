@@ -420,8 +420,9 @@ def _refit_unsettled(record: Record, avg: StepAverage, fit: TimeFitResult, struc
                   if v != 0 and np.isfinite(fit.std.get(k, np.nan)) and fit.std[k] > 0), default=np.inf)
     skip = min(settle, 0.25 * record.duration)
     weights = after_gaps(record, fit.measured, skip=skip)
-    misfit = 0.0 if settle > window or UNSETTLED_FACTOR * left > finest else edge_misfit(record, fit.measured, weights)
-    if settle <= window and not UNSETTLED_FACTOR * left > finest and not misfit > EDGE_MISFIT:
+    unsettled = settle > window or UNSETTLED_FACTOR * left > finest
+    misfit = 0.0 if unsettled else edge_misfit(record, fit.measured, weights)
+    if not unsettled and not misfit > EDGE_MISFIT:
         return fit, ""
     why = (f"the edge windows ({window:.3g} s) are shorter than the model's settling time ({settle:.3g} s)"
            if settle > window else

@@ -314,7 +314,7 @@ def _walk_to_feasible(spec: Spec, box: _Box, above: list[np.ndarray], counter: d
                 loops = [Loop(p, c) for p in plants]
                 if not all(loop.stability().stable for loop in loops):
                     return np.inf
-                worst = max(-r.slack(loop) for r in spec.requirements for loop in loops)
+                worst = max(-r.stable_slack(loop) for r in spec.requirements for loop in loops)  # counted above
         except (ArithmeticError, ValueError, RuntimeError, SynthError):
             return np.inf
         return float(worst) if np.isfinite(worst) else np.inf
