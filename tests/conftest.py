@@ -11,6 +11,11 @@ from pathlib import Path
 # each worker would compete with the other worker for the same cores (set before anything imports numpy; the
 # workers and the commands the tests start inherit it).
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+# The same for synth's own helper process: a command computes ahead on the other core only when that core is idle
+# (synth.forked, synth.speculation), which under xdist it is not; the guesses it would compute there cost the other
+# worker's time. The tests of forking itself unset this (tests/test_forked.py, test_speculation.py,
+# test_cli_design_progress.py); test_forked.py also checks that a forked command writes the same bytes.
+os.environ.setdefault("SYNTH_JOBS", "1")
 
 import pytest
 

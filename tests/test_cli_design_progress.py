@@ -13,7 +13,8 @@ from synth.cli import main
 from synth.forked import allow_fork, run_beside
 
 
-def test_a_forked_childs_stage_is_seen_by_the_parent():
+def test_a_forked_childs_stage_is_seen_by_the_parent(monkeypatch):
+    monkeypatch.delenv("SYNTH_JOBS", raising=False)  # conftest turns forking off for the rest of the suite
     progress.enable()
     allow_fork(True)
     try:

@@ -37,7 +37,8 @@ def _child_has_begun():
     return begin, wait
 
 @pytest.fixture(autouse=True)
-def _fork_allowed():
+def _fork_allowed(monkeypatch):
+    monkeypatch.delenv("SYNTH_JOBS", raising=False)  # conftest turns the helper process off for the rest of the suite
     allow_fork(True)
     yield
     allow_fork(False)
