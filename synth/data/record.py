@@ -18,7 +18,7 @@ from typing import Any
 import numpy as np
 
 from synth.data.gaps import find_gaps, hidden_changes
-from synth.data.interpolated_noise import interpolation_noise_factor
+from synth.data.interpolated_noise import interpolation_noise_correlation, interpolation_noise_factor
 from synth.data.readers import Table, read_table, table_from_columns, time_scale
 from synth.errors import DataError
 from synth.plant import Signal
@@ -55,6 +55,10 @@ class Record:
         What a fit's white-noise variance estimate is multiplied by for its parameters' uncertainty: 1, unless
         the output was interpolated from uneven time stamps (then adjacent samples share logged samples' noise;
         :func:`synth.data.interpolated_noise.interpolation_noise_factor`).
+    noise_correlation : tuple of float
+        The autocorrelation at lags 1, 2, ... samples that the output's interpolation from uneven time stamps gives
+        white logged noise (:func:`synth.data.interpolated_noise.interpolation_noise_correlation`); ``()`` when the
+        output was not interpolated. A fit's test of its residuals' whiteness looks for correlation beyond it.
     gaps : tuple of (float, float)
         Gaps in the logged time stamps (:func:`synth.data.gaps.find_gaps`): the stamps before and after each. The
         samples inside were made up by the resampling; fits weight them 0 and averages leave them out.
@@ -77,6 +81,7 @@ class Record:
     notes: tuple[str, ...] = ()
     noise_factor: float = 1.0
     gaps: tuple[tuple[float, float], ...] = ()
+    noise_correlation: tuple[float, ...] = ()
 
     @property
     def n(self) -> int:
@@ -112,7 +117,7 @@ class Record:
             raise DataError(f"segment [{t0}, {t1}] s holds fewer than 2 samples", where=self.source)
         return Record(self.t[keep], self.u[keep], self.y[keep], self.input, self.output,
                       {k: v[keep] for k, v in self.aux.items()}, self.source, self.notes, self.noise_factor,
-                      tuple(g for g in self.gaps if g[1] > t0 and g[0] < t1))
+                      tuple(g for g in self.gaps if g[1] > t0 and g[0] < t1), self.noise_correlation)
 
     def require_duration(self, w_min: float) -> None:
         """Raise unless the record is long enough to resolve ``w_min`` [rad/s].
@@ -292,6 +297,7 @@ def record_from_arrays(
     source: str = "arrays",
     names: tuple[str, str, str] = ("time", "input", "output"),
     noise_factor: float | None = None,
+    noise_correlation: Sequence[float] | None = None,
 ) -> Record:
     """Validate arrays and build a :class:`Record` (resampling irregular time explicitly).
 
@@ -313,6 +319,9 @@ def record_from_arrays(
     noise_factor : float, optional
         :attr:`Record.noise_factor`; by default 1, or on irregular time what the output's interpolation implies
         (:func:`synth.data.interpolated_noise.interpolation_noise_factor`).
+    noise_correlation : sequence of float, optional
+        :attr:`Record.noise_correlation`; by default what the output's interpolation implies (``()`` on regular
+        time).
 
     Raises
     ------
@@ -345,8 +354,11 @@ def record_from_arrays(
             notes += (f"the interpolated output shares each logged sample's noise between grid samples: a fit's "
                       f"noise variance is taken {noise_factor:.3g} times its residuals' for the parameters' "
                       "uncertainty",)
+    if noise_correlation is None:
+        noise_correlation = interpolation_noise_correlation(np.asarray(t, dtype=float).ravel(), tt)
     gaps = find_gaps(np.asarray(t, dtype=float).ravel())  # none on a uniform grid
-    return Record(tt, uu, yy, input, output, arrays, source, notes, float(noise_factor), gaps)
+    return Record(tt, uu, yy, input, output, arrays, source, notes, float(noise_factor), gaps,
+                  tuple(float(r) for r in noise_correlation))
 
 
 def read_columns(path: str | Path) -> dict[str, np.ndarray]:

@@ -185,6 +185,9 @@ class StepAverage:
     in_gaps : int
         Windows left out because they hold samples a gap in the log made up (:mod:`synth.data.gaps`; counted in
         ``dropped`` too).
+    noise_correlation : tuple of float
+        The record's :attr:`~synth.data.Record.noise_correlation`, carried to :meth:`record` (averaging windows of
+        independent noise keeps it).
     """
 
     mode: str
@@ -209,6 +212,7 @@ class StepAverage:
     first_window: int = 0
     noise_factor: float = 1.0
     in_gaps: int = 0
+    noise_correlation: tuple[float, ...] = ()
 
     def record(self) -> Record:
         """The averaged window as a :class:`~synth.data.Record` (time starting at the window's start).
@@ -222,7 +226,7 @@ class StepAverage:
         """
         return record_from_arrays(self.t, self.u, self.y, self.input, self.output,
                                   source=f"{self.source} (average of {self.count} {self.mode}s)",
-                                  noise_factor=self.noise_factor)
+                                  noise_factor=self.noise_factor, noise_correlation=self.noise_correlation)
 
     def to_dict(self) -> dict[str, Any]:
         """JSON summary (no samples).
@@ -381,7 +385,7 @@ def _average_cycles(record: Record, steps: Steps, period: int, high: int, settle
     t = (np.arange(period) - low_time) * record.dt
     return StepAverage("cycle", t, u, y, len(use), len(use), len(use), int(ups.size) - len(use), step, before, after,
                        _snr(step, before), _snr(step, after), True, steps, record.input, record.output, record.source,
-                       low_time, int(use[0]), record.noise_factor, in_gaps)
+                       low_time, int(use[0]), record.noise_factor, in_gaps, record.noise_correlation)
 
 
 def _average_edges(record: Record, steps: Steps, pre: float | None, direction: int = 0) -> StepAverage:
@@ -429,4 +433,4 @@ def _average_edges(record: Record, steps: Steps, pre: float | None, direction: i
     ups = int(np.sum(dirs > 0))
     return StepAverage("edge", t, u, y, int(idx.size), ups, int(idx.size) - ups, cut + in_gaps, step, before, after,
                        _snr(step, before), _snr(step, after), False, steps, record.input, record.output, record.source,
-                       n_pre, 0, record.noise_factor, in_gaps)
+                       n_pre, 0, record.noise_factor, in_gaps, record.noise_correlation)

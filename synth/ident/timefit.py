@@ -453,7 +453,7 @@ def fit_structure(record: Record, structure: Structure | str, delay: str | float
     # an output interpolated from uneven stamps: its residuals understate the noise the estimates carry
     cov, note = fit_covariance(gram, s2 * record.noise_factor, p if fit_delay else None, dt)
     cov = cov[:J.shape[1], :J.shape[1]]
-    correlated = correlated_residuals_note(resid)
+    correlated = correlated_residuals_note(resid, expected=record.noise_correlation)
     if note or correlated:
         info["covariance_note"] = "; ".join(n for n in (note, correlated) if n)
     with np.errstate(all="ignore"):
