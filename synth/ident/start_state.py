@@ -60,6 +60,10 @@ class StartState:
         Where the estimated free response has less energy left than one noise variance, plus the delay [s].
     first : float
         Time of the first fitted sample from the record's start [s].
+    left_std : float
+        The residuals' standard deviation with the free responses in the regression: where a start state is what the
+        fit missed, about the record's noise; a structure that cannot explain the record leaves far more
+        (:mod:`synth.ident.misfit`).
     """
 
     statistic: float
@@ -71,6 +75,7 @@ class StartState:
     shifted: str
     window: float
     first: float
+    left_std: float = 0.0
 
     @property
     def matters(self) -> bool:
@@ -254,7 +259,8 @@ def start_state_test(jacobian: np.ndarray, jtj: np.ndarray, residual: np.ndarray
     above = np.flatnonzero(tail > noise)
     window = (float(above[-1] + 1) * dt if above.size else 0.0) + delay
     return StartState(statistic, float(chi2.isf(ALPHA, dof)) * inflation, dof, inflation, len(later),
-                      float(shifts[worst]) if shifts.size else 0.0, names[worst] if shifts.size else "", window, k0 * dt)
+                      float(shifts[worst]) if shifts.size else 0.0, names[worst] if shifts.size else "", window, k0 * dt,
+                      float(np.sqrt(noise)))
 
 
 def _score(jacobian: np.ndarray, residual: np.ndarray, jtj: np.ndarray, jtr: np.ndarray, energy: float,

@@ -49,6 +49,7 @@ from synth.ident.fit_failure import (
     start_ssr,
 )
 from synth.ident.identifiability import TiedParameter, WeakParameter, coinciding, tied_to_weak, weak_parameters
+from synth.ident.misfit import misfit_note
 from synth.ident.nyquist import nyquist_note
 from synth.ident.residual_whiteness import correlated_residuals_note
 from synth.ident.sim_error_problem import SimulationErrorProblem
@@ -453,9 +454,9 @@ def fit_structure(record: Record, structure: Structure | str, delay: str | float
     # an output interpolated from uneven stamps: its residuals understate the noise the estimates carry
     cov, note = fit_covariance(gram, s2 * record.noise_factor, p if fit_delay else None, dt)
     cov = cov[:J.shape[1], :J.shape[1]]
-    correlated = correlated_residuals_note(resid, expected=record.noise_correlation)
-    if note or correlated:
-        info["covariance_note"] = "; ".join(n for n in (note, correlated) if n)
+    notes = (note, misfit_note(y[rows], (yhat - b_hat)[rows], resid) if resid.size == rows.size else "",
+             correlated_residuals_note(resid, expected=record.noise_correlation))  # the structure, then the noise
+    info.update({"covariance_note": "; ".join(n for n in notes if n)} if any(notes) else {})
     with np.errstate(all="ignore"):
         sd = np.sqrt(np.clip(np.diag(cov), 0.0, None))
     remaining = float("inf")

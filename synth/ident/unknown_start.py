@@ -20,6 +20,7 @@ import numpy as np
 
 from synth.data.record import Record
 from synth.errors import DataError, FitError
+from synth.ident.misfit import does_not_explain, times_the_noise
 from synth.ident.start_state import ALPHA, StartState
 from synth.ident.structure import Structure
 from synth.ident.timefit import TimeFitResult, fit_structure
@@ -86,7 +87,7 @@ def fit_from_unknown_start(record: Record, fit: TimeFitResult, structure: Struct
             why = exc.message.removeprefix(f"fit of {structure.formula!r} failed: ")
             raise FitError(f"fit of {structure.formula!r} failed: the record does not start at rest (its start state "
                            f"would move {first_test.shifted} by {first_test.shift:.3g} std) and the fit after its first "
-                           f"{skip:.3g} s failed: {why}", where=record.source,
+                           f"{skip:.3g} s failed: {why}{_misfit(original, first_test)}", where=record.source,
                            status=getattr(exc, "status", None)) from None
         gain = _gain_without_start(original, fit)
         if round_ == 0 and first_test.masked and not gain > float(chi2.isf(ALPHA, len(fit.names))):
@@ -102,12 +103,24 @@ def fit_from_unknown_start(record: Record, fit: TimeFitResult, structure: Struct
                     f"state takes {first_test.statistic:.3g} noise variances out of the residual (threshold "
                     f"{first_test.threshold / first_test.inflation:.3g}, chi-square with {first_test.dof} degrees of "
                     f"freedom at {ALPHA:g}){masked} and would move {first_test.shifted} by {first_test.shift:.3g} std; "
-                    f"fitted from {test.first:.4g} s on, the samples before simulated from rest and weighted 0")
+                    f"fitted from {test.first:.4g} s on, the samples before simulated from rest and weighted 0"
+                    f"{_misfit(original, first_test)}")
             fit.solver["start_state_note"] = note
             return fit, note
     raise FitError(f"fit of {structure.formula!r} failed: the record does not start at rest, and its start state "
                    f"still moves {test.shifted} by {test.shift:.3g} std with the first {fitted:.3g} s left out, {why}; "
-                   "cut the record to start at rest, or fit a shorter part of it", where=record.source)
+                   f"cut the record to start at rest, or fit a shorter part of it{_misfit(original, first_test)}",
+                   where=record.source)
+
+
+def _misfit(fit: TimeFitResult, test: StartState) -> str:
+    """A clause for the result: the fit does not explain the record even with its start state free (then the
+    structure, not the start, is what the start-state test sees), else ``""``."""
+    rows = slice(None) if fit.weights is None else fit.weights > 0
+    ratio = does_not_explain(fit.y[rows], test.left_std)
+    return (f"; but with its start state free the fit still leaves residuals {times_the_noise(ratio)} the record's "
+            "noise: a structure that does not explain the record moves its parameters as a start state would "
+            "(another structure, or a gain parameter, may be what it lacks)" if ratio else "")
 
 
 def _refit(record: Record, structure: Structure, delay: str | float | None, sensor: Plant | str | None,
