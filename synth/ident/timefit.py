@@ -488,8 +488,7 @@ def fit_structure(record: Record, structure: Structure | str, delay: str | float
         params[delay_name], std[delay_name] = float(d_hat), 0.0
     ci = {k: (params[k] - tq * std[k], params[k] + tq * std[k]) for k in params}
     plant = st.plant(theta, delay=d_hat, input=record.input, output=record.output, label="identified")
-    if beyond := nyquist_note(plant, dt):
-        info["nyquist_note"] = beyond
+    info.update({"nyquist_note": beyond} if (beyond := nyquist_note(plant, dt)) else {})
     measured = plant.series(sensor) if sensor is not None else plant
     if sensor is not None:
         measured = Plant(measured.num, measured.den, d_hat, record.input, record.output, "identified with sensor")
