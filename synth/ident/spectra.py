@@ -19,6 +19,7 @@ from synth.errors import DataError
 from synth.ident.coherence import COHERENCE_THRESHOLD, CoherentBand, coherence_from_spectra, coherent_band, random_error
 from synth.ident.excitation_edge import trim_to_excitation
 from synth.ident.model_phase import anchored_phase
+from synth.ident.output_alignment import alignment_samples, shifted_runs
 from synth.ident.spectral_windows import (
     as_runs,
     check_length,
@@ -152,6 +153,7 @@ def frequency_response(
     points_per_decade: int = 40,
     coherence_threshold: float = COHERENCE_THRESHOLD,
     detrend: str = "linear",
+    align: bool = True,
 ) -> FrequencyResponse:
     """Composite multi-window frequency response of one or several sweep runs.
 
@@ -179,6 +181,10 @@ def frequency_response(
         For the coherent band (the seed: 0.8).
     detrend : {"linear", "constant", "none"}
         Per-segment detrending.
+    align : bool
+        Move the output back by the response's delay before windowing where that delay is a material share of
+        the shortest window, and put it back in the phase (:mod:`synth.ident.output_alignment`); the band stays
+        within the unaligned estimate's. False: the windows on the runs as they are.
 
     Returns
     -------
@@ -203,7 +209,35 @@ def frequency_response(
     (1.79, 1.77)
     """
     runs = as_runs(records)
+    first = _composite(runs, w_min, w_max, windows, overlap, points_per_decade, coherence_threshold, detrend)
+    k = alignment_samples(first.w, first.H, first.band, runs[0].fs, min(first.windows), max(r.n for r in runs)) \
+        if align else 0
+    if not k:
+        return first
+    try:
+        aligned = _composite(runs, w_min, w_max, windows, overlap, points_per_decade, coherence_threshold, detrend, k)
+    except DataError:  # a window no longer fits the runs shortened by the delay: the estimate as it was
+        return first
+    note = (f"the output was moved {k / runs[0].fs:.4g} s earlier before windowing (the lower quartile of the "
+            "response's group delay over the upper half of the band), and that delay put back in the phase: the "
+            "windows then see the output's answer to what their input holds (synth.ident.output_alignment)")
+    band = aligned.band
+    if first.band.found and band.found and (band.w_min < first.band.w_min or band.w_max > first.band.w_max):
+        # realigned, the leakage past a sweep's end answers coherently too: the band stays within the first's
+        lo, hi = max(band.w_min, first.band.w_min), min(band.w_max, first.band.w_max)
+        band = replace(band, w_min=lo, w_max=hi, mask=band.mask & first.band.mask)
+        note += (f"; the band is kept within the estimate's before the move ({first.band.w_min:.4g}-"
+                 f"{first.band.w_max:.4g} rad/s): the move makes a sweep's leakage past its band coherent too")
+    return replace(aligned, band=band, notes=(*aligned.notes, note))
+
+
+def _composite(runs: list[Record], w_min: float | None, w_max: float | None, windows: Sequence[float] | None,
+               overlap: float, points_per_decade: int, coherence_threshold: float, detrend: str,
+               shift: int = 0) -> FrequencyResponse:
+    """:func:`frequency_response` of ``runs``, their windows' outputs moved ``shift`` samples earlier (the range,
+    the windows and the whole-run low end from the runs as they are)."""
     fs = runs[0].fs
+    windowed = shifted_runs(runs, shift) if shift else runs
     if not 0 <= overlap < 1:
         raise DataError(f"overlap must be in [0, 1), got {overlap:g}")
     if detrend not in ("linear", "constant", "none"):
@@ -238,9 +272,10 @@ def frequency_response(
         if nseg < 8 or nseg > longest_run:
             raise DataError(f"window {length:g} s must hold at least 8 samples and fit in the longest run "
                             f"({longest_run / fs:.4g} s)")
-        results.append(window_spectra(runs, fs, nseg, overlap, grid, detrend))
+        results.append(window_spectra(windowed, fs, nseg, overlap, grid, detrend))
     gxx, gyy, gxy, n_d = combine_windows(results, grid)
     coh = coherence_from_spectra(gxx, gyy, gxy)
+    gxy = gxy * np.exp(-1j * grid * shift / fs)  # the delay the windows' outputs were moved by, back in the phase
     with np.errstate(divide="ignore", invalid="ignore"):
         H = gxy / gxx
     err = random_error(coh, n_d)
@@ -251,7 +286,7 @@ def frequency_response(
         # as dense as the grid's top cell (in rad/s) up to the cap: a lightly damped peak located within a cell
         dense = int(np.ceil(points_per_decade * LOOK_AHEAD_CAP / DEFAULT_TOP))
         ext = log_grid(w_max, LOOK_AHEAD_CAP * nyquist, dense)[1:]
-        spectra = combine_windows([window_spectra(runs, fs, round(float(x) * fs), overlap, ext, detrend)
+        spectra = combine_windows([window_spectra(windowed, fs, round(float(x) * fs), overlap, ext, detrend)
                                    for x in lengths], ext)
         above = _above_default_top(grid, gxx, gxy, coh, band, ext, *spectra[:3], coherence_threshold)
     notes = ((_above_note(above, nyquist),) if above else ()) + ((low_note,) if low_note else ())
