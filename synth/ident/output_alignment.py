@@ -28,11 +28,11 @@ ALIGN_SHARE = 0.05
 
 
 def alignment_samples(w: np.ndarray, H: np.ndarray, band: CoherentBand, fs: float, shortest_window: float,
-                      longest_run: int) -> int:
+                      shortest_run: int) -> int:
     """Samples by which to move the output earlier: the lower quartile of the group delay ``-d(phase)/dw`` over
     the upper half (in log frequency) of the coherent band, rounded to samples; 0 where there is no band, where that delay is
     negative or below :data:`ALIGN_SHARE` of ``shortest_window`` [s], or where it would leave less than half the
-    longest run.
+    shortest run.
 
     Examples
     --------
@@ -58,7 +58,7 @@ def alignment_samples(w: np.ndarray, H: np.ndarray, band: CoherentBand, fs: floa
     if not delay >= ALIGN_SHARE * shortest_window:
         return 0
     k = round(delay * fs)
-    return k if 0 < k <= longest_run // 2 else 0
+    return k if 0 < k <= shortest_run // 2 else 0
 
 
 def shifted_runs(runs: list[Record], k: int) -> list[Record]:

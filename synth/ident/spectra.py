@@ -210,7 +210,7 @@ def frequency_response(
     """
     runs = as_runs(records)
     first = _composite(runs, w_min, w_max, windows, overlap, points_per_decade, coherence_threshold, detrend)
-    k = alignment_samples(first.w, first.H, first.band, runs[0].fs, min(first.windows), max(r.n for r in runs)) \
+    k = alignment_samples(first.w, first.H, first.band, runs[0].fs, min(first.windows), min(r.n for r in runs)) \
         if align else 0
     if not k:
         return first
