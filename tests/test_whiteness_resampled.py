@@ -76,4 +76,4 @@ def test_coloured_noise_at_jittered_stamps_is_still_named() -> None:
     t, u, y = _record(0, 0.9)
     fit = identify(record_from_arrays(t, u, y), "k/(s^2+a*s+b)", average="none").fit
     note = fit.solver.get("covariance_note", "")
-    assert "the residuals are correlated" in note and "beyond the 0." in note, note
+    assert "the residuals are correlated" in note and "of it from the resampling of uneven stamps" in note, note

@@ -79,8 +79,8 @@ def correlated_residuals_note(residuals: np.ndarray, lags: int = 20, expected: S
     if p >= P_VALUE or abs(rho[worst]) < MIN_CORRELATION:
         return ""
     shown = f"= {p:.1g}" if p > 1e-300 else "< 1e-300"
-    beyond = f" beyond the {known[worst]:.2f} the resampling gives" if known[worst] else ""
-    return (f"the residuals are correlated (autocorrelation {rho[worst] + known[worst]:.2f}{beyond} at lag {worst + 1} "
-            f"sample{'s' if worst else ''}, Ljung-Box p {shown} over {m} lags): coloured noise, drift or a model "
+    share = f", {known[worst]:.2f} of it from the resampling of uneven stamps" if known[worst] else ""
+    return (f"the residuals are correlated (autocorrelation {rho[worst] + known[worst]:.2f} at lag {worst + 1} "
+            f"sample{'s' if worst else ''}{share}; Ljung-Box p {shown} over {m} lags): coloured noise, drift or a model "
             f"error; the stds assume white residuals and may be several times too small (the split check, "
             f"synth.ident.split_check or --split-check 5, measures the real scatter)")
