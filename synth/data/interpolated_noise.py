@@ -19,10 +19,15 @@ import numpy as np
 __all__ = ["interpolation_noise_correlation", "interpolation_noise_factor"]
 
 
-def _weights(native: np.ndarray, grid: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def _weights(native: np.ndarray, grid: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
     """The logged times (one per stamp), and for each grid time the logged sample ``i`` before it and its
-    fraction ``f`` of the way to ``i + 1``: the grid value is ``(1 - f) y_i + f y_(i+1)``."""
+    fraction ``f`` of the way to ``i + 1``: the grid value is ``(1 - f) y_i + f y_(i+1)``. None where the grid is
+    the logged times themselves (or too few were logged to interpolate)."""
+    native = np.asarray(native, float)
     native = native[np.r_[np.diff(native) > 0, True]]  # one per time stamp
+    grid = np.asarray(grid, float)
+    if native.size < 2 or (grid.size == native.size and np.array_equal(grid, native)):
+        return None
     i = np.clip(np.searchsorted(native, grid, side="right") - 1, 0, native.size - 2)
     f = np.clip((grid - native[i]) / (native[i + 1] - native[i]), 0.0, 1.0)
     return native, i, f
@@ -42,19 +47,13 @@ def interpolation_noise_factor(native: np.ndarray, grid: np.ndarray) -> float:
     >>> round(interpolation_noise_factor(np.arange(0.0, 1001.0), np.arange(0.0, 1000.0) + 0.5), 3)  # midpoints
     2.0
     """
-    native, grid = np.asarray(native, float), np.asarray(grid, float)
-    if _logged(native, grid):
+    weights = _weights(native, grid)
+    if weights is None:  # the logged times
         return 1.0
-    native, i, f = _weights(native, grid)
+    native, i, f = weights
     kappa = float(np.mean((1.0 - f) ** 2 + f**2))
     carried = np.bincount(i, 1.0 - f, native.size) + np.bincount(i + 1, f, native.size)
     return float(np.sum(carried**2) / np.sum(carried) / kappa)
-
-
-def _logged(native: np.ndarray, grid: np.ndarray) -> bool:
-    """Whether the grid is the logged times themselves (or too few were logged to interpolate)."""
-    unique = native[np.r_[np.diff(native) > 0, True]]
-    return unique.size < 2 or (grid.size == unique.size and np.array_equal(grid, unique))
 
 
 def interpolation_noise_correlation(native: np.ndarray, grid: np.ndarray, lags: int = 20) -> tuple[float, ...]:
@@ -71,14 +70,14 @@ def interpolation_noise_correlation(native: np.ndarray, grid: np.ndarray, lags: 
     >>> [round(r, 3) for r in interpolation_noise_correlation(np.arange(0.0, 1001.0), np.arange(1000.0) + 0.5, 2)]
     [0.5, 0.0]
     """
-    native, grid = np.asarray(native, float), np.asarray(grid, float)
-    if _logged(native, grid):
+    weights = _weights(native, grid)
+    if weights is None:
         return ()
-    native, i, f = _weights(native, grid)
+    _, i, f = weights
     a, b = 1.0 - f, f  # weights on samples i and i + 1
     energy = float(np.mean(a**2 + b**2))
     rho = []
-    for k in range(1, min(int(lags), grid.size - 1) + 1):
+    for k in range(1, min(int(lags), i.size - 1) + 1):
         same = i[:-k] == i[k:]  # both between the same two logged samples
         next_ = i[:-k] + 1 == i[k:]  # the later one starts at the earlier one's right sample
         shared = np.where(same, a[:-k] * a[k:] + b[:-k] * b[k:], 0.0) + np.where(next_, b[:-k] * a[k:], 0.0)

@@ -348,15 +348,16 @@ def record_from_arrays(
                         where=source)
     if np.ptp(yy) == 0:
         raise DataError(f"column '{names[2]}': the output never responds (constant {yy[0]:g})", where=source)
+    logged = np.asarray(t, dtype=float).ravel()
     if noise_factor is None:  # exactly 1 unless the grid is not the logged stamps (resampled)
-        noise_factor = interpolation_noise_factor(np.asarray(t, dtype=float).ravel(), tt)
+        noise_factor = interpolation_noise_factor(logged, tt)
         if noise_factor != 1.0:
             notes += (f"the interpolated output shares each logged sample's noise between grid samples: a fit's "
                       f"noise variance is taken {noise_factor:.3g} times its residuals' for the parameters' "
                       "uncertainty",)
     if noise_correlation is None:
-        noise_correlation = interpolation_noise_correlation(np.asarray(t, dtype=float).ravel(), tt)
-    gaps = find_gaps(np.asarray(t, dtype=float).ravel())  # none on a uniform grid
+        noise_correlation = interpolation_noise_correlation(logged, tt)
+    gaps = find_gaps(logged)  # none on a uniform grid
     return Record(tt, uu, yy, input, output, arrays, source, notes, float(noise_factor), gaps,
                   tuple(float(r) for r in noise_correlation))
 

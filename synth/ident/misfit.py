@@ -45,14 +45,16 @@ def misfit_ratio(y: np.ndarray, residuals: np.ndarray) -> float:
     >>> round(misfit_ratio(y, y - 0.5 * (1 - np.exp(-t))))  # half the gain
     10
     """
-    y, residuals = np.asarray(y, float), np.asarray(residuals, float)
+    return float(np.std(np.asarray(residuals, float)) / _noise_floor(y))
+
+
+def _noise_floor(y: np.ndarray) -> float:
+    """The white-noise std of ``y`` from its second difference; NaN where it has none to measure."""
     try:
-        sigma = noise_sigma(y)
+        sigma = noise_sigma(np.asarray(y, float))
     except ModelError:
         return float("nan")
-    if not sigma > 0.0:
-        return float("nan")
-    return float(np.std(residuals) / sigma)
+    return float(sigma) if sigma > 0.0 else float("nan")
 
 
 def times_the_noise(ratio: float) -> str:
@@ -79,7 +81,7 @@ def does_not_explain(y: np.ndarray, residual_rms: float) -> float:
     y = np.asarray(y, float)
     spread = float(np.linalg.norm(y - np.mean(y)))
     fit = 100.0 * (1.0 - residual_rms * np.sqrt(y.size) / spread) if spread > 0.0 else 100.0
-    ratio = misfit_ratio(y, np.array([residual_rms, -residual_rms]))
+    ratio = float(residual_rms / _noise_floor(y))
     return ratio if ratio > MISFIT and fit < FIT_FLOOR else 0.0
 
 

@@ -454,7 +454,7 @@ def fit_structure(record: Record, structure: Structure | str, delay: str | float
     # an output interpolated from uneven stamps: its residuals understate the noise the estimates carry
     cov, note = fit_covariance(gram, s2 * record.noise_factor, p if fit_delay else None, dt)
     cov = cov[:J.shape[1], :J.shape[1]]
-    notes = (note, misfit_note(y[rows], (yhat - b_hat)[rows], resid) if resid.size == rows.size else "",
+    notes = (note, misfit_note(y[rows], (yhat - b_hat)[rows], resid),  # resid is on rows (scaled_jacobian)
              correlated_residuals_note(resid, expected=record.noise_correlation))  # the structure, then the noise
     info.update({"covariance_note": "; ".join(n for n in notes if n)} if any(notes) else {})
     with np.errstate(all="ignore"):
