@@ -50,6 +50,7 @@ from synth.synthesis.cvxpy_loader import cp
 from synth.synthesis.delay_grid import controller_gain_bound
 from synth.synthesis.objective_forms import CoefficientRatioFloor, Level, ReturnDifferenceFloor
 from synth.synthesis.parametrization import Parametrization
+from synth.synthesis.phase_one_stop import heading_above
 from synth.synthesis.stabilizing_plane import plane_starts
 
 __all__ = ["GRID_TOLERANCE", "SOLVER", "ConvexDesigner"]
@@ -138,7 +139,6 @@ class ConvexDesigner:
         if "elastic" not in self._problems:
             self._s = cp.Variable(len(self.elastic_forms), nonneg=True)
             slacks = {id(f): self._s[i] for i, f in enumerate(self.elastic_forms)}
-            self._elastic_box = list(self.box)
             cons = self._constraints(slacks)
             self._problems["elastic"] = cp.Problem(cp.Minimize(cp.sum(self._s)), cons)
         return self._problems["elastic"]
@@ -175,16 +175,14 @@ class ConvexDesigner:
             phi0 = self.par.basis(np.array([0.0]))[0]
             c = np.real(np.where(np.isfinite(phi0), phi0, 0.0))
         else:
-            raise SynthError("objective integral_gain needs a controller with integral action",
-                             where="objective")
+            raise SynthError("objective integral_gain needs a controller with integral action", where="objective")
         return c
 
     def _level_form(self, name: str, sense: str) -> Form:
         """The objective as a constraint whose level is bisected."""
         pts = make_points(self.plants, self.par, self.grid)
         level = self._level
-        if self.par.ctype == "rational" and name in ("integral_gain", "low_frequency_gain") \
-                and sense == "maximize":
+        if self.par.ctype == "rational" and name in ("integral_gain", "low_frequency_gain") and sense == "maximize":
             return CoefficientRatioFloor(self.par, level)
         if name == "bandwidth" and sense == "maximize":
             return bandwidth_floor(name, pts, self.par.size, T0(self.plants, self.par), below=lambda: level.value)
@@ -222,13 +220,9 @@ class ConvexDesigner:
             self._gamma_form.update(rho_c)
 
     def _stable(self, rho: np.ndarray) -> bool:
-        c = self.par.controller(rho)
-        cn, cd = c.tf()
-        for p in self.plants:
-            if not closed_loop_stability(np.polymul(cn, p.num), np.polymul(cd, p.den), p.delay,
-                                         stability_floor(p.num, p.den, p.delay)).stable:
-                return False
-        return True
+        cn, cd = self.par.controller(rho).tf()
+        return all(closed_loop_stability(np.polymul(cn, p.num), np.polymul(cd, p.den), p.delay,
+                                         stability_floor(p.num, p.den, p.delay)).stable for p in self.plants)
 
     def exact_slacks(self, rho: np.ndarray) -> np.ndarray:
         """Worst-plant slack of every requirement (exact evaluation with peak refinement)."""
@@ -291,20 +285,18 @@ class ConvexDesigner:
     def _pinned(c: np.ndarray | None, lo: np.ndarray, rng: np.random.Generator) -> np.ndarray | None:
         """``c`` with a random half of its parameters at their lower bounds (a PID whose stabilizing set
         needs ki = 0 on an unstable plant with an integrator is never drawn with every gain positive)."""
-        if c is None:
-            return None
-        pin = rng.random(c.size) < 0.5
-        return np.where(pin & np.isfinite(lo), lo, c)
+        return None if c is None else np.where((rng.random(c.size) < 0.5) & np.isfinite(lo), lo, c)
 
     def start(self, initial: np.ndarray | None = None) -> np.ndarray:
         """The first stabilizing start (see :meth:`starts`)."""
         return self.starts(initial, 1)[0]
 
-    def feasible(self, rho0: np.ndarray, history: list) -> tuple[np.ndarray, float]:
+    def feasible(self, rho0: np.ndarray, history: list, floor: float = np.inf) -> tuple[np.ndarray, float]:
         """Phase 1: minimize the total elastic slack from ``rho0``: ``(rho, violation)``, ``violation`` 0 when the
-        exact check finds every requirement met at ``rho``, else the elastic total."""
+        exact check finds every requirement met at ``rho``, else the elastic total. ``floor``: an earlier start's
+        total (``settings.restart_limit``)."""
         problem = self._elastic_problem()
-        rho_c, total = rho0, np.inf
+        rho_c, total, totals = rho0, np.inf, []
         for it in range(self.settings.max_iterations):
             if np.all(self.grid_violations(rho_c) <= GRID_TOLERANCE):
                 return rho_c, 0.0
@@ -319,6 +311,9 @@ class ConvexDesigner:
                 total = new_total
                 break
             total = new_total
+            totals.append(total)
+            if heading_above(totals, self.settings.restart_limit * floor):
+                break
         if np.all(self.grid_violations(rho_c) <= GRID_TOLERANCE):
             return rho_c, 0.0
         return rho_c, max(total if np.isfinite(total) else 1.0, 1e-6)
@@ -447,10 +442,12 @@ class ConvexDesigner:
 
     def is_feasible(self, restarts: int = 6) -> bool:
         """Phase 1 only, from up to ``restarts + 1`` stabilizing starts: can every requirement be met?"""
+        floor = np.inf
         for rho0 in itertools.islice(self.iter_starts(None), restarts + 1):
-            _, total = self.feasible(rho0, [])
+            _, total = self.feasible(rho0, [], floor)
             if total == 0.0:
                 return True
+            floor = min(floor, total)
         return False
 
     def run(self, initial: np.ndarray | None = None, refinements: int = 4, restarts: int = 6) -> ConvexResult:
@@ -470,7 +467,7 @@ class ConvexDesigner:
         self.converged = False
         for rho0 in starts:
             self.starts_tried += 1
-            rho, total = self.feasible(rho0, history)
+            rho, total = self.feasible(rho0, history, np.inf if best is None else best[0])
             if best is None or total < best[0]:
                 best = (total, rho)
             if total == 0.0:

@@ -45,6 +45,12 @@ class ConvexSettings:
     bisection_tolerance : float
         The bisection stops when its bracket on the objective's logarithm is narrower than this (1e-3:
         0.1 % of the objective; the NLP polish that follows refines the answer to its own tolerance).
+    restart_limit : float
+        A restart of phase 1 (another stabilizing start after one that ended infeasible) stops once its elastic
+        totals shrink geometrically towards at least this share of the lowest total an earlier start reached
+        (:func:`synth.synthesis.phase_one_stop.heading_above`): it is converging to the same infeasible point or
+        a worse one. Each start of an infeasible PID filter value took 30-40 solves to creep to the first start's
+        total (k1 of session 62: 222-276 solves per value, 51-64 with the stop); 0 lets every start converge.
     """
 
     per_decade: int = 40
@@ -54,6 +60,7 @@ class ConvexSettings:
     stability_level: float = 0.05
     bisection_steps: int = 18
     bisection_tolerance: float = 1e-3
+    restart_limit: float = 0.9
 
 
 def design_grid(plants: list[Plant], requirements: list[Requirement], settings: ConvexSettings,
