@@ -32,3 +32,19 @@ def test_a_pid_with_a_free_filter_is_designed_with_the_filter_held_and_meets_its
                  0.0, 0.0)
     # the search of the filter's whole grid in every design of the bisection reached ki = 3.921 (d4d891e)
     assert p["ki"] >= 0.99 * 3.921
+
+
+@pytest.mark.slow
+def test_when_no_level_passes_with_the_structure_held_the_bisection_searches_its_grid(monkeypatch) -> None:
+    import synth.synthesis.surrogate as surrogate
+
+    def nothing_designs(spec, key, value):  # every design with the structure held: no gain left to design with
+        bounds = {**spec.controller.all_bounds(), key: (value, value), "kp": (0.0, 0.0), "ki": (0.0, 0.0)}
+        return spec.model_copy(update={"controller": spec.controller.model_copy(update={"bounds": bounds})})
+
+    monkeypatch.setattr(surrogate, "_hold", nothing_designs)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        result = synth.design(synth.parse_spec(spec_of(71, 0)))
+    assert result.feasible and result.extras["surrogate"]["held"] is None and "held at" not in result.verdict
+    assert result.controller.parameters["ki"] == pytest.approx(3.921, rel=2e-3)  # d4d891e's design, the grid's

@@ -147,9 +147,7 @@ def design_certified(spec: Spec, design_fn: Callable[[Spec], DesignResult],
     if not free.feasible:  # the other requirements already fail: nothing for the surrogate to add
         return design_fn(spec)
     loose = _peaks_db(spec, free)  # the free design's level: too loose (it fails the exact check)
-    tight = _FLOOR_DB  # no design below this level
-    best, tried, over = None, 1, free.controller
-    level = float(np.clip(_start_level(hard), tight + 0.2, max(loose - 0.2, tight + 0.2)))
+    level = float(np.clip(_start_level(hard), _FLOOR_DB + 0.2, max(loose - 0.2, _FLOOR_DB + 0.2)))
     held = _held_structure(spec, free.controller)
     make = trial_fn or design_fn
     trial_make = make if held is None else (lambda s: make(_hold(s, held[0], held[1])))
@@ -157,24 +155,11 @@ def design_certified(spec: Spec, design_fn: Callable[[Spec], DesignResult],
         guesses.ahead(level)  # while the free design is checked
         if quick_check(spec, free.controller).feasible:
             return _certified(spec, free, None, 1)
-        for _ in range(BISECTIONS + 2):
-            if level - tight >= RESOLUTION_DB and not guesses.expects(level):  # the next level should this fail
-                guesses.ahead(float(np.sqrt(tight * level)))
-            with within(f"outer loop {tried + 1}/{BISECTIONS + 3} (surrogate bound {level:.2f} dB)"):
-                trial, designed, passes = guesses.value(level)
-            tried += 1
-            if passes:  # the certificate re-checks the chosen one
-                if best is None or _better(trial, best[0]):
-                    best = (trial, level)
-                tight = level  # passes: a looser level may do better
-            elif designed or best is not None:
-                loose = level  # fails the exact check (or, above a level that passed, no design: stay below)
-                over = trial.controller if designed else over
-            else:
-                tight = level  # no design and nothing passed yet: the surrogate is too strict
-            if loose - tight < RESOLUTION_DB:
-                break
-            level = float(np.sqrt(tight * loose))  # geometric: the free level can be tens of dB
+        best, tried, over = _bisection(guesses, level, loose, free.controller, 1)
+    if best is None and held is not None:  # no level passed with the structure held: its grid in each design
+        held = None
+        with Speculator(lambda level: _trial(spec, make, level)) as guesses:
+            best, tried, over = _bisection(guesses, level, loose, free.controller, tried)
     integral_only = all(n in ("integral_gain", "low_frequency_gain") and sense == "maximize"
                         for n, sense, _ in objective_terms(spec))
     found = None
@@ -204,6 +189,33 @@ def design_certified(spec: Spec, design_fn: Callable[[Spec], DesignResult],
     if plain.feasible and _better(plain, found):
         return plain
     return found
+
+
+def _bisection(guesses: Speculator, level: float, loose: float, over: Controller, tried: int
+               ) -> tuple[tuple[DesignResult, float] | None, int, Controller]:
+    """The bisection on the surrogate's level from ``level`` (``loose``: a level whose design fails the exact
+    check) down to :data:`_FLOOR_DB`: the best design that passed and its level (or None), the number of designs
+    made (``tried`` before), and the last design that failed the exact check (``over`` when none did)."""
+    best, tight = None, _FLOOR_DB  # no design below this level
+    for _ in range(BISECTIONS + 2):
+        if level - tight >= RESOLUTION_DB and not guesses.expects(level):  # the next level should this fail
+            guesses.ahead(float(np.sqrt(tight * level)))
+        with within(f"outer loop {tried + 1}/{BISECTIONS + 3} (surrogate bound {level:.2f} dB)"):
+            trial, designed, passes = guesses.value(level)
+        tried += 1
+        if passes:  # the certificate re-checks the chosen one
+            if best is None or _better(trial, best[0]):
+                best = (trial, level)
+            tight = level  # passes: a looser level may do better
+        elif designed or best is not None:
+            loose = level  # fails the exact check (or, above a level that passed, no design: stay below)
+            over = trial.controller if designed else over
+        else:
+            tight = level  # no design and nothing passed yet: the surrogate is too strict
+        if loose - tight < RESOLUTION_DB:
+            break
+        level = float(np.sqrt(tight * loose))  # geometric: the free level can be tens of dB
+    return best, tried, over
 
 
 def _held_structure(spec: Spec, controller: Controller) -> tuple[str, float, str] | None:
