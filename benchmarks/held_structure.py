@@ -82,15 +82,16 @@ def summarize(rows: dict[str, list[dict]]) -> str:
              "|---|---|---|---|---|---|"]
     for i in sorted(set(base) & set(new)):
         a, b = base[i], new[i]
-        (name, sense), = b["objective_spec"].items()
+        (sense, name), = b["objective_spec"].items()
         gain = ""
         if a.get("objective") and b.get("objective"):
             rel = (b["objective"] - a["objective"]) / abs(a["objective"])
             gain = f"{(rel if sense == 'maximize' else -rel) * 100:+.2f} %"
             if b["objective_spec"].get("minimize") == "control_effort":  # in dB: the difference in dB
                 gain = f"{a['objective'] - b['objective']:+.3f} dB"
-        lines.append(f"| {i} | {b['type']} | {sense} {name} | {a.get('objective', a.get('error'))} ({a['cpu']:.1f}) "
-                     f"| {b.get('objective', b.get('error'))} ({b['cpu']:.1f}) | {gain} |")
+        cells = [f"{r['objective']:.6g}" if r.get("objective") is not None else str(r.get("error"))[:40] for r in (a, b)]
+        lines.append(f"| {i} | {b['type']} | {sense} {name} | {cells[0]} ({a['cpu']:.1f}) | {cells[1]} ({b['cpu']:.1f}) "
+                     f"| {gain} |")
     both = sorted(set(base) & set(new))
     cpu = [sum(side[i]["cpu"] for i in both) for side in (base, new)]
     lines.append(f"\nCPU: baseline {cpu[0]:.1f} s, current {cpu[1]:.1f} s over {len(both)} problems")

@@ -140,7 +140,7 @@ def _term(b: NLPBuilder, name: str, plants: list[Plant], grid: np.ndarray, start
     if name in ("peak_complementary", "control_effort"):
         curve = loop0.T if name == "peak_complementary" else loop0.KS
         m0 = float(np.max(np.abs(curve(grid))))
-        M = b.var("M", m0, 1e-9, 1e3 * m0)
+        M = b.var("M", max(m0, 1e-9), 1e-9, max(1e3 * m0, 1e-6))  # a start without gain: m0 = 0
         for p in plants:
             C, L = loop_response(ctrl, p, grid)
             top = L if name == "peak_complementary" else C
