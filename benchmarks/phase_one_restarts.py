@@ -59,7 +59,8 @@ def main() -> None:
         print(json.dumps(rows[-1]), flush=True)
     differ = [r["index"] for r in rows if r["every"] != r["stopped"]]
     infeasible = sum(1 for r in rows if "infeasible" in str(r["every"]))
-    print(f"{len(rows)} problems ({infeasible} with an infeasible run): verdicts or objectives differ on {differ or 'no'}; "
+    where = f"on {differ}" if differ else "on none"
+    print(f"{len(rows)} problems ({infeasible} with an infeasible run): verdicts or objectives differ {where}; "
           f"solves {sum(r['solves']['every'] for r in rows)} -> {sum(r['solves']['stopped'] for r in rows)}; "
           f"CPU {sum(r['cpu']['every'] for r in rows):.1f} -> {sum(r['cpu']['stopped'] for r in rows):.1f} s")
 

@@ -8,6 +8,7 @@ import numpy as np
 
 __all__ = ["heading_above"]
 
+
 def heading_above(totals: list[float], level: float) -> bool:
     """Whether the last three totals of phase 1 shrink geometrically (the last two decreases in a ratio below 0.9)
     towards a limit at or above ``level`` (the last total less the rest of the geometric series).

@@ -225,9 +225,9 @@ def _held_structure(spec: Spec, controller: Controller) -> tuple[str, float, str
     Each design of the bisection is then one convex run instead of the structural grid's eleven or more, and the
     pattern search on the exact check that follows moves it with the other parameters (session 62's PID on
     ``2/((s-0.5)(s+4)) e^(-0.05 s)`` with step limits: 4 min 44 s -> 1 min 41 s, control effort 8.285 -> 8.322 dB;
-    benchmarks/README.md, "held structure")."""
+    benchmarks/README.md, "Certified designs with a free structural parameter")."""
     key = STRUCTURAL.get(spec.controller.type)
-    if key is None:
+    if key is None or controller.parameters.get(key) is None:
         return None
     lo, hi = spec.controller.all_bounds()[key]
     return None if lo == hi else (key, float(np.clip(controller.parameters[key], lo, hi)), controller.kind.units[key])
