@@ -13,7 +13,7 @@ from synth.plant import Plant
 from synth.requirements.base import Requirement, RequirementResult, fmt
 from synth.spec import Spec
 
-__all__ = ["CheckResult", "QuickCheck", "check", "evaluate_all", "quick_check", "stability_result"]
+__all__ = ["CheckResult", "QuickCheck", "check", "evaluate_all", "margin_slack", "quick_check", "stability_result"]
 
 
 @dataclass
@@ -162,7 +162,7 @@ class QuickCheck:
     min_slack: float
 
 
-def quick_check(spec: Spec, controller: Controller, per_decade: int = 80) -> QuickCheck:
+def quick_check(spec: Spec, controller: Controller, per_decade: int = 80, margins: bool = True) -> QuickCheck:
     """:func:`check`'s verdict and smallest slack, with the work a failure makes unnecessary left out.
 
     Searches on the exact check (:mod:`synth.synthesis.pattern`, :mod:`synth.synthesis.exact_search`) make
@@ -170,7 +170,9 @@ def quick_check(spec: Spec, controller: Controller, per_decade: int = 80) -> Qui
     evaluates the requirements, the ones that simulate (:attr:`~synth.requirements.base.Requirement.costly`)
     last, and stops at the first that fails (a costly one is first asked whether a cheaper evaluation proves it
     fails: :meth:`~synth.requirements.base.Requirement.fails_surely`); the gain margins of a stable loop
-    (stability's slack) are computed only when everything passed. The verdict and slack are :func:`check`'s.
+    (stability's slack) are computed only when everything passed. The verdict and slack are :func:`check`'s;
+    with ``margins=False`` the slack leaves the gain margins out (:func:`margin_slack` gives them: a search that
+    reads the slack only to break ties between equal scores computes them only then).
 
     Examples
     --------
@@ -194,5 +196,21 @@ def quick_check(spec: Spec, controller: Controller, per_decade: int = 80) -> Qui
             if not slack >= 0:  # a NaN fails too, as in check
                 return QuickCheck(False, -np.inf)
             slacks.append(slack)
-    slacks += [stability_result(loop).slack for loop in loops]
-    return QuickCheck(True, float(min(slacks)))
+    if margins:
+        slacks += [stability_result(loop).slack for loop in loops]
+    return QuickCheck(True, float(min(slacks, default=np.inf)))
+
+
+def margin_slack(spec: Spec, controller: Controller) -> float:
+    """The smallest of stability's slacks over the spec's plants (:func:`stability_result`: the two-sided loop-gain
+    margin in nepers of a stable loop), the part of :func:`quick_check`'s slack that ``margins=False`` leaves out.
+
+    Examples
+    --------
+    >>> from synth.spec import load_spec
+    >>> spec = load_spec("specs/x4_rotor.yaml")
+    >>> c = Controller("P", {"kp": 3.0})
+    >>> min(quick_check(spec, c, margins=False).min_slack, margin_slack(spec, c)) == quick_check(spec, c).min_slack
+    True
+    """
+    return float(min(stability_result(Loop(plant, controller)).slack for plant in spec.plants()))
