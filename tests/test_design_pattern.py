@@ -64,10 +64,10 @@ def test_a_check_that_cannot_be_made_is_a_failed_trial_not_a_crash(monkeypatch):
                        "objective": {"maximize": "integral_gain"}})
     real = pattern.quick_check
 
-    def flaky(spec_, c, per_decade=80):
+    def flaky(spec_, c, per_decade=80, margins=True):
         if c.parameters["kp"] > 1.2:
             raise RuntimeError("Nyquist count failed to converge (winding -2.000)")
-        return real(spec_, c, per_decade)
+        return real(spec_, c, per_decade, margins)
 
     monkeypatch.setattr(pattern, "quick_check", flaky)
     result = pattern.pattern_search(spec, Controller("PI", {"kp": 1.0, "ki": 2.0}),

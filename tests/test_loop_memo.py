@@ -45,9 +45,9 @@ def test_the_pattern_search_checks_each_point_once(monkeypatch):
     seen: list[tuple[float, ...]] = []
     original = pattern_module.quick_check
 
-    def spy(spec, controller, *args):
+    def spy(spec, controller, *args, **kwargs):
         seen.append(tuple(controller.parameters.values()))
-        return original(spec, controller, *args)
+        return original(spec, controller, *args, **kwargs)
 
     monkeypatch.setattr(pattern_module, "quick_check", spy)
     result = pattern_search(spec, Controller("PI", {"kp": 1.0, "ki": 2.0}), [("integral_gain", "maximize", 1.0)])
