@@ -36,13 +36,15 @@ def test_a_pid_with_a_free_filter_is_designed_with_the_filter_held_and_meets_its
 
 @pytest.mark.slow
 def test_when_no_level_passes_with_the_structure_held_the_bisection_searches_its_grid(monkeypatch) -> None:
-    import synth.synthesis.surrogate as surrogate
+    from synth.spec import Spec
 
-    def nothing_designs(spec, key, value):  # every design with the structure held: no gain left to design with
-        bounds = {**spec.controller.all_bounds(), key: (value, value), "kp": (0.0, 0.0), "ki": (0.0, 0.0)}
-        return spec.model_copy(update={"controller": spec.controller.model_copy(update={"bounds": bounds})})
+    fixed = Spec.with_parameter_fixed
 
-    monkeypatch.setattr(surrogate, "_hold", nothing_designs)
+    def nothing_designs(spec, key, value):  # every design with the filter held: no gain left to design with
+        spec = fixed(spec, key, value)
+        return fixed(fixed(spec, "kp", 0.0), "ki", 0.0) if key == "tf" else spec
+
+    monkeypatch.setattr(Spec, "with_parameter_fixed", nothing_designs)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         result = synth.design(synth.parse_spec(spec_of(71, 0)))

@@ -74,4 +74,16 @@ class Spec(StrictModel):
         """The nominal plant."""
         return self.plant.build()
 
+    def with_parameter_fixed(self, name: str, value: float) -> Spec:
+        """This spec with the controller parameter ``name`` held at ``value`` (its bounds ``[value, value]``).
 
+        Examples
+        --------
+        >>> from synth.spec import parse_spec
+        >>> spec = parse_spec({"name": "pi", "plant": {"tf": "1/(s+1)"}, "controller": {"type": "PI"},
+        ...                    "requirements": [{"type": "bandwidth", "min": 1.0}]})
+        >>> spec.with_parameter_fixed("ki", 0.0).controller.all_bounds()["ki"]
+        (0.0, 0.0)
+        """
+        bounds = {**self.controller.all_bounds(), name: (value, value)}
+        return self.model_copy(update={"controller": self.controller.model_copy(update={"bounds": bounds})})

@@ -40,8 +40,7 @@ def without_integral_action(spec: Spec) -> Spec | None:
     bounds = spec.controller.all_bounds()
     if "ki" not in bounds or bounds["ki"][0] != 0.0 or bounds["ki"][1] == 0.0:
         return None
-    return spec.model_copy(update={"controller": spec.controller.model_copy(
-        update={"bounds": {**bounds, "ki": (0.0, 0.0)}})})
+    return spec.with_parameter_fixed("ki", 0.0)
 
 
 def integral_only(spec: Spec) -> bool:

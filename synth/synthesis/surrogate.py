@@ -150,7 +150,7 @@ def design_certified(spec: Spec, design_fn: Callable[[Spec], DesignResult],
     level = float(np.clip(_start_level(hard), _FLOOR_DB + 0.2, max(loose - 0.2, _FLOOR_DB + 0.2)))
     held = _held_structure(spec, free.controller)
     make = trial_fn or design_fn
-    trial_make = make if held is None else (lambda s: make(_hold(s, held[0], held[1])))
+    trial_make = make if held is None else (lambda s: make(s.with_parameter_fixed(held[0], held[1])))
     with Speculator(lambda level: _trial(spec, trial_make, level)) as guesses:  # the idle core
         guesses.ahead(level)  # while the free design is checked
         if quick_check(spec, free.controller).feasible:
@@ -231,12 +231,6 @@ def _held_structure(spec: Spec, controller: Controller) -> tuple[str, float, str
         return None
     lo, hi = spec.controller.all_bounds()[key]
     return None if lo == hi else (key, float(np.clip(controller.parameters[key], lo, hi)), controller.kind.units[key])
-
-
-def _hold(spec: Spec, key: str, value: float) -> Spec:
-    """``spec`` with the parameter ``key`` fixed at ``value``."""
-    return spec.model_copy(update={"controller": spec.controller.model_copy(
-        update={"bounds": {**spec.controller.all_bounds(), key: (value, value)}})})
 
 
 def _trial(spec: Spec, make: Callable[[Spec], DesignResult], level: float) -> tuple[DesignResult, bool, bool]:
