@@ -29,7 +29,7 @@ from synth.ident.simulate import simulate_plant
 from synth.plant import Plant
 from synth.sim.blocks import Quantizer
 
-__all__ = ["QuantizationEffect", "quantizer_grid"]
+__all__ = ["QuantizationEffect", "batch_ssr", "batch_width", "quantizer_grid", "step_responses"]
 
 _GRAM_VALUES = 600  # distinct command values up to which the dense search uses their Gram matrix
 _GRAM_ENTRIES = 2.5e7  # ... and entries of the response table it is formed from (samples x columns)
@@ -123,7 +123,7 @@ class QuantizationEffect(Effect):
         return u if q <= 0 else Quantizer(q, float(params.get("offset", 0.0)) % q).apply(u, dt)
 
 
-def _step_responses(plant: Plant, t: np.ndarray) -> tuple[list[np.ndarray], list[np.ndarray]]:
+def step_responses(plant: Plant, t: np.ndarray) -> tuple[list[np.ndarray], list[np.ndarray]]:
     """Per unit numerator of ``plant``: the response to a unit step at ``t[0]`` from rest, and to a held 1 (steady).
 
     (The quantizer's dense search holds the denominator: a Gauss-Newton step in it would double the work of
@@ -131,7 +131,7 @@ def _step_responses(plant: Plant, t: np.ndarray) -> tuple[list[np.ndarray], list
 
     Examples
     --------
-    >>> steps, consts = _step_responses(Plant.from_string("2/(s+1)"), np.arange(0, 3, 1.0))
+    >>> steps, consts = step_responses(Plant.from_string("2/(s+1)"), np.arange(0, 3, 1.0))
     >>> steps[0].round(3).tolist(), consts[0].round(3).tolist()
     ([0.0, 0.632, 0.865], [1.0, 1.0, 1.0])
     """
@@ -141,7 +141,7 @@ def _step_responses(plant: Plant, t: np.ndarray) -> tuple[list[np.ndarray], list
             [simulate_plant(g, t, ones) for g in units])
 
 
-def _batch_ssr(v: np.ndarray, y: np.ndarray, steps: list[np.ndarray], consts: list[np.ndarray],
+def batch_ssr(v: np.ndarray, y: np.ndarray, steps: list[np.ndarray], consts: list[np.ndarray],
                mask: np.ndarray | None = None) -> np.ndarray:
     """Least-squares SSR of ``y`` on the unit-numerator responses to each column of ``v`` plus a constant.
 
@@ -152,10 +152,10 @@ def _batch_ssr(v: np.ndarray, y: np.ndarray, steps: list[np.ndarray], consts: li
     Examples
     --------
     >>> t = np.arange(0, 5, 0.1); G = Plant.from_string("1/(s+1)")
-    >>> steps, consts = _step_responses(G, t)
+    >>> steps, consts = step_responses(G, t)
     >>> v = np.column_stack([np.ones_like(t), np.where(t > 1, 1.0, 0.0)])
     >>> y = simulate_plant(G, t, v[:, 1], initial="zero")
-    >>> _batch_ssr(v, y, steps, consts).round(6).tolist()[1]
+    >>> batch_ssr(v, y, steps, consts).round(6).tolist()[1]
     0.0
     """
     n, m = v.shape
@@ -181,6 +181,27 @@ def _batch_ssr(v: np.ndarray, y: np.ndarray, steps: list[np.ndarray], consts: li
     return np.maximum(float(y @ y) - np.einsum("mi,mi->m", coef, xty), 0.0)
 
 
+_BATCH_ENTRIES = 250_000
+"""Samples times columns of one :func:`batch_ssr` call in the dense search (2 MB per array). Its FFT and
+least-squares arrays are several times that; once they pass glibc's 32 MB ``mmap`` threshold every call maps fresh
+pages that the kernel zeroes: 512 columns of a 20,000-sample record spent more time in the kernel than in numpy
+(a 60,000-sample diagnosis: 16-20 s of system time, 48-55 s of wall time against 36 s with the threshold lifted).
+Each column's arithmetic is the same whatever the batch, so the SSRs are the same bits. The passes over the search's
+points keep their (values x points) rounding table within 2e6 entries for the same reason (it was 2e7: 160 MB per
+temporary); a pass groups fewer points into distinct rounding patterns, and the search found the same points."""
+
+
+def batch_width(samples: int) -> int:
+    """Columns per :func:`batch_ssr` call on a record of ``samples`` samples (16 to 512).
+
+    Examples
+    --------
+    >>> batch_width(1000), batch_width(20000), batch_width(400000)
+    (250, 16, 16)
+    """
+    return int(min(512, max(16, _BATCH_ENTRIES // max(samples, 1))))
+
+
 class _LevelGram:
     """Least-squares SSR of ``y`` on the unit numerators' responses to ``v = L[u_index]`` plus a constant.
 
@@ -188,16 +209,16 @@ class _LevelGram:
     them to a level is ``sum_j L_j r_j`` with ``r_j`` the response to the indicator of value ``j``. The Gram
     matrix of those responses (and the constant, and their products with ``y``) is formed once; every
     point then costs ``O(J^2)`` for ``J`` distinct values instead of an FFT convolution of the record
-    (:func:`_batch_ssr`, the same least squares).
+    (:func:`batch_ssr`, the same least squares).
 
     Examples
     --------
     >>> t = np.arange(0, 5, 0.1); G = Plant.from_string("1/(s+1)"); u = np.where(t > 1, 1.0, 0.0)
-    >>> steps, consts = _step_responses(G, t)
+    >>> steps, consts = step_responses(G, t)
     >>> values, index = np.unique(u, return_inverse=True)
     >>> L = np.array([[0.0, 0.0], [1.0, 2.0]]); y = simulate_plant(G, t, 2.0 * u) + 0.3 * np.sin(t)
     >>> gram = _LevelGram(G, t, index, values.size, y)
-    >>> np.allclose(gram.ssr(L), _batch_ssr(L[index], y, steps, consts))
+    >>> np.allclose(gram.ssr(L), batch_ssr(L[index], y, steps, consts))
     True
     """
 
@@ -240,7 +261,7 @@ def quantizer_grid(plant: Plant, t: np.ndarray, u: np.ndarray, y: np.ndarray, ke
     eighth of a step at the edges of the data between neighbours (relative spacing ``step / (4 span)``);
     phases on eight points in [0, 1). The best ``keep`` points are then searched again on a grid four times
     finer in both directions around each. Every point's SSR is the least-squares fit of the unit numerators
-    and a constant (:func:`_batch_ssr`).
+    and a constant (:func:`batch_ssr`).
 
     Parameters
     ----------
@@ -277,7 +298,7 @@ def quantizer_grid(plant: Plant, t: np.ndarray, u: np.ndarray, y: np.ndarray, ke
     n_use = _dense_samples(u, len(unit_numerators(plant)))
     if n_use < t.size:  # a long record: the search on its start (from rest, as the whole); points kept per the whole
         t, u, y, mask = t[:n_use], u[:n_use], y[:n_use], None if mask is None else np.asarray(mask)[:n_use]
-    steps_r, consts = _step_responses(plant, t)
+    steps_r, consts = step_responses(plant, t)
     q_lo, q_hi = 0.005 * span, 0.5 * span
     steps = [q_lo]
     while steps[-1] < q_hi:
@@ -292,7 +313,8 @@ def quantizer_grid(plant: Plant, t: np.ndarray, u: np.ndarray, y: np.ndarray, ke
             if u_values.size <= _GRAM_VALUES and t.size * (len(steps_r) * u_values.size + 1) <= _GRAM_ENTRIES
             else None)
 
-    chunk = max(512, int(2e7 // u_values.size))  # points per pass: bounds the (values x points) level table
+    chunk = max(64, int(2e6 // u_values.size))  # points per pass: the (values x points) level table within 16 MB
+    width = 512 if gram is not None else batch_width(t.size)  # candidate inputs per least-squares batch
     # the SSR is unchanged by v -> a v + b when the steady responses are constant (gain in the numerator fit, the
     # offset in the constant column): then only the integer rounding pattern, less its first entry, matters
     affine = all(np.ptp(c) <= 1e-9 * max(np.max(np.abs(c)), 1e-300) for c in consts)
@@ -306,9 +328,9 @@ def quantizer_grid(plant: Plant, t: np.ndarray, u: np.ndarray, y: np.ndarray, ke
             levels = k - k[:1] if affine else lat[None, :] + q[None, :] * k
             distinct, which = _distinct_columns(levels)
             cost = np.empty(distinct.shape[1])
-            for i in range(0, distinct.shape[1], 512):
-                cost[i:i + 512] = (gram.ssr(distinct[:, i:i + 512]) if gram is not None else
-                                   _batch_ssr(distinct[:, i:i + 512][u_index], y, steps_r, consts, mask))
+            for i in range(0, distinct.shape[1], width):
+                cost[i:i + width] = (gram.ssr(distinct[:, i:i + width]) if gram is not None else
+                                     batch_ssr(distinct[:, i:i + width][u_index], y, steps_r, consts, mask))
             out[start:start + chunk] = cost[np.ravel(which)]
         return out
 
