@@ -19,7 +19,7 @@ from synth.results import DesignResult
 from synth.spec import Spec
 from synth.synthesis.scalar import design_scalar
 
-__all__ = ["design", "design_jobs"]
+__all__ = ["design", "design_jobs", "with_tracking_caveat"]
 
 
 def design(spec: Spec) -> DesignResult:
@@ -45,12 +45,37 @@ def design(spec: Spec) -> DesignResult:
     (True, 20.0, True)
     """
     if len(spec.controller.free_parameters()) == 1:
-        return design_scalar(spec)
+        return with_tracking_caveat(spec, design_scalar(spec))
     from synth.synthesis.multi import design_convex, design_trial  # cvxpy and casadi: several parameters only
     from synth.synthesis.surrogate import design_certified
 
     # the surrogate's bisection only needs to know which level passes: its designs are the convex stage's alone
-    return design_certified(spec, design_convex, design_trial)
+    return with_tracking_caveat(spec, design_certified(spec, design_convex, design_trial))
+
+
+def with_tracking_caveat(spec: Spec, result: DesignResult) -> DesignResult:
+    """``result`` with its verdict saying so when the design's loop on the nominal plant barely follows the reference
+    (:func:`synth.requirements.tracking.tracking_caveat`); said once, however often this is applied.
+
+    Examples
+    --------
+    >>> from synth.spec import parse_spec
+    >>> spec = parse_spec({"name": "idle", "plant": {"tf": "5/((s+1)*(s+4))"}, "requirements": [
+    ...     {"type": "margins", "gain_margin_db": 6}], "controller": {"type": "P", "bounds": {"kp": [0, 10]}},
+    ...     "objective": {"minimize": "control_effort"}})
+    >>> design(spec).verdict.split("; but ")[1][:45]
+    'its loop follows a slow reference to only 0 o'
+    """
+    from synth.loop import Loop
+    from synth.requirements.tracking import tracking_caveat
+
+    if not result.feasible or result.controller is None:
+        return result
+    note = tracking_caveat(Loop(spec.nominal_plant(), result.controller))
+    if note and note not in result.verdict:
+        text = result.verdict.rstrip()
+        result.verdict = f"{text.removesuffix('.')}{note}{'.' if text.endswith('.') else ''}"
+    return result
 
 
 def design_jobs(spec: Spec) -> tuple[list[Callable[[], Any]], Callable[[list[Any]], DesignResult]]:
@@ -74,7 +99,8 @@ def design_jobs(spec: Spec) -> tuple[list[Callable[[], Any]], Callable[[list[Any
     if len(spec.controller.free_parameters()) == 1:  # the design and the reference controller's check
         from synth.synthesis.scalar import scalar_jobs
 
-        return scalar_jobs(spec)
+        jobs, combine_scalar = scalar_jobs(spec)
+        return jobs, lambda results: with_tracking_caveat(spec, combine_scalar(results))
     without = without_integral_action(spec)
     if certified_only(spec) or without is None \
             or integral_only(spec):  # maximize ki: the design without it only runs when this one fails
@@ -88,6 +114,6 @@ def design_jobs(spec: Spec) -> tuple[list[Callable[[], Any]], Callable[[list[Any
     def combine(results: list[DesignResult]) -> DesignResult:
         from synth.synthesis.multi import choose
 
-        return choose(spec, *results)
+        return with_tracking_caveat(spec, choose(spec, *results))
 
     return [with_integral_action, lambda: design(without)], combine

@@ -12,7 +12,7 @@ from synth.requirements.base import RequirementResult, fmt
 if TYPE_CHECKING:
     from synth.loop import Loop
 
-__all__ = ["tracking_note"]
+__all__ = ["tracking_caveat", "tracking_note"]
 
 
 def tracking_note(result: RequirementResult, loop: Loop) -> RequirementResult:
@@ -37,3 +37,27 @@ def tracking_note(result: RequirementResult, loop: Loop) -> RequirementResult:
                    f"({fmt(20 * np.log10(t0), 3) if t0 > 0 else '-inf'} dB): the loop follows a slow reference to "
                    f"{fmt(t0, 3)} of it; bound the static sensitivity or require integral action to exclude such "
                    "designs")
+
+
+def tracking_caveat(loop: Loop) -> str:
+    """What a design's headline verdict adds when its loop barely follows the reference (``|T(0)|`` below -3 dB,
+    as :func:`tracking_note`), else ``""``. A spec that minimizes control effort and asks for no tracking is met
+    best by a controller that does almost nothing (``PI(kp=5e-06, ki=0)``: "meets all 2 requirements"); the
+    requirement notes said so in the list below the verdict, the verdict did not.
+
+    Examples
+    --------
+    >>> from synth.loop import Loop; from synth.plant import Plant; from synth.controllers import Controller
+    >>> tracking_caveat(Loop(Plant.from_string("1/(s+1)"), Controller("P", {"kp": 1e-5})))[:59]
+    '; but its loop follows a slow reference to only 1e-05 of it'
+    >>> tracking_caveat(Loop(Plant.from_string("1/(s+1)"), Controller("PI", {"kp": 1e-5, "ki": 1e-5})))
+    ''
+    """
+    from synth.loop import BANDWIDTH_LEVEL
+
+    t0 = abs(loop.T0())
+    if not (np.isfinite(t0) and t0 < BANDWIDTH_LEVEL):
+        return ""
+    level = f"{fmt(20 * np.log10(t0), 3)} dB" if t0 > 0 else "-inf dB"
+    return (f"; but its loop follows a slow reference to only {fmt(t0, 3)} of it (|T(0)| = {level}): no requirement "
+            "asks for more; bound the static sensitivity or require integral action to exclude such designs")
