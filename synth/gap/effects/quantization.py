@@ -21,7 +21,7 @@ from dataclasses import dataclass
 from typing import ClassVar
 
 import numpy as np
-from scipy.fft import next_fast_len
+from scipy.fft import irfft, next_fast_len, rfft
 
 from synth.errors import ModelError
 from synth.gap.effects.base import Effect, Params, command_span, log_grid, unit_numerators
@@ -161,10 +161,10 @@ def batch_ssr(v: np.ndarray, y: np.ndarray, steps: list[np.ndarray], consts: lis
     n, m = v.shape
     dv = np.diff(v, axis=0)
     size = next_fast_len(2 * n - 1, real=True)  # a linear convolution of two n-sample signals, no wrap-around
-    fdv = np.fft.rfft(dv, size, axis=0)
+    fdv = rfft(dv, size, axis=0)
     cols = []
     for s, c in zip(steps, consts):
-        conv = np.fft.irfft(fdv * np.fft.rfft(s, size)[:, None], size, axis=0)[: n - 1]
+        conv = irfft(fdv * rfft(s, size)[:, None], size, axis=0)[: n - 1]
         x = np.empty((n, m))
         x[0] = 0.0
         x[1:] = conv
