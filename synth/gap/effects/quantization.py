@@ -142,7 +142,7 @@ def step_responses(plant: Plant, t: np.ndarray) -> tuple[list[np.ndarray], list[
 
 
 def batch_ssr(v: np.ndarray, y: np.ndarray, steps: list[np.ndarray], consts: list[np.ndarray],
-               mask: np.ndarray | None = None) -> np.ndarray:
+              mask: np.ndarray | None = None) -> np.ndarray:
     """Least-squares SSR of ``y`` on the unit-numerator responses to each column of ``v`` plus a constant.
 
     ``v`` is ``(N, M)``: M candidate plant inputs. The response of a linear model started at the
