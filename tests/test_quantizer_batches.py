@@ -33,3 +33,34 @@ def test_batches_stay_within_a_quarter_million_entries() -> None:
         w = batch_width(n)
         assert 16 <= w <= 512
         assert w * n <= 250_000 or w == 16
+
+
+def test_the_search_shared_with_a_forked_child_finds_the_same_points(monkeypatch) -> None:
+    """The dense search's passes go to :func:`synth.forked.run_beside` in jobs (taken by this process and a child on
+    the other core); the points found are the same as in one process."""
+    import synth.gap.effects.quantization as quantization
+    from synth.forked import allow_fork, run_beside
+    from synth.gap.effects.quantization import QuantizationEffect, quantizer_grid
+
+    rng = np.random.default_rng(4)
+    t = np.arange(6000) * 0.01
+    u = 200.0 + 40.0 * np.sin(0.31 * t) * np.sin(1.7 * t)  # every sample a distinct value: no Gram matrix
+    plant = Plant.from_string("50/((s+2)*(s+5))")
+    y = QuantizationEffect().apply(plant, t, u, {"step": 7.0, "offset": 1.3}) + 0.05 * rng.normal(size=t.size)
+    serial = quantizer_grid(plant, t, u, y)
+    offered = []
+
+    def counted(jobs, own_work, **kwargs):
+        offered.append(len(jobs))
+        return run_beside(jobs, own_work, **kwargs)
+
+    monkeypatch.setattr(quantization, "run_beside", counted)
+    monkeypatch.delenv("SYNTH_JOBS", raising=False)  # conftest turns forking off for the suite
+    allow_fork(True)
+    try:
+        shared = quantizer_grid(plant, t, u, y)
+    finally:
+        allow_fork(False)
+    assert shared == serial
+    assert offered and max(offered) >= 2  # the coarse passes in several jobs
+    assert abs(serial[0]["step"] / 7.0 - 1.0) < 0.02  # and the search finds the quantizer

@@ -18,12 +18,14 @@ from __future__ import annotations
 
 import hashlib
 from dataclasses import dataclass
+from functools import partial
 from typing import ClassVar
 
 import numpy as np
 from scipy.fft import irfft, next_fast_len, rfft
 
 from synth.errors import ModelError
+from synth.forked import run_beside
 from synth.gap.effects.base import Effect, Params, command_span, log_grid, unit_numerators
 from synth.ident.simulate import simulate_plant
 from synth.plant import Plant
@@ -191,6 +193,12 @@ points keep their (values x points) rounding table within 2e6 entries for the sa
 temporary); a pass groups fewer points into distinct rounding patterns, and the search found the same points."""
 
 
+_PASS_JOBS = 32
+"""Jobs the dense search's passes are grouped in, taken in turn by this process and a forked child on the other core
+(:func:`synth.forked.run_beside`; one process where forking is off). Each pass's costs are the same bits wherever it
+runs."""
+
+
 def batch_width(samples: int) -> int:
     """Columns per :func:`batch_ssr` call on a record of ``samples`` samples (16 to 512).
 
@@ -319,9 +327,9 @@ def quantizer_grid(plant: Plant, t: np.ndarray, u: np.ndarray, y: np.ndarray, ke
     # offset in the constant column): then only the integer rounding pattern, less its first entry, matters
     affine = all(np.ptp(c) <= 1e-9 * max(np.max(np.abs(c)), 1e-300) for c in consts)
 
-    def ssr(points: np.ndarray) -> np.ndarray:  # points (M, 2): step, phase
-        out = np.empty(len(points))
-        for start in range(0, len(points), chunk):
+    def passes(points: np.ndarray, starts: list[int]) -> np.ndarray:  # points (M, 2): step, phase
+        out = []
+        for start in starts:
             q, ph = points[start:start + chunk, 0], points[start:start + chunk, 1]
             lat = center + ph * q
             k = np.floor((u_values[:, None] - lat[None, :]) / q[None, :] + 0.5)  # as the block rounds, per value
@@ -331,8 +339,14 @@ def quantizer_grid(plant: Plant, t: np.ndarray, u: np.ndarray, y: np.ndarray, ke
             for i in range(0, distinct.shape[1], width):
                 cost[i:i + width] = (gram.ssr(distinct[:, i:i + width]) if gram is not None else
                                      batch_ssr(distinct[:, i:i + width][u_index], y, steps_r, consts, mask))
-            out[start:start + chunk] = cost[np.ravel(which)]
-        return out
+            out.append(cost[np.ravel(which)])
+        return np.concatenate(out)
+
+    def ssr(points: np.ndarray) -> np.ndarray:  # the passes shared with a forked child where the other core is free
+        starts = list(range(0, len(points), chunk))
+        per_job = -(-len(starts) // _PASS_JOBS)
+        jobs = [partial(passes, points, starts[i:i + per_job]) for i in range(0, len(starts), per_job)]
+        return np.concatenate(run_beside(jobs, lambda: None)[0])
 
     coarse = np.array([(q, (j + 0.5) / n_phase) for q in steps for j in range(n_phase)])
     cost = ssr(coarse)
