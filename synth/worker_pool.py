@@ -19,7 +19,7 @@ def watch_parent(parent: int) -> None:
     On Linux the kernel sends SIGKILL when the parent dies (``prctl(PR_SET_PDEATHSIG)``, even when the
     parent is killed by SIGKILL); elsewhere a daemon thread checks the parent's pid every second. SIGINT
     is ignored (a Ctrl-C reaches the whole process group: the parent handles it and terminates the
-    workers) and SIGTERM has its default action.
+    workers) and SIGTERM has its default action. A worker forks nothing further (:func:`synth.forked.become_helper`).
 
     Examples
     --------
@@ -35,6 +35,9 @@ def watch_parent(parent: int) -> None:
 
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    from synth.forked import become_helper
+
+    become_helper()  # the pool has the cores: a job's own run_beside (the quantizer's search) runs here, serially
     armed = False
     if sys.platform.startswith("linux"):
         try:

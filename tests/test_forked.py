@@ -176,3 +176,24 @@ def test_design_outputs_are_the_same_bytes_forked_or_serial(tmp_path: Path, spec
     stale = [name for name in serial if not same_content(name, (committed / name).read_bytes(), serial[name])]
     assert not stale, (f"reports/{committed.name} differs from what `synth design {spec}` writes: {stale}; "
                        f"regenerate it with `synth design {spec} --force` and commit it")
+
+
+def test_a_worker_of_the_pool_forks_nothing_further():
+    """The diagnosis' worker pool (synth.worker_pool.map_jobs) has the cores: a job's own run_beside (the quantizer's
+    search in a joint fit) runs serially in the worker, not in a grandchild."""
+    import os
+    import time
+
+    from synth.worker_pool import map_jobs
+
+    def slow_pid() -> int:  # while this runs, a forked child would take both jobs
+        time.sleep(0.3)
+        return os.getpid()
+
+    def job(_):
+        out, mine = run_beside([os.getpid, os.getpid], slow_pid)
+        return set(out) == {mine}
+
+    assert map_jobs(job, [0, 1], workers=2) == [True, True]
+    out, mine = run_beside([os.getpid, os.getpid], slow_pid)  # here, forking allowed, the child takes them
+    assert mine not in out
