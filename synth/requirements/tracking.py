@@ -28,15 +28,12 @@ def tracking_note(result: RequirementResult, loop: Loop) -> RequirementResult:
     >>> Bandwidth(min=0.5).evaluate(loop).message.split("; ")[1][:44]
     'measured relative to |T(0)| = 1e-05 (-100 dB'
     """
-    from synth.loop import BANDWIDTH_LEVEL
-
-    t0 = abs(loop.T0())
-    if not (np.isfinite(t0) and t0 < BANDWIDTH_LEVEL):
+    slow = _slow_reference(loop)
+    if slow is None:
         return result
-    return replace(result, message=f"{result.message}; measured relative to |T(0)| = {fmt(t0, 3)} "
-                   f"({fmt(20 * np.log10(t0), 3) if t0 > 0 else '-inf'} dB): the loop follows a slow reference to "
-                   f"{fmt(t0, 3)} of it; bound the static sensitivity or require integral action to exclude such "
-                   "designs")
+    t0, db = slow
+    return replace(result, message=f"{result.message}; measured relative to |T(0)| = {t0} ({db} dB): the loop "
+                   f"follows a slow reference to {t0} of it; {_EXCLUDE}")
 
 
 def tracking_caveat(loop: Loop) -> str:
@@ -53,11 +50,22 @@ def tracking_caveat(loop: Loop) -> str:
     >>> tracking_caveat(Loop(Plant.from_string("1/(s+1)"), Controller("PI", {"kp": 1e-5, "ki": 1e-5})))
     ''
     """
+    slow = _slow_reference(loop)
+    if slow is None:
+        return ""
+    t0, db = slow
+    return f"; but its loop follows a slow reference to only {t0} of it (|T(0)| = {db} dB): no requirement asks for " \
+           f"more; {_EXCLUDE}"
+
+
+_EXCLUDE = "bound the static sensitivity or require integral action to exclude such designs"
+
+
+def _slow_reference(loop: Loop) -> tuple[str, str] | None:
+    """``|T(0)|`` and its dB value as text where it is below -3 dB (the bandwidth's level), else None."""
     from synth.loop import BANDWIDTH_LEVEL
 
     t0 = abs(loop.T0())
     if not (np.isfinite(t0) and t0 < BANDWIDTH_LEVEL):
-        return ""
-    level = f"{fmt(20 * np.log10(t0), 3)} dB" if t0 > 0 else "-inf dB"
-    return (f"; but its loop follows a slow reference to only {fmt(t0, 3)} of it (|T(0)| = {level}): no requirement "
-            "asks for more; bound the static sensitivity or require integral action to exclude such designs")
+        return None
+    return fmt(t0, 3), fmt(20 * np.log10(t0), 3) if t0 > 0 else "-inf"
