@@ -82,6 +82,8 @@ class ErrorModel:
     wald: float
     wald_p: float
     level: float
+    nb_asked: int | None = None
+    """The taps asked for, where the input pinned down fewer (``b`` holds those kept)."""
 
     @property
     def significant_overall(self) -> bool:
@@ -98,11 +100,29 @@ class ErrorModel:
     def to_dict(self) -> dict[str, Any]:
         """Plain dict for JSON."""
         mag = np.abs(self.response)
-        return {"structure": "ARX", "na": int(self.a.size - 1), "nb": int(self.b.size), "level": self.level,
+        fewer = self.nb_asked is not None and self.nb_asked > self.b.size
+        note = {"nb_asked": self.nb_asked,
+                "note": f"the input excites too few frequencies for {self.nb_asked} input taps: {self.b.size} kept; "
+                        "between the frequencies it excites, the response is the low-order model's "
+                        "interpolation"} if fewer else {}
+        return {"structure": "ARX", "na": int(self.a.size - 1), "nb": int(self.b.size), **note, "level": self.level,
                 "wald": self.wald, "wald_p": self.wald_p, "significant": self.significant_overall,
                 "peak_magnitude": float(mag.max()), "w_peak": float(self.w[np.argmax(mag)]),
                 "method": "least-squares ARX input->residual; Gauss approximation of the response covariance; "
                           "pointwise chi2(2) ellipse test, gated by a Wald test of B = 0"}
+
+
+COLLINEAR = 1e-14
+"""Regressors whose scaled Gram matrix has a smallest eigenvalue below this fraction of its largest are collinear."""
+
+
+def _independent(columns: list[np.ndarray]) -> bool:
+    """Whether the columns are linearly independent to :data:`COLLINEAR` (scaled to unit norm first)."""
+    X = np.column_stack(columns)
+    norms = np.linalg.norm(X, axis=0)
+    X = X / np.where(norms == 0.0, 1.0, norms)
+    eig = np.linalg.eigvalsh(np.einsum("ki,kj->ij", X, X))
+    return bool(eig[0] >= COLLINEAR * eig[-1])
 
 
 def _response(a: np.ndarray, b: np.ndarray, w: np.ndarray, dt: float) -> tuple[np.ndarray, np.ndarray]:
@@ -161,6 +181,9 @@ def fit_error_model(u: np.ndarray, e: np.ndarray, dt: float, na: int = 4, nb: in
                         where="residual")
     uc = u - u.mean()
     target = e[k0:]
+    nb_asked = nb
+    while nb > 1 and not _independent([uc[k0 - j: u.size - j] for j in range(nb)] + [np.ones(n)]):
+        nb -= 1  # an input of few frequencies (a sum of sines) pins down as many taps as it has sines times two
     while True:
         Phi = np.column_stack([-e[k0 - i: u.size - i] for i in range(1, na + 1)]
                               + [uc[k0 - j: u.size - j] for j in range(nb)] + [np.ones(n)])
@@ -169,10 +192,10 @@ def fit_error_model(u: np.ndarray, e: np.ndarray, dt: float, na: int = 4, nb: in
         Phis = Phi / scale
         gram = np.einsum("ki,kj->ij", Phis, Phis)  # small normal equations (no threaded BLAS on a busy machine)
         eig = np.linalg.eigvalsh(gram)
-        if eig[0] >= 1e-14 * eig[-1]:
+        if eig[0] >= COLLINEAR * eig[-1]:
             break
         if na == 0:
-            raise DataError("the input does not excite the error model (regressors are collinear); lower nb",
+            raise DataError("the input is constant: it does not excite an error model from the input to the residual",
                             where="residual")
         na -= 1  # a noise-free residual that a lower-order ARX fits exactly
     ginv = np.linalg.inv(gram)
@@ -204,4 +227,4 @@ def fit_error_model(u: np.ndarray, e: np.ndarray, dt: float, na: int = 4, nb: in
     radius = np.sqrt(chi2_ppf(level, 2) * lam[:, -1])
     mag = np.abs(E)
     return ErrorModel(a, b, P, float(dt), w, E, stat, np.maximum(mag - radius, 0.0), mag + radius,
-                      wald, wald_p, float(level))
+                      wald, wald_p, float(level), nb_asked)
