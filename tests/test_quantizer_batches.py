@@ -64,3 +64,45 @@ def test_the_search_shared_with_a_forked_child_finds_the_same_points(monkeypatch
     assert shared == serial
     assert offered and max(offered) >= 2  # the coarse passes in several jobs
     assert abs(serial[0]["step"] / 7.0 - 1.0) < 0.02  # and the search finds the quantizer
+
+
+def test_diagnose_with_one_worker_forks_nothing(run_cli, tmp_path, monkeypatch) -> None:
+    """``synth diagnose --workers 1`` runs in one process: not even the quantizer's search forks a child (it
+    did before: only ``SYNTH_JOBS=1`` kept it in); with two workers the search does fork. A worker count below 1
+    is bad input."""
+    import os
+
+    import synth.forked as forked
+    from synth.forked import allow_fork
+    from synth.gap.effects.quantization import QuantizationEffect
+
+    t = np.arange(3000) * 0.01
+    u = 200.0 + 40.0 * np.sin(0.31 * t) * np.sin(1.7 * t)
+    plant = Plant.from_string("50/((s+2)*(s+5))")
+    y = QuantizationEffect().apply(plant, t, u, {"step": 7.0, "offset": 1.3})
+    y = y + 0.05 * np.random.default_rng(4).normal(size=t.size)
+    path = tmp_path / "q.csv"
+    np.savetxt(path, np.c_[t, u, y], delimiter=",", header="t,u,y", comments="")
+    forks = []
+    real_fork = os.fork
+
+    def counted_fork() -> int:
+        forks.append(1)
+        return real_fork()
+
+    monkeypatch.setattr(forked.os, "fork", counted_fork)
+    monkeypatch.delenv("SYNTH_JOBS", raising=False)  # conftest turns forking off for the suite
+    args = ["diagnose", "--plant", "50/((s+2)*(s+5))", "--data", str(path), "--time", "t", "--input", "u",
+            "--output", "y", "--candidates", "quantization", "--no-report", "--quiet"]
+    try:
+        one = run_cli(*args, "--workers", "1")
+        assert one.code == 0, one.err
+        assert forks == []
+        two = run_cli(*args, "--workers", "2")
+        assert two.code == 0, two.err
+        assert forks  # the search's passes shared with a child
+        bad = run_cli(*args, "--workers", "0")
+    finally:
+        allow_fork(False)
+    assert bad.code == 2 and "--workers" in bad.err and "at least 1" in bad.err
+    assert len(bad.err.strip().splitlines()) == 1

@@ -98,7 +98,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--burn-in", type=float, default=0.0, metavar="S",
                    help="seconds at the start of each record left out of every cost (unknown initial state)")
     p.add_argument("--workers", type=int, default=min(2, os.cpu_count() or 1), metavar="N",
-                   help="processes for the joint re-fits (default: 2, or 1 on a one-core machine)")
+                   help="processes for the joint re-fits and the quantizer's search; 1: everything in this one "
+                        "process (default: 2, or 1 on a one-core machine)")
     p.add_argument("--heldout-offset", choices=("auto", "carry", "fit"), default="auto",
                    help="output offset on held-out data: re-estimated per model (fit), kept from the training "
                         "fit (carry), or auto: fit with --validate (another run, its own sensor zero), else carry")
@@ -122,9 +123,14 @@ def run(args: argparse.Namespace) -> int:
     from synth.data import load_record
     from synth.data.readers import parse_column_map
     from synth.errors import SynthError
+    from synth.forked import allow_fork
     from synth.gap.diagnose import check_candidates, diagnose, load_model
     from synth.outputs import dump_json, write_json
 
+    if args.workers < 1:
+        raise SynthError(f"must be at least 1, got {args.workers}", where="--workers")
+    if args.workers == 1:  # one process: no forked child for the quantizer's search either (synth.forked)
+        allow_fork(False)
     try:
         candidates = check_candidates(_split([args.candidates])) if args.candidates is not None else None
     except SynthError as exc:
