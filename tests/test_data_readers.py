@@ -412,3 +412,42 @@ def test_a_command_change_hidden_in_a_gap_of_the_time_stamps_is_noted(tmp_path, 
     res = run_cli("identify", "--data", str(path), "--structure", "K/s", "--average", "none", "--no-figures",
                   "--out", str(tmp_path / "o"))
     assert "note: 'u' changed inside a 0.31 s gap in the time stamps (t = 23.89-24.2 s)" in res.out, res.out + res.err
+
+
+@pytest.mark.parametrize("delimiter", [",", ";", "\t", " "])
+def test_a_file_without_a_header_row_is_read_with_its_columns_named_by_position(tmp_path, delimiter):
+    """A logger's plain numbers (no header): the first line is data, not names (it used to be read as a header of
+    numbers: "column '0' appears 2 times in the header")."""
+    rng = np.random.default_rng(len(delimiter) + ord(delimiter))
+    data = np.c_[np.arange(50) * 0.01, np.repeat([0.0, 1.0], 25), rng.normal(size=50)]
+    path = tmp_path / "plain.csv"
+    path.write_text("\n".join(delimiter.join(f"{x:.9g}" for x in row) for row in data) + "\n")
+    table = read_table(path)
+    assert list(table.columns) == ["col1", "col2", "col3"]
+    assert np.allclose(table.columns["col3"], data[:, 2], rtol=1e-8, atol=0)
+    assert any("no header row" in note for note in table.notes)
+    record = load_record(path)  # time, input, output in file order
+    assert record.n == 50 and record.y[0] == pytest.approx(data[0, 2], rel=1e-8)
+
+
+def test_a_column_without_a_name_above_numbers_is_kept_and_noted_and_a_trailing_separator_is_not(tmp_path):
+    path = tmp_path / "gap.csv"
+    path.write_text("t,u,,y,\n0,0,5,0.5,\n0.01,1,6,0.25,\n0.02,1,7,0.125,\n")
+    table = read_table(path)
+    assert list(table.columns) == ["t", "u", "col3", "y"]  # the trailing separator's empty column is dropped
+    assert table.columns["col3"].tolist() == [5.0, 6.0, 7.0]
+    assert table.notes == ("column 3 has no name in the header: called col3",)
+    record = load_record(path, time="t", input="u", output="y")
+    assert record.y.tolist() == [0.5, 0.25, 0.125]
+    assert load_record(path).y.tolist() == [5.0, 6.0, 7.0]  # by position: the file's third column
+
+
+@pytest.mark.parametrize("dt", [0.0, -0.01, float("nan"), float("inf")])
+def test_a_sample_interval_that_is_not_positive_is_named_as_such(tmp_path, run_cli, dt):
+    path = tmp_path / "r.csv"
+    path.write_text("u,y\n" + "\n".join(f"{k // 10},{k * 0.1}" for k in range(40)) + "\n")
+    with pytest.raises(DataError, match="sample interval must be a finite number > 0 s"):
+        load_record(path, dt=dt)
+    res = run_cli("identify", "--data", str(path), "--structure", "K/(T*s+1)", "--dt", str(dt), "--no-figures",
+                  "--out", str(tmp_path / "out"))
+    assert res.code == 2 and "dt: the sample interval" in res.err and len(res.err.strip().splitlines()) == 1

@@ -10,7 +10,9 @@ found.
 CSV: lines starting with ``#`` are comments wherever they stand (before the
 header, among the rows, at the end); the separator is ``,`` ``;`` tab or
 whitespace; empty cells are NaN; a header cell left empty by a trailing separator
-is dropped; with ``;`` as separator a decimal comma is read. MAT (v5): 1-D
+is dropped, one left empty above numbers names its column by position (``col2``), and a
+file whose first line holds numbers only has no header: its columns are ``col1``,
+``col2``, ... (each with a note); with ``;`` as separator a decimal comma is read. MAT (v5): 1-D
 variables by name, the columns of a matrix as ``name[0]``, ``name[1]``, ... (a
 k x N or N x k matrix: the longer side is time), the fields of a struct as
 ``struct.field``.
@@ -25,7 +27,7 @@ import itertools
 import re
 import warnings
 from collections.abc import Iterable, Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
@@ -335,27 +337,36 @@ def _read_csv(path: Path) -> Table:
         raise DataError("file is empty", where=str(path))
     delimiter = stated.group(1) if stated else _delimiter(lines[0][1], lines[1][1] if len(lines) > 1 else None)
     header = _cells(lines[0][1], delimiter)
-    if delimiter is None and len(lines) > 1 and len(_cells(lines[1][1], None)) == 1:
+    notes: tuple[str, ...] = ()
+    if header and all(_number(c, delimiter) is not None for c in header):  # the first line is data
+        header = [f"col{i + 1}" for i in range(len(header))]
+        lines = [(0, ""), *lines]
+        notes += (f"no header row (the first line holds numbers only): columns named col1 to col{len(header)} "
+                  "in file order",)
+    elif delimiter is None and len(lines) > 1 and len(_cells(lines[1][1], None)) == 1:
         header = [lines[0][1].strip('"')]  # one column: its header may hold spaces ("speed (rad/s)")
     row_units = _units_row(lines, delimiter)
     if row_units is not None:  # a row of units under the header (s, V, rad/s): the header's units, read once
         lines = [lines[0], *lines[2:]]
         header = [h if split_unit(h)[1] or not u else f"{h} [{u}]" for h, u in
                   itertools.zip_longest(header, row_units[:len(header)], fillvalue="")]
-    keep = [i for i, h in enumerate(header) if h]
+    unnamed = [i for i, h in enumerate(header) if not h]  # named by position; dropped below if empty (a trailing ',')
+    header = [h or f"col{i + 1}" for i, h in enumerate(header)]
+    keep = list(range(len(header)))
     twice = {h: [i + 1 for i in keep if header[i] == h] for h in {header[i] for i in keep}}
     twice = {h: at for h, at in twice.items() if len(at) > 1}  # a header written twice: which one is meant?
     order = tuple(dict.fromkeys(header[i] for i in keep))  # file order, a doubled header once
     keep = [i for i in keep if header[i] not in twice]
     names = [header[i] for i in keep]
-    notes = (f"skipped {comments} comment line(s) starting with {' or '.join(sorted(marks))}",) if comments else ()
+    notes += (f"skipped {comments} comment line(s) starting with {' or '.join(sorted(marks))}",) if comments else ()
     notes += ("read the units from the row under the header",) if row_units is not None else ()
     doubled = {h: f"column '{h}' appears {len(at)} times in the header (columns {', '.join(map(str, at))}); "
                "rename all but one in the file" for h, at in twice.items()}
     fast = _numeric_body(lines[1:], delimiter, len(header))
     if fast is not None:
-        return Table({h: fast[:, i].copy() for i, h in zip(keep, names)}, {h: split_unit(h)[1] for h in names},
-                     str(path), doubled, notes, order)
+        return _named_by_position(Table({h: fast[:, i].copy() for i, h in zip(keep, names)},
+                                        {h: split_unit(h)[1] for h in names}, str(path), doubled, notes, order),
+                                  [header[i] for i in unnamed])
     values: dict[str, list[float]] = {h: [] for h in names}
     problems: dict[str, str] = {}
     decimal_comma = 0
@@ -377,7 +388,21 @@ def _read_csv(path: Path) -> Table:
                     values[h].append(x)
     notes += (f"read {decimal_comma} decimal comma(s)",) if decimal_comma else ()
     columns = {h: np.asarray(v, float) for h, v in values.items() if h not in problems}
-    return Table(columns, {h: split_unit(h)[1] for h in names}, str(path), {**problems, **doubled}, notes, order)
+    return _named_by_position(Table(columns, {h: split_unit(h)[1] for h in names}, str(path),
+                                    {**problems, **doubled}, notes, order), [header[i] for i in unnamed])
+
+
+def _named_by_position(table: Table, unnamed: list[str]) -> Table:
+    """``table`` without the columns whose header cell was empty and that hold no number (a trailing separator),
+    with a note for each such column that does hold numbers (named by its position)."""
+    empty = [h for h in unnamed if h in table.columns and not np.any(np.isfinite(table.columns[h]))]
+    kept = [h for h in unnamed if h not in empty and (h in table.columns or h in table.problems)]
+    if not empty and not kept:
+        return table
+    columns = {h: v for h, v in table.columns.items() if h not in empty}
+    notes = table.notes + tuple(f"column {h[3:]} has no name in the header: called {h}" for h in kept)
+    return replace(table, columns=columns, units={h: u for h, u in table.units.items() if h not in empty},
+                   notes=notes, order=tuple(h for h in table.order if h not in empty))
 
 
 def _numeric_body(rows: list[tuple[int, str]], delimiter: str | None, width: int) -> np.ndarray | None:

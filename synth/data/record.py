@@ -469,6 +469,8 @@ def record_from_columns(
     if not table.columns:
         raise DataError("no numeric columns found", where=table.source)
     from_dt = time is None and dt is not None
+    if from_dt and not (np.isfinite(dt) and dt > 0):
+        raise DataError(f"the sample interval must be a finite number > 0 s, got {dt!r}", where="dt")
     t_name = "time" if from_dt else _pick(table, time, "time", 0)
     shift = 1 if from_dt else 0  # without a time column, input and output default to the first two columns
     u_name = _pick(table, input, "input", 1 - shift)
