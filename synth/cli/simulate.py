@@ -297,6 +297,7 @@ def _run_sweep(args: argparse.Namespace, spec: Any, sim: Any, loop: Any, step: t
     from synth.cli._table import table
     from synth.outputs import GENERATOR, OutputDir, dump_json, to_jsonable, write_json
     from synth.requirements.base import fmt
+    from synth.sim.hidden_mode import unseen_root
     from synth.sim.metrics import nonlinear_step_metrics
     from synth.sim.signals import step_reference
     from synth.sim.simulator import simulate_batch
@@ -316,7 +317,8 @@ def _run_sweep(args: argparse.Namespace, spec: Any, sim: Any, loop: Any, step: t
             window = sim.limit_cycle.window or (horizon - t_step) / 4
             m = nonlinear_step_metrics(res, t_step, min_amplitude=sim.limit_cycle.min_amplitude, window=window,
                                        step_size=step[1] - step[0])
-            j = judge(res, t_step, step, m, sim.limit_cycle.min_amplitude)
+            j = judge(res, t_step, step, m, sim.limit_cycle.min_amplitude, actuator=loops[start + i].actuator,
+                      unseen_root=unseen_root(loops[start + i]))
             value = values[start + i]
             verdict = j.verdict
             evidence: dict[str, Any] = {"horizon": float(res.t[-1]), "dt": res.dt, "samples": int(res.t.size),

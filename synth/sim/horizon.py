@@ -25,7 +25,7 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["CYCLES", "HorizonPlan", "plan_horizon"]
+__all__ = ["CYCLES", "HorizonPlan", "linear_loop_stable", "plan_horizon"]
 
 CYCLES = 14
 """Whole periods of the describing-function cycle the first horizon holds."""
@@ -133,6 +133,23 @@ def _cycle_period(loop: Any) -> float | None:
     i = int(cross[0])
     wc = w[i] + (w[i + 1] - w[i]) * im[i] / (im[i] - im[i + 1])
     return float(2 * np.pi / wc)
+
+
+def linear_loop_stable(loop: Any) -> bool:
+    """Whether the loop's linear part (its blocks left out) has every closed-loop root left of the imaginary axis,
+    the roots a controller pole cancelled by a plant zero included.
+
+    Examples
+    --------
+    >>> from synth.plant import Plant; from synth.controllers import Controller
+    >>> from synth.sim.loops import NonlinearLoop
+    >>> pi = Controller("PI", {"kp": 1, "ki": 1})
+    >>> linear_loop_stable(NonlinearLoop(Plant.from_string("1/(s+1)^2"), pi))
+    True
+    >>> linear_loop_stable(NonlinearLoop(Plant.from_string("s/(s+1)^2"), pi))  # the integrator on the zero at 0
+    False
+    """
+    return _linear_settling(loop)[0]
 
 
 def plan_horizon(loop: Any, t_step: float = 0.0, given: float | None = None) -> HorizonPlan:

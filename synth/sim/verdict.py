@@ -29,6 +29,10 @@ decide, doubles the horizon up to a cap. The rules (:func:`judge`), on the outpu
   (0.01 %) of the step (or ``min_amplitude``) of the final value and moves (peak to peak) at most
   half as much as the quarter before, its last eighth at most :data:`SHRINK` times the eighth
   before (or less than twice ``min_amplitude``, or 1e-9 of the step: the numerical floor);
+* **not settled** either, where a loop of linear blocks only has a root on or right of the imaginary axis, while the
+  controller's command under the still output does not die out (:func:`synth.sim.hidden_mode.hidden_drift`: a
+  mode the output does not see); on two horizons in a row (at the cap alone: over the run and its first half)
+  that is **diverging**;
 * otherwise the horizon is doubled; at the cap the verdict is **undetermined** and says what was
   seen (cycles, the rule that failed).
 
@@ -46,6 +50,7 @@ import numpy as np
 
 from synth.errors import ModelError
 from synth.sim.cycles import autocorrelation_period, measure_cycle
+from synth.sim.hidden_mode import hidden_drift, unseen_root
 from synth.sim.holding import winding_behind
 from synth.sim.horizon import plan_horizon
 from synth.sim.limitcycle import SAMPLED_HYSTERESIS, Oscillation, cycle_table, detect_oscillation
@@ -171,7 +176,7 @@ def _new_record(ta: np.ndarray, ya: np.ndarray, end: float) -> bool:
 
 def judge(result: SimResult, t_step: float, step: tuple[float, float], metrics: NonlinearStepMetrics,
           min_amplitude: float = 0.0, previous: Judgement | None = None, last_run: bool = False,
-          actuator: Sequence[Any] = ()) -> Judgement:
+          actuator: Sequence[Any] = (), unseen_root: bool = False) -> Judgement:
     """Does this run decide? (The rules are in the module docstring.)
 
     Parameters
@@ -193,6 +198,11 @@ def judge(result: SimResult, t_step: float, step: tuple[float, float], metrics: 
     actuator : sequence of Block
         The loop's actuator chain: a still output is not settled while the command winds behind a block
         that holds it only for a while (a dead zone, backlash, quantizer, relay).
+    unseen_root : bool
+        The loop has linear blocks only and a closed-loop root on or right of the imaginary axis
+        (:func:`synth.sim.hidden_mode.unseen_root`): a still output over a command that does not die out is that
+        root, which the output does not see (:func:`synth.sim.hidden_mode.hidden_drift`): not settled; on two runs
+        in a row, diverging.
 
     Examples
     --------
@@ -272,6 +282,13 @@ def judge(result: SimResult, t_step: float, step: tuple[float, float], metrics: 
     held = winding_behind(result, after, span, actuator, SHRINK)
     if held is not None:
         return Judgement(None, held.text, a.cycles, wait=held.wait)
+    hidden = hidden_drift(result, after, span) if unseen_root else None
+    if hidden is not None:
+        if previous is not None and previous.growing:
+            return Judgement("diverging", f"on two horizons in a row, {hidden.text()}", a.cycles, True)
+        if last_run and previous is None and hidden_drift(result, ta <= ta[0] + span / 2, span / 2) is not None:
+            return Judgement("diverging", f"over the run and over its first half, {hidden.text()}", a.cycles, True)
+        return Judgement(None, f"{hidden.text()}; confirming on a longer horizon", a.cycles, True)
     return Judgement("settled", f"within {100 * SETTLED:g} % of the step over the last {span / 4:.2g} s, "
                      f"its motion at most half that of the quarter before and still shrinking", a.cycles)
 
@@ -369,7 +386,7 @@ def step_verdict(loop: NonlinearLoop, start: float, end: float, t_step: float = 
                                          whole_cycles=True, step_size=end - start,
                                          window=window if window is not None else (T - t_step) / 4)
         j = judge(result, t_step, (start, end), metrics, min_amplitude, previous, T >= cap * (1 - 1e-12),
-                  loop.actuator)
+                  loop.actuator, unseen_root(loop, plan.linear_stable))
         if j.verdict is None and T >= cap * (1 - 1e-12) and max_horizon is None and np.isfinite(j.wait):
             # the output waits behind a block the winding command leaves within j.wait: the default cap gives way
             # to a run that sees it let go, as far as the sample cap allows
