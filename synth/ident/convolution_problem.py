@@ -30,7 +30,7 @@ from scipy.linalg import matrix_balance
 
 from synth.errors import ModelError
 from synth.ident.structure import Structure
-from synth.ident.symbolic_model import companion_form, taylor_expm, with_sensor
+from synth.ident.symbolic_model import companion_form, on_sample, taylor_expm, with_sensor
 from synth.plant import Plant
 
 __all__ = ["ConvolutionProblem"]
@@ -195,7 +195,8 @@ class ConvolutionProblem:
             h[:, 1:] += h2[:, 1, :-1]
             if self.periodic:
                 h[:, 0] += h2[:, 1, -1]
-            h[:, self.col] += D
+            # a delay of whole samples: a direct feedthrough sees the held input at the sample itself
+            h[:, 0 if not self.fit_delay and on_sample(par.fixed_f or 0.0, self.dt) else self.col] += D
             if not np.all(np.isfinite(h)):
                 return np.full((C.shape[0], n), np.nan)
             nfft = n if self.periodic else next_fast_len(n + h.shape[1] - 1, real=True)

@@ -39,7 +39,7 @@ from scipy.linalg import matrix_balance
 
 from synth.errors import ModelError
 from synth.ident.structure import Structure
-from synth.ident.symbolic_model import companion_form, taylor_expm, with_sensor
+from synth.ident.symbolic_model import companion_form, on_sample, taylor_expm, with_sensor
 from synth.plant import Plant
 
 __all__ = ["MIN_HESSIAN_PERTURBATION", "SimulationErrorProblem"]
@@ -216,6 +216,10 @@ class SimulationErrorProblem:
         else:
             late = np.r_[np.zeros(min(m, n)), w[:max(0, n - m)]]
             early = np.r_[np.zeros(min(m + 1, n)), w[:max(0, n - m - 1)]]
+        if fixed_f is not None and on_sample(fixed_f, self.dt):
+            # a delay of whole samples: the held input reaches the plant at the sample itself, so a direct
+            # feedthrough sees u[k - m] there (the 'early' row feeds only D then: B_early is 0 at f = 0)
+            early = late
         vec = np.column_stack([late, early]).ravel()  # column-major vec of the 2 x n matrix
         return vec if fixed_f is None else np.r_[vec, fixed_f]
 

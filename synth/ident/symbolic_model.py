@@ -9,7 +9,7 @@ import numpy as np
 
 from synth.plant import Plant
 
-__all__ = ["companion_form", "taylor_expm", "with_sensor"]
+__all__ = ["companion_form", "on_sample", "taylor_expm", "with_sensor"]
 
 
 def companion_form(num: list[Any], den: list[Any]) -> tuple[list[list[Any]], list[Any], Any]:
@@ -79,3 +79,16 @@ def taylor_expm(M: Any, squarings: int, order: int = 12, symbolic: str = "MX") -
     for _ in range(squarings):
         E = E @ E
     return E
+
+
+def on_sample(fraction: float, dt: float) -> bool:
+    """Whether a delay's fraction of a sample interval is zero (to 1e-9 of the interval): the delay is whole
+    samples, and a biproper model's direct feedthrough sees the held input at the sample itself, ``u[k - m]``;
+    with any fraction it sees the sample before, ``u[k - m - 1]``.
+
+    Examples
+    --------
+    >>> on_sample(0.0, 0.01), on_sample(1e-15, 0.01), on_sample(0.002, 0.01)
+    (True, True, False)
+    """
+    return abs(float(fraction)) <= 1e-9 * dt
