@@ -40,10 +40,10 @@ def _one_line_exit_2(r, *needles):
 
 # ------------------------------------------------------------------------------------------ 1. bands
 @pytest.mark.parametrize(("option", "w1", "w2", "what"), [
-    ("--band", "10", "1000", "past the Nyquist frequency 314.2 rad/s"),
-    ("--floor-band", "100", "500", "past the Nyquist frequency 314.2 rad/s"),
-    ("--band", "400", "1000", "wholly above the Nyquist frequency 314.2 rad/s"),
-    ("--floor-band", "400", "1000", "wholly above the Nyquist frequency 314.2 rad/s"),
+    ("--band", "10", "1000", "past the Nyquist frequency 314.15927 rad/s"),
+    ("--floor-band", "100", "500", "past the Nyquist frequency 314.15927 rad/s"),
+    ("--band", "400", "1000", "wholly above the Nyquist frequency 314.15927 rad/s"),
+    ("--floor-band", "400", "1000", "wholly above the Nyquist frequency 314.15927 rad/s"),
     ("--band", "0", "100", "must be > 0 rad/s"),
     ("--band", "-5", "100", "must be > 0 rad/s"),
     ("--band", "100", "50", "increasing"),
@@ -263,3 +263,15 @@ def test_the_headers_unit_labels_the_text_and_the_variance_is_called_so(run_cli,
     assert "Thrust [gf]" in r.out and "[unit]" not in r.out
     line = next(ln for ln in r.out.splitlines() if ln.strip().startswith("variance"))
     assert float(line.split()[1]) == pytest.approx(float(np.var(x)), rel=1e-3) and "gf^2" in line
+
+
+def test_a_top_a_hair_above_nyquist_is_told_with_digits_that_differ(tmp_path):
+    """157.08 against a Nyquist frequency of 157.0796 rad/s (50 Hz) was shown as '157.08 ... above 157.1'."""
+    from synth.data import record_from_arrays
+    from synth.errors import DataError
+    from synth.ident.spectra import frequency_response
+
+    t = np.arange(3000) * 0.02
+    u = np.random.default_rng(0).normal(size=t.size)
+    with pytest.raises(DataError, match=r"w_max = 157.08 rad/s is above the Nyquist frequency 157.07963 rad/s"):
+        frequency_response([record_from_arrays(t, u, u)], w_min=1.0, w_max=157.08)

@@ -353,10 +353,10 @@ def check_band(band: Sequence[float], dt: float, where: str) -> tuple[float, flo
         raise DataError(f"expected two increasing frequencies (each must be > 0 rad/s), got {shown}", where=where)
     nyquist = math.pi / dt
     if vals[0] >= nyquist:
-        raise DataError(f"{shown.replace(' ', '-')} rad/s lies wholly above the Nyquist frequency {nyquist:.4g} rad/s "
+        raise DataError(f"{shown.replace(' ', '-')} rad/s lies wholly above the Nyquist frequency {nyquist:.8g} rad/s "
                         f"(pi/dt, dt = {dt:g} s)", where=where)
     if vals[1] > nyquist * (1 + 1e-6):
-        raise DataError(f"upper end {vals[1]:g} rad/s is past the Nyquist frequency {nyquist:.4g} rad/s "
+        raise DataError(f"upper end {vals[1]:.8g} rad/s is past the Nyquist frequency {nyquist:.8g} rad/s "
                         f"(pi/dt, dt = {dt:g} s)", where=where)
     return vals[0], vals[1]
 

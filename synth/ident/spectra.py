@@ -255,7 +255,7 @@ def _composite(runs: list[Record], w_min: float | None, w_max: float | None, win
     if not (0 < w_min < w_max):
         raise DataError(f"need 0 < w_min < w_max, got w_min = {w_min:g}, w_max = {w_max:g} rad/s")
     if w_max > nyquist:
-        raise DataError(f"w_max = {w_max:g} rad/s is above the Nyquist frequency {nyquist:.4g} rad/s "
+        raise DataError(f"w_max = {w_max:.8g} rad/s is above the Nyquist frequency {nyquist:.8g} rad/s "
                         f"(sample rate {fs:g} Hz)")
     check_length(runs, w_min, overlap)
     if windows is None:
