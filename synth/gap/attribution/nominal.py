@@ -8,7 +8,7 @@ import numpy as np
 from synth.errors import ModelError
 from synth.plant import Plant
 
-__all__ = ["monomial", "nominal_structure", "plant_from_values"]
+__all__ = ["free_coefficients", "monomial", "nominal_structure", "plant_from_values"]
 
 
 def monomial(power: int) -> str:
@@ -22,8 +22,24 @@ def monomial(power: int) -> str:
     return "" if power == 0 else ("s" if power == 1 else f"s^{power}")
 
 
+def free_coefficients(coeffs: np.ndarray) -> np.ndarray:
+    """Which coefficients of a polynomial (highest power first) a re-fit moves: the nonzero ones and the zeros
+    between them (the damping of an undamped pair, ``s^2 + 4``: a value, not structure). Zeros below the lowest
+    nonzero coefficient (an integrator, a zero at the origin) stay zero.
+
+    Examples
+    --------
+    >>> free_coefficients(np.array([1.0, 0.0, 4.0])).tolist(), free_coefficients(np.array([1.0, 2.0, 0.0])).tolist()
+    ([True, True, True], [True, True, False])
+    """
+    nonzero = np.flatnonzero(coeffs != 0.0)
+    index = np.arange(coeffs.size)
+    return (index >= nonzero[0]) & (index <= nonzero[-1]) if nonzero.size else np.zeros(coeffs.size, bool)
+
+
 def nominal_structure(plant: Plant) -> tuple[str, dict[str, float]]:
-    """Structure formula in the plant's nonzero coefficients (monic denominator) and their values.
+    """Structure formula in the plant's free coefficients (:func:`free_coefficients`; monic denominator) and their
+    values.
 
     Examples
     --------
@@ -31,6 +47,8 @@ def nominal_structure(plant: Plant) -> tuple[str, dict[str, float]]:
     '(n1*s+n0)/(s^2+d1*s+d0)'
     >>> nominal_structure(Plant.from_string("2/(s*(0.5*s+1))"))
     ('(n0)/(s^2+d1*s)', {'n0': 4.0, 'd1': 2.0})
+    >>> nominal_structure(Plant.from_string("1/(s^2+4)"))  # an undamped pair: its damping is re-fitted too
+    ('(n0)/(s^2+d1*s+d0)', {'n0': 1.0, 'd1': 0.0, 'd0': 4.0})
     """
     num, den = plant.num, plant.den
     values: dict[str, float] = {}
@@ -38,9 +56,10 @@ def nominal_structure(plant: Plant) -> tuple[str, dict[str, float]]:
     def poly(coeffs: np.ndarray, prefix: str, monic: bool) -> str:
         deg = coeffs.size - 1
         terms = []
+        free = free_coefficients(coeffs)
         for i, c in enumerate(coeffs):
             power = deg - i
-            if c == 0.0:
+            if not free[i]:
                 continue
             mono = monomial(power)
             if monic and i == 0:
@@ -59,8 +78,8 @@ def nominal_structure(plant: Plant) -> tuple[str, dict[str, float]]:
 
 
 def plant_from_values(plant: Plant, values: dict[str, float], delay: float) -> Plant:
-    """``plant`` with the coefficients of :func:`nominal_structure` set to ``values`` (its zero coefficients
-    stay zero) and the delay ``delay`` (at least 0).
+    """``plant`` with the coefficients of :func:`nominal_structure` set to ``values`` (those it does not free stay
+    zero) and the delay ``delay`` (at least 0).
 
     Examples
     --------
@@ -69,8 +88,8 @@ def plant_from_values(plant: Plant, values: dict[str, float], delay: float) -> P
     >>> P.num.tolist(), P.den.tolist(), P.delay
     ([6.0], [1.0, 3.0, 0.0], 0.01)
     """
-    num = np.array([values.get(f"n{plant.num.size - 1 - i}", 0.0) if c != 0.0 else 0.0
-                    for i, c in enumerate(plant.num)])
-    den = np.array([1.0 if i == 0 else (values.get(f"d{plant.den.size - 1 - i}", 0.0) if c != 0.0 else 0.0)
-                    for i, c in enumerate(plant.den)])
+    num = np.array([values.get(f"n{plant.num.size - 1 - i}", 0.0) if free else 0.0
+                    for i, free in enumerate(free_coefficients(plant.num))])
+    den = np.array([1.0 if i == 0 else (values.get(f"d{plant.den.size - 1 - i}", 0.0) if free else 0.0)
+                    for i, free in enumerate(free_coefficients(plant.den))])
     return Plant(num, den, max(0.0, delay), plant.input, plant.output, "re-fitted")
