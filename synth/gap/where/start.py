@@ -20,8 +20,8 @@ def start_transient_warning(plant: Plant, residual: ModelResidual, ratio: float 
     """A sentence when the residual's first five slowest time constants hold a decaying transient, else "".
 
     The window's residual must be ``ratio`` times the rest's rms and its first third ``ratio`` times its
-    last third (a decay, not a gap that lasts). Not judged (""): a model without a stable slowest pole, or a
-    window longer than a quarter of the record.
+    last third (a decay, not a gap that lasts). The window is at most a quarter of the record; not judged (""):
+    a model without a stable slowest pole, or a record whose quarter holds fewer than two slowest time constants.
 
     Parameters
     ----------
@@ -53,10 +53,11 @@ def start_transient_warning(plant: Plant, residual: ModelResidual, ratio: float 
     poles = plant.poles()
     if poles.size == 0 or np.max(poles.real) >= 0.0:
         return ""
-    window = 5.0 / float(np.min(np.abs(poles.real)))
+    tau = 1.0 / float(np.min(np.abs(poles.real)))
     t = residual.t - residual.t[0]
+    window = min(5.0 * tau, 0.25 * t[-1])  # a record of 20 time constants or less: its first quarter
     first = t < window
-    if window > 0.25 * t[-1] or np.count_nonzero(first) < 9:
+    if window < 2.0 * tau or np.count_nonzero(first) < 9:
         return ""
     e = residual.e - np.median(residual.e[~first])
     rest = float(np.sqrt(np.mean(e[~first] ** 2)))
