@@ -5,7 +5,7 @@ provides ``HELP``, ``add_arguments(parser)`` and ``run(args) -> int``. Heavy
 imports happen inside ``run`` so that ``synth --help`` and ``synth check``
 start fast.
 
-Exit codes: 0 met / designed, 1 not met / infeasible, 2 bad input.
+Exit codes: 0 met / designed, 1 not met / infeasible / failed, 2 bad input, 3 undetermined (design, simulate).
 """
 
 from __future__ import annotations
@@ -53,7 +53,8 @@ def build_parser() -> argparse.ArgumentParser:
     parser = _Parser(
         prog="synth",
         description="Design fixed-structure compensators from measured data and written specs.",
-        epilog="Exit codes: 0 met/designed, 1 not met/infeasible, 2 bad input.",
+        epilog="Exit codes: 0 met/designed, 1 not met/infeasible/failed, 2 bad input, 3 undetermined (design, "
+               "simulate); each command's --help says what its own mean.",
     )
     parser.add_argument("--version", action="version", version=f"synth {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
