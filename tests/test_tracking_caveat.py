@@ -9,6 +9,8 @@ from __future__ import annotations
 
 import json
 
+import pytest
+
 from synth.controllers import Controller
 from synth.design import design, design_jobs, with_tracking_caveat
 from synth.results import DesignResult
@@ -65,3 +67,18 @@ def test_the_caveat_joins_a_verdict_once_before_its_full_stop() -> None:
 def test_a_loop_with_enough_gain_has_no_caveat() -> None:
     loud = design(parse_spec({**IDLE_P, "name": "p", "objective": {"maximize": "crossover"}}))
     assert loud.controller.parameters["kp"] > 1.0 and _caveats(loud.verdict) == 0  # |T(0)| = 1.25 k / (1 + 1.25 k)
+
+
+def test_a_pi_kept_without_integral_action_says_so_in_its_verdict() -> None:
+    """A black-box test: a PI design that ended at ki = 0 read as a design of kp alone ("the objective minimized over
+    the exact feasible set of kp"), though ki was free; the verdict now says the design without integral action
+    was kept, and against what."""
+    spec = parse_spec({"name": "effort", "plant": {"tf": "(3*s+3)/(s^4+10.5*s^3+46*s^2+70.5*s+25)", "delay": 0.1},
+                       "controller": {"type": "PI", "bounds": {"kp": [0, 20], "ki": [0, 20]}},
+                       "requirements": [{"type": "bandwidth", "min": 0.8}, {"type": "peak_sensitivity", "max_db": 6}],
+                       "objective": {"minimize": "control_effort"}})
+    result = design(spec)
+    assert result.feasible and result.controller.parameters["ki"] == 0.0
+    kept = result.verdict.split("The design without integral action (ki = 0) was kept: ")[1]
+    mine, theirs = (float(x) for x in kept.split(" dB with ki free")[0].split(" against "))
+    assert mine == pytest.approx(result.objective["value"], rel=1e-5) and mine <= theirs

@@ -161,6 +161,10 @@ def choose(spec: Spec, main: DesignResult, alt: DesignResult) -> DesignResult:
         alt.method = (main.method + "; the same structure without integral action (ki = 0) did better: "
                       + alt.method)
         alt.extras.setdefault("alternatives", []).append({"with_integral_action": main.objective})
+        unit = f" {alt.objective['unit']}" if alt.objective.get("unit") else ""
+        than = (f"{alt.objective['value']:.6g} against {main.objective['value']:.6g}{unit} with ki free"
+                if main.feasible else "with ki free no feasible design was found")
+        alt.verdict = f"{alt.verdict.rstrip()} The design without integral action (ki = 0) was kept: {than}."
         return alt
     return main
 
