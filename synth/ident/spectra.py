@@ -280,6 +280,9 @@ def _composite(runs: list[Record], w_min: float | None, w_max: float | None, win
         H = gxy / gxx
     err = random_error(coh, n_d)
     H, err, low_note = _whole_run_low_end(runs, grid, H, err, gyy, coh, max(lengths))
+    H, err, coh, n_d, leak_note = _resonance_from_whole_runs(runs, results, grid, H, err, coh, n_d,
+                                                             coherence_threshold)
+    low_note = "; ".join(n for n in (low_note, leak_note) if n) or None
     band = trim_to_excitation(coherent_band(grid, coh, coherence_threshold), grid, gxx)
     above = None
     if not given_max:
@@ -329,6 +332,32 @@ def _whole_run_low_end(runs: list[Record], grid: np.ndarray, H: np.ndarray, err:
                     f"{int(low.sum())} points (the composite where that method's random error is over "
                     f"{LRM_ERROR_LIMIT:g} times the composite's): a run does not start and end at rest, and a "
                     "window's taper biases a sweep's lowest frequencies")
+
+
+def _resonance_from_whole_runs(runs: list[Record], results: list[Any], grid: np.ndarray, H: np.ndarray,
+                               err: np.ndarray, coh: np.ndarray, n_d: np.ndarray, threshold: float) -> tuple:
+    """Where every run is at rest at both ends and the windows leak at a resonance
+    (:func:`synth.ident.resonance_leakage.leakage_points`): the whole-run ratio, the longest window's coherence,
+    averages and noise; and a note (None where nothing changed)."""
+    from synth.ident.resonance_leakage import leakage_points
+    from synth.ident.whole_run import at_rest, whole_run_response
+
+    if not all(at_rest(r) for r in runs):
+        return H, err, coh, n_d, None
+    longest = max(results, key=lambda r: r.length)
+    leak = leakage_points(results, grid, np.abs(H), threshold)  # the composite's peaks: flattened, not moved
+    if not leak.any():
+        return H, err, coh, n_d, None
+    coh_l = coherence_from_spectra(longest.gxx, longest.gyy, longest.gxy)
+    gnn = np.maximum(np.nan_to_num(longest.gyy * (1.0 - coh_l)), 0.0)
+    H, err, coh, n_d = np.array(H, complex), np.array(err, float), np.array(coh, float), np.array(n_d, float)
+    H[leak], whole_err = whole_run_response(runs, grid[leak], gnn[leak])
+    err[leak] = np.fmax(whole_err, err[leak])  # never a smaller error than the composite claimed
+    coh[leak], n_d[leak] = coh_l[leak], longest.n_d[leak]
+    return H, err, coh, n_d, (f"at {int(leak.sum())} point(s) in {grid[leak][0]:.4g}-{grid[leak][-1]:.4g} rad/s a "
+                              "resonance rings longer than the shorter windows (their coherence falls with their "
+                              "length there: leakage, not noise): the response is the ratio of the whole runs' "
+                              "transforms, the coherence the longest window's")
 
 
 def _above_default_top(w: np.ndarray, gxx: np.ndarray, gxy: np.ndarray, coh: np.ndarray, band: CoherentBand,
