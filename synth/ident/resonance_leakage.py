@@ -42,9 +42,9 @@ PEAK_SPAN = 0.1
 def leakage_points(results: Sequence[WindowSpectra], grid: np.ndarray, magnitude: np.ndarray,
                    threshold: float) -> np.ndarray:
     """Grid points with the leakage signature: within :data:`PEAK_SPAN` decades of a resonance's peak
-    (:data:`PROMINENCE`) of ``magnitude`` (``|H|``: the composite flattens a peak, it does not move it), the longest window and at least
-    one shorter one usable there, the longest window's coherence at least ``threshold``, at least the shorter
-    ones' (to :data:`TIE`) and :data:`LEAK_RISE` above their mean.
+    (:data:`PROMINENCE`) of ``magnitude`` (``|H|``: the composite flattens a peak, it does not move it), the
+    longest window and at least one shorter one usable there, the longest window's coherence at least
+    ``threshold``, at least the shorter ones' (to :data:`TIE`) and :data:`LEAK_RISE` above their mean.
 
     Examples
     --------
