@@ -256,7 +256,8 @@ def _print_metrics(say: Any, spec: Any, loop: Any, m: Any, step: tuple[float, fl
         ["rise time 10-90 %", timing[0]],
         ["overshoot", timing[1]],
         ["settling time (2 %)", timing[2]],
-        ["final value", f"{fmt(m.final_value)} {y}"],
+        ["final value", f"{fmt(m.final_value)} {y}" if verdict != "limit_cycle" or lc.center is None else
+         f"none: it oscillates about {fmt(lc.center)} {y} (the mean of its last whole cycles)"],
         ["peak actuator rate", f"{fmt(m.actuator_peak_rate)} {u}/s"],
         ["actuator range", f"{fmt(m.actuator_min)} to {fmt(m.actuator_max)} {u}"],
         ["time rate-limited", f"{fmt(m.rate_limited_time)} s"],
