@@ -68,3 +68,11 @@ def test_simulate_exits_1_with_the_diverging_verdict(run_cli, tmp_path) -> None:
     assert res.code == 1, res.out + res.err
     assert "verdict: diverging" in res.out and "a mode the output does not see" in res.out
     assert "moves at 0.5 input units/s" in res.out  # ki times the steady error 0.5
+
+
+def test_a_first_horizon_that_is_the_cap_decides_on_its_two_halves_with_the_step_later_than_zero() -> None:
+    """The run and its first half stand for two horizons when no longer run is allowed; with the step at 1 s that
+    check indexed the run with a mask of the samples after the step (an IndexError, found reviewing the change)."""
+    loop = NonlinearLoop(Plant.from_string("s/(s+1)^2"), Controller("PI", {"kp": 1, "ki": 1}), dt=0.001)
+    v = step_verdict(loop, 0.0, 1.0, t_step=1.0, horizon=21.0, max_horizon=21.0)
+    assert v.verdict == "diverging" and v.evidence.criterion.startswith("over the run and over its first half")

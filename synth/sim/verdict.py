@@ -286,7 +286,7 @@ def judge(result: SimResult, t_step: float, step: tuple[float, float], metrics: 
     if hidden is not None:
         if previous is not None and previous.growing:
             return Judgement("diverging", f"on two horizons in a row, {hidden.text()}", a.cycles, True)
-        if last_run and previous is None and hidden_drift(result, ta <= ta[0] + span / 2, span / 2) is not None:
+        if last_run and previous is None and hidden_drift(result, after & (t <= ta[0] + span / 2), span / 2) is not None:
             return Judgement("diverging", f"over the run and over its first half, {hidden.text()}", a.cycles, True)
         return Judgement(None, f"{hidden.text()}; confirming on a longer horizon", a.cycles, True)
     return Judgement("settled", f"within {100 * SETTLED:g} % of the step over the last {span / 4:.2g} s, "
