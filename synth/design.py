@@ -44,13 +44,19 @@ def design(spec: Spec) -> DesignResult:
     >>> result.feasible, result.controller.parameters["kp"], result.gain_set.contains(3.0)
     (True, 20.0, True)
     """
+    return with_tracking_caveat(spec, _designed(spec))
+
+
+def _designed(spec: Spec) -> DesignResult:
+    """:func:`design` before its verdict's tracking caveat (which the combining step of :func:`design_jobs` adds once,
+    to the design it keeps)."""
     if len(spec.controller.free_parameters()) == 1:
-        return with_tracking_caveat(spec, design_scalar(spec))
+        return design_scalar(spec)
     from synth.synthesis.multi import design_convex, design_trial  # cvxpy and casadi: several parameters only
     from synth.synthesis.surrogate import design_certified
 
     # the surrogate's bisection only needs to know which level passes: its designs are the convex stage's alone
-    return with_tracking_caveat(spec, design_certified(spec, design_convex, design_trial))
+    return design_certified(spec, design_convex, design_trial)
 
 
 def with_tracking_caveat(spec: Spec, result: DesignResult) -> DesignResult:
@@ -116,4 +122,4 @@ def design_jobs(spec: Spec) -> tuple[list[Callable[[], Any]], Callable[[list[Any
 
         return with_tracking_caveat(spec, choose(spec, *results))
 
-    return [with_integral_action, lambda: design(without)], combine
+    return [with_integral_action, lambda: _designed(without)], combine

@@ -41,7 +41,7 @@ def test_the_low_end_of_a_sweep_from_rest_is_the_whole_run_ratio(monkeypatch) ->
     assert low.sum() >= 8 and np.max(np.abs(err)) < 2.0, err.round(2)
     from synth.ident import spectra
 
-    monkeypatch.setattr(spectra, "_whole_run_low_end", lambda runs, grid, H, err, gyy, coh, longest: (H, err, None))
+    monkeypatch.setattr(spectra, "_whole_run_low_end", lambda runs, rest, grid, H, err, gyy, coh, longest: (H, err, None))
     old = frequency_response(runs)  # the composite alone, for the comparison
     old_err = np.degrees(np.angle(old.H[low] / PLANT.freqresp(resp.w[low])))
     assert np.max(np.abs(old_err)) > 5.0  # the windows' bias this replaces
@@ -64,7 +64,7 @@ def test_a_run_cut_while_moving_gets_its_low_end_from_the_local_rational_method(
     assert np.max(z) < 3.0 * 1.5 and np.median(z) < 1.5, z.round(2)  # its errors say how far it may be off
     from synth.ident import spectra
 
-    monkeypatch.setattr(spectra, "_whole_run_low_end", lambda runs, grid, H, err, gyy, coh, longest: (H, err, None))
+    monkeypatch.setattr(spectra, "_whole_run_low_end", lambda runs, rest, grid, H, err, gyy, coh, longest: (H, err, None))
     old = frequency_response(runs)
     old_err = np.degrees(np.angle(old.H[low] / PLANT.freqresp(resp.w[low])))
     assert np.max(np.abs(old_err)) > 5.0, old_err.round(2)  # the windows' bias this replaces

@@ -279,8 +279,11 @@ def _composite(runs: list[Record], w_min: float | None, w_max: float | None, win
     with np.errstate(divide="ignore", invalid="ignore"):
         H = gxy / gxx
     err = random_error(coh, n_d)
-    H, err, low_note = _whole_run_low_end(runs, grid, H, err, gyy, coh, max(lengths))
-    H, err, coh, n_d, leak_note = _resonance_from_whole_runs(runs, results, grid, H, err, coh, n_d,
+    from synth.ident.whole_run import at_rest
+
+    rest = all(at_rest(r) for r in runs)
+    H, err, low_note = _whole_run_low_end(runs, rest, grid, H, err, gyy, coh, max(lengths))
+    H, err, coh, n_d, leak_note = _resonance_from_whole_runs(runs, rest, results, grid, H, err, coh, n_d,
                                                              coherence_threshold)
     low_note = "; ".join(n for n in (low_note, leak_note) if n) or None
     band = trim_to_excitation(coherent_band(grid, coh, coherence_threshold), grid, gxx)
@@ -305,20 +308,20 @@ the two cannot be told apart (a linear 0.1-5 Hz sweep of 60 s with 1 % noise: |H
 0.7-2.3 rad/s, random errors of 37-150 %; the composite within 1 dB there)."""
 
 
-def _whole_run_low_end(runs: list[Record], grid: np.ndarray, H: np.ndarray, err: np.ndarray, gyy: np.ndarray,
-                       coh: np.ndarray, longest: float) -> tuple[np.ndarray, np.ndarray, str | None]:
+def _whole_run_low_end(runs: list[Record], rest: bool, grid: np.ndarray, H: np.ndarray, err: np.ndarray,
+                       gyy: np.ndarray, coh: np.ndarray, longest: float) -> tuple[np.ndarray, np.ndarray, str | None]:
     """``H`` and its random error with the points below :data:`~synth.ident.whole_run.WHOLE_RUN_PERIODS` periods of
     the longest window taken from the whole runs (and a note saying so): the ratio of their transforms when every
     run starts and ends at rest, else the local rational method, which removes each run's transient."""
     from synth.ident.local_rational import HALF_WIDTH, local_rational_response
-    from synth.ident.whole_run import WHOLE_RUN_PERIODS, at_rest, whole_run_response
+    from synth.ident.whole_run import WHOLE_RUN_PERIODS, whole_run_response
 
     low = grid < WHOLE_RUN_PERIODS * 2.0 * np.pi / longest
     if not np.any(low):
         return H, err, None
     H, err = np.array(H, complex), np.array(err, float)
     head = f"below {grid[low][-1]:.4g} rad/s ({WHOLE_RUN_PERIODS:g} periods of the longest window) the response is"
-    if all(at_rest(r) for r in runs):
+    if rest:  # every run starts and ends at rest (synth.ident.whole_run.at_rest)
         gnn = np.maximum(np.nan_to_num(gyy * (1.0 - coh)), 0.0)
         H[low], err[low] = whole_run_response(runs, grid[low], gnn[low])
         return H, err, (f"{head} the ratio of the whole runs' transforms: every run starts and ends at rest, and a "
@@ -334,15 +337,16 @@ def _whole_run_low_end(runs: list[Record], grid: np.ndarray, H: np.ndarray, err:
                     "window's taper biases a sweep's lowest frequencies")
 
 
-def _resonance_from_whole_runs(runs: list[Record], results: list[Any], grid: np.ndarray, H: np.ndarray,
-                               err: np.ndarray, coh: np.ndarray, n_d: np.ndarray, threshold: float) -> tuple:
+def _resonance_from_whole_runs(runs: list[Record], rest: bool, results: list[Any], grid: np.ndarray,
+                               H: np.ndarray, err: np.ndarray, coh: np.ndarray, n_d: np.ndarray,
+                               threshold: float) -> tuple:
     """Where every run is at rest at both ends and the windows leak at a resonance
     (:func:`synth.ident.resonance_leakage.leakage_points`): the whole-run ratio, the longest window's coherence,
     averages and noise; and a note (None where nothing changed)."""
     from synth.ident.resonance_leakage import leakage_points
-    from synth.ident.whole_run import at_rest, whole_run_response
+    from synth.ident.whole_run import whole_run_response
 
-    if not all(at_rest(r) for r in runs):
+    if not rest:
         return H, err, coh, n_d, None
     longest = max(results, key=lambda r: r.length)
     leak = leakage_points(results, grid, np.abs(H), threshold)  # the composite's peaks: flattened, not moved

@@ -116,13 +116,19 @@ COLLINEAR = 1e-14
 """Regressors whose scaled Gram matrix has a smallest eigenvalue below this fraction of its largest are collinear."""
 
 
-def _independent(columns: list[np.ndarray]) -> bool:
-    """Whether the columns are linearly independent to :data:`COLLINEAR` (scaled to unit norm first)."""
-    X = np.column_stack(columns)
+def _pinned_taps(lags: list[np.ndarray]) -> int:
+    """How many of the leading input ``lags`` (with a constant) are linearly independent to :data:`COLLINEAR`, at
+    least 1: one scaled Gram matrix, its leading blocks tested from the largest down."""
+    X = np.column_stack([*lags, np.ones(lags[0].size)])
     norms = np.linalg.norm(X, axis=0)
     X = X / np.where(norms == 0.0, 1.0, norms)
-    eig = np.linalg.eigvalsh(np.einsum("ki,kj->ij", X, X))
-    return bool(eig[0] >= COLLINEAR * eig[-1])
+    gram = np.einsum("ki,kj->ij", X, X)
+    for nb in range(len(lags), 1, -1):
+        keep = [*range(nb), len(lags)]
+        eig = np.linalg.eigvalsh(gram[np.ix_(keep, keep)])
+        if eig[0] >= COLLINEAR * eig[-1]:
+            return nb
+    return 1
 
 
 def _response(a: np.ndarray, b: np.ndarray, w: np.ndarray, dt: float) -> tuple[np.ndarray, np.ndarray]:
@@ -182,8 +188,8 @@ def fit_error_model(u: np.ndarray, e: np.ndarray, dt: float, na: int = 4, nb: in
     uc = u - u.mean()
     target = e[k0:]
     nb_asked = nb
-    while nb > 1 and not _independent([uc[k0 - j: u.size - j] for j in range(nb)] + [np.ones(n)]):
-        nb -= 1  # an input of few frequencies (a sum of sines) pins down as many taps as it has sines times two
+    # an input of few frequencies (a sum of sines) pins down as many taps as it has sines times two
+    nb = _pinned_taps([uc[k0 - j: u.size - j] for j in range(nb)])
     while True:
         Phi = np.column_stack([-e[k0 - i: u.size - i] for i in range(1, na + 1)]
                               + [uc[k0 - j: u.size - j] for j in range(nb)] + [np.ones(n)])
