@@ -313,6 +313,7 @@ def _whole_run_low_end(runs: list[Record], rest: bool, grid: np.ndarray, H: np.n
     """``H`` and its random error with the points below :data:`~synth.ident.whole_run.WHOLE_RUN_PERIODS` periods of
     the longest window taken from the whole runs (and a note saying so): the ratio of their transforms when every
     run starts and ends at rest, else the local rational method, which removes each run's transient."""
+    from synth.ident.composite_bias import composite_bias
     from synth.ident.local_rational import HALF_WIDTH, local_rational_response
     from synth.ident.whole_run import WHOLE_RUN_PERIODS, whole_run_response
 
@@ -328,8 +329,11 @@ def _whole_run_low_end(runs: list[Record], rest: bool, grid: np.ndarray, H: np.n
                         "window's taper biases a sweep's lowest frequencies")
     H_lrm, err_lrm = local_rational_response(runs, grid[low])
     use = np.isfinite(H_lrm) & ~(err_lrm > LRM_ERROR_LIMIT * err[low])
+    # the composite's error with the bias its neighbours show against the method, then the choice again
+    err_c = np.hypot(err[low], composite_bias(H[low], err[low], H_lrm, err_lrm, use))
+    use = np.isfinite(H_lrm) & ~(err_lrm > LRM_ERROR_LIMIT * err_c)
     H[low] = np.where(use, H_lrm, H[low])
-    err[low] = np.where(use, err_lrm, err[low])
+    err[low] = np.where(use, err_lrm, err_c)
     return H, err, (f"{head} from the whole runs' transforms with each run's transient removed (the local rational "
                     f"method, {2 * HALF_WIDTH + 1} neighbouring frequencies per run) at {int(use.sum())} of its "
                     f"{int(low.sum())} points (the composite where that method's random error is over "
