@@ -229,8 +229,9 @@ def _print(result: Any, args: argparse.Namespace, json_path: Path, figures: list
             print(f"note: {step['note']}")
     if fit.solver.get("covariance_note"):
         print(f"note on the std column: {fit.solver['covariance_note']}")
-    if fit.solver.get("nyquist_note"):
-        print(f"note: {fit.solver['nyquist_note']}")
+    for key in ("nyquist_note", "zero_delay"):
+        if fit.solver.get(key):
+            print(f"note: {fit.solver[key]}")
     solver = "Levenberg-Marquardt" if fit.solver.get("method", "").startswith("Levenberg-Marquardt") else "IPOPT"
     status, iterations = fit.solver.get("status"), fit.solver.get("iterations")
     remaining = fit.solver.get("remaining_improvement_std")

@@ -40,6 +40,7 @@ from synth.errors import DataError, FitError, ModelError
 from synth.ident.convolution_problem import ConvolutionProblem
 from synth.ident.covariance import fit_covariance
 from synth.ident.delay_samples import best_sample, walk_intervals
+from synth.ident.fit_arguments import as_sensor, resolve_delay
 from synth.ident.fit_failure import (
     LIMIT_STATUSES,
     fit_failure,
@@ -57,6 +58,7 @@ from synth.ident.srivc import linear_initial_model, map_to_structure
 from synth.ident.start_kept import START_CONVERGED, converged_replaces, converged_start
 from synth.ident.start_state import free_columns, free_start_gram, start_state_test
 from synth.ident.structure import Structure, parse_structure
+from synth.ident.zero_delay import at_zero_delay, zero_delay_candidate
 from synth.plant import Plant
 
 __all__ = ["LONG_RECORD", "TimeFitResult", "fit_structure"]
@@ -210,35 +212,6 @@ class TimeFitResult:
 # ----------------------------------------------------------------- interface
 
 
-def _resolve_delay(st: Structure, delay: str | float | None) -> tuple[bool, float | None, str]:
-    name = st.delay_parameter or "delay"
-    if isinstance(st.delay, float):
-        if delay is not None:
-            raise ModelError(f"structure {st.formula!r} fixes the delay at {st.delay:g} s; do not give a delay too")
-        return False, st.delay, name
-    if delay is None:
-        return (True, None, name) if st.delay_parameter else (False, 0.0, name)
-    if isinstance(delay, str):
-        if delay.strip().lower() == "fit":
-            return True, None, name
-        try:
-            delay = float(delay)
-        except ValueError:
-            raise ModelError(f"delay must be 'fit' or a number of seconds, got {delay!r}") from None
-    if not np.isfinite(delay) or delay < 0:
-        raise ModelError(f"delay must be 'fit' or a number >= 0 s, got {delay!r}")
-    return False, float(delay), name
-
-
-def _as_sensor(sensor: Plant | str | None) -> Plant | None:
-    if sensor is None or isinstance(sensor, Plant):
-        return sensor
-    try:
-        return Plant.from_string(sensor)
-    except ModelError as exc:
-        raise exc.located("sensor") from None
-
-
 def fit_structure(record: Record, structure: Structure | str, delay: str | float | None = None,
                   sensor: Plant | str | None = None, periodic: bool = False,
                   initial: dict[str, float] | None = None,
@@ -313,8 +286,28 @@ def fit_structure(record: Record, structure: Structure | str, delay: str | float
     ({'k': 2.0, 'p': 3.0, 'delay': 0.043}, 3.0)
     """
     st = parse_structure(structure) if isinstance(structure, str) else structure
-    sensor = _as_sensor(sensor)
-    fit_delay, fixed_delay, delay_name = _resolve_delay(st, delay)
+    if not (resolve_delay(st, delay)[0] and sensor is None and st.num_degree >= st.den_degree):
+        return _fit_structure(record, st, delay, sensor, periodic, initial, lower, weights, check, solver, rtol,
+                              free_start)
+    fit = _fit_structure(record, st, delay, sensor, periodic, initial, lower, weights, False, solver, rtol, free_start)
+    if zero_delay_candidate(fit, record.dt):  # a feedthrough's jump at a delay of exactly 0 (synth.ident.zero_delay)
+        zero = _fit_structure(record, fit.structure, 0.0, sensor, periodic, initial, lower, weights, False, solver,
+                              rtol, free_start)
+        if not zero.solver.get("failure") and zero.fit_percent > fit.fit_percent:
+            fit, delay = at_zero_delay(zero, fit), 0.0
+    if check and fit.solver.get("failure"):  # the same fit again, raising its FitError
+        _fit_structure(record, fit.structure, delay, sensor, periodic, initial, lower, weights, True, solver, rtol,
+                       free_start)
+    return fit
+
+
+def _fit_structure(record: Record, structure: Structure | str, delay: str | float | None, sensor: Plant | str | None,
+                   periodic: bool, initial: dict[str, float] | None, lower: dict[str, float] | None,
+                   weights: np.ndarray | None, check: bool, solver: str, rtol: float, free_start: bool) -> TimeFitResult:
+    """:func:`fit_structure` at the delay asked for (a fitted delay within ``(0, dt]`` of its intervals)."""
+    st = parse_structure(structure) if isinstance(structure, str) else structure
+    sensor = as_sensor(sensor)
+    fit_delay, fixed_delay, delay_name = resolve_delay(st, delay)
     t, u, y = record.t, record.u, record.y
     n, dt = t.size, record.dt
     p_total = len(st.parameters) + (2 if fit_delay else 1)
