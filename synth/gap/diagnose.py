@@ -35,9 +35,10 @@ from synth.data.coerce import RecordLike, as_record
 from synth.data.record import Record
 from synth.errors import DataError, ModelError
 from synth.gap.attribution.heldout import DiagnoseOptions, diagnose_effects
-from synth.gap.attribution.verdict import CONCENTRATED_RATIO, EffectDiagnosis, aux_explained, not_carried
+from synth.gap.attribution.verdict import EffectDiagnosis, aux_explained, not_carried
 from synth.gap.effects.registry import DEFAULT_CANDIDATES, aux_candidates, make_effect
 from synth.gap.preflight import check_model
+from synth.gap.verdict_sentence import verdict_sentence
 from synth.gap.where.clipping import Clipping, record_clipping
 from synth.gap.where.localize import GapLocalization, localize_gap
 from synth.gap.where.residual import hidden_pulse_warnings, not_judged_warning
@@ -211,30 +212,8 @@ class Diagnosis:
         return f" Measured channels, held-out shrinkage beyond the re-fit: {'; '.join(parts)}." if parts else ""
 
     def _verdict_sentence(self) -> str:
-        v = self.verdict
-        status = v["status"]
-        gap = f"{100 * self.localization.residual.nrmse:.0f} % NRMSE"
-        if status == "none":
-            ratio = self.attribution.j_nominal / self.attribution.noise_floor
-            return (f"No gap beyond the measurement noise (gap {gap})." if ratio < CONCENTRATED_RATIO else
-                    f"No consistent gap (gap {gap}): the held-out error is {ratio:.3g} times the noise floor, but it "
-                    "comes from a few segments of the record.")
-        if status == "effect":
-            best = next(e for e in self.attribution.effects if e.effect == v["effects"][0])
-            # a center or scale the record fixes stays out; a fitted one (it has an interval) is shown
-            params = ", ".join(f"{k} = {_fmt(x)}" for k, x in best.parameters.items()
-                               if k not in ("center", "scale") or k in best.parameter_ci)
-            text = (f"The gap ({gap}) is explained by {best.effect.replace('_', ' ')} ({params}): it removes "
-                    f"{100 * best.share_of_gap:.0f} % of the held-out error above the noise floor.")
-            if v["indistinguishable"]:
-                text += " The data cannot tell it from " + ", ".join(v["indistinguishable"][0][1:]) + "."
-            return text
-        if status == "parameter_mismatch":
-            return (f"The gap ({gap}) is a parameter mismatch: re-fitting the nominal coefficients closes it "
-                    f"(held-out shrinkage {self.attribution.refit_shrinkage:.2f}).")
-        return (f"The gap ({gap}) is not explained by the candidate effects"
-                + (" (re-fitting the nominal coefficients helps, but the gap remains)."
-                   if v["effects"] == ["parameter_mismatch"] else "."))
+        return verdict_sentence(self.verdict, self.attribution, self.localization.residual.nrmse, self.plant,
+                                self.record)
 
     def _clipping_sentence(self) -> str:
         """What the clipped signals say, with the matching candidate's held-out shrinkage."""
@@ -275,11 +254,6 @@ class Diagnosis:
                          if isinstance(self.validate, tuple) else self.validate.to_dict()),
             "attribution": {k: att[k] for k in ("j_nominal", "j_refit", "parameter_mismatch", "threshold", "split")},
         })
-
-
-def _fmt(x: float) -> str:
-    """A parameter in the headline, as the effects' table writes it (an absent limit is ``inf`` or ``-inf``)."""
-    return f"{x:.4g}" if np.isfinite(x) else ("inf" if x > 0 else "-inf")
 
 
 def check_candidates(candidates: list[str] | tuple[str, ...]) -> list[str]:
