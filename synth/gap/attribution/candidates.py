@@ -2,7 +2,9 @@
 
 :func:`candidate_fits` screens each candidate (:mod:`synth.gap.attribution.screen`) and re-fits the
 best ``confirm`` jointly (:func:`synth.gap.attribution.refit.fit_augmented`), started on the grid
-:func:`seeded_grid` builds around the screened point; :func:`confirmed_candidates` says which.
+:func:`seeded_grid` builds around the screened point; :func:`confirmed_candidates` says which. A confirmed fit
+that is not the effect it names (:func:`synth.gap.attribution.physical.wrong_sign`) gives its place to the next
+screened candidate.
 """
 
 from __future__ import annotations
@@ -14,6 +16,7 @@ import numpy as np
 
 from synth.data.record import Record
 from synth.errors import ModelError
+from synth.gap.attribution.physical import wrong_sign
 from synth.gap.attribution.refit import AugmentedFit, fit_augmented
 from synth.gap.attribution.screen import ScreenedFit, screen_effect
 from synth.gap.effects.base import Effect, Params
@@ -118,16 +121,27 @@ def candidate_fits(plant: Plant, effects: list[Effect], refit: AugmentedFit, tra
             advance(progress, f"screen {eff.label}")
     screened.sort(key=lambda es: es[1].ssr)
     chosen = confirmed_candidates(screened, confirm)
-    jobs = []
-    for i in chosen:
+
+    def job(i: int) -> tuple[Any, ...]:
         eff, sc = screened[i]
         if i >= (confirm or 0) and sc.params_held:  # confirmed for its held-denominator fit: start there
             sc = replace(sc, params=sc.params_held)
-        jobs.append((plant, t_tr, u_tr, y_tr, eff, refit.plant, weights, seeded_grid(eff, sc, u_tr)))
-    if progress is not None:  # the joint fits were counted as `confirm` steps; there may be one more
-        progress["total"] = int(progress.get("total", 0)) + len(chosen) - (confirm or 0)
-    joints = dict(zip(chosen, map_jobs(joint_fit, jobs, workers,
-                                       lambda i: advance(progress, f"joint fit {screened[chosen[i]][0].label}"))))
+        return plant, t_tr, u_tr, y_tr, eff, refit.plant, weights, seeded_grid(eff, sc, u_tr)
+
+    def confirm_jointly(which: list[int]) -> dict[int, AugmentedFit | None]:
+        if progress is not None:  # the joint fits were counted as `confirm` steps; there may be more
+            progress["total"] = int(progress.get("total", 0)) + len(which) - (0 if joints else (confirm or 0))
+        return dict(zip(which, map_jobs(joint_fit, [job(i) for i in which], workers,
+                                        lambda k: advance(progress, f"joint fit {screened[which[k]][0].label}"))))
+
+    joints: dict[int, AugmentedFit | None] = {}
+    joints = confirm_jointly(chosen)
+    # a confirmed fit that is not the effect it names (a resonance without a peak) cannot be the verdict: its place
+    # goes to the next screened candidate
+    lost = sum(1 for i, f in joints.items() if f is not None and wrong_sign(screened[i][0], f.params, t_tr, u_tr, plant))
+    spare = [i for i in range(len(screened)) if i not in joints][:lost]
+    if spare:
+        joints.update(confirm_jointly(spare))
     for rank, (eff, sc) in enumerate(screened):
         fit: AugmentedFit | ScreenedFit = sc
         joint = joints.get(rank)

@@ -406,7 +406,7 @@ def diagnose_effects(plant: Plant, record: Record, validate: Record | Sequence[R
         status = "effect"
         group = [best.effect]
         for res, yhat, s in results:
-            if res.effect == best.effect or not res.significant:
+            if res.effect == best.effect or not res.significant or res.unphysical:
                 continue
             d_lo, d_hi = diff_ci(s, s_best)
             same_j = d_lo <= 0.0 <= d_hi

@@ -1,11 +1,13 @@
-"""Whether a fitted candidate is still the effect it names: the sign of its basis parameters.
+"""Whether a fitted candidate is still the effect it names: the sign of its basis parameters, and what the effect itself
+checks.
 
 A basis parameter (:mod:`synth.gap.effects.base`) is solved by unconstrained least squares and can come out with
 a sign no such effect has: a noise-free record half a sample ahead of a first-order model was "explained by
 supply sag, sag = -0.498", a supply that rises when the command steps up. Only the sign is checked, against a
 one-signed range in :meth:`~synth.gap.effects.base.Effect.bounds`; the magnitudes there are search ranges, not
 physics (a benchmark's strong cubic spring lies beyond them), and the grid and factor parameters are searched
-inside their ranges anyway.
+inside their ranges anyway. An effect may also say when a fit is not what its name says
+(:meth:`synth.gap.effects.dynamics.ResonanceEffect.unlike_its_name`: a mode without a peak).
 """
 
 from __future__ import annotations
@@ -43,4 +45,5 @@ def wrong_sign(effect: Effect, params: Params, t: np.ndarray, u: np.ndarray, pla
         slack = BOUND_SLACK * (hi - lo) if np.isfinite(hi - lo) else 0.0
         if (lo >= 0.0 and x < lo - slack) or (hi <= 0.0 and x > hi + slack):
             return f"{name} = {x:.4g} has the wrong sign: its physical range is [{lo:.4g}, {hi:.4g}] for this record"
-    return ""
+    unlike = getattr(effect, "unlike_its_name", None)  # an effect that knows when a fit is not what it names
+    return unlike(params) if unlike is not None else ""

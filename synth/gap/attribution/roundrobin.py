@@ -62,6 +62,9 @@ class PooledEffect:
         Part of the re-fit's pooled held-out excess over the noise floor removed.
     j_heldout : float
         Pooled held-out mean squared error (output units squared).
+    unphysical : str
+        Why a run's fit is not the effect it names (:func:`synth.gap.attribution.physical.wrong_sign`; never
+        accepted, nor counted as indistinguishable from the verdict). Empty: physical in every run.
     """
 
     effect: str
@@ -72,6 +75,7 @@ class PooledEffect:
     share_of_gap: float
     accepted: bool
     j_heldout: float
+    unphysical: str = ""
 
     def to_dict(self) -> dict[str, Any]:
         """JSON entry of ``"effects"``.
@@ -84,7 +88,7 @@ class PooledEffect:
         return {"effect": self.effect, "parameters_by_run": [None if p is None else dict(p) for p in self.parameters],
                 "shrinkage": self.shrinkage, "shrinkage_ci": [float(x) for x in self.shrinkage_ci],
                 "significant": self.significant, "share_of_gap": self.share_of_gap, "accepted": self.accepted,
-                "j_heldout": self.j_heldout}
+                "j_heldout": self.j_heldout, **({"unphysical": self.unphysical} if self.unphysical else {})}
 
 
 @dataclass(frozen=True, eq=False)
@@ -146,7 +150,7 @@ class RunsDiagnosis:
             for name, p in zip(self.runs, best.parameters))
         text = (f"Over {where}, {best.effect.replace('_', ' ')} shrinks the held-out error by {best.shrinkage:.2f} "
                 f"[{lo:.2f}, {hi:.2f}] (threshold {self.threshold:.3g}). Fitted on each run: {per_run}.")
-        others = [e for e in self.effects if e.significant and e.effect != best.effect]
+        others = [e for e in self.effects if e.significant and e.effect != best.effect and not e.unphysical]
         if others:
             text += " Also significant: " + ", ".join(
                 f"{e.effect} {e.shrinkage:.2f} [{e.shrinkage_ci[0]:.2f}, {e.shrinkage_ci[1]:.2f}]" for e in others) + "."
@@ -271,8 +275,11 @@ def _pool(folds: list[EffectDiagnosis], names: list[str], blocks: int, n_boot: i
         joint = all(b[label].fit == "joint" for b in by_fold)
         share = share_of_excess(j_ref, j, floor)
         params = [dict(b[label].parameters) if b[label].fit == "joint" else None for b in by_fold]
+        unphysical = next((f"{name}: {b[label].unphysical}" for name, b in zip(names, by_fold) if b[label].unphysical),
+                          "")  # a run's fit is not the effect it names
         pooled.append(PooledEffect(label, params, 1.0 - j / j_ref if j_ref > 0 else 0.0, ci, significant,
-                                   float(share), bool(significant and joint and share >= min_share), j))
+                                   float(share), bool(significant and joint and not unphysical and share >= min_share),
+                                   j, unphysical))
     pooled.sort(key=lambda e: -e.shrinkage)
     relevant = [e for e in pooled if e.accepted]
     indist: list[list[str]] = []
@@ -292,7 +299,7 @@ def _pool(folds: list[EffectDiagnosis], names: list[str], blocks: int, n_boot: i
         group = [best.effect]
         y_best = np.concatenate([f.segments.predictions[best.effect] for f in folds])
         for e in pooled:
-            if e.effect == best.effect or not e.significant:
+            if e.effect == best.effect or not e.significant or e.unphysical:
                 continue
             d = (boot(sums[e.effect]) - boot(sums[best.effect])) / boot(sums["refit"])
             same_j = float(np.quantile(d, 0.025)) <= 0.0 <= float(np.quantile(d, 0.975))

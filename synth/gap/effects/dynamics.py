@@ -70,6 +70,26 @@ class ResonanceEffect(Effect):
 
     #: largest damping handed to the fit (``z`` finite)
     zeta_max: ClassVar[float] = 1.0 - 1e-6
+    #: above this damping ``|wn^2/(s^2 + 2 zeta wn s + wn^2)|`` has no peak: not a resonance
+    no_peak_damping: ClassVar[float] = float(np.sqrt(0.5))
+
+    def unlike_its_name(self, params: Params) -> str:
+        """Why a fitted mode is no resonance ('' when it is one): its damping leaves ``|G|`` without a peak.
+
+        On a DC motor's step runs the fit ran to ``zeta = 1``, a double real pole, and was named "resonance".
+
+        Examples
+        --------
+        >>> ResonanceEffect().unlike_its_name({"wn": 30.0, "zeta": 0.2})
+        ''
+        >>> ResonanceEffect().unlike_its_name({"wn": 30.0, "zeta": 0.999999})[:40]
+        'zeta = 1: a mode this damped has no res'
+        """
+        zeta = float(params.get("zeta", 0.0))
+        if zeta <= self.no_peak_damping:
+            return ""
+        return (f"zeta = {zeta:.3g}: a mode this damped has no resonance peak (none above {self.no_peak_damping:.3f}); "
+                "real poles are a lag's, or the re-fit's own")
 
     def factor(self, params: Params | None = None) -> str:
         wn = float((params or {}).get("wn", 1.0))
