@@ -208,6 +208,21 @@ def objective_label(spec: Spec, loop: Loop) -> dict[str, Any]:
             "value": objective_score(loop, obj.terms()), "terms": parts}
 
 
+def describe_objective(spec: Spec, label: dict[str, Any]) -> str:
+    """The design's objective and its value, as its verdict states them (the smallest peak |S| without an objective).
+
+    Examples
+    --------
+    >>> from synth.spec import load_spec
+    >>> spec = load_spec("specs/x4_rotor.yaml")
+    >>> describe_objective(spec, {"value": 473.3, "unit": "rad/s"})
+    'maximize bandwidth: 473.3 rad/s'
+    """
+    if spec.objective is None:
+        return f"smallest peak |S|: {fmt(label['value'])} dB"
+    return f"{spec.objective.describe()}: {fmt(label['value'])} {label['unit']}".rstrip()
+
+
 def objective_note(label: dict[str, Any] | None) -> str:
     """The sentence a design's verdict adds when its objective's value needs a caveat (see
     :func:`objective_label`'s ``note``), else "".

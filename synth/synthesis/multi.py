@@ -31,6 +31,7 @@ from synth.results import (
     CERTIFICATE_PER_DECADE,
     Certificate,
     DesignResult,
+    describe_objective,
     objective_label,
     objective_note,
     reference_check,
@@ -460,8 +461,9 @@ def _design(spec: Spec, settings: ConvexSettings, nlp: bool | str, explain: bool
         result = DesignResult(spec.name, True, controller, certificate.check, label, None, certificate,
                               None, method + f"; chosen: {stage}", reference=ref, extras=extras)
         result.verdict = (f"{controller} meets all {len(spec.requirements)} requirements and keeps the loop "
-                          f"stable on {len(spec.plants())} plant(s) ({_describe(spec, label)}).") + objective_note(label) \
-            + edge.warning() + (f" Optimality: {optimality.basis}." if spec.objective is not None else "") \
+                          f"stable on {len(spec.plants())} plant(s) ({describe_objective(spec, label)}).") \
+            + objective_note(label) + edge.warning() \
+            + (f" Optimality: {optimality.basis}." if spec.objective is not None else "") \
             + slices_text(slices, spec.plants()) + reference_verdict(spec, ref)
         return result
     if feasible_runs:  # optimal on the grid but none survives the certificate
@@ -492,9 +494,3 @@ def _design(spec: Spec, settings: ConvexSettings, nlp: bool | str, explain: bool
     nlp_note += "".join(f" Also tried: {r.note}." for _, r in runs if r.note)
     result.verdict = infeasible_verdict(worst, compromise) + nlp_note + reference_verdict(spec, ref)
     return result
-
-
-def _describe(spec: Spec, label: dict) -> str:
-    if spec.objective is None:
-        return f"smallest peak |S|: {fmt(label['value'])} dB"
-    return f"{spec.objective.describe()}: {fmt(label['value'])} {label['unit']}".rstrip()

@@ -31,7 +31,14 @@ from synth.objectives import score
 from synth.progress import within
 from synth.requirements import NoLimitCycle, PeakComplementary, PeakSensitivity, StepResponse
 from synth.requirements.base import Requirement, db, fmt
-from synth.results import CERTIFICATE_PER_DECADE, Certificate, DesignResult, objective_label, objective_note
+from synth.results import (
+    CERTIFICATE_PER_DECADE,
+    Certificate,
+    DesignResult,
+    describe_objective,
+    objective_label,
+    objective_note,
+)
 from synth.spec import Spec
 from synth.speculation import Speculator
 from synth.synthesis.convex_settings import ConvexSettings
@@ -348,6 +355,7 @@ def _certified(spec: Spec, result: DesignResult, level: float | None, tried: int
                        Certificate(cert.feasible, CERTIFICATE_PER_DECADE, cert), None,
                        result.method + f"; requirements with no solver form ({hard}): {how}; certificate: every "
                        "requirement re-checked exactly", reference=result.reference, extras=extras)
+    value = f" ({describe_objective(spec, objective)})" if objective is not None and "value" in objective else ""
     out.verdict = (f"{chosen} meets all {len(spec.requirements)} requirements and keeps the loop "
-                   f"stable on {len(spec.plants())} plant(s); {hard}: {how}.") + objective_note(objective)
+                   f"stable on {len(spec.plants())} plant(s){value}; {hard}: {how}.") + objective_note(objective)
     return out
