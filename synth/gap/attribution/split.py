@@ -177,7 +177,9 @@ def split_heldout(plant: Plant, record: Record, validate: Record | Sequence[Reco
             where = (evaluated.source or "record") if runs is None else f"validate run {r + 1}"
             because = (f" (gaps in the log left out {gapped}: their made-up samples and the model's settling after "
                        "those that may hide a command change)" if judged_ev is not None and gapped else "")
-            raise ModelError(f"{n_r} held-out samples are too few for {blocks} segments{because}", where=where)
+            raise ModelError(f"{n_r} held-out samples are too few for the held-out test ({blocks} segments of at least "
+                             f"10 samples: {10 * blocks}){because}; record longer, or give --validate with a record "
+                             "of its own", where=where)
     settled = (t_ev >= t_ev[0] + burn_in) if runs is None else held
     if judged_ev is not None:
         settled = settled & (judged_ev > 0)

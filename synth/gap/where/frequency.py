@@ -147,7 +147,7 @@ def localize_frequency(residual: ModelResidual, max_lag: int = 50, n_segments: i
     max_lag : int
         Largest cross-correlation lag [samples].
     n_segments : int
-        Welch segments for the coherence and the PSDs.
+        Welch segments for the coherence and the PSDs (fewer on a record too short for them to hold 8 samples each).
     na, nb : int
         Error-model orders.
     level : float
@@ -175,6 +175,7 @@ def localize_frequency(residual: ModelResidual, max_lag: int = 50, n_segments: i
     u, e, dt = residual.u, residual.e, residual.dt
     alpha = 1.0 - level
     xc = prewhitened_xcorr(u, e, dt, max_lag=max_lag, alpha=alpha)
+    n_segments = max(2, min(n_segments, u.size // 8))  # a short record: fewer segments of 8 samples, not a refusal
     coh = input_residual_coherence(u, e, dt, n_segments=n_segments, alpha=alpha)
     model = fit_error_model(u, e, dt, na=na, nb=nb, level=level)
     nper = max(8, u.size // n_segments)
