@@ -69,20 +69,16 @@ def test_parsimonious_lead_needs_a_significant_advantage_against_each_simpler_ca
 
 
 # ------------------------------------------------------------------------------------------------ end to end
-def test_a_true_lag_leads_a_resonance_that_is_better_on_held_out_data_but_not_significantly():
+def test_a_true_lag_is_not_contested_by_a_resonance_without_a_peak():
+    """The resonance's fit here has the lower held-out J (it led before the parsimony rule, which then chose the
+    lag); its damping of 0.83 leaves no peak, so it is no resonance at all (synth.gap.attribution.physical)."""
     dg = diagnose_effects(NOMINAL, _record("lag", {"tau": 0.0144}, seed=8),
                           options=DiagnoseOptions(candidates=["lag", "resonance"], confirm=None, max_effects=1))
     res = _by_label(dg)
-    # the premise: the two-parameter resonance has the lower held-out J (it led before the rule)
-    assert res["resonance"].j_heldout < res["lag"].j_heldout
-    assert res["resonance"].significant and res["lag"].significant
-    assert dg.verdict["effects"] == ["lag"]
-    info = dg.verdict["parsimony"]
-    assert info["best"] == "resonance" and info["lead"] == "lag"
-    assert info["lead_parameters"] == 1 and info["best_parameters"] == 2
-    assert info["advantage_ci"][0] <= dg.threshold
-    assert ["lag", "resonance"] in dg.verdict["indistinguishable"]  # still reported as not separable
-    assert dg.to_dict()["verdict"]["parsimony"] == info
+    assert res["resonance"].j_heldout < res["lag"].j_heldout   # the premise
+    assert res["resonance"].parameters["zeta"] > 0.7072 and "no resonance peak" in res["resonance"].unphysical
+    assert dg.verdict["effects"] == ["lag"] and not res["resonance"].accepted
+    assert dg.verdict["indistinguishable"] == [] and dg.verdict["parsimony"] is None
 
 
 def test_a_lightly_damped_resonance_is_still_named_resonance():

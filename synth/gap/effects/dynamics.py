@@ -83,7 +83,7 @@ class ResonanceEffect(Effect):
         >>> ResonanceEffect().unlike_its_name({"wn": 30.0, "zeta": 0.2})
         ''
         >>> ResonanceEffect().unlike_its_name({"wn": 30.0, "zeta": 0.999999})[:40]
-        'zeta = 1: a mode this damped has no res'
+        'zeta = 1: a mode this damped has no reso'
         """
         zeta = float(params.get("zeta", 0.0))
         if zeta <= self.no_peak_damping:
