@@ -139,6 +139,30 @@ def test_simulate_cli_issue_example_verdict_json_and_exit_codes(run_cli, tmp_pat
     row = next(line for line in table.out.splitlines() if line.startswith("final value"))
     centre = float(row.split("oscillates about ")[1].split()[0])
     assert centre == pytest.approx(data["limit_cycle"]["center"], rel=1e-3) and abs(centre - 0.1) < 0.002
+    # nor a rise time or overshoot, which only say where the horizon cut the cycle (the table read 0.7167 s and
+    # 121.5 %, the JSON's final value the mean of a tail, 0.143, a black-box test found)
+    assert "rise time 10-90 %    n/a: the step does not settle" in table.out
+    assert "overshoot            n/a: the step does not settle" in table.out
+    assert data["rise_time"] is None and data["overshoot"] is None and data["final_value"] is None
+    sweep = run_cli("simulate", str(spec), "-c", "P(1)", "--step", "0:0.1", "--sweep", "kp=2:20:3", "--json", "-",
+                    "--out", str(tmp_path / "s"))
+    runs = {round(r["kp"], 3): r for r in json.loads(sweep.out)["runs"]}
+    assert runs[20.0]["verdict"] == "limit_cycle" and runs[20.0]["overshoot"] is None
+    assert runs[2.0]["verdict"] == "settled" and runs[2.0]["overshoot"] > 30
+
+
+def test_a_run_that_overflows_is_diverging_not_a_traceback(run_cli, tmp_path):
+    """Forward Euler puts a PID's derivative filter pole at z = 1 - 0.01/0.002 = -4: the output reaches 1e177
+    within 3 s; the step figure's axis limits were inf and the command ended in a ValueError traceback."""
+    spec = tmp_path / "euler.yaml"
+    spec.write_text("name: euler\nplant: {tf: \"1/((s+1)*(0.5*s+1))\"}\ncontroller: {type: PID}\n"
+                    "requirements: [{type: bandwidth, min: 0.1}]\n"
+                    "simulation: {dt: 0.001, controller_rate: 100, controller_discretization: forward_euler, "
+                    "step: [0, 1]}\n")
+    res = run_cli("simulate", str(spec), "-c", "PID(2, 1, 0.2, 0.002)", "--out", str(tmp_path / "o"))
+    assert res.code == 1 and "Traceback" not in res.err, res.err
+    assert "verdict: diverging" in res.out and "final value          none: diverging" in res.out
+    assert (tmp_path / "o" / "step.png").stat().st_size > 1000
 
 
 @pytest.mark.parametrize("extra, message", [

@@ -174,6 +174,7 @@ def run(args: argparse.Namespace) -> int:
         horizon = given if given is not None else plan_horizon(loop, t_step).horizon
         return _run_sweep(args, spec, sim, loop, step, horizon, t_step, disturbances, say)
 
+    from synth.sim.metrics import unsettled
     from synth.sim.verdict import step_verdict
 
     try:
@@ -183,9 +184,10 @@ def run(args: argparse.Namespace) -> int:
         where = "--horizon" if exc.message.startswith("horizon ") and args.horizon is not None else (
             "--max-horizon" if args.max_horizon is not None else "simulation")
         raise exc.located(where) from None
-    result, metrics = v.result, v.metrics
+    result, metrics = v.result, (v.metrics if v.verdict == "settled" else unsettled(v.metrics))
     payload = {"spec": spec.name, "controller": str(controller), "step": list(step), "step_time": t_step,
-               "horizon": v.evidence.horizon, "loop": loop.to_dict(), **v.to_dict()}
+               "horizon": v.evidence.horizon, "loop": loop.to_dict(), "verdict": v.verdict,
+               "evidence": v.evidence.to_dict(), **metrics.to_dict()}
     out_dir = Path(args.out) if args.out else Path("reports") / spec.name / "simulate"
     folder = OutputDir(out_dir, args.force) if not (args.csv and args.plot) else None
     csv_path = _claim(Path(args.csv), args.force) if args.csv else folder.claim("timeseries.csv")  # type: ignore[union-attr]
@@ -252,12 +254,15 @@ def _print_metrics(say: Any, spec: Any, loop: Any, m: Any, step: tuple[float, fl
     settling = f"{fmt(m.settling_time)} s" if m.settling_time is not None else "not settled"
     timing = [f"{fmt(m.rise_time)} s", f"{fmt(m.overshoot)} %", settling] if step[0] != step[1] else \
         ["n/a: the reference does not step"] * 3
+    if verdict != "settled" and step[0] != step[1]:
+        timing = ["n/a: the step does not settle"] * 2 + ["not settled"]
     rows = [
         ["rise time 10-90 %", timing[0]],
         ["overshoot", timing[1]],
         ["settling time (2 %)", timing[2]],
-        ["final value", f"{fmt(m.final_value)} {y}" if verdict != "limit_cycle" or lc.center is None else
-         f"none: it oscillates about {fmt(lc.center)} {y} (the mean of its last whole cycles)"],
+        ["final value", f"{fmt(m.final_value)} {y}" if verdict == "settled" else
+         f"none: it oscillates about {fmt(lc.center)} {y} (the mean of its last whole cycles)"
+         if verdict == "limit_cycle" and lc.center is not None else f"none: {verdict.replace('_', ' ')}"],
         ["peak actuator rate", f"{fmt(m.actuator_peak_rate)} {u}/s"],
         ["actuator range", f"{fmt(m.actuator_min)} to {fmt(m.actuator_max)} {u}"],
         ["time rate-limited", f"{fmt(m.rate_limited_time)} s"],
@@ -299,7 +304,7 @@ def _run_sweep(args: argparse.Namespace, spec: Any, sim: Any, loop: Any, step: t
     from synth.outputs import GENERATOR, OutputDir, dump_json, to_jsonable, write_json
     from synth.requirements.base import fmt
     from synth.sim.hidden_mode import unseen_root
-    from synth.sim.metrics import nonlinear_step_metrics
+    from synth.sim.metrics import nonlinear_step_metrics, unsettled
     from synth.sim.signals import step_reference
     from synth.sim.simulator import simulate_batch
     from synth.sim.verdict import judge, step_verdict
@@ -330,6 +335,7 @@ def _run_sweep(args: argparse.Namespace, spec: Any, sim: Any, loop: Any, step: t
                 verdict, m = v.verdict, v.metrics
                 evidence = v.evidence.to_dict()
                 evidence["horizons"] = [float(res.t[-1]), *evidence["horizons"]]
+            m = m if verdict == "settled" else unsettled(m)  # no step metrics for a step that does not settle
             entries.append({name: value, "verdict": verdict, "evidence": evidence, **m.to_dict()})
             series.setdefault("t", res.t)
             series[f"output_{name}={value:.6g}"] = res.output

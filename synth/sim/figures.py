@@ -24,6 +24,14 @@ COLORS = ["#1f4e9c", "#c0392b", "#2e8b57", "#8e44ad", "#d35400", "#7f8c8d"]
 
 
 
+SHOWN_LIMIT = 1e12
+"""Values beyond this magnitude (a diverging run, up to overflow) are left out of the figures."""
+
+
+def _shown(x: np.ndarray) -> np.ndarray:
+    return np.where(np.abs(x) < SHOWN_LIMIT, x, np.nan)
+
+
 def step_comparison(runs: dict[str, dict[str, SimResult]], path: Path, units: dict[str, str],
                     t_end: float | None = None) -> Path:
     """Linear and nonlinear step responses side by side (output above, actuator below).
@@ -56,11 +64,11 @@ def step_comparison(runs: dict[str, dict[str, SimResult]], path: Path, units: di
     for i, (label, pair) in enumerate(runs.items()):
         color = COLORS[i % len(COLORS)]
         nl, lin = pair["nonlinear"], pair["linear"]
-        ax_y.plot(lin.t, lin.output, color=color, ls="--", lw=1.3, label=f"{label}, every nonlinear block off")
-        ax_y.plot(nl.t, nl.output, color=color, lw=1.8, label=f"{label}, nonlinear")
-        ax_u.plot(lin.t, lin.actuator, color=color, ls="--", lw=1.1,
+        ax_y.plot(lin.t, _shown(lin.output), color=color, ls="--", lw=1.3, label=f"{label}, every nonlinear block off")
+        ax_y.plot(nl.t, _shown(nl.output), color=color, lw=1.8, label=f"{label}, nonlinear")
+        ax_u.plot(lin.t, _shown(lin.actuator), color=color, ls="--", lw=1.1,
                   label=f"{label}, linear (peaks at {np.max(np.abs(lin.actuator)):.4g})")
-        ax_u.plot(nl.t, nl.actuator, color=color, lw=1.5, label=f"{label}")
+        ax_u.plot(nl.t, _shown(nl.actuator), color=color, lw=1.5, label=f"{label}")
         limited = nl.active("rate_limited") | nl.active("saturated")
         if np.any(limited):
             ax_u.fill_between(nl.t, 0, 1, where=limited, transform=ax_u.get_xaxis_transform(), color=color,
@@ -77,9 +85,11 @@ def step_comparison(runs: dict[str, dict[str, SimResult]], path: Path, units: di
     ax_u.grid(True, alpha=0.3)
     ax_u.legend(fontsize=7, loc="upper right")
     nl_all = np.concatenate([p["nonlinear"].actuator for p in runs.values()])
-    lo, hi = float(np.min(nl_all)), float(np.max(nl_all))
-    pad = 0.25 * (hi - lo) if hi > lo else 1.0
-    ax_u.set_ylim(lo - pad, hi + pad)  # linear actuator signals may run far outside: see the legend
+    nl_all = _shown(nl_all)
+    if np.all(np.isfinite(nl_all)):  # a diverging run's axis is matplotlib's own
+        lo, hi = float(np.min(nl_all)), float(np.max(nl_all))
+        pad = 0.25 * (hi - lo) if hi > lo else 1.0
+        ax_u.set_ylim(lo - pad, hi + pad)  # linear actuator signals may run far outside: see the legend
     if t_end is not None:
         ax_u.set_xlim(first.t[0], t_end)
     return save_figure(fig, path)

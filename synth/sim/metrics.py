@@ -10,7 +10,7 @@ limiting state), and whether the run ends in a sustained oscillation.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
@@ -20,7 +20,7 @@ from synth.sim.results import SimResult
 from synth.timeresp import StepMetrics, step_metrics
 
 __all__ = ["MAX_TAIL_CORRECTION", "MAX_TAIL_RATIO", "TAIL_SHARE", "NonlinearStepMetrics", "nonlinear_step_metrics",
-           "tail_limit"]
+           "tail_limit", "unsettled"]
 
 
 @dataclass(frozen=True)
@@ -78,6 +78,22 @@ class NonlinearStepMetrics:
         out = {k: getattr(self, k) for k in self.__dataclass_fields__ if k != "limit_cycle"}
         out["limit_cycle"] = self.limit_cycle.to_dict()
         return out
+
+
+def unsettled(metrics: NonlinearStepMetrics) -> NonlinearStepMetrics:
+    """``metrics`` of a step that does not settle (a limit cycle, a divergence, undetermined): no rise time,
+    overshoot, settling time or final value (NaN, None), which would only say where the horizon cut the run.
+
+    Examples
+    --------
+    >>> from synth.sim.limitcycle import Oscillation
+    >>> osc = Oscillation(True, 0.2, 4.5, 0.1, None, None, 12, None, "steady")
+    >>> m = NonlinearStepMetrics(0.7, 121.5, None, 0.14, 0.3, 0.0, 5.0, 1.0, -1.0, 1.0, 0.0, 9.0, {}, osc)
+    >>> u = unsettled(m); u.overshoot, u.final_value, u.actuator_max
+    (nan, nan, 1.0)
+    """
+    nan = float("nan")
+    return replace(metrics, rise_time=nan, overshoot=nan, settling_time=None, final_value=nan)
 
 
 TAIL_SHARE = 0.05
