@@ -12,19 +12,17 @@ reported as the fitted delay at its bound 0.
 from __future__ import annotations
 
 from dataclasses import replace
-from typing import TYPE_CHECKING
+from typing import Any
 
 import numpy as np
-
-if TYPE_CHECKING:
-    from synth.ident.timefit import TimeFitResult
 
 __all__ = ["at_zero_delay", "zero_delay_candidate"]
 
 
-def zero_delay_candidate(fitted: TimeFitResult, dt: float) -> bool:
+def zero_delay_candidate(fitted: Any, dt: float) -> bool:
     """Whether a fitted delay's zero is worth a fit of its own: a direct feedthrough (biproper structure, no
-    sensor) and the fitted delay within the first sample interval.
+    sensor) and the fitted delay within the first sample interval (``fitted`` a
+    :class:`~synth.ident.timefit.TimeFitResult`, which imports this module).
 
     Examples
     --------
@@ -40,7 +38,7 @@ def zero_delay_candidate(fitted: TimeFitResult, dt: float) -> bool:
             and fitted.delay <= dt * (1.0 + 1e-9))
 
 
-def at_zero_delay(zero: TimeFitResult, fitted: TimeFitResult) -> TimeFitResult:
+def at_zero_delay(zero: Any, fitted: Any) -> Any:
     """The fit with the delay held at 0 as a fitted delay at its bound: the delay's row and column (zeros) in the
     covariance, its name in ``names``, a note in ``solver["zero_delay"]`` with both fits.
 

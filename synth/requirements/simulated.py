@@ -116,8 +116,11 @@ def simulated_step(sim: SimulationSpec, loop: Loop, settle_band: float = 0.02, e
         return SimulatedStep(v.verdict, nan, nan, nan, v.summary(), evidence,
                              float(lc.amplitude) if cyc and lc.amplitude is not None else None,
                              float(lc.period) if cyc and lc.period is not None else None)
+    from synth.sim.authority import short_of_reference
     from synth.sim.metrics import nonlinear_step_metrics
 
+    if short_of_reference(v.result, sim.step_time, (start, end)):  # settled on a saturation, not at the reference
+        return SimulatedStep("short_of_reference", nan, nan, nan, v.summary(), evidence)
     m = nonlinear_step_metrics(v.result, sim.step_time, settle_band=settle_band,
                                min_amplitude=sim.limit_cycle.min_amplitude, step_size=end - start)
     settling = nan if m.settling_time is None else float(m.settling_time)

@@ -49,6 +49,7 @@ from typing import Any
 import numpy as np
 
 from synth.errors import ModelError
+from synth.sim.authority import short_of_reference
 from synth.sim.cycles import autocorrelation_period, measure_cycle
 from synth.sim.hidden_mode import hidden_drift, unseen_root
 from synth.sim.holding import winding_behind
@@ -404,8 +405,9 @@ def step_verdict(loop: NonlinearLoop, start: float, end: float, t_step: float = 
         metrics = dataclasses.replace(metrics, settling_time=None, limit_cycle=measure_cycle(
             result.t[keep], result.output[keep], metrics.limit_cycle, j.cycles, min_amplitude))
     verdict = j.verdict or "undetermined"
+    short = short_of_reference(result, t_step, (start, end)) if verdict == "settled" else None
     evidence = Evidence(float(result.t[-1]), loop.dt, int(result.t.size), j.cycles, tuple(tried), float(cap),
-                        j.criterion, plan)
+                        j.criterion + (f"; {short}" if short else ""), plan)
     return StepVerdict(verdict, evidence, metrics, result)
 
 

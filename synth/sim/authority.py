@@ -1,0 +1,57 @@
+"""A settled output that does not reach the reference: the actuator rests on its saturation for good.
+
+A saturation holds for ever once the controller's command moves away from its limit (:mod:`synth.sim.holding`):
+the output stands still and the step is settled, but where the limit is too low for the reference, it stands short
+of it while an integrator winds the command up without end (``1/(s+1)``, saturation at 1, step to 2, PI: the output
+rests at 1 and the command climbs at 2 units/s). The rise, overshoot and settling measured towards that final value
+would call such a step fine; :func:`short_of_reference` says what it is.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from synth.requirements.base import fmt
+from synth.sim.results import SimResult
+
+__all__ = ["SHORT_SHARE", "short_of_reference"]
+
+SHORT_SHARE = 0.02
+"""A settled output on a saturation this far from the reference, as a share of the step, or farther, is short of it
+(the settling band's default)."""
+
+
+def short_of_reference(result: SimResult, t_step: float, step: tuple[float, float]) -> str | None:
+    """Why a settled run does not reach the reference (None when it does, or when no saturation holds it): over the
+    last quarter after the step a saturation is active throughout and the output rests at least
+    :data:`SHORT_SHARE` of the step from the reference.
+
+    Examples
+    --------
+    >>> from synth.plant import Plant; from synth.controllers import Controller
+    >>> from synth.sim.blocks import Saturation
+    >>> from synth.sim.loops import NonlinearLoop
+    >>> from synth.sim.simulator import simulate_step
+    >>> loop = NonlinearLoop(Plant.from_string("1/(s+1)"), Controller("PI", {"kp": 1, "ki": 2}),
+    ...                      actuator=[Saturation(-1, 1)])
+    >>> short_of_reference(simulate_step(loop, 0, 2, 20.0), 0.0, (0, 2))[:58]
+    'the output rests 50 % of the step short of the reference 2'
+    >>> short_of_reference(simulate_step(loop, 0, 0.5, 20.0), 0.0, (0, 0.5)) is None
+    True
+    """
+    size = float(step[1] - step[0])
+    after = np.flatnonzero(result.t >= t_step)
+    if size == 0.0 or after.size < 8:
+        return None
+    tail = after[-max(2, after.size // 4):]
+    if not np.all(result.active("saturated")[tail]):
+        return None
+    reference, output = float(result.reference[-1]), float(np.mean(result.output[tail]))
+    short = (reference - output) / size
+    if abs(short) < SHORT_SHARE:
+        return None
+    rate = float(np.polyfit(result.t[tail], result.command[tail], 1)[0])
+    return (f"the output rests {100 * abs(short):.3g} % of the step {'short of' if short > 0 else 'beyond'} the "
+            f"reference {fmt(reference)} (at {fmt(output)}): the actuator sits on its saturation "
+            f"({fmt(float(result.actuator[-1]))}) for good, the controller's command moving at {rate:.3g} input "
+            "units/s")
