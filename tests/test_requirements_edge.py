@@ -236,6 +236,10 @@ def test_no_limit_cycle_is_confirmed_by_simulation():
     assert not outside.met and outside.details["confirmation"] == "confirmed"
     last = outside.details["simulations"][-1]
     assert last["delay"] == pytest.approx(1.4 * dm) and last["verdict"] == "limit_cycle"
+    # each run's own verdict in the sentence ('(a cycle) at 0 ms, 500 ms added' read as a cycle at both)
+    first = outside.details["simulations"][0]
+    assert f"{first['verdict'].replace('_', ' ')} with 0 ms added" in outside.message
+    assert f"limit cycle with {last['delay'] * 1e3:.4g} ms added" in outside.message
     settled = _simulate(k, 0.5 * dm, t_end=200.0)
     cycling = _simulate(k, 1.4 * dm, t_end=200.0)
     assert np.ptp(settled) < 5e-3

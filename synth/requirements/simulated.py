@@ -241,8 +241,8 @@ def confirm_prediction(req: Any, predicted: RequirementResult, loop: Loop) -> Re
         message += f"; not confirmed: the simulation with {at(unknown[0][0])} added was undetermined"
     else:
         how = "confirmed"
-        message += (f"; confirmed by simulation ({'a cycle' if cycles else 'settled'}) at "
-                    f"{', '.join(at(t) for t, _ in runs)} added")
+        message += "; confirmed by simulation: " + ", ".join(
+            f"{r.verdict.replace('_', ' ')} with {at(t)} added" for t, r in runs)
     details = {**d, "confirmation": how, "describing_function_margin_db": predicted.value,
                "simulations": [{"delay": t, **r.to_dict()} for t, r in runs], "simulation_text": said}
     return req.result(value=value, bound=predicted.bound, unit=predicted.unit, slack=slack,
