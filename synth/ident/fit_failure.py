@@ -12,8 +12,8 @@ import numpy as np
 
 from synth.distributions import f_sf
 
-__all__ = ["ABSURD_FACTOR", "CONVERGED_WITHIN", "FAILED_STATUSES", "LIMIT_STATUSES", "SIGNIFICANCE", "fit_failure",
-           "remaining_improvement", "roots_beyond_record", "scaled_jacobian", "start_point", "start_ssr"]
+__all__ = ["ABSURD_FACTOR", "CONVERGED_WITHIN", "FAILED_STATUSES", "LIMIT_STATUSES", "NO_RESPONSE", "SIGNIFICANCE",
+           "fit_failure", "remaining_improvement", "roots_beyond_record", "scaled_jacobian", "start_point", "start_ssr"]
 
 #: IPOPT return statuses that end a fit without a usable optimum
 FAILED_STATUSES = ("Diverging_Iterates", "Maximum_Iterations_Exceeded", "Maximum_CpuTime_Exceeded",
@@ -28,6 +28,9 @@ LIMIT_STATUSES = ("Maximum_Iterations_Exceeded", "Maximum_CpuTime_Exceeded", "Ma
 #: less than this many standard errors still to go (see :func:`fit_failure`) counts as converged
 CONVERGED_WITHIN = 0.1
 
+#: the words of every failure that finds no response to the input in the record (the F-tests of :func:`fit_failure`)
+NO_RESPONSE = "the fitted model explains no more of the output than"
+
 #: p-value of the F-test above which a fit explains no more than noise (see :func:`fit_failure`)
 SIGNIFICANCE = 1e-3
 
@@ -38,7 +41,7 @@ ABSURD_FACTOR = 1e8
 def fit_failure(parameters: dict[str, float], start: np.ndarray, status: str | None, success: bool,
                 fit_percent: float, delay: float | None, duration: float, samples: int = 0, free: int = 0,
                 remaining_step: float = float("inf"), start_fit_percent: float = float("nan"),
-                solver: str = "IPOPT", ridge: str = "") -> str:
+                solver: str = "IPOPT", ridge: str = "", whitened_p: float = 0.0) -> str:
     """Why a finished fit is not a result, or ``""`` if it is one.
 
     A fit fails when the solver diverged or stopped at a limit (:data:`FAILED_STATUSES`), a
@@ -79,6 +82,10 @@ def fit_failure(parameters: dict[str, float], start: np.ndarray, status: str | N
     solver : str
         The solver that made the fit, as the message names it (IPOPT, or Levenberg-Marquardt: both report
         IPOPT's status strings).
+    whitened_p : float
+        p-value that the output moves with the input at all: the cross-correlation of the two, each prewhitened by
+        its own autoregressive model (:func:`synth.ident.coloured_relevance.response_p_value`; 0: not tested): above
+        ``SIGNIFICANCE`` the model matched an output that wanders on its own, not a response to the input.
     ridge : str
         :func:`roots_beyond_record` of the fitted model: a fit with a pole or zero there ended on a ridge of its
         structure that the record cannot tell apart from its limit (``K (1 - a s)`` with ``K -> 0``,
@@ -135,9 +142,13 @@ def fit_failure(parameters: dict[str, float], start: np.ndarray, status: str | N
         p_value = float(f_sf(f_stat, free - 1, dof))
         if p_value > SIGNIFICANCE:
             began = ", ".join(f"{k} = {float(v0):.3g}" for k, v0 in zip(parameters, np.asarray(start, float)))
-            return (f"fit {fit_percent:.2f} %: the fitted model explains no more of the output than noise would "
+            return (f"fit {fit_percent:.2f} %: {NO_RESPONSE} noise would "
                     f"(F-test p = {p_value:.2g}): a local minimum reached from the start ({began}), or a record "
                     "without a response to its input")
+    if whitened_p > SIGNIFICANCE:
+        return (f"fit {_percent(fit_percent)} %: {NO_RESPONSE} the output's own drift would "
+                f"(the prewhitened output against the prewhitened input: p = {whitened_p:.2g}): an "
+                "output that wanders on its own, not a response to the input")
     if ridge:
         return f"{solver} ended ({status}) on a ridge of the structure ({ridge}, fit {_percent(fit_percent)} %)"
     return ""

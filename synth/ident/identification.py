@@ -21,6 +21,7 @@ from synth.errors import DataError, FitError, ModelError
 from synth.ident.delay_alias import ambiguity_note, whole_record_start
 from synth.ident.directions import DirectionComparison, fit_by_direction
 from synth.ident.edge_check import EDGE_MISFIT, edge_misfit
+from synth.ident.fit_failure import NO_RESPONSE
 from synth.ident.nyquist import beyond_nyquist
 from synth.ident.pair_relocation import relocate_pair
 from synth.ident.periodic_start import after_gaps, fit_whole_record, refit_periodic_start, settling_time
@@ -446,6 +447,10 @@ def _refit_unsettled(record: Record, avg: StepAverage, fit: TimeFitResult, struc
     # refit onto the ridge K -> 0, a -> inf of K(1 - a s)/(...) at 36 % where the own start reaches 95 %; windows
     # shorter than the delay (2.5 s behind steps 1-3 s apart) gave an edge fit whose refit converged at K = -0.71,
     # fit 21 %, where the own start finds the truth at 95.5 % (a black-box test)
+    if not fits and all(NO_RESPONSE in f for f in failures):  # the whole record shows no response: a failure
+        raise FitError(f"fit of {structure.formula!r} failed: {why}, and over the whole record the model explains no "
+                       f"more of the output than noise or its own drift ({failures[0]}); the edge average alone is "
+                       "no evidence of a response: check that the output responds to the input", where=record.source)
     if not fits:
         return fit, f"{why}; the whole-record fit failed ({'; '.join(failures)}), so the edge fit is kept (biased)"
     name, whole = min(fits, key=lambda named: named[1].residual_std)

@@ -37,6 +37,7 @@ from synth.data.gaps import gap_weights
 from synth.data.record import Record
 from synth.distributions import t_ppf
 from synth.errors import DataError, FitError, ModelError
+from synth.ident.coloured_relevance import no_response_p_value
 from synth.ident.convolution_problem import ConvolutionProblem
 from synth.ident.covariance import fit_covariance
 from synth.ident.delay_samples import best_sample, walk_intervals
@@ -462,7 +463,8 @@ def _fit_structure(record: Record, structure: Structure | str, delay: str | floa
                           bool(st_info.get("success")), fit_pct, d_hat if fit_delay else None, n * dt,
                           int(y_fit.size), p_total, remaining,
                           float(100.0 * (1.0 - np.sqrt(ssr_start) / np.linalg.norm(y_fit - np.mean(y_fit)))),
-                          "Levenberg-Marquardt" if isinstance(prob, ConvolutionProblem) else "IPOPT", ridge)
+                          "Levenberg-Marquardt" if isinstance(prob, ConvolutionProblem) else "IPOPT", ridge,
+                          no_response_p_value(w, y, y_fit, resid, p_total))
     info["failure"] = failure
     if failure and check:
         met = coinciding(fitted)  # stalled where two roots meet: say so
