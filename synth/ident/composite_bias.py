@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["BIAS_NEIGHBOURS", "BIAS_SIGMAS", "composite_bias"]
+__all__ = ["BIAS_NEIGHBOURS", "BIAS_SIGMAS", "PRECISE", "composite_bias"]
 
 BIAS_SIGMAS = 2.0
 """The part of the two estimates' difference within this many of their combined random errors is noise, not bias."""
@@ -21,11 +21,16 @@ BIAS_SIGMAS = 2.0
 BIAS_NEIGHBOURS = 4
 """Points on each side of a frequency whose measured bias is looked at (0.1 decade on the default grid)."""
 
+PRECISE = 0.1
+"""Only where the method's own random error is at most this is its difference from the composite evidence of bias: at
+a sweep's first frequencies the method can be many times off (18 times at 0.36 rad/s, its error 0.3)."""
+
 
 def composite_bias(H_composite: np.ndarray, err_composite: np.ndarray, H_method: np.ndarray,
                    err_method: np.ndarray, used: np.ndarray) -> np.ndarray:
     """The composite's bias (relative to ``|H|``) at each point: the median, over the points within
-    :data:`BIAS_NEIGHBOURS` on either side where the method is ``used``, of how far the two estimates differ beyond
+    :data:`BIAS_NEIGHBOURS` on either side where the method is ``used`` with a random error of at most
+    :data:`PRECISE`, of how far the two estimates differ beyond
     :data:`BIAS_SIGMAS` combined random errors; 0 where no such point is near.
 
     The median asks for most of the neighbours to agree, so one point where the method itself is off (little input
@@ -57,7 +62,7 @@ def composite_bias(H_composite: np.ndarray, err_composite: np.ndarray, H_method:
     noise = BIAS_SIGMAS * np.hypot(np.asarray(err_composite, float), np.asarray(err_method, float))
     with np.errstate(divide="ignore", invalid="ignore"):
         excess = np.abs(Hc - Hm) / np.abs(Hc) - noise
-    measured = np.asarray(used, bool) & np.isfinite(excess)
+    measured = np.asarray(used, bool) & np.isfinite(excess) & (np.asarray(err_method, float) <= PRECISE)
     bias = np.zeros(Hc.size)
     for i in range(Hc.size):
         near = slice(max(0, i - BIAS_NEIGHBOURS), i + BIAS_NEIGHBOURS + 1)

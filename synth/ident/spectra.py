@@ -329,9 +329,10 @@ def _whole_run_low_end(runs: list[Record], rest: bool, grid: np.ndarray, H: np.n
                         "window's taper biases a sweep's lowest frequencies")
     H_lrm, err_lrm = local_rational_response(runs, grid[low])
     use = np.isfinite(H_lrm) & ~(err_lrm > LRM_ERROR_LIMIT * err[low])
-    # the composite's error with the bias its neighbours show against the method, then the choice again
+    # the composite's error with the bias its neighbours show against the method; the method also where its error is
+    # no larger than that (like against like: at a sweep's first points the method can be far off too)
     err_c = np.hypot(err[low], composite_bias(H[low], err[low], H_lrm, err_lrm, use))
-    use = np.isfinite(H_lrm) & ~(err_lrm > LRM_ERROR_LIMIT * err_c)
+    use |= np.isfinite(H_lrm) & (err_lrm <= err_c)
     H[low] = np.where(use, H_lrm, H[low])
     err[low] = np.where(use, err_lrm, err_c)
     return H, err, (f"{head} from the whole runs' transforms with each run's transient removed (the local rational "
