@@ -1,10 +1,13 @@
 """A diagnosis's verdict in plain sentences: what to tell a person first (:attr:`synth.gap.diagnose.Diagnosis.summary`).
 
-When re-fitting the nominal model's coefficients alone removes most of the gap, an accepted effect explains part of
-what the re-fit leaves, not the gap: the sentence says so, with the re-fitted model and its DC gain against the
-nominal one's (a DC motor with its brake on, against the no-load model: the re-fit removes 99.97 % of the gap, at
-0.62 times the gain, and a slow supply sag some of the rest). The model given is the one re-fitted with the effect;
-when it is the nominal model again, the effect explains the gap (the re-fit alone had bent the model toward it).
+When re-fitting the nominal model's coefficients alone removes most of the gap and the model re-fitted with the
+accepted effect still differs from the nominal one, the effect explains part of what the re-fit leaves, not the
+whole gap: the sentence gives both shares and that model with its DC gain against the nominal one's (a DC motor with
+its brake on, against the no-load model: the re-fit removes 99.97 % of the gap, at 0.61 times the gain, a slow
+supply sag some of the rest). That change is a parameter mismatch, or the share of an effect the candidates miss
+that the linear part takes (the X-4 rig's rate limit beside its saturation bends the re-fitted model to 1.18 times
+the gain and a right-half-plane zero): the sentence names both readings. When the model re-fitted with the effect
+is the nominal one again, the effect explains the gap (the re-fit alone had bent the model toward it).
 """
 
 from __future__ import annotations
@@ -23,8 +26,8 @@ __all__ = ["CHANGED", "MOSTLY_REFIT", "format_parameter", "refit_share_of_gap", 
 
 MOSTLY_REFIT = 0.5
 """When re-fitting the nominal coefficients alone removes at least this share of the gap above noise, and the model
-re-fitted with the accepted effect still differs from the nominal one (:data:`CHANGED`), the summary says the gap is
-mostly a parameter mismatch (the effect explains part of what the re-fit leaves)."""
+re-fitted with the accepted effect still differs from the nominal one (:data:`CHANGED`), the summary gives the re-fit's
+share and the effect's beyond it, and that model."""
 
 
 def refit_share_of_gap(refit_shrinkage: float, j_nominal: float, floor: float) -> float:
@@ -140,10 +143,11 @@ def verdict_sentence(verdict: dict[str, Any], attribution: EffectDiagnosis, nrms
         refit_share = refit_share_of_gap(attribution.refit_shrinkage, attribution.j_nominal, attribution.noise_floor)
         joint = plant_from_values(nominal, best.nominal, best.nominal.get("delay", nominal.delay))
         if refit_share >= MOSTLY_REFIT and response_change(joint, nominal) >= CHANGED:
-            text = (f"The gap ({gap}) is mostly a parameter mismatch: re-fitting the nominal coefficients alone removes "
-                    f"{np.floor(1e4 * refit_share) / 100:g} % of the held-out error above the noise floor. Beyond the "
-                    f"re-fit, {name} ({params}) shrinks the held-out error by a further {100 * best.shrinkage:.0f} %; "
-                    f"with it, {refit_text(joint, nominal, record)}.")
+            text = (f"The gap ({gap}): re-fitting the nominal coefficients alone removes "
+                    f"{np.floor(1e4 * refit_share) / 100:g} % of the held-out error above the noise floor; beyond the "
+                    f"re-fit, {name} ({params}) shrinks it by a further {100 * best.shrinkage:.0f} % and is the verdict. "
+                    f"Re-fitted with it, the model changes ({refit_text(joint, nominal, record)}): a parameter "
+                    "mismatch, or the share of another effect the linear part takes.")
         else:
             text = (f"The gap ({gap}) is explained by {name} ({params}): it removes {100 * best.share_of_gap:.0f} % of "
                     "the held-out error above the noise floor.")

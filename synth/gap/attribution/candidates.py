@@ -128,20 +128,19 @@ def candidate_fits(plant: Plant, effects: list[Effect], refit: AugmentedFit, tra
             sc = replace(sc, params=sc.params_held)
         return plant, t_tr, u_tr, y_tr, eff, refit.plant, weights, seeded_grid(eff, sc, u_tr)
 
-    def confirm_jointly(which: list[int]) -> dict[int, AugmentedFit | None]:
-        if progress is not None:  # the joint fits were counted as `confirm` steps; there may be more
-            progress["total"] = int(progress.get("total", 0)) + len(which) - (0 if joints else (confirm or 0))
+    def confirm_jointly(which: list[int], counted: int) -> dict[int, AugmentedFit | None]:
+        if progress is not None:  # `counted` of them were in the total already
+            progress["total"] = int(progress.get("total", 0)) + len(which) - counted
         return dict(zip(which, map_jobs(joint_fit, [job(i) for i in which], workers,
                                         lambda k: advance(progress, f"joint fit {screened[which[k]][0].label}"))))
 
-    joints: dict[int, AugmentedFit | None] = {}
-    joints = confirm_jointly(chosen)
+    joints = confirm_jointly(chosen, confirm or 0)  # the diagnosis counted `confirm` joint fits
     # a confirmed fit that is not the effect it names (a resonance without a peak) cannot be the verdict: its place
     # goes to the next screened candidate
     lost = sum(1 for i, f in joints.items() if f is not None and wrong_sign(screened[i][0], f.params, t_tr, u_tr, plant))
     spare = [i for i in range(len(screened)) if i not in joints][:lost]
     if spare:
-        joints.update(confirm_jointly(spare))
+        joints.update(confirm_jointly(spare, 0))
     for rank, (eff, sc) in enumerate(screened):
         fit: AugmentedFit | ScreenedFit = sc
         joint = joints.get(rank)
