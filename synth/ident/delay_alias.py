@@ -235,7 +235,7 @@ def whole_record_start(record: Record, avg: StepAverage, fit: TimeFitResult, str
     train = float(record.t[avg.steps.index[0]])
     screen = screen_aliases(record.t, record.u, record.y, fit.measured, period_samples, weights,
                             float(record.t[-1]) - train - period_samples * record.dt)
-    if screen.best == 0:
+    if screen.best == 0 or not screen.resolved:  # below ALIAS_CRITICAL the start-up prefers nothing: the note says so
         return start, ambiguity_note(fit, avg, screen)
     delay, sign = float(screen.delays[screen.best]), float(screen.signs[screen.best])
     try:
