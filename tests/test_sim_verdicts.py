@@ -412,3 +412,15 @@ def test_a_relay_loop_at_rest_stays_at_rest_until_its_step():
     assert ref["verdict"] == v.verdict == "settled"
     assert abs(v.metrics.settling_time - ref["settling_time"]) <= case["dt"] + 1e-9
     assert abs(v.metrics.rise_time - ref["rise_time"]) <= case["dt"]
+
+
+def test_a_zero_step_on_an_unstable_linear_loop_is_undetermined_not_settled(run_cli, tmp_path):
+    """A black-box test: P(20) on 1/(s(s+1)(s+2)) behind a saturation, above the critical gain 6, with a step of 0
+    was 'settled' (nothing moved it); a step of 1e-6 finds the limit cycle. With a linear part that holds its rest
+    (P(0.5)) a zero step stays settled."""
+    spec = tmp_path / "issue.yaml"
+    spec.write_text(ISSUE)
+    unstable = run_cli("simulate", str(spec), "-c", "P(20)", "--step", "0:0", "--out", str(tmp_path / "u"))
+    assert unstable.code == 3 and "verdict: undetermined" in unstable.out and "does not step" in unstable.out
+    stable = run_cli("simulate", str(spec), "-c", "P(0.5)", "--step", "0:0", "--out", str(tmp_path / "s"))
+    assert stable.code == 0 and "verdict: settled" in stable.out, stable.out

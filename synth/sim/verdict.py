@@ -406,8 +406,14 @@ def step_verdict(loop: NonlinearLoop, start: float, end: float, t_step: float = 
             result.t[keep], result.output[keep], metrics.limit_cycle, j.cycles, min_amplitude))
     verdict = j.verdict or "undetermined"
     short = short_of_reference(result, t_step, (start, end)) if verdict == "settled" else None
+    criterion = j.criterion + (f"; {short}" if short else "")
+    if verdict == "settled" and start == end and plan.linear_stable is False and not np.any(result.output
+                                                                                           != result.output[0]):
+        verdict = "undetermined"  # nothing moved the loop off an equilibrium its linear part does not hold
+        criterion = ("the reference does not step and nothing moved the loop from rest, while its linear part is "
+                     "unstable: whether it stays there is not shown (give a step, or a disturbance)")
     evidence = Evidence(float(result.t[-1]), loop.dt, int(result.t.size), j.cycles, tuple(tried), float(cap),
-                        j.criterion + (f"; {short}" if short else ""), plan)
+                        criterion, plan)
     return StepVerdict(verdict, evidence, metrics, result)
 
 
