@@ -56,3 +56,16 @@ def test_the_diagnosis_of_an_integrating_plant_names_its_extra_delay():
     assert d.verdict["effects"][0] == "delay", d.summary
     delay = next(e for e in d.attribution.effects if e.effect == "delay").parameters["delay"]
     assert abs(delay - 0.04) < 0.004, delay
+    assert not any("the model integrates" in w for w in d.warnings)   # a 1 % offset drifts 0.23 of the range
+
+
+def test_an_integrating_model_on_the_emps_position_record_is_warned_about():
+    """A black-box test: the EMPS drive's position, diagnosed open loop against 35.15/(s (95.1 s + 203.5)),
+    'explained by a dead zone' with the gain re-fitted 150 times smaller; docs/gap.md diagnoses it on velocity."""
+    from synth.data import load_record
+    from synth.gap.where.integrating import integrating_warning
+    from tests.conftest import shared_path
+
+    rec = load_record(shared_path("data", "emps_friction_drive", "DATA_EMPS.mat"), time="t", input="vir", output="qm")
+    text = integrating_warning(Plant.from_string("35.15/(s*(95.1*s+203.5))"), rec)
+    assert text is not None and "1.5 times the output's range" in text and "velocity record" in text

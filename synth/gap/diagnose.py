@@ -40,6 +40,7 @@ from synth.gap.effects.registry import DEFAULT_CANDIDATES, aux_candidates, make_
 from synth.gap.preflight import check_model
 from synth.gap.verdict_sentence import verdict_sentence
 from synth.gap.where.clipping import Clipping, record_clipping
+from synth.gap.where.integrating import integrating_warning
 from synth.gap.where.localize import GapLocalization, localize_gap
 from synth.gap.where.residual import hidden_pulse_warnings, not_judged_warning
 from synth.gap.where.start import start_transient_warning
@@ -410,6 +411,7 @@ def diagnose(plant: Plant, record: RecordLike, validate: RecordLike | Sequence[R
     if loc.residual.left_out:
         warnings.append(not_judged_warning(loc.residual.left_out, loc.residual.dt, len(record.gaps), "the log"))
     warnings += hidden_pulse_warnings(record, loc.residual, plant)
+    warnings += [w for w in [integrating_warning(plant, record)] if w]
     for i, v in enumerate(held_out):
         clips += record_clipping(v, "validate" if len(held_out) == 1 else f"validate {i + 1}")
         warnings += [w.replace("the validation record", f"validation run {i + 1}") if len(held_out) > 1 else w
