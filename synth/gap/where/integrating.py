@@ -27,7 +27,7 @@ def integrating_warning(plant: Plant, record: Record) -> str | None:
     Examples
     --------
     >>> from synth.data import record_from_arrays
-    >>> t = np.arange(0, 20, 0.01); u = np.sign(np.sin(t)); y = np.cumsum(u) * 0.01
+    >>> t = np.arange(0, 20, 0.01); u = np.sign(np.sin(t)); y = 0.01 * np.sin(t)   # a 1 % offset: 0.4 of drift
     >>> integrating_warning(Plant.from_string("1/(s*(s+1))"), record_from_arrays(t, u, y))[:45]
     'the model integrates (a pole at s = 0): simul'
     >>> integrating_warning(Plant.from_string("1/(s+1)"), record_from_arrays(t, u, y)) is None
