@@ -119,10 +119,12 @@ def whitened_f_test(y: np.ndarray, residuals: np.ndarray, free: int, order: int 
     return float(f_sf(((ssr0 - ssr1) / max(free - 1, 1)) / (max(ssr1, 1e-300) / dof), max(free - 1, 1), dof))
 
 
-def no_response_p_value(u: np.ndarray, y: np.ndarray, y_fit: np.ndarray, residuals: np.ndarray, free: int) -> float:
+def no_response_p_value(u: np.ndarray, y: np.ndarray, y_fit: np.ndarray, residuals: np.ndarray, free: int,
+                        significance: float = 1e-3) -> float:
     """The smaller p-value of :func:`response_p_value` (on the whole input ``u`` and output ``y``) and
     :func:`whitened_f_test` (on the fitted samples ``y_fit`` and their ``residuals``): large only when neither finds a
-    response to the input.
+    response to the input. Where the F-test alone is at most ``significance`` (a response found), its p-value is
+    returned and the cross-correlation is not computed: the smaller one is at most that too.
 
     Examples
     --------
@@ -133,4 +135,5 @@ def no_response_p_value(u: np.ndarray, y: np.ndarray, y_fit: np.ndarray, residua
     >>> no_response_p_value(u, walk, walk, fake, 3) > 1e-3
     True
     """
-    return min(response_p_value(u, y), whitened_f_test(y_fit, residuals, free))
+    p = whitened_f_test(y_fit, residuals, free)
+    return p if p <= significance else min(p, response_p_value(u, y))

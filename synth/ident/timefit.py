@@ -44,6 +44,7 @@ from synth.ident.delay_samples import best_sample, walk_intervals
 from synth.ident.fit_arguments import as_sensor, resolve_delay
 from synth.ident.fit_failure import (
     LIMIT_STATUSES,
+    SIGNIFICANCE,
     fit_failure,
     remaining_improvement,
     roots_beyond_record,
@@ -295,11 +296,19 @@ def fit_structure(record: Record, structure: Structure | str, delay: str | float
         zero = _fit_structure(record, fit.structure, 0.0, sensor, periodic, initial, lower, weights, False, solver,
                               rtol, free_start)
         if not zero.solver.get("failure") and zero.fit_percent > fit.fit_percent:
-            fit, delay = at_zero_delay(zero, fit), 0.0
-    if check and fit.solver.get("failure"):  # the same fit again, raising its FitError
-        _fit_structure(record, fit.structure, delay, sensor, periodic, initial, lower, weights, True, solver, rtol,
-                       free_start)
+            fit = at_zero_delay(zero, fit)
+    if check and fit.solver.get("failure"):
+        own = {k: v for k, v in fit.parameters.items() if k in fit.structure.parameters}
+        raise _failed(fit.structure.formula, fit.solver["failure"], own, fit.solver.get("status"),
+                      {k: v for k, v in fit.parameters.items() if k not in own}, record.source)
     return fit
+
+
+def _failed(formula: str, failure: str, fitted: dict, status: str | None, delay: dict, source: str | None) -> FitError:
+    met = coinciding(fitted)  # the FitError of a failed fit (check): a stall where two roots meet named
+    return FitError(f"fit of {formula!r} failed: {failure}; {met + '; ' if met else ''}try another structure, a fixed "
+                    "delay or a shorter part of the record", where=source, status=status,
+                    parameters={**fitted, **delay})
 
 
 def _fit_structure(record: Record, structure: Structure | str, delay: str | float | None, sensor: Plant | str | None,
@@ -464,14 +473,10 @@ def _fit_structure(record: Record, structure: Structure | str, delay: str | floa
                           int(y_fit.size), p_total, remaining,
                           float(100.0 * (1.0 - np.sqrt(ssr_start) / np.linalg.norm(y_fit - np.mean(y_fit)))),
                           "Levenberg-Marquardt" if isinstance(prob, ConvolutionProblem) else "IPOPT", ridge,
-                          no_response_p_value(w, y, y_fit, resid, p_total))
+                          no_response_p_value(w, y, y_fit, resid, p_total, SIGNIFICANCE))
     info["failure"] = failure
     if failure and check:
-        met = coinciding(fitted)  # stalled where two roots meet: say so
-        raise FitError(f"fit of {st.formula!r} failed: {failure}; {met + '; ' if met else ''}try another "
-                       f"structure, a fixed delay or a shorter part of the record", where=record.source,
-                       status=st_info.get("status"),
-                       parameters={**fitted, delay_name: float(d_hat)})
+        raise _failed(st.formula, failure, fitted, st_info.get("status"), {delay_name: float(d_hat)}, record.source)
     if -1e-7 <= d_hat < 0.0 or (failure and d_hat < 0.0):  # IPOPT relaxes f >= 0 by 1e-8; a failed fit's delay
         d_hat = 0.0  # below 0 is in solver["failure"], and its model (never a result) is built with none
     tq = float(t_ppf(0.975, dof))
