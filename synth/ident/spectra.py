@@ -264,8 +264,10 @@ def _composite(runs: list[Record], w_min: float | None, w_max: float | None, win
         lengths = tuple(dict.fromkeys(max(float(x), 8.0 / fs) for x in lengths))
     else:
         lengths = tuple(windows)
+    longest_run = max(r.n for r in windowed)  # the moved outputs shorten the runs by the shift
+    if shift and windows is None:  # a default window as long as a run: as long as the shortened run
+        lengths = tuple(dict.fromkeys(min(float(x), longest_run / fs) for x in lengths))
     grid = log_grid(w_min, w_max, points_per_decade)
-    longest_run = max(r.n for r in runs)
     results = []
     for length in lengths:
         nseg = round(float(length) * fs)

@@ -184,6 +184,9 @@ def window_spectra(runs: list[Record], fs: float, nseg: int, overlap: float, gri
         shift = (starts[-1] - starts[0]) / (k - 1) if k > 1 else nseg
         n_eff += k / (1.0 + 2.0 * sum((1.0 - m / k) * _overlap_rho(win, round(m * shift))
                                       for m in range(1, k) if m * shift < nseg))
+    if count == 0:
+        longest = max(r.n for r in runs) / fs
+        raise DataError(f"a window of {nseg / fs:.4g} s fits in none of the runs (the longest {longest:.4g} s)")
     gxx, gyy, gxy = sxx * scale / count, syy * scale / count, sxy * scale / count
     wb = 2.0 * np.pi * fs * np.arange(nfreq) / nseg
     edges = np.sqrt(grid[1:] * grid[:-1])
