@@ -28,7 +28,8 @@ import numpy as np
 
 from synth.data import Record
 
-__all__ = ["END_SHARE", "LEVEL_SHARE", "STILL_SHARE", "WHOLE_RUN_PERIODS", "at_rest", "whole_run_response"]
+__all__ = ["END_SHARE", "LEVEL_SHARE", "MOVED_SHARE", "STILL_SHARE", "WHOLE_RUN_PERIODS", "at_rest", "rest_level",
+           "whole_run_response"]
 
 WHOLE_RUN_PERIODS = 20.0
 """Below this many periods of the longest window the whole-run ratio replaces the composite. On the black-box
@@ -38,6 +39,9 @@ ones 29.9 % -> 6.4 % with 20 (within two random errors: 21 -> 57 %; the band's m
 
 END_SHARE = 0.02
 """Share of a run at each end looked at for rest (at least 10 samples)."""
+
+MOVED_SHARE = 1e-3
+"""The input has moved from rest once it is this share of its range away from its first sample."""
 
 STILL_SHARE = 0.05
 """An end of a run is at rest when the output's standard deviation over it (noise and motion) is at most this
@@ -98,20 +102,50 @@ def whole_run_response(runs: Sequence[Record], w: np.ndarray, gnn: np.ndarray) -
     sxy = np.zeros(w.size, complex)
     sxx = np.zeros(w.size)
     snn = np.zeros(w.size)
+    soff = np.zeros(w.size)
     fs = runs[0].fs
     for run in runs:
-        head_y, _ = _ends(run.y)
         t = run.t - run.t[0]
-        du, dy = run.u - float(run.u[0]), run.y - float(np.mean(head_y))  # from rest: the first input, the output's
+        rest, rest_var = rest_level(run)
+        du, dy = run.u - float(run.u[0]), run.y - rest
         U = np.empty(w.size, complex)
         Y = np.empty(w.size, complex)
+        D = np.empty(w.size, complex)
         for i, wi in enumerate(w):  # the transform at the grid's own frequencies, one at a time (long runs)
             kernel = np.exp(-1j * wi * t)
-            U[i], Y[i] = kernel @ du, kernel @ dy
+            U[i], Y[i], D[i] = kernel @ du, kernel @ dy, kernel.sum()
         sxy += Y * np.conj(U)
         sxx += np.abs(U) ** 2
         snn += run.t.size * np.abs(U) ** 2
+        soff += rest_var * np.abs(D) ** 2 * np.abs(U) ** 2  # the rest level's error, through the samples' sum
     with np.errstate(divide="ignore", invalid="ignore"):
         H = sxy / sxx
-        err = np.sqrt(np.pi * fs * np.asarray(gnn, float) * snn / 2.0) / (np.abs(H) * sxx)
+        err = np.sqrt(np.pi * fs * np.asarray(gnn, float) * snn / 2.0 + soff) / (np.abs(H) * sxx)
     return H, err
+
+
+def rest_level(run: Record) -> tuple[float, float]:
+    """The output's rest level before a run (mean and variance): its mean over the samples before the input first
+    moves by :data:`MOVED_SHARE` of its range (at most the run's head, :data:`END_SHARE`; at least the first sample).
+
+    Before the input moves the output is at rest whatever the plant; a head that also holds a sweep's fade-in
+    does not (its mean 1.2 % of the output's range off on a 0.5-15 rad/s sweep through a lightly damped mode,
+    which the transforms' sum over 90 s turned into 16 % at 0.31 rad/s). The variance is the noise's over those
+    samples (from their successive differences, which a slow motion does not enter) divided by their number.
+
+    Examples
+    --------
+    >>> from synth.data import record_from_arrays
+    >>> t = np.arange(0.0, 10.0, 0.1); u = np.where(t >= 1.0, 1.0, 0.0)
+    >>> y = 3.0 + np.where(t >= 1.0, 1.0 - np.exp(-(t - 1.0)), 0.0)
+    >>> rest_level(record_from_arrays(t, u, y))
+    (3.0, 0.0)
+    """
+    span_u = float(np.ptp(run.u))
+    head_y, _ = _ends(run.y)
+    moved = np.flatnonzero(np.abs(run.u[:head_y.size] - run.u[0]) > MOVED_SHARE * span_u)
+    m = int(moved[0]) if moved.size else head_y.size
+    still = run.y[:max(m, 1)]
+    if still.size < 3:
+        return float(still.mean()), float(np.var(np.diff(head_y)) / 2.0 / still.size)
+    return float(still.mean()), float(np.var(np.diff(still)) / 2.0 / still.size)
