@@ -284,7 +284,7 @@ def test_mat_matrix_and_struct_columns(tmp_path, transpose):
 def test_missing_mat_column_lists_the_columns(tmp_path):
     p, *_ = _mat(tmp_path)
     with pytest.raises(DataError, match=r"output column 'acc\[3\]' not found; did you mean 'acc\[2\]'\? columns are "
-                                        r"run.t, run.cmd, run.info.y, acc\[0\], acc\[1\], acc\[2\]$"):
+                                        r"run.t, run.cmd, run.info.y, acc\[0\], acc\[1\], acc\[2\], label$"):
         load_record(p, "run.t", "run.cmd", "acc[3]")
     with pytest.raises(DataError, match=r"columns map: column 'acc\[7\]' not found"):
         load_record(p, "run.t", "run.cmd", "x", columns={"acc[7]": "x"})

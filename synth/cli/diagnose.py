@@ -129,6 +129,8 @@ def run(args: argparse.Namespace) -> int:
 
     if args.workers < 1:
         raise SynthError(f"must be at least 1, got {args.workers}", where="--workers")
+    if args.seed < 0:
+        raise SynthError(f"must be an integer >= 0, got {args.seed}", where="--seed")
     if args.workers == 1:  # one process: no forked child for the quantizer's search either (synth.forked)
         allow_fork(False)
     try:

@@ -120,6 +120,10 @@ def run(args: argparse.Namespace) -> int:
         raise SynthError(f"must be between 1 and 2000, got {args.points_per_decade}", where="--points-per-decade")
     if not np.isfinite(args.skew):
         raise SynthError(f"must be a finite number of seconds, got {args.skew}", where="--skew")
+    shortest = min(float(r.t[-1] - r.t[0]) for r in runs)
+    if abs(args.skew) >= shortest:
+        raise SynthError(f"a channel skew of {args.skew:g} s is not shorter than the shortest run ({shortest:.4g} s); "
+                         "a skew is the lag of the output channel's clock, a few samples at most", where="--skew")
     sensor = None
     if args.divide_by:
         try:

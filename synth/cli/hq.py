@@ -99,6 +99,8 @@ def read_frd(path: str | Path, columns: dict[str, str] | None = None) -> dict[st
             found = data.get("coherent_band")
             if isinstance(found, dict) and all(isinstance(found.get(k), (int, float)) for k in ("w_min", "w_max")):
                 band = (float(found["w_min"]), float(found["w_max"]))
+            elif isinstance(found, dict) and "w_min" in found and found.get("w_min") is None:
+                band = ()  # freqresp found no coherent band
     else:
         table = read_table(path, columns)
         data = {}
@@ -108,7 +110,7 @@ def read_frd(path: str | Path, columns: dict[str, str] | None = None) -> dict[st
                 raise DataError(f"column '{name}' not found; found {', '.join(table.names()) or 'nothing'}",
                                 where=str(path))
             if key is not None:
-                data[name] = table.columns[table.find(key)]
+                data[name] = table.columns[table.find(key)] * _unit_factor(name, table.units.get(key, ""), path)
         keys = {"w": "w", "mag_db": "mag_db", "phase_deg": "phase_deg", "coherence": "coherence"}
         averages, band = None, None
     if not isinstance(data, dict):
@@ -129,8 +131,30 @@ def read_frd(path: str | Path, columns: dict[str, str] | None = None) -> dict[st
         if bad.size:
             raise DataError(f"column '{key}': {bad.size} value(s) are NaN or inf (first at row {bad[0]})",
                             where=str(path))
+    sizes = {keys[r]: c.size for r, c in cols.items() if c is not None}
+    if len(set(sizes.values())) > 1:
+        raise DataError("columns differ in length: " + ", ".join(f"{k} {n}" for k, n in sizes.items()),
+                        where=str(path))
     H = 10 ** (cols["mag_db"] / 20) * np.exp(1j * np.radians(cols["phase_deg"]))
     return {"w": cols["w"], "H": H, "coherence": cols["coherence"], "averages": averages, "band": band}
+
+
+_UNITS = {"w": {"": 1.0, "rad/s": 1.0, "hz": 2.0 * math.pi, "1/s": 1.0},
+          "mag_db": {"": 1.0, "db": 1.0},
+          "phase_deg": {"": 1.0, "deg": 1.0, "degree": 1.0, "degrees": 1.0, "rad": 180.0 / math.pi},
+          "coherence": {"": 1.0, "-": 1.0}}
+
+
+def _unit_factor(name: str, unit: str, path: Path) -> float:
+    """The factor from a CSV header's unit to the column's own (rad/s, dB, deg); an unknown unit is an error."""
+    from synth.errors import DataError
+
+    known = _UNITS[name]
+    factor = known.get(unit.strip().lower())
+    if factor is None:
+        listed = ", ".join(k for k in known if k)
+        raise DataError(f"column '{name}': unit '{unit}' is not one of {listed}", where=str(path))
+    return factor
 
 
 def within_band(frd: dict[str, Any], where: str) -> tuple[dict[str, Any], str | None]:
@@ -154,6 +178,9 @@ def within_band(frd: dict[str, Any], where: str) -> tuple[dict[str, Any], str | 
     band, w = frd.get("band"), frd["w"]
     if band is None:
         return frd, None
+    if not band:
+        raise DataError("freqresp found no coherent band in this response: no frequency of it is trusted "
+                        "(--all-points uses every frequency, trusted or not)", where=where)
     keep = (w >= band[0] * (1 - 1e-9)) & (w <= band[1] * (1 + 1e-9))
     if keep.all():
         return frd, None

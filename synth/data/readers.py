@@ -372,6 +372,10 @@ def _read_csv(path: Path) -> Table:
     decimal_comma = 0
     for number, line in lines[1:]:
         cells = _cells(line, delimiter)
+        if any(c for c in cells[len(header):]):
+            raise DataError(f"line {number} has {len(cells)} fields, the header {len(header)}: which column does "
+                            f"'{next(c for c in cells[len(header):] if c)}' belong to? Fix the row or the header",
+                            where=str(path))
         for i, h in zip(keep, names):
             if i >= len(cells):  # a short row leaves its columns short (a "different lengths" error if used)
                 continue
@@ -435,29 +439,42 @@ def _read_mat(path: Path) -> Table:
 
     try:
         raw = loadmat(str(path), squeeze_me=True)
-    except (OSError, ValueError, NotImplementedError) as exc:  # NotImplementedError: v7.3 (HDF5) files
-        raise DataError(f"cannot read as a MATLAB file: {exc}", where=str(path)) from None
+    except Exception as exc:  # scipy raises what its parser hits: MatReadError, IndexError on text, v7.3 (HDF5)
+        detail = f"{type(exc).__name__}: {exc}" if str(exc) else type(exc).__name__
+        raise DataError(f"cannot read as a MATLAB file ({detail})", where=str(path)) from None
     out: dict[str, np.ndarray] = {}
+    problems: dict[str, str] = {}
     for key, value in raw.items():
         if not key.startswith("__"):
-            _flatten(key, value, out)
-    return Table(out, {k: "" for k in out}, str(path))
+            _flatten(key, value, out, problems)
+    return Table(out, {k: "" for k in out}, str(path), problems={k: v for k, v in problems.items() if k not in out})
 
 
-def _flatten(name: str, value: Any, out: dict[str, np.ndarray]) -> None:
-    """Columns of one MAT variable: a vector, a matrix's columns ``name[i]``, a struct's fields ``name.field``."""
+def _flatten(name: str, value: Any, out: dict[str, np.ndarray], problems: dict[str, str]) -> None:
+    """Columns of one MAT variable: a vector, a matrix's columns ``name[i]``, a struct's fields ``name.field``;
+    a variable that holds no real numbers goes to ``problems`` with what it holds."""
+    if hasattr(value, "toarray") and not isinstance(value, np.ndarray):  # a sparse matrix
+        value = np.squeeze(value.toarray())
     a = np.asarray(value)
     if a.dtype.names:  # a struct (a struct array of one element after squeeze_me)
         if a.size == 1:
             item = a.reshape(-1)[0]
             for f in a.dtype.names:
-                _flatten(f"{name}.{f}", item[f], out)
+                _flatten(f"{name}.{f}", item[f], out, problems)
+        else:
+            problems[name] = f"MAT variable '{name}' is an array of {a.size} structs; give one struct"
         return
     if a.dtype.kind == "O":  # a cell, or a struct field holding one
-        if a.size == 1:
-            _flatten(name, a.reshape(-1)[0], out)
+        if a.size == 1 and a.reshape(-1)[0] is not value:
+            _flatten(name, a.reshape(-1)[0], out, problems)
+        else:
+            problems[name] = f"MAT variable '{name}' is a cell array of {a.size} items, not a numeric vector"
         return
-    if a.dtype.kind not in "iufb" or a.size < 2:
+    if a.dtype.kind not in "iufb":
+        kind = {"c": "complex", "U": "text", "S": "text"}.get(a.dtype.kind, f"of type {a.dtype}")
+        problems[name] = f"MAT variable '{name}' is {kind}, not a real numeric vector"
+        return
+    if a.size < 2:
         return
     if a.ndim == 1:
         out[name] = a.astype(float)

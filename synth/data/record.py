@@ -19,7 +19,7 @@ import numpy as np
 
 from synth.data.gaps import find_gaps, hidden_changes
 from synth.data.interpolated_noise import interpolation_noise_correlation, interpolation_noise_factor
-from synth.data.readers import Table, read_table, table_from_columns, time_scale
+from synth.data.readers import Table, read_table, split_unit, table_from_columns, time_scale
 from synth.errors import DataError
 from synth.plant import Signal
 
@@ -437,6 +437,14 @@ def _pick(table: Table, name: str | None, role: str, fallback: int) -> str:
     return table.find(name, role)
 
 
+_TIME_NAMES = frozenset({"t", "time", "times", "timestamp", "zeit", "sec", "seconds"})
+
+
+def _looks_like_time(name: str, unit: str) -> bool:
+    bare, header_unit = split_unit(name)
+    return bare.strip().lower() in _TIME_NAMES or (unit or header_unit).strip().lower() in ("s", "ms", "us", "min")
+
+
 def record_from_columns(
     columns: Mapping[str, np.ndarray] | Table,
     source: str = "columns",
@@ -475,6 +483,11 @@ def record_from_columns(
     shift = 1 if from_dt else 0  # without a time column, input and output default to the first two columns
     u_name = _pick(table, input, "input", 1 - shift)
     y_name = _pick(table, output, "output", 2 - shift)
+    for name, given in ((u_name, input), (y_name, output)):
+        if from_dt and given is None and _looks_like_time(name, table.units.get(name, "")):
+            raise DataError(f"column '{name}' looks like a time column, and with a sample interval given (dt) the "
+                            "first columns are taken as input and output; drop the sample interval, or name the "
+                            "input and output columns", where=table.source)
     aux_cols = {key: table.columns[key] for key in (_pick(table, a, "aux", 0) for a in aux)}
     roles = [("time", t_name)] * (not from_dt) + [("input", u_name), ("output", y_name)] + [("aux", k) for k in aux_cols]
     for i, (role, key) in enumerate(roles):

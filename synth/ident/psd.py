@@ -58,6 +58,8 @@ KNEE_DB = 3.0
 #: fewer Welch segments than this (fewer than about 7.7 degrees of freedom, each bin's estimate spread over
 #: a factor of 6 for 90 % of its chi-square distribution) give no requirement: "undetermined"
 MIN_SEGMENTS = 4
+#: a signal whose values vary by less than this: its power (the square, times a sample interval) underflows
+TINY_SPREAD = 1e-140
 #: probability that a pure noise floor's power above the floor passes as a disturbance (one-sided)
 FALSE_ALARM_RATE = 1e-3
 #: the same as a number of standard deviations of the above-floor power (normal approximation)
@@ -424,6 +426,9 @@ def analyze_records(records: Sequence[DisturbanceRecord], noise: Sequence[Distur
         if not np.isfinite(power):
             raise DataError(f"column '{r.name}': values up to {float(np.max(np.abs(r.x))):.3g} overflow its power "
                             "spectrum; rescale the signal", where=r.source)
+        if float(np.ptp(r.x)) < TINY_SPREAD:
+            raise DataError(f"column '{r.name}': its values vary by {float(np.ptp(r.x)):.3g} only, and their power "
+                            "spectrum underflows double precision; rescale the signal", where=r.source)
     unit = options.pop("unit", records[0].unit)
     result = analyze_psd([r.x for r in records], dt0, noise=[r.x for r in noise] or None, unit=unit, **options)
     notes = tuple(f"{r.source}: {n}" for r in everything for n in r.notes)

@@ -401,7 +401,7 @@ def _dask_client(scheduler: Any) -> tuple[Any, str, int]:
     if isinstance(scheduler, str):
         try:
             client = Client(scheduler, timeout=os.environ.get("SYNTH_DASK_CONNECT_TIMEOUT", "10s"))
-        except OSError as exc:
+        except (OSError, ValueError, TypeError) as exc:  # ValueError: an address without a port
             raise SynthError(f"cannot reach the Dask scheduler: {exc}", where=f"--scheduler {scheduler}") from None
     else:
         client = scheduler
