@@ -46,6 +46,10 @@ def test_a_wound_up_pi_is_reported_as_the_limit_cycle_it_ends_in(report):
 def test_a_step_that_settles_keeps_its_measured_numbers(report):
     p3 = report.data["runs"]["reference"]
     assert p3["step_verdict"]["verdict"] == "settled"
-    assert p3["nonlinear"]["rise_time"] == pytest.approx(0.05225, abs=5e-5)  # the seed paper measured 0.05 s
+    # towards the final value of the verdict's 8 s run (the 1 s run shown ends 1.3 rad/s above it, under the sensor's
+    # 1.2 rad/s quantizer); the seed paper measured 0.05 s
+    assert p3["nonlinear"]["rise_time"] == pytest.approx(0.05104, abs=5e-5)
+    assert p3["step_verdict"]["evidence"]["horizon"] >= 6.3  # the linear loop settles after 6.3 s
     assert p3["nonlinear"]["final_value"] == pytest.approx(p3["step_verdict"]["final_value"], abs=1e-6)
-    assert "The reference P(kp=3) settles without a limit cycle (settled on a 1 s run)" in report.data["verdict"]
+    assert ("The reference P(kp=3) settles without a limit cycle (settled on a run of 8 s, beyond the 1 s shown)"
+            in report.data["verdict"])

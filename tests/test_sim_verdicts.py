@@ -424,3 +424,40 @@ def test_a_zero_step_on_an_unstable_linear_loop_is_undetermined_not_settled(run_
     assert unstable.code == 3 and "verdict: undetermined" in unstable.out and "does not step" in unstable.out
     stable = run_cli("simulate", str(spec), "-c", "P(0.5)", "--step", "0:0", "--out", str(tmp_path / "s"))
     assert stable.code == 0 and "verdict: settled" in stable.out, stable.out
+
+
+def test_not_settled_before_the_linear_loop_settles():
+    """The X-4 loop under its sensor's 1.2 rad/s quantizer, the spec's 1 s horizon: the reading stays still while the
+    slow zero-pole pair creeps, and the run looked settled at 913.9 rad/s (settling 0.075 s), 1.3 % of the step
+    from where it settles (912.6 rad/s, after the linear loop's 6.3 s). Now the horizon runs on until then."""
+    from synth.sim.simulator import simulate_step
+    from synth.spec import load_spec
+
+    spec = load_spec("specs/x4_rotor.yaml")
+    sim = spec.simulation
+    loop = sim.build_loop(spec.nominal_plant(), Controller("P", {"kp": 3}))
+    v = step_verdict(loop, 820.0, 920.0, 0.0, 1.0, min_amplitude=sim.limit_cycle.min_amplitude)
+    assert v.verdict == "settled" and v.evidence.horizons[0] == 1.0 and v.evidence.horizons[-1] >= 6.3
+    long = simulate_step(loop, 820.0, 920.0, 30.0, 0.0)
+    assert v.metrics.final_value == pytest.approx(float(long.output[-1]), abs=0.05)  # 0.05 % of the step
+
+
+def test_a_start_the_blocks_hold_off_the_linear_rest(run_cli, tmp_path):
+    """X-4, P(3), step 0 -> 900 rad/s: at the reference 0 the rest command (-256 PWM) lies below the saturation
+    (0 PWM), so the loop's rest is the plant's output at 0 PWM, 870 - 200 * 1.9078 = 488.4 rad/s. It started from
+    the linear rest instead (129.4 rad/s, moving at t = 0; the peak actuator rate 188,198 PWM/s against a 10,000
+    PWM/s limit, and the numbers changed with --step-time)."""
+    outs = []
+    for t_step in ("0", "0.5"):
+        out = tmp_path / t_step
+        r = run_cli("simulate", "specs/x4_rotor.yaml", "-c", "P(3)", "--step", "0:900", "--step-time", t_step,
+                    "--out", str(out), "--json", str(tmp_path / f"{t_step}.json"))
+        assert r.code == 0, r.err
+        series = np.loadtxt(out / "timeseries.csv", delimiter=",", skiprows=2)
+        assert series[0, 2] == pytest.approx(870.0 - 200.0 * 23.0 * 0.43 / (9.6 * 0.54), abs=0.5)
+        assert float(np.max(np.abs(np.diff(series[:, 5])))) / 0.001 <= 10000.0 * (1 + 1e-9)
+        data = json.loads((tmp_path / f"{t_step}.json").read_text())
+        assert data["actuator_peak_rate"] <= 10000.0 * (1 + 1e-9)
+        assert data["verdict"] == "settled" and "to find its own rest" in data["evidence"]["criterion"]
+        outs.append(data)
+    assert outs[0]["overshoot"] == pytest.approx(outs[1]["overshoot"], abs=0.05)  # was 2.8 against 0.3 %

@@ -150,6 +150,9 @@ def _step_runs(spec: Spec, label: str, ctrl: Controller) -> tuple[dict[str, SimR
                            seed=sim.seed, min_amplitude=sim.limit_cycle.min_amplitude)
     if verdict.verdict != "settled":  # no final value: nothing to rise, overshoot or settle towards
         metrics["nonlinear"] = {**metrics["nonlinear"], **dict.fromkeys(_TOWARDS_FINAL)}
+    else:  # measured towards the final value the verdict's run settles at (a shown run may end before that)
+        settled = verdict.metrics.to_dict()
+        metrics["nonlinear"] = {**metrics["nonlinear"], **{k: settled[k] for k in _TOWARDS_FINAL}}
     return runs, {"controller": str(ctrl), "loop": loop.to_dict(), **metrics,
                   "step_verdict": {**verdict.to_dict(), "summary": verdict.summary(loop.plant.output.unit or "")}}
 
@@ -219,7 +222,7 @@ def _verdict(data: dict[str, Any], y: str) -> str:
             osc = f"{_ending(v, y)} ({v['evidence']['criterion']})"
         else:
             seen = "settled" if v["verdict"] == "settled" else "seen"
-            osc = f"{_ending(v, y)} ({seen} on a {fmt(horizon)} s run{beyond if seen == 'seen' else ''})"
+            osc = f"{_ending(v, y)} ({seen} on a run of {fmt(horizon)} s{beyond})"
         limited = f"rate-limited {fmt(nl['rate_limited_time'])} s, saturated {fmt(nl['saturated_time'])} s"
         if nl["rise_time"] is not None:
             rise = (f"nonlinear rise time {fmt(nl['rise_time'])} s against {fmt(lin['rise_time'])} s with every "

@@ -26,13 +26,18 @@ decide, doubles the horizon up to a cap. The rules (:func:`judge`), on the outpu
   amplitude: :attr:`Oscillation.periodic <synth.sim.limitcycle.Oscillation>`) is reported as
   oscillating but not periodic, with the range of its cycles' amplitudes and lengths;
 * **settled**: no sustained oscillation in the last quarter, which stays within :data:`SETTLED`
-  (0.01 %) of the step (or ``min_amplitude``) of the final value and moves (peak to peak) at most
-  half as much as the quarter before, its last eighth at most :data:`SHRINK` times the eighth
+  (0.01 %) of the step (or ``min_amplitude``) of the final value, does not creep (the least-squares line
+  through it changes by at most 0.01 % of the step, or less than the ripple about it: ``min_amplitude``
+  floors a ripple below a sensor's quantum, not a slow mode's creep under a quantizer's still reading), and
+  moves (peak to peak) at most half as much as the quarter before, its last eighth at most :data:`SHRINK` times the eighth
   before (or less than twice ``min_amplitude``, or 1e-9 of the step: the numerical floor);
 * **not settled** either, where a loop of linear blocks only has a root on or right of the imaginary axis, while the
   controller's command under the still output does not die out (:func:`synth.sim.hidden_mode.hidden_drift`: a
   mode the output does not see); on two horizons in a row (at the cap alone: over the run and its first half)
   that is **diverging**;
+* a run shorter than the linear loop's settling time (:class:`~synth.sim.horizon.HorizonPlan`, the cap
+  permitting) is not settled yet, whatever its last quarter shows (a 1 s run of the X-4 loop under its
+  sensor's quantizer looked settled 1.3 % of the step from where it settles after 6 s);
 * otherwise the horizon is doubled; at the cap the verdict is **undetermined** and says what was
   seen (cycles, the rule that failed).
 
@@ -88,6 +93,8 @@ SHRINK = 0.75
 """Largest ratio of the motion (peak to peak) over the last eighth of a settled run to that over the eighth
 before: an exponential decay that halves the motion per quarter shrinks it by 0.71 per eighth; a small
 sustained oscillation reached within the last quarter keeps a ratio near 1."""
+PROBE_SAMPLES = 50
+"""Samples at the starting reference that show whether the loop's linear rest holds with its blocks."""
 MAX_SAMPLES = 1_000_000
 """Most samples of one run under the default cap (:func:`default_cap`)."""
 
@@ -269,6 +276,11 @@ def judge(result: SimResult, t_step: float, step: tuple[float, float], metrics: 
     if off > max(SETTLED * scale, min_amplitude):
         return Judgement(None, f"the last quarter is {100 * off / scale:.2g} % of the step from its final value "
                          f"(settled needs {100 * SETTLED:g} %)", a.cycles)
+    trend, ripple = _trend(ta[quarter], ya[quarter])
+    if trend > SETTLED * scale and trend > ripple:  # min_amplitude floors a ripple, not a steady creep
+        return Judgement(None, f"the output still creeps by {100 * trend / scale:.2g} % of the step over the last "
+                         f"quarter (a trend, its ripple about it {100 * ripple / scale:.2g} %; settled needs "
+                         f"{100 * SETTLED:g} %)", a.cycles)
     late, early = float(np.ptp(ya[quarter])), float(np.ptp(ya[previous_quarter]))
     quiet = max(2 * min_amplitude, 1e-9 * (scale + abs(metrics.final_value)))
     if late > quiet and late > 0.5 * early:
@@ -292,6 +304,27 @@ def judge(result: SimResult, t_step: float, step: tuple[float, float], metrics: 
         return Judgement(None, f"{hidden.text()}; confirming on a longer horizon", a.cycles, True)
     return Judgement("settled", f"within {100 * SETTLED:g} % of the step over the last {span / 4:.2g} s, "
                      f"its motion at most half that of the quarter before and still shrinking", a.cycles)
+
+
+def _own_rest(loop: NonlinearLoop, start: float, end: float, plan: Any, seed: int) -> float:
+    """Seconds to run at the starting reference before t = 0 (0 where the loop's rest with its blocks taken as
+    the identity holds with the blocks: a saturation, dead zone or quantizer that changes the rest command
+    moves the loop at once)."""
+    from synth.sim.simulator import simulate_step
+
+    probe = simulate_step(loop, start, start, PROBE_SAMPLES * loop.dt, 0.0, (), seed)
+    scale = abs(end - start) or max(abs(start), 1.0)
+    if float(np.max(np.abs(probe.output - probe.output[0]))) <= 1e-9 * scale or plan.settle_time is None:
+        return 0.0
+    return max(2.0 * plan.settle_time, PROBE_SAMPLES * loop.dt)
+
+
+def _trend(t: np.ndarray, y: np.ndarray) -> tuple[float, float]:
+    """The change of the least-squares line through ``y`` over ``t``, and the peak-to-peak range about it."""
+    if t.size < 3:
+        return 0.0, 0.0
+    slope, offset = np.polyfit(t - t[0], y, 1)
+    return abs(float(slope) * float(t[-1] - t[0])), float(np.ptp(y - (offset + slope * (t - t[0]))))
 
 
 def default_cap(loop: NonlinearLoop, first: float) -> float:
@@ -380,14 +413,21 @@ def step_verdict(loop: NonlinearLoop, start: float, end: float, t_step: float = 
     T = min(first, cap)
     tried: list[float] = []
     previous: Judgement | None = None
+    settle = _own_rest(loop, start, end, plan, seed)
     while True:
         tried.append(T)
-        result = simulate_step(loop, start, end, T, t_step, disturbances, seed)
+        result = simulate_step(loop, start, end, T, t_step, disturbances, seed, settle)
         metrics = nonlinear_step_metrics(result, t_step, min_amplitude=min_amplitude, hysteresis=SAMPLED_HYSTERESIS,
                                          whole_cycles=True, step_size=end - start,
                                          window=window if window is not None else (T - t_step) / 4)
         j = judge(result, t_step, (start, end), metrics, min_amplitude, previous, T >= cap * (1 - 1e-12),
                   loop.actuator, unseen_root(loop, plan.linear_stable))
+        linear_settles = t_step + plan.settle_time if plan.settle_time is not None else None
+        if j.verdict == "settled" and linear_settles is not None and T < min(linear_settles, cap):
+            # a slow mode under a small creep (a quantizer's still reading holds the command): not before the
+            # linear loop itself settles
+            j = Judgement(None, f"{j.criterion}, but the linear loop settles only after {linear_settles:.3g} s",
+                          j.cycles)
         if j.verdict is None and T >= cap * (1 - 1e-12) and max_horizon is None and np.isfinite(j.wait):
             # the output waits behind a block the winding command leaves within j.wait: the default cap gives way
             # to a run that sees it let go, as far as the sample cap allows
@@ -407,6 +447,9 @@ def step_verdict(loop: NonlinearLoop, start: float, end: float, t_step: float = 
     verdict = j.verdict or "undetermined"
     short = short_of_reference(result, t_step, (start, end)) if verdict == "settled" else None
     criterion = j.criterion + (f"; {short}" if short else "")
+    if settle:
+        criterion += (f"; the loop's blocks hold it off its linear rest at the starting reference {start:.6g}, so "
+                      f"it ran {settle:.3g} s at that reference before t = 0 to find its own rest")
     if verdict == "settled" and start == end and plan.linear_stable is False and not np.any(result.output
                                                                                            != result.output[0]):
         verdict = "undetermined"  # nothing moved the loop off an equilibrium its linear part does not hold
