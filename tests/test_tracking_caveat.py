@@ -82,3 +82,23 @@ def test_a_pi_kept_without_integral_action_says_so_in_its_verdict() -> None:
     kept = result.verdict.split("The design without integral action (ki = 0) was kept: ")[1]
     mine, theirs = (float(x) for x in kept.split(" dB with ki free")[0].split(" against "))
     assert mine == pytest.approx(result.objective["value"], rel=1e-5) and mine <= theirs
+
+
+@pytest.mark.parametrize("plant, kp, says", [
+    # an unstable plant under P control: L(0) = -2.358, T(0) = 2.358 / 1.358 = 1.7365 (a black-box test's case: its
+    # step overshoot 2.2 % "met", measured from a final value 74 % beyond the reference, with no word of it)
+    ("2.4/((s-0.5)*(s+3))", 1.47361, "follows a slow reference to 1.74 of it, settling 73.6 % beyond it"),
+    # L(0) = -0.6: T(0) = -0.6 / 0.4 = -1.5, the output moves against the reference
+    ("-2/(s+1)", 0.3, "moves against a slow reference, to 1.5 of it with the opposite sign"),
+])
+def test_a_loop_that_settles_beyond_or_against_the_reference(plant, kp, says) -> None:
+    from synth.loop import Loop
+    from synth.plant import Plant
+    from synth.requirements import Bandwidth
+    from synth.requirements.tracking import tracking_caveat
+
+    loop = Loop(Plant.from_string(plant), Controller("P", {"kp": kp}))
+    assert says in Bandwidth(min=0.01).evaluate(loop).message
+    assert says in tracking_caveat(loop)
+    within = Loop(Plant.from_string("2/(s+1)"), Controller("P", {"kp": 3.0}))  # T(0) = 6/7: -1.3 dB, no note
+    assert tracking_caveat(within) == "" and "slow reference" not in Bandwidth(min=0.01).evaluate(within).message

@@ -1,4 +1,5 @@
-"""A note on a requirement met by a loop that barely follows the reference (``|T(0)|`` below -3 dB)."""
+"""A note on a requirement met by a loop that does not follow a slow reference: ``|T(0)|`` below -3 dB (it barely
+follows), above +3 dB (it settles far beyond the reference), or ``T(0) < 0`` (it moves the other way)."""
 
 from __future__ import annotations
 
@@ -33,7 +34,7 @@ def tracking_note(result: RequirementResult, loop: Loop) -> RequirementResult:
         return result
     t0, db = slow
     return replace(result, message=f"{result.message}; measured relative to |T(0)| = {t0} ({db} dB): the loop "
-                   f"follows a slow reference to {t0} of it; {_EXCLUDE}")
+                   f"{_follows(loop, t0)}; {_EXCLUDE}")
 
 
 def tracking_caveat(loop: Loop) -> str:
@@ -54,18 +55,35 @@ def tracking_caveat(loop: Loop) -> str:
     if slow is None:
         return ""
     t0, db = slow
-    return f"; but its loop follows a slow reference to only {t0} of it (|T(0)| = {db} dB): no requirement asks for " \
-           f"more; {_EXCLUDE}"
+    only = "only " if abs(loop.dc_gain()) < 1 and loop.dc_gain() >= 0 else ""
+    return f"; but its loop {_follows(loop, t0, only)} (|T(0)| = {db} dB): no requirement asks for " \
+           f"better; {_EXCLUDE}"
 
 
 _EXCLUDE = "bound the static sensitivity or require integral action to exclude such designs"
 
 
+def _follows(loop: Loop, t0: str, only: str = "") -> str:
+    """How the loop follows a slow reference, in words."""
+    if loop.dc_gain() < 0:
+        return f"moves against a slow reference, to {t0} of it with the opposite sign (T(0) < 0)"
+    return f"follows a slow reference to {only}{t0} of it" + (
+        f", settling {fmt(100 * (loop.dc_gain() - 1), 3)} % beyond it" if loop.dc_gain() > 1 else "")
+
+
 def _slow_reference(loop: Loop) -> tuple[str, str] | None:
-    """``|T(0)|`` and its dB value as text where it is below -3 dB (the bandwidth's level), else None."""
+    """``|T(0)|`` and its dB value as text where it lies below -3 dB (the bandwidth's level) or above +3 dB, or
+    where ``T(0)`` is negative; else None.
+
+    Examples
+    --------
+    >>> from synth.loop import Loop; from synth.plant import Plant; from synth.controllers import Controller
+    >>> _slow_reference(Loop(Plant.from_string("2.4/((s-0.5)*(s+3))"), Controller("P", {"kp": 1.47361})))
+    ('1.74', '4.79')
+    """
     from synth.loop import BANDWIDTH_LEVEL
 
     t0 = abs(loop.T0())
-    if not (np.isfinite(t0) and t0 < BANDWIDTH_LEVEL):
+    if not np.isfinite(t0) or (BANDWIDTH_LEVEL <= t0 <= 1.0 / BANDWIDTH_LEVEL and loop.dc_gain() >= 0):
         return None
     return fmt(t0, 3), fmt(20 * np.log10(t0), 3) if t0 > 0 else "-inf"
