@@ -145,3 +145,19 @@ def test_freqresp_skew_longer_than_a_run(run_cli, tmp_path):
     _step_csv(p)
     r = run_cli("freqresp", "--data", str(p), "--skew", "1000", "--out", str(tmp_path / "o"))
     assert r.code == 2 and "--skew: a channel skew of 1000 s is not shorter than the shortest run (3.99 s)" in r.err
+
+
+def test_runs_whose_time_stamps_were_rounded_are_at_one_rate():
+    """Two runs of one 60 Hz sweep written with 6-decimal time stamps, the second cut to 70 %: their mean intervals
+    differ by 3e-7 of it, and freqresp refused them ("0.0166667 s differs from the first run's 0.0166667 s")."""
+    from synth.data import record_from_arrays
+    from synth.ident.spectral_windows import as_runs
+
+    t = np.round(np.arange(5400) / 60.0, 6)
+    u = np.sin(0.3 * t * (1 + t / 20))
+    a = record_from_arrays(t, u, u)
+    b = record_from_arrays(t[:3780], u[:3780], u[:3780])
+    assert a.dt != b.dt and len(as_runs([a, b])) == 2
+    c = record_from_arrays(t * (1 + 1e-4), u, u)
+    with pytest.raises(DataError, match=r"sample interval 0\.016668\d* s differs from the first run's 0\.016666"):
+        as_runs([a, c])

@@ -30,8 +30,9 @@ output's symmetry about trim and (--off-axis) the off-axis share of the input po
 with the runs to keep (the NASA report keeps the best 2 of 3). --divide-by removes known
 sensor/filter dynamics, --skew a known lag of the output channel behind the input channel.
 
-exit codes: 0 done, 1 no coherent band or a failed fit (one line says what failed and what
-to try; nothing written), 2 bad input"""
+exit codes: 0 done, 1 no coherent band (the response and its figure are still written, to show
+the coherence; hq refuses them without --all-points) or a failed fit (one line says what failed
+and what to try; nothing written), 2 bad input"""
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:

@@ -54,8 +54,9 @@ from synth.errors import DataError
 from synth.ident.coherence import coherence_from_spectra
 
 __all__ = [
-    "CONSISTENCY", "MIN_SEGMENTS", "PERIODS_PER_WINDOW", "USE_PERIODS", "WindowSpectra", "as_runs", "check_length",
-    "combine_windows", "default_windows", "log_grid", "lowest_frequency", "required_window", "window_spectra",
+    "CONSISTENCY", "MIN_SEGMENTS", "PERIODS_PER_WINDOW", "SAME_RATE", "USE_PERIODS", "WindowSpectra", "as_runs",
+    "check_length", "combine_windows", "default_windows", "log_grid", "lowest_frequency", "required_window",
+    "window_spectra",
 ]
 
 #: periods of a frequency a window must hold before that window is used there
@@ -68,6 +69,9 @@ MIN_SEGMENTS = 3
 #: a shorter window is used at a frequency only where its H lies within this many combined random errors
 #: of the longest window's H (leakage bias near a lightly damped mode shows up as a disagreement)
 CONSISTENCY = 3.0
+#: runs whose sample intervals differ by less than this share are at one rate (a clock drift of 1e-6 over a 100 s
+#: run moves the last sample by 0.1 ms)
+SAME_RATE = 1e-6
 
 
 def as_runs(records: Record | Sequence[Record]) -> list[Record]:
@@ -85,8 +89,8 @@ def as_runs(records: Record | Sequence[Record]) -> list[Record]:
         raise DataError("no records given")
     dt = runs[0].dt
     for r in runs[1:]:
-        if abs(r.dt - dt) > 1e-9 * dt:
-            raise DataError(f"sample interval {r.dt:g} s differs from the first run's {dt:g} s "
+        if abs(r.dt - dt) > SAME_RATE * dt:  # time stamps written to 6 decimals differ by 3e-7 of a 60 Hz interval
+            raise DataError(f"sample interval {r.dt:.9g} s differs from the first run's {dt:.9g} s "
                             f"({runs[0].source}); resample the runs to one rate", where=r.source)
     return runs
 
