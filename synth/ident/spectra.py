@@ -206,7 +206,7 @@ def frequency_response(
     >>> t, u = design_sweep(0.4, 10).signal(sample_rate=50)
     >>> r = frequency_response(record_from_arrays(t, u, simulate_plant(G, t, u, "zero")), 0.4, 10)
     >>> k = np.argmin(abs(r.w - 2)); round(float(abs(r.H[k])), 2), round(float(abs(G.freqresp(r.w[k]))), 2)
-    (1.79, 1.77)
+    (1.77, 1.77)
     """
     runs = as_runs(records)
     first = _composite(runs, w_min, w_max, windows, overlap, points_per_decade, coherence_threshold, detrend)

@@ -126,7 +126,8 @@ def whole_run_response(runs: Sequence[Record], w: np.ndarray, gnn: np.ndarray) -
 
 def rest_level(run: Record) -> tuple[float, float]:
     """The output's rest level before a run (mean and variance): its mean over the samples before the input first
-    moves by :data:`MOVED_SHARE` of its range (at most the run's head, :data:`END_SHARE`; at least the first sample).
+    moves by :data:`MOVED_SHARE` of its range, or by four times its noise (at most the run's head,
+    :data:`END_SHARE`; at least the first sample).
 
     Before the input moves the output is at rest whatever the plant; a head that also holds a sweep's fade-in
     does not (its mean 1.2 % of the output's range off on a 0.5-15 rad/s sweep through a lightly damped mode,
@@ -143,7 +144,11 @@ def rest_level(run: Record) -> tuple[float, float]:
     """
     span_u = float(np.ptp(run.u))
     head_y, _ = _ends(run.y)
-    moved = np.flatnonzero(np.abs(run.u[:head_y.size] - run.u[0]) > MOVED_SHARE * span_u)
+    head_u = run.u[:head_y.size]
+    # a measured input's noise is no motion: its level from the second differences (a smooth start hardly enters)
+    noise_u = float(np.median(np.abs(np.diff(head_u, 2)))) / 0.6745 / np.sqrt(6.0) if head_u.size > 2 else 0.0
+    level = float(np.median(head_u[:5]))
+    moved = np.flatnonzero(np.abs(head_u - level) > max(MOVED_SHARE * span_u, 4.0 * noise_u))
     m = int(moved[0]) if moved.size else head_y.size
     still = run.y[:max(m, 1)]
     if still.size < 3:
