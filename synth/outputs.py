@@ -1,7 +1,8 @@
 """Writing output files without overwriting anything the user wrote.
 
 A report folder keeps a manifest (``.synth-manifest.json``) of the files
-synth wrote there; those may be regenerated freely. Any other existing file
+synth wrote there, each with its SHA-256; those may be regenerated freely,
+unless changed since (a user's edit is not overwritten without ``force``). Any other existing file
 with the same name is left alone unless ``force`` is given. A single output
 file (``--json FILE``) may be replaced only if synth wrote it (its JSON has
 ``"generator": "synth ..."``).
@@ -173,7 +174,7 @@ class OutputDir:
         self.force = force
         if self.path.exists() and not self.path.is_dir():
             raise OutputExistsError("exists and is not a directory", where=str(self.path))
-        self.known = _manifest_files(self.path)
+        self.known, self.hashes = _manifest_files(self.path)
         self.written: list[str] = []
         for name in expect:
             self._check(name)
@@ -184,7 +185,15 @@ class OutputDir:
 
     def _check(self, name: str) -> None:
         target = self.path / name
-        if target.exists() and not self.force and name not in self.known and not written_by_synth(target):
+        if not target.exists() or self.force:
+            return
+        recorded = self.hashes.get(name)
+        if recorded is not None and recorded != _sha256(target):
+            raise OutputExistsError(
+                "was written by synth and changed since; not overwriting it (use --force or another --out)",
+                where=str(target),
+            )
+        if name not in self.known and not written_by_synth(target):
             raise OutputExistsError(
                 "exists and was not written by synth; not overwriting it (use --force or another --out)",
                 where=str(target),
@@ -240,20 +249,32 @@ class OutputDir:
                     (self.path / name).parent.mkdir(parents=True, exist_ok=True)
                     os.replace(staged, self.path / name)
             files = sorted({f for f in {*self.written, *self.known} if (self.path / f).exists()})
-            atomic_write_text(self.path / MANIFEST, json.dumps({"generator": GENERATOR, "files": files}, indent=2) + "\n")
-            self.known = set(files)
+            hashes = {f: _sha256(self.path / f) if f in self.written else self.hashes.get(f) for f in files}
+            hashes = {f: h for f, h in hashes.items() if h is not None}
+            atomic_write_text(self.path / MANIFEST, json.dumps({"generator": GENERATOR, "files": files,
+                                                                "sha256": hashes}, indent=2) + "\n")
+            self.known, self.hashes = set(files), hashes
         finally:
             self.discard()
 
 
-def _manifest_files(folder: Path) -> set[str]:
+def _manifest_files(folder: Path) -> tuple[set[str], dict[str, str]]:
+    """The names a folder's manifest lists and the SHA-256 of each as synth wrote it (none in older manifests)."""
     manifest = folder / MANIFEST
     if not manifest.exists():
-        return set()
+        return set(), {}
     try:
-        return set(json.loads(manifest.read_text(encoding="utf-8")).get("files", []))
-    except (OSError, ValueError, AttributeError):
-        return set()
+        data = json.loads(manifest.read_text(encoding="utf-8"))
+        hashes = data.get("sha256", {})
+        return set(data.get("files", [])), (dict(hashes) if isinstance(hashes, dict) else {})
+    except (OSError, ValueError, AttributeError, TypeError):
+        return set(), {}
+
+
+def _sha256(path: Path) -> str:
+    import hashlib
+
+    return hashlib.sha256(path.read_bytes()).hexdigest()
 
 
 def _check_creatable(path: Path) -> None:

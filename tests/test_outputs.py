@@ -100,3 +100,24 @@ def test_a_file_where_the_folder_should_be_is_refused(tmp_path):
     (tmp_path / "rep").write_text("x")
     with pytest.raises(OutputExistsError, match="not a directory"):
         OutputDir(tmp_path / "rep")
+
+
+def test_a_file_synth_wrote_and_the_user_changed_is_not_overwritten(tmp_path):
+    """A black-box helper edited identify.json by hand and re-ran identify: it was replaced without a word (the
+    manifest held names only). The manifest now holds each file's SHA-256 as written."""
+    folder = tmp_path / "out"
+    first = OutputDir(folder)
+    first.claim("result.json").write_text('{"generator": "synth", "x": 1}\n')
+    first.commit()
+    again = OutputDir(folder, expect=["result.json"])  # unchanged: regenerated freely
+    again.claim("result.json").write_text('{"generator": "synth", "x": 2}\n')
+    again.commit()
+    assert (folder / "result.json").read_text() == '{"generator": "synth", "x": 2}\n'
+    (folder / "result.json").write_text('{"generator": "synth", "x": 2, "my note": "keep"}\n')
+    with pytest.raises(OutputExistsError, match=r"result\.json: was written by synth and changed since"):
+        OutputDir(folder, expect=["result.json"])
+    forced = OutputDir(folder, force=True, expect=["result.json"])
+    forced.claim("result.json").write_text('{"generator": "synth", "x": 3}\n')
+    forced.commit()
+    assert (folder / "result.json").read_text() == '{"generator": "synth", "x": 3}\n'
+    assert '"sha256"' in (folder / MANIFEST).read_text()
