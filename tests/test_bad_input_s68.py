@@ -99,7 +99,7 @@ def test_initial_values_must_be_finite(run_cli, tmp_path):
         p.write_text(f"name: x\nplant: {{tf: '2/(s+3)'}}\ncontroller:\n  type: {kind}\n  initial: {initial}\n"
                      "requirements:\n  - {type: bandwidth, min: 1}\n", encoding="utf-8")
         r = run_cli("check", str(p), "-c", "P(3)" if kind == "P" else "PI(3, 1)")
-        assert r.code == 2 and f"{p.name}:5: controller.initial: kp: the initial value must be a finite number" in r.err
+        assert r.code == 2 and f"{p.name}:5: controller.initial.kp: expected a finite number, got" in r.err
 
 
 def _frd_csv(path, w_header: str, phase_header: str, w_factor: float, phase_factor: float) -> None:
@@ -161,3 +161,50 @@ def test_runs_whose_time_stamps_were_rounded_are_at_one_rate():
     c = record_from_arrays(t * (1 + 1e-4), u, u)
     with pytest.raises(DataError, match=r"sample interval 0\.016668\d* s differs from the first run's 0\.016666"):
         as_runs([a, c])
+
+
+def _spec(tmp_path, requirements: str, name: str = "s.yaml"):
+    p = tmp_path / name
+    p.write_text("name: x\nplant: {tf: '2/(s+3)'}\ncontroller: {type: P}\nrequirements:\n" + requirements,
+                 encoding="utf-8")
+    return p
+
+
+@pytest.mark.parametrize("requirements, says", [
+    ("  - {type: bandwidth, min: 1, label: a}\n  - {type: margins, phase_margin_deg: 40, label: a}\n",
+     "s.yaml:4: requirements: label 'a' is given to 2 requirements"),
+    ("  - {type: bandwidth, min: 1, label: closed-loop stability}\n",
+     "label 'closed-loop stability' names the built-in stability row"),
+    ("  - {type: bandwidth, min: .inf}\n", "s.yaml:5: requirements[0].min: expected a finite number, got inf"),
+])
+def test_spec_labels_and_infinite_bounds(run_cli, tmp_path, requirements, says):
+    r = run_cli("check", str(_spec(tmp_path, requirements)), "-c", "P(3)")
+    assert r.code == 2 and says in r.err
+
+
+def test_messages_name_what_is_wrong(run_cli, tmp_path):
+    (tmp_path / "afile").write_text("")
+    r = run_cli("hq", "--tf", "1/(s+1)", "--json", str(tmp_path / "afile" / "x.json"))
+    assert r.code == 2 and f"its folder {tmp_path / 'afile'} exists and is not a directory" in r.err
+    p = tmp_path / "huge.csv"
+    t = np.arange(200) * 0.01
+    np.savetxt(p, np.c_[t, 1e200 * np.sin(t), np.cos(t)], delimiter=",", header="t,u,y", comments="")
+    r = run_cli("diagnose", "--plant", "2/(s+3)", "--data", str(p), "--no-report")
+    assert r.code == 2 and "column 'u': values up to 1e+200 overflow double precision" in r.err
+    q = tmp_path / "r.csv"
+    _step_csv(q)
+    r = run_cli("identify", "--data", str(q), "--structure", "K/(T*s+1)", "--sensor", "1/(s-1)",
+                "--out", str(tmp_path / "o"), "--no-figures")
+    assert r.code == 2 and "sensor: a known sensor must be stable; 1/(s-1) has pole(s) at 1" in r.err
+    folder_spec = tmp_path / "f.yaml"
+    folder_spec.write_text("name: x\nplant:\n  identify: {data: " + str(tmp_path) + ", structure: 'K/(T*s+1)'}\n"
+                           "controller: {type: P}\nrequirements: [{type: bandwidth, min: 1}]\n", encoding="utf-8")
+    r = run_cli("check", str(folder_spec), "-c", "P(3)")
+    assert r.code == 2 and "is a folder, not a file" in r.err
+
+
+def test_hq_fit_band_outside_the_data(run_cli, tmp_path):
+    p = tmp_path / "f.csv"
+    _frd_csv(p, "w", "phase_deg", 1.0, 180 / math.pi)
+    r = run_cli("hq", "--frd", str(p), "--fit-band", "1000", "2000")
+    assert r.code == 2 and "--fit-band: the fit band 1000-2000 rad/s holds 0 of the response's frequencies" in r.err

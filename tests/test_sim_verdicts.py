@@ -168,8 +168,8 @@ def test_a_run_that_overflows_is_diverging_not_a_traceback(run_cli, tmp_path):
 @pytest.mark.parametrize("extra, message", [
     ("  horizon: -1\n", "simulation.horizon: must be > 0"),
     ("  horizon: 0\n", "simulation.horizon: must be > 0"),
-    ("  dt: .nan\n", "simulation.dt: expected a number, got nan"),
-    ("  actuator: [{type: rate_limit, rate: .inf}]\n", "simulation.actuator[0].rate: expected a number, got inf"),
+    ("  dt: .nan\n", "simulation.dt: expected a finite number, got nan"),
+    ("  actuator: [{type: rate_limit, rate: .inf}]\n", "simulation.actuator[0].rate: expected a finite number, got inf"),
     ("  dt: 1.0e-12\n", "at most 1e+07"),
     ("  loop_delay: 1.0e+30\n", "in-loop delays"),
     ("  dt: 0.5\n  horizon: 2\n", "dt 0.5 s must be at most 1/20 of the horizon"),

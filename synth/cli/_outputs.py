@@ -58,8 +58,11 @@ def check_outputs(folder: str | Path | None, names: Iterable[str] = (), files: I
         check_writable(path, force)
         try:
             OutputDir(path.parent)  # the folder it goes in can be created and written
-        except OutputExistsError as exc:  # named by the file the user gave
-            raise OutputExistsError(exc.message, where=str(path)) from None
+        except OutputExistsError as exc:  # named by the file the user gave, and the folder the message is about
+            message = exc.message
+            if message == "exists and is not a directory":
+                message = f"its folder {path.parent} exists and is not a directory"
+            raise OutputExistsError(message, where=str(path)) from None
 
 
 def spec_name(path: str) -> str | None:

@@ -256,6 +256,8 @@ def run(args: argparse.Namespace) -> int:
             m = hq_from_frd(frd["w"], frd["H"], frd["coherence"], averages, args.response_type, args.phase_fit,
                             tuple(args.fit_band) if args.fit_band else None)
         except DataError as exc:
+            if exc.where == "fit_band":
+                raise DataError(exc.message, where="--fit-band") from None
             raise exc.located(args.frd) if exc.where == "frequency response" else exc from None
         title = str(args.frd)
     data = m.to_dict()

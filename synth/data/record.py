@@ -343,6 +343,10 @@ def record_from_arrays(
     tt, arrays, notes = uniform_columns({names[0]: t, names[1]: u, names[2]: y, **dict(aux or {})}, names[0], source,
                                         held=(names[1],))
     uu, yy = arrays.pop(names[1]), arrays.pop(names[2])
+    for name, x in ((names[1], uu), (names[2], yy)):
+        if x.size and float(np.max(np.abs(x))) > HUGE:
+            raise DataError(f"column '{name}': values up to {float(np.max(np.abs(x))):.3g} overflow double precision "
+                            "in the sums of squares a fit takes; rescale the signal (other units)", where=source)
     if np.ptp(uu) == 0:
         raise DataError(f"column '{names[1]}': the input is constant ({uu[0]:g}); nothing excites the plant",
                         where=source)
@@ -436,6 +440,9 @@ def _pick(table: Table, name: str | None, role: str, fallback: int) -> str:
         return table.find(keys[fallback], role)
     return table.find(name, role)
 
+
+HUGE = 1e150
+"""Largest magnitude of a signal: its square summed over a record stays finite."""
 
 _TIME_NAMES = frozenset({"t", "time", "times", "timestamp", "zeit", "sec", "seconds"})
 

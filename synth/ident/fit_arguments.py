@@ -47,9 +47,17 @@ def as_sensor(sensor: Plant | str | None) -> Plant | None:
     >>> as_sensor("50/(s+50)").dc_gain(), as_sensor(None)
     (1.0, None)
     """
-    if sensor is None or isinstance(sensor, Plant):
-        return sensor
-    try:
-        return Plant.from_string(sensor)
-    except ModelError as exc:
-        raise exc.located("sensor") from None
+    if sensor is None:
+        return None
+    if not isinstance(sensor, Plant):
+        try:
+            sensor = Plant.from_string(sensor)
+        except ModelError as exc:
+            raise exc.located("sensor") from None
+    unstable = [p for p in np.atleast_1d(sensor.poles()) if p.real > 0]
+    if unstable:
+        shown = ", ".join(f"{complex(p).real:.4g}" + (f"{complex(p).imag:+.4g}j" if complex(p).imag else "")
+                          for p in unstable)
+        raise ModelError(f"a known sensor must be stable; {sensor.to_string()} has pole(s) at {shown}",
+                         where="sensor")
+    return sensor

@@ -397,6 +397,10 @@ def hq_from_frd(w: Any, H: Any, coherence: Any = None, averages: Any = None,
     phase2 = tau = None
     method, line = "raw", None
     sig_phi2 = slope2 = None
+    if fit_band is not None and np.count_nonzero((w >= fit_band[0]) & (w <= fit_band[1])) < 3:
+        raise DataError(f"the fit band {fit_band[0]:.4g}-{fit_band[1]:.4g} rad/s holds "
+                        f"{np.count_nonzero((w >= fit_band[0]) & (w <= fit_band[1]))} of the response's frequencies "
+                        f"({w[0]:.4g}-{w[-1]:.4g} rad/s); the phase line needs 3", where="fit_band")
     if w180 is not None:
         w2 = 2 * w180
         band = fit_band or (w180, min(w2, w[-1]))

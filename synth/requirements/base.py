@@ -217,7 +217,7 @@ def tagged_type(table: dict[str, Any], entry: Any) -> Any:
 class Requirement(BaseModel):
     """Base of all requirement types (one pydantic model per ``type:``)."""
 
-    model_config = ConfigDict(extra="forbid", frozen=True)
+    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
 
     type: str
     label: str | None = None

@@ -109,9 +109,6 @@ class ControllerSpec(StrictModel):
             raise ValueError(f"{names.name} has no parameter {extra[0]!r}")
         if missing:
             raise ValueError(f"initial needs a value for every parameter; missing {', '.join(missing)}")
-        for name, value in initial.items():
-            if not np.isfinite(value):
-                raise ValueError(f"{name}: the initial value must be a finite number, got {value}")
         return initial
 
     def initial_controller(self) -> Controller | None:

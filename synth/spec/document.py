@@ -24,6 +24,8 @@ from synth.spec.strict import StrictModel
 __all__ = ["RequirementEntry", "Spec"]
 
 _NAME = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.-]*$")
+STABILITY_ROW = "closed-loop stability"
+"""The label of the stability row every check reports (:mod:`synth.check`)."""
 
 
 def _requirement_union() -> Any:
@@ -55,6 +57,18 @@ class Spec(StrictModel):
     reference: ReferenceSpec | None = None
     analysis: AnalysisSpec = AnalysisSpec()
     simulation: SimulationSpec | None = None
+
+    @field_validator("requirements")
+    @classmethod
+    def _distinct_labels(cls, requirements: list[Any]) -> list[Any]:
+        labels = [r.label for r in requirements if getattr(r, "label", None)]
+        repeated = sorted({x for x in labels if labels.count(x) > 1})
+        if repeated:
+            raise ValueError(f"label {repeated[0]!r} is given to {labels.count(repeated[0])} requirements; each "
+                             "label names one (the report's rows, a --sweep requirements.LABEL)")
+        if STABILITY_ROW in labels:
+            raise ValueError(f"label {STABILITY_ROW!r} names the built-in stability row; choose another")
+        return requirements
 
     @field_validator("name")
     @classmethod

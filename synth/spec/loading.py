@@ -208,7 +208,8 @@ def _check_identify_data(spec: Spec, source: str, root: yaml.Node | None) -> Non
     except ModelError as exc:
         path, problem = None, exc.message
     else:
-        problem = None if path.is_file() else f"data file {str(path)!r} not found"
+        problem = (None if path.is_file() else f"data file {str(path)!r} is a folder, not a file" if path.is_dir()
+                   else f"data file {str(path)!r} not found")
     if problem:
         loc = ("plant", "identify", "data")
         line = line_of(root, loc)

@@ -167,7 +167,9 @@ def _message(err: dict[str, Any], data: Any, loc: tuple[Any, ...]) -> str:
                 f"{', '.join(REQUIREMENT_TYPES)}")
     if kind == "union_tag_not_found":
         return f"requirement has no 'type'; expected one of: {', '.join(REQUIREMENT_TYPES)}"
-    if kind in {"float_type", "float_parsing", "int_type", "finite_number"}:
+    if kind == "finite_number":
+        return f"expected a finite number, got {given!r}"
+    if kind in {"float_type", "float_parsing", "int_type"}:
         return f"expected a number, got {given!r}"
     if kind in {"string_type"}:
         return f"expected text, got {given!r}"

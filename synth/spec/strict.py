@@ -31,7 +31,7 @@ class StrictModel(BaseModel):
     extra_forbidden
     """
 
-    model_config = ConfigDict(extra="forbid", frozen=True)
+    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
 
 
 def check_transfer_function(text: str | None) -> str | None:

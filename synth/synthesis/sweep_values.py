@@ -114,7 +114,8 @@ def item_index(items: list, key: str, where: str, parent: str) -> int:
         return match[0]
     if not match:
         raise SpecError(f"no {parent or 'item'} with label or type {key!r}", where=f"--sweep {where}")
-    raise SpecError(f"{len(match)} requirements of type {key!r}: give a label or an index", where=f"--sweep {where}")
+    what = "labelled" if labelled else "of type"
+    raise SpecError(f"{len(match)} {parent or 'items'} {what} {key!r}: give a label or an index", where=f"--sweep {where}")
 
 
 def check_distinct(data: dict[str, Any], sweeps: list[Sweep]) -> None:
