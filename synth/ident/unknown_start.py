@@ -109,8 +109,17 @@ def fit_from_unknown_start(record: Record, fit: TimeFitResult, structure: Struct
             return fit, note
     raise FitError(f"fit of {structure.formula!r} failed: the record does not start at rest, and its start state "
                    f"still moves {test.shifted} by {test.shift:.3g} std with the first {fitted:.3g} s left out, {why}; "
-                   f"cut the record to start at rest, or fit a shorter part of it{_misfit(original, first_test)}",
-                   where=record.source)
+                   f"cut the record to start at rest, or fit a shorter part of it{_integrating_hint(original, record)}"
+                   f"{_misfit(original, first_test)}", where=record.source)
+
+
+def _integrating_hint(fit: TimeFitResult, record: Record) -> str:
+    """For an integrating model whose record's input is not 0 at its first sample: how that sample is read."""
+    if np.isfinite(fit.plant.dc_gain()) or float(record.u[0]) == 0.0:
+        return ""
+    return (f" (an integrating model is at rest only where its input holds the output still: the first input "
+            f"sample, {float(record.u[0]):.4g}, is taken as that trim; a record whose input steps to it at its first "
+            "sample from 0 needs the samples before the step)")
 
 
 def _misfit(fit: TimeFitResult, test: StartState) -> str:
