@@ -48,7 +48,8 @@ def test_the_top_of_a_sweep_behind_a_long_delay_is_not_biased(seed: int) -> None
 def test_a_seeded_sample_of_random_sweeps_behind_delays_comes_closer_to_the_truth() -> None:
     """Four of ``benchmarks/freqresp_alignment.py --seed 1``'s cases the rule realigns (second-order plants behind
     0.7-2.7 s, log sweeps of 240-300 s): the largest magnitude error over the band, before (the runs as they are)
-    and after. Before: 2.38, 2.40, 2.25 and 2.43 dB."""
+    and after. Before: 2.38, 2.40, 2.25 and 2.43 dB; since the band's ends are tested on the longest window's
+    input spectrum (session 68), 0.79, 2.40, 0.72 and 2.43 dB before, 0.06, 1.82, 0.24 and 0.25 dB after."""
     from benchmarks.freqresp_alignment import case, record, score
     from synth.ident import spectra
 
@@ -61,4 +62,4 @@ def test_a_seeded_sample_of_random_sweeps_behind_delays_comes_closer_to_the_trut
         assert any("output was moved" in n for n in after.notes)
         assert after.band.w_max <= before.band.w_max  # the move does not widen the band past the input's
         (_, worst_before), (_, worst_after) = score(before, cases[index]), score(after, cases[index])
-        assert worst_before > 2.0 and worst_after < 0.8 * worst_before, (index, worst_before, worst_after)
+        assert worst_before > 0.5 and worst_after < 0.8 * worst_before, (index, worst_before, worst_after)
