@@ -160,4 +160,29 @@ def compare(spec: Spec, controller: Controller | None) -> dict[str, Any]:
             out["slew_rate"] = slew_reconciliation(spec, probe, ref.slew_rate_crossing)
     if spec.controller.type == "P" and spec.analysis.loop_delays:
         out["delay_table"] = critical_gains(plant, list(spec.analysis.loop_delays))
+        if controller is not None and controller.type == "P":
+            out["delay_warning"] = delay_warning(controller, out["delay_table"], loops["design"]["margins"])
     return out
+
+
+def delay_warning(controller: Controller, table: list[dict[str, Any]], margins: dict[str, Any]) -> str | None:
+    """What the report's top verdict adds when the design is unstable at a delay of the spec's delay table
+    (``analysis.loop_delays``), else None: its requirements then hold only without that delay in the loop. The X-4
+    design P(kp=20) met every requirement with no word that 5 ms of delay makes it unstable (a black-box review;
+    the identified plant has 20 ms).
+
+    Examples
+    --------
+    >>> delay_warning(Controller("P", {"kp": 20.0}), [{"delay": 0.0, "critical_gain": float("inf")},
+    ...               {"delay": 0.005, "critical_gain": 13.93}], {"delay_margin": 0.00346}).split(" (")[0]
+    'P(kp=20) is unstable with 5 ms of delay in the loop'
+    """
+    kp = float(controller.parameters["kp"])
+    first = next((r for r in table if kp >= float(r["critical_gain"])), None)
+    if first is None:
+        return None
+    margin = margins.get("delay_margin")
+    exact = f"; its exact delay margin is {fmt(1000 * margin, 3)} ms" if isinstance(margin, float) else ""
+    return (f"{controller} is unstable with {fmt(1000 * float(first['delay']), 3)} ms of delay in the loop (critical "
+            f"gain {fmt(float(first['critical_gain']), 4)} there; delay table below){exact}: the requirements hold "
+            "only without that delay")

@@ -140,6 +140,14 @@ def test_committed_x4_report_has_the_nonlinear_reconciliation():
     assert rows[("as specified", 0.0)]["onset_gain"] > 20  # no oscillation near K = 5 without delay
     needed = sim["published"]["onset"]["delay_for_published_onset"]["as specified"]
     assert 0.010 < needed < 0.015
+    # the continuous model's exactly: K = 5 on 23(s+0.43)/((s+9.6)(s+0.54)) crosses over at 114.6 rad/s with a
+    # phase margin of 94.85 deg, 14.44 ms (interpolated between the table's delays it was 14.54 ms)
+    w = np.logspace(1, 3, 200001)
+    L = 5 * 23 * (1j * w + 0.43) / ((1j * w + 9.6) * (1j * w + 0.54))
+    k = int(np.argmin(np.abs(np.abs(L) - 1)))
+    exact = (np.pi + np.angle(L[k])) / w[k]
+    continuous = sim["published"]["onset"]["delay_for_published_onset"]["continuous linear model"]
+    assert continuous == pytest.approx(exact, rel=1e-4) and continuous == pytest.approx(0.014445, abs=2e-6)
     html = Path("reports/x4_rotor/report.html").read_text()
     for text in ["Nonlinear step check", "Onset of oscillation", "Where the source's statements sit",
                  "oscillation_onset.png", "nonlinear_step.png", "K &gt; 5"]:
