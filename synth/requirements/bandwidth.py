@@ -67,7 +67,9 @@ class Bandwidth(Requirement):
         if np.isnan(wb):
             slack, margin = -np.inf, -np.inf
         met = slack >= 0
-        msg = (f"closed-loop bandwidth {fmt(wb)} rad/s {rel} {fmt(bound)} rad/s: "
+        t0 = loop.T0()
+        level = "" if not np.isfinite(t0) or abs(t0 - 1.0) < 1e-9 else f" (|T| 3 dB below |T(0)| = {fmt(t0, 3)})"
+        msg = (f"closed-loop bandwidth {fmt(wb)} rad/s{level} {rel} {fmt(bound)} rad/s: "
                f"{'met' if met else 'NOT met'} (loop crossover {fmt(wc)} rad/s)")
         return tracking_note(self.result(value=wb, bound=bound, unit="rad/s", slack=slack, margin=margin,
                                          binding_frequency=wb if np.isfinite(wb) else None, message=msg,
