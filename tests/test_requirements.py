@@ -111,3 +111,18 @@ def test_slack_sign_convention_and_units():
                                                                                           abs=1e-4)
     r = MarginsRequirement(type="margins", phase_margin_deg=120).evaluate(x4(3.0))
     assert not r.met and r.slack == pytest.approx(np.radians(98.09 - 120), abs=1e-4)
+
+
+def test_slew_rate_met_only_by_the_band_says_so():
+    """|e| K w reaches B at B/(|e| K) whatever K: the X-4's K = 3 crosses at 10000/(5 * 3) = 666.7 rad/s, above the
+    spec's band top of 100 rad/s, so 'met' rests on where the band ends (a black-box review)."""
+    from synth.controllers import Controller
+    from synth.loop import Loop
+    from synth.plant import Plant
+    from synth.requirements import SlewRate
+
+    loop = Loop(Plant.from_string("23*(s+0.43)/((s+9.6)*(s+0.54))"), Controller("P", {"kp": 3.0}))
+    r = SlewRate(rate_limit=10000, max_error=5, band=(0.1, 100)).evaluate(loop)
+    assert r.slack > 0 and "the demand reaches B at 666.7 rad/s, above the band's top" in r.message
+    inside = SlewRate(rate_limit=10000, max_error=5, band=(0.1, 1000)).evaluate(loop)
+    assert inside.slack < 0 and "above the band's top" not in inside.message

@@ -82,7 +82,9 @@ class SlewRate(BandMixin, Requirement):
         msg = (f"slew-rate bound: a {fmt(self.max_error)} {y} error asks for up to {fmt(value)} {u}/s "
                f"(at {fmt(w_peak)} rad/s) against B = {fmt(self.rate_limit)} {u}/s over "
                f"{fmt(self.band[0])}-{fmt(self.band[1])} rad/s: {'met' if margin >= 0 else 'NOT met'}; "
-               f"the demand reaches B at {fmt(w_cross)} rad/s")
+               f"the demand reaches B at {fmt(w_cross)} rad/s"
+               + (f", above the band's top: the verdict rests on the band ending at {fmt(self.band[1])} rad/s"
+                  if margin >= 0 and w_cross is not None and np.isfinite(w_cross) and w_cross > self.band[1] else ""))
         return self.result(value=value, bound=self.rate_limit, unit=f"{u}/s", slack=slack, margin=margin,
                            binding_frequency=w_peak, message=msg, crossing_frequency=w_cross,
                            bound_over_error=self.rate_limit / self.max_error)
