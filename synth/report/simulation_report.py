@@ -20,6 +20,7 @@ import numpy as np
 
 from synth.controllers import Controller
 from synth.loop import Loop
+from synth.report.onset_delay import delay_for_gain, exact_delay_for_gain
 from synth.requirements.base import fmt
 from synth.sim.blocks import RateLimit
 from synth.sim.loops import OperatingPoint
@@ -345,8 +346,8 @@ def _published(spec: Spec, sim: SimulationSpec, report: SimulationReport,
             rows = [r for r in report.onset.rows if r.variant == variant]
             ds = np.array([r.delay for r in rows])
             ks = np.array([r.onset_gain if r.onset_gain is not None else np.inf for r in rows])
-            needed[variant] = _delay_for_gain(ds, ks, k)
-        needed["continuous linear model"] = _exact_delay_for_gain(plant, sim.loop_delay, k)
+            needed[variant] = delay_for_gain(ds, ks, k)
+        needed["continuous linear model"] = exact_delay_for_gain(plant, sim.loop_delay, k)
         out["onset"] = {"published_gain": k, "delay_for_published_onset": needed}
     out["statements"] = _statements(out, report, sim, u, plant.output.unit or "output units")
     return out
@@ -364,35 +365,6 @@ def _crossing(x: np.ndarray, y: np.ndarray, level: float) -> float | None:
         a, b = y[i - 1] - level, y[i] - level
         if np.isfinite(a) and np.isfinite(b) and a * b <= 0 and a != b:
             return float(x[i - 1] + (x[i] - x[i - 1]) * (-a) / (b - a))
-    return None
-
-
-def _exact_delay_for_gain(plant: Any, loop_delay: float, k: float) -> float | None:
-    """The in-loop delay (beyond ``loop_delay``) at which P(``k``) on the continuous ``plant`` reaches the stability
-    boundary: its exact delay margin, ``min PM/wc`` over the gain crossovers (None if that loop is not stable).
-    Interpolated between the onset table's delays it was 14.54 ms for the X-4's K = 5, exactly 14.44 ms."""
-    from synth.controllers import Controller
-    from synth.loop import Loop
-    from synth.requirements.delay_margin import delay_margins_per_crossover
-
-    loop = Loop(plant.with_delay(plant.delay + loop_delay), Controller("P", {"kp": float(k)}))
-    if not loop.stability().stable:
-        return None
-    margins = delay_margins_per_crossover(loop)
-    return min(m[2] for m in margins) if margins else float("inf")
-
-
-def _delay_for_gain(delays: np.ndarray, gains: np.ndarray, k: float) -> float | None:
-    """In-loop delay at which the onset gain falls to ``k`` (interpolated in log gain)."""
-    for i in range(len(delays) - 1):
-        a, b = gains[i], gains[i + 1]
-        if a >= k >= b and np.isfinite(b):
-            if not np.isfinite(a):
-                return None
-            if a == b:
-                return float(delays[i])
-            f = (np.log(a) - np.log(k)) / (np.log(a) - np.log(b))
-            return float(delays[i] + f * (delays[i + 1] - delays[i]))
     return None
 
 
@@ -424,7 +396,8 @@ def _statements(out: dict[str, Any], report: SimulationReport, sim: SimulationSp
             lo_rate, hi_rate = fmt(sweep["rates"][0]), fmt(sweep["rates"][-1])
             lines.append(f"No rate limit between {lo_rate} and {hi_rate} {u}/s gives the published "
                          f"{fmt(rise['published'])} s exactly: above about {fmt(flat, 2)} {u}/s the rise time "
-                         f"stays at {fmt(float(np.nanmin(rr)))} s, set by the other limits of the loop.")
+                         f"stays within 2 % of {fmt(float(np.nanmin(rr)))} s, set by the other limits of the "
+                         "loop.")
     ol = out.get("open_loop")
     if ol:
         lines.append(
@@ -463,16 +436,22 @@ def _statements(out: dict[str, Any], report: SimulationReport, sim: SimulationSp
                 f"and its output amplitude within {fmt(100 * da, 2)} % of the simulation at 1.3 times each onset "
                 "gain where the simulation oscillates (a single-sinusoid describing function ignores the shift of "
                 "the cycle's mean that an asymmetric limit causes, and the sensor's quantization).")
-        spread = []
+        spread, split = [], []
         for dl in sorted({r.delay for r in report.onset.rows}):
-            vals = [r.onset_gain for r in report.onset.rows if r.delay == dl and r.onset_gain is not None]
+            rows = [r for r in report.onset.rows if r.delay == dl]
+            vals = [r.onset_gain for r in rows if r.onset_gain is not None]
             if len(vals) > 1:
                 spread.append(max(vals) / min(vals) - 1)
+            if vals and len(vals) < len(rows):  # some variants oscillate at this delay, others not up to the top gain
+                split.append(dl)
         if spread:
+            where = ("" if not split else
+                     f" where every variant oscillates; at {', '.join(fmt(1000 * dl) for dl in split)} ms some "
+                     f"oscillate and others do not up to K = {fmt(report.onset.gains[1])} (the table)")
             lines.append(
                 f"The rate limit and the saturation move the onset gain by at most {fmt(100 * max(spread), 2)} % "
-                "against the linear sampled loop: in this model the delay sets where oscillation starts; the "
-                "limits set how large the cycle grows (compare the amplitudes in the table).")
+                f"against the linear sampled loop{where}: in this model the delay sets where oscillation starts; "
+                "the limits set how large the cycle grows (compare the amplitudes in the table).")
     return lines
 
 
