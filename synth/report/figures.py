@@ -126,6 +126,12 @@ def sensitivity_plot(loops: list[tuple[str, Loop]], requirements: list[Any], pat
                                label=f"static bound {r.max_db:g} dB on S(0) with {gain} (drawn over the lowest decade)")
             ax.plot([w[0]], [r.max_db], marker="v", color="#c0392b", ms=10, ls="none")
             found.append((artist, r.name(), "static |S(0)| bound [dB]"))
+            if r.plant_gain:  # the requirement's own |S(0)|, with its stated gain (the curves use the model's)
+                for i, (name, loop) in enumerate(loops):
+                    value = r.evaluate(loop).value
+                    if np.isfinite(value):
+                        ax.plot([w[0]], [value], marker="o", color=COLORS[i % len(COLORS)], ms=7, ls="none",
+                                label=f"|S(0)| with {gain}, {name}: {value:.4g} dB")
         elif isinstance(r, PeakSensitivity):
             artist = ax.hlines(r.max_db, w[0], w[-1], color="#8e44ad", linestyles="dashed", lw=1.2,
                                label=f"peak |S| bound {r.max_db:g} dB")
