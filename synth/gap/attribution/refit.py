@@ -448,6 +448,7 @@ def fit_augmented(plant: Plant, t: np.ndarray, u: np.ndarray, y: np.ndarray, eff
             points += extra
             same += extra
             best = fewest_limits(points, list(eff.grid_names), n_fit)
+        ci = dict(best.ci)  # the final point's own intervals (the grid's best gave a damping's that missed its value)
         ci[key] = profile_interval([(p.params.get(key, np.nan), p.ssr) for p in same],
                                        (best.params[key], best.ssr), n_fit)
         if eff.joint_search:
