@@ -344,10 +344,8 @@ def diagnose_effects(plant: Plant, record: Record, validate: Record | Sequence[R
     floor = sigma**2
     pm_shrink = 1.0 - j_ref / j_nom if j_nom > 0 else 0.0
     pm_ci = ratio_ci(s_ref, s_nom)
-    excess_nom = boot(s_nom) / floor - 1.0
-    excess_ref = boot(s_ref) / floor - 1.0
-    gap_present = float(np.quantile(excess_nom, 0.025)) > relevance
-    gap_after_refit = float(np.quantile(excess_ref, 0.025)) > relevance
+    gap_present = float(np.quantile(boot(s_nom) / floor - 1.0, 0.025)) > relevance
+    gap_after_refit = float(np.quantile(boot(s_ref) / floor - 1.0, 0.025)) > relevance
 
     # calibration: parametric bootstrap of the re-fit
     if calibration == "linearized":
@@ -360,6 +358,15 @@ def diagnose_effects(plant: Plant, record: Record, validate: Record | Sequence[R
     advance(progress, "calibration")
 
     fits = candidate_fits(plant, effects, refit, sp.train, sp.evaluated, confirm, train_mask, workers, progress)
+    # the floor from the re-fit's residual holds whatever that model misses at high frequency (a resonance at half
+    # the Nyquist frequency put it at 3.5 times the noise, and "no gap"): each model's residual holds the noise and
+    # its own error, so the least of them is the floor
+    sigmas = [noise_sigma((y_ev - yhat)[sp.settled]) for _, fit, _, yhat in fits if isinstance(fit, AugmentedFit)]
+    if sigmas and min(sigmas) < sigma:
+        sigma = min(sigmas)
+        floor = sigma**2
+        gap_present = float(np.quantile(boot(s_nom) / floor - 1.0, 0.025)) > relevance
+        gap_after_refit = float(np.quantile(boot(s_ref) / floor - 1.0, 0.025)) > relevance
 
     # the form a joint fit kept (a dead zone's center held at rest or fitted) is what its parameters count
     by_label = {eff.label: (fit.effect if isinstance(fit, AugmentedFit) and fit.effect is not None else eff, fit)
@@ -370,7 +377,7 @@ def diagnose_effects(plant: Plant, record: Record, validate: Record | Sequence[R
         j = float(s.sum() / n_held)
         shrink = 1.0 - j / j_ref if j_ref > 0 else 0.0
         ci = ratio_ci(s, s_ref)
-        share = (j_nom - j) / (j_nom - floor) if j_nom > floor else 0.0
+        share = share_of_excess(j_nom, j, floor)  # at most 1: a model below the floor's estimate removes it all
         share_ref = share_of_excess(j_ref, j, floor)
         significant = bool(gap_present and ci[0] > threshold)
         joint = isinstance(fit, AugmentedFit)
