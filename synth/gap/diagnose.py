@@ -37,6 +37,7 @@ from synth.errors import DataError, ModelError
 from synth.gap.attribution.heldout import DiagnoseOptions, diagnose_effects
 from synth.gap.attribution.verdict import EffectDiagnosis, aux_explained, not_carried
 from synth.gap.effects.registry import DEFAULT_CANDIDATES, aux_candidates, make_effect
+from synth.gap.heldout_warnings import heldout_warnings
 from synth.gap.preflight import check_model
 from synth.gap.verdict_sentence import verdict_sentence
 from synth.gap.where.clipping import Clipping, record_clipping
@@ -421,53 +422,3 @@ def diagnose(plant: Plant, record: RecordLike, validate: RecordLike | Sequence[R
             label = "the validation record's log" if len(held_out) == 1 else f"validation run {i + 1}'s log"
             warnings.append(not_judged_warning(int(np.sum(judged <= 0)), 1.0 / v.fs, len(v.gaps), label))
     return Diagnosis(plant, record, validate, loc, att, tuple(clips), tuple(warnings))
-
-
-def heldout_warnings(record: Record, validate: Record | None = None, split: str = "tail",
-                     train_fraction: float = 0.5, min_span: float = 0.05) -> list[str]:
-    """Why the held-out test may not see an effect: a held-out command that barely moves.
-
-    An effect of the dynamics (a delay, a lag, a limit) shows where the command changes. When
-    the held-out part's command spans less than ``min_span`` of the record's (a single step
-    early in a record split at its tail; a validation record at one operating point), the
-    held-out test judges only the steady state and can neither confirm nor reject such an
-    effect.
-
-    Parameters
-    ----------
-    record, validate : Record
-        As given to :func:`diagnose`.
-    split : {"tail", "interleaved"}
-    train_fraction : float
-    min_span : float
-        Smallest held-out command span, relative to the record's, that counts as excitation.
-
-    Returns
-    -------
-    list of str
-        Plain sentences; empty when the held-out part is excited.
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> from synth.data import record_from_arrays
-    >>> t = np.arange(0, 10, 0.01); u = np.where(t >= 2, 1.0, 0.0)
-    >>> heldout_warnings(record_from_arrays(t, u, u))[0][:58]
-    'the held-out part (t >= 5 s, the tail of the record) has a'
-    >>> heldout_warnings(record_from_arrays(t, u, u), split="interleaved")
-    []
-    """
-    span = float(np.ptp(record.u))
-    if validate is not None:
-        held, where = validate.u, "the validation record"
-    elif split == "tail":
-        k = round(train_fraction * record.n)
-        held, where = record.u[k:], f"the held-out part (t >= {record.t[k]:.4g} s, the tail of the record)"
-    else:
-        return []
-    held_span = float(np.ptp(held)) if held.size else 0.0
-    if span > 0.0 and held_span >= min_span * span:
-        return []
-    return [f"{where} has a command that spans {100 * held_span / span if span > 0 else 0.0:.2g} % of the "
-            "record's: the held-out test judges only the steady state there and cannot see an effect of the "
-            "transients (a delay, a lag, a limit); give --validate with steps, or --split interleaved"]

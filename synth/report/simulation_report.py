@@ -78,7 +78,7 @@ def simulation_report(spec: Spec, design: Controller | None, reference: Controll
     >>> quick = spec.model_copy(update={"simulation": spec.simulation.model_copy(update={"onset": None})})
     >>> rep = simulation_report(quick, Controller("P", {"kp": 3.0}), None)
     >>> round(rep.data["runs"]["design"]["nonlinear"]["rise_time"], 3)  # linear model: 0.025 s
-    0.052
+    0.051
     """
     sim = spec.simulation
     if sim is None:
