@@ -65,6 +65,10 @@ def start_transient_warning(plant: Plant, residual: ModelResidual, ratio: float 
     thirds = np.array_split(np.abs(e[first]), 3)
     if head <= ratio * rest or np.mean(thirds[0]) <= ratio * np.mean(thirds[2]):
         return ""
+    moved = np.flatnonzero(np.abs(residual.u - residual.u[0]) > 1e-9 * max(float(np.ptp(residual.u)), 1e-300))
+    still = int(moved[0]) if moved.size else residual.u.size
+    if still >= 5 and float(np.sqrt(np.mean(e[:still] ** 2))) <= ratio * rest:
+        return ""  # quiet until the first command change: the transient is the model's answer to it, not the start's
     return (f"the residual in the first {window:.3g} s is {head / max(rest, 1e-300):.2g} times its rms after, "
             "and decays: the record may not start at rest at its first command, which the model assumes; "
             f"a transient there reads as a gap and a drift (give --burn-in {window:.3g} or a record that starts "
