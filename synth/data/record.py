@@ -17,9 +17,10 @@ from typing import Any
 
 import numpy as np
 
+from synth.data.column_checks import check_magnitude, looks_like_time
 from synth.data.gaps import find_gaps, hidden_changes
 from synth.data.interpolated_noise import interpolation_noise_correlation, interpolation_noise_factor
-from synth.data.readers import Table, read_table, split_unit, table_from_columns, time_scale
+from synth.data.readers import Table, read_table, table_from_columns, time_scale
 from synth.errors import DataError
 from synth.plant import Signal
 
@@ -344,9 +345,7 @@ def record_from_arrays(
                                         held=(names[1],))
     uu, yy = arrays.pop(names[1]), arrays.pop(names[2])
     for name, x in ((names[1], uu), (names[2], yy)):
-        if x.size and float(np.max(np.abs(x))) > HUGE:
-            raise DataError(f"column '{name}': values up to {float(np.max(np.abs(x))):.3g} overflow double precision "
-                            "in the sums of squares a fit takes; rescale the signal (other units)", where=source)
+        check_magnitude(name, x, source)
     if np.ptp(uu) == 0:
         raise DataError(f"column '{names[1]}': the input is constant ({uu[0]:g}); nothing excites the plant",
                         where=source)
@@ -441,17 +440,6 @@ def _pick(table: Table, name: str | None, role: str, fallback: int) -> str:
     return table.find(name, role)
 
 
-HUGE = 1e150
-"""Largest magnitude of a signal: its square summed over a record stays finite."""
-
-_TIME_NAMES = frozenset({"t", "time", "times", "timestamp", "zeit", "sec", "seconds"})
-
-
-def _looks_like_time(name: str, unit: str) -> bool:
-    bare, header_unit = split_unit(name)
-    return bare.strip().lower() in _TIME_NAMES or (unit or header_unit).strip().lower() in ("s", "ms", "us", "min")
-
-
 def record_from_columns(
     columns: Mapping[str, np.ndarray] | Table,
     source: str = "columns",
@@ -491,7 +479,7 @@ def record_from_columns(
     u_name = _pick(table, input, "input", 1 - shift)
     y_name = _pick(table, output, "output", 2 - shift)
     for name, given in ((u_name, input), (y_name, output)):
-        if from_dt and given is None and _looks_like_time(name, table.units.get(name, "")):
+        if from_dt and given is None and looks_like_time(name, table.units.get(name, "")):
             raise DataError(f"column '{name}' looks like a time column, and with a sample interval given (dt) the "
                             "first columns are taken as input and output; drop the sample interval, or name the "
                             "input and output columns", where=table.source)

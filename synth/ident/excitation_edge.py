@@ -13,17 +13,20 @@ dB within a fraction of a decade.
 from __future__ import annotations
 
 from dataclasses import replace
+from typing import Any
 
 import numpy as np
 
 from synth.ident.coherence import CoherentBand
 
-__all__ = ["EDGE_DB", "SLOPE_DB", "trim_to_excitation"]
+__all__ = ["EDGE_DB", "FINE_BINS", "SLOPE_DB", "excitation_level", "trim_to_excitation"]
 
 #: dB, beyond the allowed slope, by which a band end's input autospectrum may lie below a point inward
 EDGE_DB = 10.0
 #: dB per decade an input autospectrum may fall inside its excitation
 SLOPE_DB = 20.0
+#: the longest window's input autospectrum tests the band's ends where a cell holds at least this many of its bins
+FINE_BINS = 8
 
 
 def trim_to_excitation(band: CoherentBand, w: np.ndarray, gxx: np.ndarray) -> CoherentBand:
@@ -87,3 +90,30 @@ def trim_to_excitation(band: CoherentBand, w: np.ndarray, gxx: np.ndarray) -> Co
             f"{EDGE_DB:g} dB plus {SLOPE_DB:g} dB per decade below its level inward (leakage: the estimate there "
             f"is biased whatever its coherence)")
     return replace(band, w_min=float(w[lo]), w_max=float(w[hi]), mask=mask, note=note)
+
+
+def excitation_level(results: list[Any], grid: np.ndarray, gxx: np.ndarray) -> np.ndarray:
+    """The input autospectrum the band's ends are tested on (:func:`trim_to_excitation`): the composite's, or the
+    longest window's where that is lower and its cell holds at least :data:`FINE_BINS` of its bins.
+
+    A short window's main lobe spreads a sweep's power past its end: a 0.5-10 rad/s sweep's 2.5 s window put the
+    input at 12.5 rad/s 13 dB below its level in the band, the 45 s window 50 dB, and the composite there was 23 %
+    off at coherence 0.93 (leakage answers coherently). Where its cells hold several bins the longest window's
+    estimate is smooth enough to tell an edge from the scatter of a noise input.
+
+    Examples
+    --------
+    >>> from synth.ident.spectral_windows import WindowSpectra
+    >>> grid = np.array([1.0, 10.0, 12.5]); composite = np.array([1.0, 1.0, 0.05])
+    >>> fine = WindowSpectra(100.0, np.array([1.0, 1.0, 1e-5]), np.ones(3), np.ones(3, complex), np.ones(3))
+    >>> excitation_level([fine], grid, composite).tolist()  # the 12.5 rad/s cell holds 8 or more of its bins
+    [1.0, 1.0, 1e-05]
+    """
+    fine = max(results, key=lambda r: r.length)
+    mid = np.sqrt(grid[1:] * grid[:-1])
+    if grid.size > 1:
+        edges = np.r_[grid[0] ** 2 / mid[0], mid, grid[-1] ** 2 / mid[-1]]
+    else:
+        edges = np.r_[grid / 1.01, grid * 1.01]
+    bins = np.diff(edges) * fine.length / (2.0 * np.pi)
+    return np.where(bins >= FINE_BINS, np.fmin(gxx, fine.gxx), gxx)

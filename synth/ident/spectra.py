@@ -17,7 +17,7 @@ import numpy as np
 from synth.data import Record
 from synth.errors import DataError
 from synth.ident.coherence import COHERENCE_THRESHOLD, CoherentBand, coherence_from_spectra, coherent_band, random_error
-from synth.ident.excitation_edge import trim_to_excitation
+from synth.ident.excitation_edge import excitation_level, trim_to_excitation
 from synth.ident.model_phase import anchored_phase
 from synth.ident.output_alignment import alignment_samples, shifted_runs
 from synth.ident.spectral_windows import (
@@ -41,8 +41,6 @@ DEFAULT_TOP = 0.2
 LOOK_AHEAD_CAP = 0.8
 #: the coherent band must go on at least this far above the default top [decades] for a note
 LOOK_AHEAD_MIN_DECADES = 0.05
-#: the longest window's input autospectrum tests the band's ends where a cell holds at least this many of its bins
-FINE_BINS = 8
 
 
 @dataclass(frozen=True)
@@ -290,7 +288,7 @@ def _composite(runs: list[Record], w_min: float | None, w_max: float | None, win
     H, err, coh, n_d, leak_note = _resonance_from_whole_runs(runs, rest, results, grid, H, err, coh, n_d,
                                                              coherence_threshold)
     low_note = "; ".join(n for n in (low_note, leak_note) if n) or None
-    level = _excitation_level(results, grid, gxx)
+    level = excitation_level(results, grid, gxx)
     band = trim_to_excitation(coherent_band(grid, coh, coherence_threshold), grid, level)
     above = None
     if not given_max:
@@ -311,24 +309,6 @@ LRM_ERROR_LIMIT = 3.0
 stays: a sweep's transform is smooth in frequency, like a transient, and where little input reaches a frequency
 the two cannot be told apart (a linear 0.1-5 Hz sweep of 60 s with 1 % noise: |H| 5-28 times the truth at
 0.7-2.3 rad/s, random errors of 37-150 %; the composite within 1 dB there)."""
-
-
-def _excitation_level(results: list[Any], grid: np.ndarray, gxx: np.ndarray) -> np.ndarray:
-    """The input autospectrum the band's ends are tested on (:func:`trim_to_excitation`): the composite's, or the
-    longest window's where that is lower and its cell holds at least :data:`FINE_BINS` of its bins.
-
-    A short window's main lobe spreads a sweep's power past its end: a 0.5-10 rad/s sweep's 2.5 s window put the
-    input at 12.5 rad/s 13 dB below its level in the band, the 45 s window 50 dB, and the composite there was 23 %
-    off at coherence 0.93 (leakage answers coherently). Where its cells hold several bins the longest window's
-    estimate is smooth enough to tell an edge from the scatter of a noise input."""
-    fine = max(results, key=lambda r: r.length)
-    mid = np.sqrt(grid[1:] * grid[:-1])
-    if grid.size > 1:
-        edges = np.r_[grid[0] ** 2 / mid[0], mid, grid[-1] ** 2 / mid[-1]]
-    else:
-        edges = np.r_[grid / 1.01, grid * 1.01]
-    bins = np.diff(edges) * fine.length / (2.0 * np.pi)
-    return np.where(bins >= FINE_BINS, np.fmin(gxx, fine.gxx), gxx)
 
 
 def _whole_run_low_end(runs: list[Record], rest: bool, grid: np.ndarray, H: np.ndarray, err: np.ndarray,

@@ -29,12 +29,10 @@ the simulation error ``sum_k (y_k - yhat_k)^2`` with
   the model's own velocity) by alternating the friction signal of the current
   linear model with the casadi fit, as above.
 
-Intervals: casadi-fitted parameters carry the Jacobian intervals of
-:class:`synth.ident.timefit.TimeFitResult`; grid parameters a profile interval
-(the parameter values whose training SSR is within ``chi2_1(0.95) s^2`` of the
-best, ``s^2 = SSR/N``, interpolated in log between grid points); basis
-parameters their least-squares interval. All assume white residuals and are too
-narrow otherwise.
+Intervals: casadi-fitted parameters carry the Jacobian intervals of :class:`synth.ident.timefit.TimeFitResult`
+(of the final point, not the grid point it was refined from); grid parameters a profile interval (the parameter
+values whose training SSR is within ``chi2_1(0.95) s^2`` of the best, ``s^2 = SSR/N``, interpolated in log between
+grid points); basis parameters their least-squares interval. All assume white residuals and are too narrow otherwise.
 """
 
 from __future__ import annotations
