@@ -33,5 +33,5 @@ def test_a_single_lag_is_not_given_a_quantizer_for_what_the_refit_gains():
     assert d.verdict["effects"] == ["lag"], d.summary  # was ['lag', 'quantization'], shrinkage 0.062
     lag = next(e for e in d.attribution.effects if e.effect == "lag")
     assert abs(lag.parameters["tau"] - tau) < 0.03 * tau
-    second = next(e for e in d.attribution.effects if e.effect == "lag+quantization")
-    assert not second.accepted and second.shrinkage < 0.02
+    # since session 68 no further effect is tried on one whose held-out error is within the noise (this lag's)
+    assert not any("+" in e.effect for e in d.attribution.effects)

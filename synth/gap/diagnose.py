@@ -380,7 +380,9 @@ def diagnose(plant: Plant, record: RecordLike, validate: RecordLike | Sequence[R
     ['delay']
     """
     record = as_record(record)
-    default = list(DEFAULT_CANDIDATES) + list(aux_candidates(sorted(record.aux)))
+    clips = record_clipping(record)  # an output clip seen in the data joins the default candidates
+    default = list(dict.fromkeys([*DEFAULT_CANDIDATES, *aux_candidates(sorted(record.aux)),
+                                  *(c.effect for c in clips if c.effect == "saturation(output)")]))
     names = check_candidates(list(default if candidates is None else candidates))
     validate = as_validation(validate)
     held_out = validate if isinstance(validate, tuple) else (() if validate is None else (validate,))
@@ -406,7 +408,6 @@ def diagnose(plant: Plant, record: RecordLike, validate: RecordLike | Sequence[R
     if channels:
         att.verdict["aux"] = aux_explained(att, channels)
     progress["stage"] = "done"
-    clips = record_clipping(record)
     warnings: list[str] = [] if held_out else heldout_warnings(record, None, split, train_fraction)
     warnings += [w for w in [start_transient_warning(plant, loc.residual)] if w]  # after any burn-in
     if loc.residual.left_out:
