@@ -340,7 +340,7 @@ def diagnose_effects(plant: Plant, record: Record, validate: Record | Sequence[R
     y_ref = refit.predict(t_ev, u_ev)
     s_nom, s_ref = sums(y_nom), sums(y_ref)
     j_nom, j_ref = float(s_nom.sum() / n_held), float(s_ref.sum() / n_held)
-    # every settled sample of the evaluated record (same white noise) that moves (a clipped output rests)
+    # every settled sample of the evaluated record (same white noise) but those resting on a clip (they hold none)
     sigma = _moving_noise((y_ev - y_ref)[sp.settled], y_ev[sp.settled]) or noise_sigma((y_ev - y_ref)[sp.settled])
     floor = sigma**2
     pm_shrink = 1.0 - j_ref / j_nom if j_nom > 0 else 0.0
