@@ -208,3 +208,15 @@ def test_hq_fit_band_outside_the_data(run_cli, tmp_path):
     _frd_csv(p, "w", "phase_deg", 1.0, 180 / math.pi)
     r = run_cli("hq", "--frd", str(p), "--fit-band", "1000", "2000")
     assert r.code == 2 and "--fit-band: the fit band 1000-2000 rad/s holds 0 of the response's frequencies" in r.err
+
+
+def test_diagnose_with_a_constant_training_part(run_cli, tmp_path):
+    """A step at 60 % of the record, the tail split at 50 %: every fit failed with "arrays: column 'input': the input
+    is constant (0)", which did not say that it was the training part (a black-box helper)."""
+    t = np.arange(2000) * 0.01
+    u = np.where(t >= 12.0, 1.0, 0.0)
+    y = np.where(t >= 12.0, 1.0 - np.exp(-(t - 12.0) / 0.3), 0.0) + 0.001 * np.sin(7 * t)
+    p = tmp_path / "late_step.csv"
+    np.savetxt(p, np.c_[t, u, y], delimiter=",", header="t,u,y", comments="")
+    r = run_cli("diagnose", "--plant", "1/(0.3*s+1)", "--data", str(p), "--no-report", "--workers", "1")
+    assert r.code == 2 and "the training part (t < 10 s, the record's first 50 %) holds a constant command" in r.err

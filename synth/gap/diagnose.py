@@ -387,7 +387,7 @@ def diagnose(plant: Plant, record: RecordLike, validate: RecordLike | Sequence[R
     validate = as_validation(validate)
     held_out = validate if isinstance(validate, tuple) else (() if validate is None else (validate,))
     effects = [make_effect(n).bind([record, *held_out], plant) for n in names]
-    check_model(plant, record, effects, train_fraction if split == "tail" else 0.5, bool(held_out))
+    check_model(plant, record, effects, train_fraction if split == "tail" else 0.5, bool(held_out), split == "tail")
     progress = {} if progress is None else progress
     progress["stage"] = "localization"
     for i, v in enumerate(held_out):

@@ -42,7 +42,7 @@ def nominal_coefficients(plant: Plant) -> int:
 
 
 def check_model(plant: Plant, record: Record, effects: Sequence[Effect], train_fraction: float = 0.5,
-                validated: bool = False) -> None:
+                validated: bool = False, tail: bool = True) -> None:
     """Raise when ``plant`` cannot be judged on ``record`` for ``effects`` (one line; nothing is fitted).
 
     Parameters
@@ -57,6 +57,8 @@ def check_model(plant: Plant, record: Record, effects: Sequence[Effect], train_f
     train_fraction : float
     validated : bool
         A validation record is held out (the whole record trains).
+    tail : bool
+        The record's tail is held out (its head trains): a head with a constant command is an error.
 
     Raises
     ------
@@ -104,6 +106,11 @@ def check_model(plant: Plant, record: Record, effects: Sequence[Effect], train_f
         raise ModelError(f"the model cannot be simulated on the {duration:.4g} s record (its output grows beyond "
                          "10^6 times the measured output): check its gain and units", where="--plant")
     n_train = record.n if validated else round(train_fraction * record.n)
+    if tail and not validated and n_train < record.n and np.ptp(record.u[:n_train]) == 0:
+        raise DataError(f"the training part (t < {record.t[n_train]:.4g} s, the record's first "
+                        f"{100 * train_fraction:.3g} %) holds a constant command ({record.u[0]:.4g}): nothing there "
+                        "excites a fit; give --split interleaved, a validation record (--validate), or a record with "
+                        "steps in its first part", where="--data")
     n_coef = nominal_coefficients(plant)
     for eff in effects:
         need = eff.required_samples(n_coef)
