@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from synth.data.readers import split_unit
+from synth.data.readers import TIME_UNITS, split_unit
 from synth.errors import DataError
 
 __all__ = ["HUGE", "TIME_NAMES", "check_magnitude", "looks_like_time"]
@@ -25,7 +25,7 @@ def looks_like_time(name: str, unit: str = "") -> bool:
     (True, True, False)
     """
     bare, header_unit = split_unit(name)
-    return bare.strip().lower() in TIME_NAMES or (unit or header_unit).strip().lower() in ("s", "ms", "us", "min")
+    return bare.strip().lower() in TIME_NAMES or (unit or header_unit).strip().lower() in TIME_UNITS
 
 
 def check_magnitude(name: str, x: np.ndarray, source: str) -> None:

@@ -109,11 +109,8 @@ def excitation_level(results: list[Any], grid: np.ndarray, gxx: np.ndarray) -> n
     >>> excitation_level([fine], grid, composite).tolist()  # the 12.5 rad/s cell holds 8 or more of its bins
     [1.0, 1.0, 1e-05]
     """
+    from synth.ident.spectral_windows import cell_edges
+
     fine = max(results, key=lambda r: r.length)
-    mid = np.sqrt(grid[1:] * grid[:-1])
-    if grid.size > 1:
-        edges = np.r_[grid[0] ** 2 / mid[0], mid, grid[-1] ** 2 / mid[-1]]
-    else:
-        edges = np.r_[grid / 1.01, grid * 1.01]
-    bins = np.diff(edges) * fine.length / (2.0 * np.pi)
+    bins = np.diff(cell_edges(grid)) * fine.length / (2.0 * np.pi)
     return np.where(bins >= FINE_BINS, np.fmin(gxx, fine.gxx), gxx)

@@ -15,7 +15,7 @@ from synth.errors import ModelError
 __all__ = ["noise_sigma"]
 
 
-def noise_sigma(e: np.ndarray) -> float:
+def noise_sigma(e: np.ndarray, keep: np.ndarray | None = None) -> float:
     """Robust white-noise standard deviation from the second difference (MAD): ``1.4826 MAD / sqrt(6)``.
 
     Raises
@@ -30,6 +30,8 @@ def noise_sigma(e: np.ndarray) -> float:
     0.1
     """
     d2 = np.diff(np.asarray(e, float), 2)
+    if keep is not None:  # the second differences to use (a mask or indices into them)
+        d2 = d2[keep]
     if d2.size < 3:
         raise ModelError("too few samples to estimate the noise floor", where="record")
     mad = float(np.median(np.abs(d2 - np.median(d2))))

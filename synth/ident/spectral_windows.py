@@ -55,7 +55,7 @@ from synth.ident.coherence import coherence_from_spectra
 
 __all__ = [
     "CONSISTENCY", "MIN_SEGMENTS", "PERIODS_PER_WINDOW", "SAME_RATE", "USE_PERIODS", "WindowSpectra", "as_runs",
-    "check_length", "combine_windows", "default_windows", "log_grid", "lowest_frequency", "required_window",
+    "cell_edges", "check_length", "combine_windows", "default_windows", "log_grid", "lowest_frequency", "required_window",
     "window_spectra",
 ]
 
@@ -148,6 +148,20 @@ class WindowSpectra:
     n_d: np.ndarray
 
 
+def cell_edges(grid: np.ndarray) -> np.ndarray:
+    """The edges of each grid point's cell [rad/s]: the geometric midpoints, the ends mirrored (``grid.size + 1``).
+
+    Examples
+    --------
+    >>> cell_edges(np.array([1.0, 4.0])).tolist()
+    [0.5, 2.0, 8.0]
+    """
+    if grid.size < 2:
+        return np.r_[grid / 1.01, grid * 1.01]
+    mid = np.sqrt(grid[1:] * grid[:-1])
+    return np.r_[grid[0] ** 2 / mid[0], mid, grid[-1] ** 2 / mid[-1]]
+
+
 def window_spectra(runs: list[Record], fs: float, nseg: int, overlap: float, grid: np.ndarray,
                    detrend: str) -> WindowSpectra:
     """Segment-averaged spectra of all runs for one window of ``nseg`` samples, on ``grid`` [rad/s].
@@ -193,10 +207,7 @@ def window_spectra(runs: list[Record], fs: float, nseg: int, overlap: float, gri
         raise DataError(f"a window of {nseg / fs:.4g} s fits in none of the runs (the longest {longest:.4g} s)")
     gxx, gyy, gxy = sxx * scale / count, syy * scale / count, sxy * scale / count
     wb = 2.0 * np.pi * fs * np.arange(nfreq) / nseg
-    edges = np.sqrt(grid[1:] * grid[:-1])
-    first = grid[0] ** 2 / edges[0] if grid.size > 1 else grid[0] / 1.01
-    last = grid[-1] ** 2 / edges[-1] if grid.size > 1 else grid[0] * 1.01
-    edges = np.r_[first, edges, last]
+    edges = cell_edges(grid)
     cell = np.searchsorted(edges, wb, side="right") - 1
     inside = (cell >= 0) & (cell < grid.size)
     c = np.bincount(cell[inside], minlength=grid.size).astype(float)

@@ -27,6 +27,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from synth.data import Record
+from synth.ident.noise_floor import noise_sigma
 
 __all__ = ["END_SHARE", "LEVEL_SHARE", "MOVED_SHARE", "STILL_SHARE", "WHOLE_RUN_PERIODS", "at_rest", "rest_level",
            "whole_run_response"]
@@ -146,7 +147,7 @@ def rest_level(run: Record) -> tuple[float, float]:
     head_y, _ = _ends(run.y)
     head_u = run.u[:head_y.size]
     # a measured input's noise is no motion: its level from the second differences (a smooth start hardly enters)
-    noise_u = float(np.median(np.abs(np.diff(head_u, 2)))) / 0.6745 / np.sqrt(6.0) if head_u.size > 2 else 0.0
+    noise_u = noise_sigma(head_u) if head_u.size > 4 else 0.0
     level = float(np.median(head_u[:5]))
     moved = np.flatnonzero(np.abs(head_u - level) > max(MOVED_SHARE * span_u, 4.0 * noise_u))
     m = int(moved[0]) if moved.size else head_y.size

@@ -23,13 +23,9 @@ def exact_delay_for_gain(plant: Any, loop_delay: float, k: float) -> float | Non
     """
     from synth.controllers import Controller
     from synth.loop import Loop
-    from synth.requirements.delay_margin import delay_margins_per_crossover
 
     loop = Loop(plant.with_delay(plant.delay + loop_delay), Controller("P", {"kp": float(k)}))
-    if not loop.stability().stable:
-        return None
-    margins = delay_margins_per_crossover(loop)
-    return min(m[2] for m in margins) if margins else float("inf")
+    return float(loop.margins().delay_margin) if loop.stability().stable else None
 
 
 def delay_for_gain(delays: np.ndarray, gains: np.ndarray, k: float) -> float | None:

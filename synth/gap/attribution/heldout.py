@@ -477,11 +477,7 @@ def _moving_noise(e: np.ndarray, y: np.ndarray) -> float:
     largest or smallest value: resting on a clip it holds no noise, and the residual's second differences there are
     the model's smooth curve (a record clipped over half its samples had a floor of 3e-9 for a noise variance of
     2.5e-5; 0 where fewer than 5 samples are left). A quantized output's equal neighbours inside its range stay in."""
-    d2 = np.diff(np.asarray(e, float), 2)
     y = np.asarray(y, float)
     edge = (y == np.max(y)) | (y == np.min(y))
     moving = np.flatnonzero(~(edge[:-2] & edge[1:-1] & edge[2:]))
-    if moving.size < 5:
-        return 0.0
-    d2 = d2[moving]
-    return float(1.4826 * np.median(np.abs(d2 - np.median(d2))) / np.sqrt(6.0))
+    return float(noise_sigma(e, moving)) if moving.size >= 5 else 0.0
