@@ -103,7 +103,7 @@ def test_share_of_excess_takes_the_floor_as_at_most_the_judged_models_error():
 def test_an_effect_that_beats_an_overestimated_noise_floor_is_relevant(monkeypatch):
     rec = _record("lag", {"tau": 0.0144}, seed=3)
     # a floor estimate 20 % (in sigma) above the re-fit's error: the re-fit alone looks within the noise
-    monkeypatch.setattr(heldout, "noise_sigma", lambda e: 1.2 * float(np.sqrt(np.mean(np.square(e)))))
+    monkeypatch.setattr(heldout, "noise_sigma", lambda e, keep=None: 1.2 * float(np.sqrt(np.mean(np.square(e)))))
     dg = diagnose_effects(NOMINAL, rec, options=DiagnoseOptions(candidates=["lag"], confirm=None, max_effects=1))
     lag = dg.effects[0]
     # the premise was the re-fit's residual alone, 1.44 J_refit: no excess over it; since session 68 the floor is
