@@ -37,7 +37,8 @@ def test_too_short_is_one_line_and_exit_2(tmp_path, run_cli, option, value, samp
     res = run_cli("simulate", str(spec), "-c", "P(0.2)", option, value, "--out", str(tmp_path / "o"), "-q")
     assert res.code == 2
     lines = res.err.strip().splitlines()
-    assert len(lines) == 1 and f"{option}: " in lines[0] and f"leaves {samples} samples of 0.01 s" in lines[0]
+    expected = "must be at most 1/20 of the horizon" if option == "--horizon" else f"leaves {samples} samples of 0.01 s"
+    assert len(lines) == 1 and f"{option}: " in lines[0] and expected in lines[0], lines
 
 
 def test_eight_samples_after_the_step_give_a_verdict(tmp_path, run_cli):

@@ -234,6 +234,13 @@ def _check_times(args: argparse.Namespace, given: float | None, t_step: float, d
         raise SynthError(f"must be >= 0 s, got {t_step:g}", where="--step-time")
     if args.max_horizon is not None and not args.max_horizon > t_step:
         raise SynthError(f"must be after the step ({t_step:g} s), got {args.max_horizon:g}", where="--max-horizon")
+    if given is not None and args.max_horizon is not None and args.max_horizon < given:
+        raise SynthError(f"must be at least the horizon ({given:g} s), got {args.max_horizon:g}", where="--max-horizon")
+    if args.horizon is not None and dt > args.horizon / 20:
+        raise SynthError(f"dt {dt:g} s must be at most 1/20 of the horizon, got {args.horizon:g} s", where="--horizon")
+    if t_step / dt > 10 * MAX_SAMPLES:
+        raise SynthError(f"{t_step:g} s is {t_step / dt:.3g} samples of {dt:g} s; at most {10 * MAX_SAMPLES:.3g}",
+                         where="--step-time")
     for name, value in (("--horizon", given), ("--max-horizon", args.max_horizon)):
         if value is not None and value / dt > 10 * MAX_SAMPLES:
             raise SynthError(f"{value:g} s is {value / dt:.3g} samples of {dt:g} s; at most {10 * MAX_SAMPLES:.3g}",
@@ -256,6 +263,8 @@ def _print_metrics(say: Any, spec: Any, loop: Any, m: Any, step: tuple[float, fl
         ["n/a: the reference does not step"] * 3
     if verdict != "settled" and step[0] != step[1]:
         timing = ["n/a: the step does not settle"] * 2 + ["not settled"]
+    elif step[0] != step[1] and m.rise_time != m.rise_time:  # NaN: the output did not move
+        timing = ["n/a: the output does not move"] * 3
     rows = [
         ["rise time 10-90 %", timing[0]],
         ["overshoot", timing[1]],

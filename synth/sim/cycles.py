@@ -129,9 +129,8 @@ def measure_cycle(t: np.ndarray, y: np.ndarray, osc: Oscillation, cycles: int,
         half = 0.5 * float(np.ptp(y))
         period = osc.period if osc.period else (found[0] if found else float("nan"))
         low = osc.amplitude_range[0] if osc.amplitude_range else half
-        lengths = osc.period_range or (period, period)
-        if found is not None:
-            lengths = (min(lengths[0], found[0]), max(lengths[1], found[0]))
+        lengths = osc.period_range or (period, period)  # cycle lengths; not the lag at which the record best
+        # repeats, which may span several cycles (a range of 0.1 to 1.09 s for cycles of 0.1-0.11 s)
         how = (f"not periodic: shifted by any period the record differs by more than {100 * REPEAT:g} % RMS "
                "or 10 % at a sample; "
                f"amplitude half the peak-to-peak range of the window, period the mean length of its cycles "

@@ -15,6 +15,7 @@ from typing import Any
 
 import numpy as np
 
+from synth.sim.authority import output_still
 from synth.sim.limitcycle import Oscillation, detect_oscillation
 from synth.sim.results import SimResult
 from synth.timeresp import StepMetrics, step_metrics
@@ -172,7 +173,8 @@ def nonlinear_step_metrics(result: SimResult, t_step: float = 0.0, final_value: 
         passes :data:`~synth.sim.limitcycle.SAMPLED_HYSTERESIS` and True).
     step_size : float, optional
         The reference's change at ``t_step``: 0 leaves rise time, overshoot and settling time undefined (NaN; a run
-        held at its operating point, where the output's change is rounding).
+        held at its operating point, where the output's change is rounding), as does an output that did not move
+        (:func:`synth.sim.authority.output_still`: a command change inside a backlash's play).
 
     Examples
     --------
@@ -201,7 +203,8 @@ def nonlinear_step_metrics(result: SimResult, t_step: float = 0.0, final_value: 
     else:
         yf = tail_limit(ya, extrapolate=not (osc.present or osc.diverging))
     y0 = float(y[i0])
-    if step_size == 0.0:  # the reference does not step: no rise, overshoot or settling to measure
+    if step_size == 0.0 or (step_size is not None and output_still(ya, y0, step_size)):
+        # the reference does not step, or the output did not move: no rise, overshoot or settling to measure
         base = StepMetrics(float("nan"), float("nan"), float("nan"), yf, float(np.max(ya)))
     else:
         base = step_metrics(ta - ta[0], ya, y0=y0, y_final=yf, settle_band=settle_band)

@@ -21,7 +21,10 @@ decide, doubles the horizon up to a cap. The rules (:func:`judge`), on the outpu
   themselves (autocorrelation above 0.98) with the same period and amplitude within 1 %, or (a
   sustained irregular oscillation, e.g. quasi-periodic relay or quantizer chatter) the peak-to-peak
   ranges of the last three quarters are equal within 10 % and above twice ``min_amplitude`` and
-  the numerical floor (amplitude: half that range; period: the mean of the crossings). A limit
+  the numerical floor (amplitude: half that range; period: the mean of the crossings). Regular cycles also need
+  the output's centre and the controller's command, each averaged over the quarters' whole cycles, to have
+  stopped moving one way (within 1 % of its half range, or converging geometrically to within that): a
+  command still winding towards a block's threshold ends the cycle there. A limit
   cycle whose whole cycles do not repeat (lengths within 1 %, maxima and minima within 1 % of the
   amplitude: :attr:`Oscillation.periodic <synth.sim.limitcycle.Oscillation>`) is reported as
   oscillating but not periodic, with the range of its cycles' amplitudes and lengths;
@@ -157,6 +160,36 @@ def _steady(a: Oscillation, b: Oscillation, c: Oscillation, drift: float,
     return f"the amplitude still changes {100 * da:.2g} % between the last three quarters", ""
 
 
+def _centre_drift(ta: np.ndarray, ya: np.ndarray, signal: np.ndarray, name: str) -> str | None:
+    """Why the cycle over the last three quarters has not reached its own steady state, or None: the mean of
+    ``signal`` over each quarter's whole cycles of the output (delimited as :func:`cycle_table` delimits them)
+    moves one way by more than :data:`STEADY` of the signal's half range over the last quarter, and not so
+    geometrically that the rest of the way is within that (a periodic state repeats the controller's command
+    and the output's centre; a command still winding towards a block's threshold ends the cycle there)."""
+    span = ta[-1] - ta[0]
+    keep = ta >= ta[-1] - 0.75 * span
+    starts, _ = cycle_table(ta[keep], ya[keep])
+    means = []
+    for k in (3, 2, 1):
+        lo, hi = ta[-1] - k * span / 4, ta[-1] - (k - 1) * span / 4 + 1e-12
+        inside = starts[(starts >= lo) & (starts <= hi)]
+        if inside.size < 2:
+            return None
+        means.append(float(np.mean(signal[(ta >= inside[0]) & (ta < inside[-1])])))
+    last = ta >= ta[-1] - span / 4
+    half = 0.5 * float(np.ptp(signal[last]))
+    d1, d2 = means[1] - means[0], means[2] - means[1]
+    if not (half > 0 and d1 * d2 > 0 and abs(d2) > STEADY * half):
+        return None
+    r = d2 / d1
+    rest = abs(d2) * r / (1.0 - r) if r < 0.8 else float("inf")
+    if rest <= STEADY * half:
+        return None
+    return (f"the {name}'s mean over whole cycles still moves one way ({means[0]:.4g}, {means[1]:.4g}, "
+            f"{means[2]:.4g} over the last three quarters: {100 * abs(d2) / half:.2g} % of its half range in the "
+            f"last), so the cycle has not reached its own steady state")
+
+
 def _excursion_grows(ta: np.ndarray, ya: np.ndarray, end: float, scale: float) -> bool:
     """The largest distance from the reference over the last quarter is more than 10 steps and 1.3
     times that over the second quarter: a drift, or an oscillation growing without a bound."""
@@ -266,6 +299,9 @@ def judge(result: SimResult, t_step: float, step: tuple[float, float], metrics: 
                                   ya[(ta >= ta[-1] - k * span / 4) & (ta <= ta[-1] - (k - 1) * span / 4)])
                       for k in (1, 2, 3))
         why, how = _steady(a, b, c, _drift(ta, ya), sizes)  # type: ignore[arg-type]
+        if why is None:
+            why = _centre_drift(ta, ya, ya, "output") or _centre_drift(ta, ya, result.command[after],
+                                                                        "controller's command")
         if why is not None:
             return Judgement(None, why, cycles)
         return Judgement("limit_cycle", f"{how} ({span / 4:.3g} s each)", cycles)
