@@ -62,6 +62,8 @@ def short_of_reference(result: SimResult, t_step: float, step: tuple[float, floa
     if output_still(result.output[after], float(result.output[after[0]]), size):
         return (f"{rests}: it did not move, the actuator's output stayed at {fmt(float(result.actuator[-1]))} (the "
                 "controller's command stayed inside what the actuator's blocks hold)")
+    if np.ptp(result.command[tail]) == 0.0:
+        return None  # the command rests too (a P controller's own steady-state error under a still reading)
     return (f"{rests}: the actuator's output stands still at {fmt(float(result.actuator[-1]))} for good (an actuator "
             f"block holds it there, e.g. the flat end of a table), the controller's command moving at {rate:.3g} "
             "input units/s")
