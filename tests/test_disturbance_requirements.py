@@ -118,7 +118,9 @@ def test_a_flat_record_asks_for_no_sensitivity():
     shape = DisturbanceShape(-40.0, 30.0, -30.0, -30.0)  # disturbance 10 dB below the floor
     _, r = requirements_from_records([synthetic_disturbance_record(shape, duration=20.0)])
     assert r.max_db is None and any("does not stand above" in n for n in r.notes)
-    assert [e["type"] for e in r.spec_entries()] == ["bandwidth"]
+    # nor a bandwidth floor: no frequency has the disturbance 3 dB above the floor (it was the fitted corner)
+    assert r.spec_entries() == [] and r.min_bandwidth is None and r.ideal_bandwidth is None
+    assert any("no bandwidth floor follows" in n for n in r.notes) and r.yaml().startswith("requirements: []")
 
 
 def test_bad_input():

@@ -205,6 +205,9 @@ def _check_options(args: argparse.Namespace) -> None:
                               ("--w-min", args.w_min, "a finite number > 0 rad/s")):
         if value is not None and not (math.isfinite(value) and value > 0):
             raise SynthError(f"must be {what}, got {value:g}", where=flag)
+    if args.time is not None and args.time == args.signal:
+        raise SynthError(f"names the time column '{args.time}' (--time); give the disturbance's own column",
+                         where="--signal")
     if not (math.isfinite(args.share) and 0 < args.share < 1):
         raise SynthError(f"share must lie strictly between 0 and 1, got {args.share:g}", where="--share")
 
@@ -215,6 +218,11 @@ def _check_against_records(args: argparse.Namespace, records: list[Any]) -> None
     from synth.ident.psd import check_band
 
     dt = records[0].dt
+    units = {r.unit: r.source for r in records if r.unit}
+    if len(units) > 1:  # spectra in different units cannot be averaged or compared
+        (u1, f1), (u2, f2) = list(units.items())[:2]
+        raise SynthError(f"{f2}: the signal '{args.signal}' is in {u2}, in {f1} it is in {u1}; give every record "
+                         "(and --noise-data) in one unit", where="--noise-data" if f2 in args.noise_data else "--data")
     if args.dt is not None and args.time is not None:
         for r in records:
             if abs(args.dt - r.dt) > 0.01 * r.dt:

@@ -173,10 +173,11 @@ class DisturbanceRequirements:
         ``|S|`` needed over ``band`` [dB] (``None``: the disturbance never stands above the sensor floor).
     band : tuple of float
         ``(0, corner)`` [rad/s].
-    min_bandwidth : float
-        Bandwidth floor: the disturbance falls to ``margin_db`` above the sensor floor here [rad/s].
-    ideal_bandwidth : float
-        The disturbance meets the sensor floor here [rad/s].
+    min_bandwidth : float or None
+        Bandwidth floor: the disturbance falls to ``margin_db`` above the sensor floor here [rad/s] (``None``: its
+        plateau does not stand ``margin_db`` above the floor, so no frequency is).
+    ideal_bandwidth : float or None
+        The disturbance meets the sensor floor here [rad/s] (``None``: it never stands above the floor).
     margin_db : float
     sensor_floor_db : float
         [dB re 1 unit^2/(rad/s)]
@@ -197,8 +198,8 @@ class DisturbanceRequirements:
 
     max_db: float | None
     band: tuple[float, float]
-    min_bandwidth: float
-    ideal_bandwidth: float
+    min_bandwidth: float | None
+    ideal_bandwidth: float | None
     margin_db: float
     sensor_floor_db: float
     sensor_floor_source: str
@@ -211,13 +212,18 @@ class DisturbanceRequirements:
         out: list[dict[str, Any]] = []
         if self.max_db is not None:
             out.append({"type": "sensitivity", "max_db": _g(self.max_db), "band": [0, _g(self.band[1])]})
-        out.append({"type": "bandwidth", "min": _g(self.min_bandwidth)})
+        if self.min_bandwidth is not None:
+            out.append({"type": "bandwidth", "min": _g(self.min_bandwidth)})
         return out
 
     def yaml(self) -> str:
         """A ready ``requirements:`` block, each entry with its evidence as a comment."""
+        entries = self.spec_entries()
+        if not entries:
+            return (f"requirements: []   # none: the disturbance's plateau ({self.fit.plateau_db:.3g} dB) does not stand "
+                    f"above the sensor floor ({self.sensor_floor_db:.3g} dB, {self.sensor_floor_source})")
         lines = ["requirements:"]
-        for e in self.spec_entries():
+        for e in entries:
             if e["type"] == "sensitivity":
                 lines.append(f"  - {{type: sensitivity, max_db: {e['max_db']:g}, band: [0, {e['band'][1]:g}]}}   "
                              f"# plateau {self.fit.plateau_db:.3g} dB vs sensor floor {self.sensor_floor_db:.3g} dB "
@@ -294,8 +300,16 @@ def requirements_from_disturbance(analysis: PsdAnalysis, resolution: float | Non
     if fit.corner <= w[2]:
         notes.append("the fitted corner lies at the lowest bins: the spectrum has no plateau in the record "
                      "(a longer record resolves lower frequencies)")
-    ideal = fit.frequency_at(sensor_db)
-    minimum = fit.frequency_at(sensor_db + margin_db)
+    # frequency_at gives the corner for a level the plateau does not reach: no frequency, then, meets that level
+    ideal = fit.frequency_at(sensor_db) if fit.plateau_db > sensor_db else None
+    minimum = fit.frequency_at(sensor_db + margin_db) if fit.plateau_db > sensor_db + margin_db else None
+    if minimum is None:
+        notes.append(f"the plateau ({fit.plateau_db:.3g} dB) does not stand {margin_db:g} dB above the sensor floor "
+                     f"({sensor_db:.3g} dB): no bandwidth floor follows")
+    if (max_db is not None or minimum is not None) and analysis.suggestion_withheld is not None \
+            and analysis.suggestion_withheld.startswith("not significant"):
+        notes.append("the power above the floor is within the Welch estimate's scatter (not significant): a "
+                     "requirement above rests on a plateau the record may not show")
     D = np.where(mask, 0.0, S - analysis.floor)
     level = f"dB re 1 {unit_squared(analysis.unit)}/(rad/s)"
     share_below = float(np.sum(D[w <= fit.corner]) / np.sum(D)) if np.sum(D) > 0 else float("nan")
@@ -308,9 +322,10 @@ def requirements_from_disturbance(analysis: PsdAnalysis, resolution: float | Non
         Evidence("share of disturbance power below the corner", share_below, "1",
                  "power above the measured floor, spikes left out"),
         Evidence("decay", fit.slope_db_per_decade, "dB/decade", "log-log slope above the corner"),
-        Evidence("bandwidth floor", minimum, "rad/s", f"fitted disturbance {margin_db:g} dB above the sensor floor"),
-        Evidence("ideal bandwidth", ideal, "rad/s", "fitted disturbance meets the sensor floor"),
     ]
+    ev += [Evidence(name, value, "rad/s", what) for name, value, what in (
+        ("bandwidth floor", minimum, f"fitted disturbance {margin_db:g} dB above the sensor floor"),
+        ("ideal bandwidth", ideal, "fitted disturbance meets the sensor floor")) if value is not None]
     if analysis.share_frequency is not None and analysis.suggestion_withheld is None:
         s = suggest_bandwidth(analysis)
         ev.append(Evidence(f"{100 * s.share:g} % power frequency", s.share_frequency, "rad/s",

@@ -48,10 +48,12 @@ def disturbance_requirements_plot(a: PsdAnalysis, r: DisturbanceRequirements, pa
     if r.max_db is not None:
         ax.axvspan(a.w[0], r.band[1], color="#2e8b57", alpha=0.12,
                    label=f"sensitivity <= {r.max_db:.3g} dB below {r.band[1]:.3g} rad/s")
-    ax.axvline(r.min_bandwidth, color="#8e44ad", lw=1.5, label=f"bandwidth floor {r.min_bandwidth:.3g} rad/s "
-               f"({r.margin_db:g} dB above the sensor floor)")
-    ax.axvline(r.ideal_bandwidth, color="#8e44ad", lw=1.0, ls="--",
-               label=f"disturbance meets the sensor floor {r.ideal_bandwidth:.3g} rad/s")
+    if r.min_bandwidth is not None:
+        ax.axvline(r.min_bandwidth, color="#8e44ad", lw=1.5, label=f"bandwidth floor {r.min_bandwidth:.3g} rad/s "
+                   f"({r.margin_db:g} dB above the sensor floor)")
+    if r.ideal_bandwidth is not None:
+        ax.axvline(r.ideal_bandwidth, color="#8e44ad", lw=1.0, ls="--",
+                   label=f"disturbance meets the sensor floor {r.ideal_bandwidth:.3g} rad/s")
     ax.set_xlabel("frequency [rad/s]")
     ax.set_ylabel(f"PSD [dB re 1 {u}]")
     low = min(a.floor_db, r.sensor_floor_db) - 15

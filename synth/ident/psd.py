@@ -231,7 +231,11 @@ def analyze_psd(signals: Sequence[np.ndarray], dt: float, share: float = 0.9, ba
     median = running_median_db(S)
     spikes, mask = find_spikes(w, S, spike_db, median)
     if noise:
-        wn, Sn, kn = welch_psd(noise, dt, 2 * np.pi / dw * 1.0, None, detrend)
+        try:
+            wn, Sn, kn = welch_psd(noise, dt, 2 * np.pi / dw * 1.0, None, detrend)
+        except DataError as exc:  # its segments are the records' (the same bins)
+            raise DataError(f"the noise record is shorter than one segment of the records' spectrum: {exc.message}",
+                            where="--noise-data") from None
         floor, fband = noise_floor(wn, Sn, kn, floor_band or (float(wn[0]), float(wn[-1])))
         source = "noise record"
         floor_bins, floor_segments = int(np.count_nonzero((wn >= fband[0]) & (wn <= fband[1]))), kn

@@ -84,13 +84,15 @@ def welch_psd(signals: Sequence[np.ndarray], dt: float, segment: float | None = 
         nper = int(np.ceil(4 * np.pi / (w_min * dt)))
     else:
         nper = max(16, shortest // 8)
+    option = "--segment" if segment is not None else "--w-min" if w_min is not None else "psd"  # what set the length
     if nper < 8:
-        raise DataError(f"segment of {nper} samples is too short; give a longer segment", where="psd")
+        raise DataError(f"a segment of {nper} samples of {dt:.4g} s is too short (8 at least); give a longer segment "
+                        "or a lower frequency", where=option)
     if shortest < nper:
         need = nper * dt
         what = f"the lowest frequency {w_min:g} rad/s needs" if w_min is not None and segment is None else "needs"
         raise DataError(f"a record holds {shortest} samples ({shortest * dt:.4g} s); {what} segments of "
-                        f"{need:.4g} s", where="psd")
+                        f"{need:.4g} s", where=option)
     total, count = None, 0
     for x in signals:
         x = np.asarray(x, float)
