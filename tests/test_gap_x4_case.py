@@ -5,6 +5,8 @@ import pytest
 from synth.gap.x4_case import gap_case_applies, x4_gap_case
 from synth.spec import load_spec
 
+pytestmark = pytest.mark.xdist_group("gap_x4_case")  # one worker diagnoses the case once for the module's tests
+
 
 @pytest.fixture(scope="module")
 def case():
