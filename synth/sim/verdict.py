@@ -58,6 +58,7 @@ import numpy as np
 
 from synth.errors import ModelError
 from synth.sim.authority import short_of_reference
+from synth.sim.centre_drift import STEADY, centre_drift
 from synth.sim.cycles import autocorrelation_period, measure_cycle
 from synth.sim.hidden_mode import hidden_drift, unseen_root
 from synth.sim.holding import winding_behind
@@ -88,8 +89,6 @@ VERDICTS = ("settled", "limit_cycle", "diverging", "undetermined")
 """The four answers of a step simulation."""
 MIN_CYCLES = 6
 """Whole cycles a limit cycle needs in the last half of the run."""
-STEADY = 0.01
-"""Largest relative change of amplitude and period between the last three quarters of a limit cycle."""
 SETTLED = 1e-4
 """Largest distance from the final value over the last quarter of a settled run (fraction of the step)."""
 SHRINK = 0.75
@@ -158,36 +157,6 @@ def _steady(a: Oscillation, b: Oscillation, c: Oscillation, drift: float,
     if da < 0.2 and drift > STEADY:
         return f"the amplitude varies {100 * da:.2g} % and drifts {100 * drift:.2g} % over the last three quarters", ""
     return f"the amplitude still changes {100 * da:.2g} % between the last three quarters", ""
-
-
-def _centre_drift(ta: np.ndarray, ya: np.ndarray, signal: np.ndarray, name: str) -> str | None:
-    """Why the cycle over the last three quarters has not reached its own steady state, or None: the mean of
-    ``signal`` over each quarter's whole cycles of the output (delimited as :func:`cycle_table` delimits them)
-    moves one way by more than :data:`STEADY` of the signal's half range over the last quarter, and not so
-    geometrically that the rest of the way is within that (a periodic state repeats the controller's command
-    and the output's centre; a command still winding towards a block's threshold ends the cycle there)."""
-    span = ta[-1] - ta[0]
-    keep = ta >= ta[-1] - 0.75 * span
-    starts, _ = cycle_table(ta[keep], ya[keep])
-    means = []
-    for k in (3, 2, 1):
-        lo, hi = ta[-1] - k * span / 4, ta[-1] - (k - 1) * span / 4 + 1e-12
-        inside = starts[(starts >= lo) & (starts <= hi)]
-        if inside.size < 2:
-            return None
-        means.append(float(np.mean(signal[(ta >= inside[0]) & (ta < inside[-1])])))
-    last = ta >= ta[-1] - span / 4
-    half = 0.5 * float(np.ptp(signal[last]))
-    d1, d2 = means[1] - means[0], means[2] - means[1]
-    if not (half > 0 and d1 * d2 > 0 and abs(d2) > STEADY * half):
-        return None
-    r = d2 / d1
-    rest = abs(d2) * r / (1.0 - r) if r < 0.8 else float("inf")
-    if rest <= STEADY * half:
-        return None
-    return (f"the {name}'s mean over whole cycles still moves one way ({means[0]:.4g}, {means[1]:.4g}, "
-            f"{means[2]:.4g} over the last three quarters: {100 * abs(d2) / half:.2g} % of its half range in the "
-            f"last), so the cycle has not reached its own steady state")
 
 
 def _excursion_grows(ta: np.ndarray, ya: np.ndarray, end: float, scale: float) -> bool:
@@ -300,8 +269,8 @@ def judge(result: SimResult, t_step: float, step: tuple[float, float], metrics: 
                       for k in (1, 2, 3))
         why, how = _steady(a, b, c, _drift(ta, ya), sizes)  # type: ignore[arg-type]
         if why is None:
-            why = _centre_drift(ta, ya, ya, "output") or _centre_drift(ta, ya, result.command[after],
-                                                                        "controller's command")
+            why = centre_drift(ta, ya, ya, "output") or centre_drift(ta, ya, result.command[after],
+                                                                      "controller's command")
         if why is not None:
             return Judgement(None, why, cycles)
         return Judgement("limit_cycle", f"{how} ({span / 4:.3g} s each)", cycles)
