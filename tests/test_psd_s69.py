@@ -75,3 +75,51 @@ def test_a_noise_record_shorter_than_a_segment_names_it(run_cli, tmp_path):
     noise = write(tmp_path / "n.csv", np.arange(3000) / 1000, rng.standard_normal(3000))
     res = run_cli("psd", "--data", data, "--noise-data", noise, "--time", "t", "--signal", "d")
     assert res.code == 2 and "--noise-data" in res.err and "noise record" in res.err, res.err
+
+
+def tone_record(seed: int, n: int = 80000, coloured: float = 0.0):
+    """White noise (std 0.2), tones at 50 and 400 Hz, and optionally a disturbance low-passed at 2 Hz."""
+    from scipy import signal
+
+    rng = np.random.default_rng(seed)
+    t = np.arange(n) / 1000
+    x = 0.2 * rng.standard_normal(n) + np.sin(2 * np.pi * 50 * t) + 0.5 * np.sin(2 * np.pi * 400 * t)
+    if coloured:
+        b, a = signal.butter(1, 2.0 / 500.0)
+        x += coloured * signal.lfilter(b, a, rng.standard_normal(n))
+    return t, x, rng
+
+
+def suggestion(run_cli, tmp_path, data, *extra):
+    out = tmp_path / "psd.json"
+    res = run_cli("psd", "--data", data, "--signal", "d", "--json", str(out), *extra)
+    assert res.code == 0, res.err
+    return json.loads(out.read_text())
+
+
+def test_a_hole_in_the_log_is_not_interpolated_into_a_requirement(run_cli, tmp_path):
+    t, x, _ = tone_record(31)
+    t[40001:] += 0.5  # a 0.5 s hole
+    data = suggestion(run_cli, tmp_path, write(tmp_path / "gap.csv", t, x), "--time", "t")
+    assert data["bandwidth_suggestion"]["status"] == "not significant"  # was a bandwidth of 320 rad/s
+    assert len(data["records"]) == 2 and any("split there" in n for n in data["notes"])
+
+
+def test_tones_interpolated_across_dropped_samples_are_not_a_disturbance(run_cli, tmp_path):
+    t, x, rng = tone_record(80)
+    keep = rng.uniform(size=t.size) > 0.02
+    keep[0] = keep[-1] = True
+    data = suggestion(run_cli, tmp_path, write(tmp_path / "drop.csv", t[keep], x[keep]), "--time", "t")
+    assert data["bandwidth_suggestion"]["status"] == "interpolated", data["bandwidth_suggestion"]  # was 1220 rad/s
+
+
+def test_a_disturbance_with_dropped_samples_keeps_its_suggestion(run_cli, tmp_path):
+    t, x, rng = tone_record(81, coloured=3.0)
+    whole = suggestion(run_cli, tmp_path, write(tmp_path / "whole.csv", t, x), "--time", "t")
+    keep = rng.uniform(size=t.size) > 0.02
+    keep[0] = keep[-1] = True
+    dropped = suggestion(run_cli, tmp_path, write(tmp_path / "drop.csv", t[keep], x[keep]), "--time", "t")
+    a, b = whole["bandwidth_suggestion"], dropped["bandwidth_suggestion"]
+    assert "min_bandwidth" in a and "min_bandwidth" in b, (a, b)
+    # the tones' interpolation error spread over the band still moves the 90 % frequency up (12 % here)
+    assert a["min_bandwidth"] <= b["min_bandwidth"] <= 1.15 * a["min_bandwidth"]

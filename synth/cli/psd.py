@@ -83,7 +83,7 @@ def run(args: argparse.Namespace) -> int:
     from synth.errors import DataError, SynthError
     from synth.ident.bandwidth_suggestion import suggest_bandwidth
     from synth.ident.psd import MIN_SEGMENTS, analyze_records
-    from synth.ident.psd_stamps import load_psd_record
+    from synth.ident.psd_stamps import load_psd_records
     from synth.ident.welch import unit_squared
     from synth.outputs import OutputDir, check_writable, dump_json, write_json
 
@@ -91,9 +91,11 @@ def run(args: argparse.Namespace) -> int:
                   inputs=args.data)  # before any computation
     _check_options(args)
     columns = parse_column_map(args.columns)
-    loaded = [load_psd_record(f, args.time, args.signal, args.unit, args.dt, columns) for f in args.data]
+    loaded = [piece for f in args.data for piece in load_psd_records(f, args.time, args.signal, args.unit, args.dt,
+                                                                         columns)]
     records = [r for r, _ in loaded]
-    noise = [load_psd_record(f, args.time, args.signal, args.unit, args.dt, columns)[0] for f in args.noise_data]
+    noise = [r for f in args.noise_data for r, _ in load_psd_records(f, args.time, args.signal, args.unit, args.dt,
+                                                                     columns)]
     _check_against_records(args, [*records, *noise])
     raw_var = sum(ms * r.x.size for r, ms in loaded) / sum(r.x.size for r in records)
     a = analyze_records(records, noise, share=args.share, band=tuple(args.band) if args.band else None,

@@ -37,6 +37,8 @@ class DisturbanceRecord:
     unit: str = ""
     source: str = "arrays"
     notes: tuple[str, ...] = ()
+    made_up: float = 0.0
+    """Share of the samples made up by linear interpolation across dropped time stamps."""
 
     @property
     def dt(self) -> float:

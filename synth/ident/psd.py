@@ -435,6 +435,19 @@ def analyze_records(records: Sequence[DisturbanceRecord], noise: Sequence[Distur
                             "spectrum underflows double precision; rescale the signal", where=r.source)
     unit = options.pop("unit", records[0].unit)
     result = analyze_psd([r.x for r in records], dt0, noise=[r.x for r in noise] or None, unit=unit, **options)
-    notes = tuple(f"{r.source}: {n}" for r in everything for n in r.notes)
-    return PsdAnalysis(**{**result.__dict__, "notes": notes + result.notes})
+    notes = tuple(dict.fromkeys(f"{r.source}: {n}" for r in everything for n in r.notes))  # a split file's once
+    made_up = sum(r.made_up * r.x.size for r in records) / sum(r.x.size for r in records)
+    # a tone interpolated at the midpoint of a dropped stamp misses by A sin(wt) (1 - cos w dt): that error, on the
+    # made-up share of the samples, is power spread over every frequency that no record holds
+    spread = made_up * sum(sp.power * (1.0 - np.cos(sp.w * dt0)) ** 2 for sp in result.spikes)
+    extra: tuple[str, ...] = ()
+    if spread > 0.0 and result.suggestion_withheld is None and result.disturbance_power <= 2.0 * spread:
+        sq = unit_squared(unit)
+        why = (f"interpolated: the power above the floor ({result.disturbance_power:.3g} {sq}) is within twice what "
+               f"interpolating the spikes across the dropped stamps ({100 * made_up:.2g} % of the samples) spreads "
+               f"over the band (about {spread:.3g} {sq}); a record without dropped stamps shows whether it is the "
+               "disturbance's")
+        result = PsdAnalysis(**{**result.__dict__, "share_frequency": None, "suggestion_withheld": why})
+        extra = (f"no share frequency and no bandwidth requirement: {why}",)
+    return PsdAnalysis(**{**result.__dict__, "notes": notes + result.notes + extra})
 
