@@ -22,7 +22,9 @@ feedback attenuates a disturbance only below the loop's bandwidth. No requiremen
 power above the floor is within the Welch estimate's chi-square scatter (false-alarm rate 0.1 %), and it is
 "undetermined" with fewer than 4 segments averaged. Bands must lie in (0, Nyquist]; uneven time stamps
 that jitter around a grid are used without interpolation (otherwise the note states the interpolation's
-attenuation), and the variance printed is the raw samples'.
+attenuation), a record is split at gaps of 5 intervals or more (its pieces averaged), a suggestion that
+tones interpolated across dropped stamps could explain is withheld, and the variance printed is the raw
+samples'.
 
 example:
   synth psd --data env.csv --data env2.csv --time t --signal speed --unit rad/s

@@ -23,7 +23,10 @@ put together:
   the suggestion is "undetermined".
 - **Uneven time stamps** (:func:`synth.ident.psd_stamps.load_psd_record`): stamps jittering around a uniform grid are used as
   they are on that grid (interpolation would low-pass the spectrum); otherwise the linear interpolation
-  is kept and its attenuation stated; the variance of the raw samples is reported either way.
+  is kept and its attenuation stated; the variance of the raw samples is reported either way. A record is split
+  at gaps of its stamps (:func:`synth.ident.psd_stamps.load_psd_records`, :data:`~synth.ident.psd_stamps.GAP_FACTOR`
+  intervals or more) and its pieces averaged as records; where tones interpolated across dropped stamps spread
+  at least half the power above the floor over the band (:func:`analyze_records`), no suggestion is made.
 """
 
 from __future__ import annotations
