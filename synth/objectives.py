@@ -13,7 +13,7 @@ from synth.freqgrid import log_grid, peak
 if TYPE_CHECKING:
     from synth.loop import Loop
 
-__all__ = ["Measure", "measure", "score"]
+__all__ = ["Measure", "in_plant_units", "measure", "score"]
 
 
 @dataclass(frozen=True)
@@ -113,3 +113,23 @@ def score(loop: Loop, terms: list[tuple[str, str, float]]) -> float:
         value = measure(name).evaluate(loop)
         total += weight * (value if sense == "maximize" else -value)
     return float(total)
+
+
+def in_plant_units(unit: str, input_unit: str | None, output_unit: str | None) -> str:
+    """A unit written in ``u`` (plant input) and ``y`` (plant output) with the plant's own units put in, when the spec
+    gives both (a unit with ``/``, ``*`` or a space in parentheses); else ``unit`` as it is.
+
+    Examples
+    --------
+    >>> in_plant_units("u/(y*s)", "%", "l/min"), in_plant_units("u/y", "V", "rpm"), in_plant_units("u/y", "", "rpm")
+    ('%/((l/min)*s)', 'V/rpm', 'u/y')
+    """
+    import re
+
+    if not (input_unit and output_unit):
+        return unit
+
+    def wrap(text: str) -> str:
+        return f"({text})" if re.search(r"[/* ]", text) else text
+
+    return re.sub(r"\b[uy]\b", lambda m: wrap(input_unit if m.group(0) == "u" else output_unit), unit)

@@ -16,7 +16,7 @@ import numpy as np
 from synth.check import CheckResult, check
 from synth.controllers import Controller
 from synth.loop import BANDWIDTH_LEVEL, Loop
-from synth.objectives import measure
+from synth.objectives import in_plant_units, measure
 from synth.objectives import score as objective_score
 from synth.requirements.base import fmt
 from synth.spec import Spec
@@ -194,7 +194,8 @@ def objective_label(spec: Spec, loop: Loop) -> dict[str, Any]:
     assert obj is not None
     if obj.weighted is None:
         m = measure(obj.name)
-        label = {"name": m.name, "sense": obj.sense, "unit": m.unit, "description": m.description,
+        unit = in_plant_units(m.unit, spec.plant.input.unit, spec.plant.output.unit)
+        label = {"name": m.name, "sense": obj.sense, "unit": unit, "description": m.description,
                  "value": float(m.evaluate(loop))}
         t0 = abs(loop.T0())
         if m.name == "bandwidth" and np.isfinite(t0) and t0 < BANDWIDTH_LEVEL:
