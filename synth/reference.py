@@ -178,9 +178,13 @@ def delay_warning(controller: Controller, table: list[dict[str, Any]], margins: 
     'P(kp=20) is unstable with 5 ms of delay in the loop'
     """
     kp = float(controller.parameters["kp"])
-    first = next((r for r in table if kp >= float(r["critical_gain"])), None)
+    first = next((r for r in table if not float(r.get("lowest_gain") or 0.0) < kp < float(r["critical_gain"])), None)
     if first is None:
         return None
+    if kp <= float(first.get("lowest_gain") or 0.0) < float(first["critical_gain"]):
+        return (f"{controller} is unstable with {fmt(1000 * float(first['delay']), 3)} ms of delay in the loop (the "
+                f"gain must lie between {fmt(float(first['lowest_gain']), 4)} and {fmt(float(first['critical_gain']), 4)} "
+                "there; delay table below): the requirements hold only without that delay")
     margin = margins.get("delay_margin")
     exact = f"; its exact delay margin is {fmt(1000 * margin, 3)} ms" if isinstance(margin, float) else ""
     return (f"{controller} is unstable with {fmt(1000 * float(first['delay']), 3)} ms of delay in the loop (critical "

@@ -244,6 +244,9 @@ def delay_chart(rows: list[dict[str, Any]], marks: dict[str, float], path: Path)
     k = np.array([r["critical_gain"] for r in rows], float)
     finite = np.isfinite(k)
     ax.semilogy(d[finite], k[finite], "o-", color=COLORS[0], label="critical gain (loop turns unstable)")
+    low = np.array([r.get("lowest_gain") or 0.0 for r in rows], float)
+    if np.any(low > 0):  # an open-loop unstable plant: gains below these leave it unstable too
+        ax.semilogy(d[low > 0], low[low > 0], "s--", color=COLORS[1], label="lowest stabilizing gain")
     for j, (label, value) in enumerate(marks.items()):
         ax.axhline(value, color="black", ls=["-", "--", ":"][j % 3], lw=1.2, label=label)
     ax.set_xlabel("in-loop delay [ms]")

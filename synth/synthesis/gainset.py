@@ -447,13 +447,19 @@ def _binding(x: float, sets: dict[str, list[tuple[float, float]]], lo: float, hi
 
 
 def critical_gains(plant: Plant, delays: list[float], k_max: float = 1e3) -> list[dict[str, float | None]]:
-    """Smallest positive proportional gain that destabilizes the loop, for each in-loop delay.
+    """The lowest stabilizing range of a proportional gain, for each in-loop delay: ``critical_gain``, where the loop
+    turns unstable (and ``frequency``, where it oscillates then), and ``lowest_gain``, where that range starts (0
+    for a plant the smallest gains keep stable; above 0 for an open-loop unstable one, whose small gains leave it
+    unstable; ``critical_gain`` 0 where no gain up to ``k_max`` stabilizes).
 
     Examples
     --------
     >>> G = Plant.from_string("23*(s+0.43)/((s+9.6)*(s+0.54))")
     >>> [round(r["critical_gain"], 2) for r in critical_gains(G, [0.015, 0.02])]
     [4.83, 3.69]
+    >>> r = critical_gains(Plant.from_string("10/((s-1)*(s+5))"), [0.02])[0]  # unstable below 0.5
+    >>> round(r["lowest_gain"], 3), round(r["critical_gain"], 2)
+    (0.5, 20.26)
     """
     out = []
     one = (np.array([1.0]), np.array([1.0]))
@@ -461,11 +467,15 @@ def critical_gains(plant: Plant, delays: list[float], k_max: float = 1e3) -> lis
         p = plant.with_delay(plant.delay + d) if d else plant
         ivs = affine_stability_intervals(None, one, p.num, p.den, p.delay, 0.0, k_max, first_only=True)
         first = next((iv for iv in ivs if iv.lo <= 1e-12), None)
+        lowest = 0.0
+        if first is None:  # small gains leave the loop unstable: the first range of gains that stabilizes
+            first = next(iter(affine_stability_intervals(None, one, p.num, p.den, p.delay, 0.0, k_max)), None)
+            lowest = float(first.lo) if first is not None else 0.0
         if first is None:
             crit, w = 0.0, None
         elif first.hi_is_boundary:
             crit, w = first.hi, first.hi_frequency
         else:
             crit, w = float("inf"), None
-        out.append({"delay": float(d), "critical_gain": float(crit), "frequency": w})
+        out.append({"delay": float(d), "critical_gain": float(crit), "frequency": w, "lowest_gain": lowest})
     return out
