@@ -16,9 +16,10 @@ from synth.loop import BANDWIDTH_LEVEL, Loop
 from synth.plant import Plant
 from synth.requirements import SlewRate
 from synth.requirements.base import fmt
+from synth.settled_step import settled_step
 from synth.spec import Spec
 from synth.synthesis.gainset import critical_gains
-from synth.timeresp import step_metrics, step_response
+from synth.timeresp import step_metrics
 
 __all__ = ["compare", "loop_summary", "published_summary", "slew_reconciliation"]
 
@@ -44,7 +45,7 @@ def loop_summary(loop: Loop) -> dict[str, Any]:
     ('69*(s+0.43)/((s+78.7)*(s+0.4429))', ['-0.4429', '-78.7'])
     """
     poles = loop.closed_loop_poles()
-    t, y, dt = step_response(loop)
+    t, y, dt = settled_step(loop)
     metrics = step_metrics(t, y, y_final=loop.dc_gain())
     margins = loop.margins()
     return {

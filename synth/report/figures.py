@@ -32,7 +32,8 @@ from synth.freqgrid import log_grid
 from synth.loop import Loop
 from synth.requirements import Sensitivity, SlewRate, StaticSensitivity, StepResponse
 from synth.requirements.sensitivity import PeakSensitivity
-from synth.timeresp import default_horizon, step_response
+from synth.settled_step import settled_step
+from synth.timeresp import step_response
 
 COLORS = ["#1f4e9c", "#c0392b", "#2e8b57", "#8e44ad", "#d35400"]
 
@@ -159,7 +160,7 @@ def step_plot(loops: list[tuple[str, Loop]], path: Path, scale: float = 1.0, uni
     """
     limits = [r for r in requirements if isinstance(r, StepResponse) and r.under != "simulation"]
     fig, ax = plt.subplots(figsize=(8, 4.2))
-    horizon = t_end if t_end is not None else max(default_horizon(loop) for _, loop in loops)
+    horizon = t_end if t_end is not None else max(float(settled_step(loop)[0][-1]) for _, loop in loops)
     if t_end is None:
         horizon = max([horizon] + [1.25 * r.max_settling_time for r in limits if r.max_settling_time is not None])
     first: tuple[np.ndarray, np.ndarray] | None = None
