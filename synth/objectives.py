@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
@@ -124,8 +125,6 @@ def in_plant_units(unit: str, input_unit: str | None, output_unit: str | None) -
     >>> in_plant_units("u/(y*s)", "%", "l/min"), in_plant_units("u/y", "V", "rpm"), in_plant_units("u/y", "", "rpm")
     ('%/((l/min)*s)', 'V/rpm', 'u/y')
     """
-    import re
-
     if not (input_unit and output_unit):
         return unit
 

@@ -41,7 +41,7 @@ def settled_step(loop: Loop, settle_band: float = 0.02) -> tuple[np.ndarray, np.
     if not loop.stability().stable:
         return first
     run = first
-    for _ in range(MAX_DOUBLINGS + 1):
+    for _ in range(MAX_DOUBLINGS):
         t, y, _ = run
         settling = step_metrics(t, y, y_final=loop.dc_gain(), settle_band=settle_band).settling_time
         if np.isfinite(settling) and settling <= 0.75 * t[-1]:

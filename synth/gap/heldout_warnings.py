@@ -45,17 +45,16 @@ def heldout_warnings(record: Record, validate: Record | None = None, split: str 
     []
     """
     span = float(np.ptp(record.u))
+    k = round(train_fraction * record.n)  # the tail split's first held-out sample
     if validate is not None:
         held, where = validate.u, "the validation record"
     elif split == "tail":
-        k = round(train_fraction * record.n)
         held, where = record.u[k:], f"the held-out part (t >= {record.t[k]:.4g} s, the tail of the record)"
     else:
         return []
     held_span = float(np.ptp(held)) if held.size else 0.0
     if span > 0.0 and held_span >= min_span * span:
         if validate is None:
-            k = round(train_fraction * record.n)
             apart = _excited_apart(record.u[:k], held, record.dt)
             if apart:
                 return [f"the training part (t < {record.t[k]:.4g} s) and {where} excite different frequencies "

@@ -154,11 +154,12 @@ def load_psd_records(path: str | Path, time: str | None, signal: str, unit: str 
     """
     raw = read_disturbance_columns(path, time, signal, unit, dt, columns)
     pieces, note = split_at_gaps(raw.t, raw.x)
+    raw_var = float(np.var(raw.x))
     out = []
     for t, x in pieces:
         record, _ = psd_record(t, x, raw.column, raw.unit, raw.source, raw.time_name,
                                (*raw.notes, *([note] if note else [])))
-        out.append((replace(record, name=raw.name), float(np.var(raw.x))))
+        out.append((replace(record, name=raw.name), raw_var))
     return out
 
 

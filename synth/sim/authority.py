@@ -53,10 +53,12 @@ def short_of_reference(result: SimResult, t_step: float, step: tuple[float, floa
         return None
     rests = (f"the output rests {100 * abs(short):.3g} % of the step {'short of' if short > 0 else 'beyond'} the "
              f"reference {fmt(reference)} (at {fmt(output)})")
-    rate = float(np.polyfit(result.t[tail], result.command[tail], 1)[0])
+    def rate() -> float:  # how fast the controller's command winds over the tail (input units/s)
+        return float(np.polyfit(result.t[tail], result.command[tail], 1)[0])
+
     if np.all(result.active("saturated")[tail]):
         return (f"{rests}: the actuator sits on its saturation ({fmt(float(result.actuator[-1]))}) for good, the "
-                f"controller's command moving at {rate:.3g} input units/s")
+                f"controller's command moving at {rate():.3g} input units/s")
     if not result.actuator_blocks or np.ptp(result.actuator[tail]) > 0.0:
         return None  # a loop that follows its command there: its own steady-state error, not a block's hold
     if output_still(result.output[after], float(result.output[after[0]]), size):
@@ -65,7 +67,7 @@ def short_of_reference(result: SimResult, t_step: float, step: tuple[float, floa
     if np.ptp(result.command[tail]) == 0.0:
         return None  # the command rests too (a P controller's own steady-state error under a still reading)
     return (f"{rests}: the actuator's output stands still at {fmt(float(result.actuator[-1]))} for good (an actuator "
-            f"block holds it there, e.g. the flat end of a table), the controller's command moving at {rate:.3g} "
+            f"block holds it there, e.g. the flat end of a table), the controller's command moving at {rate():.3g} "
             "input units/s")
 
 
