@@ -342,7 +342,7 @@ class ConvexDesigner:
                 if d > 1e-6:
                     i = int(np.argmax(np.abs(row)))
                     rel = "<=" if row[i] > 0 else ">="
-                    active.append(f"{self.par.names[i]} {rel} {rhs * np.sign(row[i]) * scale[i]:.6g}")
+                    active.append(f"{self.par.names[i]} {rel} {rhs * np.sign(row[i]) * scale[i] + 0.0:.6g}")  # no "-0"
         return Diagnosis(total, conflicts, active, self.par.controller(rho))
 
     def optimize(self, rho_c: np.ndarray, history: list) -> tuple[np.ndarray, float]:

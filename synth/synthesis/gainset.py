@@ -442,7 +442,8 @@ def _binding(x: float, sets: dict[str, list[tuple[float, float]]], lo: float, hi
         if name not in out and abs(f(x)) <= 1e-9:
             out.append(name)  # active exactly at the end (e.g. the bound coincides with it)
     if abs(x - lo) <= tol or abs(x - hi) <= tol:
-        out.append(f"bounds ({family.parameter} {'>=' if abs(x - lo) <= tol else '<='} {x:.6g})")
+        at_lo = abs(x - lo) <= tol
+        out.append(f"bounds ({family.parameter} {'>=' if at_lo else '<='} {(lo if at_lo else hi) + 0.0:.6g})")
     return out
 
 

@@ -117,22 +117,44 @@ class TradeoffResult:
                 "points": [p.to_dict() for p in self.points], **self.extras}
 
 
-def _binding(design_result: Any) -> list[str]:
+BINDING_SLACK = 1e-2
+"""Slack (Np, 0.09 dB) within which a requirement named at the end of a one-parameter feasible set is listed as
+binding a design there: every requirement that presumes a stable loop ends where stability does, but only those
+near their own bound bind it."""
+
+ACTIVE_SLACK = 1e-3
+"""Slack (Np) within which a requirement binds a design of several parameters."""
+
+
+def _near(x: float, end: float) -> bool:
+    """``x`` at the end of an interval, relative to their size (``kp = 3.6e-6`` is not at an end ``3e-13``)."""
+    return abs(x - end) <= 1e-4 * max(abs(x), abs(end))
+
+
+def _binding(design_result: Any, bounds: dict[str, tuple[float, float]] | None = None) -> list[str]:
+    """What holds a point's design where it is: the requirements at their bounds and the parameters at theirs."""
     if not design_result.feasible:
         diag = design_result.extras.get("diagnosis")
         if diag:
             return list(diag.get("conflicting", []))
         gs = design_result.gain_set
         return gs.never_met() + [n for pair in gs.conflicts() for n in pair] if gs is not None else []
+    slack = {r.label: r.slack for r in design_result.check.requirements[1:]}
     gs = design_result.gain_set
     if gs is not None:
         x = design_result.controller.parameters[gs.parameter]
         for iv in gs.intervals:
             if iv.lo <= x <= iv.hi:
-                near_hi = abs(x - iv.hi) <= 1e-4 * max(1.0, abs(x))
-                near_lo = abs(x - iv.lo) <= 1e-4 * max(1.0, abs(x))
-                return (iv.hi_binding if near_hi else []) + (iv.lo_binding if near_lo else [])
-    active = [r.label for r in design_result.check.requirements[1:] if r.slack <= 1e-3]
+                ends = (iv.hi_binding if _near(x, iv.hi) else []) + (iv.lo_binding if _near(x, iv.lo) else [])
+                return [n for n in ends if slack.get(n, 0.0) <= BINDING_SLACK]
+    active = [name for name, s in slack.items() if s <= ACTIVE_SLACK]
+    for name, (lo, hi) in (bounds or {}).items():
+        x = design_result.controller.parameters.get(name)
+        if x is not None and lo < hi:
+            if _near(x, lo) or x == lo:
+                active.append(f"bounds ({name} >= {lo:.6g})")
+            elif _near(x, hi) or x == hi:
+                active.append(f"bounds ({name} <= {hi:.6g})")
     return active
 
 
@@ -159,8 +181,8 @@ def design_point(data: dict[str, Any], sweeps: list[Sweep], values: tuple[float,
     slacks = {r.label: r.slack for r in shown.requirements} if shown else {}
     controller = result.controller.parameters if result.controller else None
     objective = result.objective["value"] if result.objective else None
-    return TradeoffPoint(labels, result.feasible, objective, controller, _binding(result), slacks,
-                         result.verdict, time.perf_counter() - t0, status=result.status)
+    return TradeoffPoint(labels, result.feasible, objective, controller, _binding(result, spec.controller.bounds),
+                         slacks, result.verdict, time.perf_counter() - t0, status=result.status)
 
 
 def _point(data: dict[str, Any], sweeps: list[Sweep], values: tuple[float, ...]) -> dict[str, Any]:
@@ -286,7 +308,9 @@ def mark_pareto(points: list[TradeoffPoint], sweeps: list[Sweep], sense: str,
     feas = [p for p in points if p.feasible and p.objective is not None]
     if not feas:
         return
-    scale = max((abs(p.objective) for p in feas), default=1.0) or 1.0
+    # the tie tolerance from the finite objectives: an infinite one (no control effort at kp = 0: -inf dB) made it
+    # infinite, inf - inf = nan, and no point dominated another (every point was marked)
+    scale = max((abs(p.objective) for p in feas if np.isfinite(p.objective)), default=1.0) or 1.0
     demands = np.array([[s * p.values[sw.path] for s, sw in zip(signs, sweeps)] for p in feas], float)
     front = non_dominated(demands, np.array([sign_y * p.objective for p in feas]), 1e-6 * scale)
     for p, on in zip(feas, front):
