@@ -72,6 +72,10 @@ def _interior(L: np.ndarray, w: np.ndarray, delays: tuple[float, float], rate_li
     return k
 
 
+LOW_DECADES = 6
+"""Decades searched below the grid where the critical factor still falls at its lowest frequency."""
+
+
 def critical_gain_factor(L: Callable[[np.ndarray], np.ndarray], w: np.ndarray, delays: tuple[float, float],
                          kinds: tuple[str, ...]) -> tuple[float, float | None, float | None]:
     """Smallest loop-gain factor ``k`` at which ``k L(jw) exp(-jw tau)`` meets a block's critical locus for
@@ -106,6 +110,14 @@ def critical_gain_factor(L: Callable[[np.ndarray], np.ndarray], w: np.ndarray, d
         return v if np.isfinite(v) else 1e300  # Brent needs finite values
 
     k = _interior(Lw, w, delays, rate)
+    if k.size > 1 and np.isfinite(k[0]) and k[0] < k[1]:
+        # still falling at the grid's low end: the locus is met lower still (a loop on the negative real axis at
+        # w = 0, e.g. an unstable pole under positive gain, approaches 1/|L(0)|; one with integrators, 0);
+        # LOW_DECADES more decades below it
+        low = w[0] * np.logspace(-LOW_DECADES, 0.0, 20 * LOW_DECADES + 1)[:-1]
+        w = np.concatenate([low, w])
+        Lw = np.concatenate([L(low), Lw])
+        k = _interior(Lw, w, delays, rate)
     k_star, w_star, tau_star = np.inf, None, None
     if np.any(np.isfinite(k)):
         best = float(np.min(k))
