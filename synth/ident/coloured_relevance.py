@@ -95,7 +95,8 @@ def response_p_value(u: np.ndarray, y: np.ndarray, order: int = WHITENING_ORDER)
 
 def whitened_f_test(y: np.ndarray, residuals: np.ndarray, free: int, order: int = WHITENING_ORDER) -> float:
     """p-value of the F-test of the fitted model against the output's mean, both whitened by the residuals'
-    autoregressive model (1 when the model does no better; 0 when too few samples leave nothing to test).
+    autoregressive model (1 when the model does no better; 0 when too few samples leave nothing to test, or the
+    residuals are not finite: a fit whose model output is NaN is a failure for :func:`fit_failure`'s reasons).
 
     Examples
     --------
@@ -106,7 +107,7 @@ def whitened_f_test(y: np.ndarray, residuals: np.ndarray, free: int, order: int 
     """
     r = np.asarray(residuals, float)
     n = r.size
-    if n <= 4 * order + free + 2:
+    if n <= 4 * order + free + 2 or not np.all(np.isfinite(r)):  # a model whose output is not finite failed anyway
         return 0.0
     r = r - r.mean()
     inverse = _inverse_ar(r, order)

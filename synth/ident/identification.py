@@ -197,7 +197,7 @@ def identify(record: RecordLike, structure: Structure | str, delay: str | float 
         # the average's fit failed (e.g. IPOPT at its limit on a few short edge windows, or a diverged pole):
         # the whole record, which holds the same steps and assumes less, from its own deterministic start
         def both_failed(whole_error: FitError) -> FitError:
-            average_failed = failed if fit is not None else f"fit failed ({failed})"
+            average_failed = failed.removeprefix("its ") if fit is not None else f"fit failed ({failed})"
             return FitError(f"fit of {structure.formula!r} failed: the {avg.mode} average's {average_failed}, and "
                             f"the whole record's fit failed too ({whole_error}); try another structure, a fixed delay "
                             "or a shorter part of the record", where=record.source)

@@ -202,7 +202,11 @@ class SimulationErrorProblem:
         H = lam_f * (Jw.T @ Jw) / s2
         hess = ca.Function("nlp_hess_l", [dec, params, lam_f, lam_g], [ca.triu(H)],
                            ["x", "p", "lam_f", "lam_g"], ["triu_hess_gamma_x_x"])
-        opts = {"print_time": False, "hess_lag": hess, "show_eval_warnings": False,  # diverging trial points: IPOPT recovers
+        # calc_lam_p: the multipliers of the parameters (the record's input, thousands of samples) are never read;
+        # computing them cost a gradient pass per solve and, after a solve that met NaN, printed casadi's "Failed to
+        # calculate multipliers" warning to the user's terminal
+        opts = {"print_time": False, "hess_lag": hess, "calc_lam_p": False,
+                "show_eval_warnings": False,  # diverging trial points: IPOPT recovers
                 "ipopt": {"print_level": 0, "sb": "yes", "tol": 1e-12, "acceptable_tol": 1e-9, "max_iter": 300,
                           "min_hessian_perturbation": MIN_HESSIAN_PERTURBATION}}
         self.solver = ca.nlpsol("timefit", "ipopt", {"x": dec, "p": params, "f": obj}, opts)
