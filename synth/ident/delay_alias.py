@@ -25,8 +25,8 @@ from synth.ident.structure import Structure
 from synth.ident.timefit import TimeFitResult
 from synth.plant import Plant
 
-__all__ = ["ALIAS_CRITICAL", "MAX_ALIASES", "AliasScreen", "alias_start", "ambiguity_note", "screen_aliases",
-           "whole_record_start"]
+__all__ = ["ALIAS_CRITICAL", "MAX_ALIASES", "AliasScreen", "alias_start", "ambiguity_note", "fixed_delay_note",
+           "screen_aliases", "whole_record_start"]
 
 ALIAS_CRITICAL = 3.84
 """Least drop of the weighted squared residual, in units of the noise variance, by which the record must prefer
@@ -229,12 +229,11 @@ def whole_record_start(record: Record, avg: StepAverage, fit: TimeFitResult, str
     {'K': 1.0, 'T': 0.2, 'delay': 2.3}
     """
     start = {**fit.parameters}
+    if fit.periodic and not fit.delay_fitted:  # the user's delay: kept, with a note where an alias fits better
+        return start, fixed_delay_note(record, avg, fit, weights)
     if not (fit.periodic and fit.delay_fitted):
         return start, ""
-    period_samples = len(avg.t)
-    train = float(record.t[avg.steps.index[0]])
-    screen = screen_aliases(record.t, record.u, record.y, fit.measured, period_samples, weights,
-                            float(record.t[-1]) - train - period_samples * record.dt)
+    screen = _screen(record, avg, fit, weights)
     if screen.best == 0 or not screen.resolved:  # below ALIAS_CRITICAL the start-up prefers nothing: the note says so
         return start, ambiguity_note(fit, avg, screen)
     delay, sign = float(screen.delays[screen.best]), float(screen.signs[screen.best])
@@ -247,6 +246,48 @@ def whole_record_start(record: Record, avg: StepAverage, fit: TimeFitResult, str
                            f"half period with the gain reversed, of the {screen.period:.6g} s train); the start-up "
                            f"from rest prefers {delay:.6g} s by {screen.margin:.3g} noise variances "
                            f"({screen.delays.size} aliases screened): the whole record was fitted from there")
+
+
+def _screen(record: Record, avg: StepAverage, fit: TimeFitResult, weights: np.ndarray | None) -> AliasScreen:
+    period_samples = len(avg.t)
+    train = float(record.t[avg.steps.index[0]])
+    return screen_aliases(record.t, record.u, record.y, fit.measured, period_samples, weights,
+                          float(record.t[-1]) - train - period_samples * record.dt)
+
+
+def fixed_delay_note(record: Record, avg: StepAverage | None, fit: TimeFitResult,
+                     weights: np.ndarray | None = None) -> str:
+    """A note when the start-up from rest prefers an alias of a delay the user fixed ('' otherwise): the periodic
+    fit answers the given delay as well as one a period, or a half period with the gain reversed, away from it.
+    Screened where the input is constant before the train, with ``weights`` (default: that stretch weighted 0 up
+    to the model's settling time, as the whole-record fit from rest weights it).
+
+    Examples
+    --------
+    >>> from synth.ident.identification import identify
+    >>> t = np.arange(0, 40, 0.01); u = np.where(t < 3, 0.0, ((t - 3) // 2.0) % 2 == 0).astype(float)
+    >>> y = simulate_plant(Plant.from_string("2/(0.5*s+1)", delay=0.1), t, u)
+    >>> res = identify((t, u, y + 0.02 * np.random.default_rng(0).normal(size=t.size)), "k/(T*s+1)", delay=2.1)
+    >>> round(res.fit.parameters["k"], 2), "prefers a delay of 0.1 s with the gain reversed" in res.whole_record_note
+    (-2.0, True)
+    """
+    from synth.ident.periodic_start import after_gaps, settling_time
+
+    if avg is None or not fit.periodic or fit.delay_fitted:
+        return ""
+    first = float(record.t[avg.steps.index[0]] - record.t[0])
+    settle = settling_time(fit.measured)
+    if not (first > 0 and np.isfinite(settle)):
+        return ""
+    screen = _screen(record, avg, fit, after_gaps(record, fit.measured, skip=min(settle, first)) if weights is None
+                     else weights)
+    if screen.best == 0 or not screen.resolved:
+        return ""
+    delay, sign = float(screen.delays[screen.best]), float(screen.signs[screen.best])
+    return (f"the delay was given as {fit.delay:.6g} s, but the start-up from rest prefers a delay of {delay:.6g} s"
+            f"{' with the gain reversed' if sign < 0 else ''} by {screen.margin:.3g} noise variances (the averaged "
+            f"period of the {screen.period:.6g} s train answers delays a period apart alike, and a half period apart "
+            "with the gain reversed): check the given delay, or fit it (--delay fit)")
 
 
 def ambiguity_note(fit: TimeFitResult, avg: StepAverage | None, screen: AliasScreen | None) -> str:

@@ -18,7 +18,7 @@ import numpy as np
 from synth.data.coerce import RecordLike, as_record
 from synth.data.record import Record
 from synth.errors import DataError, FitError, ModelError
-from synth.ident.delay_alias import ambiguity_note, whole_record_start
+from synth.ident.delay_alias import ambiguity_note, fixed_delay_note, whole_record_start
 from synth.ident.directions import DirectionComparison, fit_by_direction
 from synth.ident.edge_check import EDGE_MISFIT, edge_misfit
 from synth.ident.fit_failure import NO_RESPONSE
@@ -246,7 +246,8 @@ def identify(record: RecordLike, structure: Structure | str, delay: str | float 
         _require_settled_windows(directions, record.source)
     periodic_delay = ambiguity_note(fit, avg, None) if fit.periodic else ""  # a fitted delay, up to the period
     return IdentifyResult(record, fit, avg, directions, note, by_direction, "; ".join(
-        x for x in (not_averaged, whole, _aliased_delay(delay, fit, avg), periodic_delay) if x))
+        x for x in (not_averaged, whole, _aliased_delay(delay, fit, avg) or fixed_delay_note(record, avg, fit),
+                    periodic_delay) if x))
 
 
 def _require_settled_windows(directions: DirectionComparison, source: str) -> None:
