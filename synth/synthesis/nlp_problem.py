@@ -182,29 +182,11 @@ class NLPBuilder:
         problems and lost on others (``benchmarks/polish_scalar_form.py``), so they keep the matrix form."""
         x = ca.vertcat(*self.x)
         g = ca.vertcat(*self.g) if self.g else SYM(0, 1)
-        start = np.concatenate(self.x0) if x0 is None else x0
-        if CONSTRAINT_CAP is not None and self.g:
-            g = g * ca.DM(_constraint_scales(ca.Function("g", [x], [g]), start, np.array(self.ubg), CONSTRAINT_CAP))
         solver = ca.nlpsol("polish", "ipopt", {"x": x, "f": self.f, "g": g}, {**IPOPT_OPTIONS, **(options or {}),
                                                                             "expand": expand and SCALAR_FORM})
-        res = solver(x0=start, lbx=np.concatenate(self.lbx),
+        res = solver(x0=np.concatenate(self.x0) if x0 is None else x0, lbx=np.concatenate(self.lbx),
                      ubx=np.concatenate(self.ubx), lbg=np.array(self.lbg), ubg=np.array(self.ubg))
         return np.asarray(res["x"]).ravel(), solver.stats()
-
-
-CONSTRAINT_CAP: float | None = 1e3
-"""Largest magnitude an inequality constraint of the polish has at IPOPT's start: one larger is divided by a
-positive constant down to it (its feasible set unchanged). ``|1 + L|^2`` at low frequencies of a PI on an
-integrating plant reached 2.6e18; IPOPT's steps in the slacks of such entries were 1e10 long and every solve of
-a PI design crawled to its iteration limit (38 s of CPU). ``None``: unscaled (the behaviour before)."""
-
-
-def _constraint_scales(g: Any, x0: np.ndarray, ubg: np.ndarray, cap: float) -> np.ndarray:
-    """Per-entry factors (<= 1) bringing each inequality's start value to at most ``cap`` in magnitude
-    (equalities and non-finite values keep 1)."""
-    with np.errstate(invalid="ignore", divide="ignore"):
-        v = np.abs(np.asarray(g(x0), float).ravel())
-        return np.where(np.isfinite(v) & (v > cap) & (ubg > 0), cap / v, 1.0)
 
 
 def loop_response(ctrl: SymbolicController, plant: Plant, w: Any) -> tuple[Cx, Cx]:
