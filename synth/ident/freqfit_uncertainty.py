@@ -157,10 +157,16 @@ def _log_model(structure: Any, theta: np.ndarray, w: np.ndarray, fit_delay: bool
         return np.log(np.polyval(num, s) / np.polyval(den, s)) - s * delay
 
 
+ROUNDING_RESIDUAL = 1e-10
+"""Residual (relative magnitude in nepers, phase in radians) below which a fit is exact to rounding."""
+
+
 def _lag1(z: np.ndarray) -> float:
-    """Lag-1 autocorrelation of ``z`` about zero (the residuals of a fit), 0 when undefined."""
+    """Lag-1 autocorrelation of ``z`` about zero (the residuals of a fit, in nepers and radians), 0 when undefined
+    or when every residual is below :data:`ROUNDING_RESIDUAL` (an exact fit: the correlation of rounding errors
+    varies with the machine's arithmetic, 0.0 on one and 0.113 on another)."""
     z = z[np.isfinite(z)]
-    if z.size < 3 or not np.any(z):
+    if z.size < 3 or not np.any(np.abs(z) > ROUNDING_RESIDUAL):
         return 0.0
     return float(np.sum(z[:-1] * z[1:]) / np.sum(z * z))
 
