@@ -255,12 +255,12 @@ def _screen(record: Record, avg: StepAverage, fit: TimeFitResult, weights: np.nd
                           float(record.t[-1]) - train - period_samples * record.dt)
 
 
-def fixed_delay_note(record: Record, avg: StepAverage | None, fit: TimeFitResult,
-                     weights: np.ndarray | None = None) -> str:
+def fixed_delay_note(record: Record, avg: StepAverage | None, fit: TimeFitResult, weights: np.ndarray | None) -> str:
     """A note when the start-up from rest prefers an alias of a delay the user fixed ('' otherwise): the periodic
     fit answers the given delay as well as one a period, or a half period with the gain reversed, away from it.
-    Screened where the input is constant before the train, with ``weights`` (default: that stretch weighted 0 up
-    to the model's settling time, as the whole-record fit from rest weights it).
+    Screened with ``weights`` (:func:`synth.ident.periodic_start.start_up_weights`: the constant input before the
+    train weighted 0 up to the model's settling time, as the whole-record fit from rest weights it); ``None``: no
+    constant start to screen on.
 
     Examples
     --------
@@ -271,16 +271,9 @@ def fixed_delay_note(record: Record, avg: StepAverage | None, fit: TimeFitResult
     >>> round(res.fit.parameters["k"], 2), "prefers a delay of 0.1 s with the gain reversed" in res.whole_record_note
     (-2.0, True)
     """
-    from synth.ident.periodic_start import after_gaps, settling_time
-
-    if avg is None or not fit.periodic or fit.delay_fitted:
+    if avg is None or not fit.periodic or fit.delay_fitted or weights is None:
         return ""
-    first = float(record.t[avg.steps.index[0]] - record.t[0])
-    settle = settling_time(fit.measured)
-    if not (first > 0 and np.isfinite(settle)):
-        return ""
-    screen = _screen(record, avg, fit, after_gaps(record, fit.measured, skip=min(settle, first)) if weights is None
-                     else weights)
+    screen = _screen(record, avg, fit, weights)
     if screen.best == 0 or not screen.resolved:
         return ""
     delay, sign = float(screen.delays[screen.best]), float(screen.signs[screen.best])

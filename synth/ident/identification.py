@@ -24,7 +24,7 @@ from synth.ident.edge_check import EDGE_MISFIT, edge_misfit
 from synth.ident.fit_failure import NO_RESPONSE
 from synth.ident.nyquist import beyond_nyquist
 from synth.ident.pair_relocation import relocate_pair
-from synth.ident.periodic_start import after_gaps, fit_whole_record, refit_periodic_start, settling_time
+from synth.ident.periodic_start import after_gaps, fit_whole_record, refit_periodic_start, settling_time, start_up_weights
 from synth.ident.steps import StepAverage, average_steps, find_steps
 from synth.ident.structure import Structure, parse_structure
 from synth.ident.timefit import TimeFitResult, fit_structure
@@ -246,7 +246,8 @@ def identify(record: RecordLike, structure: Structure | str, delay: str | float 
         _require_settled_windows(directions, record.source)
     periodic_delay = ambiguity_note(fit, avg, None) if fit.periodic else ""  # a fitted delay, up to the period
     return IdentifyResult(record, fit, avg, directions, note, by_direction, "; ".join(
-        x for x in (not_averaged, whole, _aliased_delay(delay, fit, avg) or fixed_delay_note(record, avg, fit),
+        x for x in (not_averaged, whole, _aliased_delay(delay, fit, avg) or fixed_delay_note(
+                        record, avg, fit, start_up_weights(record, avg, fit)),
                     periodic_delay) if x))
 
 

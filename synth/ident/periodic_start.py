@@ -61,6 +61,30 @@ left a mismatch of about 0.4 % of the step after it, which on a record with an e
 of its standard errors off."""
 
 
+def start_up_weights(record: Record, avg: StepAverage | None, fit: TimeFitResult) -> np.ndarray | None:
+    """The whole record's weights for a fit from rest after a periodic fit: the constant input before the train
+    weighted 0 up to the model's settling time (:func:`after_gaps`); ``None`` without a constant start or a model
+    that settles.
+
+    Examples
+    --------
+    >>> from synth.ident.identification import identify
+    >>> t = np.arange(0, 40, 0.01); u = np.where(t < 3, 0.0, ((t - 3) // 2.0) % 2 == 0).astype(float)
+    >>> y = simulate_plant(Plant.from_string("2/(0.5*s+1)"), t, u) + 0.02 * np.random.default_rng(0).normal(size=t.size)
+    >>> res = identify((t, u, y), "k/(T*s+1)", delay=0.0)
+    >>> w = start_up_weights(res.record, res.average, res.fit)
+    >>> float(w[:250].max()), float(w[350:].min())  # the first 2.5 s (the model's settling time) weighted 0
+    (0.0, 1.0)
+    """
+    if avg is None:
+        return None
+    first = float(record.t[avg.steps.index[0]] - record.t[0])
+    settle = settling_time(fit.measured)
+    if not (first > 0 and np.isfinite(settle)):
+        return None
+    return after_gaps(record, fit.measured, skip=min(settle, first))
+
+
 def after_gaps(record: Record, model: Plant, weights: np.ndarray | None = None, skip: float | None = None
                ) -> np.ndarray | None:
     """``weights`` (or, with ``skip``, 0 over the record's first ``skip`` seconds and 1 after) with what the record's
