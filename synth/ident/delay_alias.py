@@ -229,10 +229,10 @@ def whole_record_start(record: Record, avg: StepAverage, fit: TimeFitResult, str
     {'K': 1.0, 'T': 0.2, 'delay': 2.3}
     """
     start = {**fit.parameters}
-    if fit.periodic and not fit.delay_fitted:  # the user's delay: kept, with a note where an alias fits better
-        return start, fixed_delay_note(record, avg, fit, weights)
-    if not (fit.periodic and fit.delay_fitted):
+    if not fit.periodic:
         return start, ""
+    if not fit.delay_fitted:  # the user's delay: kept, with a note where an alias fits better
+        return start, fixed_delay_note(record, avg, fit, weights)
     screen = _screen(record, avg, fit, weights)
     if screen.best == 0 or not screen.resolved:  # below ALIAS_CRITICAL the start-up prefers nothing: the note says so
         return start, ambiguity_note(fit, avg, screen)

@@ -245,10 +245,10 @@ def identify(record: RecordLike, structure: Structure | str, delay: str | float 
     if by_direction and directions is not None:
         _require_settled_windows(directions, record.source)
     periodic_delay = ambiguity_note(fit, avg, None) if fit.periodic else ""  # a fitted delay, up to the period
-    return IdentifyResult(record, fit, avg, directions, note, by_direction, "; ".join(
-        x for x in (not_averaged, whole, _aliased_delay(delay, fit, avg) or fixed_delay_note(
-                        record, avg, fit, start_up_weights(record, avg, fit)),
-                    periodic_delay) if x))
+    given = _aliased_delay(delay, fit, avg) or (fixed_delay_note(record, avg, fit, start_up_weights(record, avg, fit))
+                                                if fit.periodic and not fit.delay_fitted else "")  # weights: a simulation
+    return IdentifyResult(record, fit, avg, directions, note, by_direction,
+                          "; ".join(x for x in (not_averaged, whole, given, periodic_delay) if x))
 
 
 def _require_settled_windows(directions: DirectionComparison, source: str) -> None:

@@ -151,9 +151,9 @@ def _binding(design_result: Any, bounds: dict[str, tuple[float, float]] | None =
     for name, (lo, hi) in (bounds or {}).items():
         x = design_result.controller.parameters.get(name)
         if x is not None and lo < hi:
-            if _near(x, lo) or x == lo:
+            if _near(x, lo):
                 active.append(f"bounds ({name} >= {lo:.6g})")
-            elif _near(x, hi) or x == hi:
+            elif _near(x, hi):
                 active.append(f"bounds ({name} <= {hi:.6g})")
     return active
 
