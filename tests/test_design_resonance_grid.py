@@ -6,7 +6,12 @@ check fails. Seed 12 #284 of the design benchmark (a rational controller of orde
 gain and phase margins, maximize bandwidth): the convex stage's four refinements each added the violated
 crossover and the next design moved the resonance on; the NLP polish from it failed its certificate too, and the
 answer came from the screen's fallback, a vanishing-gain loop at 0.0706 rad/s where the independent reference
-(benchmarks/design_reference.py, a dense grid and Nelder-Mead from 300 starts) found 0.3854 rad/s."""
+(benchmarks/design_reference.py, a dense grid and Nelder-Mead from 300 starts) found 0.3854 rad/s.
+
+On another machine (session 71, AMD EPYC; Clarabel "solution may be inaccurate") the refinements still ended on a
+design failing the exact check (phase margin -26.9 deg), and the answer was 0.0827 rad/s: the convex stage now keeps
+its best iterate that passes the exact check (synth.synthesis.convex_exact.best_passing), from which the screen's
+polishes reach the reference's optimum."""
 
 from __future__ import annotations
 
@@ -39,11 +44,6 @@ def test_patches_cover_each_lightly_damped_root_of_the_loop_and_nothing_else():
     assert resonance_points([Plant.from_string("1/((s+2)*(s+3))")], Controller("P", {"kp": 0.1}), grid).size == 0
 
 
-@pytest.mark.xfail(strict=False, reason=(
-    "machine-dependent, open (session 70): on an AMD EPYC host the same code (2b147f5 and later) ends the convex "
-    "stage at a design whose resonance lies between grid points (Clarabel: 'solution may be inaccurate'; phase "
-    "margin -26.9 deg on the dense check) and answers 0.0827 rad/s by the pattern search; it passed on session 69's "
-    "machine"))
 def test_a_design_no_longer_hides_a_resonance_between_grid_points():
     spec = parse_spec({"name": "rand_12_284", "plant": {"tf": "0.140633*1/((s+0.0219583))"},
                        "controller": {"type": "rational", "order": [0, 3],

@@ -76,7 +76,8 @@ class ConvexResult:
     starts_tried: int = 1
     converged: bool = False
     note: str = ""
-    """What was run beyond the usual (a rescaled second run: :mod:`synth.synthesis.rational_rescale`)."""
+    """What was run or kept beyond the usual (a rescaled second run: :mod:`synth.synthesis.rational_rescale`; an
+    earlier iterate kept because the last failed the exact check: :mod:`synth.synthesis.convex_exact`)."""
 
     def to_dict(self) -> dict[str, Any]:
         return {
