@@ -156,7 +156,8 @@ def _message(err: dict[str, Any], data: Any, loc: tuple[Any, ...]) -> str:
         near = difflib.get_close_matches(str(loc[-1]), allowed, n=1)
         hint = f"; did you mean {near[0]!r}?" if near else (f"; allowed: {', '.join(allowed)}" if allowed else "")
         return f"unknown key {loc[-1]!r}{hint}"
-    if kind in {"union_tag_invalid", "union_tag_not_found"} and loc and loc[0] == "simulation":
+    if kind in {"union_tag_invalid", "union_tag_not_found"} and loc and (loc[0] == "simulation" or "actuator" in loc):
+        # a no_limit_cycle requirement's actuator holds blocks too
         what = "disturbance" if "disturbances" in loc else "block"
         expected = ", ".join(DISTURBANCE_TAGS if what == "disturbance" else BLOCK_TAGS)
         if kind == "union_tag_not_found":
