@@ -74,6 +74,9 @@ class Sensitivity(BandMixin, Requirement):
     >>> r = Sensitivity(type="sensitivity", max_db=-15, band=(0, 30)).evaluate(loop)
     >>> r.met, round(r.details["met_up_to"], 2)
     (False, 10.33)
+    >>> r = Sensitivity(type="sensitivity", max_db=-15, band=(0, 5)).evaluate(loop)
+    >>> r.met, round(r.details["met_up_to"], 2)  # met: it holds beyond the band, up to the same crossing
+    (True, 10.33)
     """
 
     type: Literal["sensitivity"] = "sensitivity"
@@ -90,12 +93,13 @@ class Sensitivity(BandMixin, Requirement):
         value_db = db(value)
         margin = self.max_db - value_db
         limit = self.linear_bound("max_db")
-        up_to = None
-        if margin < 0:
-            mags = np.abs(loop.S(grid))
-            if mags[0] <= limit:
-                cross = crossings(lambda w: np.abs(loop.S(w)), limit, grid)
-                up_to = float(cross[0]) if cross.size else None
+        up_to = None  # the highest frequency up to which it holds: None where it fails at the band's low end
+        if margin >= 0:  # met: how far beyond the band it holds (inf: at every frequency the loop is checked on)
+            grid = band_grid((self.band[0], max(self.band[1], 10 * loop.frequency_range[1])), loop.frequency_range,
+                             per_decade)
+        if np.abs(loop.S(grid[:1]))[0] <= limit:
+            cross = crossings(lambda w: np.abs(loop.S(w)), limit, grid)
+            up_to = float(cross[0]) if cross.size else (np.inf if margin >= 0 else None)
         where = band_text(self.band)
         if margin >= 0:
             msg = (f"|S| stays at or below {fmt(self.max_db)} dB {where}: met, "
