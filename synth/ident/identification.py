@@ -230,9 +230,10 @@ def identify(record: RecordLike, structure: Structure | str, delay: str | float 
         if not whole:
             fit, avg, whole = refit_periodic_start(record, avg, fit, structure, delay, sensor)
     fit = _other_pair_minima(record, fit, structure, delay, sensor)
-    if avg is None:  # a start state that is not at rest is left out (synth.ident.unknown_start)
-        fit = _settle_after_hidden_edges(record, fit, structure, delay, sensor)
-        fit, whole = fit_from_unknown_start(record, fit, structure, delay, sensor)
+    fit = _settle_after_hidden_edges(record, fit, structure, delay, sensor) if avg is None else fit
+    if avg is None or whole:  # a whole-record fit's start state, where it matters, is left out (synth.ident.
+        fit, later = fit_from_unknown_start(record, fit, structure, delay, sensor)  # unknown_start; session 71: a
+        whole = "; ".join(x for x in (whole, later) if x)  # train from a step at t = 0, p1 0.86 +- 0.04 for 0.5)
     directions, note = None, ""
     if two_ways and (compare_directions or by_direction):
         try:
