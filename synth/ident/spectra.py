@@ -19,7 +19,7 @@ from synth.errors import DataError
 from synth.ident.coherence import COHERENCE_THRESHOLD, CoherentBand, coherence_from_spectra, coherent_band, random_error
 from synth.ident.excitation_edge import excitation_level, trim_to_excitation
 from synth.ident.model_phase import anchored_phase
-from synth.ident.output_alignment import alignment_samples, shifted_runs
+from synth.ident.output_alignment import alignment_samples, band_after_alignment, run_input_level, shifted_runs
 from synth.ident.spectral_windows import (
     as_runs,
     check_length,
@@ -183,8 +183,9 @@ def frequency_response(
         Per-segment detrending.
     align : bool
         Move the output back by the response's delay before windowing where that delay is a material share of
-        the shortest window, and put it back in the phase (:mod:`synth.ident.output_alignment`); the band stays
-        within the unaligned estimate's. False: the windows on the runs as they are.
+        the shortest window, and put it back in the phase (:mod:`synth.ident.output_alignment`); past the unaligned
+        estimate's band, the band is kept only where the input excites as strongly
+        (:func:`~synth.ident.output_alignment.band_after_alignment`). False: the windows on the runs as they are.
 
     Returns
     -------
@@ -221,13 +222,11 @@ def frequency_response(
     note = (f"the output was moved {k / runs[0].fs:.4g} s earlier before windowing (the lower quartile of the "
             "response's group delay over the upper half of the band), and that delay put back in the phase: the "
             "windows then see the output's answer to what their input holds (synth.ident.output_alignment)")
-    band = aligned.band
-    if first.band.found and band.found and (band.w_min < first.band.w_min or band.w_max > first.band.w_max):
-        # realigned, the leakage past a sweep's end answers coherently too: the band stays within the first's
-        lo, hi = max(band.w_min, first.band.w_min), min(band.w_max, first.band.w_max)
-        band = replace(band, w_min=lo, w_max=hi, mask=band.mask & first.band.mask)
-        note += (f"; the band is kept within the estimate's before the move ({first.band.w_min:.4g}-"
-                 f"{first.band.w_max:.4g} rad/s): the move makes a sweep's leakage past its band coherent too")
+    band = band_after_alignment(first.band, aligned.band, aligned.w, run_input_level(runs, aligned.w))
+    if first.band.found and band.found and (band.w_min, band.w_max) != (aligned.band.w_min, aligned.band.w_max):
+        note += (f"; past the band before the move ({first.band.w_min:.4g}-{first.band.w_max:.4g} rad/s) it is kept "
+                 f"only where the input excites as strongly ({band.w_min:.4g}-{band.w_max:.4g} rad/s): the move makes "
+                 "a sweep's leakage past its band coherent too")
     return replace(aligned, band=band, notes=(*aligned.notes, note))
 
 
