@@ -287,7 +287,7 @@ def _composite(runs: list[Record], w_min: float | None, w_max: float | None, win
     H, err, coh, n_d, leak_note = _resonance_from_whole_runs(runs, rest, results, grid, H, err, coh, n_d,
                                                              coherence_threshold)
     low_note = "; ".join(n for n in (low_note, leak_note) if n) or None
-    level = excitation_level(results, grid, gxx)
+    level = excitation_level(results, grid, gxx, windowed)
     band = trim_to_excitation(coherent_band(grid, coh, coherence_threshold), grid, level)
     above = None
     if not given_max:
