@@ -16,7 +16,8 @@ Deterministic start: for each delay on a grid from 0 to 1.5 times the phase slop
 delay and rational part with the lowest ``J`` start IPOPT. A formula structure
 (:func:`synth.ident.structure.parse_structure`) is started from a few constant
 parameter vectors (1 and the range's edges and centre) with the delay of that
-order fit, and the best local optimum is kept.
+order fit, and from the parameters whose coefficients match that order fit's
+(:mod:`synth.ident.freqfit_start`), and the best local optimum is kept.
 """
 
 from __future__ import annotations
@@ -29,6 +30,7 @@ from typing import Any
 import numpy as np
 
 from synth.errors import DataError, ModelError
+from synth.ident.freqfit_start import matched_start
 from synth.ident.spectra import FrequencyResponse
 from synth.ident.structure import Structure, parse_structure
 from synth.plant import Plant
@@ -47,9 +49,10 @@ IPOPT_OPTIONS = {"ipopt.print_level": 0, "print_time": False, "ipopt.sb": "yes",
 SOLVED = ("Solve_Succeeded", "Solved_To_Acceptable_Level")
 #: a fit below this percentage (see :func:`fit_percent`) is a failure, not a result
 MIN_FIT_PERCENT = 50.0
-#: a fitted pole or zero this many times above the fitted band's top is a failure: the band cannot place it
-#: (a black-box test's short-band fits returned poles at -1.2e17 rad/s with gains of -8.8e16 as results)
-ABSURD_ROOT = 1e6
+#: a fitted pole or zero this many times above the fitted band's top is a failure: the band cannot place it (its
+#: phase there is under 0.006 deg; a black-box test's short-band fits returned poles at -1.2e17 rad/s with gains of
+#: -8.8e16 as results, and, started from the orders fit's coefficients too, one at +6.3e6 rad/s for a 94 rad/s top)
+ABSURD_ROOT = 1e4
 
 
 class FrequencyFitError(RuntimeError):
@@ -414,6 +417,8 @@ def fit_frequency_response(
         theta, tau, status = _ipopt(st, w, H, coh, theta_orders, tau0, fit_delay, delay_max)
     else:
         starts = [np.full(len(st.parameters), v) for v in (1.0, lo, np.sqrt(lo * hi), hi)]
+        matched = matched_start(st, *_Orders(m, n).coefficients(theta_orders), starts)  # any signs (freqfit_start)
+        starts += [matched] if matched is not None else []
         results = []
         for x0 in starts:
             try:
