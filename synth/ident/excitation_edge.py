@@ -13,13 +13,16 @@ dB within a fraction of a decade.
 from __future__ import annotations
 
 from dataclasses import replace
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from synth.ident.coherence import CoherentBand
 
-__all__ = ["EDGE_DB", "FINE_BINS", "SLOPE_DB", "excitation_level", "trim_to_excitation"]
+if TYPE_CHECKING:
+    from synth.data.record import Record
+
+__all__ = ["EDGE_DB", "FINE_BINS", "SLOPE_DB", "excitation_level", "run_input_level", "trim_to_excitation"]
 
 #: dB, beyond the allowed slope, by which a band end's input autospectrum may lie below a point inward
 EDGE_DB = 10.0
@@ -96,7 +99,7 @@ def excitation_level(results: list[Any], grid: np.ndarray, gxx: np.ndarray, runs
                      ) -> np.ndarray:
     """The input autospectrum the band's ends are tested on (:func:`trim_to_excitation`): the composite's, or the
     longest window's where that is lower and its cell holds at least :data:`FINE_BINS` of its bins; with ``runs``,
-    the whole runs' transforms likewise (:func:`synth.ident.output_alignment.run_input_level`: a 0.11-4.37 rad/s
+    the whole runs' transforms likewise (:func:`run_input_level`: a 0.11-4.37 rad/s
     sweep of 200 s cut at full amplitude kept 4.37-4.85 rad/s in the band on its 100 s window's leakage, +3.4 dB and
     +12 deg off at coherence 0.98).
 
@@ -120,8 +123,35 @@ def excitation_level(results: list[Any], grid: np.ndarray, gxx: np.ndarray, runs
     level = np.where(width * fine.length / (2.0 * np.pi) >= FINE_BINS, np.fmin(gxx, fine.gxx), gxx)
     if not runs:
         return level
-    from synth.ident.output_alignment import run_input_level
-
     shortest = min(r.n * r.dt for r in runs)  # the whole runs' transforms, as a density like the windows' spectra
     whole = run_input_level(runs, grid) / len(runs) * 2.0 * runs[0].dt / (2.0 * np.pi)
     return np.where(width * shortest / (2.0 * np.pi) >= FINE_BINS, np.fmin(level, whole), level)
+
+
+def run_input_level(runs: list[Record], w: np.ndarray) -> np.ndarray:
+    """The runs' input power in each cell of the grid ``w`` [rad/s], from the whole runs' transforms (the mean of
+    ``|U|^2`` over the cell's bins, summed over the runs; the nearest bin's where a cell holds none): a resolution of
+    one over the run's length, where a short window's main lobe spreads a sweep's power past its end.
+
+    Examples
+    --------
+    >>> from synth.data import record_from_arrays
+    >>> t = np.arange(0, 200, 0.01); u = np.sin(2 * np.pi * (0.05 * t + 0.5 * 0.02 * t**2))  # 0.3-25 rad/s
+    >>> level = run_input_level([record_from_arrays(t, u, u)], np.array([10.0, 20.0, 40.0]))
+    >>> bool(level[2] < 1e-3 * level[1])  # past the sweep's end
+    True
+    """
+    from synth.ident.spectral_windows import cell_edges
+
+    edges = cell_edges(np.asarray(w, float))
+    total = np.zeros(len(w))
+    for r in runs:
+        power = np.abs(np.fft.rfft(r.u - np.mean(r.u))) ** 2 / r.n
+        bins = 2 * np.pi * np.fft.rfftfreq(r.n, r.dt)
+        at = np.searchsorted(bins, edges)
+        cum = np.r_[0.0, np.cumsum(power)]
+        count = np.diff(at)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            mean = (cum[at[1:]] - cum[at[:-1]]) / count
+        total += np.where(count > 0, mean, np.interp(w, bins, power))
+    return total

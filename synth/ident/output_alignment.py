@@ -20,8 +20,9 @@ import numpy as np
 
 from synth.data import Record
 from synth.ident.coherence import CoherentBand
+from synth.ident.excitation_edge import SLOPE_DB
 
-__all__ = ["ALIGN_SHARE", "EXCITED_DB", "alignment_samples", "band_after_alignment", "run_input_level", "shifted_runs"]
+__all__ = ["ALIGN_SHARE", "EXCITED_DB", "alignment_samples", "band_after_alignment", "shifted_runs"]
 
 ALIGN_SHARE = 0.05
 """Share of the shortest window the group delay must reach for the output to be realigned."""
@@ -79,35 +80,6 @@ def shifted_runs(runs: list[Record], k: int) -> list[Record]:
     return [replace(r, t=r.t[:-k], u=r.u[:-k], y=r.y[k:], aux={}, gaps=()) for r in runs]
 
 
-def run_input_level(runs: list[Record], w: np.ndarray) -> np.ndarray:
-    """The runs' input power in each cell of the grid ``w`` [rad/s], from the whole runs' transforms (the mean of
-    ``|U|^2`` over the cell's bins, summed over the runs; the nearest bin's where a cell holds none): a resolution of
-    one over the run's length, where a short window's main lobe spreads a sweep's power past its end.
-
-    Examples
-    --------
-    >>> from synth.data import record_from_arrays
-    >>> t = np.arange(0, 200, 0.01); u = np.sin(2 * np.pi * (0.05 * t + 0.5 * 0.02 * t**2))  # 0.3-25 rad/s
-    >>> level = run_input_level([record_from_arrays(t, u, u)], np.array([10.0, 20.0, 40.0]))
-    >>> bool(level[2] < 1e-3 * level[1])  # past the sweep's end
-    True
-    """
-    from synth.ident.spectral_windows import cell_edges
-
-    edges = cell_edges(np.asarray(w, float))
-    total = np.zeros(len(w))
-    for r in runs:
-        power = np.abs(np.fft.rfft(r.u - np.mean(r.u))) ** 2 / r.n
-        bins = 2 * np.pi * np.fft.rfftfreq(r.n, r.dt)
-        at = np.searchsorted(bins, edges)
-        cum = np.r_[0.0, np.cumsum(power)]
-        count = np.diff(at)
-        with np.errstate(invalid="ignore", divide="ignore"):
-            mean = (cum[at[1:]] - cum[at[:-1]]) / count
-        total += np.where(count > 0, mean, np.interp(w, bins, power))
-    return total
-
-
 def band_after_alignment(before: CoherentBand, after: CoherentBand, w: np.ndarray, gxx: np.ndarray) -> CoherentBand:
     """The realigned estimate's coherent band ``after``, kept past the ends of the band ``before`` the move only
     where the input excites as strongly as at that end (within :data:`EXCITED_DB` plus the slope an input's
@@ -123,8 +95,8 @@ def band_after_alignment(before: CoherentBand, after: CoherentBand, w: np.ndarra
     before, after : CoherentBand
         The bands before and after the move (on the same grid ``w``).
     w, gxx : numpy.ndarray
-        Frequencies [rad/s] and the input's power on them (:func:`run_input_level`: a window's leakage past a
-        sweep's end would look like excitation).
+        Frequencies [rad/s] and the input's power on them (:func:`synth.ident.excitation_edge.run_input_level`:
+        a window's leakage past a sweep's end would look like excitation).
 
     Returns
     -------
@@ -140,8 +112,6 @@ def band_after_alignment(before: CoherentBand, after: CoherentBand, w: np.ndarra
     >>> round(band_after_alignment(before, after, w, np.where(w < 20, 1.0, 1e-3)).w_max, 1)  # a sweep's end: not
     20.0
     """
-    from synth.ident.excitation_edge import SLOPE_DB
-
     if not (before.found and after.found):
         return after
     with np.errstate(divide="ignore"):

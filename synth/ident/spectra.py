@@ -17,9 +17,9 @@ import numpy as np
 from synth.data import Record
 from synth.errors import DataError
 from synth.ident.coherence import COHERENCE_THRESHOLD, CoherentBand, coherence_from_spectra, coherent_band, random_error
-from synth.ident.excitation_edge import excitation_level, trim_to_excitation
+from synth.ident.excitation_edge import excitation_level, run_input_level, trim_to_excitation
 from synth.ident.model_phase import anchored_phase
-from synth.ident.output_alignment import alignment_samples, band_after_alignment, run_input_level, shifted_runs
+from synth.ident.output_alignment import alignment_samples, band_after_alignment, shifted_runs
 from synth.ident.spectral_windows import (
     as_runs,
     check_length,
