@@ -21,7 +21,8 @@ decide, doubles the horizon up to a cap. The rules (:func:`judge`), on the outpu
   themselves (autocorrelation above 0.98) with the same period and amplitude within 1 %, or (a
   sustained irregular oscillation, e.g. quasi-periodic relay or quantizer chatter) the peak-to-peak
   ranges of the last three quarters are equal within 10 % and above twice ``min_amplitude`` and
-  the numerical floor (amplitude: half that range; period: the mean of the crossings). Regular cycles also need
+  the numerical floor (amplitude: half that range; period: the mean of the crossings); so do regular crossings of
+  cycles that do not repeat whose quarter-mean periods differ by more than 1 %, when those ranges show no trend. Regular cycles also need
   the output's centre and the controller's command, each averaged over the quarters' whole cycles, to have
   stopped moving one way (within 1 % of its half range, or converging geometrically to within that): a
   command still winding towards a block's threshold ends the cycle there. A limit
@@ -159,6 +160,16 @@ def _steady(a: Oscillation, b: Oscillation, c: Oscillation, drift: float,
     return f"the amplitude still changes {100 * da:.2g} % between the last three quarters", ""
 
 
+def _ranges(ta: np.ndarray, ya: np.ndarray, span: float, min_amplitude: float, scale: float,
+            final: float) -> tuple[list[float], float, float]:
+    """The peak-to-peak ranges of the last, second-last and third-last quarters, their largest change between
+    neighbours relative to the last, and the floor a sustained range must exceed (the settled rule's)."""
+    spans = [float(np.ptp(ya[(ta >= ta[-1] - k * span / 4) & (ta < ta[-1] - (k - 1) * span / 4 + 1e-12)]))
+             for k in (1, 2, 3)]
+    change = max(abs(spans[0] - spans[1]), abs(spans[1] - spans[2])) / max(spans[0], 1e-300)
+    return spans, change, 2 * max(min_amplitude, 1e-9 * (scale + abs(final)))
+
+
 def _excursion_grows(ta: np.ndarray, ya: np.ndarray, end: float, scale: float) -> bool:
     """The largest distance from the reference over the last quarter is more than 10 steps and 1.3
     times that over the second quarter: a drift, or an oscillation growing without a bound."""
@@ -248,10 +259,7 @@ def judge(result: SimResult, t_step: float, step: tuple[float, float], metrics: 
             return Judgement("limit_cycle", f"the last two quarters repeat with period {pa[0]:.4g} s (autocorrelation "
                              "above 0.98; the waveform crosses its mean more than twice per period) and equal "
                              f"amplitudes within {100 * STEADY:g} %", int(span / 2 / pa[0]))
-        spans = [float(np.ptp(ya[(ta >= ta[-1] - k * span / 4) & (ta < ta[-1] - (k - 1) * span / 4 + 1e-12)]))
-                 for k in (1, 2, 3)]
-        floor = 2 * max(min_amplitude, 1e-9 * (scale + abs(metrics.final_value)))  # the settled rule's floor
-        change = max(abs(spans[0] - spans[1]), abs(spans[1] - spans[2])) / max(spans[0], 1e-300)
+        spans, change, floor = _ranges(ta, ya, span, min_amplitude, scale, metrics.final_value)
         if min(spans) > floor and change <= 0.1 and a.cycles >= 3:
             return Judgement("limit_cycle", f"a sustained irregular oscillation: its peak-to-peak range is equal within "
                              f"{100 * change:.2g} % over the last three quarters ({a.cycles} cycles of mean period "
@@ -268,6 +276,12 @@ def judge(result: SimResult, t_step: float, step: tuple[float, float], metrics: 
                                   ya[(ta >= ta[-1] - k * span / 4) & (ta <= ta[-1] - (k - 1) * span / 4)])
                       for k in (1, 2, 3))
         why, how = _steady(a, b, c, _drift(ta, ya), sizes)  # type: ignore[arg-type]
+        if why is not None and why.startswith("the period still") and not a.periodic:  # quasi-periodic chatter: the
+            spans, change, floor = _ranges(ta, ya, span, min_amplitude, scale, metrics.final_value)  # irregular rule
+            if min(spans) > floor and change <= 0.1 and (spans[0] - spans[1]) * (spans[1] - spans[2]) <= 0:
+                return Judgement("limit_cycle", f"a sustained oscillation whose cycles do not repeat ({why}): its "
+                                 f"peak-to-peak range is equal within {100 * change:.2g} % over the last three quarters "
+                                 "without a trend", cycles)
         if why is None:
             why = centre_drift(ta, ya, ya, "output") or centre_drift(ta, ya, result.command[after],
                                                                       "controller's command")
