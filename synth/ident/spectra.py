@@ -253,9 +253,10 @@ def _composite(runs: list[Record], w_min: float | None, w_max: float | None, win
                         "or give both --wmin and --wmax")
     if not (0 < w_min < w_max):
         raise DataError(f"need 0 < w_min < w_max, got w_min = {w_min:g}, w_max = {w_max:g} rad/s")
-    if w_max > nyquist:
+    if w_max > nyquist * (1 + 1e-6):
         raise DataError(f"w_max = {w_max:.8g} rad/s is above the Nyquist frequency {nyquist:.8g} rad/s "
                         f"(sample rate {fs:g} Hz)")
+    w_max = min(w_max, nyquist)  # pi fs typed to a few digits (3141.592654 for 1 kHz) is the Nyquist frequency
     check_length(runs, w_min, overlap)
     if windows is None:
         lengths = default_windows(w_min, longest=required_window(lowest_frequency(runs, overlap)) * (1 - 1e-9))
