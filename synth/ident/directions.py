@@ -29,24 +29,29 @@ one came, and each parameter's difference is compared with its statistical stand
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
 
 from synth.data.record import Record
 from synth.distributions import norm_sf
+from synth.errors import DataError, FitError
 from synth.ident.exchangeable import relabel_fit
 from synth.ident.steps import StepAverage, Steps, average_steps, find_steps, late_steps
 from synth.ident.structure import Structure
 from synth.ident.timefit import TimeFitResult, fit_structure
 from synth.plant import Plant
 
-__all__ = ["ALPHA", "UNSETTLED_FACTOR", "DirectionComparison", "compare_fits", "fit_by_direction",
-           "unsettled_fraction"]
+__all__ = ["ALPHA", "SETTLED_SHARE", "UNSETTLED_FACTOR", "DirectionComparison", "compare_fits", "fit_by_direction",
+           "settled_steps", "unsettled_fraction"]
 
 #: family-wise false-alarm probability of :func:`compare_fits`
 ALPHA = 0.01
+
+SETTLED_SHARE = 0.005
+"""Where more than this share of a step was left when the next came, the directions are compared again on the steps
+that came after the previous one had settled to it (:func:`settled_steps`)."""
 
 UNSETTLED_FACTOR = 2.0
 """A parameter's bias from windows that do not start at rest, per unit of :func:`unsettled_fraction`, taken as a
@@ -85,6 +90,7 @@ class DirectionComparison:
     up_average: StepAverage | None = None
     down_average: StepAverage | None = None
     unsettled: float = 0.0
+    selected: str = ""
 
     @property
     def largest(self) -> str:
@@ -119,6 +125,8 @@ class DirectionComparison:
         if self.unsettled > 0:
             detail += (f" (the uncertainty allows for the {100 * self.unsettled:.2g} % of a step left when the next "
                        "one came)")
+        if self.selected:
+            detail += f"; {self.selected}"
         if self.significant:
             return f"up and down steps differ: {detail}; the average is a compromise (fit by direction)"
         return f"up and down steps agree within their uncertainty: largest difference {detail}"
@@ -148,7 +156,8 @@ class DirectionComparison:
         return {"up": side(self.up, self.up_average), "down": side(self.down, self.down_average),
                 "difference": dict(self.difference), "std": dict(self.std), "z": dict(self.z),
                 "p_value": dict(self.p_value), "p_family": self.p_family, "alpha": self.alpha,
-                "significant": self.significant, "unsettled": self.unsettled, "summary": self.summary()}
+                "significant": self.significant, "unsettled": self.unsettled, "summary": self.summary()} \
+            | ({"selected": self.selected} if self.selected else {})
 
 
 def compare_fits(up: TimeFitResult, down: TimeFitResult, alpha: float = ALPHA,
@@ -258,13 +267,80 @@ def fit_by_direction(record: Record, structure: Structure | str, delay: str | fl
     compared = steps
     if np.count_nonzero(steps.direction == steps.direction[0]) >= 2:
         compared = Steps(steps.index[1:], steps.direction[1:], steps.low, steps.high)
-    up_avg = average_steps(record, compared, "edge", direction=1)
-    down_avg = average_steps(record, compared, "edge", direction=-1)
+    up_avg, down_avg, up, down = _fit_both(record, compared, structure, delay, sensor, start)
+    unsettled = unsettled_fraction(record, steps, [up.plant, down.plant])
+    if unsettled > SETTLED_SHARE:  # an aperiodic train's short holds widen every parameter's allowance: compare the
+        chosen = settled_steps(record, steps, compared, up.plant, down.plant)  # steps that start settled instead
+        if chosen is not None:
+            kept, window, left = chosen
+            try:
+                ua, da, u2, d2 = _fit_both(record, kept, structure, delay, sensor, start, window)
+            except (DataError, FitError):
+                pass
+            else:
+                note = (f"compared on the {ua.count} up and {da.count} down steps that came after the previous step "
+                        f"had settled to {100 * SETTLED_SHARE:g} % (of {up_avg.count} and {down_avg.count}: "
+                        f"{100 * unsettled:.2g} % of a step was left at the shortest hold), windows of "
+                        f"{window * record.dt:.3g} s")
+                return replace(compare_fits(u2, d2, alpha, ua, da, left), selected=note)
+    return compare_fits(up, down, alpha, up_avg, down_avg, unsettled)
+
+
+def _fit_both(record: Record, steps: Steps, structure: Structure | str, delay: str | float | None,
+              sensor: Plant | str | None, start: dict[str, float] | None, window: int | None = None
+              ) -> tuple[StepAverage, StepAverage, TimeFitResult, TimeFitResult]:
+    """The up and the down windows of ``steps`` averaged apart and fitted (``window`` samples from each step)."""
+    up_avg = average_steps(record, steps, "edge", direction=1, post=window)
+    down_avg = average_steps(record, steps, "edge", direction=-1, post=window)
     up = fit_structure(up_avg.record(), structure, delay, sensor, initial=start, check=True)
     down = fit_structure(down_avg.record(), structure, delay, sensor, initial=start, check=True)
     if start is not None:  # labelled as the fit of both directions
         up = relabel_fit(up, start)
-    return compare_fits(up, down, alpha, up_avg, down_avg, unsettled_fraction(record, steps, [up.plant, down.plant]))
+    return up_avg, down_avg, up, down
+
+
+def settled_steps(record: Record, steps: Steps, compared: Steps, up: Plant, down: Plant
+                  ) -> tuple[Steps, int, float] | None:
+    """The steps of ``compared`` that came after the previous step (of ``steps``) had settled to
+    :data:`SETTLED_SHARE` by its direction's model, the window that ends before every next step (samples) and the
+    largest share left at them; None unless an up and a down step are left with windows of 10 samples or more.
+
+    Examples
+    --------
+    >>> t = np.arange(0, 6, 0.01); edges = [0.5, 1.5, 1.6, 2.6, 2.7, 3.7, 4.7]  # holds of 1 s and 0.1 s
+    >>> u = np.zeros(t.size)
+    >>> for k, e in enumerate(edges):
+    ...     u[t >= e] = (k + 1) % 2
+    >>> from synth.data import record_from_arrays
+    >>> rec = record_from_arrays(t, u, u); steps = find_steps(rec)
+    >>> kept, window, left = settled_steps(rec, steps, steps, Plant.from_string("1/(0.1*s+1)"),
+    ...                                    Plant.from_string("1/(0.1*s+1)"))
+    >>> (t[kept.index] - 0.005).round(2).tolist(), window, round(left, 4)  # after the 1 s holds only
+    ([1.5, 2.6, 3.7, 4.7], 10, 0.0)
+    """
+    from synth.ident.simulate import simulate_plant
+
+    index = np.asarray(steps.index)
+    gaps = np.diff(np.asarray(record.t, float)[index])
+    grid = np.linspace(0.0, float(gaps.max()) if gaps.size else 0.0, 4001)
+    left: dict[int, float] = {}
+    for direction, model in ((1, up), (-1, down)):
+        final = model.dc_gain()
+        if not np.isfinite(final) or final == 0.0:
+            return None
+        response = simulate_plant(model, grid, np.ones(grid.size), initial="zero")
+        for j in np.flatnonzero(steps.direction[:-1] == direction):  # the step before j + 1 went this way
+            left[int(index[j + 1])] = abs(final - float(np.interp(gaps[j], grid, response))) / abs(final)
+    keep = np.array([left.get(int(i), 1.0) <= SETTLED_SHARE for i in compared.index])
+    if not (np.any(compared.direction[keep] > 0) and np.any(compared.direction[keep] < 0)):
+        return None
+    after = np.r_[index[1:], record.n]  # each step's next one (the record's end for the last)
+    nxt = {int(i): int(a) for i, a in zip(index, after)}
+    window = min(nxt[int(i)] - int(i) for i in compared.index[keep])
+    if window < 10:
+        return None
+    kept = Steps(compared.index[keep], compared.direction[keep], compared.low, compared.high)
+    return kept, window, max(left[int(i)] for i in kept.index)
 
 
 def unsettled_fraction(record: Record, steps: Steps, models: list[Plant]) -> float:

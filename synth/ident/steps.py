@@ -300,7 +300,7 @@ def _snr(step: float, sigma: float) -> float:
 
 
 def average_steps(record: Record, steps: Steps | None = None, mode: str = "auto", pre: float | None = None,
-                  direction: int = 0, settle: float = 0.0) -> StepAverage:
+                  direction: int = 0, settle: float = 0.0, post: int | None = None) -> StepAverage:
     """Cut, align and average the step responses of a record.
 
     Parameters
@@ -317,6 +317,11 @@ def average_steps(record: Record, steps: Steps | None = None, mode: str = "auto"
         ``"edge"`` mode: average every step (0), only the up steps (1) or only the down
         steps (-1, sign-flipped); the windows are as long as with all steps. A direction
         other than 0 implies ``"edge"``.
+    settle : float
+        ``"cycle"`` mode: average only the periods that start this long [s] after the first step.
+    post : int, optional
+        ``"edge"`` mode: samples kept from each step on (default the shortest time between two of ``steps``; give
+        it when ``steps`` leaves out steps of the record, whose windows must end before the next step).
 
     Returns
     -------
@@ -349,14 +354,14 @@ def average_steps(record: Record, steps: Steps | None = None, mode: str = "auto"
             raise DataError("a periodic average holds both directions; average one direction with mode='edge'")
         if not np.any(steps.direction == direction):
             raise DataError(f"no {'up' if direction > 0 else 'down'} step in the input", where=record.source)
-        return _average_edges(record, steps, pre, direction)
+        return _average_edges(record, steps, pre, direction, post)
     periodic = _is_periodic(steps, late_steps(record, steps))
     if mode == "cycle" and periodic is None:
         raise DataError("the input is not a periodic square wave (steps must alternate at a constant period); "
                         "use mode='edge'", where=record.source)
     if mode == "cycle" or (mode == "auto" and periodic is not None):
         return _average_cycles(record, steps, *periodic, settle)  # type: ignore[misc]
-    return _average_edges(record, steps, pre)
+    return _average_edges(record, steps, pre, window=post)
 
 
 def _average_cycles(record: Record, steps: Steps, period: int, high: int, settle: float = 0.0) -> StepAverage:
@@ -388,13 +393,14 @@ def _average_cycles(record: Record, steps: Steps, period: int, high: int, settle
                        low_time, int(use[0]), record.noise_factor, in_gaps, record.noise_correlation)
 
 
-def _average_edges(record: Record, steps: Steps, pre: float | None, direction: int = 0) -> StepAverage:
+def _average_edges(record: Record, steps: Steps, pre: float | None, direction: int = 0, window: int | None = None
+                   ) -> StepAverage:
     # the window is the shortest time between two steps; a last step closer to the record's end than that is
     # left out (its window would run past the end) rather than shortening every window to what is left of it
     late = late_steps(record, steps)
     between = np.diff(steps.index)[~late[:-1]]  # the interval after a late step is shorter than the plant's was
     tail = record.n - int(steps.index[-1])
-    post = int(np.min(between)) if between.size else tail
+    post = window if window is not None else int(np.min(between)) if between.size else tail
     keep = steps.direction == direction if direction else np.ones(steps.count, bool)
     cut = 0
     if tail < post:
