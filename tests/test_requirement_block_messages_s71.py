@@ -24,3 +24,16 @@ def test_a_requirement_block_is_named_as_a_block(block, message):
     with pytest.raises(SpecError) as err:
         parse_spec(_spec(block))
     assert message in str(err.value) and "margins" not in str(err.value)
+
+
+def test_a_check_across_a_blocks_keys_points_at_the_line_of_the_key_it_names(tmp_path):
+    """``controller_rate: 33`` under ``dt: 0.01`` pointed at the ``simulation:`` line (black-box finding)."""
+    from synth.spec import load_spec
+
+    path = tmp_path / "cr.yaml"
+    path.write_text("name: cr\nplant: {tf: '1/(s+1)'}\ncontroller: {type: P}\n"
+                    "requirements: [{type: margins, gain_margin_db: 1}]\n"
+                    "simulation:\n  dt: 0.01\n  step: [0, 1]\n  controller_rate: 33\n")
+    with pytest.raises(SpecError) as err:
+        load_spec(path)
+    assert f"{path}:8: simulation: controller_rate 33 Hz must be 1/dt" in str(err.value)

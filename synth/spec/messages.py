@@ -222,6 +222,10 @@ def spec_error(exc: ValidationError, source: str, root: yaml.Node | None, data: 
     loc = _clean_loc(tuple(err["loc"]))
     if err["type"] in {"union_tag_invalid", "union_tag_not_found"}:
         loc = (*loc, "type")
+    message = _message(err, data, loc)
     line = line_of(root, loc)
+    if err["type"] == "value_error":  # a check across a block's keys names the key first: point at its line
+        key = message.split(" ", 1)[0]
+        line = line_of(root, (*loc, key)) or line
     where = f"{source}:{line}" if line else source
-    return SpecError(_message(err, data, loc), where=f"{where}: {key_path(loc)}")
+    return SpecError(message, where=f"{where}: {key_path(loc)}")
