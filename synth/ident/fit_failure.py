@@ -12,8 +12,9 @@ import numpy as np
 
 from synth.distributions import f_sf
 
-__all__ = ["ABSURD_FACTOR", "CONVERGED_WITHIN", "FAILED_STATUSES", "LIMIT_STATUSES", "NO_RESPONSE", "SIGNIFICANCE",
-           "fit_failure", "remaining_improvement", "roots_beyond_record", "scaled_jacobian", "start_point", "start_ssr"]
+__all__ = ["ABSURD_FACTOR", "CONVERGED_WITHIN", "FAILED_STATUSES", "GROWING", "GROWTH_EXPONENT", "LIMIT_STATUSES",
+           "NO_RESPONSE", "SIGNIFICANCE", "fit_failure", "remaining_improvement", "roots_beyond_record",
+           "scaled_jacobian", "start_point", "start_ssr"]
 
 #: IPOPT return statuses that end a fit without a usable optimum
 FAILED_STATUSES = ("Diverging_Iterates", "Maximum_Iterations_Exceeded", "Maximum_CpuTime_Exceeded",
@@ -36,6 +37,12 @@ SIGNIFICANCE = 1e-3
 
 #: a fitted parameter this many times larger than its deterministic start (and than 1) is a diverged fit
 ABSURD_FACTOR = 1e8
+
+#: a fitted right-half-plane pole whose mode grows by more than e to this power over the record is a failure: the
+#: simulation explodes over the record (a black-box test: 5/((s+1)(s+5)) e^(-0.15 s) on uneven stamps, a pole at
+#: +0.85 rad/s growing e^170 over 200 s with k = 4.8e-74, fit 0.05 %, exit 0)
+GROWTH_EXPONENT = 14.0
+GROWING = "in the right half-plane, growing by"
 
 
 def fit_failure(parameters: dict[str, float], start: np.ndarray, status: str | None, success: bool,
@@ -149,6 +156,9 @@ def fit_failure(parameters: dict[str, float], start: np.ndarray, status: str | N
         return (f"fit {_percent(fit_percent)} %: {NO_RESPONSE} the output's own drift would "
                 f"(the prewhitened output against the prewhitened input: p = {whitened_p:.2g}): an "
                 "output that wanders on its own, not a response to the input")
+    if GROWING in ridge:
+        return (f"the fitted model is unstable ({ridge.split('; ')[0]}, fit {_percent(fit_percent)} %): its simulation "
+                "explodes over the record")
     if ridge:
         return f"{solver} ended ({status}) on a ridge of the structure ({ridge}, fit {_percent(fit_percent)} %)"
     return ""
@@ -156,7 +166,8 @@ def fit_failure(parameters: dict[str, float], start: np.ndarray, status: str | N
 
 def roots_beyond_record(num: np.ndarray, den: np.ndarray, duration: float, dt: float) -> str:
     """The model's poles and zeros more than a thousand times slower than the record is long (``|r| < 1e-3 /
-    duration``) or faster than its Nyquist frequency (``|r| > 1e3 pi / dt``), in words; ``""`` if none.
+    duration``) or faster than its Nyquist frequency (``|r| > 1e3 pi / dt``), and a right-half-plane pole whose mode
+    grows by more than ``e^GROWTH_EXPONENT`` over the record, in words; ``""`` if none.
 
     Examples
     --------
@@ -164,8 +175,13 @@ def roots_beyond_record(num: np.ndarray, den: np.ndarray, duration: float, dt: f
     'a zero at 5.68e-06 rad/s, far below what 60 s resolve'
     >>> roots_beyond_record(np.array([-1.5, 3.0]), np.polymul([1.0, 1.0], [0.25, 1.0]), 60.0, 0.01)
     ''
+    >>> roots_beyond_record(np.array([1.0]), np.array([1.0, -0.5]), 60.0, 0.01)  # a mode of e^(0.5 t) for 60 s
+    'a pole at +0.5 rad/s in the right half-plane, growing by e^30 over the 60 s record'
     """
-    words = []
+    poly = np.trim_zeros(np.asarray(den, float), "f")
+    poles = np.roots(poly) if poly.size > 1 else np.zeros(0)
+    words = [f"a pole at {p.real:+.3g} rad/s {GROWING} e^{p.real * duration:.3g} over the {duration:.3g} s record"
+             for p in poles if p.real * duration > GROWTH_EXPONENT][:1]
     for kind, poly in (("zero", num), ("pole", den)):
         poly = np.trim_zeros(np.asarray(poly, float), "f")
         roots = np.abs(np.roots(poly)) if poly.size > 1 else np.zeros(0)
