@@ -34,7 +34,7 @@ LAYERS: dict[str, int] = {
     "synth.batch_bandwidth": 1,
     "synth.loop": 1, "synth.loop_batch": 1, "synth.loop_memo": 1, "synth.timeresp": 1, "synth.delayed_step": 1,
     "synth.settled_step": 1,
-    "synth.objectives": 1, "synth.data": 1,
+    "synth.objectives": 1, "synth.data": 1, "synth.gap.where.clipping": 1,
     # 2 analyses on a model: requirements, simulation, identification
     "synth.requirements": 2, "synth.sim": 2, "synth.ident": 2, "synth.edge": 2,
     # 3 the problem statement, parsed

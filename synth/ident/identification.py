@@ -1,11 +1,10 @@
 """Identify a structure from a record: average a step train, fit, and compare up and down steps.
 
-:func:`identify` is the entry point behind ``synth identify`` and :func:`synth.identify`:
-a two-level input with several steps is averaged (:mod:`synth.ident.steps`), the
-structure is fitted to the average (:func:`synth.ident.timefit.fit_structure`), and when
-the train has up and down steps they are also fitted apart and compared
-(:mod:`synth.ident.directions`): a difference beyond their uncertainty is reported, and
-``by_direction=True`` makes the two fits the result.
+:func:`identify` is the entry point behind ``synth identify`` and :func:`synth.identify`: a two-level input with
+several steps is averaged (:mod:`synth.ident.steps`), the structure is fitted to the average
+(:func:`synth.ident.timefit.fit_structure`), and when the train has up and down steps they are also fitted apart and
+compared (:mod:`synth.ident.directions`): a difference beyond their uncertainty is reported, and ``by_direction=True``
+makes the two fits the result. A clipped output is named in the record's notes (:mod:`synth.ident.clipped_output`).
 """
 
 from __future__ import annotations
@@ -18,6 +17,7 @@ import numpy as np
 from synth.data.coerce import RecordLike, as_record
 from synth.data.record import Record
 from synth.errors import DataError, FitError, ModelError
+from synth.ident.clipped_output import with_clipping_note
 from synth.ident.delay_alias import ambiguity_note, fixed_delay_note, whole_record_start
 from synth.ident.directions import DirectionComparison, fit_by_direction
 from synth.ident.edge_check import EDGE_MISFIT, edge_misfit
@@ -160,7 +160,7 @@ def identify(record: RecordLike, structure: Structure | str, delay: str | float 
     >>> identify((t, u, y), "k/(s+p)", average="none").plant.to_string(4)
     '2/(s+3)'
     """
-    record = as_record(record)
+    record = with_clipping_note(as_record(record))  # a linear fit reads a clipped output as the plant's
     if average not in ("auto", "cycle", "edge", "none"):
         raise ModelError(f"average must be 'auto', 'cycle', 'edge' or 'none', got {average!r}")
     _check_fixed_delay(delay, record)

@@ -97,7 +97,8 @@ class Clipping:
         end = "maximum" if self.side == "upper" else "minimum"
         unit = f" {self.unit}" if self.unit else ""
         where = {"record": "", "validate": " (validation record)"}.get(self.record, f" (validation run {self.record[9:]})")
-        text = (f"the {self.column} {self.name}{where} rests on its {end} {self.level:.4g}{unit} for {self.samples} samples "
+        name = f" {self.name}" if self.name != self.column else ""  # a record's unnamed columns: "the output"
+        text = (f"the {self.column}{name}{where} rests on its {end} {self.level:.4g}{unit} for {self.samples} samples "
                 f"in {self.runs} run{'s' if self.runs != 1 else ''} (longest {self.longest}; no other value occurs "
                 f"more than {self.other_repeats} time{'s' if self.other_repeats != 1 else ''}): clipped")
         if self.column == "input":
