@@ -52,7 +52,7 @@ def test_best_passing_takes_the_best_objective_the_check_accepts_in_either_sense
         iterates = [(float(v), np.array([float(i)])) for i, v in enumerate(values)]
         ok = rng.random(n) < 0.5
         for maximize in (True, False):
-            got = best_passing(iterates, maximize, lambda rho: bool(ok[int(rho[0])]))
+            got = best_passing(iterates, maximize, lambda rho, ok=ok: bool(ok[int(rho[0])]))
             allowed = [v for v, good in zip(values, ok) if good and np.isfinite(v)]
             if not allowed:
                 assert got is None

@@ -16,7 +16,6 @@ polishes reach the reference's optimum."""
 from __future__ import annotations
 
 import numpy as np
-import pytest
 
 import synth
 from synth.check import check

@@ -22,9 +22,9 @@ decide, doubles the horizon up to a cap. The rules (:func:`judge`), on the outpu
   sustained irregular oscillation, e.g. quasi-periodic relay or quantizer chatter) the peak-to-peak
   ranges of the last three quarters are equal within 10 % and above twice ``min_amplitude`` and
   the numerical floor (amplitude: half that range; period: the mean of the crossings); so do regular crossings of
-  cycles that do not repeat whose quarter-mean periods differ by more than 1 %, when those ranges show no trend. Regular cycles also need
-  the output's centre and the controller's command, each averaged over the quarters' whole cycles, to have
-  stopped moving one way (within 1 % of its half range, or converging geometrically to within that): a
+  cycles that do not repeat whose quarter-mean periods differ by more than 1 %, when those ranges show no trend.
+  Regular cycles also need the output's centre and the controller's command, each averaged over the quarters'
+  whole cycles, to have stopped moving one way (within 1 % of its half range, or converging geometrically to within that): a
   command still winding towards a block's threshold ends the cycle there. A limit
   cycle whose whole cycles do not repeat (lengths within 1 %, maxima and minima within 1 % of the
   amplitude: :attr:`Oscillation.periodic <synth.sim.limitcycle.Oscillation>`) is reported as
