@@ -111,6 +111,9 @@ def band_after_alignment(before: CoherentBand, after: CoherentBand, w: np.ndarra
     100.0
     >>> round(band_after_alignment(before, after, w, np.where(w < 20, 1.0, 1e-3)).w_max, 1)  # a sweep's end: not
     20.0
+    >>> apart = coherent_band(w, np.where(w > 50, 0.99, 0.5))  # no overlap with ``before``: ``apart`` as it is
+    >>> band_after_alignment(before, apart, w, np.ones(41)).w_min == apart.w_min
+    True
     """
     if not (before.found and after.found):
         return after
@@ -125,4 +128,6 @@ def band_after_alignment(before: CoherentBand, after: CoherentBand, w: np.ndarra
                 break
             keep[i] = True
     found = np.flatnonzero(keep)
+    if found.size == 0:  # the two bands do not overlap: the realigned one as it is
+        return after
     return replace(after, w_min=float(w[found[0]]), w_max=float(w[found[-1]]), mask=keep)
