@@ -49,4 +49,11 @@ def test_when_no_level_passes_with_the_structure_held_the_bisection_searches_its
         warnings.simplefilter("ignore")
         result = synth.design(synth.parse_spec(spec_of(71, 0)))
     assert result.feasible and result.extras["surrogate"]["held"] is None and "held at" not in result.verdict
-    assert result.controller.parameters["ki"] == pytest.approx(3.921, rel=2e-3)  # d4d891e's design, the grid's
+    # d4d891e's design reached ki = 3.921 here; since the convex stage keeps its best iterate that passes the exact
+    # check when its last refinement fails it (session 71, synth.synthesis.convex_exact), 3.984: not below it, and
+    # meeting the step limits in the benchmark's independent step
+    p = dict(result.controller.parameters)
+    assert p["ki"] >= (1 - 2e-3) * 3.921
+    num, den = problem(71, 0, 0.5)["_plant"]
+    assert meets(step_metrics(num, den, "PID", p), {"max_overshoot": 5.0, "max_settling_time": 96.89527018136233},
+                 0.0, 0.0)
