@@ -318,19 +318,15 @@ def settled_steps(record: Record, steps: Steps, compared: Steps, up: Plant, down
     >>> (t[kept.index] - 0.005).round(2).tolist(), window, round(left, 4)  # after the 1 s holds only
     ([1.5, 2.6, 3.7, 4.7], 10, 0.0)
     """
-    from synth.ident.simulate import simulate_plant
-
     index = np.asarray(steps.index)
     gaps = np.diff(np.asarray(record.t, float)[index])
-    grid = np.linspace(0.0, float(gaps.max()) if gaps.size else 0.0, 4001)
     left: dict[int, float] = {}
     for direction, model in ((1, up), (-1, down)):
-        final = model.dc_gain()
-        if not np.isfinite(final) or final == 0.0:
+        after = _left_after(model, gaps)
+        if after is None:
             return None
-        response = simulate_plant(model, grid, np.ones(grid.size), initial="zero")
         for j in np.flatnonzero(steps.direction[:-1] == direction):  # the step before j + 1 went this way
-            left[int(index[j + 1])] = abs(final - float(np.interp(gaps[j], grid, response))) / abs(final)
+            left[int(index[j + 1])] = float(after[j])
     keep = np.array([left.get(int(i), 1.0) <= SETTLED_SHARE for i in compared.index])
     if not (np.any(compared.direction[keep] > 0) and np.any(compared.direction[keep] < 0)):
         return None
@@ -356,19 +352,28 @@ def unsettled_fraction(record: Record, steps: Steps, models: list[Plant]) -> flo
     >>> round(unsettled_fraction(rec, find_steps(rec), [Plant.from_string("2/(0.5*s+1)")]), 4)  # exp(-4)
     0.0183
     """
-    from synth.ident.simulate import simulate_plant
-
     edges = np.asarray(record.t, float)[steps.index]
     late = late_steps(record, steps)  # shown late by a gap in the log: their windows are not averaged
     gaps = np.diff(edges)[~(late[1:] | late[:-1])]
     if gaps.size == 0:
         return 0.0
-    grid = np.linspace(0.0, float(gaps.max()), 4001)
     worst = 0.0
     for model in models:
-        final = model.dc_gain()
-        if not np.isfinite(final) or final == 0.0:
+        left = _left_after(model, gaps)
+        if left is None:
             return 1.0
-        response = simulate_plant(model, grid, np.ones(grid.size), initial="zero")
-        worst = max(worst, float(np.max(np.abs(final - np.interp(gaps, grid, response)))) / abs(final))
+        worst = max(worst, float(np.max(left)))
     return worst
+
+
+def _left_after(model: Plant, gaps: np.ndarray) -> np.ndarray | None:
+    """The share of a step ``model`` has left to go after each of ``gaps`` [s] (``|s(inf) - s(gap)| / |s(inf)|`` of its
+    step response, delay included); None without a finite nonzero static gain."""
+    from synth.ident.simulate import simulate_plant
+
+    final = model.dc_gain()
+    if not np.isfinite(final) or final == 0.0:
+        return None
+    grid = np.linspace(0.0, float(np.max(gaps, initial=0.0)), 4001)
+    response = simulate_plant(model, grid, np.ones(grid.size), initial="zero")
+    return np.abs(final - np.interp(gaps, grid, response)) / abs(final)
