@@ -115,3 +115,23 @@ def test_columns_map_renames_before_picking(csv, run_cli, tmp_path):
     bad = run_cli("diagnose", "--plant", PLANT, "--data", str(csv), "--columns", "pwm=command",
                   "--time", "t", "--input", "pwm", "--output", "speed", "--no-report")
     assert bad.code == 2 and len(bad.err.strip().splitlines()) == 1 and "pwm" in bad.err
+
+
+def test_a_record_without_a_time_column_is_diagnosed_with_its_dt(csv, diagnosed, tmp_path, run_cli):
+    """``--dt`` as identify and freqresp have it (session 71's black-box finding: diagnose had none); the verdict
+    and the effect's numbers equal the timed record's."""
+    _, _, out = diagnosed
+    data = np.loadtxt(csv, delimiter=",", skiprows=1)
+    timeless = tmp_path / "run_no_time.csv"
+    np.savetxt(timeless, data[:, 1:], delimiter=",", header="pwm,speed,current", comments="")
+    res = run_cli("diagnose", "--plant", PLANT, "--data", str(timeless), "--dt", "0.01", "--input", "pwm",
+                  "--output", "speed", "--aux", "current", "--candidates", "rate_limit,delay", "--input-unit", "PWM",
+                  "--output-unit", "rad/s", "--json", str(tmp_path / "gap.json"), "--no-report")
+    assert res.code == 0, res.err
+    got, timed = json.loads((tmp_path / "gap.json").read_text()), json.loads((out / "gap.json").read_text())
+    assert got["verdict"]["effects"] == timed["verdict"]["effects"] == ["rate_limit"]
+    assert got["effects"][0]["parameters"]["rate"] == pytest.approx(timed["effects"][0]["parameters"]["rate"],
+                                                                    rel=1e-9)
+    res = run_cli("diagnose", "--plant", PLANT, "--data", str(timeless), "--no-report", "--input", "pwm",
+                  "--output", "speed")
+    assert res.code == 2 and res.err.count("\n") == 1

@@ -79,6 +79,9 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--time", metavar="COL", help="time column (default: the first)")
     p.add_argument("--input", metavar="COL", help="measured command column (default: the second)")
     p.add_argument("--output", metavar="COL", help="measured output column (default: the third)")
+    p.add_argument("--dt", type=float, metavar="S",
+                   help="sample interval when the files have no time column (input and output default to the first "
+                        "two columns)")
     p.add_argument("--aux", metavar="COL", action="append", default=[],
                    help="extra logged channel (current, voltage, ...); repeat or separate by commas")
     p.add_argument("--columns", metavar="OLD=NEW,...", action="append", default=[],
@@ -146,7 +149,7 @@ def run(args: argparse.Namespace) -> int:
     plant = load_model(args.plant, args.delay, where="--plant")
     aux = _split(args.aux)
     kw: dict[str, Any] = {"aux": aux, "input_unit": args.input_unit, "output_unit": args.output_unit,
-                          "columns": parse_column_map(args.columns)}
+                          "columns": parse_column_map(args.columns), "dt": args.dt}
     record = load_record(args.data, args.time, args.input, args.output, **kw)
     validates = [load_record(v, args.time, args.input, args.output, **kw) for v in args.validate or []]
     if args.round_robin:
