@@ -154,7 +154,7 @@ def run(args: argparse.Namespace) -> int:
     except ModelError as exc:
         where = "--delay" if "delay" in exc.message and "structure" not in exc.message else None
         raise (exc.located(where) if where else exc) from None
-    payload: dict[str, Any] = {"data": str(args.data), **result.to_dict()}
+    payload: dict[str, Any] = {"data": str(args.data), **result.to_dict(), "parameter_units": _units(result)}
     if args.split_check:
         from synth.errors import DataError
         from synth.ident.split_check import split_check
@@ -190,17 +190,28 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
+def _units(result: Any) -> dict[str, str]:
+    """Each fitted parameter's unit (synth.ident.parameter_units), the delay's and the offset's too."""
+    from synth.ident.parameter_units import parameter_units
+
+    fit = result.fit
+    units = parameter_units(fit.structure, fit.plant.input.unit, fit.plant.output.unit)
+    delay = fit.structure.delay if isinstance(fit.structure.delay, str) else "delay"
+    return {**units, delay: "s", "offset": fit.plant.output.unit or "output"}
+
+
 def _print(result: Any, args: argparse.Namespace, json_path: Path, figures: list[Path]) -> None:
     from synth.cli._table import table
 
     fit = result.fit
+    units = _units(result)
     rows = []
     for name, value in fit.parameters.items():
         lo, hi = fit.ci95[name]
         fixed = name not in fit.names
         rows.append([name, f"{value:.6g}", "fixed" if fixed else f"{fit.std[name]:.3g}",
-                     "-" if fixed else f"[{lo:.6g}, {hi:.6g}]"])
-    rows.append(["offset", f"{fit.offset:.6g}", f"{fit.offset_std:.3g}", ""])
+                     "-" if fixed else f"[{lo:.6g}, {hi:.6g}]", units.get(name, "?") or "-"])
+    rows.append(["offset", f"{fit.offset:.6g}", f"{fit.offset_std:.3g}", "", units["offset"]])
     print(f"{args.data}{' (SYNTHETIC)' if args.x4_demo else ''}: {fit.structure.formula}"
           f"{', sensor ' + fit.sensor.to_string() if fit.sensor is not None else ''}")
     for note in result.record.notes:  # how the record was read (resampled, converted, gaps): what the fit rests on
@@ -219,7 +230,7 @@ def _print(result: Any, args: argparse.Namespace, json_path: Path, figures: list
             row[0] += " (weak)"
         elif any(t.name == row[0] for t in tied):
             row[0] += " (tied to weak)"
-    print(table(["parameter", "value", "std", "95 % interval"], rows))
+    print(table(["parameter", "value", "std", "95 % interval", "unit"], rows))
     for w in weak:
         print(w.text() + ": the record cannot pin it down; do not use it as a confident number")
     for t in tied:
