@@ -10,6 +10,7 @@ whatever the signs.
 
 from __future__ import annotations
 
+import itertools
 from collections.abc import Sequence
 from typing import Any
 
@@ -27,10 +28,31 @@ def _normalized(num: np.ndarray, den: np.ndarray, size: tuple[int, int]) -> np.n
     return np.r_[num[-size[0]:], den[-size[1]:]] / lead
 
 
+#: the starts are tried with every sign pattern up to this many parameters (2^n each), beyond it as given
+SIGNED_UP_TO = 6
+#: at most this many Levenberg-Marquardt matches, from the signed starts with the smallest residuals
+MATCHED_RUNS = 8
+#: a match this close (sum of squared relative coefficient errors) ends the search
+EXACT_MATCH = 1e-12
+
+
+def _signed(starts: Sequence[np.ndarray]) -> list[np.ndarray]:
+    """Each start with every pattern of its parameters' signs (the given ones first): a coefficient match from a
+    positive start reaches ``c < 0, z < 0`` in ``c*(s+z)`` only across ``c = 0, z -> inf``, where the
+    Levenberg-Marquardt steps stop or not by the last digits of the arithmetic (a test's worker ended at c = 0,
+    z = 3.9e6 where the same call alone crosses)."""
+    out = []
+    for x0 in starts:
+        x0 = np.asarray(x0, float)
+        patterns = itertools.product((1.0, -1.0), repeat=x0.size) if x0.size <= SIGNED_UP_TO else [np.ones(x0.size)]
+        out += [x0 * np.asarray(p) for p in patterns]
+    return out
+
+
 def matched_start(structure: Any, orders_num: np.ndarray, orders_den: np.ndarray,
                   starts: Sequence[np.ndarray]) -> np.ndarray | None:
     """The structure's parameters whose coefficients best match the orders fit's (relative least squares, from
-    each of ``starts``); None when no start gives finite coefficients.
+    each of ``starts`` with every pattern of signs); None when no start gives finite coefficients.
 
     Parameters
     ----------
@@ -67,8 +89,15 @@ def matched_start(structure: Any, orders_num: np.ndarray, orders_den: np.ndarray
             return np.full(target.size, 1e6)
         return (got - target) / scale
 
+    def initial(x0: np.ndarray) -> float:
+        cost = float(np.sum(residual(x0) ** 2))
+        return cost if np.isfinite(cost) else np.inf
+
     best: tuple[float, np.ndarray] | None = None
-    for x0 in starts:
+    # the closest few sign patterns first (by their residual before any step), until one matches exactly
+    for x0 in sorted(_signed(starts), key=initial)[:MATCHED_RUNS]:
+        if best is not None and best[0] < EXACT_MATCH:
+            break
         try:
             sol = least_squares(residual, np.asarray(x0, float), method="lm", max_nfev=200 * (len(x0) + 1))
         except (ValueError, np.linalg.LinAlgError):
