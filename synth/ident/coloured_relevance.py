@@ -15,17 +15,6 @@ noise: p = 0.004); so a fit fails for it only when the fit's own F-test, made on
 autoregressive model (:func:`whitened_f_test`), finds no response either (:func:`no_response_p_value`): that one
 keeps its power for the right structure, whose residuals are white, and loses it only where a wrong structure
 leaves smooth residuals, where the first test finds the response.
-
-That F-test is itself spurious where the residuals are integrated (a random walk left over: regressing one
-integrated series on another finds a relation that is not there, Granger and Newbold's spurious regression): a
-black-box test's random walk, unrelated to its PRBS input, passed it at p = 1e-4 and was identified as
-``-0.2456/(s+0.02053)``, fit 71 %, exit 0, while the cross-correlation found nothing (p = 0.42). So where the
-residuals' own autoregressive model does not reject a unit root (:func:`integrated`: the augmented Dickey-Fuller
-normalized-bias statistic above the 5 % critical value of a residual-based test, :data:`UNIT_ROOT_CRITICAL`: a fit
-makes its residuals look more stationary than a series' own), the cross-correlation alone decides, provided the input
-moves often enough to carry it (:func:`input_events`, at least :data:`MIN_INPUT_EVENTS`): a step's average
-prewhitens to one impulse, and the smooth residuals of a structure's misfit at the high SNR of an average of 70
-edges had their response refused so.
 """
 
 from __future__ import annotations
@@ -36,21 +25,10 @@ import numpy as np
 
 from synth.distributions import f_sf
 
-__all__ = ["MIN_INPUT_EVENTS", "UNIT_ROOT_CRITICAL", "WHITENING_ORDER", "input_events", "integrated",
-           "no_response_p_value", "response_p_value", "whitened_f_test"]
+__all__ = ["WHITENING_ORDER", "no_response_p_value", "response_p_value", "whitened_f_test"]
 
 WHITENING_ORDER = 10
 """Order of each signal's autoregressive model."""
-
-
-UNIT_ROOT_CRITICAL = (-20.49, -26.09, -32.06, -37.15, -41.94)
-"""5 % critical values of the normalized-bias statistic ``N (rho - 1)`` of a regression's residuals about their mean,
-by the number of regressors 1-5 (Phillips and Ouliaris 1990, their Z_alpha, large samples; a fitted model's free
-parameters other than its offset stand for the regressors): a statistic above it does not reject a unit root."""
-
-
-MIN_INPUT_EVENTS = 10.0
-"""Fewest :func:`input_events` with which the cross-correlation stands in for the F-test on integrated residuals."""
 
 
 def _inverse_ar(x: np.ndarray, order: int) -> np.ndarray:
@@ -142,58 +120,12 @@ def whitened_f_test(y: np.ndarray, residuals: np.ndarray, free: int, order: int 
     return float(f_sf(((ssr0 - ssr1) / max(free - 1, 1)) / (max(ssr1, 1e-300) / dof), max(free - 1, 1), dof))
 
 
-def integrated(residuals: np.ndarray, fitted: int = 1, order: int = WHITENING_ORDER) -> bool:
-    """Whether the residuals of a fit of ``fitted`` free parameters (its offset not counted) may hold a unit root:
-    the augmented Dickey-Fuller normalized-bias statistic of their autoregressive model,
-    ``N (rho - 1) / (1 - sum(gamma))`` with ``rho - 1 = a_1 + ... + a_p - 1`` and ``1 - sum(gamma) = 1 + sum((k - 1)
-    a_k)``, is above :data:`UNIT_ROOT_CRITICAL` for that many regressors (more than 5 count as 5; False when too few
-    samples).
-
-    Examples
-    --------
-    >>> rng = np.random.default_rng(2)
-    >>> integrated(np.cumsum(rng.normal(size=4000)), 3), integrated(rng.normal(size=4000), 3)
-    (True, False)
-    """
-    r = np.asarray(residuals, float)
-    if r.size <= 4 * order + 8 or not np.all(np.isfinite(r)) or not np.ptp(r) > 0:
-        return False
-    a = -_inverse_ar(r - r.mean(), order)[1:]
-    scale = 1.0 + float(np.arange(order) @ a)
-    if not scale > 0:  # the correction is not defined: judge on the bias alone
-        scale = 1.0
-    critical = UNIT_ROOT_CRITICAL[min(max(fitted, 1), len(UNIT_ROOT_CRITICAL)) - 1]
-    return bool(r.size * (float(a.sum()) - 1.0) / scale > critical)
-
-
-def input_events(u: np.ndarray, order: int = WHITENING_ORDER) -> float:
-    """How many separate events the prewhitened input holds: the participation ratio ``(sum e^2)^2 / sum e^4`` of
-    the input filtered by the inverse of its autoregressive model (a step: about 1; a two-level train: about its
-    number of edges; white noise: about a third of its samples). 0 when the input does not move.
-
-    Examples
-    --------
-    >>> rng = np.random.default_rng(3)
-    >>> step, prbs = np.r_[np.zeros(500), np.ones(500)], np.repeat(rng.choice([0.0, 1.0], 100), 10)
-    >>> round(input_events(step)), 30 < input_events(prbs) < 70
-    (1, True)
-    """
-    u = np.asarray(u, float)
-    if u.size <= 4 * order + 8 or not np.ptp(u) > 0:
-        return 0.0
-    e = _whitened(u, order)
-    power = float(np.sum(e ** 4))
-    return float(np.sum(e ** 2) ** 2 / power) if power > 0 else 0.0
-
-
 def no_response_p_value(u: np.ndarray, y: np.ndarray, y_fit: np.ndarray, residuals: np.ndarray, free: int,
                         significance: float = 1e-3) -> float:
     """The smaller p-value of :func:`response_p_value` (on the whole input ``u`` and output ``y``) and
     :func:`whitened_f_test` (on the fitted samples ``y_fit`` and their ``residuals``): large only when neither finds a
     response to the input. Where the F-test alone is at most ``significance`` (a response found), its p-value is
-    returned and the cross-correlation is not computed: the smaller one is at most that too. Where the residuals are
-    :func:`integrated` and the input holds at least :data:`MIN_INPUT_EVENTS` events (:func:`input_events`), the
-    F-test is not made and the cross-correlation's p-value is returned.
+    returned and the cross-correlation is not computed: the smaller one is at most that too.
 
     Examples
     --------
@@ -204,7 +136,5 @@ def no_response_p_value(u: np.ndarray, y: np.ndarray, y_fit: np.ndarray, residua
     >>> no_response_p_value(u, walk, walk, fake, 3) > 1e-3
     True
     """
-    if integrated(residuals, free - 1) and input_events(u) >= MIN_INPUT_EVENTS:  # spurious regression
-        return response_p_value(u, y)
     p = whitened_f_test(y_fit, residuals, free)
     return p if p <= significance else min(p, response_p_value(u, y))
