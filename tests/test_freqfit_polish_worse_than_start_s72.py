@@ -1,8 +1,9 @@
 """A formula fit's last polish (its delay freed) that ends worse than the point it started from is not the answer:
-that start, the best fixed-delay local optimum, is a point of the polish's own problem. On the CI's machine the
-right-half-plane zero fit of ``tests/test_freqfit_nmp_start_s71.py`` (seed 0) polished from J = 1.67 to J = 103, a
-pole at 2.85e10 rad/s standing in for a 0.058 s delay, and failed; on this machine the same polish converges. The
-test makes IPOPT's delay-free polish end at the CI's point and checks that the fit still finds the zero."""
+that start, the best fixed-delay local optimum, is a point of the polish's own problem. The test makes IPOPT's
+delay-free polish end at the point where a CI test worker's fit of ``tests/test_freqfit_nmp_start_s71.py`` (seed 0)
+ended (a pole at 2.85e10 rad/s standing in for a 0.058 s delay, J = 103) and checks that the fit still finds the zero.
+That worker's failure itself came from a bad matched start (``tests/test_freqfit_matched_start_signs_s72.py``); this
+guards the other way such a fit can be lost."""
 
 from __future__ import annotations
 

@@ -432,8 +432,7 @@ def fit_frequency_response(
         start_cost, start, start_status = min(results, key=lambda r: r[0] if np.isfinite(r[0]) else np.inf)
         theta, tau, status = _ipopt(st, w, H, coh, start, tau0, fit_delay, delay_max)
         # the start (its delay held at the grid's best) is a point of the polish's own problem: a polish that ends
-        # worse than it lost its way, and the start stands (on the CI's machine a right-half-plane zero's fit went
-        # from J = 1.67 to 103, a pole at 2.85e10 rad/s, where the same polish converges on others)
+        # worse than it lost its way, and the start stands
         if not fit_cost(_model(st, theta, w, tau), H, coh) <= start_cost * (1 + 1e-9):
             theta, tau, status = start, tau0, start_status
         fit = _checked(st, theta, float(tau), text, w, H, coh, bool(fit_delay), status, own_delay, min_fit_percent)

@@ -37,7 +37,7 @@ EXACT_MATCH = 1e-12
 
 
 def _signed(starts: Sequence[np.ndarray]) -> list[np.ndarray]:
-    """Each start with every pattern of its parameters' signs (the given ones first): a coefficient match from a
+    """Each start with every pattern of its parameters' signs: a coefficient match from a
     positive start reaches ``c < 0, z < 0`` in ``c*(s+z)`` only across ``c = 0, z -> inf``, where the
     Levenberg-Marquardt steps stop or not by the last digits of the arithmetic (a test's worker ended at c = 0,
     z = 3.9e6 where the same call alone crosses)."""
