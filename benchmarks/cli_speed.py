@@ -19,12 +19,14 @@ Run:  python benchmarks/cli_speed.py [--repeat 3] [--baseline-ref main | --basel
 from __future__ import annotations
 
 import argparse
+import contextlib
 import os
 import resource
 import subprocess
 import sys
 import tempfile
 import time
+from collections.abc import Iterator
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -207,6 +209,17 @@ def baseline_checkout(ref: str, tmp: Path) -> Path:
 def remove_checkout(path: Path) -> None:
     """Remove a worktree made by :func:`baseline_checkout`."""
     subprocess.run(["git", "-C", str(ROOT), "worktree", "remove", "--force", str(path)], capture_output=True)
+
+
+@contextlib.contextmanager
+def baseline_tree(ref: str, prefix: str) -> Iterator[Path]:
+    """A temporary :func:`baseline_checkout` of ``ref``, removed with its folder on leaving the block."""
+    with tempfile.TemporaryDirectory(prefix=prefix) as tmp:
+        path = baseline_checkout(ref, Path(tmp))
+        try:
+            yield path
+        finally:
+            remove_checkout(path)
 
 
 def main() -> None:

@@ -18,7 +18,6 @@ import json
 import os
 import subprocess
 import sys
-import tempfile
 import time
 from pathlib import Path
 
@@ -83,18 +82,14 @@ def side(root: Path, seeds: int) -> list[dict]:
 
 
 def main() -> None:
-    from benchmarks.cli_speed import baseline_checkout, remove_checkout
+    from benchmarks.cli_speed import baseline_tree
 
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--seeds", type=int, default=200)
     parser.add_argument("--baseline-ref", default="main")
     args = parser.parse_args()
-    with tempfile.TemporaryDirectory(prefix="synth-delay-walk-") as tmp:
-        base = baseline_checkout(args.baseline_ref, Path(tmp))
-        try:
-            rows = {"this checkout": side(ROOT, args.seeds), f"baseline {args.baseline_ref}": side(base, args.seeds)}
-        finally:
-            remove_checkout(base)
+    with baseline_tree(args.baseline_ref, "synth-delay-walk-") as base:
+        rows = {"this checkout": side(ROOT, args.seeds), f"baseline {args.baseline_ref}": side(base, args.seeds)}
     kinds = ("right", "flagged", "wrong", "exception")
     print(f"{args.seeds} seeds x 2 solvers = {2 * args.seeds} fits")
     print(f"| side | {' | '.join(kinds)} | CPU total [s] | CPU median fit [s] |")

@@ -18,7 +18,6 @@ import json
 import os
 import subprocess
 import sys
-import tempfile
 import time
 from pathlib import Path
 
@@ -86,21 +85,17 @@ def collect(proc: subprocess.Popen) -> list[dict]:
 
 
 def main() -> None:
-    from benchmarks.cli_speed import baseline_checkout, remove_checkout
+    from benchmarks.cli_speed import baseline_tree
 
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--walks", type=int, default=100)
     parser.add_argument("--controls", type=int, default=40)
     parser.add_argument("--baseline-ref", default="main")
     args = parser.parse_args()
-    with tempfile.TemporaryDirectory(prefix="synth-no-response-") as tmp:
-        base = baseline_checkout(args.baseline_ref, Path(tmp))
-        try:
-            procs = {"this checkout": side(ROOT, args.walks, args.controls),
-                     f"baseline {args.baseline_ref}": side(base, args.walks, args.controls)}
-            rows = {name: collect(proc) for name, proc in procs.items()}
-        finally:
-            remove_checkout(base)
+    with baseline_tree(args.baseline_ref, "synth-no-response-") as base:
+        procs = {"this checkout": side(ROOT, args.walks, args.controls),
+                 f"baseline {args.baseline_ref}": side(base, args.walks, args.controls)}
+        rows = {name: collect(proc) for name, proc in procs.items()}
     print(f"{args.walks} random walks (must be refused), {args.controls} square trains through second-order plants "
           "(must be identified)")
     print("| side | walks identified | walks refused | controls identified | controls refused | exceptions "

@@ -154,7 +154,8 @@ def run(args: argparse.Namespace) -> int:
     except ModelError as exc:
         where = "--delay" if "delay" in exc.message and "structure" not in exc.message else None
         raise (exc.located(where) if where else exc) from None
-    payload: dict[str, Any] = {"data": str(args.data), **result.to_dict(), "parameter_units": _units(result)}
+    units = _units(result)
+    payload: dict[str, Any] = {"data": str(args.data), **result.to_dict(), "parameter_units": units}
     if args.split_check:
         from synth.errors import DataError
         from synth.ident.split_check import split_check
@@ -184,7 +185,7 @@ def run(args: argparse.Namespace) -> int:
     elif args.json:
         write_json(args.json, payload, force=args.force)
     if not args.quiet and args.json != "-":
-        _print(result, args, json_path, figures)
+        _print(result, units, args, json_path, figures)
         if "split_check" in payload:
             print(payload["split_check"]["text"])
     return 0
@@ -200,11 +201,10 @@ def _units(result: Any) -> dict[str, str]:
     return {**units, delay: "s", "offset": fit.plant.output.unit or "output"}
 
 
-def _print(result: Any, args: argparse.Namespace, json_path: Path, figures: list[Path]) -> None:
+def _print(result: Any, units: dict[str, str], args: argparse.Namespace, json_path: Path, figures: list[Path]) -> None:
     from synth.cli._table import table
 
     fit = result.fit
-    units = _units(result)
     rows = []
     for name, value in fit.parameters.items():
         lo, hi = fit.ci95[name]

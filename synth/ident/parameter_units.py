@@ -91,7 +91,7 @@ def parameter_units(structure: Structure | str, input_unit: str = "", output_uni
     st = structure if isinstance(structure, Structure) else parse_structure(structure)
     names = [*st.parameters, *([st.delay] if isinstance(st.delay, str) else [])]
     rng = np.random.default_rng(0)
-    rows_time, rows_gain, rhs_time, rhs_gain = [], [], [], []
+    rows, rhs_time, rhs_gain = [], [], []  # both systems share the matrix; only the right-hand sides differ
     for _ in range(4):
         theta = rng.uniform(0.5, 2.0, len(st.parameters))
         tau = float(rng.uniform(0.05, 0.2)) if isinstance(st.delay, str) else 0.0  # a fixed delay: no parameter
@@ -103,13 +103,13 @@ def parameter_units(structure: Structure | str, input_unit: str = "", output_uni
             return {}
         if not (np.all(np.isfinite(H)) and np.all(np.isfinite(cols)) and np.all(np.abs(H) > 0)):
             return {}
-        rows_time.append(cols / H[:, None])
+        rows.append(cols / H[:, None])
         rhs_time.append(-ds / H)
-        rows_gain.append(cols / H[:, None])
         rhs_gain.append(np.ones(s.size, complex))
     cols = len(names) if isinstance(st.delay, str) else len(st.parameters)
-    time = _exponents(np.vstack(rows_time)[:, :cols], np.concatenate(rhs_time))
-    gain = _exponents(np.vstack(rows_gain)[:, :cols], np.concatenate(rhs_gain))
+    matrix = np.vstack(rows)[:, :cols]
+    time = _exponents(matrix, np.concatenate(rhs_time))
+    gain = _exponents(matrix, np.concatenate(rhs_gain))
     units = {}
     for name, a, b in zip(names, time, gain):
         text = _text(a, b, input_unit, output_unit)
