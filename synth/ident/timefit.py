@@ -1,18 +1,17 @@
 """Simulation-error fit of a parametric structure to a sampled record, with casadi (IPOPT).
 
-The model, its exact zero-order-hold discretization with a fractional delay and the
-Gauss-Newton IPOPT problem are in :mod:`synth.ident.sim_error_problem`; the
-deterministic start (SRIVC on a delay grid, mapped onto the structure) in :mod:`synth.ident.srivc`. Here: the
-fit itself (the whole-sample delay search, the fallback starts) and its uncertainty;
-:func:`synth.ident.identification.identify` averages a step train first.
+The model, its exact zero-order-hold discretization with a fractional delay and the Gauss-Newton IPOPT problem are
+in :mod:`synth.ident.sim_error_problem`; the deterministic start (SRIVC on a delay grid, mapped onto the structure) in
+:mod:`synth.ident.srivc`. Here: the fit itself (the whole-sample delay search, the fallback starts) and its
+uncertainty; :func:`synth.ident.identification.identify` averages a step train first.
 
 Delay search
 ------------
-The fractional delay ``f`` is bounded in ``[0, dt]``; if it ends on a bound, the
-whole-sample part ``m`` moves by one sample and the fit is repeated (at ``f = dt`` the
-models for ``m`` and ``m + 1`` coincide, so the cost is continuous in ``d``).
-IPOPT starts at the deterministic initial model; only where it fails or ends worse than
-it, Levenberg-Marquardt from the same start and scaled starts are tried, and a start no
+The fractional delay ``f`` is bounded in ``[0, dt]``; if it ends on a bound, the whole-sample part ``m`` moves by
+one sample and the fit is repeated (at ``f = dt`` the models for ``m`` and ``m + 1`` coincide: the cost is continuous).
+IPOPT starts at the deterministic initial model; only where it fails or ends worse than it, Levenberg-Marquardt
+from the same start and scaled starts are tried (not after a bounded run that reached its iteration limit below its
+start: it crawls along a bound, a pole heading for infinity, and scaled starts repeat the crawl), and a start no
 Gauss-Newton step improves is kept (:mod:`synth.ident.start_kept`).
 
 Uncertainty
@@ -415,7 +414,8 @@ def _fit_structure(record: Record, structure: Structure | str, delay: str | floa
                               f"from the same start: {failed_status}, SSR {failed_ssr:.4g}, {ssr_start:.4g} at the start)")
         else:
             prob = ipopt
-    if not st_info["success"] or not np.isfinite(ssr) or ssr > min(init_ssr, ssr_start):
+    crawled = lb is not None and st_info.get("status") in LIMIT_STATUSES and ssr < min(init_ssr, ssr_start)  # see above
+    if (not st_info["success"] or not np.isfinite(ssr) or ssr > min(init_ssr, ssr_start)) and not crawled:
         for factor in (0.5, 2.0, 0.2, 5.0):
             cand = run(theta0 * factor, d0)
             info["starts"] += 1
