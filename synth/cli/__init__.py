@@ -22,7 +22,8 @@ from synth.errors import SynthError
 from synth.forked import allow_fork
 from synth.version import __version__
 
-__all__ = ["EXIT_BAD_INPUT", "EXIT_NOT_MET", "EXIT_OK", "GC_YOUNG_THRESHOLD", "build_parser", "joined_values", "main"]
+__all__ = ["EXIT_BAD_INPUT", "EXIT_NOT_MET", "EXIT_OK", "GC_YOUNG_THRESHOLD", "build_parser", "joined_values", "main",
+           "unrecognized_message"]
 
 EXIT_OK, EXIT_NOT_MET, EXIT_BAD_INPUT = 0, 1, 2
 
@@ -113,6 +114,27 @@ def joined_values(parser: argparse.ArgumentParser, argv: list[str]) -> list[str]
     return out
 
 
+def unrecognized_message(parser: argparse.ArgumentParser, args: argparse.Namespace, extra: list[str]) -> str:
+    """argparse's "unrecognized arguments" message, with a hint where a command reads its record from ``--data``
+    and was given a file name on its own (``synth identify log.csv``).
+
+    Examples
+    --------
+    >>> p = build_parser()
+    >>> unrecognized_message(p, *p.parse_known_args(["identify", "log.csv"]))
+    'unrecognized arguments: log.csv (a record is given with --data: synth identify --data log.csv)'
+    >>> unrecognized_message(p, *p.parse_known_args(["check", "a.yaml", "b.yaml", "--controller", "P(1)"]))
+    'unrecognized arguments: b.yaml'
+    """
+    message = f"unrecognized arguments: {' '.join(extra)}"
+    sub = next((a for a in parser._actions if isinstance(a, argparse._SubParsersAction)), None)
+    command = sub.choices.get(getattr(args, "command", None) or "") if sub is not None else None
+    bare = [a for a in extra if not a.startswith("-")]
+    if command is not None and bare and "--data" in command._option_string_actions and getattr(args, "data", 1) is None:
+        message += f" (a record is given with --data: synth {args.command} --data {bare[0]})"
+    return message
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``synth`` command.
 
@@ -122,7 +144,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     0
     """
     parser = build_parser()
-    args = parser.parse_args(joined_values(parser, list(sys.argv[1:] if argv is None else argv)))
+    args, extra = parser.parse_known_args(joined_values(parser, list(sys.argv[1:] if argv is None else argv)))
+    if extra:
+        parser.error(unrecognized_message(parser, args, extra))
     allow_fork()  # reports and designs may use the second core (synth.forked; SYNTH_JOBS=1 turns it off)
     if not getattr(args, "_run", None):
         parser.print_help()
