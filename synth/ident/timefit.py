@@ -11,16 +11,15 @@ The fractional delay ``f`` is bounded in ``[0, dt]``; if it ends on a bound, the
 one sample and the fit is repeated (at ``f = dt`` the models for ``m`` and ``m + 1`` coincide: the cost is continuous).
 IPOPT starts at the deterministic initial model; only where it fails or ends worse than it, Levenberg-Marquardt
 from the same start and scaled starts are tried (not after a bounded run that reached its iteration limit below its
-start: it crawls along a bound, a pole heading for infinity, and scaled starts repeat the crawl), and a start no
-Gauss-Newton step improves is kept (:mod:`synth.ident.start_kept`).
+start, crawling along a bound; by Levenberg-Marquardt where IPOPT reached its limit and Levenberg-Marquardt converged
+to the same SSR), and a start no Gauss-Newton step improves is kept (:mod:`synth.ident.start_kept`).
 
 Uncertainty
 -----------
-``cov = s^2 (J^T J)^{-1}`` with ``s^2 = SSR/(N - p)`` and ``J`` the Jacobian of ``yhat`` in
-the parameters (delay and offset included; with ``free_start``, the state at the first fitted
-sample too, as a nuisance); standard errors are the square roots of its diagonal and the 95 %
-intervals ``theta +- t_{0.975, N-p} std``. This assumes white noise: with coloured noise (drift,
-a disturbance, a model error) the residuals are correlated and these standard errors too small.
+``cov = s^2 (J^T J)^{-1}`` with ``s^2 = SSR/(N - p)`` and ``J`` the Jacobian of ``yhat`` in the parameters (delay and
+offset included; with ``free_start``, the state at the first fitted sample too, as a nuisance); standard errors are
+the square roots of its diagonal and the 95 % intervals ``theta +- t_{0.975, N-p} std``. This assumes white noise:
+with coloured noise (drift, a disturbance, a model error) the residuals are correlated and these errors too small.
 
 ``fit_percent = 100 (1 - ||y - yhat|| / ||y - mean(y)||)``.
 """
@@ -56,7 +55,7 @@ from synth.ident.nyquist import nyquist_note
 from synth.ident.residual_whiteness import correlated_residuals_note
 from synth.ident.sim_error_problem import SimulationErrorProblem
 from synth.ident.srivc import linear_initial_model, map_to_structure
-from synth.ident.start_kept import START_CONVERGED, converged_replaces, converged_start
+from synth.ident.start_kept import SCALED_BY_LM, START_CONVERGED, converged_replaces, converged_start, same_ssr
 from synth.ident.start_state import free_columns, free_start_gram, start_state_test
 from synth.ident.structure import Structure, parse_structure
 from synth.ident.zero_delay import at_zero_delay, zero_delay_candidate
@@ -66,8 +65,6 @@ __all__ = ["LONG_RECORD", "TimeFitResult", "fit_structure"]
 
 #: records longer than this (samples) are fitted by :class:`~synth.ident.convolution_problem.ConvolutionProblem`
 LONG_RECORD = 10_000
-
-# ------------------------------------------------------------------- results
 
 
 @dataclass(frozen=True, eq=False)
@@ -207,7 +204,6 @@ class TimeFitResult:
             "weakly_identifiable": [w.to_dict() for w in self.weak],
             "tied_to_weak": [t.to_dict() for t in self.tied],
         }
-
 
 
 # ----------------------------------------------------------------- interface
@@ -399,7 +395,7 @@ def _fit_structure(record: Record, structure: Structure | str, delay: str | floa
     ssr_start = start_ssr(prob, theta0, d0, b0, w, y, mask, fit_delay, dt)
     def below_zero(fit: tuple) -> bool:  # a whole delay below 0: no plant's (fit_failure)
         return fit_delay and fit[2] * dt + float(fit[0][len(st.parameters)]) < 0.0
-    lost = below_zero((xs, ssr, m)) or not st_info["success"] or not ssr <= min(init_ssr, ssr_start)
+    lost, lm = below_zero((xs, ssr, m)) or not st_info["success"] or not ssr <= min(init_ssr, ssr_start), None
     if isinstance(prob, SimulationErrorProblem) and lb is None and lost:
         # IPOPT lost its way (a cancelling pair trading with the delay, or the delay's bound at 0 missed): Levenberg-
         # Marquardt from the same start; not with lower bounds (IPOPT's constraints, Levenberg-Marquardt's clipping)
@@ -412,17 +408,20 @@ def _fit_structure(record: Record, structure: Structure | str, delay: str | floa
             xs, ssr, m, st_info, shifts = cand
             info["method"] = (f"Levenberg-Marquardt, exact Jacobian by FFT convolution of the sensitivities (IPOPT "
                               f"from the same start: {failed_status}, SSR {failed_ssr:.4g}, {ssr_start:.4g} at the start)")
-        else:
-            prob = ipopt
+        else:  # IPOPT at its limit where Levenberg-Marquardt converged to its SSR: the scaled starts by the latter
+            prob, lm = ipopt, (prob if failed_status in LIMIT_STATUSES and same_ssr(cand, ssr, noise_dof) else None)
     crawled = lb is not None and st_info.get("status") in LIMIT_STATUSES and ssr < min(init_ssr, ssr_start)  # see above
     if (not st_info["success"] or not np.isfinite(ssr) or ssr > min(init_ssr, ssr_start)) and not crawled:
+        prob, kept_prob = (lm or prob), prob
         for factor in (0.5, 2.0, 0.2, 5.0):
             cand = run(theta0 * factor, d0)
             info["starts"] += 1
             if cand[3]["success"] and (cand[1] < ssr or converged_replaces(cand[3], cand[1], st_info, ssr, noise_dof)):
-                xs, ssr, m, st_info, shifts = cand
+                (xs, ssr, m, st_info, shifts), kept_prob = cand, prob
                 if st_info["success"] and ssr <= min(init_ssr, ssr_start):
                     break
+        info["method"] += "" if kept_prob is not lm or lm is None else f"; {SCALED_BY_LM}"
+        prob = kept_prob
     if fit_delay and st.num_degree >= st.den_degree:  # a jump at the delay: each sample interval its own valley
         xs, ssr, m, st_info, shifts = best_sample(run, xs, ssr, m, st_info, shifts, prob.scale, dt, info)
     if not ssr <= ssr_start and (kept := converged_start(prob, theta0, d0, b0, w, y, mask, fit_delay, dt, lb)):
