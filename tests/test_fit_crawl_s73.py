@@ -7,7 +7,7 @@ each crawling to the same limit (the saturation re-fit of ``tests/test_gap_satur
 39 s fit, none of 12 such retries in the gap tests converged). Now the first run stands, reported at its limit.
 
 Unbounded, IPOPT crawls the same way while Levenberg-Marquardt from the same start converges (in 20 iterations, where
-IPOPT's 300 cost 20 ms each on 2,000 samples) to the same SSR; the four scaled starts are now run by
+IPOPT's 300 cost 20 ms each on 2,000 samples) to about the same SSR; the four scaled starts are now run by
 Levenberg-Marquardt (``synth identify`` of a second-order structure on a first-order step train: 39 s -> 11 s)."""
 
 from __future__ import annotations

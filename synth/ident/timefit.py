@@ -11,8 +11,8 @@ The fractional delay ``f`` is bounded in ``[0, dt]``; if it ends on a bound, the
 one sample and the fit is repeated (at ``f = dt`` the models for ``m`` and ``m + 1`` coincide: the cost is continuous).
 IPOPT starts at the deterministic initial model; only where it fails or ends worse than it, Levenberg-Marquardt
 from the same start and scaled starts are tried (not after a bounded run that reached its iteration limit below its
-start, crawling along a bound; by Levenberg-Marquardt where IPOPT reached its limit and Levenberg-Marquardt converged
-to the same SSR), and a start no Gauss-Newton step improves is kept (:mod:`synth.ident.start_kept`).
+start, crawling along a bound; by Levenberg-Marquardt where IPOPT crawled to its limit and Levenberg-Marquardt
+converged: :func:`~synth.ident.start_kept.crawl_over`), and a start no Gauss-Newton step improves is kept.
 
 Uncertainty
 -----------
@@ -55,7 +55,7 @@ from synth.ident.nyquist import nyquist_note
 from synth.ident.residual_whiteness import correlated_residuals_note
 from synth.ident.sim_error_problem import SimulationErrorProblem
 from synth.ident.srivc import linear_initial_model, map_to_structure
-from synth.ident.start_kept import SCALED_BY_LM, START_CONVERGED, converged_replaces, converged_start, same_ssr
+from synth.ident.start_kept import SCALED_BY_LM, START_CONVERGED, converged_replaces, converged_start, crawl_over
 from synth.ident.start_state import free_columns, free_start_gram, start_state_test
 from synth.ident.structure import Structure, parse_structure
 from synth.ident.zero_delay import at_zero_delay, zero_delay_candidate
@@ -408,8 +408,9 @@ def _fit_structure(record: Record, structure: Structure | str, delay: str | floa
             xs, ssr, m, st_info, shifts = cand
             info["method"] = (f"Levenberg-Marquardt, exact Jacobian by FFT convolution of the sensitivities (IPOPT "
                               f"from the same start: {failed_status}, SSR {failed_ssr:.4g}, {ssr_start:.4g} at the start)")
-        else:  # IPOPT at its limit where Levenberg-Marquardt converged to its SSR: the scaled starts by the latter
-            prob, lm = ipopt, (prob if failed_status in LIMIT_STATUSES and same_ssr(cand, ssr, noise_dof) else None)
+        else:  # IPOPT at its limit on a ridge or where Levenberg-Marquardt converged to its SSR: scaled starts by LM
+            ridge = bool(roots_beyond_record(*st.coefficients(xs[:len(st.parameters)] * ipopt.scale), n * dt, dt))
+            prob, lm = ipopt, (prob if failed_status in LIMIT_STATUSES and crawl_over(cand, ssr, noise_dof, ridge) else None)
     crawled = lb is not None and st_info.get("status") in LIMIT_STATUSES and ssr < min(init_ssr, ssr_start)  # see above
     if (not st_info["success"] or not np.isfinite(ssr) or ssr > min(init_ssr, ssr_start)) and not crawled:
         prob, kept_prob = (lm or prob), prob
