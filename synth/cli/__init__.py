@@ -83,6 +83,12 @@ def entry() -> None:
     sys.exit(code)
 
 
+def _command_parser(parser: argparse.ArgumentParser, name: str) -> argparse.ArgumentParser | None:
+    """The subcommand ``name``'s own parser, None if there is no such command."""
+    sub = next((a for a in parser._actions if isinstance(a, argparse._SubParsersAction)), None)
+    return sub.choices.get(name) if sub is not None else None
+
+
 def joined_values(parser: argparse.ArgumentParser, argv: list[str]) -> list[str]:
     """``argv`` with an option's value that starts with "-" but is no option of the command joined to it by "=".
 
@@ -95,8 +101,7 @@ def joined_values(parser: argparse.ArgumentParser, argv: list[str]) -> list[str]
     >>> joined_values(build_parser(), ["check", "a.yaml", "--controller", "-q"])  # -q is an option of check
     ['check', 'a.yaml', '--controller', '-q']
     """
-    sub = next((a for a in parser._actions if isinstance(a, argparse._SubParsersAction)), None)
-    command = sub.choices.get(argv[0]) if sub is not None and argv else None
+    command = _command_parser(parser, argv[0]) if argv else None
     if command is None:
         return argv
     taking = {o for a in command._actions if a.option_strings and a.nargs is None for o in a.option_strings}  # one value
@@ -127,10 +132,9 @@ def unrecognized_message(parser: argparse.ArgumentParser, args: argparse.Namespa
     'unrecognized arguments: b.yaml'
     """
     message = f"unrecognized arguments: {' '.join(extra)}"
-    sub = next((a for a in parser._actions if isinstance(a, argparse._SubParsersAction)), None)
-    command = sub.choices.get(getattr(args, "command", None) or "") if sub is not None else None
+    command = _command_parser(parser, getattr(args, "command", None) or "")
     bare = [a for a in extra if not a.startswith("-")]
-    if command is not None and bare and "--data" in command._option_string_actions and getattr(args, "data", 1) is None:
+    if command is not None and bare and "--data" in command._option_string_actions and args.data is None:
         message += f" (a record is given with --data: synth {args.command} --data {bare[0]})"
     return message
 

@@ -421,7 +421,7 @@ def _fit_structure(record: Record, structure: Structure | str, delay: str | floa
                 (xs, ssr, m, st_info, shifts), kept_prob = cand, prob
                 if st_info["success"] and ssr <= min(init_ssr, ssr_start):
                     break
-        info["method"] += "" if kept_prob is not lm or lm is None else f"; {SCALED_BY_LM}"
+        info["method"] += f"; {SCALED_BY_LM}" if lm is not None and kept_prob is lm else ""
         prob = kept_prob
     if fit_delay and st.num_degree >= st.den_degree:  # a jump at the delay: each sample interval its own valley
         xs, ssr, m, st_info, shifts = best_sample(run, xs, ssr, m, st_info, shifts, prob.scale, dt, info)
