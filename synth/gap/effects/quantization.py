@@ -430,18 +430,20 @@ def _dense_samples(u: np.ndarray, units: int) -> int:
     return best if best >= _DENSE_SAMPLES else _DENSE_SAMPLES
 
 
-_MARGINS: dict[tuple[bytes, float, float], Params] = {}
-""":func:`_max_margin`'s answers by (digest of the levels, step, lattice): a diagnosis screens the same record's levels
-again and again, and 2 in 5 of its linear programs were ones it had solved (emptied past 4096 entries)."""
+_CELLS: dict[tuple[bytes, bytes], tuple[float, float] | None] = {}
+""":func:`_cell_centre`'s answers by (digest of the levels, of their lattice indices), all the program depends on:
+the search asks for a few dozen cells from a thousand points (emptied past 4096 entries)."""
 
 
 def _kept_max_margin(levels: np.ndarray, digest: bytes, step: float, lattice: float) -> Params:
-    key = (digest, step, lattice)
-    if key not in _MARGINS:
-        if len(_MARGINS) >= 4096:
-            _MARGINS.clear()
-        _MARGINS[key] = _max_margin(levels, step, lattice)
-    return dict(_MARGINS[key])
+    """:func:`_max_margin` with the cell's program solved once per rounding pattern of ``levels``."""
+    n = np.floor((levels - lattice) / step + 0.5)
+    key = (digest, hashlib.blake2b((n - n[0]).tobytes(), digest_size=16).digest())
+    if key not in _CELLS:
+        if len(_CELLS) >= 4096:
+            _CELLS.clear()
+        _CELLS[key] = _cell_centre(levels, n - n[0])
+    return _margin_params(_CELLS[key], step, lattice)
 
 
 def _max_margin(levels: np.ndarray, step: float, lattice: float) -> Params:
@@ -459,27 +461,39 @@ def _max_margin(levels: np.ndarray, step: float, lattice: float) -> Params:
     >>> round(g["step"], 6), round(g["offset"], 6) % 1.0
     (1.0, 0.0)
     """
+    n = np.floor((levels - lattice) / step + 0.5)
+    return _margin_params(_cell_centre(levels, n - n[0]), step, lattice)
+
+
+def _margin_params(centre: tuple[float, float] | None, step: float, lattice: float) -> Params:
+    """The quantizer of the cell's centre ``(a, b)``, or the given point without one. The cell's indices count
+    from the first level's: ``b`` differs from the lattice's by a whole number, which the offset ``(b step) mod
+    step`` does not see; every point of a cell gives the same quantizer to the last bit."""
+    if centre is None or centre[0] <= 0:
+        return {"step": float(step), "offset": float(lattice % step)}
+    q = 1.0 / centre[0]
+    return {"step": q, "offset": float((centre[1] * q) % q)}
+
+
+def _cell_centre(levels: np.ndarray, n: np.ndarray) -> tuple[float, float] | None:
+    """``(a, b)`` of the largest-margin point of the cell where ``levels`` round to indices ``n`` (see
+    :func:`_max_margin`); None when the program fails."""
     from scipy.optimize import linprog
 
-    n = np.floor((levels - lattice) / step + 0.5)
     ones = np.ones_like(levels)
     # a u - b - m >= n - 1/2  ->  -a u + b + m <= 1/2 - n ;  a u - b + m <= n + 1/2
     a_ub = np.vstack([np.column_stack([-levels, ones, ones]), np.column_stack([levels, -ones, ones])])
     b_ub = np.concatenate([0.5 - n, n + 0.5])
-    fallback = {"step": float(step), "offset": float(lattice % step)}
-    bounds = [(1e-12 / step, None), (None, None), (0.0, 0.5)]
+    bounds = [(1e-12 / (float(np.ptp(levels)) or 1.0), None), (None, None), (0.0, 0.5)]
     try:
         res = linprog([0.0, 0.0, -1.0], A_ub=a_ub, b_ub=b_ub, bounds=bounds, method="highs")
         if not res.success:
-            return fallback
+            return None
         # the largest margin may be reached on a segment: take the middle of its ends in 1/step
         m = float(res.x[2]) * (1.0 - 1e-9)
         ends = [linprog([c, 0.0, 0.0], A_ub=a_ub, b_ub=b_ub, bounds=[*bounds[:2], (m, 0.5)], method="highs")
                 for c in (1.0, -1.0)]
     except ValueError:
-        return fallback
+        return None
     x = 0.5 * (ends[0].x + ends[1].x) if all(e.success for e in ends) else res.x
-    if x[0] <= 0:
-        return fallback
-    q = 1.0 / float(x[0])
-    return {"step": q, "offset": float((x[1] * q) % q)}
+    return float(x[0]), float(x[1])
