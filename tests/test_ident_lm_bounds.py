@@ -50,12 +50,13 @@ def test_a_delay_held_at_its_bound_converges_to_the_bounded_optimum(seed: int) -
         assert abs(fit.parameters[name] - value) <= 0.01 * fit.std[name], name
 
 
-@pytest.mark.parametrize("seed", [6, 9])
+@pytest.mark.parametrize("seed", [9, 16])
 def test_ipopt_at_its_limit_on_the_bound_gives_way_to_the_converged_fit_there(seed: int) -> None:
     """On records of 2,000-6,000 samples IPOPT fits first; with the delay's bound at 0 active it can run its 300
     iterations at the optimum, its SSR taken 1e-8 past the bound (IPOPT's relaxation) and so a hair below what any
     delay of 0 or more gives. Levenberg-Marquardt from the same start converges there; its answer was refused for
-    not being lower, and the fit went on to four restarts (or ended at the limit). It is kept now."""
+    not being lower, and the fit went on to four restarts (or ended at the limit). It is kept now. (Seed 6 ran into
+    the limit until session 74 made SRIVC's filters exact; from that start IPOPT converges, at the same optimum.)"""
     t, u, y, dt, T = _record(seed)
     fit = fit_structure(record_from_arrays(t, u, y), "K/(T*s+1)", "fit")
     assert "IPOPT from the same start: Maximum_Iterations_Exceeded" in fit.solver["method"]

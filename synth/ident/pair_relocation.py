@@ -34,8 +34,9 @@ from scipy.optimize import least_squares
 
 from synth.data.record import Record
 from synth.errors import DataError, FitError, ModelError
+from synth.ident.filter_bank import filter_bank
 from synth.ident.simulate import simulate_plant
-from synth.ident.srivc import filter_bank, map_to_structure, srivc_with_root
+from synth.ident.srivc import map_to_structure, srivc_with_root
 from synth.ident.structure import Structure
 from synth.ident.timefit import TimeFitResult, fit_structure
 from synth.plant import Plant

@@ -16,110 +16,16 @@
 
 from __future__ import annotations
 
-from typing import Any
-
 import numpy as np
 from scipy.optimize import least_squares
 
 from synth.distributions import chi2_ppf
 from synth.errors import ModelError
+from synth.ident.filter_bank import filter_bank
 from synth.ident.structure import Structure
 from synth.plant import Plant
 
-__all__ = ["filter_bank", "linear_initial_model", "map_to_structure", "srivc_with_root"]
-
-
-def _expm_np(M: np.ndarray) -> np.ndarray:
-    """Matrix exponential of a small matrix (Taylor series, scaling and squaring).
-
-    Used instead of :func:`scipy.linalg.expm` on the hot paths: for 2x2 to 6x6
-    matrices scipy's BLAS calls can cost milliseconds each when the machine is
-    busy (thread start-up), this costs microseconds.
-    """
-    norm = float(np.max(np.sum(np.abs(M), axis=0))) if M.size else 0.0
-    k = max(0, int(np.ceil(np.log2(norm))) + 2) if norm > 0 else 0
-    X = M / 2.0**k
-    eye = np.eye(M.shape[0])  # one identity for all 16 terms (each step makes a new E)
-    E = eye
-    for j in range(16, 0, -1):
-        E = eye + (X @ E) / j
-    for _ in range(k):
-        E = E @ E
-    return E
-
-
-def _delayed_zoh(A: np.ndarray, B: np.ndarray, dt: float, delay: float) -> Any:
-    """:func:`synth.sim.discretize.delayed_zoh` with :func:`_expm_np`."""
-    from synth.sim.discretize import DelayedZOH
-
-    n = A.shape[0]
-
-    def zoh(h: float) -> tuple[np.ndarray, np.ndarray]:
-        M = np.zeros((n + 1, n + 1))
-        M[:n, :n], M[:n, n] = A * h, B * h
-        E = _expm_np(M)
-        return E[:n, :n], E[:n, n]
-
-    steps = int(np.floor(delay / dt + 1e-9))
-    fraction = delay - steps * dt
-    Ad, G = zoh(dt)
-    if fraction < 1e-9 * dt:
-        return DelayedZOH(Ad, np.zeros(n), G, steps, 0.0)
-    A_rest, G_late = zoh(dt - fraction)
-    _, G_f = zoh(fraction)
-    return DelayedZOH(Ad, A_rest @ G_f, G_late, steps, fraction)
-
-
-def filter_bank(den: np.ndarray, dt: float, x: np.ndarray, count: int, delay: float = 0.0) -> list[np.ndarray]:
-    """``s^k / den(s)`` applied to the held samples ``x`` (delayed), ``k = 0 .. count - 1``, zero initial state.
-
-    One exact ZOH discretization of the companion form of ``1/den`` serves every ``k``
-    (its states are ``s^k/den x``); ``k = deg(den)`` follows from ``den`` itself.
-
-    Examples
-    --------
-    ``1/(s+2)`` and ``s/(s+2)`` of a unit step held from the first sample, 0.5 s later: ``(1 - e^-1)/2`` and
-    ``e^-1``:
-
-    >>> x = np.ones(51)
-    >>> [round(float(v[-1]), 6) for v in filter_bank(np.array([1.0, 2.0]), 0.01, x, 2)]
-    [0.31606, 0.367879]
-    """
-    from scipy.signal import lfilter
-
-    den = np.asarray(den, float) / den[0]
-    n = den.size - 1
-    A = np.zeros((n, n))
-    A[:-1, 1:] = np.eye(n - 1)
-    A[-1, :] = -den[1:][::-1]
-    B = np.zeros(n)
-    B[-1] = 1.0
-    z = _delayed_zoh(A, B, dt, delay)
-
-    def shift(v: np.ndarray, k: int) -> np.ndarray:
-        out = np.zeros_like(v)
-        if k < v.size:
-            out[k:] = v[:v.size - k]
-        return out
-
-    late, early = shift(x, z.steps), shift(x, z.steps + 1)
-    # scipy.signal.ss2tf's transfer function of (Ad, Bk, C, 0), written out: its denominator, det(zI - Ad), is the
-    # same for every k and Bk (formed once here, not once per call), its numerator det(zI - Ad + Bk C) - den
-    dd = np.poly(z.Ad)
-    out = []
-    for k in range(min(count, n)):
-        C = np.zeros((1, n))
-        C[0, k] = 1.0
-        y = np.zeros_like(x)
-        for Bk, xin in ((z.B_late, late), (z.B_early, early)):
-            if np.any(Bk):
-                num = np.poly(z.Ad - np.dot(Bk[:, None], C)) + (np.zeros(1) - 1) * dd
-                y = y + lfilter(num, dd, xin)
-        out.append(y)
-    if count > n:
-        direct = shift(x, z.steps + (1 if z.fraction > 0 else 0))
-        out.append(direct - sum(den[n - k] * out[k] for k in range(n)))
-    return out
+__all__ = ["linear_initial_model", "map_to_structure", "srivc_with_root"]
 
 
 def _bank(den: np.ndarray, t: np.ndarray, x: np.ndarray, count: int, delay: float, periodic: bool,
