@@ -43,8 +43,8 @@ from synth.ident.structure import Structure
 from synth.ident.timefit import TimeFitResult, fit_structure
 from synth.plant import Plant
 
-__all__ = ["ALPHA", "SETTLED_SHARE", "UNSETTLED_FACTOR", "DirectionComparison", "compare_fits", "fit_by_direction",
-           "settled_steps", "unsettled_fraction"]
+__all__ = ["ALPHA", "SETTLED_SHARE", "UNSETTLED_FACTOR", "UNSETTLED_LIMIT", "DirectionComparison", "compare_fits",
+           "fit_by_direction", "settled_steps", "too_unsettled", "unsettled_fraction"]
 
 #: family-wise false-alarm probability of :func:`compare_fits`
 ALPHA = 0.01
@@ -56,6 +56,13 @@ that came after the previous one had settled to it (:func:`settled_steps`)."""
 UNSETTLED_FACTOR = 2.0
 """A parameter's bias from windows that do not start at rest, per unit of :func:`unsettled_fraction`, taken as a
 systematic standard error: the noise-free train above differs by 1.0 % in its gain where 1.8 % was left."""
+
+UNSETTLED_LIMIT = 0.25
+"""Where the model fitted to both directions has more than this share of a step left at every next step, the
+directions are not compared (:func:`too_unsettled`): the comparison's allowance for windows that do not start at rest
+(:data:`UNSETTLED_FACTOR` times the share) would be half of every parameter or more, and the fits of such windows
+from rest crawl to IPOPT's iteration limit (a 2 s hold of ``3/(s^2 + 2.5 s + 1)``, 48 % of a step left: two failed
+fits of 300 iterations, 8 s each, for "not compared: the fit failed")."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -377,3 +384,38 @@ def _left_after(model: Plant, gaps: np.ndarray) -> np.ndarray | None:
     grid = np.linspace(0.0, float(np.max(gaps, initial=0.0)), 4001)
     response = simulate_plant(model, grid, np.ones(grid.size), initial="zero")
     return np.abs(final - np.interp(gaps, grid, response)) / abs(final)
+
+
+def too_unsettled(record: Record, steps: Steps, model: Plant, limit: float = UNSETTLED_LIMIT) -> str:
+    """Why the up and down steps of ``record`` cannot be compared, or ``""`` when they can: ``model`` (the fit of
+    both directions) has more than ``limit`` of a step left whenever the next step comes (so no step starts settled,
+    as :func:`settled_steps` would need). A model without a finite static gain is not judged here.
+
+    Examples
+    --------
+    >>> from synth.data import record_from_arrays
+    >>> t = np.arange(0, 40, 0.01)
+    >>> rec = record_from_arrays(t, np.where((t // 2) % 2 == 0, 1.0, 0.0), np.sin(t))
+    >>> too_unsettled(rec, find_steps(rec), Plant.from_string("3/(s^2+2.5*s+1)"))[:52]
+    'every step was 48 % or more short of its final value'
+    >>> too_unsettled(rec, find_steps(rec), Plant.from_string("3/(0.2*s+1)"))
+    ''
+    """
+    edges = np.asarray(record.t, float)[steps.index]
+    gaps = np.diff(edges)
+    left = _left_after(model, gaps) if gaps.size else None
+    if left is None or float(np.min(left)) <= limit:
+        return ""
+    lo, hi = f"{float(np.min(gaps)):.3g}", f"{float(np.max(gaps)):.3g}"
+    return (f"every step was {100 * float(np.min(left)):.2g} % or more short of its final value when the next came "
+            f"(holds of {lo if lo == hi else f'{lo}-{hi}'} s): windows fitted from rest would need an allowance of "
+            f"{100 * UNSETTLED_FACTOR * float(np.min(left)):.2g} % of every parameter for their start, more than a "
+            f"difference between the directions could be told from; holds of {_hold_needed(model):.3g} s or more "
+            "would let them be compared")
+
+
+def _hold_needed(model: Plant) -> float:
+    """The hold after which ``model``'s step response is within :data:`SETTLED_SHARE` of its final value."""
+    from synth.ident.periodic_start import settling_time
+
+    return settling_time(model, SETTLED_SHARE)

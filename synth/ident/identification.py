@@ -19,7 +19,7 @@ from synth.data.record import Record
 from synth.errors import DataError, FitError, ModelError
 from synth.ident.clipped_output import with_clipping_note
 from synth.ident.delay_alias import ambiguity_note, fixed_delay_note, whole_record_start
-from synth.ident.directions import DirectionComparison, fit_by_direction
+from synth.ident.directions import DirectionComparison, fit_by_direction, too_unsettled
 from synth.ident.edge_check import EDGE_MISFIT, edge_misfit
 from synth.ident.fit_failure import NO_RESPONSE
 from synth.ident.nyquist import beyond_nyquist
@@ -85,11 +85,9 @@ class IdentifyResult:
 
     def to_dict(self) -> dict[str, Any]:
         """The fit's JSON plus ``record``, ``averaging`` and ``directions`` (up/down fits and their comparison)."""
-        return {**self.fit.to_dict(), "record": self.record.to_dict(),
-                "averaging": self.average.to_dict() if self.average is not None else None,
-                "directions": self.directions.to_dict() if self.directions is not None else None,
-                "direction_note": self.direction_note, "by_direction": self.by_direction,
-                "whole_record": self.whole_record_note}
+        return {**self.fit.to_dict(), "record": self.record.to_dict(), "averaging": self.average and self.average.to_dict(),
+                "directions": self.directions and self.directions.to_dict(), "direction_note": self.direction_note,
+                "by_direction": self.by_direction, "whole_record": self.whole_record_note}
 
 
 def _two_level(u: np.ndarray) -> bool:
@@ -234,15 +232,17 @@ def identify(record: RecordLike, structure: Structure | str, delay: str | float 
     if avg is None or whole:  # a whole-record fit's start state, where it matters, is left out (synth.ident.
         fit, later = fit_from_unknown_start(record, fit, structure, delay, sensor)  # unknown_start; session 71: a
         whole = "; ".join(x for x in (whole, later) if x)  # train from a step at t = 0, p1 0.86 +- 0.04 for 0.5)
-    directions, note = None, ""
-    if two_ways and (compare_directions or by_direction):
+    directions = None  # holds too short for windows from rest are not fitted by direction (unless asked to)
+    note = too_unsettled(record, avg.steps, fit.plant) if two_ways and compare_directions and not by_direction else ""
+    if two_ways and (compare_directions or by_direction) and not note:
         try:
             directions = fit_by_direction(record, structure, delay, sensor, avg.steps,  # type: ignore[union-attr]
                                           start=dict(fit.parameters))
         except (DataError, ModelError, RuntimeError, ValueError, np.linalg.LinAlgError) as exc:  # FitError too
             if by_direction:
                 raise
-            note = f"up and down steps not compared: {exc}"
+            note = str(exc)
+    note = note and f"up and down steps not compared: {note}"
     if by_direction and directions is not None:
         _require_settled_windows(directions, record.source)
     periodic_delay = ambiguity_note(fit, avg, None) if fit.periodic else ""  # a fitted delay, up to the period
