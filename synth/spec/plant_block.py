@@ -39,8 +39,10 @@ class SignalSpec(StrictModel):
 class VariantSpec(StrictModel):
     """A plant variant the requirements must also hold on (e.g. a battery state).
 
-    ``gain`` scales the nominal plant; ``tf`` replaces its rational part and
-    ``delay`` its delay. At least one must be given.
+    ``gain`` scales the variant (the nominal plant, or its own ``tf``); ``tf`` replaces the nominal's rational
+    part and ``delay`` the nominal's delay. A delay written in the variant's ``tf`` (``exp(-tau*s)``) is added to
+    its ``delay``, or to the nominal's delay when it gives none (as ``plant.delay`` is added to an ``exp`` in the
+    nominal's ``tf``). At least one must be given.
     """
 
     label: str
@@ -58,12 +60,10 @@ class VariantSpec(StrictModel):
 
     def build(self, nominal: Plant) -> Plant:
         """The variant plant derived from ``nominal``."""
-        base = nominal
-        if self.tf is not None:
+        base = nominal if self.delay is None else nominal.with_delay(self.delay)
+        if self.tf is not None:  # the tf's own exp(-tau*s) adds to the delay (it was replaced by `delay` before)
             parsed = Plant.from_string(self.tf)
-            base = Plant(parsed.num, parsed.den, nominal.delay + parsed.delay, nominal.input, nominal.output)
-        if self.delay is not None:
-            base = base.with_delay(self.delay)
+            base = Plant(parsed.num, parsed.den, base.delay + parsed.delay, nominal.input, nominal.output)
         if self.gain is not None:
             base = base.scaled(self.gain)
         return Plant(base.num, base.den, base.delay, nominal.input, nominal.output, self.label)
