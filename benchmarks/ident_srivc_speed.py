@@ -18,8 +18,6 @@ from __future__ import annotations
 import argparse
 import json
 import os
-import resource
-import subprocess
 import sys
 import tempfile
 from pathlib import Path
@@ -68,10 +66,9 @@ def identify(root: Path, path: Path, structure: str, out: str) -> dict:
     env = {**os.environ, "PYTHONPATH": str(root), "SYNTH_IDENTIFY_CACHE": "off", "SYNTH_JOBS": "1"}
     argv = [sys.executable, "-m", "synth", "identify", "--data", str(path), "--structure", structure, "--delay", "fit",
             "--json", "-", "--no-figures", "--out", out, "--force"]
-    before = resource.getrusage(resource.RUSAGE_CHILDREN)
-    proc = subprocess.run(argv, cwd=root, env=env, capture_output=True, text=True)
-    after = resource.getrusage(resource.RUSAGE_CHILDREN)
-    cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
+    from benchmarks.cli_speed import timed_run
+
+    _, cpu, proc = timed_run(argv, root, env)
     if proc.returncode == 0:
         answer: dict | str = {k: float(v) for k, v in json.loads(proc.stdout)["parameters"].items()}
     else:

@@ -14,8 +14,6 @@ from __future__ import annotations
 import argparse
 import json
 import os
-import resource
-import subprocess
 import sys
 import tempfile
 from pathlib import Path
@@ -38,11 +36,10 @@ def commands() -> dict[str, list[str]]:
 def run(root: Path, argv: list[str], out: Path) -> tuple[float, str]:
     """CPU seconds (process and children) and the verdict of one command with ``root``'s synth."""
     env = {**os.environ, "PYTHONPATH": str(root)}
-    before = resource.getrusage(resource.RUSAGE_CHILDREN)
-    proc = subprocess.run([sys.executable, "-m", "synth", *argv, "--out", str(out), "--force", "--json", "-"],
-                          cwd=root, env=env, capture_output=True, text=True)
-    after = resource.getrusage(resource.RUSAGE_CHILDREN)
-    cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
+    from benchmarks.cli_speed import timed_run
+
+    _, cpu, proc = timed_run([sys.executable, "-m", "synth", *argv, "--out", str(out), "--force", "--json", "-"],
+                             root, env)
     try:
         verdict = json.loads(proc.stdout)["verdict"]
         answer = f"{verdict.get('status')}: {', '.join(verdict.get('effects', [])) or '-'}"

@@ -401,6 +401,8 @@ def too_unsettled(record: Record, steps: Steps, model: Plant, limit: float = UNS
     >>> too_unsettled(rec, find_steps(rec), Plant.from_string("3/(0.2*s+1)"))
     ''
     """
+    from synth.ident.periodic_start import settling_time
+
     edges = np.asarray(record.t, float)[steps.index]
     gaps = np.diff(edges)
     left = _left_after(model, gaps) if gaps.size else None
@@ -410,12 +412,5 @@ def too_unsettled(record: Record, steps: Steps, model: Plant, limit: float = UNS
     return (f"every step was {100 * float(np.min(left)):.2g} % or more short of its final value when the next came "
             f"(holds of {lo if lo == hi else f'{lo}-{hi}'} s): windows fitted from rest would need an allowance of "
             f"{100 * UNSETTLED_FACTOR * float(np.min(left)):.2g} % of every parameter for their start, more than a "
-            f"difference between the directions could be told from; holds of {_hold_needed(model):.3g} s or more "
-            "would let them be compared")
-
-
-def _hold_needed(model: Plant) -> float:
-    """The hold after which ``model``'s step response is within :data:`SETTLED_SHARE` of its final value."""
-    from synth.ident.periodic_start import settling_time
-
-    return settling_time(model, SETTLED_SHARE)
+            f"difference between the directions could be told from; holds of {settling_time(model, SETTLED_SHARE):.3g} "
+            "s or more would let them be compared")

@@ -365,7 +365,7 @@ def quantizer_grid(plant: Plant, t: np.ndarray, u: np.ndarray, y: np.ndarray, ke
     out: list[Params] = []
     for i in order:
         q, ph = pts[i]
-        g = _kept_max_margin(levels, digest, float(q), float(center + ph * q))
+        g = _max_margin(levels, digest, float(q), float(center + ph * q))
         if g not in out:
             out.append(g)
         if len(out) == keep:
@@ -435,8 +435,22 @@ _CELLS: dict[tuple[bytes, bytes], tuple[float, float] | None] = {}
 the search asks for a few dozen cells from a thousand points (emptied past 4096 entries)."""
 
 
-def _kept_max_margin(levels: np.ndarray, digest: bytes, step: float, lattice: float) -> Params:
-    """:func:`_max_margin` with the cell's program solved once per rounding pattern of ``levels``."""
+def _max_margin(levels: np.ndarray, digest: bytes, step: float, lattice: float) -> Params:
+    """The point of the quantizer's cell farthest from rounding any of ``levels`` differently (``digest``: their
+    hash, the cache's key with the rounding pattern).
+
+    Every ``(step, offset)`` that rounds each level to the same lattice index ``n_i`` fits the
+    training data equally well; the data do not tell them apart, and the one with the largest margin
+    ``m`` (in steps) to the rounding boundaries is the least likely to round unseen levels wrongly. With
+    ``a = 1/step``, ``b = offset/step`` the cell is ``n_i - 1/2 + m <= a u_i - b <= n_i + 1/2 - m``: a linear
+    program in ``(a, b, m)``, solved once per rounding pattern. Returns the given point when the program fails.
+
+    Examples
+    --------
+    >>> g = _max_margin(np.array([0.0, 1.0, 2.0]), b"example", 1.1, 0.3)  # rounds to 0, 1, 2: step 1, offset 0
+    >>> round(g["step"], 6), round(g["offset"], 6) % 1.0
+    (1.0, 0.0)
+    """
     n = np.floor((levels - lattice) / step + 0.5)
     key = (digest, hashlib.blake2b((n - n[0]).tobytes(), digest_size=16).digest())
     if key not in _CELLS:
@@ -444,25 +458,6 @@ def _kept_max_margin(levels: np.ndarray, digest: bytes, step: float, lattice: fl
             _CELLS.clear()
         _CELLS[key] = _cell_centre(levels, n - n[0])
     return _margin_params(_CELLS[key], step, lattice)
-
-
-def _max_margin(levels: np.ndarray, step: float, lattice: float) -> Params:
-    """The point of the quantizer's cell farthest from rounding any of ``levels`` differently.
-
-    Every ``(step, offset)`` that rounds each level to the same lattice index ``n_i`` fits the
-    training data equally well; the data do not tell them apart, and the one with the largest margin
-    ``m`` (in steps) to the rounding boundaries is the least likely to round unseen levels wrongly. With
-    ``a = 1/step``, ``b = offset/step`` the cell is ``n_i - 1/2 + m <= a u_i - b <= n_i + 1/2 - m``: a linear
-    program in ``(a, b, m)``. Returns the given point when the program fails.
-
-    Examples
-    --------
-    >>> g = _max_margin(np.array([0.0, 1.0, 2.0]), 1.1, 0.3)  # rounds to 0, 1, 2: the cell's centre is step 1, offset 0
-    >>> round(g["step"], 6), round(g["offset"], 6) % 1.0
-    (1.0, 0.0)
-    """
-    n = np.floor((levels - lattice) / step + 0.5)
-    return _margin_params(_cell_centre(levels, n - n[0]), step, lattice)
 
 
 def _margin_params(centre: tuple[float, float] | None, step: float, lattice: float) -> Params:
