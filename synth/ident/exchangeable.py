@@ -11,14 +11,11 @@ from __future__ import annotations
 
 from dataclasses import replace
 from itertools import permutations
-from typing import TYPE_CHECKING
+from typing import Any
 
 import numpy as np
 
 from synth.ident.structure import Structure
-
-if TYPE_CHECKING:
-    from synth.ident.timefit import TimeFitResult
 
 __all__ = ["align_labels", "exchangeable_groups", "relabel_fit"]
 
@@ -74,10 +71,11 @@ def align_labels(values: dict[str, float], stds: dict[str, float], reference: di
     return out_v, out_s
 
 
-def relabel_fit(fit: TimeFitResult, reference: dict[str, float]) -> TimeFitResult:
-    """``fit`` with the values of each exchangeable group of its structure permuted to lie closest to
-    ``reference`` (as :func:`align_labels`), with their standard errors, intervals, covariance and starts: the
-    same model, labelled as the reference (two fits compared name by name then compare like with like).
+def relabel_fit(fit: Any, reference: dict[str, float]) -> Any:
+    """``fit`` (a :class:`~synth.ident.timefit.TimeFitResult`, whose module imports this one through
+    :mod:`synth.ident.symmetric_ridge`) with the values of each exchangeable group of its structure permuted to lie
+    closest to ``reference`` (as :func:`align_labels`), with their standard errors, intervals, covariance and
+    starts: the same model, labelled as the reference (two fits compared name by name then compare like with like).
 
     Examples
     --------

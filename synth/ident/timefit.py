@@ -58,6 +58,7 @@ from synth.ident.srivc import linear_initial_model, map_to_structure
 from synth.ident.start_kept import SCALED_BY_LM, START_CONVERGED, converged_replaces, converged_start, crawl_over
 from synth.ident.start_state import free_columns, free_start_gram, start_state_test
 from synth.ident.structure import Structure, parse_structure
+from synth.ident.symmetric_ridge import off_ridge, ridge_split_start
 from synth.ident.zero_delay import at_zero_delay, zero_delay_candidate
 from synth.plant import Plant
 
@@ -283,13 +284,12 @@ def fit_structure(record: Record, structure: Structure | str, delay: str | float
     ({'k': 2.0, 'p': 3.0, 'delay': 0.043}, 3.0)
     """
     st = parse_structure(structure) if isinstance(structure, str) else structure
-    if not (resolve_delay(st, delay)[0] and sensor is None and st.num_degree >= st.den_degree):
-        return _fit_structure(record, st, delay, sensor, periodic, initial, lower, weights, check, solver, rtol,
-                              free_start)
-    fit = _fit_structure(record, st, delay, sensor, periodic, initial, lower, weights, False, solver, rtol, free_start)
+    args = (sensor, periodic, initial, lower, weights, False, solver, rtol, free_start)
+    fit = _fit_structure(record, st, delay, *args)
+    if initial is None and (split := ridge_split_start(fit, lower)):  # exchangeable values met (symmetric_ridge)
+        fit = off_ridge(_fit_structure(record, st, delay, sensor, periodic, split, *args[3:]), fit)
     if zero_delay_candidate(fit, record.dt):  # a feedthrough's jump at a delay of exactly 0 (synth.ident.zero_delay)
-        zero = _fit_structure(record, fit.structure, 0.0, sensor, periodic, initial, lower, weights, False, solver,
-                              rtol, free_start)
+        zero = _fit_structure(record, fit.structure, 0.0, *args)
         if not zero.solver.get("failure") and zero.fit_percent > fit.fit_percent:
             fit = at_zero_delay(zero, fit)
     if check and fit.solver.get("failure"):
