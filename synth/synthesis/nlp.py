@@ -191,7 +191,7 @@ def polish(requirements: list[Requirement], plants: list[Plant], start: Controll
 
     Examples
     --------
-    >>> from synth.requirements import Bandwidth, PeakSensitivity
+    >>> from synth.requirements import PeakSensitivity
     >>> G = Plant.from_string("23*(s+0.43)/((s+9.6)*(s+0.54))", delay=0.02)
     >>> req = PeakSensitivity(type="peak_sensitivity", max_db=6)
     >>> r = polish([req], [G], Controller("PI", {"kp": 1.0, "ki": 20.0}), {"kp": (0, 10), "ki": (0, 200)},
