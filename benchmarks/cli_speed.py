@@ -184,16 +184,18 @@ def run(root: Path, args: list[str], tmp: Path) -> tuple[float, float]:
     return elapsed, cpu
 
 
-def timed_run(argv: list[str], root: Path, env: dict[str, str]) -> tuple[float, float, subprocess.CompletedProcess]:
+def timed_run(argv: list[str], root: Path, env: dict[str, str], codes: tuple[int, ...] = (0, 1),
+              timeout: float | None = None) -> tuple[float, float, subprocess.CompletedProcess]:
     """Wall and CPU (user + system) time of the command ``argv`` run in ``root``, and the finished process;
-    raises unless it exits 0 or 1 (1: a design that is infeasible, a check or a fit that fails, is still a run)."""
+    raises unless it exits with one of ``codes`` (default 0 or 1: a design that is infeasible, a check or a fit that
+    fails, is still a run), and ``subprocess.TimeoutExpired`` when it runs longer than ``timeout`` wall seconds."""
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
     t0 = time.perf_counter()
-    proc = subprocess.run(argv, cwd=root, env=env, capture_output=True, text=True)
+    proc = subprocess.run(argv, cwd=root, env=env, capture_output=True, text=True, timeout=timeout)
     elapsed = time.perf_counter() - t0
     after = resource.getrusage(resource.RUSAGE_CHILDREN)
     cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
-    if proc.returncode not in (0, 1):
+    if proc.returncode not in codes:
         raise RuntimeError(f"{' '.join(argv)} in {root} exited {proc.returncode}:\n{proc.stderr[-2000:]}")
     return elapsed, cpu, proc
 

@@ -16,11 +16,9 @@ from __future__ import annotations
 import argparse
 import json
 import os
-import resource
 import subprocess
 import sys
 import tempfile
-import time
 from pathlib import Path
 
 import numpy as np
@@ -33,21 +31,18 @@ def design(root: Path, spec: Path, cap: float) -> dict:
     """One ``synth design`` with ``root``'s synth: exit code (``None`` when capped), CPU seconds, parameters."""
     env = {**os.environ, "PYTHONPATH": str(root), "SYNTH_JOBS": "1"}
     argv = [sys.executable, "-m", "synth", "design", str(spec), "--no-report", "--json", "-", "--quiet"]
-    before = resource.getrusage(resource.RUSAGE_CHILDREN)
-    t0 = time.perf_counter()
+    from benchmarks.cli_speed import timed_run
+
     try:
-        proc = subprocess.run(argv, cwd=root, env=env, capture_output=True, text=True, timeout=cap)
+        wall, cpu, proc = timed_run(argv, root, env, codes=(0, 1, 2, 3), timeout=cap)
         code, out = proc.returncode, proc.stdout
     except subprocess.TimeoutExpired:
-        code, out = None, ""
-    after = resource.getrusage(resource.RUSAGE_CHILDREN)
-    cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
+        wall, cpu, code, out = cap, cap, None, ""
     params: dict[str, float] = {}
     if code in (0, 1, 3) and out.strip():
         controller = json.loads(out).get("controller") or {}
         params = {k: float(v) for k, v in (controller.get("parameters") or {}).items()}
-    return {"code": code, "cpu": cpu if code is not None else max(cpu, cap), "wall": time.perf_counter() - t0,
-            "params": params}
+    return {"code": code, "cpu": cpu, "wall": wall, "params": params}
 
 
 def same_answer(a: dict, b: dict) -> bool:
